@@ -1,0 +1,159 @@
+//! The wgpu plumbing written once: shader modules from `shaders/`, and compute kernels
+//! whose bind-group layout, bind group and dispatch follow from a list of slots. A pass
+//! names its slots and binds resources in the same order; binding `i` is slot `i`.
+
+use super::Gpu;
+
+/// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
+pub const TILE: u32 = 8;
+
+/// WGSL sources, compiled into the binary so it runs from any directory.
+const SHADERS: &[(&str, &str)] = &[
+    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
+    ("gbuffer_multiview.wgsl", include_str!("../../shaders/gbuffer_multiview.wgsl")),
+    ("gbuffer_multipass.wgsl", include_str!("../../shaders/gbuffer_multipass.wgsl")),
+    ("lighting.wgsl", include_str!("../../shaders/lighting.wgsl")),
+    ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+];
+
+/// A shader module made of the named files, concatenated in order (common first), so
+/// passes share `common.wgsl` without string formatting.
+pub fn shader_module(device: &wgpu::Device, label: &str, files: &[&str]) -> wgpu::ShaderModule {
+    let mut source = String::new();
+    for file in files {
+        let text = SHADERS
+            .iter()
+            .find(|(name, _)| name == file)
+            .map(|(_, text)| *text)
+            .unwrap_or_else(|| panic!("shader {file} is not registered in SHADERS"));
+        source.push_str(text);
+        source.push('\n');
+    }
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}
+
+/// What a kernel binds at one binding index.
+#[derive(Clone, Copy, Debug)]
+pub enum Slot {
+    /// `texture_depth_2d_array`, read with `textureLoad`.
+    Depth,
+    /// `texture_2d_array<f32>`, read with `textureLoad`.
+    Layers,
+    /// `texture_2d<f32>`, filterable (environment map).
+    Texture2d,
+    /// A filtering sampler.
+    Sampler,
+    /// `texture_storage_2d_array<FORMAT, write>`.
+    Output(wgpu::TextureFormat),
+    /// `var<uniform>`.
+    Uniform,
+    /// `var<storage, read>`.
+    ReadBuffer,
+}
+
+impl Slot {
+    fn layout_entry(self, binding: u32) -> wgpu::BindGroupLayoutEntry {
+        let ty = match self {
+            Slot::Depth => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::Layers => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::Texture2d => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            Slot::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            Slot::Output(format) => wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+            },
+            Slot::Uniform => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Slot::ReadBuffer => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+        };
+        wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+    }
+}
+
+/// A full-screen compute kernel over layered targets: one dispatch covers every layer
+/// (`global_id.z` is the layer).
+pub struct Kernel {
+    label: String,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    slots: Vec<Slot>,
+}
+
+impl Kernel {
+    pub fn new(gpu: &Gpu, label: &str, files: &[&str], entry: &str, slots: &[Slot]) -> Kernel {
+        let device = &gpu.device;
+        let entries: Vec<_> = slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32)).collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = shader_module(device, label, files);
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Kernel { label: label.to_string(), pipeline, layout, slots: slots.to_vec() }
+    }
+
+    /// Binds `resources` (one per slot, in slot order) and dispatches over
+    /// `width × height × layers` invocations.
+    pub fn dispatch(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &[wgpu::BindingResource],
+        (width, height, layers): (u32, u32, u32),
+    ) {
+        assert_eq!(resources.len(), self.slots.len(), "kernel {}: one resource per slot", self.label);
+        let entries: Vec<_> = resources
+            .iter()
+            .enumerate()
+            .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
+            .collect();
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(&self.label),
+            layout: &self.layout,
+            entries: &entries,
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(&self.label),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);
+    }
+}

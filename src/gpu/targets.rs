@@ -1,0 +1,59 @@
+//! Layered render targets: one 2D array texture, layer 0 = left eye, layer 1 = right eye
+//! (one layer for a mono view).
+
+/// A 2D array texture with a view of the whole array and one view per layer.
+pub struct LayeredTarget {
+    pub texture: wgpu::Texture,
+    /// All layers, as `texture_2d_array` / `texture_storage_2d_array` / multiview attachment.
+    pub array_view: wgpu::TextureView,
+    /// One single-layer 2D view per layer, for per-eye render passes.
+    pub layer_views: Vec<wgpu::TextureView>,
+    pub format: wgpu::TextureFormat,
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+}
+
+impl LayeredTarget {
+    pub fn new(
+        device: &wgpu::Device,
+        label: &str,
+        format: wgpu::TextureFormat,
+        (width, height, layers): (u32, u32, u32),
+        usage: wgpu::TextureUsages,
+    ) -> LayeredTarget {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            // Every target can be read back (debug outputs, tests, measurements).
+            usage: usage | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(label),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            array_layer_count: Some(layers),
+            ..Default::default()
+        });
+        let layer_views = (0..layers)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some(label),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        LayeredTarget { texture, array_view, layer_views, format, width, height, layers }
+    }
+
+    pub fn extent(&self) -> (u32, u32, u32) {
+        (self.width, self.height, self.layers)
+    }
+}

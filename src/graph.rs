@@ -1,0 +1,194 @@
+//! The frame graph. Each pass declares what it reads and writes, and whether the scene
+//! and settings let it exist at all. Given the outputs a frame must produce, the graph
+//! keeps exactly the passes those outputs depend on and says why every other pass was
+//! left out. Passes are declared in execution order, so the kept ones run in that order.
+
+use std::collections::BTreeSet;
+use std::fmt;
+
+/// A resource that flows between passes (a layered texture, one layer per view).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Resource {
+    /// Reversed-Z depth, `Depth32Float`.
+    Depth,
+    /// View-space unit normals, `Rgba16Float` (w unused).
+    Normals,
+    /// Diffuse albedo, `Rgba8UnormSrgb` (reads back linear).
+    Albedo,
+    /// Emitted radiance, `Rgba16Float`.
+    Emission,
+    /// Lit scene radiance before tone mapping, `Rgba16Float`.
+    Hdr,
+    /// Tone-mapped, sRGB-encoded eye colour, `Rgba8Unorm`.
+    Color,
+}
+
+impl Resource {
+    pub fn name(self) -> &'static str {
+        match self {
+            Resource::Depth => "depth",
+            Resource::Normals => "normals",
+            Resource::Albedo => "albedo",
+            Resource::Emission => "emission",
+            Resource::Hdr => "hdr",
+            Resource::Color => "color",
+        }
+    }
+
+    pub fn format(self) -> wgpu::TextureFormat {
+        match self {
+            Resource::Depth => wgpu::TextureFormat::Depth32Float,
+            Resource::Normals | Resource::Emission | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
+            Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
+            Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
+        }
+    }
+}
+
+/// What a pass declares for one frame.
+#[derive(Clone, Debug)]
+pub struct PassDecl {
+    pub name: &'static str,
+    pub reads: Vec<Resource>,
+    pub writes: Vec<Resource>,
+    /// `Some(reason)` when the scene or settings rule the pass out for this frame.
+    pub disabled: Option<String>,
+}
+
+impl PassDecl {
+    pub fn new(name: &'static str) -> PassDecl {
+        PassDecl { name, reads: Vec::new(), writes: Vec::new(), disabled: None }
+    }
+    pub fn read(mut self, r: Resource) -> Self {
+        self.reads.push(r);
+        self
+    }
+    pub fn write(mut self, r: Resource) -> Self {
+        self.writes.push(r);
+        self
+    }
+    /// Rules the pass out when `condition` holds, with `reason` shown by `--explain`.
+    pub fn disabled_if(mut self, condition: bool, reason: impl Into<String>) -> Self {
+        if condition && self.disabled.is_none() {
+            self.disabled = Some(reason.into());
+        }
+        self
+    }
+}
+
+/// The passes one frame runs and the ones it leaves out.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// Indices into the declarations, in execution order.
+    pub run: Vec<usize>,
+    pub names: Vec<&'static str>,
+    /// (pass, reason) for every pass that does not run.
+    pub left_out: Vec<(&'static str, String)>,
+    /// Every resource some running pass writes or the frame outputs.
+    pub resources: BTreeSet<Resource>,
+}
+
+impl Plan {
+    pub fn runs(&self, name: &str) -> bool {
+        self.names.contains(&name)
+    }
+}
+
+impl fmt::Display for Plan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "passes that run, in order:")?;
+        for name in &self.names {
+            writeln!(f, "  ran       {name}")?;
+        }
+        if self.left_out.is_empty() {
+            writeln!(f, "no pass was left out")?;
+        } else {
+            writeln!(f, "passes left out:")?;
+            for (name, why) in &self.left_out {
+                writeln!(f, "  left out  {name}: {why}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Keeps the passes `outputs` depend on. An output that no enabled pass produces is an
+/// error naming it (a renderer bug or an impossible request, never silently dropped).
+pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
+    let mut needed: BTreeSet<Resource> = outputs.iter().copied().collect();
+    let mut keep = vec![false; decls.len()];
+    // Walk backwards: a pass is kept if it writes something needed downstream.
+    for (i, decl) in decls.iter().enumerate().rev() {
+        if decl.disabled.is_some() {
+            continue;
+        }
+        if decl.writes.iter().any(|w| needed.contains(w)) {
+            keep[i] = true;
+            needed.extend(decl.reads.iter().copied());
+        }
+    }
+    for r in &needed {
+        let produced = decls.iter().zip(&keep).any(|(d, k)| *k && d.writes.contains(r));
+        if !produced {
+            return Err(format!("nothing produces '{}' for this frame", r.name()));
+        }
+    }
+    let mut plan = Plan { run: Vec::new(), names: Vec::new(), left_out: Vec::new(), resources: needed };
+    for (i, decl) in decls.iter().enumerate() {
+        if keep[i] {
+            plan.run.push(i);
+            plan.names.push(decl.name);
+        } else if let Some(reason) = &decl.disabled {
+            plan.left_out.push((decl.name, reason.clone()));
+        } else {
+            let writes: Vec<_> = decl.writes.iter().map(|w| w.name()).collect();
+            plan.left_out.push((decl.name, format!("nothing this frame needs reads its output ({})", writes.join(", "))));
+        }
+    }
+    Ok(plan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use Resource::*;
+
+    fn decls() -> Vec<PassDecl> {
+        vec![
+            PassDecl::new("gbuffer").write(Depth).write(Normals).write(Albedo),
+            PassDecl::new("lighting").read(Depth).read(Normals).read(Albedo).write(Hdr),
+            PassDecl::new("tonemap").read(Hdr).write(Color),
+        ]
+    }
+
+    #[test]
+    fn color_pulls_in_the_whole_chain() {
+        let plan = plan(&decls(), &[Color]).unwrap();
+        assert_eq!(plan.names, vec!["gbuffer", "lighting", "tonemap"]);
+        assert!(plan.left_out.is_empty());
+    }
+
+    #[test]
+    fn a_pass_whose_output_nobody_reads_is_left_out() {
+        let plan = plan(&decls(), &[Normals]).unwrap();
+        assert_eq!(plan.names, vec!["gbuffer"]);
+        let names: Vec<_> = plan.left_out.iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, vec!["lighting", "tonemap"]);
+        assert!(plan.left_out[0].1.contains("hdr"));
+    }
+
+    #[test]
+    fn disabled_pass_is_left_out_with_its_reason() {
+        let mut d = decls();
+        d.push(PassDecl::new("mirror").read(Color).write(Emission).disabled_if(true, "display mode is none"));
+        let plan = plan(&d, &[Color]).unwrap();
+        assert_eq!(plan.left_out, vec![("mirror", "display mode is none".to_string())]);
+    }
+
+    #[test]
+    fn an_output_nobody_produces_is_an_error() {
+        let mut d = decls();
+        d[2].disabled = Some("off".into());
+        assert!(plan(&d, &[Color]).unwrap_err().contains("color"));
+    }
+}

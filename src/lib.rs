@@ -1,0 +1,22 @@
+//! vrao: a stereo VR renderer for screen-space ambient occlusion on wgpu.
+//!
+//! The library is usable without the CLI: load a [`Scene`], open a [`Gpu`], make a
+//! [`Renderer`] with [`Settings`], and render an [`EyePair`] into layered targets.
+
+pub mod error;
+pub mod gpu;
+pub mod graph;
+pub mod output;
+pub mod passes;
+pub mod renderer;
+pub mod scene;
+pub mod settings;
+pub mod stereo;
+
+pub use error::{Error, Result};
+pub use gpu::{BackendChoice, Gpu};
+pub use graph::Resource;
+pub use renderer::{FrameReport, Renderer};
+pub use scene::Scene;
+pub use settings::{Settings, StereoMode};
+pub use stereo::{Eye, EyePair, Fov, HeadPose, HeadsetProfile};

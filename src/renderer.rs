@@ -1,0 +1,186 @@
+//! The renderer: owns the passes and their targets. Each frame it asks the passes what
+//! they read and write, lets the graph keep only what the requested outputs need, and
+//! records the kept passes with a GPU timestamp span around each.
+
+use crate::error::{Error, Result};
+use crate::gpu::frame::FrameBuffers;
+use crate::gpu::readback;
+use crate::gpu::scene::GpuScene;
+use crate::gpu::targets::LayeredTarget;
+use crate::gpu::timing::GpuTimer;
+use crate::gpu::Gpu;
+use crate::graph::{self, Plan, Resource};
+use crate::passes::gbuffer::GBufferPass;
+use crate::passes::lighting::LightingPass;
+use crate::passes::tonemap::TonemapPass;
+use crate::passes::{FrameContext, FrameSetup, Pass};
+use crate::scene::Scene;
+use crate::settings::{Settings, StereoMode};
+use crate::stereo::Eye;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// What one frame did: the plan (passes run and left out) and how long each took.
+#[derive(Clone, Debug)]
+pub struct FrameReport {
+    pub plan: Plan,
+    /// (span, GPU milliseconds) per pass, plus per-eye spans where a pass runs per eye.
+    /// Empty when the adapter has no timestamp queries.
+    pub gpu_ms: Vec<(String, f64)>,
+    /// CPU time spent encoding the frame's commands.
+    pub cpu_encode_ms: f64,
+}
+
+impl FrameReport {
+    pub fn gpu_ms_of(&self, span: &str) -> Option<f64> {
+        self.gpu_ms.iter().find(|(s, _)| s == span).map(|(_, ms)| *ms)
+    }
+}
+
+pub struct Renderer {
+    gpu: Arc<Gpu>,
+    scene: Scene,
+    settings: Settings,
+    multiview: bool,
+    gpu_scene: GpuScene,
+    frame: FrameBuffers,
+    passes: Vec<Box<dyn Pass>>,
+    targets: BTreeMap<Resource, LayeredTarget>,
+    timer: GpuTimer,
+}
+
+impl Renderer {
+    pub fn new(gpu: Arc<Gpu>, scene: &Scene, settings: &Settings) -> Result<Renderer> {
+        settings.validate()?;
+        let multiview = match settings.stereo {
+            StereoMode::Auto => gpu.caps.multiview,
+            StereoMode::Multipass => false,
+            StereoMode::Multiview if gpu.caps.multiview => true,
+            StereoMode::Multiview => {
+                return Err(Error::input(format!(
+                    "--stereo multiview: adapter '{}' has no multiview; use --stereo multipass",
+                    gpu.adapter.get_info().name
+                )))
+            }
+        };
+        let gpu_scene = GpuScene::upload(&gpu, scene);
+        let frame = FrameBuffers::new(&gpu.device, scene.lights.len());
+        // Declaration order is execution order.
+        let passes: Vec<Box<dyn Pass>> = vec![
+            Box::new(GBufferPass::new(&gpu, &gpu_scene, &frame)),
+            Box::new(LightingPass::new(&gpu)),
+            Box::new(TonemapPass::new(&gpu)),
+        ];
+        let timer = GpuTimer::new(&gpu, 32);
+        Ok(Renderer {
+            gpu,
+            scene: scene.clone(),
+            settings: settings.clone(),
+            multiview,
+            gpu_scene,
+            frame,
+            passes,
+            targets: BTreeMap::new(),
+            timer,
+        })
+    }
+
+    pub fn gpu(&self) -> &Arc<Gpu> {
+        &self.gpu
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Whether the G-buffer draws both eyes in one multiview pass.
+    pub fn uses_multiview(&self) -> bool {
+        self.multiview
+    }
+
+    fn setup(&self, views: u32) -> FrameSetup<'_> {
+        FrameSetup { scene: &self.scene, settings: &self.settings, views, multiview: self.multiview }
+    }
+
+    /// The plan for a frame of `views` layers that must produce `outputs`.
+    pub fn plan(&self, views: u32, outputs: &[Resource]) -> Result<Plan> {
+        let setup = self.setup(views);
+        let decls: Vec<_> = self.passes.iter().map(|p| p.declare(&setup)).collect();
+        graph::plan(&decls, outputs).map_err(Error::Gpu)
+    }
+
+    /// Renders one frame for `views` (two eyes, or one mono view) producing `outputs`,
+    /// and waits for it. Only the passes the outputs need are recorded.
+    pub fn render(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<FrameReport> {
+        if views.is_empty() || views.len() > 2 {
+            return Err(Error::input(format!("a frame has 1 or 2 views, not {}", views.len())));
+        }
+        let layers = views.len() as u32;
+        let encode_start = Instant::now();
+        let plan = self.plan(layers, outputs)?;
+        self.allocate_targets(&plan, layers);
+        self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        self.timer.reset();
+        let setup = FrameSetup { scene: &self.scene, settings: &self.settings, views: layers, multiview: self.multiview };
+        let mut ctx = FrameContext {
+            gpu: &self.gpu,
+            encoder: &mut encoder,
+            targets: &self.targets,
+            frame: &self.frame,
+            scene: &self.gpu_scene,
+            timer: &mut self.timer,
+            setup: &setup,
+        };
+        for (&index, name) in plan.run.iter().zip(&plan.names) {
+            let span = ctx.timer.begin(ctx.encoder, name);
+            self.passes[index].record(&mut ctx);
+            ctx.timer.end(ctx.encoder, span);
+        }
+        self.timer.resolve(&mut encoder);
+        let cpu_encode_ms = encode_start.elapsed().as_secs_f64() * 1e3;
+        self.gpu.queue.submit([encoder.finish()]);
+        let gpu_ms = self.timer.read(&self.gpu)?;
+        self.gpu.wait_idle()?;
+        Ok(FrameReport { plan, gpu_ms, cpu_encode_ms })
+    }
+
+    /// (Re)creates the targets this plan touches at the frame's size; others are kept
+    /// only if already the right size, so a resource no pass needs costs no memory.
+    fn allocate_targets(&mut self, plan: &Plan, layers: u32) {
+        let p = &self.settings.profile;
+        let extent = (p.width, p.height, layers);
+        self.targets.retain(|_, t| t.extent() == extent);
+        for &r in &plan.resources {
+            self.targets.entry(r).or_insert_with(|| {
+                let usage = match r {
+                    Resource::Depth | Resource::Normals | Resource::Albedo | Resource::Emission => {
+                        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
+                    }
+                    Resource::Hdr | Resource::Color => {
+                        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING
+                    }
+                };
+                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent, usage)
+            });
+        }
+    }
+
+    /// The target a previous frame wrote, if that frame needed it.
+    pub fn target(&self, r: Resource) -> Option<&LayeredTarget> {
+        self.targets.get(&r)
+    }
+
+    /// Raw bytes per layer of a resource the last frame produced.
+    pub fn read_bytes(&self, r: Resource) -> Result<Vec<Vec<u8>>> {
+        let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        readback::read_layers(&self.gpu, target)
+    }
+
+    /// Values per layer (channels interleaved) of a float or depth resource.
+    pub fn read_f32(&self, r: Resource) -> Result<Vec<Vec<f32>>> {
+        let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        readback::read_layers_f32(&self.gpu, target)
+    }
+}

@@ -1,0 +1,252 @@
+//! Vertex normals for meshes that come without them (all three shared scenes do).
+//!
+//! Normals are smooth and area-weighted (the sum of unnormalised face cross products), but
+//! only across faces that meet at less than a crease angle: where faces meet more sharply
+//! the vertex is split, so boxes and architecture stay flat-shaded while a scanned surface
+//! such as the bunny is smooth. Faces are joined by position, not by vertex index, so a
+//! texture seam does not become a shading seam. No output normal is ever NaN.
+
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
+
+/// Faces meeting at more than this angle (degrees) get separate vertex normals.
+pub const DEFAULT_CREASE_DEG: f32 = 60.0;
+
+/// Vertex arrays and a triangle list, as the normal computation reads and writes them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Geometry {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<u32>,
+}
+
+/// The normal used where nothing defines one (a vertex touched only by degenerate faces).
+const FALLBACK_NORMAL: Vec3 = Vec3::Y;
+
+/// The triangles of `indices` whose three indices are in range, with their unnormalised
+/// normals (twice the area along the CCW normal). Out-of-range triangles cannot be drawn,
+/// so they are dropped; a trailing partial triangle likewise.
+fn triangles(positions: &[Vec3], indices: &[u32]) -> Vec<([u32; 3], Vec3)> {
+    indices
+        .chunks_exact(3)
+        .filter(|t| t.iter().all(|&i| (i as usize) < positions.len()))
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+            ([t[0], t[1], t[2]], (b - a).cross(c - a))
+        })
+        .collect()
+}
+
+/// Smooth, area-weighted vertex normals that stay sharp across creases steeper than
+/// `crease_angle_deg`. `uvs` is either empty or one per position; the result has one
+/// position, normal and uv per output vertex (vertices are duplicated where a crease
+/// splits them). Zero-area triangles are kept in the index list but carry no weight.
+pub fn compute_normals(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], crease_angle_deg: f32) -> Geometry {
+    let crease = if crease_angle_deg.is_finite() { crease_angle_deg } else { DEFAULT_CREASE_DEG };
+    let cos_crease = crease.clamp(0.0, 180.0).to_radians().cos();
+    let tris = triangles(positions, indices);
+    let units: Vec<Option<Vec3>> = tris.iter().map(|(_, n)| n.try_normalize()).collect();
+
+    // Weld vertices by exact position (adding 0.0 turns -0.0 into +0.0 so both weld).
+    let mut weld_of_position: HashMap<[u32; 3], usize> = HashMap::new();
+    let weld: Vec<usize> = positions
+        .iter()
+        .map(|p| {
+            let key = (*p + Vec3::ZERO).to_array().map(f32::to_bits);
+            let next = weld_of_position.len();
+            *weld_of_position.entry(key).or_insert(next)
+        })
+        .collect();
+
+    // Faces around each welded vertex, in compressed-row form.
+    let mut start = vec![0usize; weld_of_position.len() + 1];
+    for (corners, _) in &tris {
+        for &v in corners {
+            start[weld[v as usize] + 1] += 1;
+        }
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut fill = start.clone();
+    let mut faces_around = vec![0usize; start[start.len() - 1]];
+    for (f, (corners, _)) in tris.iter().enumerate() {
+        for &v in corners {
+            let w = weld[v as usize];
+            faces_around[fill[w]] = f;
+            fill[w] += 1;
+        }
+    }
+
+    // The normal of face `f`'s corner at welded vertex `w`: the weighted sum over the faces
+    // around `w` within the crease angle of `f`. A degenerate face borrows the normal of
+    // the largest face around `w`.
+    let corner_normal = |f: usize, w: usize| -> Vec3 {
+        let around = &faces_around[start[w]..start[w + 1]];
+        let own = units[f].or_else(|| {
+            let largest = around
+                .iter()
+                .copied()
+                .max_by(|&a, &b| tris[a].1.length_squared().total_cmp(&tris[b].1.length_squared()))?;
+            units[largest]
+        });
+        let Some(own) = own else { return FALLBACK_NORMAL };
+        let sum: Vec3 =
+            around.iter().filter(|&&g| units[g].is_some_and(|u| u.dot(own) >= cos_crease)).map(|&g| tris[g].1).sum();
+        sum.try_normalize().unwrap_or(own)
+    };
+
+    // One output vertex per (input vertex, normal): corners that agree share a vertex.
+    let mut out = Geometry::default();
+    let mut output_of: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+    for (f, (corners, _)) in tris.iter().enumerate() {
+        for &v in corners {
+            let normal = corner_normal(f, weld[v as usize]);
+            let key = (v, normal.to_array().map(f32::to_bits));
+            let index = *output_of.entry(key).or_insert_with(|| {
+                out.positions.push(positions[v as usize]);
+                out.normals.push(normal);
+                out.uvs.push(uvs.get(v as usize).copied().unwrap_or(Vec2::ZERO));
+                (out.positions.len() - 1) as u32
+            });
+            out.indices.push(index);
+        }
+    }
+    out
+}
+
+/// Makes normals read from a file unit length. A zero-length or non-finite normal is
+/// replaced by the area-weighted normal of the faces around its vertex (the face normal
+/// when there is one face), or +Y when those faces have no area either.
+pub fn repair_normals(positions: &[Vec3], normals: &mut [Vec3], indices: &[u32]) {
+    let mut face_sums: Option<Vec<Vec3>> = None;
+    for (v, normal) in normals.iter_mut().enumerate() {
+        if let Some(unit) = normal.try_normalize() {
+            *normal = unit;
+            continue;
+        }
+        let sums = face_sums.get_or_insert_with(|| {
+            let mut sums = vec![Vec3::ZERO; positions.len()];
+            for (corners, n) in triangles(positions, indices) {
+                corners.iter().for_each(|&c| sums[c as usize] += n);
+            }
+            sums
+        });
+        *normal = sums.get(v).and_then(|s| s.try_normalize()).unwrap_or(FALLBACK_NORMAL);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn geometry(positions: &[Vec3], indices: &[u32]) -> Geometry {
+        compute_normals(positions, &[], indices, DEFAULT_CREASE_DEG)
+    }
+
+    /// A unit cube with 8 shared corners and CCW-outward faces.
+    fn cube() -> (Vec<Vec3>, Vec<u32>) {
+        let p = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let indices = quads.iter().flat_map(|q: &[u32; 4]| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
+        (p, indices)
+    }
+
+    #[test]
+    fn cube_stays_flat_shaded() {
+        let (p, i) = cube();
+        let g = geometry(&p, &i);
+        assert_eq!(g.indices.len(), 36);
+        assert_eq!(g.positions.len(), 24, "each corner splits into three face vertices");
+        let centre = Vec3::splat(0.5);
+        for t in g.indices.chunks(3) {
+            let n = g.normals[t[0] as usize];
+            assert!(t.iter().all(|&v| g.normals[v as usize] == n), "one normal per face");
+            assert_eq!(n.abs().max_element(), 1.0, "axis-aligned: {n}");
+            assert!(n.dot(g.positions[t[0] as usize] - centre) > 0.0, "outward");
+        }
+    }
+
+    #[test]
+    fn fine_sphere_normals_are_radial_within_one_degree() {
+        let (rings, segments) = (90, 180);
+        // Rings of vertices from pole to pole; each pole row is one point repeated (the
+        // points weld by position), and the seam wraps around by index.
+        let mut p = Vec::new();
+        for r in 0..=rings {
+            let theta = std::f32::consts::PI * r as f32 / rings as f32;
+            for s in 0..segments {
+                let phi = std::f32::consts::TAU * s as f32 / segments as f32;
+                let dir = match r {
+                    0 => Vec3::Y,
+                    r if r == rings => Vec3::NEG_Y,
+                    _ => Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin()),
+                };
+                p.push(dir * 3.0);
+            }
+        }
+        let mut i = Vec::new();
+        for r in 0..rings {
+            for s in 0..segments {
+                let [a, b] = [s, (s + 1) % segments].map(|s| (r * segments + s) as u32);
+                let row = segments as u32;
+                i.extend([a, a + row, b + row, a, b + row, b]);
+            }
+        }
+        let g = geometry(&p, &i);
+        let cos_one_degree = 1f32.to_radians().cos();
+        for (n, q) in g.normals.iter().zip(&g.positions) {
+            assert!(n.dot(q.normalize()) > cos_one_degree, "normal {n} at {q}");
+        }
+    }
+
+    #[test]
+    fn larger_face_weighs_more() {
+        // A big and a tiny triangle share vertex 0 and meet at a shallow angle.
+        let p = [
+            Vec3::ZERO,
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -4.0),
+            Vec3::new(-0.1, 0.0, 0.0),
+            Vec3::new(0.0, 0.02, 0.1),
+        ];
+        let g = geometry(&p, &[0, 1, 2, 0, 3, 4]);
+        let big = Vec3::Y;
+        let small = (p[3] - p[0]).cross(p[4] - p[0]).normalize();
+        assert!(small.dot(big) > 30f32.to_radians().cos(), "the test needs a shallow angle");
+        let shared = g.normals[g.indices[0] as usize];
+        assert_eq!(shared, g.normals[g.indices[3] as usize], "smoothed into one vertex");
+        // An unweighted mean would sit halfway (about 5.7° from each face).
+        assert!(shared.dot(big) > 0.5f32.to_radians().cos(), "{shared} follows the big face");
+    }
+
+    #[test]
+    fn degenerate_triangles_give_no_nan() {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::X * 2.0, Vec3::ZERO, Vec3::ZERO];
+        // Collinear, repeated-vertex and coincident triangles, plus an out-of-range one.
+        let g = geometry(&p, &[0, 1, 2, 0, 0, 1, 3, 4, 0, 0, 1, 99]);
+        assert_eq!(g.indices.len(), 9, "degenerate triangles stay, out-of-range ones go");
+        assert!(g.normals.iter().all(|n| n.is_finite() && (n.length() - 1.0).abs() < 1e-6));
+        let mixed = geometry(&[Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::X * 2.0], &[0, 2, 1, 0, 1, 3]);
+        assert!(mixed.normals.iter().all(|n| *n == Vec3::Y), "the collinear face borrows its neighbour's normal");
+    }
+
+    #[test]
+    fn uvs_travel_with_split_vertices() {
+        let (p, i) = cube();
+        let uvs: Vec<Vec2> = (0..8).map(|v| Vec2::new(v as f32, 0.0)).collect();
+        let g = compute_normals(&p, &uvs, &i, DEFAULT_CREASE_DEG);
+        for (q, uv) in g.positions.iter().zip(&g.uvs) {
+            assert_eq!(p[uv.x as usize], *q);
+        }
+    }
+
+    #[test]
+    fn bad_file_normals_are_repaired() {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::NEG_Z, Vec3::Y];
+        let mut n = [Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, Vec3::NAN, Vec3::ZERO];
+        repair_normals(&p, &mut n, &[0, 1, 2]);
+        assert_eq!(n, [Vec3::Y, Vec3::Y, Vec3::Y, Vec3::Y]);
+    }
+}

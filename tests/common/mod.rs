@@ -1,0 +1,48 @@
+//! Shared by the GPU integration tests: one device per test binary, and one GPU test at
+//! a time (lavapipe uses every core; parallel frames only slow each other down).
+
+#![allow(dead_code)]
+
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
+use vrao::scene::{HeadPath, Material, Mesh, Scene};
+use vrao::{BackendChoice, Gpu};
+
+pub fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
+    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
+    static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+    let guard = ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let gpu = GPU.get_or_init(|| Arc::new(Gpu::new(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests")));
+    (gpu.clone(), guard)
+}
+
+/// A square of side `size` centred on `center`, facing +Z (towards a viewer on +Z).
+pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Mesh {
+    let h = size * 0.5;
+    Mesh {
+        name: name.into(),
+        origin: center,
+        positions: vec![
+            glam::Vec3::new(-h, -h, 0.0),
+            glam::Vec3::new(h, -h, 0.0),
+            glam::Vec3::new(h, h, 0.0),
+            glam::Vec3::new(-h, h, 0.0),
+        ],
+        normals: vec![glam::Vec3::Z; 4],
+        uvs: vec![glam::Vec2::ZERO; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material,
+    }
+}
+
+/// A scene of the given meshes with one grey material, no lights and no environment,
+/// viewed from the origin looking down −Z.
+pub fn bare_scene(meshes: Vec<Mesh>) -> Scene {
+    Scene {
+        name: "test".into(),
+        meshes,
+        materials: vec![Material::plain("grey", glam::Vec3::splat(0.5))],
+        lights: Vec::new(),
+        environment: None,
+        head: HeadPath::fixed(vrao::HeadPose::IDENTITY),
+    }
+}
