@@ -11,11 +11,7 @@ pub const EXIT_OVER_BUDGET: i32 = 3;
 #[derive(Debug)]
 pub enum Error {
     /// Malformed or missing input. `file` and `line` name the place when known.
-    Input {
-        file: Option<PathBuf>,
-        line: Option<usize>,
-        message: String,
-    },
+    Input { file: Option<PathBuf>, line: Option<usize>, message: String },
     /// No usable GPU adapter or device.
     Device(String),
     /// A GPU operation failed while running (validation, lost device, readback).

@@ -84,7 +84,7 @@ pub struct Plan {
     pub names: Vec<&'static str>,
     /// (pass, reason) for every pass that does not run.
     pub left_out: Vec<(&'static str, String)>,
-    /// Every resource some running pass writes or the frame outputs.
+    /// Every resource a running pass reads or writes (what the frame must allocate).
     pub resources: BTreeSet<Resource>,
 }
 
@@ -136,13 +136,15 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
     let mut plan = Plan { run: Vec::new(), names: Vec::new(), left_out: Vec::new(), resources: needed };
     for (i, decl) in decls.iter().enumerate() {
         if keep[i] {
+            plan.resources.extend(decl.writes.iter().copied());
             plan.run.push(i);
             plan.names.push(decl.name);
         } else if let Some(reason) = &decl.disabled {
             plan.left_out.push((decl.name, reason.clone()));
         } else {
             let writes: Vec<_> = decl.writes.iter().map(|w| w.name()).collect();
-            plan.left_out.push((decl.name, format!("nothing this frame needs reads its output ({})", writes.join(", "))));
+            plan.left_out
+                .push((decl.name, format!("nothing this frame needs reads its output ({})", writes.join(", "))));
         }
     }
     Ok(plan)

@@ -97,7 +97,13 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     }
     let mut profile = HeadsetProfile::with_size("vive", args.width, args.height);
     profile.ipd = args.ipd;
-    let settings = Settings { profile, stereo: args.stereo, exposure: args.exposure, white_point: args.white_point, ..Settings::default() };
+    let settings = Settings {
+        profile,
+        stereo: args.stereo,
+        exposure: args.exposure,
+        white_point: args.white_point,
+        ..Settings::default()
+    };
     settings.validate()?;
     let gpu = Arc::new(Gpu::new(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;

@@ -54,9 +54,16 @@ impl Renderer {
     pub fn new(gpu: Arc<Gpu>, scene: &Scene, settings: &Settings) -> Result<Renderer> {
         settings.validate()?;
         let multiview = match settings.stereo {
-            StereoMode::Auto => gpu.caps.multiview,
+            StereoMode::Auto => gpu.caps.multiview_reliable,
             StereoMode::Multipass => false,
-            StereoMode::Multiview if gpu.caps.multiview => true,
+            StereoMode::Multiview if gpu.caps.multiview => {
+                if !gpu.caps.multiview_reliable {
+                    log::warn!(
+                        "multiview on this adapter failed the start-up probe: clipped triangles may miss the right eye"
+                    );
+                }
+                true
+            }
             StereoMode::Multiview => {
                 return Err(Error::input(format!(
                     "--stereo multiview: adapter '{}' has no multiview; use --stereo multipass",
@@ -121,9 +128,11 @@ impl Renderer {
         let plan = self.plan(layers, outputs)?;
         self.allocate_targets(&plan, layers);
         self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
-        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.timer.reset();
-        let setup = FrameSetup { scene: &self.scene, settings: &self.settings, views: layers, multiview: self.multiview };
+        let setup =
+            FrameSetup { scene: &self.scene, settings: &self.settings, views: layers, multiview: self.multiview };
         let mut ctx = FrameContext {
             gpu: &self.gpu,
             encoder: &mut encoder,

@@ -58,12 +58,7 @@ pub struct Fov {
 impl Fov {
     /// Tangents of the four angles (left, right, up, down).
     pub fn tangents(&self) -> [f64; 4] {
-        [
-            (self.left as f64).tan(),
-            (self.right as f64).tan(),
-            (self.up as f64).tan(),
-            (self.down as f64).tan(),
-        ]
+        [(self.left as f64).tan(), (self.right as f64).tan(), (self.up as f64).tan(), (self.down as f64).tan()]
     }
 
     /// The same field of view mirrored left/right (the other eye of a symmetric headset).
@@ -91,10 +86,22 @@ impl Fov {
 pub fn reversed_z_projection(fov: &Fov, near: f64) -> DMat4 {
     let [l, r, u, d] = fov.tangents();
     DMat4::from_cols_array(&[
-        2.0 / (r - l), 0.0, 0.0, 0.0,
-        0.0, 2.0 / (u - d), 0.0, 0.0,
-        (r + l) / (r - l), (u + d) / (u - d), 0.0, -1.0,
-        0.0, 0.0, near, 0.0,
+        2.0 / (r - l),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        2.0 / (u - d),
+        0.0,
+        0.0,
+        (r + l) / (r - l),
+        (u + d) / (u - d),
+        0.0,
+        -1.0,
+        0.0,
+        0.0,
+        near,
+        0.0,
     ])
 }
 

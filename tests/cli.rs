@@ -47,12 +47,22 @@ fn render_writes_both_eyes_and_explains_the_graph() {
     let dir = temp_dir("render");
     let out_dir = dir.join("out");
     let out = vrao(&[
-        "render", "--scene", "builtin:room", "--out", out_dir.to_str().unwrap(), "--width", "96", "--height", "108",
-        "--debug", "--explain",
+        "render",
+        "--scene",
+        "builtin:room",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--width",
+        "96",
+        "--height",
+        "108",
+        "--debug",
+        "--explain",
     ]);
     let t = text(&out);
     assert!(out.status.success(), "{t}");
-    for name in ["left", "right", "depth_left", "depth_right", "normals_left", "normals_right", "albedo_left", "albedo_right"]
+    for name in
+        ["left", "right", "depth_left", "depth_right", "normals_left", "normals_right", "albedo_left", "albedo_right"]
     {
         let image = image::open(out_dir.join(format!("{name}.png"))).unwrap_or_else(|e| panic!("{name}.png: {e}"));
         assert_eq!((image.width(), image.height()), (96, 108), "{name}.png size");

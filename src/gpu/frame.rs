@@ -85,7 +85,12 @@ impl FrameBuffers {
             for light in &scene.lights {
                 lights.push(match *light {
                     Light::Directional { direction, color, intensity } => LightUniform {
-                        pos_or_dir: view_from_world.transform_vector3(direction.as_dvec3()).normalize_or_zero().as_vec3().extend(0.0).to_array(),
+                        pos_or_dir: view_from_world
+                            .transform_vector3(direction.as_dvec3())
+                            .normalize_or_zero()
+                            .as_vec3()
+                            .extend(0.0)
+                            .to_array(),
                         radiance: (color * intensity).extend(0.0).to_array(),
                         kind: [0; 4],
                     },

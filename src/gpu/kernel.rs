@@ -13,6 +13,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("gbuffer_multiview.wgsl", include_str!("../../shaders/gbuffer_multiview.wgsl")),
     ("gbuffer_multipass.wgsl", include_str!("../../shaders/gbuffer_multipass.wgsl")),
+    ("multiview_probe.wgsl", include_str!("../../shaders/multiview_probe.wgsl")),
     ("lighting.wgsl", include_str!("../../shaders/lighting.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
 ];
@@ -107,10 +108,8 @@ impl Kernel {
     pub fn new(gpu: &Gpu, label: &str, files: &[&str], entry: &str, slots: &[Slot]) -> Kernel {
         let device = &gpu.device;
         let entries: Vec<_> = slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32)).collect();
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(label),
-            entries: &entries,
-        });
+        let layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
             bind_group_layouts: &[Some(&layout)],
@@ -148,10 +147,8 @@ impl Kernel {
             layout: &self.layout,
             entries: &entries,
         });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&self.label),
-            timestamp_writes: None,
-        });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);

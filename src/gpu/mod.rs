@@ -4,6 +4,7 @@
 pub mod frame;
 pub mod half;
 pub mod kernel;
+pub mod multiview_probe;
 pub mod readback;
 pub mod scene;
 pub mod targets;
@@ -36,8 +37,11 @@ impl std::str::FromStr for BackendChoice {
 /// What the chosen device can do that the renderer cares about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Capabilities {
-    /// One render pass writes both eye layers (`view_index` in the vertex shader).
+    /// The adapter offers multiview: one render pass writes both eye layers.
     pub multiview: bool,
+    /// Multiview passed the start-up probe (clipped triangles reach every layer), so the
+    /// `auto` stereo mode may use it.
+    pub multiview_reliable: bool,
     /// Timestamp queries between passes (encoder-level writes).
     pub timestamps: bool,
 }
@@ -55,24 +59,32 @@ impl Gpu {
     /// Opens the best adapter for `choice`: a discrete or integrated GPU when one exists,
     /// otherwise a CPU (lavapipe) adapter. No adapter at all is `Error::Device`.
     pub fn new(choice: BackendChoice) -> Result<Gpu> {
-        let backends = match choice {
-            BackendChoice::Auto => wgpu::Backends::VULKAN | wgpu::Backends::GL | wgpu::Backends::METAL | wgpu::Backends::DX12,
-            BackendChoice::Vulkan => wgpu::Backends::VULKAN,
-            BackendChoice::Gl => wgpu::Backends::GL,
+        // Auto tries the native APIs first and OpenGL only when they found nothing, so a
+        // machine with Vulkan never initialises (and hears from) the GL/EGL stack.
+        let attempts: &[wgpu::Backends] = match choice {
+            BackendChoice::Auto => &[wgpu::Backends::PRIMARY, wgpu::Backends::GL],
+            BackendChoice::Vulkan => &[wgpu::Backends::VULKAN],
+            BackendChoice::Gl => &[wgpu::Backends::GL],
         };
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
-        let adapter = pick_adapter(&instance, backends)?;
-        Self::from_adapter(instance, adapter)
+        let mut last_error = None;
+        for &backends in attempts {
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+            desc.backends = backends;
+            let instance = wgpu::Instance::new(desc);
+            match pick_adapter(&instance, backends) {
+                Ok(adapter) => return Self::from_adapter(instance, adapter),
+                Err(e) => last_error = Some(e),
+            }
+        }
+        Err(last_error.unwrap_or_else(|| Error::Device("no backend was tried".into())))
     }
 
     fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu> {
         let available = adapter.features();
         let adapter_limits = adapter.limits();
         let multiview = available.contains(wgpu::Features::MULTIVIEW) && adapter_limits.max_multiview_view_count >= 2;
-        let timestamps = available
-            .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+        let timestamps =
+            available.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
         let mut features = wgpu::Features::empty();
         if multiview {
             features |= wgpu::Features::MULTIVIEW;
@@ -101,7 +113,15 @@ impl Gpu {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| Error::Device(format!("{} refused a device: {e}", adapter.get_info().name)))?;
-        Ok(Gpu { instance, adapter, device, queue, caps: Capabilities { multiview, timestamps } })
+        let mut gpu = Gpu {
+            instance,
+            adapter,
+            device,
+            queue,
+            caps: Capabilities { multiview, multiview_reliable: false, timestamps },
+        };
+        gpu.caps.multiview_reliable = multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
+        Ok(gpu)
     }
 
     /// Blocks until all submitted work has finished.
@@ -122,7 +142,14 @@ impl Gpu {
         let _ = writeln!(s, "type:         {:?}", info.device_type);
         let _ = writeln!(s, "backend:      {:?}", info.backend);
         let _ = writeln!(s, "driver:       {} {}", info.driver, info.driver_info);
-        let _ = writeln!(s, "multiview:    {} (stereo G-buffer in one pass)", yes_no(self.caps.multiview));
+        let multiview = match (self.caps.multiview, self.caps.multiview_reliable) {
+            (false, _) => "no (one G-buffer pass per eye)",
+            (true, true) => "yes (stereo G-buffer in one pass)",
+            (true, false) => {
+                "yes, but unreliable: clipped triangles reach layer 0 only (probe failed); auto uses one pass per eye"
+            }
+        };
+        let _ = writeln!(s, "multiview:    {multiview}");
         let _ = writeln!(s, "timestamps:   {} (per-pass GPU timing)", yes_no(self.caps.timestamps));
         let _ = writeln!(s, "limits:");
         let _ = writeln!(s, "  max_texture_dimension_2d          {}", limits.max_texture_dimension_2d);

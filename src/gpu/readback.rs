@@ -1,7 +1,7 @@
 //! Copies layered textures back to the CPU (debug images, tests, error measurement).
 
-use super::targets::LayeredTarget;
 use super::half::f16_to_f32;
+use super::targets::LayeredTarget;
 use super::Gpu;
 use crate::error::{Error, Result};
 
@@ -30,11 +30,8 @@ pub fn read_layers(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<u8>>> {
         mapped_at_creation: false,
     });
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let aspect = if target.format.is_depth_stencil_format() {
-        wgpu::TextureAspect::DepthOnly
-    } else {
-        wgpu::TextureAspect::All
-    };
+    let aspect =
+        if target.format.is_depth_stencil_format() { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All };
     encoder.copy_texture_to_buffer(
         wgpu::TexelCopyTextureInfo { texture: &target.texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
         wgpu::TexelCopyBufferInfo {

@@ -152,7 +152,11 @@ fn rgba8_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8]) 
 /// half range saturate rather than turn into Inf.
 fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureView {
     let (width, height, texels) = match env {
-        Some(e) => (e.width, e.height, e.texels.iter().map(|t| [t[0] * e.intensity, t[1] * e.intensity, t[2] * e.intensity]).collect()),
+        Some(e) => (
+            e.width,
+            e.height,
+            e.texels.iter().map(|t| [t[0] * e.intensity, t[1] * e.intensity, t[2] * e.intensity]).collect(),
+        ),
         None => (1, 1, vec![[0.0; 3]]),
     };
     let data: Vec<u16> = texels.iter().flat_map(|t: &[f32; 3]| [t[0], t[1], t[2], 1.0]).map(f32_to_f16).collect();

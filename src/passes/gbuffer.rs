@@ -86,7 +86,8 @@ impl GBufferPass {
                 bind_group_layouts: &[Some(&frame_layout), Some(&material_layout)],
                 immediate_size: 0,
             });
-            let module = shader_module(device, "gbuffer multiview", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multiview.wgsl"]);
+            let module =
+                shader_module(device, "gbuffer multiview", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multiview.wgsl"]);
             pipeline(device, &layout, &module, NonZeroU32::new(0b11))
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -94,7 +95,8 @@ impl GBufferPass {
             bind_group_layouts: &[Some(&frame_layout), Some(&material_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, "gbuffer multipass", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multipass.wgsl"]);
+        let module =
+            shader_module(device, "gbuffer multipass", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multipass.wgsl"]);
         let multipass = pipeline(device, &layout, &module, None);
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer frame"),

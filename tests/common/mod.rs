@@ -11,7 +11,8 @@ pub fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
     static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
     static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
     let guard = ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    let gpu = GPU.get_or_init(|| Arc::new(Gpu::new(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests")));
+    let gpu =
+        GPU.get_or_init(|| Arc::new(Gpu::new(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests")));
     (gpu.clone(), guard)
 }
 
@@ -30,6 +31,28 @@ pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Me
         normals: vec![glam::Vec3::Z; 4],
         uvs: vec![glam::Vec2::ZERO; 4],
         indices: vec![0, 1, 2, 0, 2, 3],
+        material,
+    }
+}
+
+/// A disc of `radius` centred on `center`, facing +Z, as a 64-sided fan.
+pub fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Mesh {
+    let sides = 64;
+    let mut positions = vec![glam::Vec3::ZERO];
+    let mut indices = Vec::new();
+    for i in 0..sides {
+        let a = i as f32 / sides as f32 * std::f32::consts::TAU;
+        positions.push(glam::Vec3::new(a.cos() * radius, a.sin() * radius, 0.0));
+        indices.extend([0, 1 + i, 1 + (i + 1) % sides]);
+    }
+    let n = positions.len();
+    Mesh {
+        name: name.into(),
+        origin: center,
+        positions,
+        normals: vec![glam::Vec3::Z; n],
+        uvs: vec![glam::Vec2::ZERO; n],
+        indices,
         material,
     }
 }
