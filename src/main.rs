@@ -62,6 +62,10 @@ struct RenderArgs {
     /// Linear exposure before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
+    /// Render this many frames and report per-pass GPU medians (with --explain); the
+    /// first frames are warm-up and not counted.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    frames: u32,
     /// Reinhard white point (smallest exposed luminance shown as white).
     #[arg(long, default_value_t = 4.0)]
     white_point: f32,
@@ -112,7 +116,19 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     if args.debug {
         outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
     }
-    let report = renderer.render(&eyes.eyes, &outputs)?;
+    // Warm-up frames (pipeline compilation, first-touch allocation) are not measured.
+    let warmup = if args.frames > 1 { (args.frames / 10).clamp(1, 10) } else { 0 };
+    let mut timings = Vec::new();
+    let mut report = None;
+    for frame in 0..warmup + args.frames {
+        let r = renderer.render(&eyes.eyes, &outputs)?;
+        if frame >= warmup {
+            timings.push(r.gpu_ms.clone());
+            timings.last_mut().unwrap().push(("cpu encode".into(), r.cpu_encode_ms));
+        }
+        report = Some(r);
+    }
+    let report = report.expect("at least one frame");
     let written = vrao::output::write_images(&renderer, &args.out, 2, args.debug)?;
     println!(
         "rendered '{}' ({} triangles) on {}: {}x{} per eye, {} G-buffer",
@@ -125,10 +141,18 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     );
     if args.explain {
         print!("{}", report.plan);
-        for (span, ms) in &report.gpu_ms {
-            println!("  gpu {span:<16} {ms:8.3} ms");
+        let adapter = gpu.adapter.get_info();
+        println!(
+            "timing over {} frame(s) after {warmup} warm-up, {} ({:?}):",
+            args.frames, adapter.name, adapter.backend
+        );
+        println!("  {:<18} {:>10} {:>10} {:>10}", "span", "median ms", "p25 ms", "p75 ms");
+        for s in vrao::gpu::timing::summarize(&timings) {
+            println!("  {:<18} {:>10.3} {:>10.3} {:>10.3}", s.label, s.median_ms, s.p25_ms, s.p75_ms);
         }
-        println!("  cpu encode       {:8.3} ms", report.cpu_encode_ms);
+        if report.gpu_ms.is_empty() {
+            println!("  (this adapter has no timestamp queries: GPU times are not available)");
+        }
     }
     for path in written {
         println!("wrote {}", path.display());

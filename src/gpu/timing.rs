@@ -121,3 +121,71 @@ impl GpuTimer {
             .collect())
     }
 }
+
+/// One span's times over many frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpanSummary {
+    pub label: String,
+    pub frames: usize,
+    pub median_ms: f64,
+    /// Interquartile range: the spread that one slow frame does not distort.
+    pub p25_ms: f64,
+    pub p75_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+}
+
+/// Median and spread of every span over frames, in the order spans first appear.
+pub fn summarize(frames: &[Vec<(String, f64)>]) -> Vec<SpanSummary> {
+    let mut labels: Vec<&str> = Vec::new();
+    for frame in frames {
+        for (label, _) in frame {
+            if !labels.contains(&label.as_str()) {
+                labels.push(label);
+            }
+        }
+    }
+    labels
+        .into_iter()
+        .map(|label| {
+            let mut times: Vec<f64> =
+                frames.iter().flat_map(|f| f.iter().filter(|(l, _)| l == label).map(|(_, ms)| *ms)).collect();
+            times.sort_by(f64::total_cmp);
+            SpanSummary {
+                label: label.to_string(),
+                frames: times.len(),
+                median_ms: quantile(&times, 0.5),
+                p25_ms: quantile(&times, 0.25),
+                p75_ms: quantile(&times, 0.75),
+                min_ms: times[0],
+                max_ms: times[times.len() - 1],
+            }
+        })
+        .collect()
+}
+
+/// Linear-interpolated quantile of sorted, non-empty values.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let pos = q.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
+    let (i, frac) = (pos.floor() as usize, pos.fract());
+    let next = sorted[(i + 1).min(sorted.len() - 1)];
+    sorted[i] + (next - sorted[i]) * frac
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_and_quartiles_of_spans() {
+        let frames: Vec<Vec<(String, f64)>> = [1.0, 5.0, 2.0, 4.0, 3.0]
+            .iter()
+            .map(|&ms| vec![("a".to_string(), ms), ("b".to_string(), 10.0 * ms)])
+            .collect();
+        let s = summarize(&frames);
+        assert_eq!(s.len(), 2);
+        assert_eq!((s[0].median_ms, s[0].p25_ms, s[0].p75_ms, s[0].min_ms, s[0].max_ms), (3.0, 2.0, 4.0, 1.0, 5.0));
+        assert_eq!(s[1].median_ms, 30.0);
+        assert_eq!(quantile(&[1.0, 2.0], 0.5), 1.5);
+    }
+}
