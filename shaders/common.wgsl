@@ -61,3 +61,144 @@ fn finite_or_zero3(v: vec3<f32>) -> vec3<f32> {
     let ok = (v == v) & (abs(v) <= vec3<f32>(3.0e38));
     return clamp(select(vec3<f32>(0.0), v, ok), vec3<f32>(-65504.0), vec3<f32>(65504.0));
 }
+
+// Parameters of the occlusion passes (AO technique, blur, upsample, composite).
+struct AoParams {
+    // Size of the occlusion targets (half the full size, rounded up, with half-res).
+    ao_size: vec2<u32>,
+    // Full-resolution pixels per occlusion pixel along each axis: 1 or 2.
+    scale: u32,
+    // SSAO/SSDO samples per pixel.
+    samples: u32,
+    // HBAO directions and steps per direction (directions × steps ≈ samples).
+    directions: u32,
+    steps: u32,
+    // 1 when the pass runs (technique not none).
+    technique: u32,
+    // 0 tiled 5×5 rotations, 1 Halton/R2 per-pixel rotation.
+    noise: u32,
+    // World-space radius (metres).
+    radius: f32,
+    // Occlusion weight in [0, 4].
+    strength: f32,
+    // Depth bias as a fraction of the radius.
+    bias: f32,
+    // 1: occluders beyond the radius fade out (range check).
+    range_check: u32,
+    // SSDO bounce strength (0: no bounce work).
+    bounce: f32,
+    // Mip level of the environment for one SSDO sample's solid angle 2π/N.
+    environment_lod: f32,
+    // Bilateral blur radius in pixels (5 → 11×11).
+    blur_radius: u32,
+    // Frame counter, for patterns that rotate over time.
+    frame_index: u32,
+};
+
+// The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left
+// full-res pixel, clamped for odd sizes), so every pass at AO resolution agrees on it.
+fn full_res_pixel(p: vec2<u32>, scale: u32, full_size: vec2<u32>) -> vec2<u32> {
+    return min(p * scale, full_size - vec2<u32>(1u));
+}
+
+// Centre of full-resolution pixel `p` in 0..1 texture coordinates.
+fn full_res_uv(p: vec2<u32>, full_size: vec2<u32>) -> vec2<f32> {
+    return pixel_uv(p, full_size);
+}
+
+// Rebuilds a view-space position at an integer full-res pixel of one layer.
+fn load_view_position(depth: f32, p: vec2<u32>, eye: Eye, full_size: vec2<u32>, near: f32) -> vec3<f32> {
+    return view_position_from_depth(pixel_uv(p, full_size), depth, eye.tangents, near);
+}
+
+// Where a view-space point lands: uv (0..1, top-left origin). Uses the frustum tangents,
+// the exact inverse of `view_position_from_depth`.
+fn view_to_uv(v: vec3<f32>, tangents: vec4<f32>) -> vec2<f32> {
+    let inv_distance = 1.0 / max(-v.z, 1e-30);
+    let tan_x = v.x * inv_distance;
+    let tan_y = v.y * inv_distance;
+    return vec2<f32>((tan_x - tangents.x) / (tangents.y - tangents.x), (tan_y - tangents.z) / (tangents.w - tangents.z));
+}
+
+// Clamps to [0, 1] and maps NaN to 1 (unoccluded): AO never leaves its range.
+fn saturate_ao(a: f32) -> f32 {
+    return select(1.0, clamp(a, 0.0, 1.0), a == a);
+}
+
+// Irradiance from the order-2 SH projection (Ramamoorthi & Hanrahan 2001), world normal.
+fn sh_irradiance(c: array<vec4<f32>, 9>, n: vec3<f32>) -> vec3<f32> {
+    var e = c[0].xyz * 0.282095;
+    e += c[1].xyz * (0.488603 * n.y) + c[2].xyz * (0.488603 * n.z) + c[3].xyz * (0.488603 * n.x);
+    e += c[4].xyz * (1.092548 * n.x * n.y) + c[5].xyz * (1.092548 * n.y * n.z);
+    e += c[6].xyz * (0.315392 * (3.0 * n.z * n.z - 1.0));
+    e += c[7].xyz * (1.092548 * n.x * n.z) + c[8].xyz * (0.546274 * (n.x * n.x - n.y * n.y));
+    return max(e, vec3<f32>(0.0));
+}
+
+// Equirectangular lookup at mip `lod`; the layout matches `scene::Environment::direction`
+// (row 0 = +Y, the image centre = −Z, u = 0.75 = +X).
+fn environment_radiance(env: texture_2d<f32>, env_sampler: sampler, dir: vec3<f32>, lod: f32) -> vec3<f32> {
+    let d = normalize(dir);
+    let u = fract(atan2(d.x, -d.z) / (2.0 * PI) + 0.5);
+    let v = acos(clamp(d.y, -1.0, 1.0)) / PI;
+    return textureSampleLevel(env, env_sampler, vec2<f32>(u, v), lod).rgb;
+}
+
+// ---- Occlusion helpers shared by SSAO, HBAO and SSDO ----
+
+// Per-pixel kernel rotation (radians). noise 0: a 5×5 tile repeated over the screen
+// (seed 003), its 25 angles visited in a stride-7 permutation so neighbours differ;
+// noise 1: a per-pixel low-discrepancy rotation (the R2 sequence), no visible tile.
+fn kernel_rotation(p: vec2<u32>, noise: u32) -> f32 {
+    if (noise == 0u) {
+        let index = (p.x % 5u) + 5u * (p.y % 5u);
+        return 2.0 * PI * f32((index * 7u) % 25u) / 25.0;
+    }
+    return 2.0 * PI * fract(0.5 + f32(p.x) * 0.7548776662 + f32(p.y) * 0.5698402910);
+}
+
+// An orthonormal frame around `n` (columns: tangent, bitangent, normal), turned by
+// `angle` about `n`.
+fn tangent_frame(n: vec3<f32>, angle: f32) -> mat3x3<f32> {
+    let helper = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(n.y) > 0.9);
+    let t0 = normalize(cross(helper, n));
+    let b0 = cross(n, t0);
+    let t = t0 * cos(angle) + b0 * sin(angle);
+    return mat3x3<f32>(t, cross(n, t), n);
+}
+
+// The unit normal stored at a pixel; a zero or non-finite one becomes the direction to
+// the eye, so a broken normal never turns into NaN.
+fn safe_normal(stored: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
+    let len2 = dot(stored, stored);
+    if (len2 > 1e-12 && len2 < 1e12) {
+        return stored * inverseSqrt(len2);
+    }
+    return normalize(-position);
+}
+
+// What the depth buffer holds where view-space point `s` projects: `valid` is false
+// off-screen, behind the eye or on the sky; `distance` is the stored surface's
+// distance along −z and `pixel` the full-res pixel read.
+struct DepthProbe {
+    valid: bool,
+    pixel: vec2<u32>,
+    distance: f32,
+};
+
+fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, eye: Eye) -> DepthProbe {
+    var probe: DepthProbe;
+    probe.valid = false;
+    if (!(-s.z > frame.near * 0.5)) {
+        return probe;
+    }
+    let uv = view_to_uv(s, eye.tangents);
+    if (!(all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
+        return probe;
+    }
+    probe.pixel = min(vec2<u32>(uv * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
+    let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+    probe.valid = d > 0.0;
+    probe.distance = frame.near / max(d, 1e-30);
+    return probe;
+}

@@ -17,6 +17,18 @@ pub enum Resource {
     Albedo,
     /// Emitted radiance, `Rgba16Float`.
     Emission,
+    /// Outgoing direct radiance (lights and emission), `Rgba16Float`: the composite's
+    /// base and the sender radiance of SSDO's bounce.
+    Direct,
+    /// Occlusion as computed (at AO resolution), `Rgba16Float`: rgb = SSDO's gathered
+    /// irradiance (environment through unblocked directions plus the bounce), a = AO.
+    AoRaw,
+    /// Horizontally blurred occlusion (first half of the separable bilateral blur).
+    AoBlurH,
+    /// Bilaterally blurred occlusion, at AO resolution.
+    AoBlurred,
+    /// Occlusion upsampled from half to full resolution (3×3 joint bilateral).
+    AoFull,
     /// Lit scene radiance before tone mapping, `Rgba16Float`.
     Hdr,
     /// Tone-mapped, sRGB-encoded eye colour, `Rgba8Unorm`.
@@ -24,12 +36,27 @@ pub enum Resource {
 }
 
 impl Resource {
+    /// Resources that live at the occlusion resolution (half per axis with `--half-res`).
+    pub fn at_ao_resolution(self) -> bool {
+        matches!(self, Resource::AoRaw | Resource::AoBlurH | Resource::AoBlurred)
+    }
+
+    /// Written by render passes (attachments) rather than by compute kernels.
+    pub fn is_attachment(self) -> bool {
+        matches!(self, Resource::Depth | Resource::Normals | Resource::Albedo | Resource::Emission)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Resource::Depth => "depth",
             Resource::Normals => "normals",
             Resource::Albedo => "albedo",
             Resource::Emission => "emission",
+            Resource::Direct => "direct",
+            Resource::AoRaw => "ao-raw",
+            Resource::AoBlurH => "ao-blur-h",
+            Resource::AoBlurred => "ao-blurred",
+            Resource::AoFull => "ao-full",
             Resource::Hdr => "hdr",
             Resource::Color => "color",
         }
@@ -38,7 +65,14 @@ impl Resource {
     pub fn format(self) -> wgpu::TextureFormat {
         match self {
             Resource::Depth => wgpu::TextureFormat::Depth32Float,
-            Resource::Normals | Resource::Emission | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
+            Resource::Normals
+            | Resource::Emission
+            | Resource::Direct
+            | Resource::AoRaw
+            | Resource::AoBlurH
+            | Resource::AoBlurred
+            | Resource::AoFull
+            | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
             Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
             Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
         }
@@ -53,11 +87,13 @@ pub struct PassDecl {
     pub writes: Vec<Resource>,
     /// `Some(reason)` when the scene or settings rule the pass out for this frame.
     pub disabled: Option<String>,
+    /// What `--explain` should add about work left out inside a running pass.
+    pub note: Option<String>,
 }
 
 impl PassDecl {
     pub fn new(name: &'static str) -> PassDecl {
-        PassDecl { name, reads: Vec::new(), writes: Vec::new(), disabled: None }
+        PassDecl { name, reads: Vec::new(), writes: Vec::new(), disabled: None, note: None }
     }
     pub fn read(mut self, r: Resource) -> Self {
         self.reads.push(r);
@@ -65,6 +101,10 @@ impl PassDecl {
     }
     pub fn write(mut self, r: Resource) -> Self {
         self.writes.push(r);
+        self
+    }
+    pub fn note(mut self, note: impl Into<String>) -> Self {
+        self.note = Some(note.into());
         self
     }
     /// Rules the pass out when `condition` holds, with `reason` shown by `--explain`.
@@ -82,6 +122,8 @@ pub struct Plan {
     /// Indices into the declarations, in execution order.
     pub run: Vec<usize>,
     pub names: Vec<&'static str>,
+    /// Notes of running passes (work they leave out internally).
+    pub notes: Vec<(&'static str, String)>,
     /// (pass, reason) for every pass that does not run.
     pub left_out: Vec<(&'static str, String)>,
     /// Every resource a running pass reads or writes (what the frame must allocate).
@@ -99,6 +141,9 @@ impl fmt::Display for Plan {
         writeln!(f, "passes that run, in order:")?;
         for name in &self.names {
             writeln!(f, "  ran       {name}")?;
+            for (_, note) in self.notes.iter().filter(|(n, _)| n == name) {
+                writeln!(f, "              {note}")?;
+            }
         }
         if self.left_out.is_empty() {
             writeln!(f, "no pass was left out")?;
@@ -133,12 +178,16 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
             return Err(format!("nothing produces '{}' for this frame", r.name()));
         }
     }
-    let mut plan = Plan { run: Vec::new(), names: Vec::new(), left_out: Vec::new(), resources: needed };
+    let mut plan =
+        Plan { run: Vec::new(), names: Vec::new(), notes: Vec::new(), left_out: Vec::new(), resources: needed };
     for (i, decl) in decls.iter().enumerate() {
         if keep[i] {
             plan.resources.extend(decl.writes.iter().copied());
             plan.run.push(i);
             plan.names.push(decl.name);
+            if let Some(note) = &decl.note {
+                plan.notes.push((decl.name, note.clone()));
+            }
         } else if let Some(reason) = &decl.disabled {
             plan.left_out.push((decl.name, reason.clone()));
         } else {

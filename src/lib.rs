@@ -9,6 +9,7 @@ pub mod graph;
 pub mod output;
 pub mod passes;
 pub mod renderer;
+pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod stereo;

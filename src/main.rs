@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use vrao::error::{Error, Result};
+use vrao::settings::{AoSettings, Noise, Quality, Technique};
 use vrao::stereo::HeadsetProfile;
 use vrao::{BackendChoice, Gpu, HeadPose, Renderer, Resource, Scene, Settings, StereoMode};
 
@@ -69,6 +70,63 @@ struct RenderArgs {
     /// Reinhard white point (smallest exposed luminance shown as white).
     #[arg(long, default_value_t = 4.0)]
     white_point: f32,
+    #[command(flatten)]
+    ao: AoArgs,
+}
+
+/// Occlusion options (shared by every command that renders).
+#[derive(Args, Clone)]
+struct AoArgs {
+    /// Occlusion technique: none, ssao, hbao, ssdo or ssdo-bounce.
+    #[arg(long, default_value = "ssao")]
+    technique: Technique,
+    /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
+    #[arg(long, default_value = "medium")]
+    quality: Quality,
+    /// Depth taps per pixel, 1..=256 (overrides --quality).
+    #[arg(long)]
+    samples: Option<u32>,
+    /// Occlusion radius in metres (default: 8 % of the scene's diagonal, within 0.01..=1 m).
+    #[arg(long)]
+    radius: Option<f32>,
+    /// Occlusion weight, 0..=4 (1 = full occlusion).
+    #[arg(long, default_value_t = 1.0)]
+    strength: f32,
+    /// Depth bias as a fraction of the radius.
+    #[arg(long, default_value_t = 0.02)]
+    bias: f32,
+    /// SSDO bounce strength (ssdo-bounce); 0 leaves the bounce out.
+    #[arg(long, default_value_t = 1.0)]
+    bounce: f32,
+    /// Compute occlusion at half resolution per axis and upsample it.
+    #[arg(long)]
+    half_res: bool,
+    /// Bilateral blur radius in pixels (5 = 11×11); 0 turns the blur off.
+    #[arg(long, default_value_t = 5)]
+    blur: u32,
+    /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
+    #[arg(long, default_value = "halton")]
+    noise: Noise,
+    /// Turn SSAO's range check (depth constraint) off.
+    #[arg(long)]
+    no_range_check: bool,
+}
+
+impl AoArgs {
+    fn settings(&self, scene: &Scene) -> AoSettings {
+        AoSettings {
+            technique: self.technique,
+            samples: self.samples.unwrap_or(self.quality.samples()),
+            radius: self.radius.unwrap_or_else(|| scene.suggested_ao_radius()),
+            strength: self.strength,
+            bias: self.bias,
+            range_check: !self.no_range_check,
+            bounce: self.bounce,
+            noise: self.noise,
+            half_res: self.half_res,
+            blur_radius: self.blur,
+        }
+    }
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
@@ -106,6 +164,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         stereo: args.stereo,
         exposure: args.exposure,
         white_point: args.white_point,
+        ao: args.ao.settings(&scene),
         ..Settings::default()
     };
     settings.validate()?;
@@ -115,6 +174,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     let mut outputs = vec![Resource::Color];
     if args.debug {
         outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
+        outputs.extend(vrao::output::occlusion_outputs(&settings));
     }
     // Warm-up frames (pipeline compilation, first-touch allocation) are not measured.
     let warmup = if args.frames > 1 { (args.frames / 10).clamp(1, 10) } else { 0 };
@@ -131,13 +191,17 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     let report = report.expect("at least one frame");
     let written = vrao::output::write_images(&renderer, &args.out, 2, args.debug)?;
     println!(
-        "rendered '{}' ({} triangles) on {}: {}x{} per eye, {} G-buffer",
+        "rendered '{}' ({} triangles) on {}: {}x{} per eye, {} G-buffer, {} N={} r={} m{}",
         scene.name,
         scene.triangle_count(),
         gpu.adapter.get_info().name,
         settings.profile.width,
         settings.profile.height,
-        if renderer.uses_multiview() { "multiview" } else { "multipass" }
+        if renderer.uses_multiview() { "multiview" } else { "multipass" },
+        settings.ao.technique.name(),
+        settings.ao.samples,
+        settings.ao.radius,
+        if settings.ao.half_res { ", half resolution" } else { "" },
     );
     if args.explain {
         print!("{}", report.plan);

@@ -3,6 +3,7 @@
 use crate::error::{Error, Result};
 use crate::graph::Resource;
 use crate::renderer::Renderer;
+use crate::settings::{Settings, Technique};
 use std::path::{Path, PathBuf};
 
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
@@ -42,6 +43,26 @@ pub fn normals_to_rgba(normals: &[f32]) -> Vec<u8> {
         .collect()
 }
 
+/// The occlusion resources `--debug` writes: raw, and final (blurred and/or upsampled).
+pub fn occlusion_outputs(settings: &Settings) -> Vec<Resource> {
+    match crate::passes::final_occlusion(settings) {
+        Some(last) if last != Resource::AoRaw => vec![Resource::AoRaw, last],
+        Some(_) => vec![Resource::AoRaw],
+        None => Vec::new(),
+    }
+}
+
+/// The AO channel (alpha) of an occlusion target as grey.
+pub fn occlusion_to_rgba(occlusion: &[f32]) -> Vec<u8> {
+    occlusion
+        .chunks_exact(4)
+        .flat_map(|p| {
+            let v = (p[3].clamp(0.0, 1.0) * 255.0).round() as u8;
+            [v, v, v, 255]
+        })
+        .collect()
+}
+
 /// Writes `left.png` and `right.png` (or `mono.png` for one view), and with `debug`
 /// the depth, normals and albedo of each view. Returns the files written.
 pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) -> Result<Vec<PathBuf>> {
@@ -50,12 +71,13 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
     let (w, h) = (profile.width, profile.height);
     let names: &[&str] = if views == 2 { &EYE_NAMES } else { &["mono"] };
     let mut written = Vec::new();
-    let mut save = |name: String, rgba: Vec<u8>| -> Result<()> {
+    let mut save_sized = |name: String, (w, h): (u32, u32), rgba: Vec<u8>| -> Result<()> {
         let path = out.join(name);
         save_rgba(&path, w, h, rgba)?;
         written.push(path);
         Ok(())
     };
+    let mut save = |name: String, rgba: Vec<u8>| save_sized(name, (w, h), rgba);
     for (name, rgba) in names.iter().zip(renderer.read_bytes(Resource::Color)?) {
         save(format!("{name}.png"), rgba)?;
     }
@@ -69,6 +91,16 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
         }
         for (name, albedo) in names.iter().zip(renderer.read_bytes(Resource::Albedo)?) {
             save(format!("albedo_{name}.png"), albedo)?;
+        }
+        if renderer.settings().ao.technique != Technique::None {
+            for r in occlusion_outputs(renderer.settings()) {
+                let target = renderer.target(r).expect("occlusion was rendered");
+                let size = (target.width, target.height);
+                let label = if r == Resource::AoRaw { "ao_raw" } else { "ao" };
+                for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
+                    save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
+                }
+            }
         }
     }
     Ok(written)

@@ -3,6 +3,7 @@
 //! records the kept passes with a GPU timestamp span around each.
 
 use crate::error::{Error, Result};
+use crate::gpu::frame::ao_extent;
 use crate::gpu::frame::FrameBuffers;
 use crate::gpu::readback;
 use crate::gpu::scene::GpuScene;
@@ -10,9 +11,15 @@ use crate::gpu::targets::LayeredTarget;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::Gpu;
 use crate::graph::{self, Plan, Resource};
+use crate::passes::blur::BlurPass;
+use crate::passes::composite::CompositePass;
+use crate::passes::direct::DirectLightPass;
 use crate::passes::gbuffer::GBufferPass;
-use crate::passes::lighting::LightingPass;
+use crate::passes::hbao::HbaoPass;
+use crate::passes::ssao::SsaoPass;
+use crate::passes::ssdo::SsdoPass;
 use crate::passes::tonemap::TonemapPass;
+use crate::passes::upsample::UpsamplePass;
 use crate::passes::{FrameContext, FrameSetup, Pass};
 use crate::scene::Scene;
 use crate::settings::{Settings, StereoMode};
@@ -48,6 +55,7 @@ pub struct Renderer {
     passes: Vec<Box<dyn Pass>>,
     targets: BTreeMap<Resource, LayeredTarget>,
     timer: GpuTimer,
+    frame_index: u32,
 }
 
 impl Renderer {
@@ -76,7 +84,13 @@ impl Renderer {
         // Declaration order is execution order.
         let passes: Vec<Box<dyn Pass>> = vec![
             Box::new(GBufferPass::new(&gpu, &gpu_scene, &frame)),
-            Box::new(LightingPass::new(&gpu)),
+            Box::new(DirectLightPass::new(&gpu)),
+            Box::new(SsaoPass::new(&gpu)),
+            Box::new(HbaoPass::new(&gpu)),
+            Box::new(SsdoPass::new(&gpu)),
+            Box::new(BlurPass::new(&gpu)),
+            Box::new(UpsamplePass::new(&gpu)),
+            Box::new(CompositePass::new(&gpu)),
             Box::new(TonemapPass::new(&gpu)),
         ];
         let timer = GpuTimer::new(&gpu, 32);
@@ -90,6 +104,7 @@ impl Renderer {
             passes,
             targets: BTreeMap::new(),
             timer,
+            frame_index: 0,
         })
     }
 
@@ -128,6 +143,8 @@ impl Renderer {
         let plan = self.plan(layers, outputs)?;
         self.allocate_targets(&plan, layers);
         self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
+        self.frame.update_ao(&self.gpu.queue, &self.scene, &self.settings, self.frame_index);
+        self.frame_index = self.frame_index.wrapping_add(1);
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.timer.reset();
@@ -155,23 +172,27 @@ impl Renderer {
         Ok(FrameReport { plan, gpu_ms, cpu_encode_ms })
     }
 
-    /// (Re)creates the targets this plan touches at the frame's size; others are kept
-    /// only if already the right size, so a resource no pass needs costs no memory.
+    /// (Re)creates the targets this plan touches at their size for this frame; targets
+    /// of another size are dropped, so a resource no pass needs costs no memory.
     fn allocate_targets(&mut self, plan: &Plan, layers: u32) {
         let p = &self.settings.profile;
-        let extent = (p.width, p.height, layers);
-        self.targets.retain(|_, t| t.extent() == extent);
+        let (ao_w, ao_h) = ao_extent(p.width, p.height, self.settings.ao.half_res);
+        let extent_of = |r: Resource| {
+            if r.at_ao_resolution() {
+                (ao_w, ao_h, layers)
+            } else {
+                (p.width, p.height, layers)
+            }
+        };
+        self.targets.retain(|r, t| t.extent() == extent_of(*r));
         for &r in &plan.resources {
             self.targets.entry(r).or_insert_with(|| {
-                let usage = match r {
-                    Resource::Depth | Resource::Normals | Resource::Albedo | Resource::Emission => {
-                        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
-                    }
-                    Resource::Hdr | Resource::Color => {
-                        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING
-                    }
+                let usage = if r.is_attachment() {
+                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
+                } else {
+                    wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING
                 };
-                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent, usage)
+                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent_of(r), usage)
             });
         }
     }

@@ -27,6 +27,178 @@ impl std::str::FromStr for StereoMode {
     }
 }
 
+/// The occlusion technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Technique {
+    /// No occlusion pass: the ambient term is unoccluded.
+    None,
+    /// Normal-oriented hemisphere SSAO (seed 003 §3.2, seed 000 ch. 3).
+    #[default]
+    Ssao,
+    /// Horizon-based AO, directions × steps ray-marched in depth (seed 003 §3.3).
+    Hbao,
+    /// Screen-space directional occlusion of the environment (seed 002 eq. 1).
+    Ssdo,
+    /// SSDO plus one indirect bounce in the same loop (seed 002 eq. 2).
+    SsdoBounce,
+}
+
+impl Technique {
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::None => "none",
+            Technique::Ssao => "ssao",
+            Technique::Hbao => "hbao",
+            Technique::Ssdo => "ssdo",
+            Technique::SsdoBounce => "ssdo-bounce",
+        }
+    }
+    pub const ALL: [Technique; 5] =
+        [Technique::None, Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce];
+}
+
+impl std::str::FromStr for Technique {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Technique::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| format!("unknown technique '{s}' (expected none, ssao, hbao, ssdo or ssdo-bounce)"))
+    }
+}
+
+/// Sampling quality presets: seed 003's kernel sizes N = 12, 24, 36, 64.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Quality {
+    Low,
+    #[default]
+    Medium,
+    High,
+    Ultra,
+}
+
+impl Quality {
+    pub const ALL: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Low => "low",
+            Quality::Medium => "medium",
+            Quality::High => "high",
+            Quality::Ultra => "ultra",
+        }
+    }
+    /// Depth taps per pixel (SSAO/SSDO samples; HBAO directions × steps).
+    pub fn samples(self) -> u32 {
+        match self {
+            Quality::Low => 12,
+            Quality::Medium => 24,
+            Quality::High => 36,
+            Quality::Ultra => 64,
+        }
+    }
+}
+
+impl std::str::FromStr for Quality {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Quality::ALL
+            .into_iter()
+            .find(|q| q.name() == s)
+            .ok_or_else(|| format!("unknown quality '{s}' (expected low, medium, high or ultra)"))
+    }
+}
+
+/// Where each pixel's kernel rotation comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Noise {
+    /// A 5×5 tile of rotations repeated over the screen (seed 003).
+    Tiled5x5,
+    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (seed 000).
+    #[default]
+    Halton,
+}
+
+impl std::str::FromStr for Noise {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "tiled" | "tiled5x5" => Ok(Noise::Tiled5x5),
+            "halton" => Ok(Noise::Halton),
+            other => Err(format!("unknown noise '{other}' (expected tiled or halton)")),
+        }
+    }
+}
+
+/// Occlusion parameters shared by every technique.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AoSettings {
+    pub technique: Technique,
+    /// Depth taps per pixel, 1..=256 (a quality preset sets it).
+    pub samples: u32,
+    /// World-space radius r (SSAO/SSDO r_max, HBAO R), metres.
+    pub radius: f32,
+    /// Occlusion weight: 0 leaves the ambient untouched, 1 applies the full occlusion.
+    pub strength: f32,
+    /// Depth bias against self-occlusion, as a fraction of the radius.
+    pub bias: f32,
+    /// Range check: an occluder farther than the radius from the pixel counts less
+    /// (SSAO's depth constraint) instead of darkening distant backgrounds.
+    pub range_check: bool,
+    /// SSDO bounce strength (scales the sender patch area π r²/N); 0 turns the bounce off.
+    pub bounce: f32,
+    pub noise: Noise,
+    /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
+    pub half_res: bool,
+    /// Separable geometry-aware bilateral blur radius in pixels (5 = 11×11); 0 turns it off.
+    pub blur_radius: u32,
+}
+
+impl Default for AoSettings {
+    fn default() -> Self {
+        AoSettings {
+            technique: Technique::Ssao,
+            samples: Quality::Medium.samples(),
+            radius: 0.5,
+            strength: 1.0,
+            bias: 0.02,
+            range_check: true,
+            bounce: 1.0,
+            noise: Noise::Halton,
+            half_res: false,
+            blur_radius: 5,
+        }
+    }
+}
+
+impl AoSettings {
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=256).contains(&self.samples) {
+            return Err(Error::input(format!("samples {} is not within 1..=256", self.samples)));
+        }
+        if !(self.radius.is_finite() && self.radius > 0.0 && self.radius <= 1e6) {
+            return Err(Error::input(format!("radius {} m must be a finite number in (0, 1e6]", self.radius)));
+        }
+        if !(self.strength.is_finite() && (0.0..=4.0).contains(&self.strength)) {
+            return Err(Error::input(format!("strength {} is not within 0..=4", self.strength)));
+        }
+        if !(self.bias.is_finite() && (0.0..1.0).contains(&self.bias)) {
+            return Err(Error::input(format!("bias {} is not within 0..1 (a fraction of the radius)", self.bias)));
+        }
+        if !(self.bounce.is_finite() && (0.0..=100.0).contains(&self.bounce)) {
+            return Err(Error::input(format!("bounce {} is not within 0..=100", self.bounce)));
+        }
+        if self.blur_radius > 16 {
+            return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));
+        }
+        Ok(())
+    }
+
+    /// True when the SSDO pass also gathers the bounce.
+    pub fn bounce_active(&self) -> bool {
+        self.technique == Technique::SsdoBounce && self.bounce > 0.0
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// The headset's per-eye size, refresh rate, IPD and fields of view.
@@ -38,6 +210,7 @@ pub struct Settings {
     pub exposure: f32,
     /// Reinhard's L_white: the smallest (exposed) luminance mapped to white.
     pub white_point: f32,
+    pub ao: AoSettings,
 }
 
 impl Default for Settings {
@@ -48,6 +221,7 @@ impl Default for Settings {
             near: DEFAULT_NEAR,
             exposure: 1.0,
             white_point: 4.0,
+            ao: AoSettings::default(),
         }
     }
 }
@@ -74,6 +248,6 @@ impl Settings {
         if !(self.white_point.is_finite() && self.white_point > 0.0) {
             return Err(Error::input(format!("white point {} must be a positive finite number", self.white_point)));
         }
-        Ok(())
+        self.ao.validate()
     }
 }

@@ -2,8 +2,9 @@
 //! shaders/common.wgsl), built in f64 and rounded once.
 
 use super::scene::GpuScene;
+use crate::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
 use crate::scene::{Light, Scene};
-use crate::settings::Settings;
+use crate::settings::{Noise, Settings, Technique};
 use crate::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, Mat4};
@@ -39,11 +40,48 @@ pub struct LightUniform {
     pub kind: [u32; 4],
 }
 
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct AoParamsUniform {
+    pub ao_size: [u32; 2],
+    pub scale: u32,
+    pub samples: u32,
+    pub directions: u32,
+    pub steps: u32,
+    pub technique: u32,
+    pub noise: u32,
+    pub radius: f32,
+    pub strength: f32,
+    pub bias: f32,
+    pub range_check: u32,
+    pub bounce: f32,
+    pub environment_lod: f32,
+    pub blur_radius: u32,
+    pub frame_index: u32,
+}
+
+/// Most samples a kernel may hold (the settings' limit on N).
+pub const MAX_KERNEL_SAMPLES: usize = 256;
+
 /// The uniform and light buffers of one frame.
 pub struct FrameBuffers {
     pub frame: wgpu::Buffer,
     pub lights: wgpu::Buffer,
+    /// `AoParams` of common.wgsl.
+    pub ao: wgpu::Buffer,
+    /// The hemisphere kernel: one [x, y, z, length] per sample.
+    pub kernel: wgpu::Buffer,
     light_capacity: usize,
+}
+
+/// Occlusion targets' size: half per axis (rounded up, so odd sizes keep their last
+/// row and column) with half resolution.
+pub fn ao_extent(width: u32, height: u32, half_res: bool) -> (u32, u32) {
+    if half_res {
+        (width.div_ceil(2), height.div_ceil(2))
+    } else {
+        (width, height)
+    }
 }
 
 impl FrameBuffers {
@@ -63,8 +101,54 @@ impl FrameBuffers {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
+            ao: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ao params"),
+                size: std::mem::size_of::<AoParamsUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            kernel: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ao kernel"),
+                size: (MAX_KERNEL_SAMPLES * 16) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
             light_capacity,
         }
+    }
+
+    /// Writes the occlusion parameters and the kernel that suits the technique.
+    pub fn update_ao(&self, queue: &wgpu::Queue, scene: &Scene, settings: &Settings, frame_index: u32) {
+        let ao = &settings.ao;
+        let (width, height) = ao_extent(settings.profile.width, settings.profile.height, ao.half_res);
+        let (directions, steps) = hbao_directions_steps(ao.samples);
+        let density = match ao.technique {
+            Technique::Ssdo | Technique::SsdoBounce => HemisphereDensity::Uniform,
+            _ => HemisphereDensity::Cosine,
+        };
+        let kernel = hemisphere_kernel(ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
+        let params = AoParamsUniform {
+            ao_size: [width, height],
+            scale: if ao.half_res { 2 } else { 1 },
+            samples: ao.samples,
+            directions,
+            steps,
+            technique: (ao.technique != Technique::None) as u32,
+            noise: match ao.noise {
+                Noise::Tiled5x5 => 0,
+                Noise::Halton => 1,
+            },
+            radius: ao.radius,
+            strength: ao.strength,
+            bias: ao.bias,
+            range_check: ao.range_check as u32,
+            bounce: if ao.bounce_active() { ao.bounce } else { 0.0 },
+            environment_lod: scene.environment.as_ref().map_or(0.0, |e| environment_lod(e.width, e.height, ao.samples)),
+            blur_radius: ao.blur_radius,
+            frame_index,
+        };
+        queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
+        queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
     }
 
     /// Writes this frame's views (1 or 2), lights in each view's space, and settings.
@@ -124,4 +208,12 @@ impl FrameBuffers {
             queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(&lights));
         }
     }
+}
+
+/// The environment mip level whose texels cover one SSDO sample's solid angle 2π/N
+/// (seed 002 pre-filters the map so N lookups do not alias).
+pub fn environment_lod(width: u32, height: u32, samples: u32) -> f32 {
+    let texel_solid_angle = 4.0 * std::f64::consts::PI / (width as f64 * height as f64);
+    let sample_solid_angle = 2.0 * std::f64::consts::PI / samples.max(1) as f64;
+    (0.5 * (sample_solid_angle / texel_solid_angle).log2()).max(0.0) as f32
 }

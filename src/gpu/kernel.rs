@@ -10,11 +10,17 @@ pub const TILE: u32 = 8;
 /// WGSL sources, compiled into the binary so it runs from any directory.
 const SHADERS: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("ssao.wgsl", include_str!("../../shaders/ssao.wgsl")),
+    ("hbao.wgsl", include_str!("../../shaders/hbao.wgsl")),
+    ("ssdo.wgsl", include_str!("../../shaders/ssdo.wgsl")),
+    ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),
+    ("upsample.wgsl", include_str!("../../shaders/upsample.wgsl")),
+    ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("gbuffer_multiview.wgsl", include_str!("../../shaders/gbuffer_multiview.wgsl")),
     ("gbuffer_multipass.wgsl", include_str!("../../shaders/gbuffer_multipass.wgsl")),
     ("multiview_probe.wgsl", include_str!("../../shaders/multiview_probe.wgsl")),
-    ("lighting.wgsl", include_str!("../../shaders/lighting.wgsl")),
+    ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
 ];
 
@@ -106,6 +112,18 @@ pub struct Kernel {
 
 impl Kernel {
     pub fn new(gpu: &Gpu, label: &str, files: &[&str], entry: &str, slots: &[Slot]) -> Kernel {
+        Self::with_constants(gpu, label, files, entry, slots, &[])
+    }
+
+    /// A kernel whose WGSL `override` constants take the given values.
+    pub fn with_constants(
+        gpu: &Gpu,
+        label: &str,
+        files: &[&str],
+        entry: &str,
+        slots: &[Slot],
+        constants: &[(&str, f64)],
+    ) -> Kernel {
         let device = &gpu.device;
         let entries: Vec<_> = slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32)).collect();
         let layout =
@@ -121,7 +139,7 @@ impl Kernel {
             layout: Some(&pipeline_layout),
             module: &module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,
         });
         Kernel { label: label.to_string(), pipeline, layout, slots: slots.to_vec() }

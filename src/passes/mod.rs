@@ -1,10 +1,17 @@
 //! One file per pass. A pass declares what it reads and writes for this frame (the
 //! graph decides whether it runs) and records its GPU work when it does.
 
+pub mod blur;
+pub mod composite;
+pub mod direct;
 pub mod gbuffer;
-pub mod lighting;
+pub mod hbao;
+pub mod ssao;
+pub mod ssdo;
 pub mod tonemap;
+pub mod upsample;
 
+use crate::gpu::frame::ao_extent;
 use crate::gpu::frame::FrameBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::LayeredTarget;
@@ -12,7 +19,7 @@ use crate::gpu::timing::GpuTimer;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::scene::Scene;
-use crate::settings::Settings;
+use crate::settings::{Settings, Technique};
 use std::collections::BTreeMap;
 
 /// What passes may consult when declaring themselves for a frame.
@@ -46,11 +53,48 @@ impl<'a> FrameContext<'a> {
         wgpu::BindingResource::TextureView(&self.target(r).array_view)
     }
 
-    /// Width × height × layers of this frame's targets.
+    /// Width × height × layers of this frame's full-resolution targets.
     pub fn extent(&self) -> (u32, u32, u32) {
         let p = &self.setup.settings.profile;
         (p.width, p.height, self.setup.views)
     }
+
+    /// Width × height × layers of the occlusion targets (half size with half-res).
+    pub fn ao_extent(&self) -> (u32, u32, u32) {
+        let p = &self.setup.settings.profile;
+        let (w, h) = ao_extent(p.width, p.height, self.setup.settings.ao.half_res);
+        (w, h, self.setup.views)
+    }
+}
+
+/// The occlusion the blur-and-upsample chain starts from, if any technique runs.
+pub fn occlusion_before_upsample(settings: &Settings) -> Option<Resource> {
+    match (settings.ao.technique, settings.ao.blur_radius) {
+        (Technique::None, _) => None,
+        (_, 0) => Some(Resource::AoRaw),
+        _ => Some(Resource::AoBlurred),
+    }
+}
+
+/// The full-resolution occlusion the composite reads, if any technique runs.
+pub fn final_occlusion(settings: &Settings) -> Option<Resource> {
+    let ao = occlusion_before_upsample(settings)?;
+    Some(if settings.ao.half_res { Resource::AoFull } else { ao })
+}
+
+/// Completes a technique pass's declaration: it reads the G-buffer, writes raw
+/// occlusion, and is left out unless the chosen technique is one of `runs_for`.
+pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup) -> PassDecl {
+    let chosen = setup.settings.ao.technique;
+    let reason = if chosen == Technique::None {
+        "technique is none: no occlusion pass".to_string()
+    } else {
+        format!("technique is {}", chosen.name())
+    };
+    decl.read(Resource::Depth)
+        .read(Resource::Normals)
+        .write(Resource::AoRaw)
+        .disabled_if(!runs_for.contains(&chosen), reason)
 }
 
 pub trait Pass {

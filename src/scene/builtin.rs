@@ -30,7 +30,10 @@ pub const SPHERE_CENTER: DVec3 = DVec3::new(0.0, 1.0, 0.0);
 pub const SPHERE_RADIUS: f64 = 1.0;
 /// "room": the inside of a closed box, normals facing in. The −X wall is red, the +X wall
 /// green, the rest white; a 0.8 m cube stands on the floor; a point light hangs below the
-/// ceiling. The room has no environment: nothing outside can be seen or light it.
+/// ceiling. Being closed, nothing outside can be seen; the default sky at
+/// `ROOM_AMBIENT` intensity stands in for the light bounced around the room, so the
+/// ambient term (what occlusion attenuates) is not zero.
+pub const ROOM_AMBIENT: f32 = 0.5;
 pub const ROOM_MIN: DVec3 = DVec3::new(-2.0, 0.0, -4.0);
 pub const ROOM_MAX: DVec3 = DVec3::new(2.0, 3.0, 0.0);
 pub const ROOM_BOX_MIN: DVec3 = DVec3::new(0.0, 0.0, -3.0);
@@ -130,7 +133,7 @@ fn room() -> Scene {
             Material::plain("green", Vec3::new(0.1, 0.75, 0.1)),
         ],
         lights: vec![Light::Point { position: ROOM_LIGHT, color: Vec3::ONE, intensity: 6.0 }],
-        environment: None,
+        environment: Some(Environment { intensity: ROOM_AMBIENT, ..Environment::default_sky() }),
         // Standing with the front wall (z = 0) at our back, looking at the box.
         head: HeadPath::fixed(eye_at(DVec3::new(0.0, 1.6, -0.4), box_centre)),
     }
@@ -282,7 +285,7 @@ mod tests {
     #[test]
     fn room_is_closed_and_faces_inward() {
         let scene = load("room").unwrap();
-        assert!(scene.environment.is_none());
+        assert_eq!(scene.environment.as_ref().map(|e| e.intensity), Some(ROOM_AMBIENT));
         let bounds = scene.bounds();
         assert!(bounds.min.abs_diff_eq(ROOM_MIN, 1e-6) && bounds.max.abs_diff_eq(ROOM_MAX, 1e-6), "{bounds:?}");
         let centre = (ROOM_MIN + ROOM_MAX) * 0.5;

@@ -187,6 +187,14 @@ impl Scene {
         b
     }
 
+    /// A default occlusion radius for this scene: 8 % of its bounding-box diagonal,
+    /// kept within 1 cm and 1 m (room-scale detail; a cathedral still gets 1 m).
+    pub fn suggested_ao_radius(&self) -> f32 {
+        let b = self.bounds();
+        let diagonal = if b.is_empty() { 0.0 } else { b.size().length() };
+        ((0.08 * diagonal) as f32).clamp(0.01, 1.0)
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.indices.len() / 3).sum()
     }

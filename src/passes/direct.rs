@@ -1,16 +1,16 @@
-//! Direct diffuse light plus environment irradiance, in HDR. Occlusion will attenuate
-//! the ambient term here.
+//! Direct light from the scene's point and directional lights, plus emission, as
+//! outgoing radiance. The composite builds on it; SSDO's bounce reads it as L_pixel.
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 
-pub struct LightingPass {
+pub struct DirectLightPass {
     kernel: Kernel,
 }
 
-impl LightingPass {
+impl DirectLightPass {
     pub fn new(gpu: &Gpu) -> Self {
         let slots = [
             Slot::Uniform,
@@ -19,22 +19,20 @@ impl LightingPass {
             Slot::Layers,
             Slot::Layers,
             Slot::Layers,
-            Slot::Texture2d,
-            Slot::Sampler,
-            Slot::Output(Resource::Hdr.format()),
+            Slot::Output(Resource::Direct.format()),
         ];
-        LightingPass { kernel: Kernel::new(gpu, "lighting", &["common.wgsl", "lighting.wgsl"], "main", &slots) }
+        DirectLightPass { kernel: Kernel::new(gpu, "direct", &["common.wgsl", "direct.wgsl"], "main", &slots) }
     }
 }
 
-impl Pass for LightingPass {
+impl Pass for DirectLightPass {
     fn declare(&self, _: &FrameSetup) -> PassDecl {
-        PassDecl::new("lighting")
+        PassDecl::new("direct")
             .read(Resource::Depth)
             .read(Resource::Normals)
             .read(Resource::Albedo)
             .read(Resource::Emission)
-            .write(Resource::Hdr)
+            .write(Resource::Direct)
     }
 
     fn record(&self, ctx: &mut FrameContext) {
@@ -45,9 +43,7 @@ impl Pass for LightingPass {
             ctx.view(Resource::Normals),
             ctx.view(Resource::Albedo),
             ctx.view(Resource::Emission),
-            wgpu::BindingResource::TextureView(&ctx.scene.environment),
-            wgpu::BindingResource::Sampler(&ctx.scene.sampler),
-            ctx.view(Resource::Hdr),
+            ctx.view(Resource::Direct),
         ];
         let extent = ctx.extent();
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);

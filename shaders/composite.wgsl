@@ -1,0 +1,47 @@
+// Composite: direct light plus the ambient term attenuated by occlusion, in HDR.
+// technique 0: unoccluded ambient (SH irradiance of the environment);
+// 1: ambient × AO (SSAO, HBAO); 2: SSDO's gathered irradiance (rgb) replaces it.
+// Sky pixels show the environment.
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<uniform> ao: AoParams;
+@group(0) @binding(2) var depth_layers: texture_depth_2d_array;
+@group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
+@group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
+@group(0) @binding(5) var direct_layers: texture_2d_array<f32>;
+@group(0) @binding(6) var occlusion_layers: texture_2d_array<f32>;
+@group(0) @binding(7) var environment: texture_2d<f32>;
+@group(0) @binding(8) var environment_sampler: sampler;
+@group(0) @binding(9) var hdr_out: texture_storage_2d_array<rgba16float, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= frame.size.x || id.y >= frame.size.y || id.z >= frame.layers) {
+        return;
+    }
+    let layer = i32(id.z);
+    let eye = frame.eyes[id.z];
+    let p = vec2<i32>(id.xy);
+    let depth = textureLoad(depth_layers, p, layer, 0);
+    var radiance = vec3<f32>(0.0);
+    if (depth <= 0.0) {
+        if (frame.has_environment != 0u) {
+            let dir = (eye.world_from_view * vec4<f32>(view_ray(pixel_uv(id.xy, frame.size), eye.tangents), 0.0)).xyz;
+            radiance = environment_radiance(environment, environment_sampler, dir, 0.0);
+        }
+    } else {
+        let n = textureLoad(normal_layers, p, layer, 0).xyz;
+        let albedo = textureLoad(albedo_layers, p, layer, 0).rgb;
+        var ambient = vec3<f32>(0.0);
+        if (frame.has_environment != 0u) {
+            ambient = sh_irradiance(frame.irradiance_sh, (eye.world_from_view * vec4<f32>(n, 0.0)).xyz);
+        }
+        if (ao.technique == 1u) {
+            ambient *= saturate_ao(textureLoad(occlusion_layers, p, layer, 0).a);
+        } else if (ao.technique == 2u) {
+            ambient = max(textureLoad(occlusion_layers, p, layer, 0).rgb, vec3<f32>(0.0));
+        }
+        radiance = textureLoad(direct_layers, p, layer, 0).rgb + albedo / PI * ambient;
+    }
+    textureStore(hdr_out, p, layer, vec4<f32>(finite_or_zero3(radiance), 1.0));
+}

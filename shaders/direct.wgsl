@@ -1,0 +1,43 @@
+// Direct light: the scene's point and directional lights on diffuse surfaces, plus
+// emission, as outgoing radiance. The composite adds the ambient term on top, and
+// SSDO's bounce uses this as the sender radiance L_pixel (seed 002 eq. 2).
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(2) var depth_layers: texture_depth_2d_array;
+@group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
+@group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
+@group(0) @binding(5) var emission_layers: texture_2d_array<f32>;
+@group(0) @binding(6) var direct_out: texture_storage_2d_array<rgba16float, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= frame.size.x || id.y >= frame.size.y || id.z >= frame.layers) {
+        return;
+    }
+    let layer = id.z;
+    let eye = frame.eyes[layer];
+    let p = vec2<i32>(id.xy);
+    let depth = textureLoad(depth_layers, p, i32(layer), 0);
+    var radiance = vec3<f32>(0.0);
+    if (depth > 0.0) {
+        let position = view_position_from_depth(pixel_uv(id.xy, frame.size), depth, eye.tangents, frame.near);
+        let n = textureLoad(normal_layers, p, i32(layer), 0).xyz;
+        let albedo = textureLoad(albedo_layers, p, i32(layer), 0).rgb;
+        var irradiance = vec3<f32>(0.0);
+        for (var i = 0u; i < frame.light_count; i++) {
+            let light = lights[layer * frame.light_count + i];
+            if (light.kind.x == 0u) {
+                irradiance += light.radiance.rgb * max(dot(n, -light.pos_or_dir.xyz), 0.0);
+            } else {
+                let to_light = light.pos_or_dir.xyz - position;
+                // Clamp the distance so a light on a surface does not blow up to Inf.
+                let d2 = max(dot(to_light, to_light), 1e-4);
+                irradiance += light.radiance.rgb * max(dot(n, to_light * inverseSqrt(d2)), 0.0) / d2;
+            }
+        }
+        let emission = textureLoad(emission_layers, p, i32(layer), 0).rgb;
+        radiance = albedo / PI * irradiance + emission;
+    }
+    textureStore(direct_out, p, i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
+}

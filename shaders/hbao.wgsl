@@ -1,0 +1,72 @@
+// HBAO (seed 003 §3.3, after Bavoil, Sainz and Dimitrov 2008): D screen directions,
+// rotated per pixel, each ray-marched S steps through the depth buffer. A sample above
+// the current horizon raises it and adds its occlusion, attenuated by
+// W = max(0, 1 − r/R). Horizon angles are measured from the tangent plane (the normal
+// is known), and increments use sin²h instead of sin h: the cosine-weighted form of
+// eq. 3.2, so HBAO estimates the same cosine-weighted visibility as the reference.
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<uniform> ao: AoParams;
+@group(0) @binding(2) var depth_layers: texture_depth_2d_array;
+@group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
+@group(0) @binding(4) var ao_out: texture_storage_2d_array<rgba16float, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
+        return;
+    }
+    let layer = id.z;
+    let eye = frame.eyes[layer];
+    let fp = full_res_pixel(id.xy, ao.scale, frame.size);
+    let depth = textureLoad(depth_layers, vec2<i32>(fp), i32(layer), 0);
+    if (depth <= 0.0) {
+        textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    let position = load_view_position(depth, fp, eye, frame.size, frame.near);
+    let n = safe_normal(textureLoad(normal_layers, vec2<i32>(fp), i32(layer), 0).xyz, position);
+    // The radius R in pixels at this depth (tangent span per pixel × distance).
+    let metres_per_pixel = (eye.tangents.y - eye.tangents.x) / f32(frame.size.x) * -position.z;
+    let radius_px = ao.radius / max(metres_per_pixel, 1e-30);
+    let steps = max(ao.steps, 1u);
+    let directions = max(ao.directions, 1u);
+    // Never step less than a pixel; never further than the screen.
+    let step_px = clamp(radius_px / f32(steps + 1u), 1.0, f32(max(frame.size.x, frame.size.y)));
+    let rotation = kernel_rotation(fp, ao.noise);
+    let jitter = fract(rotation * 0.1591549 * 7.0);
+    // Angle bias: horizons below this elevation do not count (tessellation, noise).
+    let sin_bias = min(5.0 * ao.bias, 0.9);
+    var occlusion = 0.0;
+    for (var d = 0u; d < directions; d++) {
+        let angle = rotation + 2.0 * PI * f32(d) / f32(directions);
+        let dir = vec2<f32>(cos(angle), sin(angle));
+        var max_sin = sin_bias;
+        for (var s = 0u; s < steps; s++) {
+            let offset = dir * (f32(s) + jitter + 1.0) * step_px;
+            let q = vec2<f32>(fp) + vec2<f32>(0.5) + offset;
+            if (any(q < vec2<f32>(0.0)) || any(q >= vec2<f32>(frame.size))) {
+                break;
+            }
+            let qp = vec2<u32>(q);
+            let qd = textureLoad(depth_layers, vec2<i32>(qp), i32(layer), 0);
+            if (qd <= 0.0) {
+                continue;
+            }
+            let h = load_view_position(qd, qp, eye, frame.size, frame.near) - position;
+            let dist = length(h);
+            if (dist < 1e-20 || dist > ao.radius) {
+                continue;
+            }
+            let sin_h = dot(h, n) / dist;
+            if (sin_h > max_sin) {
+                let attenuation = max(0.0, 1.0 - dist / ao.radius);
+                occlusion += (sin_h * sin_h - max_sin * max_sin) * attenuation;
+                max_sin = sin_h;
+            }
+        }
+    }
+    let visibility = 1.0 - occlusion / f32(directions);
+    let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
+    textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, result));
+}

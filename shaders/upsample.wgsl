@@ -1,0 +1,67 @@
+// Joint bilateral upsampling (Kopf et al. 2007; seed 000: 3×3, not separated) of
+// half-resolution occlusion to full resolution. Each of the 3×3 low-res neighbours is
+// weighted by its distance to the full-res pixel and by how well its geometry (the
+// full-res pixel it was computed at) matches: tangent-plane distance and normal.
+// Odd sizes work because low-res pixel q stands for full-res pixel min(2q, size − 1).
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<uniform> ao: AoParams;
+@group(0) @binding(2) var depth_layers: texture_depth_2d_array;
+@group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
+@group(0) @binding(4) var occlusion_low: texture_2d_array<f32>;
+@group(0) @binding(5) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
+
+const PLANE_SIGMA: f32 = 0.02;
+const NORMAL_POWER: f32 = 16.0;
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= frame.size.x || id.y >= frame.size.y || id.z >= frame.layers) {
+        return;
+    }
+    let layer = id.z;
+    let eye = frame.eyes[layer];
+    let p = vec2<i32>(id.xy);
+    let base = vec2<i32>(id.xy / 2u);
+    let nearest = textureLoad(occlusion_low, min(base, vec2<i32>(ao.ao_size) - 1), i32(layer), 0);
+    let depth = textureLoad(depth_layers, p, i32(layer), 0);
+    if (depth <= 0.0) {
+        textureStore(occlusion_out, p, i32(layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    let position = load_view_position(depth, id.xy, eye, frame.size, frame.near);
+    let n = safe_normal(textureLoad(normal_layers, p, i32(layer), 0).xyz, position);
+    let plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
+    var sum = vec4<f32>(0.0);
+    var total = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = base + vec2<i32>(dx, dy);
+            if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(ao.ao_size))) {
+                continue;
+            }
+            let fq = full_res_pixel(vec2<u32>(q), 2u, frame.size);
+            let qd = textureLoad(depth_layers, vec2<i32>(fq), i32(layer), 0);
+            if (qd <= 0.0) {
+                continue;
+            }
+            let qpos = load_view_position(qd, fq, eye, frame.size, frame.near);
+            let qn = safe_normal(textureLoad(normal_layers, vec2<i32>(fq), i32(layer), 0).xyz, qpos);
+            // Full-res distance between this pixel's centre and the neighbour's sample.
+            let offset = vec2<f32>(fq) - vec2<f32>(id.xy);
+            let spatial = 1.0 / (1.0 + dot(offset, offset));
+            let plane = dot(qpos - position, n) * plane_scale;
+            let w = spatial * exp(-plane * plane) * pow(max(dot(n, qn), 0.0), NORMAL_POWER);
+            if (w == w) {
+                sum += textureLoad(occlusion_low, q, i32(layer), 0) * w;
+                total += w;
+            }
+        }
+    }
+    var result = nearest;
+    if (total > 1e-20) {
+        result = sum / total;
+    }
+    result = vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
+    textureStore(occlusion_out, p, i32(layer), result);
+}

@@ -1,0 +1,89 @@
+//! SSDO, with the optional bounce gathered in the same loop (seed 002 eqs. 1–2,
+//! seed 003 §4.1–4.2). The technique itself is shaders/ssdo.wgsl; a bounce strength of
+//! 0 selects the pipeline compiled without bounce work, which also does not read the
+//! direct light, so the graph need not produce it for an occlusion-only frame.
+
+use super::{technique_decl, FrameContext, FrameSetup, Pass};
+use crate::gpu::kernel::{Kernel, Slot};
+use crate::gpu::targets::LayeredTarget;
+use crate::gpu::Gpu;
+use crate::graph::{PassDecl, Resource};
+use crate::settings::Technique;
+
+pub struct SsdoPass {
+    without_bounce: Kernel,
+    with_bounce: Kernel,
+    /// Bound in place of the direct light when the bounce is off (never read then).
+    no_direct: LayeredTarget,
+}
+
+const SLOTS: [Slot; 9] = [
+    Slot::Uniform,
+    Slot::Uniform,
+    Slot::ReadBuffer,
+    Slot::Depth,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::Texture2d,
+    Slot::Sampler,
+    Slot::Output(wgpu::TextureFormat::Rgba16Float),
+];
+
+impl SsdoPass {
+    pub fn new(gpu: &Gpu) -> Self {
+        let files = ["common.wgsl", "ssdo.wgsl"];
+        let no_direct = LayeredTarget::new(
+            &gpu.device,
+            "no direct light",
+            Resource::Direct.format(),
+            (1, 1, 2),
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        SsdoPass {
+            without_bounce: Kernel::with_constants(gpu, "ssdo", &files, "main", &SLOTS, &[("BOUNCE", 0.0)]),
+            with_bounce: Kernel::with_constants(gpu, "ssdo-bounce", &files, "main", &SLOTS, &[("BOUNCE", 1.0)]),
+            no_direct,
+        }
+    }
+}
+
+impl Pass for SsdoPass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let ao = &setup.settings.ao;
+        let chosen = ao.technique;
+        let decl = if ao.bounce_active() {
+            PassDecl::new("ssdo-bounce").read(Resource::Direct)
+        } else {
+            let decl = PassDecl::new("ssdo");
+            if chosen == Technique::SsdoBounce {
+                decl.note("bounce left out: bounce strength is 0")
+            } else {
+                decl
+            }
+        };
+        technique_decl(decl, &[Technique::Ssdo, Technique::SsdoBounce], setup)
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let bounce = ctx.setup.settings.ao.bounce_active();
+        let direct = if bounce {
+            ctx.view(Resource::Direct)
+        } else {
+            wgpu::BindingResource::TextureView(&self.no_direct.array_view)
+        };
+        let resources = [
+            ctx.frame.frame.as_entire_binding(),
+            ctx.frame.ao.as_entire_binding(),
+            ctx.frame.kernel.as_entire_binding(),
+            ctx.view(Resource::Depth),
+            ctx.view(Resource::Normals),
+            direct,
+            wgpu::BindingResource::TextureView(&ctx.scene.environment),
+            wgpu::BindingResource::Sampler(&ctx.scene.sampler),
+            ctx.view(Resource::AoRaw),
+        ];
+        let extent = ctx.ao_extent();
+        let kernel = if bounce { &self.with_bounce } else { &self.without_bounce };
+        kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+    }
+}
