@@ -13,8 +13,6 @@
 
 // Tangent-plane distance, as a fraction of the centre's distance, that halves a weight.
 const PLANE_SIGMA: f32 = 0.02;
-// Exponent of the normal agreement weight.
-const NORMAL_POWER: f32 = 16.0;
 
 fn blur(id: vec3<u32>, axis: vec2<i32>) {
     if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
@@ -35,6 +33,7 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
     let radius = i32(ao.blur_radius);
     let sigma = max(f32(radius) * 0.5, 0.5);
     let plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
+    let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
     var sum = vec4<f32>(0.0);
     var total = 0.0;
     for (var k = -radius; k <= radius; k++) {
@@ -50,7 +49,8 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         let qpos = load_view_position(qd, fq, eye, frame.size, frame.near);
         let qn = safe_normal(textureLoad(normal_layers, vec2<i32>(fq), i32(layer), 0).xyz, qpos);
         let plane = dot(qpos - position, n) * plane_scale;
-        let w = exp(-f32(k * k) / (2.0 * sigma * sigma)) * exp(-plane * plane) * pow(max(dot(n, qn), 0.0), NORMAL_POWER);
+        // One exp for the spatial and depth terms; the normal term is (n·q)^16.
+        let w = exp(-f32(k * k) * inv_two_sigma2 - plane * plane) * normal_agreement(n, qn);
         if (w == w) {
             sum += textureLoad(occlusion_in, q, i32(layer), 0) * w;
             total += w;

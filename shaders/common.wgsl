@@ -23,6 +23,8 @@ struct Frame {
     has_environment: u32,
     // Irradiance SH9 (already scaled by the environment intensity), rgb in xyz.
     irradiance_sh: array<vec4<f32>, 9>,
+    // Pre-filtered (Hann-windowed) radiance SH9 for per-direction lookups (SSDO).
+    radiance_sh: array<vec4<f32>, 9>,
 };
 
 // A light in one eye's view space. kind: 0 directional (dir = direction light travels),
@@ -73,7 +75,8 @@ struct AoParams {
     // HBAO directions and steps per direction (directions × steps ≈ samples).
     directions: u32,
     steps: u32,
-    // 1 when the pass runs (technique not none).
+    // How the composite applies occlusion: 0 none, 1 scalar AO (SSAO, HBAO),
+    // 2 directional (SSDO's gathered irradiance replaces the ambient term).
     technique: u32,
     // 0 tiled 5×5 rotations, 1 Halton/R2 per-pixel rotation.
     noise: u32,
@@ -87,8 +90,7 @@ struct AoParams {
     range_check: u32,
     // SSDO bounce strength (0: no bounce work).
     bounce: f32,
-    // Mip level of the environment for one SSDO sample's solid angle 2π/N.
-    environment_lod: f32,
+    _pad: u32,
     // Bilateral blur radius in pixels (5 → 11×11).
     blur_radius: u32,
     // Frame counter, for patterns that rotate over time.
@@ -125,8 +127,10 @@ fn saturate_ao(a: f32) -> f32 {
     return select(1.0, clamp(a, 0.0, 1.0), a == a);
 }
 
-// Irradiance from the order-2 SH projection (Ramamoorthi & Hanrahan 2001), world normal.
-fn sh_irradiance(c: array<vec4<f32>, 9>, n: vec3<f32>) -> vec3<f32> {
+// Evaluates nine SH coefficients (Ramamoorthi & Hanrahan 2001) in world direction `n`:
+// irradiance from `irradiance_sh`, pre-filtered radiance from `radiance_sh`. Clamped at 0
+// because nine coefficients can ring negative opposite a bright sun.
+fn sh_eval(c: array<vec4<f32>, 9>, n: vec3<f32>) -> vec3<f32> {
     var e = c[0].xyz * 0.282095;
     e += c[1].xyz * (0.488603 * n.y) + c[2].xyz * (0.488603 * n.z) + c[3].xyz * (0.488603 * n.x);
     e += c[4].xyz * (1.092548 * n.x * n.y) + c[5].xyz * (1.092548 * n.y * n.z);
@@ -135,13 +139,13 @@ fn sh_irradiance(c: array<vec4<f32>, 9>, n: vec3<f32>) -> vec3<f32> {
     return max(e, vec3<f32>(0.0));
 }
 
-// Equirectangular lookup at mip `lod`; the layout matches `scene::Environment::direction`
+// Equirectangular lookup; the layout matches `scene::Environment::direction`
 // (row 0 = +Y, the image centre = −Z, u = 0.75 = +X).
-fn environment_radiance(env: texture_2d<f32>, env_sampler: sampler, dir: vec3<f32>, lod: f32) -> vec3<f32> {
+fn environment_radiance(env: texture_2d<f32>, env_sampler: sampler, dir: vec3<f32>) -> vec3<f32> {
     let d = normalize(dir);
     let u = fract(atan2(d.x, -d.z) / (2.0 * PI) + 0.5);
     let v = acos(clamp(d.y, -1.0, 1.0)) / PI;
-    return textureSampleLevel(env, env_sampler, vec2<f32>(u, v), lod).rgb;
+    return textureSampleLevel(env, env_sampler, vec2<f32>(u, v), 0.0).rgb;
 }
 
 // ---- Occlusion helpers shared by SSAO, HBAO and SSDO ----
@@ -201,4 +205,14 @@ fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, e
     probe.valid = d > 0.0;
     probe.distance = frame.near / max(d, 1e-30);
     return probe;
+}
+
+// Edge-stopping weight for normals, (n·q)^16 by repeated squaring (no pow): 1 for equal
+// normals, 0.5 at about 17°, 0 for perpendicular or opposite ones.
+fn normal_agreement(n: vec3<f32>, q: vec3<f32>) -> f32 {
+    let c = max(dot(n, q), 0.0);
+    let c2 = c * c;
+    let c4 = c2 * c2;
+    let c8 = c4 * c4;
+    return c8 * c8;
 }

@@ -27,14 +27,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (depth <= 0.0) {
         if (frame.has_environment != 0u) {
             let dir = (eye.world_from_view * vec4<f32>(view_ray(pixel_uv(id.xy, frame.size), eye.tangents), 0.0)).xyz;
-            radiance = environment_radiance(environment, environment_sampler, dir, 0.0);
+            radiance = environment_radiance(environment, environment_sampler, dir);
         }
     } else {
         let n = textureLoad(normal_layers, p, layer, 0).xyz;
         let albedo = textureLoad(albedo_layers, p, layer, 0).rgb;
         var ambient = vec3<f32>(0.0);
         if (frame.has_environment != 0u) {
-            ambient = sh_irradiance(frame.irradiance_sh, (eye.world_from_view * vec4<f32>(n, 0.0)).xyz);
+            ambient = sh_eval(frame.irradiance_sh, (eye.world_from_view * vec4<f32>(n, 0.0)).xyz);
         }
         if (ao.technique == 1u) {
             ambient *= saturate_ao(textureLoad(occlusion_layers, p, layer, 0).a);

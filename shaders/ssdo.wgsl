@@ -1,7 +1,8 @@
 // SSDO (seed 002 eq. 1; seed 003 §4.1): N directions uniform over the normal's
 // hemisphere, each covering Δω = 2π/N, with sample points P + λ_i ω_i, λ_i ∈ [0, r_max].
 // A point below the visible surface (its projection moves towards the eye) blocks its
-// direction; unblocked directions gather the pre-filtered environment radiance.
+// direction; unblocked directions gather the environment radiance, pre-filtered as a
+// Hann-windowed SH9 (a smooth map needs no per-sample texture fetch, seed 002 §7.2).
 // With the bounce (seed 002 eq. 2; seed 003 §4.2), in the same loop, each blocking
 // sample's surface becomes a sender patch of area π r_max²/N × bounce strength that
 // reflects the direct light stored at its pixel towards P.
@@ -13,9 +14,7 @@
 @group(0) @binding(3) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(4) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var direct_layers: texture_2d_array<f32>;
-@group(0) @binding(6) var environment: texture_2d<f32>;
-@group(0) @binding(7) var environment_sampler: sampler;
-@group(0) @binding(8) var ao_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(6) var ao_out: texture_storage_2d_array<rgba16float, write>;
 
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the variant without).
 override BOUNCE: bool = false;
@@ -55,7 +54,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let cos_theta = k.z;
         var incoming = vec3<f32>(0.0);
         if (frame.has_environment != 0u) {
-            incoming = environment_radiance(environment, environment_sampler, world_from_view * omega, ao.environment_lod);
+            incoming = sh_eval(frame.radiance_sh, world_from_view * omega);
         }
         gathered_all += incoming * cos_theta;
         weight_all += cos_theta;

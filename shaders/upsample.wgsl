@@ -12,7 +12,6 @@
 @group(0) @binding(5) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
 
 const PLANE_SIGMA: f32 = 0.02;
-const NORMAL_POWER: f32 = 16.0;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -51,7 +50,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             let offset = vec2<f32>(fq) - vec2<f32>(id.xy);
             let spatial = 1.0 / (1.0 + dot(offset, offset));
             let plane = dot(qpos - position, n) * plane_scale;
-            let w = spatial * exp(-plane * plane) * pow(max(dot(n, qn), 0.0), NORMAL_POWER);
+            let w = spatial * exp(-plane * plane) * normal_agreement(n, qn);
             if (w == w) {
                 sum += textureLoad(occlusion_low, q, i32(layer), 0) * w;
                 total += w;

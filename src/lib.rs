@@ -3,6 +3,8 @@
 //! The library is usable without the CLI: load a [`Scene`], open a [`Gpu`], make a
 //! [`Renderer`] with [`Settings`], and render an [`EyePair`] into layered targets.
 
+pub mod analytic;
+pub mod bench;
 pub mod error;
 pub mod gpu;
 pub mod graph;

@@ -26,6 +26,46 @@ enum Command {
     Info,
     /// Render both eyes of a scene to left.png and right.png.
     Render(RenderArgs),
+    /// Sweep technique × samples × radius × resolution: median GPU ms per eye per pass.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// A scene file (.toml), a bare .obj, or builtin:NAME.
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// Techniques to sweep, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "ssao,hbao,ssdo,ssdo-bounce")]
+    techniques: Vec<Technique>,
+    /// Sample counts, comma-separated (seed 003's grid by default).
+    #[arg(long, value_delimiter = ',', default_value = "12,24,36,64")]
+    samples: Vec<u32>,
+    /// Radii in metres, comma-separated (default: the scene's radius × 0.5, 1, 2).
+    #[arg(long, value_delimiter = ',')]
+    radii: Vec<f32>,
+    /// Resolutions: full, half or both.
+    #[arg(long, default_value = "both")]
+    resolution: String,
+    /// Measured frames per case, after warm-up.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    frames: u32,
+    /// Warm-up frames per case (not measured).
+    #[arg(long, default_value_t = 3)]
+    warmup: u32,
+    /// Per-eye width in pixels.
+    #[arg(long, default_value_t = 1080)]
+    width: u32,
+    /// Per-eye height in pixels.
+    #[arg(long, default_value_t = 1200)]
+    height: u32,
+    /// Timing: pipelined (one submission per frame, GPU timestamps) or serial (one
+    /// submission per pass, wall clock; for drivers whose timestamps misattribute work).
+    #[arg(long, default_value = "pipelined")]
+    timing: TimingArg,
+    /// Output directory for bench.csv and bench.md.
+    #[arg(long, default_value = "bench")]
+    out: PathBuf,
 }
 
 #[derive(Args)]
@@ -63,6 +103,9 @@ struct RenderArgs {
     /// Linear exposure before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
+    /// Timing with --frames: pipelined (GPU timestamps) or serial (wall clock per pass).
+    #[arg(long, default_value = "pipelined")]
+    timing: TimingArg,
     /// Render this many frames and report per-pass GPU medians (with --explain); the
     /// first frames are warm-up and not counted.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
@@ -77,7 +120,8 @@ struct RenderArgs {
 /// Occlusion options (shared by every command that renders).
 #[derive(Args, Clone)]
 struct AoArgs {
-    /// Occlusion technique: none, ssao, hbao, ssdo or ssdo-bounce.
+    /// Occlusion technique: none, ssao, hbao, ssdo or ssdo-bounce (fetch-only: the
+    /// benchmark baseline with SSAO's depth taps and no occlusion arithmetic).
     #[arg(long, default_value = "ssao")]
     technique: Technique,
     /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
@@ -129,6 +173,20 @@ impl AoArgs {
     }
 }
 
+#[derive(Clone, Copy)]
+struct TimingArg(vrao::renderer::Timing);
+
+impl std::str::FromStr for TimingArg {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "pipelined" => Ok(TimingArg(vrao::renderer::Timing::Pipelined)),
+            "serial" => Ok(TimingArg(vrao::renderer::Timing::Serial)),
+            other => Err(format!("unknown timing '{other}' (expected pipelined or serial)")),
+        }
+    }
+}
+
 fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
@@ -170,6 +228,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     settings.validate()?;
     let gpu = Arc::new(Gpu::new(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;
+    renderer.set_timing(args.timing.0);
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let mut outputs = vec![Resource::Color];
     if args.debug {
@@ -183,8 +242,10 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     for frame in 0..warmup + args.frames {
         let r = renderer.render(&eyes.eyes, &outputs)?;
         if frame >= warmup {
-            timings.push(r.gpu_ms.clone());
-            timings.last_mut().unwrap().push(("cpu encode".into(), r.cpu_encode_ms));
+            let mut spans = r.gpu_ms.clone();
+            spans.extend(r.wall_ms.iter().map(|(pass, ms)| (format!("{pass} (wall)"), *ms)));
+            spans.push(("cpu encode".into(), r.cpu_encode_ms));
+            timings.push(spans);
         }
         report = Some(r);
     }
@@ -210,9 +271,9 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
             "timing over {} frame(s) after {warmup} warm-up, {} ({:?}):",
             args.frames, adapter.name, adapter.backend
         );
-        println!("  {:<18} {:>10} {:>10} {:>10}", "span", "median ms", "p25 ms", "p75 ms");
+        println!("  {:<22} {:>10} {:>10} {:>10}", "span", "median ms", "p25 ms", "p75 ms");
         for s in vrao::gpu::timing::summarize(&timings) {
-            println!("  {:<18} {:>10.3} {:>10.3} {:>10.3}", s.label, s.median_ms, s.p25_ms, s.p75_ms);
+            println!("  {:<22} {:>10.3} {:>10.3} {:>10.3}", s.label, s.median_ms, s.p25_ms, s.p75_ms);
         }
         if report.gpu_ms.is_empty() {
             println!("  (this adapter has no timestamp queries: GPU times are not available)");
@@ -224,12 +285,89 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
+    use vrao::bench::{sweep, to_csv, to_markdown, BenchCase};
+    let scene = Scene::load(&args.scene)?;
+    let resolutions: &[bool] = match args.resolution.as_str() {
+        "full" => &[false],
+        "half" => &[true],
+        "both" => &[false, true],
+        other => return Err(Error::input(format!("--resolution '{other}' is not full, half or both"))),
+    };
+    let base_radius = scene.suggested_ao_radius();
+    let radii = if args.radii.is_empty() {
+        vec![base_radius * 0.5, base_radius, base_radius * 2.0]
+    } else {
+        args.radii.clone()
+    };
+    let settings =
+        Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
+    let mut cases = Vec::new();
+    for &technique in &args.techniques {
+        for &samples in &args.samples {
+            for &radius in &radii {
+                for &half_res in resolutions {
+                    cases.push(BenchCase { technique, samples, radius, half_res });
+                }
+            }
+        }
+    }
+    for case in &cases {
+        let mut s = settings.clone();
+        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res) =
+            (case.technique, case.samples, case.radius, case.half_res);
+        s.validate()?;
+        if case.technique == Technique::None {
+            return Err(Error::input("--techniques: none has no occlusion to measure"));
+        }
+    }
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let info = gpu.adapter.get_info();
+    eprintln!(
+        "bench: {} cases on '{}' ({:?}), {}x{} per eye, {} frames each",
+        cases.len(),
+        scene.name,
+        info.name,
+        args.width,
+        args.height,
+        args.frames
+    );
+    let started = std::time::Instant::now();
+    let rows = sweep(&gpu, &scene, &settings, &cases, args.timing.0, args.warmup, args.frames, |done, total, row| {
+        let elapsed = started.elapsed().as_secs_f64();
+        let eta = elapsed / done as f64 * (total - done) as f64;
+        eprintln!(
+            "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
+            row.case.technique.name(),
+            row.case.samples,
+            row.case.radius,
+            if row.case.half_res { "half" } else { "full" },
+            row.occlusion_ms_per_eye()
+        );
+    })?;
+    std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
+    for (name, text) in [("bench.csv", to_csv(&rows)), ("bench.md", to_markdown(&rows))] {
+        let path = args.out.join(name);
+        std::fs::write(&path, text).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
+    }
+    println!("{}", to_markdown(&rows));
+    println!(
+        "adapter: {} ({:?}, {}); wrote {}/bench.csv and bench.md",
+        info.name,
+        info.backend,
+        info.driver_info,
+        args.out.display()
+    );
+    Ok(())
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Info) => info(cli.backend),
         Some(Command::Render(args)) => render(cli.backend, args),
+        Some(Command::Bench(args)) => bench(cli.backend, args),
         None => {
             use clap::CommandFactory;
             let _ = Cli::command().print_help();

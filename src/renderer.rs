@@ -14,6 +14,7 @@ use crate::graph::{self, Plan, Resource};
 use crate::passes::blur::BlurPass;
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectLightPass;
+use crate::passes::fetch::FetchOnlyPass;
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::hbao::HbaoPass;
 use crate::passes::ssao::SsaoPass;
@@ -37,6 +38,20 @@ pub struct FrameReport {
     pub gpu_ms: Vec<(String, f64)>,
     /// CPU time spent encoding the frame's commands.
     pub cpu_encode_ms: f64,
+    /// With [`Timing::Serial`]: (pass, wall-clock ms from submit to completion) per pass.
+    pub wall_ms: Vec<(String, f64)>,
+}
+
+/// How a frame's passes are submitted and timed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Timing {
+    /// One submission per frame, a timestamp pair around every pass (how frames run).
+    #[default]
+    Pipelined,
+    /// One submission per pass, each waited for: timestamps plus the wall-clock time of
+    /// each pass. Slower, but immune to drivers that misplace timestamps between passes
+    /// (lavapipe 22.x credits one compute pass's work to its neighbour).
+    Serial,
 }
 
 impl FrameReport {
@@ -56,6 +71,7 @@ pub struct Renderer {
     targets: BTreeMap<Resource, LayeredTarget>,
     timer: GpuTimer,
     frame_index: u32,
+    timing: Timing,
 }
 
 impl Renderer {
@@ -88,6 +104,7 @@ impl Renderer {
             Box::new(SsaoPass::new(&gpu)),
             Box::new(HbaoPass::new(&gpu)),
             Box::new(SsdoPass::new(&gpu)),
+            Box::new(FetchOnlyPass::new(&gpu)),
             Box::new(BlurPass::new(&gpu)),
             Box::new(UpsamplePass::new(&gpu)),
             Box::new(CompositePass::new(&gpu)),
@@ -105,6 +122,7 @@ impl Renderer {
             targets: BTreeMap::new(),
             timer,
             frame_index: 0,
+            timing: Timing::Pipelined,
         })
     }
 
@@ -114,6 +132,10 @@ impl Renderer {
 
     pub fn settings(&self) -> &Settings {
         &self.settings
+    }
+
+    pub fn set_timing(&mut self, timing: Timing) {
+        self.timing = timing;
     }
 
     /// Whether the G-buffer draws both eyes in one multiview pass.
@@ -139,37 +161,49 @@ impl Renderer {
             return Err(Error::input(format!("a frame has 1 or 2 views, not {}", views.len())));
         }
         let layers = views.len() as u32;
-        let encode_start = Instant::now();
         let plan = self.plan(layers, outputs)?;
         self.allocate_targets(&plan, layers);
         self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
-        self.frame.update_ao(&self.gpu.queue, &self.scene, &self.settings, self.frame_index);
+        self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
         self.frame_index = self.frame_index.wrapping_add(1);
-        let mut encoder =
-            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.timer.reset();
         let setup =
             FrameSetup { scene: &self.scene, settings: &self.settings, views: layers, multiview: self.multiview };
-        let mut ctx = FrameContext {
-            gpu: &self.gpu,
-            encoder: &mut encoder,
-            targets: &self.targets,
-            frame: &self.frame,
-            scene: &self.gpu_scene,
-            timer: &mut self.timer,
-            setup: &setup,
-        };
-        for (&index, name) in plan.run.iter().zip(&plan.names) {
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut wall_ms = Vec::new();
+        let mut cpu_encode_ms = 0.0;
+        for (step, (&index, name)) in plan.run.iter().zip(&plan.names).enumerate() {
+            let encode_start = Instant::now();
+            let mut ctx = FrameContext {
+                gpu: &self.gpu,
+                encoder: &mut encoder,
+                targets: &self.targets,
+                frame: &self.frame,
+                scene: &self.gpu_scene,
+                timer: &mut self.timer,
+                setup: &setup,
+            };
             let span = ctx.timer.begin(ctx.encoder, name);
             self.passes[index].record(&mut ctx);
             ctx.timer.end(ctx.encoder, span);
+            if step + 1 == plan.run.len() {
+                self.timer.resolve(&mut encoder);
+            }
+            cpu_encode_ms += encode_start.elapsed().as_secs_f64() * 1e3;
+            if self.timing == Timing::Serial {
+                let finished =
+                    std::mem::replace(&mut encoder, self.gpu.device.create_command_encoder(&Default::default()));
+                let submitted = Instant::now();
+                self.gpu.queue.submit([finished.finish()]);
+                self.gpu.wait_idle()?;
+                wall_ms.push((name.to_string(), submitted.elapsed().as_secs_f64() * 1e3));
+            }
         }
-        self.timer.resolve(&mut encoder);
-        let cpu_encode_ms = encode_start.elapsed().as_secs_f64() * 1e3;
         self.gpu.queue.submit([encoder.finish()]);
         let gpu_ms = self.timer.read(&self.gpu)?;
         self.gpu.wait_idle()?;
-        Ok(FrameReport { plan, gpu_ms, cpu_encode_ms })
+        Ok(FrameReport { plan, gpu_ms, cpu_encode_ms, wall_ms })
     }
 
     /// (Re)creates the targets this plan touches at their size for this frame; targets

@@ -41,6 +41,8 @@ pub enum Technique {
     Ssdo,
     /// SSDO plus one indirect bounce in the same loop (seed 002 eq. 2).
     SsdoBounce,
+    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
+    FetchOnly,
 }
 
 impl Technique {
@@ -51,19 +53,25 @@ impl Technique {
             Technique::Hbao => "hbao",
             Technique::Ssdo => "ssdo",
             Technique::SsdoBounce => "ssdo-bounce",
+            Technique::FetchOnly => "fetch-only",
         }
     }
-    pub const ALL: [Technique; 5] =
-        [Technique::None, Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce];
+    pub const ALL: [Technique; 6] = [
+        Technique::None,
+        Technique::Ssao,
+        Technique::Hbao,
+        Technique::Ssdo,
+        Technique::SsdoBounce,
+        Technique::FetchOnly,
+    ];
 }
 
 impl std::str::FromStr for Technique {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Technique::ALL
-            .into_iter()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| format!("unknown technique '{s}' (expected none, ssao, hbao, ssdo or ssdo-bounce)"))
+        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
+            format!("unknown technique '{s}' (expected none, ssao, hbao, ssdo, ssdo-bounce or fetch-only)")
+        })
     }
 }
 
@@ -191,6 +199,15 @@ impl AoSettings {
             return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));
         }
         Ok(())
+    }
+
+    /// The graph pass that runs the technique: SSDO is `ssdo-bounce` only while the
+    /// bounce strength is above 0.
+    pub fn pass_name(&self) -> &'static str {
+        match self.technique {
+            Technique::SsdoBounce if !self.bounce_active() => Technique::Ssdo.name(),
+            technique => technique.name(),
+        }
     }
 
     /// True when the SSDO pass also gathers the bounce.

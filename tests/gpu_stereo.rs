@@ -198,7 +198,10 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
     let report = renderer.render(&eyes.eyes, &[Resource::Normals]).unwrap();
     assert_eq!(report.plan.names, vec!["gbuffer"]);
     let left_out: Vec<_> = report.plan.left_out.iter().map(|(n, _)| *n).collect();
-    assert_eq!(left_out, vec!["direct", "ssao", "hbao", "ssdo", "blur", "upsample", "composite", "tonemap"]);
+    assert_eq!(
+        left_out,
+        vec!["direct", "ssao", "hbao", "ssdo", "fetch-only", "blur", "upsample", "composite", "tonemap"]
+    );
     assert!(renderer.target(Resource::Hdr).is_none(), "no HDR target is allocated when nothing needs it");
     if gpu.caps.timestamps {
         assert!(report.gpu_ms_of("gbuffer").is_some() && report.gpu_ms_of("composite").is_none());

@@ -30,6 +30,7 @@ pub struct FrameUniform {
     pub white_point: f32,
     pub has_environment: u32,
     pub irradiance_sh: [[f32; 4]; 9],
+    pub radiance_sh: [[f32; 4]; 9],
 }
 
 #[repr(C)]
@@ -55,7 +56,7 @@ pub struct AoParamsUniform {
     pub bias: f32,
     pub range_check: u32,
     pub bounce: f32,
-    pub environment_lod: f32,
+    pub _pad: u32,
     pub blur_radius: u32,
     pub frame_index: u32,
 }
@@ -118,7 +119,7 @@ impl FrameBuffers {
     }
 
     /// Writes the occlusion parameters and the kernel that suits the technique.
-    pub fn update_ao(&self, queue: &wgpu::Queue, scene: &Scene, settings: &Settings, frame_index: u32) {
+    pub fn update_ao(&self, queue: &wgpu::Queue, settings: &Settings, frame_index: u32) {
         let ao = &settings.ao;
         let (width, height) = ao_extent(settings.profile.width, settings.profile.height, ao.half_res);
         let (directions, steps) = hbao_directions_steps(ao.samples);
@@ -133,7 +134,11 @@ impl FrameBuffers {
             samples: ao.samples,
             directions,
             steps,
-            technique: (ao.technique != Technique::None) as u32,
+            technique: match ao.technique {
+                Technique::None => 0,
+                Technique::Ssao | Technique::Hbao | Technique::FetchOnly => 1,
+                Technique::Ssdo | Technique::SsdoBounce => 2,
+            },
             noise: match ao.noise {
                 Noise::Tiled5x5 => 0,
                 Noise::Halton => 1,
@@ -143,7 +148,7 @@ impl FrameBuffers {
             bias: ao.bias,
             range_check: ao.range_check as u32,
             bounce: if ao.bounce_active() { ao.bounce } else { 0.0 },
-            environment_lod: scene.environment.as_ref().map_or(0.0, |e| environment_lod(e.width, e.height, ao.samples)),
+            _pad: 0,
             blur_radius: ao.blur_radius,
             frame_index,
         };
@@ -186,12 +191,11 @@ impl FrameBuffers {
                 });
             }
         }
-        let mut irradiance_sh = [[0.0; 4]; 9];
-        if let Some(env) = &scene.environment {
-            for (dst, c) in irradiance_sh.iter_mut().zip(env.irradiance_sh_scaled()) {
-                *dst = c.extend(0.0).to_array();
-            }
-        }
+        let to_vec4 = |sh: [glam::Vec3; 9]| sh.map(|c| c.extend(0.0).to_array());
+        let (irradiance_sh, radiance_sh) = match &scene.environment {
+            Some(env) => (to_vec4(env.irradiance_sh_scaled()), to_vec4(env.radiance_sh_prefiltered())),
+            None => ([[0.0; 4]; 9], [[0.0; 4]; 9]),
+        };
         let uniform = FrameUniform {
             eyes,
             size: [settings.profile.width, settings.profile.height],
@@ -202,18 +206,11 @@ impl FrameBuffers {
             white_point: settings.white_point,
             has_environment: scene.environment.is_some() as u32,
             irradiance_sh,
+            radiance_sh,
         };
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));
         if !lights.is_empty() {
             queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(&lights));
         }
     }
-}
-
-/// The environment mip level whose texels cover one SSDO sample's solid angle 2π/N
-/// (seed 002 pre-filters the map so N lookups do not alias).
-pub fn environment_lod(width: u32, height: u32, samples: u32) -> f32 {
-    let texel_solid_angle = 4.0 * std::f64::consts::PI / (width as f64 * height as f64);
-    let sample_solid_angle = 2.0 * std::f64::consts::PI / samples.max(1) as f64;
-    (0.5 * (sample_solid_angle / texel_solid_angle).log2()).max(0.0) as f32
 }

@@ -13,6 +13,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("ssao.wgsl", include_str!("../../shaders/ssao.wgsl")),
     ("hbao.wgsl", include_str!("../../shaders/hbao.wgsl")),
     ("ssdo.wgsl", include_str!("../../shaders/ssdo.wgsl")),
+    ("fetch.wgsl", include_str!("../../shaders/fetch.wgsl")),
     ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),
     ("upsample.wgsl", include_str!("../../shaders/upsample.wgsl")),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),

@@ -114,7 +114,7 @@ impl GpuScene {
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
         });
         GpuScene {
@@ -148,45 +148,27 @@ fn rgba8_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8]) 
     texture.create_view(&Default::default())
 }
 
-/// The environment's radiance (times its intensity) as Rgba16Float with a full mip
-/// chain (2×2 box filter), so SSDO can read it pre-filtered to its sample cone. Values
-/// beyond the half range saturate rather than turn into Inf.
+/// The environment's radiance (times its intensity) as Rgba16Float, for the sky behind
+/// the scene. Values beyond the half range saturate rather than turn into Inf.
 fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureView {
     let (width, height, texels): (u32, u32, Vec<[f32; 3]>) = match env {
         Some(e) => (e.width, e.height, e.texels.iter().map(|t| t.map(|c| c * e.intensity)).collect()),
         None => (1, 1, vec![[0.0; 3]]),
     };
-    let mut levels = vec![(width, height, texels)];
-    while let Some((w, h, prev)) = levels.last().filter(|(w, h, _)| *w > 1 || *h > 1) {
-        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-        let at = |x: u32, y: u32| prev[(y.min(h - 1) * w + x.min(w - 1)) as usize];
-        let next = (0..nh)
-            .flat_map(|y| (0..nw).map(move |x| (x, y)))
-            .map(|(x, y)| {
-                let quad = [at(2 * x, 2 * y), at(2 * x + 1, 2 * y), at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)];
-                [0, 1, 2].map(|c| quad.iter().map(|t| t[c]).sum::<f32>() * 0.25)
-            })
-            .collect();
-        levels.push((nw, nh, next));
-    }
-    let data: Vec<u16> = levels
-        .iter()
-        .flat_map(|(_, _, texels)| texels.iter().flat_map(|t| [t[0], t[1], t[2], 1.0]))
-        .map(f32_to_f16)
-        .collect();
+    let data: Vec<u16> = texels.iter().flat_map(|t| [t[0], t[1], t[2], 1.0]).map(f32_to_f16).collect();
     let texture = gpu.device.create_texture_with_data(
         &gpu.queue,
         &wgpu::TextureDescriptor {
             label: Some("environment"),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: levels.len() as u32,
+            mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba16Float,
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         },
-        wgpu::util::TextureDataOrder::MipMajor,
+        wgpu::util::TextureDataOrder::LayerMajor,
         bytemuck::cast_slice(&data),
     );
     texture.create_view(&Default::default())

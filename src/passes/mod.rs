@@ -4,6 +4,7 @@
 pub mod blur;
 pub mod composite;
 pub mod direct;
+pub mod fetch;
 pub mod gbuffer;
 pub mod hbao;
 pub mod ssao;

@@ -17,15 +17,13 @@ pub struct SsdoPass {
     no_direct: LayeredTarget,
 }
 
-const SLOTS: [Slot; 9] = [
+const SLOTS: [Slot; 7] = [
     Slot::Uniform,
     Slot::Uniform,
     Slot::ReadBuffer,
     Slot::Depth,
     Slot::Layers,
     Slot::Layers,
-    Slot::Texture2d,
-    Slot::Sampler,
     Slot::Output(wgpu::TextureFormat::Rgba16Float),
 ];
 
@@ -51,16 +49,12 @@ impl Pass for SsdoPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
         let chosen = ao.technique;
-        let decl = if ao.bounce_active() {
-            PassDecl::new("ssdo-bounce").read(Resource::Direct)
-        } else {
-            let decl = PassDecl::new("ssdo");
-            if chosen == Technique::SsdoBounce {
-                decl.note("bounce left out: bounce strength is 0")
-            } else {
-                decl
-            }
-        };
+        let mut decl = PassDecl::new(ao.pass_name());
+        if ao.bounce_active() {
+            decl = decl.read(Resource::Direct);
+        } else if chosen == Technique::SsdoBounce {
+            decl = decl.note("bounce left out: bounce strength is 0");
+        }
         technique_decl(decl, &[Technique::Ssdo, Technique::SsdoBounce], setup)
     }
 
@@ -78,8 +72,6 @@ impl Pass for SsdoPass {
             ctx.view(Resource::Depth),
             ctx.view(Resource::Normals),
             direct,
-            wgpu::BindingResource::TextureView(&ctx.scene.environment),
-            wgpu::BindingResource::Sampler(&ctx.scene.sampler),
             ctx.view(Resource::AoRaw),
         ];
         let extent = ctx.ao_extent();

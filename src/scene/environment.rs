@@ -126,6 +126,26 @@ impl Environment {
         self.irradiance_sh.map(|c| c * self.intensity)
     }
 
+    /// Radiance (times `intensity`) as nine SH coefficients, low-passed with a Hann
+    /// window over the bands (1, 0.75, 0.25) against ringing: the pre-filtered
+    /// environment SSDO reads once per sample direction (seed 002 asks for a pre-smoothed
+    /// map). Evaluate with [`sh9_basis`] and clamp at 0.
+    pub fn radiance_sh_prefiltered(&self) -> [Vec3; 9] {
+        const WINDOW_OVER_KERNEL: [f32; 9] = [
+            1.0 / PI,
+            0.75 * 3.0 / TAU,
+            0.75 * 3.0 / TAU,
+            0.75 * 3.0 / TAU,
+            0.25 * 4.0 / PI,
+            0.25 * 4.0 / PI,
+            0.25 * 4.0 / PI,
+            0.25 * 4.0 / PI,
+            0.25 * 4.0 / PI,
+        ];
+        let e = self.irradiance_sh_scaled();
+        std::array::from_fn(|k| e[k] * WINDOW_OVER_KERNEL[k])
+    }
+
     /// Irradiance E(n) (times `intensity`) on a surface with unit normal `n` that sees the
     /// whole environment: ∫ L(ω) max(0, n·ω) dω, so a constant radiance L gives π L.
     /// Clamped at 0 because nine coefficients can ring slightly negative opposite a sun.
@@ -195,6 +215,16 @@ mod tests {
 
     fn directions() -> impl Iterator<Item = Vec3> {
         (0..50).map(|i| direction((i as f32 * 0.618_034).fract(), (i as f32 + 0.5) / 50.0))
+    }
+
+    #[test]
+    fn prefiltered_radiance_of_a_constant_sky_is_that_constant() {
+        let env = Environment::from_texels(16, 8, vec![[0.5, 1.0, 2.0]; 128], 2.0).unwrap();
+        let sh = env.radiance_sh_prefiltered();
+        for dir in [Vec3::X, Vec3::Y, -Vec3::Y, Vec3::new(0.3, -0.5, 0.8).normalize()] {
+            let l: Vec3 = sh.iter().zip(sh9_basis(dir)).map(|(c, y)| *c * y).sum();
+            assert!((l - Vec3::new(1.0, 2.0, 4.0)).abs().max_element() < 0.02, "{dir}: {l}");
+        }
     }
 
     #[test]
