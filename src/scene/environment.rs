@@ -223,7 +223,9 @@ mod tests {
         let sh = env.radiance_sh_prefiltered();
         for dir in [Vec3::X, Vec3::Y, -Vec3::Y, Vec3::new(0.3, -0.5, 0.8).normalize()] {
             let l: Vec3 = sh.iter().zip(sh9_basis(dir)).map(|(c, y)| *c * y).sum();
-            assert!((l - Vec3::new(1.0, 2.0, 4.0)).abs().max_element() < 0.02, "{dir}: {l}");
+            // Within 1 %: the SH projection of a 16×8 map is a coarse quadrature.
+            let expected = Vec3::new(1.0, 2.0, 4.0);
+            assert!(((l - expected) / expected).abs().max_element() < 0.01, "{dir}: {l}");
         }
     }
 
