@@ -1,15 +1,15 @@
 // Separable geometry-aware bilateral blur of the occlusion (seed 000: 11×11, edge stops
-// on normal and depth; seed 003 §4.3.2). A neighbour counts by its pixel distance
+// on normal and depth; seed 003 §4.3.2). Geometry comes from AoGeometry (normal and
+// distance at each occlusion pixel, written by the technique): one fetch per tap. A neighbour counts by its pixel distance
 // (Gaussian), by how far it lies off the centre's tangent plane relative to the centre's
 // distance (depth edge) and by normal agreement. Each layer is blurred on its own, so
 // the eyes never mix. When every weight vanishes the centre value is kept.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
-@group(0) @binding(2) var depth_layers: texture_depth_2d_array;
-@group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
-@group(0) @binding(4) var occlusion_in: texture_2d_array<f32>;
-@group(0) @binding(5) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(2) var geometry_layers: texture_2d_array<f32>;
+@group(0) @binding(3) var occlusion_in: texture_2d_array<f32>;
+@group(0) @binding(4) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
 
 // Tangent-plane distance, as a fraction of the centre's distance, that halves a weight.
 const PLANE_SIGMA: f32 = 0.02;
@@ -22,14 +22,13 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
     let eye = frame.eyes[layer];
     let p = vec2<i32>(id.xy);
     let centre_value = textureLoad(occlusion_in, p, i32(layer), 0);
-    let fp = full_res_pixel(id.xy, ao.scale, frame.size);
-    let depth = textureLoad(depth_layers, vec2<i32>(fp), i32(layer), 0);
-    if (depth <= 0.0 || ao.blur_radius == 0u) {
+    let centre = textureLoad(geometry_layers, p, i32(layer), 0);
+    if (!(centre.w > 0.0) || ao.blur_radius == 0u) {
         textureStore(occlusion_out, p, i32(layer), centre_value);
         return;
     }
-    let position = load_view_position(depth, fp, eye, frame.size, frame.near);
-    let n = safe_normal(textureLoad(normal_layers, vec2<i32>(fp), i32(layer), 0).xyz, position);
+    let position = view_position_from_distance(pixel_uv(full_res_pixel(id.xy, ao.scale, frame.size), frame.size), centre.w, eye.tangents);
+    let n = centre.xyz;
     let radius = i32(ao.blur_radius);
     let sigma = max(f32(radius) * 0.5, 0.5);
     let plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
@@ -41,13 +40,12 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(ao.ao_size))) {
             continue;
         }
-        let fq = full_res_pixel(vec2<u32>(q), ao.scale, frame.size);
-        let qd = textureLoad(depth_layers, vec2<i32>(fq), i32(layer), 0);
-        if (qd <= 0.0) {
+        let geometry = textureLoad(geometry_layers, q, i32(layer), 0);
+        if (!(geometry.w > 0.0)) {
             continue;
         }
-        let qpos = load_view_position(qd, fq, eye, frame.size, frame.near);
-        let qn = safe_normal(textureLoad(normal_layers, vec2<i32>(fq), i32(layer), 0).xyz, qpos);
+        let qpos = view_position_from_distance(pixel_uv(full_res_pixel(vec2<u32>(q), ao.scale, frame.size), frame.size), geometry.w, eye.tangents);
+        let qn = geometry.xyz;
         let plane = dot(qpos - position, n) * plane_scale;
         // One exp for the spatial and depth terms; the normal term is (n·q)^16.
         let w = exp(-f32(k * k) * inv_two_sigma2 - plane * plane) * normal_agreement(n, qn);

@@ -113,6 +113,12 @@ fn load_view_position(depth: f32, p: vec2<u32>, eye: Eye, full_size: vec2<u32>, 
     return view_position_from_depth(pixel_uv(p, full_size), depth, eye.tangents, near);
 }
 
+// View-space position at `uv` of a surface at `distance` along −z (the form AoGeometry
+// stores; the same frustum-tangent mapping as `view_position_from_depth`).
+fn view_position_from_distance(uv: vec2<f32>, distance: f32, tangents: vec4<f32>) -> vec3<f32> {
+    return vec3<f32>(mix(tangents.x, tangents.y, uv.x) * distance, mix(tangents.z, tangents.w, uv.y) * distance, -distance);
+}
+
 // Where a view-space point lands: uv (0..1, top-left origin). Uses the frustum tangents,
 // the exact inverse of `view_position_from_depth`.
 fn view_to_uv(v: vec3<f32>, tangents: vec4<f32>) -> vec2<f32> {

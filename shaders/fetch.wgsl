@@ -8,6 +8,7 @@
 @group(0) @binding(3) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(4) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var ao_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(6) var geometry_out: texture_storage_2d_array<rgba32float, write>;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -17,6 +18,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let layer = i32(id.z);
     let fp = vec2<i32>(full_res_pixel(id.xy, ao.scale, frame.size));
     let depth = textureLoad(depth_layers, fp, layer, 0);
+    // The geometry the blur and upsample read, as every technique writes it.
+    let n = textureLoad(normal_layers, fp, layer, 0).xyz;
+    textureStore(geometry_out, vec2<i32>(id.xy), layer, vec4<f32>(n, select(0.0, frame.near / depth, depth > 0.0)));
     // The footprint of the radius in pixels, as SSAO's samples cover it.
     let eye = frame.eyes[id.z];
     let radius_px = ao.radius * depth / frame.near * f32(frame.size.x) / (eye.tangents.y - eye.tangents.x);

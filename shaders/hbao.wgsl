@@ -10,6 +10,7 @@
 @group(0) @binding(2) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(4) var ao_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(5) var geometry_out: texture_storage_2d_array<rgba32float, write>;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -22,10 +23,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let depth = textureLoad(depth_layers, vec2<i32>(fp), i32(layer), 0);
     if (depth <= 0.0) {
         textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(geometry_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0));
         return;
     }
     let position = load_view_position(depth, fp, eye, frame.size, frame.near);
     let n = safe_normal(textureLoad(normal_layers, vec2<i32>(fp), i32(layer), 0).xyz, position);
+    textureStore(geometry_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(n, -position.z));
     // The radius R in pixels at this depth (tangent span per pixel × distance).
     let metres_per_pixel = (eye.tangents.y - eye.tangents.x) / f32(frame.size.x) * -position.z;
     let radius_px = ao.radius / max(metres_per_pixel, 1e-30);

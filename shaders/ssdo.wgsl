@@ -15,6 +15,7 @@
 @group(0) @binding(4) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var direct_layers: texture_2d_array<f32>;
 @group(0) @binding(6) var ao_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(7) var geometry_out: texture_storage_2d_array<rgba32float, write>;
 
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the variant without).
 override BOUNCE: bool = false;
@@ -30,10 +31,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let depth = textureLoad(depth_layers, vec2<i32>(fp), i32(layer), 0);
     if (depth <= 0.0) {
         textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(geometry_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0));
         return;
     }
     let position = load_view_position(depth, fp, eye, frame.size, frame.near);
     let n = safe_normal(textureLoad(normal_layers, vec2<i32>(fp), i32(layer), 0).xyz, position);
+    textureStore(geometry_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(n, -position.z));
     let frame_rot = tangent_frame(n, kernel_rotation(fp, ao.noise));
     let world_from_view = mat3x3<f32>(eye.world_from_view[0].xyz, eye.world_from_view[1].xyz, eye.world_from_view[2].xyz);
     let bias = ao.bias * ao.radius;

@@ -1,15 +1,17 @@
 // Joint bilateral upsampling (Kopf et al. 2007; seed 000: 3×3, not separated) of
 // half-resolution occlusion to full resolution. Each of the 3×3 low-res neighbours is
-// weighted by its distance to the full-res pixel and by how well its geometry (the
-// full-res pixel it was computed at) matches: tangent-plane distance and normal.
+// weighted by its distance to the full-res pixel and by how well its geometry (normal
+// and distance in AoGeometry, from the full-res pixel it was computed at) matches:
+// tangent-plane distance and normal.
 // Odd sizes work because low-res pixel q stands for full-res pixel min(2q, size − 1).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
 @group(0) @binding(2) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
-@group(0) @binding(4) var occlusion_low: texture_2d_array<f32>;
-@group(0) @binding(5) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(4) var geometry_low: texture_2d_array<f32>;
+@group(0) @binding(5) var occlusion_low: texture_2d_array<f32>;
+@group(0) @binding(6) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
 
 const PLANE_SIGMA: f32 = 0.02;
 
@@ -39,13 +41,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(ao.ao_size))) {
                 continue;
             }
-            let fq = full_res_pixel(vec2<u32>(q), 2u, frame.size);
-            let qd = textureLoad(depth_layers, vec2<i32>(fq), i32(layer), 0);
-            if (qd <= 0.0) {
+            let geometry = textureLoad(geometry_low, q, i32(layer), 0);
+            if (!(geometry.w > 0.0)) {
                 continue;
             }
-            let qpos = load_view_position(qd, fq, eye, frame.size, frame.near);
-            let qn = safe_normal(textureLoad(normal_layers, vec2<i32>(fq), i32(layer), 0).xyz, qpos);
+            let fq = full_res_pixel(vec2<u32>(q), 2u, frame.size);
+            let qpos = view_position_from_distance(pixel_uv(fq, frame.size), geometry.w, eye.tangents);
+            let qn = geometry.xyz;
             // Full-res distance between this pixel's centre and the neighbour's sample.
             let offset = vec2<f32>(fq) - vec2<f32>(id.xy);
             let spatial = 1.0 / (1.0 + dot(offset, offset));

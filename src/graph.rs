@@ -23,6 +23,10 @@ pub enum Resource {
     /// Occlusion as computed (at AO resolution), `Rgba16Float`: rgb = SSDO's gathered
     /// irradiance (environment through unblocked directions plus the bounce), a = AO.
     AoRaw,
+    /// Normal (xyz) and view distance (w, 0 on the sky) at each occlusion pixel,
+    /// `Rgba32Float`, written by the technique so the blur and upsample need one fetch
+    /// per tap instead of depth, normal and a reconstruction.
+    AoGeometry,
     /// Horizontally blurred occlusion (first half of the separable bilateral blur).
     AoBlurH,
     /// Bilaterally blurred occlusion, at AO resolution.
@@ -38,7 +42,7 @@ pub enum Resource {
 impl Resource {
     /// Resources that live at the occlusion resolution (half per axis with `--half-res`).
     pub fn at_ao_resolution(self) -> bool {
-        matches!(self, Resource::AoRaw | Resource::AoBlurH | Resource::AoBlurred)
+        matches!(self, Resource::AoRaw | Resource::AoGeometry | Resource::AoBlurH | Resource::AoBlurred)
     }
 
     /// Written by render passes (attachments) rather than by compute kernels.
@@ -54,6 +58,7 @@ impl Resource {
             Resource::Emission => "emission",
             Resource::Direct => "direct",
             Resource::AoRaw => "ao-raw",
+            Resource::AoGeometry => "ao-geometry",
             Resource::AoBlurH => "ao-blur-h",
             Resource::AoBlurred => "ao-blurred",
             Resource::AoFull => "ao-full",
@@ -74,6 +79,7 @@ impl Resource {
             | Resource::AoFull
             | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
             Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
+            Resource::AoGeometry => wgpu::TextureFormat::Rgba32Float,
             Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
         }
     }

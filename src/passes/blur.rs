@@ -14,14 +14,8 @@ pub struct BlurPass {
 
 impl BlurPass {
     pub fn new(gpu: &Gpu) -> Self {
-        let slots = [
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Depth,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Output(Resource::AoBlurred.format()),
-        ];
+        let slots =
+            [Slot::Uniform, Slot::Uniform, Slot::Layers, Slot::Layers, Slot::Output(Resource::AoBlurred.format())];
         let files = ["common.wgsl", "bilateral.wgsl"];
         BlurPass {
             horizontal: Kernel::new(gpu, "blur horizontal", &files, "blur_horizontal", &slots),
@@ -34,8 +28,7 @@ impl Pass for BlurPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
         PassDecl::new("blur")
-            .read(Resource::Depth)
-            .read(Resource::Normals)
+            .read(Resource::AoGeometry)
             .read(Resource::AoRaw)
             .write(Resource::AoBlurH)
             .write(Resource::AoBlurred)
@@ -53,8 +46,7 @@ impl Pass for BlurPass {
             let resources = [
                 ctx.frame.frame.as_entire_binding(),
                 ctx.frame.ao.as_entire_binding(),
-                ctx.view(Resource::Depth),
-                ctx.view(Resource::Normals),
+                ctx.view(Resource::AoGeometry),
                 ctx.view(input),
                 ctx.view(output),
             ];

@@ -20,6 +20,7 @@ impl FetchOnlyPass {
             Slot::Depth,
             Slot::Layers,
             Slot::Output(Resource::AoRaw.format()),
+            Slot::Output(Resource::AoGeometry.format()),
         ];
         FetchOnlyPass { kernel: Kernel::new(gpu, "fetch-only", &["common.wgsl", "fetch.wgsl"], "main", &slots) }
     }
@@ -38,6 +39,7 @@ impl Pass for FetchOnlyPass {
             ctx.view(Resource::Depth),
             ctx.view(Resource::Normals),
             ctx.view(Resource::AoRaw),
+            ctx.view(Resource::AoGeometry),
         ];
         let extent = ctx.ao_extent();
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);

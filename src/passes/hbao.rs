@@ -13,7 +13,14 @@ pub struct HbaoPass {
 
 impl HbaoPass {
     pub fn new(gpu: &Gpu) -> Self {
-        let slots = [Slot::Uniform, Slot::Uniform, Slot::Depth, Slot::Layers, Slot::Output(Resource::AoRaw.format())];
+        let slots = [
+            Slot::Uniform,
+            Slot::Uniform,
+            Slot::Depth,
+            Slot::Layers,
+            Slot::Output(Resource::AoRaw.format()),
+            Slot::Output(Resource::AoGeometry.format()),
+        ];
         HbaoPass { kernel: Kernel::new(gpu, "hbao", &["common.wgsl", "hbao.wgsl"], "main", &slots) }
     }
 }
@@ -30,6 +37,7 @@ impl Pass for HbaoPass {
             ctx.view(Resource::Depth),
             ctx.view(Resource::Normals),
             ctx.view(Resource::AoRaw),
+            ctx.view(Resource::AoGeometry),
         ];
         let extent = ctx.ao_extent();
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);

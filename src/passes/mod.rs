@@ -84,7 +84,8 @@ pub fn final_occlusion(settings: &Settings) -> Option<Resource> {
 }
 
 /// Completes a technique pass's declaration: it reads the G-buffer, writes raw
-/// occlusion, and is left out unless the chosen technique is one of `runs_for`.
+/// occlusion and its geometry, and is left out unless the chosen technique is one of
+/// `runs_for`.
 pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup) -> PassDecl {
     let chosen = setup.settings.ao.technique;
     let reason = if chosen == Technique::None {
@@ -95,6 +96,7 @@ pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup
     decl.read(Resource::Depth)
         .read(Resource::Normals)
         .write(Resource::AoRaw)
+        .write(Resource::AoGeometry)
         .disabled_if(!runs_for.contains(&chosen), reason)
 }
 

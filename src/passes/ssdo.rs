@@ -17,7 +17,7 @@ pub struct SsdoPass {
     no_direct: LayeredTarget,
 }
 
-const SLOTS: [Slot; 7] = [
+const SLOTS: [Slot; 8] = [
     Slot::Uniform,
     Slot::Uniform,
     Slot::ReadBuffer,
@@ -25,6 +25,7 @@ const SLOTS: [Slot; 7] = [
     Slot::Layers,
     Slot::Layers,
     Slot::Output(wgpu::TextureFormat::Rgba16Float),
+    Slot::Output(wgpu::TextureFormat::Rgba32Float),
 ];
 
 impl SsdoPass {
@@ -49,7 +50,7 @@ impl Pass for SsdoPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
         let chosen = ao.technique;
-        let mut decl = PassDecl::new(ao.pass_name());
+        let mut decl = PassDecl::new(if ao.bounce_active() { "ssdo-bounce" } else { "ssdo" });
         if ao.bounce_active() {
             decl = decl.read(Resource::Direct);
         } else if chosen == Technique::SsdoBounce {
@@ -73,6 +74,7 @@ impl Pass for SsdoPass {
             ctx.view(Resource::Normals),
             direct,
             ctx.view(Resource::AoRaw),
+            ctx.view(Resource::AoGeometry),
         ];
         let extent = ctx.ao_extent();
         let kernel = if bounce { &self.with_bounce } else { &self.without_bounce };

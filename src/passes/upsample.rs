@@ -18,6 +18,7 @@ impl UpsamplePass {
             Slot::Depth,
             Slot::Layers,
             Slot::Layers,
+            Slot::Layers,
             Slot::Output(Resource::AoFull.format()),
         ];
         UpsamplePass { kernel: Kernel::new(gpu, "upsample", &["common.wgsl", "upsample.wgsl"], "main", &slots) }
@@ -26,7 +27,11 @@ impl UpsamplePass {
 
 impl Pass for UpsamplePass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        let decl = PassDecl::new("upsample").read(Resource::Depth).read(Resource::Normals).write(Resource::AoFull);
+        let decl = PassDecl::new("upsample")
+            .read(Resource::Depth)
+            .read(Resource::Normals)
+            .read(Resource::AoGeometry)
+            .write(Resource::AoFull);
         match occlusion_before_upsample(setup.settings) {
             None => decl.disabled_if(true, "technique is none: nothing to upsample"),
             Some(input) => {
@@ -42,6 +47,7 @@ impl Pass for UpsamplePass {
             ctx.frame.ao.as_entire_binding(),
             ctx.view(Resource::Depth),
             ctx.view(Resource::Normals),
+            ctx.view(Resource::AoGeometry),
             ctx.view(input),
             ctx.view(Resource::AoFull),
         ];
