@@ -190,6 +190,19 @@ fn safe_normal(stored: vec3<f32>, position: vec3<f32>) -> vec3<f32> {
 // What the depth buffer holds where view-space point `s` projects: `valid` is false
 // off-screen, behind the eye or on the sky; `distance` is the stored surface's
 // distance along −z and `pixel` the full-res pixel read.
+// Whether the surface found by `probe` occludes a sample at view-space `s` for a receiver
+// at `position` with normal `n`: the surface lies in front of the sample (by more than
+// `bias`) AND rises above the receiver's tangent plane. The second test removes the
+// self-occlusion a flat surface gives itself at grazing angles, where one pixel's depth
+// spans far more than the bias.
+fn occludes(probe: DepthProbe, s: vec3<f32>, position: vec3<f32>, n: vec3<f32>, eye: Eye, bias: f32) -> bool {
+    if (!probe.valid || !(probe.distance < -s.z - bias)) {
+        return false;
+    }
+    let surface = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
+    return dot(surface - position, n) > bias + 1e-5 * -position.z;
+}
+
 struct DepthProbe {
     valid: bool,
     pixel: vec2<u32>,

@@ -35,8 +35,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let k = kernel[i];
         let s = origin + frame_rot * k.xyz * (k.w * ao.radius);
         let probe = probe_depth(depth_layers, layer, s, eye);
-        // Occluded: the visible surface lies in front of the sample point.
-        if (probe.valid && probe.distance < -s.z - bias) {
+        if (occludes(probe, s, position, n, eye, bias)) {
             var weight = 1.0;
             if (ao.range_check != 0u) {
                 // Depth constraint: occluders far in front of the pixel (a foreground

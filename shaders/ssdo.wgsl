@@ -63,7 +63,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         weight_all += cos_theta;
         let s = origin + omega * (k.w * ao.radius);
         let probe = probe_depth(depth_layers, layer, s, eye);
-        var blocked = probe.valid && probe.distance < -s.z - bias;
+        var blocked = occludes(probe, s, position, n, eye, bias);
         if (blocked && ao.range_check != 0u && abs(-position.z - probe.distance) > ao.radius) {
             // A surface far in front is not a neighbour: the direction stays open.
             blocked = false;

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use vrao::error::{Error, Result};
+use vrao::renderer::Timing;
 use vrao::settings::{AoSettings, Noise, Quality, Technique};
 use vrao::stereo::HeadsetProfile;
 use vrao::{BackendChoice, Gpu, HeadPose, Renderer, Resource, Scene, Settings, StereoMode};
@@ -59,9 +60,10 @@ struct BenchArgs {
     /// Per-eye height in pixels.
     #[arg(long, default_value_t = 1200)]
     height: u32,
-    /// Timing: pipelined (one submission per frame, GPU timestamps) or serial (one
-    /// submission per pass, wall clock; for drivers whose timestamps misattribute work).
-    #[arg(long, default_value = "pipelined")]
+    /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one
+    /// submission per pass, wall clock) or auto (serial on CPU adapters such as lavapipe,
+    /// whose timestamps misattribute work between passes; pipelined on GPUs).
+    #[arg(long, default_value = "auto")]
     timing: TimingArg,
     /// Output directory for bench.csv and bench.md.
     #[arg(long, default_value = "bench")]
@@ -103,7 +105,8 @@ struct RenderArgs {
     /// Linear exposure before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
-    /// Timing with --frames: pipelined (GPU timestamps) or serial (wall clock per pass).
+    /// Timing with --frames: pipelined (GPU timestamps), serial (also wall clock per
+    /// pass) or auto (serial on CPU adapters, pipelined on GPUs).
     #[arg(long, default_value = "pipelined")]
     timing: TimingArg,
     /// Render this many frames and report per-pass GPU medians (with --explain); the
@@ -173,17 +176,31 @@ impl AoArgs {
     }
 }
 
+/// `--timing`: a mode, or `auto` (decided once the adapter is known).
 #[derive(Clone, Copy)]
-struct TimingArg(vrao::renderer::Timing);
+struct TimingArg(Option<Timing>);
 
 impl std::str::FromStr for TimingArg {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
         match s {
-            "pipelined" => Ok(TimingArg(vrao::renderer::Timing::Pipelined)),
-            "serial" => Ok(TimingArg(vrao::renderer::Timing::Serial)),
-            other => Err(format!("unknown timing '{other}' (expected pipelined or serial)")),
+            "auto" => Ok(TimingArg(None)),
+            "pipelined" => Ok(TimingArg(Some(Timing::Pipelined))),
+            "serial" => Ok(TimingArg(Some(Timing::Serial))),
+            other => Err(format!("unknown timing '{other}' (expected auto, pipelined or serial)")),
         }
+    }
+}
+
+impl TimingArg {
+    /// `auto` is serial on CPU adapters, whose timestamps between passes in one
+    /// submission credit work to the wrong pass (lavapipe 22.x), and pipelined elsewhere.
+    fn resolve(self, gpu: &Gpu) -> Timing {
+        self.0.unwrap_or(if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+            Timing::Serial
+        } else {
+            Timing::Pipelined
+        })
     }
 }
 
@@ -228,7 +245,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     settings.validate()?;
     let gpu = Arc::new(Gpu::new(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;
-    renderer.set_timing(args.timing.0);
+    renderer.set_timing(args.timing.resolve(&gpu));
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let mut outputs = vec![Resource::Color];
     if args.debug {
@@ -333,7 +350,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         args.frames
     );
     let started = std::time::Instant::now();
-    let rows = sweep(&gpu, &scene, &settings, &cases, args.timing.0, args.warmup, args.frames, |done, total, row| {
+    let rows = sweep(&gpu, &scene, &settings, &cases, timing, args.warmup, args.frames, |done, total, row| {
         let elapsed = started.elapsed().as_secs_f64();
         let eta = elapsed / done as f64 * (total - done) as f64;
         eprintln!(
@@ -362,6 +379,12 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    // Mesa's Vulkan drivers probe for a Wayland display and print "error: XDG_RUNTIME_DIR
+    // is invalid" on headless machines although nothing is wrong; give the probe a
+    // directory to look in (it then finds no display, quietly).
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {

@@ -111,6 +111,7 @@ impl Renderer {
             Box::new(TonemapPass::new(&gpu)),
         ];
         let timer = GpuTimer::new(&gpu, 32);
+        gpu.take_error()?;
         Ok(Renderer {
             gpu,
             scene: scene.clone(),

@@ -53,6 +53,9 @@ pub struct Gpu {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub caps: Capabilities,
+    /// The first wgpu error no scope caught (validation, out of memory, lost device):
+    /// kept here instead of wgpu's default panic, and returned by [`Gpu::take_error`].
+    uncaptured: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl Gpu {
@@ -113,23 +116,33 @@ impl Gpu {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| Error::Device(format!("{} refused a device: {e}", adapter.get_info().name)))?;
-        let mut gpu = Gpu {
-            instance,
-            adapter,
-            device,
-            queue,
-            caps: Capabilities { multiview, multiview_reliable: false, timestamps },
-        };
+        let uncaptured = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let sink = uncaptured.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            log::error!("wgpu: {e}");
+            let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
+            slot.get_or_insert_with(|| e.to_string());
+        }));
+        let caps = Capabilities { multiview, multiview_reliable: false, timestamps };
+        let mut gpu = Gpu { instance, adapter, device, queue, caps, uncaptured };
         gpu.caps.multiview_reliable = multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
         Ok(gpu)
+    }
+
+    /// The first GPU error since the last call, as `Error::Gpu` (then cleared).
+    pub fn take_error(&self) -> Result<()> {
+        match self.uncaptured.lock().unwrap_or_else(|p| p.into_inner()).take() {
+            Some(message) => Err(Error::Gpu(message)),
+            None => Ok(()),
+        }
     }
 
     /// Blocks until all submitted work has finished.
     pub fn wait_idle(&self) -> Result<()> {
         self.device
             .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
-            .map(|_| ())
-            .map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))
+            .map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
+        self.take_error()
     }
 
     /// Human-readable description for `vrao info`.
