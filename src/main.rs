@@ -340,8 +340,9 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     }
     let gpu = Arc::new(Gpu::new(backend)?);
     let info = gpu.adapter.get_info();
+    let timing = args.timing.resolve(&gpu);
     eprintln!(
-        "bench: {} cases on '{}' ({:?}), {}x{} per eye, {} frames each",
+        "bench: {} cases on '{}' ({}), {}x{} per eye, {} frames each, {timing:?} timing",
         cases.len(),
         scene.name,
         info.name,
