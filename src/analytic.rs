@@ -7,12 +7,13 @@
 //!   optionally with HBAO's linear attenuation W(d) = max(0, 1 − d/r) on each occluded
 //!   direction ([`crease_visibility`], [`crease_visibility_falloff`] in closed form,
 //!   [`visibility_by_ray_casting`] by quadrature for any geometry made of [`Rect`]s).
-//! - The *expected value of a screen-space estimator*: what SSAO or SSDO computes at a
-//!   pixel on average over the per-pixel kernel rotation ([`ssao_crease_expectation`],
-//!   [`ssdo_crease_expectation`] in closed form on the 90° crease,
-//!   [`screen_space_expectation`] numerically for any eye and geometry). These are not
-//!   the reference: SSAO's sample lengths crowd towards the centre, so it sees less of
-//!   a wall than a ray of length r does.
+//! - The *expected value of a screen-space estimator*: what SSAO, SSDO or HBAO computes
+//!   at a pixel on average over the per-pixel kernel rotation ([`ssao_crease_expectation`],
+//!   [`ssdo_crease_expectation`] in closed form on the 90° crease, exact in the rotation;
+//!   [`screen_space_expectation`] and [`hbao_expectation`] by running the estimator's
+//!   test on the CPU for any eye and geometry). These are not the reference: SSAO's
+//!   sample lengths crowd towards the centre, so it sees less of a wall than a ray of
+//!   length r does, and HBAO's slices contain the view ray rather than the normal.
 //!
 //! Closed forms on the crease use the projected-disk view of the cosine-weighted
 //! hemisphere: projecting a unit direction ω onto the tangent plane maps the measure
@@ -20,6 +21,7 @@
 //! area on the disk divided by π.
 
 use crate::scene::builtin::{CREASE_FLOOR_END_Z, CREASE_HALF_WIDTH, CREASE_WALL_HEIGHT, CREASE_WALL_Z};
+use crate::stereo::Eye;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 
@@ -212,7 +214,9 @@ fn rotation_fraction_past_wall(reach: f64, beyond: f64) -> f64 {
 /// - The eye and every sample are above the floor and in front of the wall, so the
 ///   surface seen towards a sample is closer than it exactly when the sample is behind
 ///   the wall plane (the floor or wall behind a sample in front of the wall is farther).
-///   The normal offset bias·r is vertical and does not move a sample towards the wall.
+///   The normal offset bias·r is vertical and does not move a sample towards the wall;
+///   it also lifts every sample, and so the wall point that hides it, above the floor's
+///   tangent plane by bias·r, which the renderer requires of an occluder.
 /// - The depth difference equals the distance behind the wall plane (a view along the
 ///   wall normal); see [`ssao_crease_expectation_with_depth_scale`] for an oblique view.
 /// - The range check never engages: every occluding wall point is within r of P in depth
@@ -261,7 +265,19 @@ pub fn ssao_crease_expectation_with_depth_scale(
 /// fraction of unblocked directions, Σ cos θᵢ (1 − blockedᵢ) / Σ cos θᵢ. As N grows it
 /// tends to [`crease_visibility_falloff`] (plus the bias).
 pub fn ssdo_crease_expectation(distance_to_wall: f64, radius: f64, bias: f64, samples: &[[f32; 4]]) -> f64 {
-    let beyond = distance_to_wall.max(0.0) + bias * radius;
+    ssdo_crease_expectation_with_depth_scale(distance_to_wall, radius, bias, samples, 1.0)
+}
+
+/// As [`ssdo_crease_expectation`] for an oblique view (see
+/// [`ssao_crease_expectation_with_depth_scale`] for `depth_per_metre`).
+pub fn ssdo_crease_expectation_with_depth_scale(
+    distance_to_wall: f64,
+    radius: f64,
+    bias: f64,
+    samples: &[[f32; 4]],
+    depth_per_metre: f64,
+) -> f64 {
+    let beyond = distance_to_wall.max(0.0) + bias * radius / depth_per_metre;
     let (mut blocked, mut total) = (0.0, 0.0);
     for k in samples {
         let cos_t = (k[2] as f64).max(0.0);
@@ -298,8 +314,9 @@ impl DepthView {
 }
 
 /// Which screen-space estimator [`screen_space_expectation`] simulates. Both start from
-/// P + bias·r·n and test a sample point S against the depth buffer: S is behind the
-/// visible surface W when depth(S) − depth(W) > bias·r.
+/// P + bias·r·n and test a sample point S against the depth buffer: S is blocked by the
+/// visible surface W when depth(S) − depth(W) > bias·r and W rises above P's tangent
+/// plane, (W − P)·n > bias·r (the renderer's guard against grazing self-occlusion).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Estimator {
     /// S = P + bias·r·n + s ω, each sample weight 1 (cosine-distributed kernel); the range
@@ -357,7 +374,11 @@ pub fn screen_space_expectation(
             total += weight;
             let Some(seen) = view.seen(sample, &hit) else { continue };
             let seen_depth = view.depth(seen);
-            if view.depth(sample) - seen_depth <= tolerance {
+            // In front of the sample by more than the tolerance, and rising above the
+            // receiver's tangent plane by more than it (no grazing self-occlusion).
+            if view.depth(sample) - seen_depth <= tolerance
+                || (seen - point).dot(normal) <= tolerance + 1e-5 * point_depth
+            {
                 continue;
             }
             let gap = (point_depth - seen_depth).abs();
@@ -375,6 +396,117 @@ pub fn screen_space_expectation(
     } else {
         1.0
     }
+}
+
+/// The world-space direction (unit) through the centre of `pixel` of an eye whose image
+/// is `size` pixels (x right, y down from the top-left corner).
+pub fn pixel_ray(eye: &Eye, size: (u32, u32), pixel: (f64, f64)) -> DVec3 {
+    let [l, r, u, d] = eye.fov.tangents();
+    let (s, t) = (pixel.0 / size.0 as f64, pixel.1 / size.1 as f64);
+    (eye.pose.orientation * DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0)).normalize()
+}
+
+/// HBAO as the renderer runs it (shaders/hbao.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HbaoParams {
+    pub radius: f64,
+    /// Fraction of the radius; the angle bias is sin h₀ = min(5 · bias, 0.9).
+    pub bias: f64,
+    pub directions: u32,
+    pub steps: u32,
+    /// Per-pixel rotations averaged (evenly spaced over 2π).
+    pub rotations: u32,
+}
+
+/// The expected HBAO value at full-resolution `pixel` of `eye` (image `size`), averaged
+/// over a uniform per-pixel rotation, by running the estimator on the CPU against the
+/// surfaces `hit` returns for each pixel's centre ray: `directions` screen directions
+/// turned by the rotation α; along each, `steps` taps at (s + j + 1) · R_px / (steps + 1)
+/// pixels, where R_px is the radius in pixels at the receiver's depth and the jitter
+/// j = fract(7α / 2π) comes with the rotation, as on the GPU; a tap snaps to the pixel it
+/// falls in; a tap within r whose elevation above the tangent plane, sin h, exceeds the
+/// running horizon (which starts at the angle bias) adds (sin²h − sin²h_prev)(1 − d/r).
+/// AO = 1 − (occlusion summed over directions) / directions.
+///
+/// In the continuum (infinitely many steps, no angle bias, vertical slices with uniform
+/// azimuths) this is [`crease_visibility_falloff`] on the crease, because a slice at
+/// horizontal distance D from the wall adds ∫ (1 − d/r) d(sin²h) = (1 − D/r)². HBAO's
+/// expected value differs from that by its discretisation (the horizon rises at a few
+/// taps, each weighted by the attenuation at its own, farther, distance), the angle bias,
+/// and the perspective: uniform screen directions are not uniform azimuths on a surface
+/// seen obliquely, and a screen line is not a vertical slice.
+pub fn hbao_expectation(
+    params: &HbaoParams,
+    eye: &Eye,
+    size: (u32, u32),
+    pixel: (u32, u32),
+    normal: DVec3,
+    hit: impl Fn(DVec3, DVec3) -> Option<f64>,
+) -> f64 {
+    let origin = eye.pose.position;
+    let surface = |x: f64, y: f64| {
+        let dir = pixel_ray(eye, size, (x, y));
+        hit(origin, dir).map(|t| origin + dir * t)
+    };
+    let Some(p) = surface(pixel.0 as f64 + 0.5, pixel.1 as f64 + 0.5) else { return 1.0 };
+    let forward = eye.pose.orientation * DVec3::NEG_Z;
+    let [l, r, _, _] = eye.fov.tangents();
+    let metres_per_pixel = (r - l) / size.0 as f64 * (p - origin).dot(forward);
+    let radius_px = params.radius / metres_per_pixel.max(1e-30);
+    let steps = params.steps.max(1);
+    let directions = params.directions.max(1);
+    let step_px = (radius_px / (steps + 1) as f64).clamp(1.0, size.0.max(size.1) as f64);
+    let sin_bias = (5.0 * params.bias).min(0.9);
+    let rotations = params.rotations.max(1);
+    let mut total = 0.0;
+    for i in 0..rotations {
+        let alpha = TAU * (i as f64 + 0.5) / rotations as f64;
+        let jitter = (alpha / TAU * 7.0).fract();
+        let mut occlusion = 0.0;
+        for d in 0..directions {
+            let angle = alpha + TAU * d as f64 / directions as f64;
+            let dir = (angle.cos(), angle.sin());
+            let mut max_sin = sin_bias;
+            for s in 0..steps {
+                let reach = (s as f64 + jitter + 1.0) * step_px;
+                let q = (pixel.0 as f64 + 0.5 + dir.0 * reach, pixel.1 as f64 + 0.5 + dir.1 * reach);
+                if q.0 < 0.0 || q.1 < 0.0 || q.0 >= size.0 as f64 || q.1 >= size.1 as f64 {
+                    break;
+                }
+                let Some(tap) = surface(q.0.floor() + 0.5, q.1.floor() + 0.5) else { continue };
+                let h = tap - p;
+                let dist = h.length();
+                if dist < 1e-20 || dist > params.radius {
+                    continue;
+                }
+                let sin_h = h.dot(normal) / dist;
+                if sin_h > max_sin {
+                    occlusion += (sin_h * sin_h - max_sin * max_sin) * (1.0 - dist / params.radius).max(0.0);
+                    max_sin = sin_h;
+                }
+            }
+        }
+        total += 1.0 - occlusion / directions as f64;
+    }
+    total / rotations as f64
+}
+
+/// The continuum limit of HBAO on the crease with vertical slices at uniform azimuths:
+/// the mean over azimuths ψ (from the wall normal) of 1 − (1 − D/r)²₊ with
+/// D = x / cos ψ. Equal to [`crease_visibility_falloff`] (checked in the tests below).
+pub fn crease_hbao_slices(distance_to_wall: f64, radius: f64, azimuths: usize) -> f64 {
+    let mut occlusion = 0.0;
+    for i in 0..azimuths {
+        let psi = TAU * (i as f64 + 0.5) / azimuths as f64;
+        let c = psi.cos();
+        if c > 0.0 {
+            let d = distance_to_wall.max(0.0) / c;
+            if d < radius {
+                occlusion += (1.0 - d / radius).powi(2);
+            }
+        }
+    }
+    1.0 - occlusion / azimuths as f64
 }
 
 #[cfg(test)]
@@ -532,7 +664,7 @@ mod tests {
             let p = DVec3::new(0.2, 0.0, CREASE_WALL_Z + x);
             // An eye far out along the wall normal, barely above the floor, looking at
             // the wall: depth differences are distances behind the wall plane.
-            let view = DepthView { eye: DVec3::new(0.2, 0.5, 1e4), forward: DVec3::NEG_Z };
+            let view = DepthView { eye: DVec3::new(0.2, 0.5, 50.0), forward: DVec3::NEG_Z };
             for (estimator, kernel) in [(Estimator::Ssao, &ssao_kernel), (Estimator::Ssdo, &ssdo_kernel)] {
                 let params = EstimatorParams { estimator, radius: R, bias: 0.02, range_check: true, rotations: 720 };
                 let simulated = screen_space_expectation(&params, p, DVec3::Y, kernel, &view, hit);
@@ -569,6 +701,22 @@ mod tests {
             let simulated = screen_space_expectation(&params, p, DVec3::Y, &kernel, &view, hit);
             let closed = ssao_crease_expectation(x, R, 0.0, &kernel);
             assert!((simulated - closed).abs() < 3e-3, "x = {x}: {simulated} vs {closed}");
+            // With a bias, the depth scale along the ray through P stands in for the
+            // rays through the samples.
+            let e = (p - eye).normalize();
+            let k = e.dot(view.forward) / e.z.abs();
+            for (estimator, density) in
+                [(Estimator::Ssao, HemisphereDensity::Cosine), (Estimator::Ssdo, HemisphereDensity::Uniform)]
+            {
+                let kernel = hemisphere_kernel(64, density);
+                let params = EstimatorParams { estimator, radius: R, bias: 0.02, range_check: true, rotations: 360 };
+                let simulated = screen_space_expectation(&params, p, DVec3::Y, &kernel, &view, hit);
+                let closed = match estimator {
+                    Estimator::Ssao => ssao_crease_expectation_with_depth_scale(x, R, 0.02, &kernel, k),
+                    Estimator::Ssdo => ssdo_crease_expectation_with_depth_scale(x, R, 0.02, &kernel, k),
+                };
+                assert!((simulated - closed).abs() < 5e-3, "{estimator:?} x = {x}: {simulated} vs {closed} (k = {k})");
+            }
         }
     }
 
@@ -586,5 +734,65 @@ mod tests {
             let v = screen_space_expectation(&params, p, DVec3::Y, &hemisphere_kernel(64, density), &view, hit);
             assert_eq!(v, 1.0, "{estimator:?}");
         }
+    }
+
+    #[test]
+    fn hbao_slices_integrate_to_the_falloff_reference() {
+        for x in [0.0, 0.05, 0.2, 0.5, 0.8, 1.0, 1.5] {
+            let slices = crease_hbao_slices(x, R, 20_000);
+            let falloff = crease_visibility_falloff(x, R);
+            assert!((slices - falloff).abs() < 1e-4, "x = {x}: slices {slices}, falloff {falloff}");
+        }
+    }
+
+    fn crease_eye() -> Eye {
+        use crate::stereo::{EyeSide, HeadsetProfile};
+        let target = DVec3::new(0.0, 0.0, CREASE_WALL_Z);
+        let pose = crate::stereo::HeadPose::look_at(target + DVec3::new(0.0, 1.8, 1.8), target).unwrap();
+        Eye { side: EyeSide::Left, pose, fov: HeadsetProfile::with_size("t", 160, 180).fov_left }
+    }
+
+    #[test]
+    fn hbao_on_an_open_floor_is_one_and_on_the_crease_near_the_reference() {
+        let rects = crease_rects();
+        let hit = |o: DVec3, d: DVec3| first_hit(&rects, o, d);
+        let eye = crease_eye();
+        let size = (160, 180);
+        let params = HbaoParams { radius: R, bias: 0.02, directions: 8, steps: 8, rotations: 56 };
+        let mut last = 0.0;
+        // Walk down the middle column from the crease line towards the eye.
+        let mut seen = 0;
+        for y in 95..180 {
+            let dir = pixel_ray(&eye, size, (80.5, y as f64 + 0.5));
+            let Some(t) = hit(eye.pose.position, dir) else { continue };
+            let p = eye.pose.position + dir * t;
+            if p.y.abs() > 1e-9 {
+                continue;
+            }
+            let x = p.z - CREASE_WALL_Z;
+            let v = hbao_expectation(&params, &eye, size, (80, y), DVec3::Y, hit);
+            if x > R {
+                assert_eq!(v, 1.0, "open floor at x = {x}");
+            } else if x > 0.1 {
+                // Discretisation, angle bias and perspective keep HBAO within 0.1 of the
+                // continuum; it never darkens more than the reference.
+                let f = crease_visibility_falloff(x, R);
+                assert!((v - f).abs() < 0.1 && v >= f - 0.02, "x = {x}: hbao {v}, falloff reference {f}");
+                seen += 1;
+            }
+            assert!(v >= last - 0.01, "not monotone at x = {x}");
+            last = v;
+        }
+        assert!(seen > 10);
+    }
+
+    #[test]
+    fn pixel_ray_matches_projection() {
+        let eye = crease_eye();
+        let size = (160, 180);
+        let p = DVec3::new(0.3, 0.0, CREASE_WALL_Z + 0.4);
+        let (uv, _) = eye.project(p, 0.05).unwrap();
+        let dir = pixel_ray(&eye, size, (uv[0] * 160.0, uv[1] * 180.0));
+        assert!(dir.dot((p - eye.pose.position).normalize()) > 1.0 - 1e-12);
     }
 }

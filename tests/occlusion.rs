@@ -13,8 +13,8 @@ mod common;
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
-use vrao::analytic::{self, DepthView, Estimator, EstimatorParams};
-use vrao::sampling::{hemisphere_kernel, HemisphereDensity};
+use vrao::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
+use vrao::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
 use vrao::scene::builtin::{CREASE_WALL_Z, ROOM_MAX, ROOM_MIN};
 use vrao::scene::{environment, Environment, Scene};
 use vrao::settings::{AoSettings, Noise, Technique};
@@ -183,7 +183,7 @@ fn open_plane_is_unoccluded_for_every_technique() {
                     }
                     covered += 1;
                     let a = f.ao(r, l, x, y);
-                    if !(a >= worst.0) {
+                    if a.is_nan() || a < worst.0 {
                         worst = (a, l, x, y);
                     }
                 }
@@ -258,9 +258,12 @@ struct CreaseBin {
     pixels: usize,
     raw: f64,
     blurred: f64,
-    /// The estimator's expectation at each pixel (SSAO, SSDO), and blurred like the AO.
+    /// The estimator's expectation at each pixel, simulated on the CPU (SSAO and SSDO:
+    /// depth tests against the crease; HBAO: its march), and blurred like the AO.
     expected_raw: f64,
     expected_blurred: f64,
+    /// SSAO and SSDO: the closed forms `analytic::ss{a,d}o_crease_expectation_with_depth_scale`.
+    closed_raw: f64,
     /// Reference visibility (hits within r) and with HBAO's linear falloff, per pixel and
     /// blurred like the AO.
     reference: f64,
@@ -286,24 +289,28 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
     settings.ao.noise = Noise::Halton;
     let f = render(gpu, &scene, &settings, &crease_head(), &[Resource::AoRaw, Resource::AoBlurred]);
     let r = CREASE_RADIUS;
+    // SSAO and SSDO by their depth-test simulation, HBAO by its march (None).
     let estimator = match technique {
         Technique::Ssao => Some((Estimator::Ssao, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Cosine))),
         Technique::Ssdo | Technique::SsdoBounce => {
             Some((Estimator::Ssdo, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Uniform)))
         }
-        _ => None,
+        Technique::Hbao => None,
+        other => panic!("no crease expectation for {}", other.name()),
     };
+    let (directions, steps) = hbao_directions_steps(CREASE_SAMPLES);
+    let hbao = HbaoParams { radius: r, bias: 0.02, directions, steps, rotations: 28 };
     let rects = analytic::crease_rects();
     let hit = |o: DVec3, d: DVec3| analytic::first_hit(&rects, o, d);
     let blur = settings.ao.blur_radius as i32;
     let mut bins: Vec<CreaseBin> =
         (0..CREASE_BINS).map(|i| CreaseBin { lo: i as f64 * CREASE_BIN, ..Default::default() }).collect();
-    let mut counts = vec![0usize; CREASE_BINS];
     for layer in 0..2 {
         let n = (w * h) as usize;
         let class: Vec<u8> = f.world[layer].iter().map(|p| crease_class(*p)).collect();
         let mut modelled = vec![false; n];
         let mut expected = vec![1.0; n];
+        let mut closed = vec![1.0; n];
         let mut falloff = vec![1.0; n];
         let view = DepthView { eye: f.eyes.eyes[layer].pose.position, forward: f.forward(layer) };
         for i in 0..n {
@@ -312,33 +319,52 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
                 continue;
             }
             let d = crease_distance(p, c);
-            // The part of the other surface within r, with 0.2 m to spare.
-            let reach = r + 0.2;
-            let corners = if c == 1 {
-                [DVec3::new(p.x - reach, 0.0, CREASE_WALL_Z), DVec3::new(p.x + reach, 0.0, CREASE_WALL_Z)]
-                    .into_iter()
-                    .chain([
-                        DVec3::new(p.x - reach, reach, CREASE_WALL_Z),
-                        DVec3::new(p.x + reach, reach, CREASE_WALL_Z),
-                    ])
-                    .collect::<Vec<_>>()
-            } else {
-                vec![
-                    DVec3::new(p.x - reach, 0.0, CREASE_WALL_Z),
-                    DVec3::new(p.x + reach, 0.0, CREASE_WALL_Z),
-                    DVec3::new(p.x - reach, 0.0, CREASE_WALL_Z + reach),
-                    DVec3::new(p.x + reach, 0.0, CREASE_WALL_Z + reach),
-                ]
-            };
-            modelled[i] = p.x.abs() <= 3.0 && (d >= reach || corners.iter().all(|&q| f.on_screen(layer, q, 0.005)));
+            // The part of the other surface within r of P is a half disc of radius
+            // √(r² − d²) around the foot of P on the crease line; it (with 0.2 m to
+            // spare for the wall points that hide samples just behind the wall) must be
+            // on screen. Checked along its rim every 15°.
+            let rim = (r * r - d * d).max(0.0).sqrt() + 0.2;
+            let on_screen = (0..=12).all(|k| {
+                let (sin, cos) = (k as f64 * std::f64::consts::PI / 12.0).sin_cos();
+                let q = if c == 1 {
+                    DVec3::new(p.x + rim * cos, rim * sin, CREASE_WALL_Z)
+                } else {
+                    DVec3::new(p.x + rim * cos, 0.0, CREASE_WALL_Z + rim * sin)
+                };
+                f.on_screen(layer, q, 0.005)
+            });
+            modelled[i] = p.x.abs() <= 3.0 && (d >= r || on_screen);
             falloff[i] = analytic::crease_visibility_falloff(d, r);
-            if let Some((est, kernel)) = &estimator {
-                if d < r * 1.05 {
-                    let normal = if c == 1 { DVec3::Y } else { DVec3::Z };
-                    let params =
-                        EstimatorParams { estimator: *est, radius: r, bias: 0.02, range_check: true, rotations: 24 };
-                    expected[i] = analytic::screen_space_expectation(&params, p, normal, kernel, &view, hit);
-                }
+            if d < r * 1.05 {
+                let normal = if c == 1 { DVec3::Y } else { DVec3::Z };
+                expected[i] = match &estimator {
+                    Some((est, kernel)) => {
+                        // Depth per metre behind the other surface along the ray to P.
+                        let e = (p - view.eye).normalize();
+                        let other_normal = if c == 1 { DVec3::Z } else { DVec3::Y };
+                        let k = e.dot(view.forward) / e.dot(other_normal).abs();
+                        closed[i] = match est {
+                            Estimator::Ssao => {
+                                analytic::ssao_crease_expectation_with_depth_scale(d, r, 0.02, kernel, k)
+                            }
+                            Estimator::Ssdo => {
+                                analytic::ssdo_crease_expectation_with_depth_scale(d, r, 0.02, kernel, k)
+                            }
+                        };
+                        let params = EstimatorParams {
+                            estimator: *est,
+                            radius: r,
+                            bias: 0.02,
+                            range_check: true,
+                            rotations: 24,
+                        };
+                        analytic::screen_space_expectation(&params, p, normal, kernel, &view, hit)
+                    }
+                    None => {
+                        let pixel = (i as u32 % w, i as u32 / w);
+                        analytic::hbao_expectation(&hbao, &f.eyes.eyes[layer], (w, h), pixel, normal, hit)
+                    }
+                };
             }
         }
         let expected_blurred = same_surface_blur(&expected, &class, w, h, blur);
@@ -374,17 +400,16 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
                 b.pixels += 1;
                 b.raw += f.ao(Resource::AoRaw, layer, x, y);
                 b.expected_raw += expected[i];
+                b.closed_raw += closed[i];
                 b.reference += analytic::crease_visibility(d, r);
                 b.falloff_raw += falloff[i];
-                let window_ok =
-                    near_other(blur, &|q| class[q] != class[i] || modelled[q]) && x as i32 >= blur && y as i32 >= blur;
+                let window_ok = near_other(blur, &|q| class[q] != class[i] || modelled[q]);
                 if window_ok {
                     b.blurred_pixels += 1;
                     b.blurred += f.ao(Resource::AoBlurred, layer, x, y);
                     b.expected_blurred += expected_blurred[i];
                     b.falloff_blurred += falloff_blurred[i];
                 }
-                counts[bin] += 1;
             }
         }
     }
@@ -392,26 +417,32 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
         let (n, nb) = (b.pixels.max(1) as f64, b.blurred_pixels.max(1) as f64);
         b.raw /= n;
         b.expected_raw /= n;
+        b.closed_raw /= n;
         b.reference /= n;
         b.falloff_raw /= n;
         b.blurred /= nb;
         b.expected_blurred /= nb;
         b.falloff_blurred /= nb;
     }
-    eprintln!("crease {}: distance | px raw expected | px blurred expected | reference falloff", technique.name());
+    eprintln!(
+        "crease {}: distance | px raw expected closed-form | px blurred expected | reference, falloff reference raw blurred",
+        technique.name()
+    );
     for b in &bins {
         eprintln!(
-            "  [{:.1}, {:.1}) | {:4} {:.3} {:.3} | {:4} {:.3} {:.3} | {:.3} {:.3}",
+            "  [{:.1}, {:.1}) | {:4} {:.3} {:.3} {:.3} | {:4} {:.3} {:.3} | {:.3} {:.3} {:.3}",
             b.lo,
             b.lo + CREASE_BIN,
             b.pixels,
             b.raw,
             b.expected_raw,
+            b.closed_raw,
             b.blurred_pixels,
             b.blurred,
             b.expected_blurred,
             b.reference,
-            b.falloff_raw
+            b.falloff_raw,
+            b.falloff_blurred
         );
     }
     bins
@@ -443,100 +474,130 @@ fn assert_falls_towards_the_edge(name: &str, bins: &[CreaseBin]) {
     );
 }
 
+/// Asserts `|value − expected| ≤ tolerance` in every bin with at least 100 pixels.
+fn assert_bins(
+    name: &str,
+    what: &str,
+    bins: &[CreaseBin],
+    tolerance: f64,
+    get: impl Fn(&CreaseBin) -> (usize, f64, f64),
+) {
+    let mut checked = 0;
+    for b in bins {
+        let (pixels, value, expected) = get(b);
+        if pixels < 100 {
+            continue;
+        }
+        checked += 1;
+        assert!(
+            (value - expected).abs() <= tolerance,
+            "{name} {what} at [{:.1}, {:.1}) m ({pixels} px): {value:.3}, expected {expected:.3} ± {tolerance}",
+            b.lo,
+            b.lo + CREASE_BIN
+        );
+    }
+    assert!(checked >= 10, "{name} {what}: only {checked} bins populated");
+}
+
+/// Tolerance of a bin mean against the estimator's own expectation (SSAO, HBAO, SSDO).
+///
+/// The expectation runs the estimator's test on the CPU (`vrao::analytic`) at each
+/// pixel's reconstructed position with the real eye, averaged over kernel rotations, so
+/// what remains is: (a) the finite rotation pattern: one pixel's SSAO with 64 taps varies
+/// by ±0.02 (one standard deviation) over rotations near the crease, and a bin averages
+/// ≥ 100 (mostly ≥ 500) pixels whose R2-sequence rotations are evenly spread, so the bin
+/// mean is within about 0.002 of the rotation average; (b) the depth probe reads the
+/// surface at the centre of the pixel a sample falls in, not on the ray through the
+/// sample: half a pixel on a surface seen at 45° moves the depth tolerance by up to
+/// ±0.01 m per sample, which averages out over samples and pixels to well below 0.005;
+/// (c) f16 storage (2.5e-4 near 0.8) and 24 (HBAO 28) simulated rotations (≈ 0.002).
+/// 0.01 covers these. It is tight enough to catch a wrong parameter: at 0.15 m from
+/// the crease a radius 10 % short raises SSAO by 0.016, no bias lowers it by 0.013, a
+/// doubled bias raises it by 0.018, half the taps (a shorter kernel) by 0.006.
+const EXPECTATION_TOLERANCE: f64 = 0.01;
+
 #[test]
 fn crease_ssao_matches_its_expected_value() {
     let (gpu, _guard) = common::gpu();
     let bins = measure_crease(&gpu, Technique::Ssao);
     assert_falls_towards_the_edge("ssao", &bins);
-    // Tolerance 0.03 per bin. The expectation simulates SSAO's own test (kernel,
-    // normal offset, depth tolerance bias·r, range check) at each pixel's reconstructed
-    // position with the real eye, averaged over 24 kernel rotations; what remains is
-    // (a) the finite rotation pattern: the per-pixel AO of 64 taps varies by about ±0.05
-    // over rotations, and a bin averages ≥ 300 pixels with R2-sequence rotations, so its
-    // mean is within about 0.005 of the rotation average; (b) the depth probe reads the
-    // surface at the centre of the pixel a sample falls in, not on the ray through it:
-    // half a pixel on a wall seen at 45° shifts the depth tolerance by up to ±0.01 m
-    // (about ±0.01 in AO where AO changes fastest), mostly averaging out; (c) f16
-    // storage (5e-4). Blur is linear, so the blurred AO is compared with the same blur
-    // applied to the expectation image.
+    assert_bins("ssao", "raw vs simulated", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.expected_raw));
+    // The closed form takes the depth tolerance at the depth scale of the ray through P
+    // instead of each sample's ray: no difference at this size (checked against the
+    // simulation in analytic's unit tests to 0.005).
+    assert_bins("ssao", "raw vs closed form", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.closed_raw));
+    // Blur is linear, so the blurred AO is compared with the same blur applied to the
+    // expectation image.
+    assert_bins("ssao", "blurred vs simulated", &bins, EXPECTATION_TOLERANCE, |b| {
+        (b.blurred_pixels, b.blurred, b.expected_blurred)
+    });
+    // SSAO's samples crowd towards P (lengths r(0.1 + 0.9t²)), so it is lighter than the
+    // reference within r (hits within r); it must not be darker.
     for b in bins.iter().filter(|b| b.pixels >= 100) {
-        assert!(
-            (b.raw - b.expected_raw).abs() <= 0.03,
-            "ssao raw at [{:.1}, {:.1}) m: {:.3}, expected {:.3}",
-            b.lo,
-            b.lo + CREASE_BIN,
-            b.raw,
-            b.expected_raw
-        );
-    }
-    for b in bins.iter().filter(|b| b.blurred_pixels >= 100) {
-        assert!(
-            (b.blurred - b.expected_blurred).abs() <= 0.03,
-            "ssao blurred at [{:.1}, {:.1}) m: {:.3}, expected {:.3}",
-            b.lo,
-            b.lo + CREASE_BIN,
-            b.blurred,
-            b.expected_blurred
-        );
+        assert!(b.raw >= b.reference - EXPECTATION_TOLERANCE, "ssao darker than the reference at {:.1} m: {b:?}", b.lo);
     }
 }
 
 #[test]
-fn crease_hbao_approximates_the_falloff_weighted_reference() {
+fn crease_hbao_matches_its_expected_value_and_approximates_the_falloff_reference() {
     let (gpu, _guard) = common::gpu();
     let bins = measure_crease(&gpu, Technique::Hbao);
     assert_falls_towards_the_edge("hbao", &bins);
+    assert_bins("hbao", "raw vs simulated", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.expected_raw));
+    assert_bins("hbao", "blurred vs simulated", &bins, EXPECTATION_TOLERANCE, |b| {
+        (b.blurred_pixels, b.blurred, b.expected_blurred)
+    });
+    // Against the reference with HBAO's attenuation (1 − d/r), the quantity HBAO's
+    // cosine-weighted (sin²h) horizon integral tends to for vertical slices at uniform
+    // azimuths (`crease_hbao_slices` = `crease_visibility_falloff`, unit-tested):
+    // tolerance 0.11 = 0.10 + 0.01. The 0.10 bounds HBAO's own bias on this view: its
+    // expectation (`hbao_expectation`) lies up to 0.095 above the reference per bin
+    // (0.11 at single pixels at x = 0.12 m, 0.05 at 0.25 m), asserted first. About 0.09
+    // of it remains with 64 directions × 64 steps and no angle bias, so it is the slice
+    // geometry, not sampling: a screen line through P contains the view ray, so it meets
+    // the wall along a tilted line whose points lie farther to the side than a vertical
+    // slice's, and its horizon is lower. 8 × 8 taps (the horizon rises only at taps, each
+    // weighted by the attenuation at its own, farther, distance) and the angle bias
+    // sin h₀ = 5 · bias add 0.01–0.02. The 0.01 is the noise allowance above. All these
+    // biases lighten, so HBAO must not be darker than the reference beyond the noise.
+    assert_bins("hbao", "expectation vs falloff reference", &bins, 0.10, |b| {
+        (b.blurred_pixels, b.expected_blurred, b.falloff_blurred)
+    });
+    assert_bins("hbao", "blurred vs falloff reference", &bins, 0.11, |b| {
+        (b.blurred_pixels, b.blurred, b.falloff_blurred)
+    });
     for b in bins.iter().filter(|b| b.blurred_pixels >= 100) {
         assert!(
-            (b.blurred - b.falloff_blurred).abs() <= HBAO_TOLERANCE,
-            "hbao blurred at [{:.1}, {:.1}) m: {:.3}, falloff reference {:.3}",
-            b.lo,
-            b.lo + CREASE_BIN,
-            b.blurred,
-            b.falloff_blurred
+            b.blurred >= b.falloff_blurred - EXPECTATION_TOLERANCE,
+            "hbao darker than the falloff reference at {:.1} m: {b:?}",
+            b.lo
         );
     }
 }
-
-/// HBAO against the falloff-weighted reference (see `crease_hbao_…`).
-const HBAO_TOLERANCE: f64 = 0.1;
 
 #[test]
 fn crease_ssdo_matches_its_expected_value_and_the_falloff_reference() {
     let (gpu, _guard) = common::gpu();
     let bins = measure_crease(&gpu, Technique::Ssdo);
     assert_falls_towards_the_edge("ssdo", &bins);
-    for b in bins.iter().filter(|b| b.pixels >= 100) {
-        assert!(
-            (b.raw - b.expected_raw).abs() <= 0.03,
-            "ssdo raw at [{:.1}, {:.1}) m: {:.3}, expected {:.3}",
-            b.lo,
-            b.lo + CREASE_BIN,
-            b.raw,
-            b.expected_raw
-        );
-    }
-    for b in bins.iter().filter(|b| b.blurred_pixels >= 100) {
-        assert!(
-            (b.blurred - b.expected_blurred).abs() <= 0.03,
-            "ssdo blurred at [{:.1}, {:.1}) m: {:.3}, expected {:.3}",
-            b.lo,
-            b.lo + CREASE_BIN,
-            b.blurred,
-            b.expected_blurred
-        );
-        assert!(
-            (b.blurred - b.falloff_blurred).abs() <= SSDO_REFERENCE_TOLERANCE,
-            "ssdo blurred at [{:.1}, {:.1}) m: {:.3}, falloff reference {:.3}",
-            b.lo,
-            b.lo + CREASE_BIN,
-            b.blurred,
-            b.falloff_blurred
-        );
-    }
+    assert_bins("ssdo", "raw vs simulated", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.expected_raw));
+    assert_bins("ssdo", "raw vs closed form", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.closed_raw));
+    assert_bins("ssdo", "blurred vs simulated", &bins, EXPECTATION_TOLERANCE, |b| {
+        (b.blurred_pixels, b.blurred, b.expected_blurred)
+    });
+    // SSDO's λ uniform in [0, r] makes its continuous expectation exactly the falloff
+    // reference (`crease_visibility_falloff` docs). Tolerance 0.06 = 0.05 + 0.01: the
+    // 64-sample kernel's own deviation from the continuum plus the depth bias (samples
+    // must be 0.02 r behind the wall, the occluder 0.02 r above the floor) is at most
+    // 0.045 at x ≥ 0.1 m (`ssdo_crease_expectation` against `crease_visibility_falloff`;
+    // 0.03 per bin here), asserted first, plus the noise allowance above.
+    assert_bins("ssdo", "expectation vs falloff reference", &bins, 0.05, |b| {
+        (b.blurred_pixels, b.expected_blurred, b.falloff_blurred)
+    });
+    assert_bins("ssdo", "blurred vs falloff reference", &bins, 0.06, |b| {
+        (b.blurred_pixels, b.blurred, b.falloff_blurred)
+    });
 }
-
-const SSDO_REFERENCE_TOLERANCE: f64 = 0.08;
 
 // ---------------------------------------------------------------------------------------
 // SSDO with a single light
@@ -568,15 +629,18 @@ fn ssdo_shadows_the_side_away_from_a_single_light_where_ssao_cannot() {
     let mut scene = Scene::load("builtin:sphere").unwrap();
     scene.lights.clear();
     scene.environment = Some(single_light_environment(Vec3::new(1.0, 1.0, 0.0), 30.0, 8.0));
-    let head = scene.head.pose_at(0.0);
+    // From above and in front, so the floor on both sides of the sphere is in view.
+    let head = HeadPose::look_at(DVec3::new(0.0, 3.2, 3.6), DVec3::new(0.0, 0.3, 0.0)).unwrap();
     let luminance_of = |technique: Technique| {
-        let s = settings(128, 144, ao(technique, 64, 1.5));
+        let s = settings(160, 180, ao(technique, 64, 1.5));
         let f = render(&gpu, &scene, &s, &head, &[Resource::Hdr]);
         // Floor beside the sphere, on the side away from the light (−X) and on the lit
         // side (+X), mirror images of each other for this eye.
         let (mut away, mut lit) = (Vec::new(), Vec::new());
         for (l, x, y) in f.pixels() {
             let Some(p) = f.world(l, x, y) else { continue };
+            // Inside the sphere's shadow on the −X side, (X + 1)²/2 + Z² < 1 for a light at
+            // 45° above +X; the +X side mirrors it.
             if p.y.abs() > 1e-3 || p.z.abs() > 0.5 || !(1.1..=1.6).contains(&p.x.abs()) {
                 continue;
             }
@@ -597,13 +661,71 @@ fn ssdo_shadows_the_side_away_from_a_single_light_where_ssao_cannot() {
     };
     let (ssao_away, ssao_lit) = luminance_of(Technique::Ssao);
     let (ssdo_away, ssdo_lit) = luminance_of(Technique::Ssdo);
-    eprintln!("single light: ssao away {ssao_away:.4} lit {ssao_lit:.4}; ssdo away {ssdo_away:.4} lit {ssdo_lit:.4}");
-    // SSAO scales the (unshadowed) ambient irradiance by a direction-blind AO, so both
-    // sides of the sphere, mirror images, come out alike.
-    assert!((ssao_away / ssao_lit - 1.0).abs() < 0.1, "ssao differs between the sides: {ssao_away} vs {ssao_lit}");
-    // SSDO blocks the light's directions where the sphere stands between floor and light.
-    assert!(ssdo_away < 0.8 * ssdo_lit, "ssdo does not shadow the side away from the light: {ssdo_away} vs {ssdo_lit}");
-    assert!(ssdo_away < 0.9 * ssao_away, "the side away from the light is not darker under ssdo than under ssao");
+    let (ssao_ratio, ssdo_ratio) = (ssao_away / ssao_lit, ssdo_away / ssdo_lit);
+    eprintln!(
+        "single light: floor luminance away from / towards the light: ssao {ssao_away:.4} / {ssao_lit:.4} \
+         (ratio {ssao_ratio:.3}), ssdo {ssdo_away:.4} / {ssdo_lit:.4} (ratio {ssdo_ratio:.3})"
+    );
+    // SSAO scales the unshadowed ambient irradiance by a direction-blind AO, so the two
+    // sides, mirror images of each other for this eye, come out alike (within 5 %: the
+    // eyes sit ±32 mm off the mirror plane and the rotation noise differs).
+    assert!((ssao_ratio - 1.0).abs() < 0.05, "ssao differs between the sides: {ssao_away} vs {ssao_lit}");
+    // SSDO blocks the light's directions where the sphere stands between floor and light:
+    // the side away from the light is darker than the lit side by clearly more than
+    // under SSAO (comparing each technique with itself cancels any overall difference
+    // in how the two gather the unoccluded ambient) ...
+    assert!(
+        ssdo_ratio < ssao_ratio - 0.08,
+        "ssdo does not shadow the side away from the light: ratio {ssdo_ratio:.3} vs ssao {ssao_ratio:.3}"
+    );
+    // ... and that side is darker under SSDO than under SSAO.
+    assert!(ssdo_away < ssao_away, "the side away from the light is not darker under ssdo: {ssdo_away} vs {ssao_away}");
+}
+
+#[test]
+fn ssdo_on_an_open_plane_gathers_the_unoccluded_ambient() {
+    let (gpu, _guard) = common::gpu();
+    // On an open plane nothing is occluded, so SSDO's gathered irradiance must be the
+    // ambient irradiance the composite uses without occlusion (technique none). Lights
+    // are removed so the image is ambient only: albedo / π × irradiance.
+    let mut scene = Scene::load("builtin:plane").unwrap();
+    scene.lights.clear();
+    let head = scene.head.pose_at(0.0);
+    let floor_luminance = |scene: &Scene, technique: Technique, samples: u32| {
+        let f = render(&gpu, scene, &settings(96, 108, ao(technique, samples, 0.5)), &head, &[Resource::Hdr]);
+        mean(
+            f.pixels()
+                .filter(|&(l, x, y)| f.world(l, x, y).is_some())
+                .map(|(l, x, y)| analytic::luminance(f.rgb(Resource::Hdr, l, x, y))),
+        )
+    };
+    let mut failures = Vec::new();
+    // A constant environment L: the irradiance is π L for any normal, which every
+    // correctly normalised quadrature reproduces exactly whatever its directions; only
+    // f16 storage and the SH projection's texel sums (< 0.5 %) remain. Tolerance 2 %.
+    let texels = vec![[1.0f32; 3]; 64 * 32];
+    scene.environment = Some(Environment::from_texels(64, 32, texels, 1.0).unwrap());
+    let unoccluded = floor_luminance(&scene, Technique::None, 24);
+    for samples in [12, 24, 36, 64] {
+        let ssdo = floor_luminance(&scene, Technique::Ssdo, samples);
+        let ratio = ssdo / unoccluded;
+        eprintln!("constant sky, N = {samples}: ssdo / unoccluded floor luminance = {ratio:.4}");
+        if (ratio - 1.0).abs() > 0.02 {
+            failures.push(format!("constant environment, N = {samples}: ssdo / unoccluded = {ratio:.3}"));
+        }
+    }
+    // The single bright patch of the shadow test: the irradiance of a floor that sees
+    // all of it. SSDO's 64 rotated directions integrate a band-limited radiance to about
+    // 1 % once averaged over the floor's rotations; tolerance 5 %.
+    scene.environment = Some(single_light_environment(Vec3::new(1.0, 1.0, 0.0), 30.0, 8.0));
+    let unoccluded = floor_luminance(&scene, Technique::None, 64);
+    let ssdo = floor_luminance(&scene, Technique::Ssdo, 64);
+    let ratio = ssdo / unoccluded;
+    eprintln!("single light, N = 64: ssdo / unoccluded floor luminance = {ratio:.4}");
+    if (ratio - 1.0).abs() > 0.05 {
+        failures.push(format!("single bright patch, N = 64: ssdo / unoccluded = {ratio:.3}"));
+    }
+    assert!(failures.is_empty(), "ssdo does not reproduce the unoccluded ambient on an open plane: {failures:#?}");
 }
 
 // ---------------------------------------------------------------------------------------
@@ -646,18 +768,25 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     let (bounce_hdr, bounce_raw) = measure(&bounce);
     let (off_hdr, off_raw) = measure(&bounce_off);
     let ratio = |c: [f64; 3]| c[0] / c[1];
+    let gained: Vec<f64> = (0..3).map(|i| bounce_raw[i] - ssdo_raw[i]).collect();
     eprintln!(
-        "bounce: hdr r/g ssdo {:.3}, ssdo-bounce {:.3}, bounce 0 {:.3}; ao-raw rgb ssdo {ssdo_raw:?}, bounce {bounce_raw:?}, off {off_raw:?}",
+        "bounce: floor by the red wall, hdr r/g: ssdo {:.3}, ssdo-bounce {:.3}, bounce 0 {:.3}; \
+         ao-raw rgb: ssdo {ssdo_raw:.3?}, ssdo-bounce {bounce_raw:.3?} (gained {gained:.3?}), bounce 0 {off_raw:.3?}",
         ratio(ssdo_hdr),
         ratio(bounce_hdr),
         ratio(off_hdr)
     );
-    // A grey floor under a white light, no environment: without the bounce nothing is red.
-    assert!((ratio(ssdo_hdr) - 1.0).abs() < 0.02, "ssdo floor is not grey: {ssdo_hdr:?}");
-    assert!(ssdo_raw.iter().all(|c| c.abs() < 1e-3), "no environment: ssdo gathers nothing ({ssdo_raw:?})");
-    // With the bounce the red wall's direct light reaches the floor beside it.
-    assert!(ratio(bounce_hdr) > 1.1 * ratio(ssdo_hdr), "no red bleeding: {bounce_hdr:?} vs {ssdo_hdr:?}");
-    assert!(bounce_raw[0] > 2.0 * bounce_raw[1] && bounce_raw[0] > 1e-3, "bounce light is not red: {bounce_raw:?}");
+    // The room's ambient sky is bluish, so its floor is not grey to begin with; what the
+    // bounce adds is measured against plain SSDO, which gathers the same sky through the
+    // same samples (same kernel and rotations), so the difference of the gathered
+    // irradiance (AoRaw rgb) is the bounce alone. It carries the red wall's colour
+    // (albedo 0.75, 0.1, 0.1 under a white light): red at least 3× green and blue, and
+    // enough of it to see: a 3 % rise of the floor's r/g in the final image.
+    assert!(
+        gained[0] > 0.01 && gained[0] > 3.0 * gained[1].max(gained[2]).max(0.0),
+        "the bounce is not red: {gained:?}"
+    );
+    assert!(ratio(bounce_hdr) > 1.03 * ratio(ssdo_hdr), "no red bleeding: r/g {bounce_hdr:?} vs {ssdo_hdr:?}");
     // Bounce strength 0 is SSDO exactly (the same pass runs).
     for (a, b) in [(Resource::Hdr, Resource::Hdr), (Resource::AoRaw, Resource::AoRaw)] {
         let worst = ssdo.outputs[&a]
@@ -676,15 +805,17 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
 #[test]
 fn blur_keeps_a_depth_edge() {
     let (gpu, _guard) = common::gpu();
-    // A 1 m square 2 m ahead of a wall 4 m ahead, both facing the eye. Without the range
-    // check, SSAO darkens the far wall around the square's silhouette (samples in front
-    // of the wall project onto the much closer square): strongly occluded on the far
-    // side of the edge, unoccluded (AO = 1) on the square itself.
+    // A wall 4 m ahead, and 2 m ahead of it a panel covering the left half of the view
+    // (its right edge at x = 0), both facing the eye: a vertical depth step down the
+    // middle of each image. Without the range check, SSAO darkens the far wall beside
+    // the step (samples in front of the wall that project onto the much closer panel
+    // count as occluded, the classic halo): strongly occluded on the far side of the
+    // edge, unoccluded (AO = 1) on the panel itself.
     let scene = common::bare_scene(vec![
         common::square("wall", DVec3::new(0.0, 0.0, -4.0), 12.0, 0),
-        common::square("near", DVec3::new(0.0, 0.0, -2.0), 1.0, 0),
+        common::square("panel", DVec3::new(-3.0, 0.0, -2.0), 6.0, 0),
     ]);
-    let mut a = ao(Technique::Ssao, 32, 0.5);
+    let mut a = ao(Technique::Ssao, 32, 1.0);
     a.range_check = false;
     let s = settings(128, 144, a);
     let f = render(&gpu, &scene, &s, &HeadPose::IDENTITY, &[Resource::AoRaw, Resource::AoBlurred]);
@@ -745,9 +876,11 @@ fn blur_keeps_a_depth_edge() {
     // The blurred wall rises no more than averaging over the wall itself allows (the
     // halo fades away from the edge, so even a perfect blur lifts it a little).
     assert!(far_blur <= far_same + 0.03, "blur pulls the wall towards the square: {far_blur} vs {far_same}");
-    // Hence the jump across the silhouette survives.
+    // Hence the jump across the silhouette survives: a blur that keeps to each surface
+    // leaves about 2/3 of it here (the halo fades away from the edge, so averaging over
+    // the wall alone lifts the wall side), the naive blur about 1/7.
     assert!(
-        near_blur - far_blur >= 0.6 * (near_raw - far_raw),
+        near_blur - far_blur >= 0.5 * (near_raw - far_raw),
         "the edge is blurred away: jump {:.3} blurred vs {:.3} raw",
         near_blur - far_blur,
         near_raw - far_raw
@@ -763,31 +896,44 @@ fn half_resolution_stays_close_to_full_resolution() {
     let scene = Scene::load("builtin:room").unwrap();
     let head = scene.head.pose_at(0.0);
     for technique in [Technique::Ssao, Technique::Hbao, Technique::Ssdo] {
-        let full = settings(128, 144, ao(technique, 24, 0.5));
+        let full = settings(128, 144, ao(technique, 24, 1.0));
         let mut half = full.clone();
         half.ao.half_res = true;
         let f = render(&gpu, &scene, &full, &head, &[Resource::AoBlurred]);
         let g = render(&gpu, &scene, &half, &head, &[Resource::AoFull]);
-        let diffs: Vec<f64> = f
+        let pairs: Vec<(f64, f64)> = f
             .pixels()
             .filter(|&(l, x, y)| f.world(l, x, y).is_some())
-            .map(|(l, x, y)| (f.ao(Resource::AoBlurred, l, x, y) - g.ao(Resource::AoFull, l, x, y)).abs())
+            .map(|(l, x, y)| (f.ao(Resource::AoBlurred, l, x, y), g.ao(Resource::AoFull, l, x, y)))
             .collect();
+        let diffs: Vec<f64> = pairs.iter().map(|(a, b)| (a - b).abs()).collect();
         let mad = mean(diffs.iter().copied());
+        let mad_occluded = mean(pairs.iter().filter(|(a, b)| a.min(*b) < 0.95).map(|(a, b)| (a - b).abs()));
+        let signed = mean(pairs.iter().map(|(a, b)| a - b));
         let bad = diffs.iter().filter(|d| **d > 0.2).count() as f64 / diffs.len() as f64;
         eprintln!(
-            "half res {}: mean |full − half| {mad:.4}, {:.2} % of pixels off by > 0.2",
+            "half res {}: mean |full − half| {mad:.4} (occluded px {mad_occluded:.4}), mean full − half {signed:+.4}, \
+             {:.2} % of pixels off by > 0.2",
             technique.name(),
             bad * 100.0
         );
-        // Both estimate the same expectation from the same world-space radius; they
-        // differ by (a) residual rotation noise after the blur (per pixel about ±0.03 at
-        // 24 taps after 11×11, which alone gives a mean |difference| near 0.03), and
-        // (b) a band about one full-res pixel wide along edges where the half-res
-        // geometry misses features. 0.05 allows both; a broken upsampler (wrong
-        // neighbour, unweighted, off by a pixel) shows as bands along every edge.
-        assert!(mad < 0.05, "{}: mean |full − half| = {mad}", technique.name());
-        assert!(bad < 0.02, "{}: {:.2} % of pixels differ by > 0.2", technique.name(), bad * 100.0);
+        // Both estimate the same per-pixel expectation (same world-space radius and
+        // estimator). They differ by (a) the rotation noise left after the blur, different
+        // in the two because different pixels are sampled (about ±0.01–0.02 per pixel at
+        // 24 taps; the crease bins show the blurred AO within 0.004 of its expectation
+        // on average), and (b) interpolation: half resolution knows AO every second
+        // pixel, and where AO changes fast (contact shadows at the room's corners and
+        // box: 0.3 over about 10 px at this size) the 3×3 joint bilateral upsampling
+        // misses curvature and thin features by a few hundredths. Over every non-sky
+        // pixel (most of them unoccluded, where both are 1) the mean |difference| must
+        // stay below 0.03; over occluded pixels (AO < 0.95 in either) below 0.06, twice
+        // what (a) and (b) give. A broken upsampler (wrong neighbour, a pixel offset,
+        // weights across depth edges, a cleared last row or column) makes bands along
+        // every edge: many pixels off by more than 0.2 (allowed: 0.5 %).
+        assert!(mad < 0.03, "{}: mean |full − half| = {mad}", technique.name());
+        assert!(mad_occluded < 0.06, "{}: mean |full − half| on occluded pixels = {mad_occluded}", technique.name());
+        assert!(signed.abs() < 0.01, "{}: half resolution is biased ({signed:+.4})", technique.name());
+        assert!(bad < 0.005, "{}: {:.2} % of pixels differ by > 0.2", technique.name(), bad * 100.0);
     }
 }
 
@@ -826,9 +972,9 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
     let scene = Scene::load("builtin:room").unwrap();
     let head = scene.head.pose_at(0.0);
     for technique in AO_TECHNIQUES {
-        let s = settings(128, 144, ao(technique, 32, 0.5));
+        let s = settings(128, 144, ao(technique, 32, 1.0));
         let f = render(&gpu, &scene, &s, &head, &[Resource::AoBlurred]);
-        let (mut diffs, mut signed) = (Vec::new(), Vec::new());
+        let (mut diffs, mut signed, mut occluded, mut unmatched) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let margin = 16;
         for y in margin..f.height - margin {
             for x in margin..f.width - margin {
@@ -842,26 +988,43 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
                 if (q - p).length() > 0.01 * (p - f.eyes.eyes[0].pose.position).length() {
                     continue;
                 }
-                let d = f.ao(Resource::AoBlurred, 0, x, y) - f.ao(Resource::AoBlurred, 1, rx, ry);
+                let (left, right) = (f.ao(Resource::AoBlurred, 0, x, y), f.ao(Resource::AoBlurred, 1, rx, ry));
+                let d = left - right;
                 diffs.push(d.abs());
                 signed.push(d);
+                if left.min(right) < 0.95 {
+                    occluded.push(d.abs());
+                    // The same pixel of the right eye (no reprojection): what a test that
+                    // ignored parallax would compare.
+                    unmatched.push((left - f.ao(Resource::AoBlurred, 1, x, y)).abs());
+                }
             }
         }
         let (mad, bias) = (mean(diffs.iter().copied()), mean(signed.iter().copied()));
+        let (mad_occluded, mad_unmatched) = (mean(occluded.iter().copied()), mean(unmatched.iter().copied()));
         eprintln!(
-            "stereo {}: {} matched px, mean |left − right| {mad:.4}, mean left − right {bias:+.4}",
+            "stereo {}: {} matched px, mean |left − right| {mad:.4}, mean left − right {bias:+.4}; \
+             {} occluded px (AO < 0.95): mean |left − right| {mad_occluded:.4}, same pixel without reprojection {mad_unmatched:.4}",
             technique.name(),
-            diffs.len()
+            diffs.len(),
+            occluded.len()
         );
         assert!(diffs.len() > 5000, "too few matched pixels ({})", diffs.len());
-        // The eyes see the same surface 64 mm apart: the expectation agrees up to the
-        // screen-space view dependence, which is small; each eye's pixels sample with
-        // different rotations, so residual noise after the blur remains (about ±0.03
-        // per pixel at 32 taps), giving a mean |difference| near 0.03. 0.05 allows that
-        // and fails for an eye using the other eye's matrices or layer. No systematic
-        // difference is expected: |mean signed difference| < 0.01.
-        assert!(mad < 0.05, "{}: eyes disagree, mean |left − right| = {mad}", technique.name());
+        // The eyes see the same surface from 64 mm apart, so the per-pixel expectation
+        // agrees up to the screen-space view dependence, which is small at this baseline
+        // (the crease bins match an eye-specific expectation to 0.004 in both eyes). What
+        // differs is the rotation noise: the same surface point falls on different pixels,
+        // hence different rotations; after the 11×11 blur about ±0.01 per pixel remains.
+        // Tolerances: mean |left − right| below 0.03 over occluded pixels (AO < 0.95 in
+        // either eye: where there is something to disagree about) and below 0.015 over
+        // all matched pixels, no systematic difference (|mean left − right| < 0.01).
+        // Comparing the same pixel of both eyes without reprojection gives 0.08–0.10 on
+        // occluded pixels, so an eye rendered with the other eye's view, a swapped layer
+        // or a parallax error fails.
+        assert!(mad_occluded < 0.03, "{}: eyes disagree where occluded: {mad_occluded}", technique.name());
+        assert!(mad < 0.015, "{}: eyes disagree, mean |left − right| = {mad}", technique.name());
         assert!(bias.abs() < 0.01, "{}: one eye is systematically darker ({bias:+.4})", technique.name());
+        assert!(occluded.len() > 1000 && mad_unmatched > 2.0 * 0.03, "the case cannot tell misaligned eyes");
     }
 }
 
@@ -935,7 +1098,9 @@ fn the_plan_explains_what_occlusion_left_out() {
     for pass in AO_PASSES.iter().chain(&["blur", "upsample"]) {
         assert!(!none.runs(pass), "technique none runs {pass}");
     }
-    for pass in AO_PASSES {
+    // One pass per technique is declared; SSDO's is named "ssdo-bounce" only while the
+    // bounce is on, so with technique none the SSDO pass is left out as "ssdo".
+    for pass in ["ssao", "hbao", "ssdo"] {
         let reason = none.left_out.iter().find(|(n, _)| *n == pass).map(|(_, why)| why.as_str());
         assert!(
             reason.is_some_and(|r| r.contains("none")),
