@@ -788,14 +788,14 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     );
     assert!(ratio(bounce_hdr) > 1.03 * ratio(ssdo_hdr), "no red bleeding: r/g {bounce_hdr:?} vs {ssdo_hdr:?}");
     // Bounce strength 0 is SSDO exactly (the same pass runs).
-    for (a, b) in [(Resource::Hdr, Resource::Hdr), (Resource::AoRaw, Resource::AoRaw)] {
-        let worst = ssdo.outputs[&a]
+    for r in [Resource::Hdr, Resource::AoRaw] {
+        let worst = ssdo.outputs[&r]
             .iter()
             .flatten()
-            .zip(bounce_off.outputs[&b].iter().flatten())
+            .zip(bounce_off.outputs[&r].iter().flatten())
             .map(|(x, y)| (x - y).abs())
             .fold(0f32, f32::max);
-        assert!(worst <= 1e-3, "ssdo-bounce with bounce 0 differs from ssdo in {} by {worst}", a.name());
+        assert!(worst <= 1e-3, "ssdo-bounce with bounce 0 differs from ssdo in {} by {worst}", r.name());
     }
 }
 
@@ -824,7 +824,7 @@ fn blur_keeps_a_depth_edge() {
     let (mut near, mut far) =
         ((Vec::new(), Vec::new(), Vec::new(), Vec::new()), (Vec::new(), Vec::new(), Vec::new(), Vec::new()));
     for layer in 0..2 {
-        // 1 = square (about 2 m away), 2 = wall (about 4 m).
+        // 1 = panel (about 2 m away), 2 = wall (about 4 m).
         let class: Vec<u8> = f.world[layer].iter().map(|p| p.map_or(0, |p| if p.z > -3.0 { 1 } else { 2 })).collect();
         let raw: Vec<f64> = (0..w * h).map(|i| f.outputs[&Resource::AoRaw][layer][4 * i as usize + 3] as f64).collect();
         let same = same_surface_blur(&raw, &class, w, h, blur);
@@ -866,16 +866,16 @@ fn blur_keeps_a_depth_edge() {
         far.0.len()
     );
     assert!(near.0.len() > 200 && far.0.len() > 200, "the silhouette is visible");
-    // The case has contrast: unoccluded square, strongly occluded wall beside it.
+    // The case has contrast: unoccluded panel, strongly occluded wall beside it.
     assert!(near_raw > 0.97 && near_raw - far_raw > 0.3, "no contrast across the edge: {near_raw} vs {far_raw}");
-    // A blur that ignored the edge would pull the square down and the wall up; this
+    // A blur that ignored the edge would pull the panel down and the wall up; this
     // shows by how much (the test's power), measured on the same raw AO.
     assert!(near_naive < near_same - 0.05, "the case cannot tell a leaking blur: naive {near_naive}");
-    // The blurred square stays at its own surface's average (≈ 1), within 0.02.
-    assert!(near_blur >= near_same - 0.02, "blur pulls the square towards the wall: {near_blur} vs {near_same}");
+    // The blurred panel stays at its own surface's average (≈ 1), within 0.02.
+    assert!(near_blur >= near_same - 0.02, "blur pulls the panel towards the wall: {near_blur} vs {near_same}");
     // The blurred wall rises no more than averaging over the wall itself allows (the
     // halo fades away from the edge, so even a perfect blur lifts it a little).
-    assert!(far_blur <= far_same + 0.03, "blur pulls the wall towards the square: {far_blur} vs {far_same}");
+    assert!(far_blur <= far_same + 0.03, "blur pulls the wall towards the panel: {far_blur} vs {far_same}");
     // Hence the jump across the silhouette survives: a blur that keeps to each surface
     // leaves about 2/3 of it here (the halo fades away from the edge, so averaging over
     // the wall alone lifts the wall side), the naive blur about 1/7.
