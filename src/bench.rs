@@ -21,6 +21,14 @@ pub struct BenchCase {
     pub half_res: bool,
 }
 
+/// How each case is run: frames (after warm-up) and the timing mode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measurement {
+    pub timing: Timing,
+    pub warmup: u32,
+    pub frames: u32,
+}
+
 /// One measured row: the case and per-pass medians over the measured frames.
 #[derive(Clone, Debug)]
 pub struct BenchRow {
@@ -47,15 +55,8 @@ impl BenchRow {
 
 /// Renders `warmup + frames` frames of `case` producing only the occlusion (the AO
 /// alone, as a budget test asks), and returns the per-pass medians.
-pub fn measure(
-    gpu: &Arc<Gpu>,
-    scene: &Scene,
-    base: &Settings,
-    case: &BenchCase,
-    timing: Timing,
-    warmup: u32,
-    frames: u32,
-) -> Result<BenchRow> {
+pub fn measure(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, case: &BenchCase, how: Measurement) -> Result<BenchRow> {
+    let Measurement { timing, warmup, frames } = how;
     let mut settings = base.clone();
     settings.ao.technique = case.technique;
     settings.ao.samples = case.samples;
@@ -88,14 +89,12 @@ pub fn sweep(
     scene: &Scene,
     base: &Settings,
     cases: &[BenchCase],
-    timing: Timing,
-    warmup: u32,
-    frames: u32,
+    how: Measurement,
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
     for (i, case) in cases.iter().enumerate() {
-        let row = measure(gpu, scene, base, case, timing, warmup, frames)?;
+        let row = measure(gpu, scene, base, case, how)?;
         progress(i + 1, cases.len(), &row);
         rows.push(row);
     }

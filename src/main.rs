@@ -303,7 +303,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
 }
 
 fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
-    use vrao::bench::{sweep, to_csv, to_markdown, BenchCase};
+    use vrao::bench::{sweep, to_csv, to_markdown, BenchCase, Measurement};
     let scene = Scene::load(&args.scene)?;
     let resolutions: &[bool] = match args.resolution.as_str() {
         "full" => &[false],
@@ -351,10 +351,16 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         args.frames
     );
     let started = std::time::Instant::now();
-    let rows = sweep(&gpu, &scene, &settings, &cases, timing, args.warmup, args.frames, |done, total, row| {
-        let elapsed = started.elapsed().as_secs_f64();
-        let eta = elapsed / done as f64 * (total - done) as f64;
-        eprintln!(
+    let rows = sweep(
+        &gpu,
+        &scene,
+        &settings,
+        &cases,
+        Measurement { timing, warmup: args.warmup, frames: args.frames },
+        |done, total, row| {
+            let elapsed = started.elapsed().as_secs_f64();
+            let eta = elapsed / done as f64 * (total - done) as f64;
+            eprintln!(
             "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
             row.case.technique.name(),
             row.case.samples,
@@ -362,7 +368,8 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             if row.case.half_res { "half" } else { "full" },
             row.occlusion_ms_per_eye()
         );
-    })?;
+        },
+    )?;
     std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
     for (name, text) in [("bench.csv", to_csv(&rows)), ("bench.md", to_markdown(&rows))] {
         let path = args.out.join(name);
