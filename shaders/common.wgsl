@@ -23,8 +23,9 @@ struct Frame {
     has_environment: u32,
     // Irradiance SH9 (already scaled by the environment intensity), rgb in xyz.
     irradiance_sh: array<vec4<f32>, 9>,
-    // Pre-filtered (Hann-windowed) radiance SH9 for per-direction lookups (SSDO).
-    radiance_sh: array<vec4<f32>, 9>,
+    // Pre-filtered (Hann-windowed) radiance SH9 as a quadratic polynomial in the world
+    // direction: [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz], rgb in xyz (SSDO).
+    radiance_quadratic: array<vec4<f32>, 10>,
 };
 
 // A light in one eye's view space. kind: 0 directional (dir = direction light travels),
@@ -133,9 +134,9 @@ fn saturate_ao(a: f32) -> f32 {
     return select(1.0, clamp(a, 0.0, 1.0), a == a);
 }
 
-// Evaluates nine SH coefficients (Ramamoorthi & Hanrahan 2001) in world direction `n`:
-// irradiance from `irradiance_sh`, pre-filtered radiance from `radiance_sh`. Clamped at 0
-// because nine coefficients can ring negative opposite a bright sun.
+// Evaluates nine SH coefficients (Ramamoorthi & Hanrahan 2001) in world direction `n`
+// (the irradiance). Clamped at 0 because nine coefficients can ring negative opposite a
+// bright sun.
 fn sh_eval(c: array<vec4<f32>, 9>, n: vec3<f32>) -> vec3<f32> {
     var e = c[0].xyz * 0.282095;
     e += c[1].xyz * (0.488603 * n.y) + c[2].xyz * (0.488603 * n.z) + c[3].xyz * (0.488603 * n.x);
@@ -234,4 +235,24 @@ fn normal_agreement(n: vec3<f32>, q: vec3<f32>) -> f32 {
     let c4 = c2 * c2;
     let c8 = c4 * c4;
     return c8 * c8;
+}
+
+// A unit normal in 32 bits: octahedral mapping (Meyer et al. 2010), two 16-bit snorm
+// halves, the bits carried by an f32 (never read as a number).
+fn pack_normal(n: vec3<f32>) -> f32 {
+    let l1 = abs(n.x) + abs(n.y) + abs(n.z);
+    var o = n.xy / max(l1, 1e-20);
+    if (n.z < 0.0) {
+        o = (1.0 - abs(o.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), o >= vec2<f32>(0.0));
+    }
+    return bitcast<f32>(pack2x16snorm(o));
+}
+
+fn unpack_normal(packed: f32) -> vec3<f32> {
+    let o = unpack2x16snorm(bitcast<u32>(packed));
+    var n = vec3<f32>(o, 1.0 - abs(o.x) - abs(o.y));
+    if (n.z < 0.0) {
+        n = vec3<f32>((1.0 - abs(o.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), o >= vec2<f32>(0.0)), n.z);
+    }
+    return normalize(n);
 }

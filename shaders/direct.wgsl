@@ -1,6 +1,7 @@
 // Direct light: the scene's point and directional lights on diffuse surfaces, plus
 // emission, as outgoing radiance. The composite adds the ambient term on top, and
-// SSDO's bounce uses this as the sender radiance L_pixel (seed 002 eq. 2).
+// SSDO's bounce uses this as the sender radiance L_pixel (seed 002 eq. 2); the normal
+// rides along in alpha so the bounce reads sender radiance and normal in one fetch.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
@@ -8,7 +9,7 @@
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var emission_layers: texture_2d_array<f32>;
-@group(0) @binding(6) var direct_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(6) var direct_out: texture_storage_2d_array<rgba32float, write>;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -20,9 +21,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = vec2<i32>(id.xy);
     let depth = textureLoad(depth_layers, p, i32(layer), 0);
     var radiance = vec3<f32>(0.0);
+    var packed_normal = 0.0;
     if (depth > 0.0) {
         let position = view_position_from_depth(pixel_uv(id.xy, frame.size), depth, eye.tangents, frame.near);
         let n = textureLoad(normal_layers, p, i32(layer), 0).xyz;
+        packed_normal = pack_normal(n);
         let albedo = textureLoad(albedo_layers, p, i32(layer), 0).rgb;
         var irradiance = vec3<f32>(0.0);
         for (var i = 0u; i < frame.light_count; i++) {
@@ -39,5 +42,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let emission = textureLoad(emission_layers, p, i32(layer), 0).rgb;
         radiance = albedo / PI * irradiance + emission;
     }
-    textureStore(direct_out, p, i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
+    textureStore(direct_out, p, i32(layer), vec4<f32>(finite_or_zero3(radiance), packed_normal));
 }

@@ -2,7 +2,9 @@
 // hemisphere, each covering Δω = 2π/N, with sample points P + λ_i ω_i, λ_i ∈ [0, r_max].
 // A point below the visible surface (its projection moves towards the eye) blocks its
 // direction; unblocked directions gather the environment radiance, pre-filtered as a
-// Hann-windowed SH9 (a smooth map needs no per-sample texture fetch, seed 002 §7.2).
+// Hann-windowed SH9 (seed 002 §7.2 asks for a smooth map). Nine SH terms are a quadratic
+// polynomial in ω, so Σ L(ω_i) cos θ_i needs only the samples' moments Σc, Σcω, Σcωωᵀ:
+// ten multiply-adds per sample, and the colour is evaluated once per pixel.
 // With the bounce (seed 002 eq. 2; seed 003 §4.2), in the same loop, each blocking
 // sample's surface becomes a sender patch of area π r_max²/N × bounce strength that
 // reflects the direct light stored at its pixel towards P.
@@ -16,6 +18,24 @@
 @group(0) @binding(5) var direct_layers: texture_2d_array<f32>;
 @group(0) @binding(6) var ao_out: texture_storage_2d_array<rgba16float, write>;
 @group(0) @binding(7) var geometry_out: texture_storage_2d_array<rgba32float, write>;
+
+// Σ_i c_i L(ω_i) from the moments m0 = Σc, m1 = Σcω, and Σcωωᵀ (diagonal, and
+// off-diagonal as xy, xz, yz), all in view space; `r` turns view into world directions.
+// Clamped at 0 as the quadratic can ring slightly negative opposite a bright sun.
+fn gathered_radiance(m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>, r: mat3x3<f32>) -> vec3<f32> {
+    let second = mat3x3<f32>(
+        vec3<f32>(diag.x, off.x, off.y),
+        vec3<f32>(off.x, diag.y, off.z),
+        vec3<f32>(off.y, off.z, diag.z),
+    );
+    let w1 = r * m1;
+    let w2 = r * second * transpose(r);
+    let q = frame.radiance_quadratic;
+    let sum = q[0].xyz * m0 + q[1].xyz * w1.x + q[2].xyz * w1.y + q[3].xyz * w1.z
+        + q[4].xyz * w2[0][0] + q[5].xyz * w2[1][1] + q[6].xyz * w2[2][2]
+        + q[7].xyz * w2[0][1] + q[8].xyz * w2[0][2] + q[9].xyz * w2[1][2];
+    return max(sum, vec3<f32>(0.0));
+}
 
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the variant without).
 override BOUNCE: bool = false;
@@ -46,8 +66,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // clamped to the patch's own size so the 1/d² form factor stays bounded.
     let patch_area = PI * ao.radius * ao.radius / f32(samples);
     let min_d2 = patch_area;
-    var gathered_all = vec3<f32>(0.0);
-    var gathered_visible = vec3<f32>(0.0);
+    // Cosine-weighted moments of all and of unblocked directions (view space).
+    var all_m1 = vec3<f32>(0.0);
+    var all_diag = vec3<f32>(0.0);
+    var all_off = vec3<f32>(0.0);
+    var visible_m1 = vec3<f32>(0.0);
+    var visible_diag = vec3<f32>(0.0);
+    var visible_off = vec3<f32>(0.0);
     var bounce = vec3<f32>(0.0);
     var weight_all = 0.0;
     var weight_visible = 0.0;
@@ -55,11 +80,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let k = kernel[i];
         let omega = frame_rot * k.xyz;
         let cos_theta = k.z;
-        var incoming = vec3<f32>(0.0);
-        if (frame.has_environment != 0u) {
-            incoming = sh_eval(frame.radiance_sh, world_from_view * omega);
-        }
-        gathered_all += incoming * cos_theta;
+        let m1 = omega * cos_theta;
+        let diag = omega * m1;
+        let off = vec3<f32>(m1.x * omega.y, m1.x * omega.z, m1.y * omega.z);
+        all_m1 += m1;
+        all_diag += diag;
+        all_off += off;
         weight_all += cos_theta;
         let s = origin + omega * (k.w * ao.radius);
         let probe = probe_depth(depth_layers, layer, s, eye);
@@ -69,18 +95,20 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             blocked = false;
         }
         if (!blocked) {
-            gathered_visible += incoming * cos_theta;
+            visible_m1 += m1;
+            visible_diag += diag;
+            visible_off += off;
             weight_visible += cos_theta;
         } else if (BOUNCE) {
-            let sender = load_view_position(frame.near / probe.distance, probe.pixel, eye, frame.size, frame.near);
-            let sender_n = safe_normal(textureLoad(normal_layers, vec2<i32>(probe.pixel), i32(layer), 0).xyz, sender);
+            let sender = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
+            let sender_light = textureLoad(direct_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+            let sender_n = unpack_normal(sender_light.a);
             let to_receiver = position - sender;
             let d2 = max(dot(to_receiver, to_receiver), min_d2);
             let dir = to_receiver * inverseSqrt(max(dot(to_receiver, to_receiver), 1e-30));
             let cos_sender = max(dot(sender_n, dir), 0.0);
             let cos_receiver = max(dot(n, -dir), 0.0);
-            let radiance = max(textureLoad(direct_layers, vec2<i32>(probe.pixel), i32(layer), 0).rgb, vec3<f32>(0.0));
-            bounce += radiance * (cos_sender * cos_receiver / d2);
+            bounce += max(sender_light.rgb, vec3<f32>(0.0)) * (cos_sender * cos_receiver / d2);
         }
     }
     // Eq. 1 with Δω = 2π/N estimates ∫ L V cos dω; its N-sample quadrature error (+16 %
@@ -89,6 +117,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // is blocked, per colour channel, and that share scales the exact SH irradiance: an
     // open plane gets exactly the ambient of the other techniques, at any N.
     let visibility = select(1.0, weight_visible / weight_all, weight_all > 1e-20);
+    let gathered_all = gathered_radiance(weight_all, all_m1, all_diag, all_off, world_from_view);
+    let gathered_visible = gathered_radiance(weight_visible, visible_m1, visible_diag, visible_off, world_from_view);
     let share = select(vec3<f32>(visibility), gathered_visible / gathered_all, gathered_all > vec3<f32>(1e-20));
     var unoccluded = vec3<f32>(0.0);
     if (frame.has_environment != 0u) {

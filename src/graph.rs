@@ -17,8 +17,9 @@ pub enum Resource {
     Albedo,
     /// Emitted radiance, `Rgba16Float`.
     Emission,
-    /// Outgoing direct radiance (lights and emission), `Rgba16Float`: the composite's
-    /// base and the sender radiance of SSDO's bounce.
+    /// Outgoing direct radiance (lights and emission) in rgb, and the view-space normal
+    /// packed into alpha (octahedral, 2×16 bits), `Rgba32Float`: the composite's base,
+    /// and sender radiance plus sender normal of SSDO's bounce in a single fetch.
     Direct,
     /// Occlusion as computed (at AO resolution), `Rgba16Float`: rgb = SSDO's gathered
     /// irradiance (environment through unblocked directions plus the bounce), a = AO.
@@ -72,14 +73,13 @@ impl Resource {
             Resource::Depth => wgpu::TextureFormat::Depth32Float,
             Resource::Normals
             | Resource::Emission
-            | Resource::Direct
             | Resource::AoRaw
             | Resource::AoBlurH
             | Resource::AoBlurred
             | Resource::AoFull
             | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
             Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
-            Resource::AoGeometry => wgpu::TextureFormat::Rgba32Float,
+            Resource::AoGeometry | Resource::Direct => wgpu::TextureFormat::Rgba32Float,
             Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
         }
     }

@@ -100,10 +100,10 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1200)]
     height: u32,
     /// Interpupillary distance in metres.
-    #[arg(long, default_value_t = vrao::stereo::DEFAULT_IPD)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::stereo::DEFAULT_IPD)]
     ipd: f64,
     /// Linear exposure before tone mapping.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     exposure: f32,
     /// Timing with --frames: pipelined (GPU timestamps), serial (also wall clock per
     /// pass) or auto (serial on CPU adapters, pipelined on GPUs).
@@ -114,7 +114,7 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Reinhard white point (smallest exposed luminance shown as white).
-    #[arg(long, default_value_t = 4.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 4.0)]
     white_point: f32,
     #[command(flatten)]
     ao: AoArgs,
@@ -134,16 +134,16 @@ struct AoArgs {
     #[arg(long)]
     samples: Option<u32>,
     /// Occlusion radius in metres (default: 8 % of the scene's diagonal, within 0.01..=1 m).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     radius: Option<f32>,
     /// Occlusion weight, 0..=4 (1 = full occlusion).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     strength: f32,
     /// Depth bias as a fraction of the radius.
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
     bias: f32,
     /// SSDO bounce strength (ssdo-bounce); 0 leaves the bounce out.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     bounce: f32,
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]

@@ -30,7 +30,7 @@ pub struct FrameUniform {
     pub white_point: f32,
     pub has_environment: u32,
     pub irradiance_sh: [[f32; 4]; 9],
-    pub radiance_sh: [[f32; 4]; 9],
+    pub radiance_quadratic: [[f32; 4]; 10],
 }
 
 #[repr(C)]
@@ -191,10 +191,12 @@ impl FrameBuffers {
                 });
             }
         }
-        let to_vec4 = |sh: [glam::Vec3; 9]| sh.map(|c| c.extend(0.0).to_array());
-        let (irradiance_sh, radiance_sh) = match &scene.environment {
-            Some(env) => (to_vec4(env.irradiance_sh_scaled()), to_vec4(env.radiance_sh_prefiltered())),
-            None => ([[0.0; 4]; 9], [[0.0; 4]; 9]),
+        let (irradiance_sh, radiance_quadratic) = match &scene.environment {
+            Some(env) => (
+                env.irradiance_sh_scaled().map(|c| c.extend(0.0).to_array()),
+                env.radiance_quadratic().map(|c| c.extend(0.0).to_array()),
+            ),
+            None => ([[0.0; 4]; 9], [[0.0; 4]; 10]),
         };
         let uniform = FrameUniform {
             eyes,
@@ -206,7 +208,7 @@ impl FrameBuffers {
             white_point: settings.white_point,
             has_environment: scene.environment.is_some() as u32,
             irradiance_sh,
-            radiance_sh,
+            radiance_quadratic,
         };
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));
         if !lights.is_empty() {

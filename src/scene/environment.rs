@@ -146,6 +146,27 @@ impl Environment {
         std::array::from_fn(|k| e[k] * WINDOW_OVER_KERNEL[k])
     }
 
+    /// The pre-filtered radiance of [`Environment::radiance_sh_prefiltered`] as a
+    /// quadratic polynomial in the unit direction ω = (x, y, z), which nine SH terms are:
+    /// L(ω) = a + b·ω + qxx x² + qyy y² + qzz z² + qxy xy + qxz xz + qyz yz, returned as
+    /// [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz] (rgb each). A sum of L over
+    /// weighted directions then needs only the directions' moments (SSDO).
+    pub fn radiance_quadratic(&self) -> [Vec3; 10] {
+        let c = self.radiance_sh_prefiltered();
+        [
+            c[0] * 0.282_095 - c[6] * 0.315_392,
+            c[3] * 0.488_603,
+            c[1] * 0.488_603,
+            c[2] * 0.488_603,
+            c[8] * 0.546_274,
+            c[8] * -0.546_274,
+            c[6] * (3.0 * 0.315_392),
+            c[4] * 1.092_548,
+            c[7] * 1.092_548,
+            c[5] * 1.092_548,
+        ]
+    }
+
     /// Irradiance E(n) (times `intensity`) on a surface with unit normal `n` that sees the
     /// whole environment: ∫ L(ω) max(0, n·ω) dω, so a constant radiance L gives π L.
     /// Clamped at 0 because nine coefficients can ring slightly negative opposite a sun.
@@ -215,6 +236,21 @@ mod tests {
 
     fn directions() -> impl Iterator<Item = Vec3> {
         (0..50).map(|i| direction((i as f32 * 0.618_034).fract(), (i as f32 + 0.5) / 50.0))
+    }
+
+    #[test]
+    fn quadratic_form_equals_the_sh_expansion() {
+        let texels: Vec<[f32; 3]> =
+            (0..32 * 16).map(|i| [(i % 7) as f32, (i % 5) as f32 * 0.3, (i % 11) as f32]).collect();
+        let env = Environment::from_texels(32, 16, texels, 1.5).unwrap();
+        let (sh, q) = (env.radiance_sh_prefiltered(), env.radiance_quadratic());
+        for dir in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize(), Vec3::new(-0.7, 0.1, 0.2).normalize()] {
+            let from_sh: Vec3 = sh.iter().zip(sh9_basis(dir)).map(|(c, y)| *c * y).sum();
+            let Vec3 { x, y, z } = dir;
+            let monomials = [1.0, x, y, z, x * x, y * y, z * z, x * y, x * z, y * z];
+            let from_q: Vec3 = q.iter().zip(monomials).map(|(c, m)| *c * m).sum();
+            assert!((from_sh - from_q).abs().max_element() < 1e-4 * (1.0 + from_sh.abs().max_element()), "{dir}");
+        }
     }
 
     #[test]
