@@ -5,30 +5,19 @@
 // is known), and increments use sin²h instead of sin h: the cosine-weighted form of
 // eq. 3.2, so HBAO estimates the same cosine-weighted visibility as the reference.
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> ao: AoParams;
-@group(0) @binding(2) var depth_layers: texture_depth_2d_array;
-@group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
-@group(0) @binding(4) var ao_out: texture_storage_2d_array<rgba16float, write>;
-@group(0) @binding(5) var geometry_out: texture_storage_2d_array<rgba32float, write>;
+// Bindings and `begin_receiver`: occlusion.wgsl.
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
+    let r = begin_receiver(id);
+    if (!r.valid) {
         return;
     }
-    let layer = id.z;
-    let eye = frame.eyes[layer];
-    let fp = full_res_pixel(id.xy, ao.scale, frame.size);
-    let depth = textureLoad(depth_layers, vec2<i32>(fp), i32(layer), 0);
-    if (depth <= 0.0) {
-        textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
-        textureStore(geometry_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0));
-        return;
-    }
-    let position = load_view_position(depth, fp, eye, frame.size, frame.near);
-    let n = safe_normal(textureLoad(normal_layers, vec2<i32>(fp), i32(layer), 0).xyz, position);
-    textureStore(geometry_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(n, -position.z));
+    let layer = r.layer;
+    let eye = r.eye;
+    let fp = r.pixel;
+    let position = r.position;
+    let n = r.normal;
     // The radius R in pixels at this depth (tangent span per pixel × distance).
     let metres_per_pixel = (eye.tangents.y - eye.tangents.x) / f32(frame.size.x) * -position.z;
     let radius_px = ao.radius / max(metres_per_pixel, 1e-30);

@@ -14,10 +14,8 @@ use crate::graph::{self, Plan, Resource};
 use crate::passes::blur::BlurPass;
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectLightPass;
-use crate::passes::fetch::FetchOnlyPass;
 use crate::passes::gbuffer::GBufferPass;
-use crate::passes::hbao::HbaoPass;
-use crate::passes::ssao::SsaoPass;
+use crate::passes::occlusion::OcclusionPass;
 use crate::passes::ssdo::SsdoPass;
 use crate::passes::tonemap::TonemapPass;
 use crate::passes::upsample::UpsamplePass;
@@ -101,10 +99,10 @@ impl Renderer {
         let passes: Vec<Box<dyn Pass>> = vec![
             Box::new(GBufferPass::new(&gpu, &gpu_scene, &frame)),
             Box::new(DirectLightPass::new(&gpu)),
-            Box::new(SsaoPass::new(&gpu)),
-            Box::new(HbaoPass::new(&gpu)),
+            Box::new(OcclusionPass::ssao(&gpu)),
+            Box::new(OcclusionPass::hbao(&gpu)),
             Box::new(SsdoPass::new(&gpu)),
-            Box::new(FetchOnlyPass::new(&gpu)),
+            Box::new(OcclusionPass::fetch_only(&gpu)),
             Box::new(BlurPass::new(&gpu)),
             Box::new(UpsamplePass::new(&gpu)),
             Box::new(CompositePass::new(&gpu)),

@@ -10,6 +10,7 @@ pub const TILE: u32 = 8;
 /// WGSL sources, compiled into the binary so it runs from any directory.
 const SHADERS: &[(&str, &str)] = &[
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("occlusion.wgsl", include_str!("../../shaders/occlusion.wgsl")),
     ("ssao.wgsl", include_str!("../../shaders/ssao.wgsl")),
     ("hbao.wgsl", include_str!("../../shaders/hbao.wgsl")),
     ("ssdo.wgsl", include_str!("../../shaders/ssdo.wgsl")),

@@ -4,10 +4,8 @@
 pub mod blur;
 pub mod composite;
 pub mod direct;
-pub mod fetch;
 pub mod gbuffer;
-pub mod hbao;
-pub mod ssao;
+pub mod occlusion;
 pub mod ssdo;
 pub mod tonemap;
 pub mod upsample;
@@ -81,23 +79,6 @@ pub fn occlusion_before_upsample(settings: &Settings) -> Option<Resource> {
 pub fn final_occlusion(settings: &Settings) -> Option<Resource> {
     let ao = occlusion_before_upsample(settings)?;
     Some(if settings.ao.half_res { Resource::AoFull } else { ao })
-}
-
-/// Completes a technique pass's declaration: it reads the G-buffer, writes raw
-/// occlusion and its geometry, and is left out unless the chosen technique is one of
-/// `runs_for`.
-pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup) -> PassDecl {
-    let chosen = setup.settings.ao.technique;
-    let reason = if chosen == Technique::None {
-        "technique is none: no occlusion pass".to_string()
-    } else {
-        format!("technique is {}", chosen.name())
-    };
-    decl.read(Resource::Depth)
-        .read(Resource::Normals)
-        .write(Resource::AoRaw)
-        .write(Resource::AoGeometry)
-        .disabled_if(!runs_for.contains(&chosen), reason)
 }
 
 pub trait Pass {

@@ -3,7 +3,8 @@
 //! 0 selects the pipeline compiled without bounce work, which also does not read the
 //! direct light, so the graph need not produce it for an occlusion-only frame.
 
-use super::{technique_decl, FrameContext, FrameSetup, Pass};
+use super::occlusion::{self, technique_decl};
+use super::{FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::targets::LayeredTarget;
 use crate::gpu::Gpu;
@@ -17,20 +18,21 @@ pub struct SsdoPass {
     no_direct: LayeredTarget,
 }
 
+/// The shared occlusion bindings plus the direct light (binding 7, the bounce's senders).
 const SLOTS: [Slot; 8] = [
-    Slot::Uniform,
-    Slot::Uniform,
-    Slot::ReadBuffer,
-    Slot::Depth,
+    occlusion::SLOTS[0],
+    occlusion::SLOTS[1],
+    occlusion::SLOTS[2],
+    occlusion::SLOTS[3],
+    occlusion::SLOTS[4],
+    occlusion::SLOTS[5],
+    occlusion::SLOTS[6],
     Slot::Layers,
-    Slot::Layers,
-    Slot::Output(wgpu::TextureFormat::Rgba16Float),
-    Slot::Output(wgpu::TextureFormat::Rgba32Float),
 ];
 
 impl SsdoPass {
     pub fn new(gpu: &Gpu) -> Self {
-        let files = ["common.wgsl", "ssdo.wgsl"];
+        let files = ["common.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
         let no_direct = LayeredTarget::new(
             &gpu.device,
             "no direct light",
@@ -66,16 +68,8 @@ impl Pass for SsdoPass {
         } else {
             wgpu::BindingResource::TextureView(&self.no_direct.array_view)
         };
-        let resources = [
-            ctx.frame.frame.as_entire_binding(),
-            ctx.frame.ao.as_entire_binding(),
-            ctx.frame.kernel.as_entire_binding(),
-            ctx.view(Resource::Depth),
-            ctx.view(Resource::Normals),
-            direct,
-            ctx.view(Resource::AoRaw),
-            ctx.view(Resource::AoGeometry),
-        ];
+        let mut resources = occlusion::bindings(ctx);
+        resources.push(direct);
         let extent = ctx.ao_extent();
         let kernel = if bounce { &self.with_bounce } else { &self.without_bounce };
         kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
