@@ -92,7 +92,7 @@ struct AoParams {
     // SSDO bounce strength (0: no bounce work).
     bounce: f32,
     _pad: u32,
-    // Bilateral blur radius in pixels (5 → 11×11).
+    // Bilateral blur radius in occlusion pixels (5 → 11×11 at full resolution).
     blur_radius: u32,
     // Frame counter, for patterns that rotate over time.
     frame_index: u32,

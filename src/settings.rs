@@ -157,7 +157,9 @@ pub struct AoSettings {
     pub noise: Noise,
     /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
     pub half_res: bool,
-    /// Separable geometry-aware bilateral blur radius in pixels (5 = 11×11); 0 turns it off.
+    /// Separable geometry-aware bilateral blur radius in full-resolution pixels
+    /// (5 = 11×11; at half resolution 3 taps either side cover the same footprint);
+    /// 0 turns it off.
     pub blur_radius: u32,
 }
 

@@ -149,7 +149,9 @@ impl FrameBuffers {
             range_check: ao.range_check as u32,
             bounce: if ao.bounce_active() { ao.bounce } else { 0.0 },
             _pad: 0,
-            blur_radius: ao.blur_radius,
+            // The blur radius is in full-resolution pixels: at half resolution the same
+            // screen footprint takes half as many taps.
+            blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
             frame_index,
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
