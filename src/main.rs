@@ -72,7 +72,7 @@ struct BenchArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere).
+    /// A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box).
     #[arg(long, default_value = "builtin:room")]
     scene: String,
     /// Output directory.
@@ -93,10 +93,10 @@ struct RenderArgs {
     /// Stereo G-buffer path: auto, multiview or multipass.
     #[arg(long, default_value = "auto")]
     stereo: StereoMode,
-    /// Per-eye width in pixels (default: the Vive-class 1080).
+    /// Per-eye width in pixels (Vive-class default).
     #[arg(long, default_value_t = 1080)]
     width: u32,
-    /// Per-eye height in pixels (default: the Vive-class 1200).
+    /// Per-eye height in pixels (Vive-class default).
     #[arg(long, default_value_t = 1200)]
     height: u32,
     /// Interpupillary distance in metres.
@@ -148,7 +148,7 @@ struct AoArgs {
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
-    /// Bilateral blur radius in pixels (5 = 11×11); 0 turns the blur off.
+    /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns the blur off.
     #[arg(long, default_value_t = 5)]
     blur: u32,
     /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
