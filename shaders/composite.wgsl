@@ -1,4 +1,6 @@
-// Composite: direct light plus the ambient term attenuated by occlusion, in HDR.
+// Composite: direct light plus the ambient term attenuated by occlusion, in HDR. With
+// HALF_RES the occlusion arrives at half resolution and is upsampled here, per pixel
+// (joint_upsample.wgsl), instead of in a pass of its own.
 // technique 0: unoccluded ambient (SH irradiance of the environment);
 // 1: ambient × AO (SSAO, HBAO); 2: SSDO's gathered irradiance (rgb) replaces it.
 // Sky pixels show the environment.
@@ -13,6 +15,10 @@
 @group(0) @binding(7) var environment: texture_2d<f32>;
 @group(0) @binding(8) var environment_sampler: sampler;
 @group(0) @binding(9) var hdr_out: texture_storage_2d_array<rgba16float, write>;
+// AoGeometry of half-resolution occlusion (HALF_RES only).
+@group(0) @binding(10) var geometry_low: texture_2d_array<f32>;
+
+override HALF_RES: bool = false;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -36,10 +42,19 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (frame.has_environment != 0u) {
             ambient = sh_eval(frame.irradiance_sh, (eye.world_from_view * vec4<f32>(n, 0.0)).xyz);
         }
+        var occlusion = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        if (ao.technique != 0u) {
+            if (HALF_RES) {
+                let position = view_position_from_depth(pixel_uv(id.xy, frame.size), depth, eye.tangents, frame.near);
+                occlusion = joint_upsample(geometry_low, occlusion_layers, id, eye, position, safe_normal(n, position));
+            } else {
+                occlusion = textureLoad(occlusion_layers, p, layer, 0);
+            }
+        }
         if (ao.technique == 1u) {
-            ambient *= saturate_ao(textureLoad(occlusion_layers, p, layer, 0).a);
+            ambient *= saturate_ao(occlusion.a);
         } else if (ao.technique == 2u) {
-            ambient = max(textureLoad(occlusion_layers, p, layer, 0).rgb, vec3<f32>(0.0));
+            ambient = max(occlusion.rgb, vec3<f32>(0.0));
         }
         radiance = textureLoad(direct_layers, p, layer, 0).rgb + albedo / PI * ambient;
     }

@@ -16,6 +16,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("ssdo.wgsl", include_str!("../../shaders/ssdo.wgsl")),
     ("fetch.wgsl", include_str!("../../shaders/fetch.wgsl")),
     ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),
+    ("joint_upsample.wgsl", include_str!("../../shaders/joint_upsample.wgsl")),
     ("upsample.wgsl", include_str!("../../shaders/upsample.wgsl")),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),

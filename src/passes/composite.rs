@@ -1,42 +1,49 @@
 //! Composite: direct light plus the ambient term, attenuated by the occlusion the graph
-//! produced (or unoccluded when the technique is none), and the sky.
+//! produced (or unoccluded when the technique is none), and the sky. Half-resolution
+//! occlusion is upsampled here, per pixel (3×3 joint bilateral, shared with the
+//! upsample pass), so a frame writes and reads no full-resolution occlusion target.
 
-use super::{final_occlusion, FrameContext, FrameSetup, Pass};
+use super::{occlusion_before_upsample, FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::targets::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 
 pub struct CompositePass {
-    kernel: Kernel,
-    /// Bound in place of occlusion when no technique runs (the shader ignores it then).
-    no_occlusion: LayeredTarget,
+    full_res: Kernel,
+    half_res: Kernel,
+    /// Bound in place of occlusion or its geometry where the shader does not read them.
+    unused: LayeredTarget,
 }
+
+const SLOTS: [Slot; 11] = [
+    Slot::Uniform,
+    Slot::Uniform,
+    Slot::Depth,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::Texture2d,
+    Slot::Sampler,
+    Slot::Output(wgpu::TextureFormat::Rgba16Float),
+    Slot::Layers,
+];
 
 impl CompositePass {
     pub fn new(gpu: &Gpu) -> Self {
-        let slots = [
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Depth,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Texture2d,
-            Slot::Sampler,
-            Slot::Output(Resource::Hdr.format()),
-        ];
-        let no_occlusion = LayeredTarget::new(
+        let files = ["common.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
+        let unused = LayeredTarget::new(
             &gpu.device,
-            "no occlusion",
+            "unused occlusion",
             wgpu::TextureFormat::Rgba16Float,
             (1, 1, 2),
             wgpu::TextureUsages::TEXTURE_BINDING,
         );
         CompositePass {
-            kernel: Kernel::new(gpu, "composite", &["common.wgsl", "composite.wgsl"], "main", &slots),
-            no_occlusion,
+            full_res: Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &[("HALF_RES", 0.0)]),
+            half_res: Kernel::with_constants(gpu, "composite half-res", &files, "main", &SLOTS, &[("HALF_RES", 1.0)]),
+            unused,
         }
     }
 }
@@ -49,16 +56,23 @@ impl Pass for CompositePass {
             .read(Resource::Albedo)
             .read(Resource::Direct)
             .write(Resource::Hdr);
-        match final_occlusion(setup.settings) {
-            Some(ao) => decl.read(ao),
+        match occlusion_before_upsample(setup.settings) {
             None => decl,
+            Some(occlusion) if setup.settings.ao.half_res => decl
+                .read(occlusion)
+                .read(Resource::AoGeometry)
+                .note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)"),
+            Some(occlusion) => decl.read(occlusion),
         }
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let occlusion = match final_occlusion(ctx.setup.settings) {
-            Some(ao) => ctx.view(ao),
-            None => wgpu::BindingResource::TextureView(&self.no_occlusion.array_view),
+        let unused = || wgpu::BindingResource::TextureView(&self.unused.array_view);
+        let half_res = ctx.setup.settings.ao.half_res;
+        let (occlusion, geometry) = match occlusion_before_upsample(ctx.setup.settings) {
+            Some(occlusion) if half_res => (ctx.view(occlusion), ctx.view(Resource::AoGeometry)),
+            Some(occlusion) => (ctx.view(occlusion), unused()),
+            None => (unused(), unused()),
         };
         let resources = [
             ctx.frame.frame.as_entire_binding(),
@@ -71,8 +85,10 @@ impl Pass for CompositePass {
             wgpu::BindingResource::TextureView(&ctx.scene.environment),
             wgpu::BindingResource::Sampler(&ctx.scene.sampler),
             ctx.view(Resource::Hdr),
+            geometry,
         ];
         let extent = ctx.extent();
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        let kernel = if half_res { &self.half_res } else { &self.full_res };
+        kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
     }
 }

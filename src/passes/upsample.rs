@@ -1,5 +1,7 @@
-//! 3×3 joint bilateral upsampling of half-resolution occlusion (seed 000), guided by
-//! the full-resolution depth and normals (shaders/upsample.wgsl).
+//! 3×3 joint bilateral upsampling of half-resolution occlusion (seed 000) into a
+//! full-resolution target (shaders/upsample.wgsl). Frames upsample inside the composite
+//! instead, so the graph runs this pass only when AoFull itself is asked for (debug
+//! images, tests).
 
 use super::{occlusion_before_upsample, FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
@@ -21,7 +23,15 @@ impl UpsamplePass {
             Slot::Layers,
             Slot::Output(Resource::AoFull.format()),
         ];
-        UpsamplePass { kernel: Kernel::new(gpu, "upsample", &["common.wgsl", "upsample.wgsl"], "main", &slots) }
+        UpsamplePass {
+            kernel: Kernel::new(
+                gpu,
+                "upsample",
+                &["common.wgsl", "joint_upsample.wgsl", "upsample.wgsl"],
+                "main",
+                &slots,
+            ),
+        }
     }
 }
 
