@@ -13,19 +13,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.valid) {
         return;
     }
-    let layer = r.layer;
-    let eye = r.eye;
-    let fp = r.pixel;
-    let position = r.position;
-    let n = r.normal;
     // The radius R in pixels at this depth (tangent span per pixel × distance).
-    let metres_per_pixel = (eye.tangents.y - eye.tangents.x) / f32(frame.size.x) * -position.z;
+    let metres_per_pixel = (r.eye.tangents.y - r.eye.tangents.x) / f32(frame.size.x) * -r.position.z;
     let radius_px = ao.radius / max(metres_per_pixel, 1e-30);
     let steps = max(ao.steps, 1u);
     let directions = max(ao.directions, 1u);
     // Never step less than a pixel; never further than the screen.
     let step_px = clamp(radius_px / f32(steps + 1u), 1.0, f32(max(frame.size.x, frame.size.y)));
-    let rotation = kernel_rotation(fp, ao.noise);
+    let rotation = kernel_rotation(r.pixel, ao.noise);
     let jitter = fract(rotation * 0.1591549 * 7.0);
     // Angle bias: horizons below this elevation do not count (tessellation, noise).
     let sin_bias = min(5.0 * ao.bias, 0.9);
@@ -36,21 +31,21 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         var max_sin = sin_bias;
         for (var s = 0u; s < steps; s++) {
             let offset = dir * (f32(s) + jitter + 1.0) * step_px;
-            let q = vec2<f32>(fp) + vec2<f32>(0.5) + offset;
+            let q = vec2<f32>(r.pixel) + vec2<f32>(0.5) + offset;
             if (any(q < vec2<f32>(0.0)) || any(q >= vec2<f32>(frame.size))) {
                 break;
             }
             let qp = vec2<u32>(q);
-            let qd = textureLoad(depth_layers, vec2<i32>(qp), i32(layer), 0);
+            let qd = textureLoad(depth_layers, vec2<i32>(qp), i32(r.layer), 0);
             if (qd <= 0.0) {
                 continue;
             }
-            let h = load_view_position(qd, qp, eye, frame.size, frame.near) - position;
+            let h = load_view_position(qd, qp, r.eye, frame.size, frame.near) - r.position;
             let dist = length(h);
             if (dist < 1e-20 || dist > ao.radius) {
                 continue;
             }
-            let sin_h = dot(h, n) / dist;
+            let sin_h = dot(h, r.normal) / dist;
             if (sin_h > max_sin) {
                 let attenuation = max(0.0, 1.0 - dist / ao.radius);
                 occlusion += (sin_h * sin_h - max_sin * max_sin) * attenuation;
@@ -60,5 +55,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let visibility = 1.0 - occlusion / f32(directions);
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, result));
+    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(0.0, 0.0, 0.0, result));
 }

@@ -10,30 +10,25 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.valid) {
         return;
     }
-    let layer = r.layer;
-    let eye = r.eye;
-    let fp = r.pixel;
-    let position = r.position;
-    let n = r.normal;
-    let frame_rot = tangent_frame(n, kernel_rotation(fp, ao.noise));
+    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise));
     let bias = ao.bias * ao.radius;
-    let origin = position + n * bias;
+    let origin = r.position + r.normal * bias;
     var occlusion = 0.0;
     for (var i = 0u; i < ao.samples; i++) {
         let k = kernel[i];
         let s = origin + frame_rot * k.xyz * (k.w * ao.radius);
-        let probe = probe_depth(depth_layers, layer, s, eye);
-        if (occludes(probe, s, position, n, eye, bias)) {
+        let probe = probe_depth(depth_layers, r.layer, s, r.eye);
+        if (occludes(probe, s, r.position, r.normal, r.eye, bias)) {
             var weight = 1.0;
             if (ao.range_check != 0u) {
                 // Depth constraint: occluders far in front of the pixel (a foreground
                 // object, not a neighbour) fade out instead of casting a halo.
-                weight = smoothstep(0.0, 1.0, ao.radius / max(abs(-position.z - probe.distance), 1e-20));
+                weight = smoothstep(0.0, 1.0, ao.radius / max(abs(-r.position.z - probe.distance), 1e-20));
             }
             occlusion += weight;
         }
     }
     let visibility = 1.0 - occlusion / f32(max(ao.samples, 1u));
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(0.0, 0.0, 0.0, result));
+    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(0.0, 0.0, 0.0, result));
 }

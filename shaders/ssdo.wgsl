@@ -40,15 +40,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.valid) {
         return;
     }
-    let layer = r.layer;
-    let eye = r.eye;
-    let fp = r.pixel;
-    let position = r.position;
-    let n = r.normal;
-    let frame_rot = tangent_frame(n, kernel_rotation(fp, ao.noise));
-    let world_from_view = mat3x3<f32>(eye.world_from_view[0].xyz, eye.world_from_view[1].xyz, eye.world_from_view[2].xyz);
+    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise));
+    let world_from_view = mat3x3<f32>(r.eye.world_from_view[0].xyz, r.eye.world_from_view[1].xyz, r.eye.world_from_view[2].xyz);
     let bias = ao.bias * ao.radius;
-    let origin = position + n * bias;
+    let origin = r.position + r.normal * bias;
     let samples = max(ao.samples, 1u);
     // Sender patch area (π r_max² / N) scaled by the bounce strength; distances are
     // clamped to the patch's own size so the 1/d² form factor stays bounded.
@@ -76,9 +71,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         all_off += off;
         weight_all += cos_theta;
         let s = origin + omega * (k.w * ao.radius);
-        let probe = probe_depth(depth_layers, layer, s, eye);
-        var blocked = occludes(probe, s, position, n, eye, bias);
-        if (blocked && ao.range_check != 0u && abs(-position.z - probe.distance) > ao.radius) {
+        let probe = probe_depth(depth_layers, r.layer, s, r.eye);
+        var blocked = occludes(probe, s, r.position, r.normal, r.eye, bias);
+        if (blocked && ao.range_check != 0u && abs(-r.position.z - probe.distance) > ao.radius) {
             // A surface far in front is not a neighbour: the direction stays open.
             blocked = false;
         }
@@ -88,14 +83,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             visible_off += off;
             weight_visible += cos_theta;
         } else if (BOUNCE) {
-            let sender = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
-            let sender_light = textureLoad(direct_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+            let sender = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, r.eye.tangents);
+            let sender_light = textureLoad(direct_layers, vec2<i32>(probe.pixel), i32(r.layer), 0);
             let sender_n = unpack_normal(sender_light.a);
-            let to_receiver = position - sender;
+            let to_receiver = r.position - sender;
             let d2 = max(dot(to_receiver, to_receiver), min_d2);
             let dir = to_receiver * inverseSqrt(max(dot(to_receiver, to_receiver), 1e-30));
             let cos_sender = max(dot(sender_n, dir), 0.0);
-            let cos_receiver = max(dot(n, -dir), 0.0);
+            let cos_receiver = max(dot(r.normal, -dir), 0.0);
             bounce += max(sender_light.rgb, vec3<f32>(0.0)) * (cos_sender * cos_receiver / d2);
         }
     }
@@ -110,10 +105,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let share = select(vec3<f32>(visibility), gathered_visible / gathered_all, gathered_all > vec3<f32>(1e-20));
     var unoccluded = vec3<f32>(0.0);
     if (frame.has_environment != 0u) {
-        unoccluded = sh_eval(frame.irradiance_sh, world_from_view * n);
+        unoccluded = sh_eval(frame.irradiance_sh, world_from_view * r.normal);
     }
     let direct_occlusion = mix(unoccluded, unoccluded * share, clamp(ao.strength, 0.0, 1.0));
     let irradiance = direct_occlusion + bounce * (patch_area * ao.bounce);
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    textureStore(ao_out, vec2<i32>(id.xy), i32(layer), vec4<f32>(finite_or_zero3(irradiance), result));
+    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(finite_or_zero3(irradiance), result));
 }

@@ -53,6 +53,12 @@ impl LayeredTarget {
         LayeredTarget { texture, array_view, layer_views, format, width, height, layers }
     }
 
+    /// A 1×1, 2-layer texture to bind where a layout has a slot the chosen shader
+    /// variant never reads (wgpu needs every binding filled).
+    pub fn placeholder(device: &wgpu::Device, label: &str, format: wgpu::TextureFormat) -> LayeredTarget {
+        LayeredTarget::new(device, label, format, (1, 1, 2), wgpu::TextureUsages::TEXTURE_BINDING)
+    }
+
     pub fn extent(&self) -> (u32, u32, u32) {
         (self.width, self.height, self.layers)
     }

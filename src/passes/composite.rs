@@ -33,13 +33,7 @@ const SLOTS: [Slot; 11] = [
 impl CompositePass {
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
-        let unused = LayeredTarget::new(
-            &gpu.device,
-            "unused occlusion",
-            wgpu::TextureFormat::Rgba16Float,
-            (1, 1, 2),
-            wgpu::TextureUsages::TEXTURE_BINDING,
-        );
+        let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
         CompositePass {
             full_res: Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &[("HALF_RES", 0.0)]),
             half_res: Kernel::with_constants(gpu, "composite half-res", &files, "main", &SLOTS, &[("HALF_RES", 1.0)]),

@@ -33,13 +33,7 @@ const SLOTS: [Slot; 8] = [
 impl SsdoPass {
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
-        let no_direct = LayeredTarget::new(
-            &gpu.device,
-            "no direct light",
-            Resource::Direct.format(),
-            (1, 1, 2),
-            wgpu::TextureUsages::TEXTURE_BINDING,
-        );
+        let no_direct = LayeredTarget::placeholder(&gpu.device, "no direct light", Resource::Direct.format());
         SsdoPass {
             without_bounce: Kernel::with_constants(gpu, "ssdo", &files, "main", &SLOTS, &[("BOUNCE", 0.0)]),
             with_bounce: Kernel::with_constants(gpu, "ssdo-bounce", &files, "main", &SLOTS, &[("BOUNCE", 1.0)]),
