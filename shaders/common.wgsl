@@ -94,8 +94,7 @@ struct AoParams {
     _pad: u32,
     // Bilateral blur radius in occlusion pixels (5 → 11×11 at full resolution).
     blur_radius: u32,
-    // Frame counter, for patterns that rotate over time.
-    frame_index: u32,
+    _pad2: u32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

@@ -68,7 +68,6 @@ pub struct Renderer {
     passes: Vec<Box<dyn Pass>>,
     targets: BTreeMap<Resource, LayeredTarget>,
     timer: GpuTimer,
-    frame_index: u32,
     timing: Timing,
 }
 
@@ -120,7 +119,6 @@ impl Renderer {
             passes,
             targets: BTreeMap::new(),
             timer,
-            frame_index: 0,
             timing: Timing::Pipelined,
         })
     }
@@ -163,8 +161,7 @@ impl Renderer {
         let plan = self.plan(layers, outputs)?;
         self.allocate_targets(&plan, layers);
         self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
-        self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
-        self.frame_index = self.frame_index.wrapping_add(1);
+        self.frame.update_ao(&self.gpu.queue, &self.settings);
         self.timer.reset();
         let setup =
             FrameSetup { scene: &self.scene, settings: &self.settings, views: layers, multiview: self.multiview };

@@ -58,7 +58,7 @@ pub struct AoParamsUniform {
     pub bounce: f32,
     pub _pad: u32,
     pub blur_radius: u32,
-    pub frame_index: u32,
+    pub _pad2: u32,
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).
@@ -119,7 +119,7 @@ impl FrameBuffers {
     }
 
     /// Writes the occlusion parameters and the kernel that suits the technique.
-    pub fn update_ao(&self, queue: &wgpu::Queue, settings: &Settings, frame_index: u32) {
+    pub fn update_ao(&self, queue: &wgpu::Queue, settings: &Settings) {
         let ao = &settings.ao;
         let (width, height) = ao_extent(settings.profile.width, settings.profile.height, ao.half_res);
         let (directions, steps) = hbao_directions_steps(ao.samples);
@@ -152,7 +152,7 @@ impl FrameBuffers {
             // The blur radius is in full-resolution pixels: at half resolution the same
             // screen footprint takes half as many taps.
             blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
-            frame_index,
+            _pad2: 0,
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
         queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
