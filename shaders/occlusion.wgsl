@@ -48,3 +48,42 @@ fn begin_receiver(id: vec3<u32>) -> Receiver {
 fn store_occlusion(id: vec3<u32>, value: vec4<f32>) {
     textureStore(ao_out, vec2<i32>(id.xy), i32(id.z), value);
 }
+
+// Whether the surface found by `probe` occludes a sample at view-space `s` for a receiver
+// at `position` with normal `n`: the surface lies in front of the sample (by more than
+// `bias`) AND rises above the receiver's tangent plane. The second test removes the
+// self-occlusion a flat surface gives itself at grazing angles, where one pixel's depth
+// spans far more than the bias.
+fn occludes(probe: DepthProbe, s: vec3<f32>, position: vec3<f32>, n: vec3<f32>, eye: Eye, bias: f32) -> bool {
+    if (!probe.valid || !(probe.distance < -s.z - bias)) {
+        return false;
+    }
+    let surface = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
+    return dot(surface - position, n) > bias + 1e-5 * -position.z;
+}
+
+// What the depth buffer holds where view-space point `s` projects: `valid` is false
+// off-screen, behind the eye or on the sky; `distance` is the stored surface's
+// distance along −z and `pixel` the full-res pixel read.
+struct DepthProbe {
+    valid: bool,
+    pixel: vec2<u32>,
+    distance: f32,
+};
+
+fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, eye: Eye) -> DepthProbe {
+    var probe: DepthProbe;
+    probe.valid = false;
+    if (!(-s.z > frame.near * 0.5)) {
+        return probe;
+    }
+    let uv = view_to_uv(s, eye.tangents);
+    if (!(all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
+        return probe;
+    }
+    probe.pixel = min(vec2<u32>(uv * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
+    let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+    probe.valid = d > 0.0;
+    probe.distance = frame.near / max(d, 1e-30);
+    return probe;
+}

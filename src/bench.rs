@@ -9,6 +9,11 @@ use crate::passes::final_occlusion;
 use crate::renderer::{Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::{Settings, Technique};
+use crate::analytic::luminance;
+use crate::metrics;
+use crate::plot::{ScatterPlot, Series};
+use crate::reference::ReferenceImage;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
 
@@ -38,6 +43,8 @@ pub struct BenchRow {
     pub views: u32,
     /// The pass that ran the technique.
     pub pass: &'static str,
+    /// Error against the reference, when one was traced for this row's radius.
+    pub error: Option<ErrorFigures>,
 }
 
 impl BenchRow {
@@ -54,8 +61,16 @@ impl BenchRow {
 }
 
 /// Renders `warmup + frames` frames of `case` producing only the occlusion (the AO
-/// alone, as a budget test asks), and returns the per-pass medians.
-pub fn measure(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, case: &BenchCase, how: Measurement) -> Result<BenchRow> {
+/// alone, as a budget test asks), and returns the per-pass medians; with a reference
+/// for the case's radius, also the last frame's error against it.
+pub fn measure(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    base: &Settings,
+    case: &BenchCase,
+    how: Measurement,
+    reference: Option<&ReferenceImage>,
+) -> Result<BenchRow> {
     let Measurement { timing, warmup, frames } = how;
     let mut settings = base.clone();
     settings.ao.technique = case.technique;
@@ -80,28 +95,185 @@ pub fn measure(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, case: &BenchCase,
             timings.push(if timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
         }
     }
-    Ok(BenchRow { case: case.clone(), spans: summarize(&timings), views: 2, pass: settings.ao.pass_name() })
+    let error = match reference {
+        Some(reference) => Some(error_figures(case.technique, &renderer.read_f32(output)?, reference)),
+        None => None,
+    };
+    Ok(BenchRow { case: case.clone(), spans: summarize(&timings), views: 2, pass: settings.ao.pass_name(), error })
 }
 
-/// Runs every case, calling `progress(done, total, row)` after each.
+/// Runs every case, calling `progress(done, total, row)` after each. `references` holds
+/// a reference image per radius (cases whose radius has none get no error figures).
 pub fn sweep(
     gpu: &Arc<Gpu>,
     scene: &Scene,
     base: &Settings,
     cases: &[BenchCase],
     how: Measurement,
+    references: &[(f32, ReferenceImage)],
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
     for (i, case) in cases.iter().enumerate() {
-        let row = measure(gpu, scene, base, case, how)?;
+        let reference = references.iter().find(|(r, _)| *r == case.radius).map(|(_, image)| image);
+        let row = measure(gpu, scene, base, case, how, reference)?;
         progress(i + 1, cases.len(), &row);
         rows.push(row);
     }
     Ok(rows)
 }
 
-const COLUMNS: [&str; 9] = [
+/// How far one row's occlusion is from the reference tracer's, on the pixels the
+/// reference traced (both eyes; sky excluded).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ErrorFigures {
+    /// RMSE of the AO (`.a`) against the reference the technique approximates (HBAO: with
+    /// its linear falloff), with the reference's own noise taken out in quadrature.
+    pub ao_rmse: f64,
+    /// Mean SSIM of the AO images against the reference (1 = identical), per eye averaged.
+    pub ao_ssim: f64,
+    /// RMSE of the ambient light's luminance (what the composite multiplies by albedo/π)
+    /// relative to the reference's mean: environment light that gets through within r
+    /// plus one bounce of direct light from surfaces within r. Comparable across
+    /// techniques; `None` when the reference has no ambient light at all.
+    pub ambient_rel_rmse: Option<f64>,
+}
+
+/// Compares the occlusion a frame produced (per layer, RGBA at the full image size) with
+/// the reference on its grid of traced pixels.
+pub fn error_figures(technique: Technique, occlusion: &[Vec<f32>], reference: &ReferenceImage) -> ErrorFigures {
+    let (w, h) = (reference.width as usize, reference.height as usize);
+    let stride = reference.stride.max(1) as usize;
+    let (gw, gh) = (w.div_ceil(stride), h.div_ceil(stride));
+    let (mut gpu_ao, mut ref_ao, mut noise2, mut mask) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut gpu_ambient, mut ref_ambient) = (Vec::new(), Vec::new());
+    let mut ssim_sum = 0.0;
+    for (layer, pixels) in reference.layers.iter().enumerate() {
+        let image = &occlusion[layer];
+        let first = gpu_ao.len();
+        for gy in 0..gh {
+            for gx in 0..gw {
+                let r = &pixels[gy * gw + gx];
+                let (x, y) = ((gx * stride + stride / 2).min(w - 1), (gy * stride + stride / 2).min(h - 1));
+                let texel = &image[(y * w + x) * 4..(y * w + x) * 4 + 4];
+                let target = if technique == Technique::Hbao { r.ao_falloff } else { r.ao };
+                gpu_ao.push(texel[3]);
+                ref_ao.push(target);
+                mask.push(r.hit);
+                noise2.push(if r.hit { (r.ao_std_error as f64).powi(2) } else { 0.0 });
+                let ambient = match technique {
+                    Technique::Ssdo | Technique::SsdoBounce => [texel[0], texel[1], texel[2]],
+                    _ => r.unoccluded.map(|c| c * texel[3]),
+                };
+                let truth = [0, 1, 2].map(|c| r.environment_visible[c] + r.bounce[c]);
+                gpu_ambient.push(luminance(ambient) as f32);
+                ref_ambient.push(luminance(truth) as f32);
+            }
+        }
+        let range = first..gpu_ao.len();
+        ssim_sum +=
+            metrics::ssim(&gpu_ao[range.clone()], &ref_ao[range.clone()], gw, gh, Some(&mask[range]), 1.0).unwrap_or(0.0);
+    }
+    let hits = mask.iter().filter(|&&m| m).count().max(1) as f64;
+    let noise = (noise2.iter().sum::<f64>() / hits).sqrt();
+    let ao_rmse = metrics::noise_corrected_rmse(metrics::rmse(&gpu_ao, &ref_ao, Some(&mask)).unwrap_or(f64::NAN), noise);
+    let mean_ambient =
+        ref_ambient.iter().zip(&mask).filter(|(_, &m)| m).map(|(&a, _)| a as f64).sum::<f64>() / hits;
+    let ambient_rel_rmse = (mean_ambient > 1e-12)
+        .then(|| metrics::rmse(&gpu_ambient, &ref_ambient, Some(&mask)).map(|e| e / mean_ambient))
+        .flatten();
+    ErrorFigures { ao_rmse, ao_ssim: ssim_sum / reference.layers.len().max(1) as f64, ambient_rel_rmse }
+}
+
+/// One row as written to CSV, JSON and Markdown.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchRecord {
+    pub technique: String,
+    pub samples: u32,
+    pub radius_m: f32,
+    pub resolution: String,
+    pub technique_ms_per_eye: f64,
+    pub blur_ms_per_eye: f64,
+    pub upsample_ms_per_eye: f64,
+    /// Technique + blur + upsample per eye: the occlusion's cost.
+    pub occlusion_ms_per_eye: f64,
+    /// p75 / p25 of the technique pass: the run-to-run spread.
+    pub p75_over_p25: f64,
+    pub ao_rmse: Option<f64>,
+    pub ao_ssim: Option<f64>,
+    pub ambient_rel_rmse: Option<f64>,
+    /// On the Pareto front of AO RMSE against occlusion ms per eye.
+    pub pareto: bool,
+}
+
+impl BenchRecord {
+    pub fn setting(&self) -> String {
+        format!("{} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
+    }
+}
+
+/// A whole sweep: where it ran, how, and every row.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BenchFile {
+    pub scene: String,
+    pub adapter: String,
+    pub backend: String,
+    pub driver: String,
+    pub width: u32,
+    pub height: u32,
+    pub timing: String,
+    pub warmup: u32,
+    pub frames: u32,
+    /// The reference tracer's settings and noise, when errors were measured.
+    pub reference: Option<ReferenceInfo>,
+    pub records: Vec<BenchRecord>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    pub rays_per_pixel: u32,
+    pub stride: u32,
+    /// RMS over hit pixels of the reference AO's standard error (worst radius).
+    pub ao_noise_rms: f64,
+    /// Tracer throughput on this machine (rays per second, all cores), when it traced.
+    pub rays_per_second: Option<f64>,
+}
+
+/// The records of measured rows, with the Pareto front marked.
+pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
+    let mut out: Vec<BenchRecord> = rows
+        .iter()
+        .map(|row| {
+            let c = &row.case;
+            let name = row.pass;
+            let spread = row.spans.iter().find(|s| s.label == name).map_or(0.0, |s| s.p75_ms / s.p25_ms.max(1e-9));
+            let per_eye = |p: &str| row.median_ms(p) / row.views as f64;
+            BenchRecord {
+                technique: c.technique.name().to_string(),
+                samples: c.samples,
+                radius_m: c.radius,
+                resolution: if c.half_res { "half" } else { "full" }.to_string(),
+                technique_ms_per_eye: per_eye(name),
+                blur_ms_per_eye: per_eye("blur"),
+                upsample_ms_per_eye: per_eye("upsample"),
+                occlusion_ms_per_eye: row.occlusion_ms_per_eye(),
+                p75_over_p25: spread,
+                ao_rmse: row.error.as_ref().map(|e| e.ao_rmse),
+                ao_ssim: row.error.as_ref().map(|e| e.ao_ssim),
+                ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
+                pareto: false,
+            }
+        })
+        .collect();
+    let points: Vec<(f64, f64)> =
+        out.iter().map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
+    for i in metrics::pareto_front(&points) {
+        out[i].pareto = true;
+    }
+    out
+}
+
+const COLUMNS: [&str; 13] = [
     "technique",
     "samples",
     "radius_m",
@@ -111,47 +283,95 @@ const COLUMNS: [&str; 9] = [
     "upsample_ms_per_eye",
     "occlusion_ms_per_eye",
     "p75_over_p25",
+    "ao_rmse",
+    "ao_ssim",
+    "ambient_rel_rmse",
+    "pareto",
 ];
 
-fn row_values(row: &BenchRow) -> [String; 9] {
-    let c = &row.case;
-    let name = row.pass;
-    let spread = row.spans.iter().find(|s| s.label == name).map_or(0.0, |s| s.p75_ms / s.p25_ms.max(1e-9));
-    let per_eye = |p: &str| row.median_ms(p) / row.views as f64;
+fn record_values(r: &BenchRecord) -> [String; 13] {
+    let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.4}"));
     [
-        c.technique.name().to_string(),
-        c.samples.to_string(),
-        format!("{}", c.radius),
-        if c.half_res { "half" } else { "full" }.to_string(),
-        format!("{:.3}", per_eye(name)),
-        format!("{:.3}", per_eye("blur")),
-        format!("{:.3}", per_eye("upsample")),
-        format!("{:.3}", row.occlusion_ms_per_eye()),
-        format!("{spread:.3}"),
+        r.technique.clone(),
+        r.samples.to_string(),
+        format!("{}", r.radius_m),
+        r.resolution.clone(),
+        format!("{:.3}", r.technique_ms_per_eye),
+        format!("{:.3}", r.blur_ms_per_eye),
+        format!("{:.3}", r.upsample_ms_per_eye),
+        format!("{:.3}", r.occlusion_ms_per_eye),
+        format!("{:.3}", r.p75_over_p25),
+        optional(r.ao_rmse),
+        optional(r.ao_ssim),
+        optional(r.ambient_rel_rmse),
+        if r.pareto { "yes" } else { "" }.to_string(),
     ]
 }
 
-pub fn to_csv(rows: &[BenchRow]) -> String {
+pub fn to_csv(records: &[BenchRecord]) -> String {
     let mut s = COLUMNS.join(",") + "\n";
-    for row in rows {
-        s += &(row_values(row).join(",") + "\n");
+    for r in records {
+        s += &(record_values(r).join(",") + "\n");
     }
     s
 }
 
-pub fn to_markdown(rows: &[BenchRow]) -> String {
+pub fn to_markdown(records: &[BenchRecord]) -> String {
     let mut s = format!("| {} |\n|{}\n", COLUMNS.join(" | "), "---|".repeat(COLUMNS.len()));
-    for row in rows {
-        let _ = writeln!(s, "| {} |", row_values(row).join(" | "));
+    for r in records {
+        let _ = writeln!(s, "| {} |", record_values(r).join(" | "));
     }
     s
+}
+
+pub fn to_json(file: &BenchFile) -> String {
+    serde_json::to_string_pretty(file).expect("bench records serialise")
+}
+
+/// Reads a bench JSON file (for `vrao budget --fit`).
+pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
+    serde_json::from_str(&text).map_err(|e| Error::at_line(path, e.line(), format!("not a vrao bench file: {e}")))
+}
+
+/// The plot of error against per-eye ms with the Pareto front and the budget line.
+pub fn plot(file: &BenchFile, budget_ms_per_eye: f64) -> ScatterPlot {
+    const COLOURS: [[u8; 3]; 6] = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189], [140, 86, 75]];
+    let mut series: Vec<Series> = Vec::new();
+    for r in file.records.iter().filter(|r| r.ao_rmse.is_some()) {
+        let label = format!("{} {}", r.technique, r.resolution);
+        let point = (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN));
+        match series.iter_mut().find(|s| s.label == label) {
+            Some(s) => s.points.push(point),
+            None => {
+                let color = COLOURS[series.len() % COLOURS.len()];
+                series.push(Series { label, color, points: vec![point] });
+            }
+        }
+    }
+    let mut pareto: Vec<(f64, f64)> = file
+        .records
+        .iter()
+        .filter(|r| r.pareto)
+        .map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN)))
+        .collect();
+    pareto.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ScatterPlot {
+        title: format!("{}: AO error against time, {}x{} per eye, {}", file.scene, file.width, file.height, file.adapter),
+        x_label: "occlusion ms per eye (technique + blur + upsample)".into(),
+        y_label: "AO RMSE vs reference".into(),
+        series,
+        pareto,
+        vertical_line: Some((budget_ms_per_eye, format!("budget {budget_ms_per_eye:.2} ms/eye"))),
+        log_x: true,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn row(technique: Technique, ms: f64) -> BenchRow {
+    fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
         let span = |label: &str, median_ms| SpanSummary {
             label: label.into(),
             frames: 30,
@@ -166,20 +386,49 @@ mod tests {
             spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
             views: 2,
             pass: technique.name(),
+            error: Some(ErrorFigures { ao_rmse, ao_ssim: 0.9, ambient_rel_rmse: None }),
+        }
+    }
+
+    fn file(records: Vec<BenchRecord>) -> BenchFile {
+        BenchFile {
+            scene: "crease".into(),
+            adapter: "test".into(),
+            backend: "Vulkan".into(),
+            driver: String::new(),
+            width: 64,
+            height: 48,
+            timing: "serial".into(),
+            warmup: 1,
+            frames: 30,
+            reference: None,
+            records,
         }
     }
 
     #[test]
     fn per_eye_cost_halves_both_eye_dispatches_and_ignores_other_passes() {
-        assert_eq!(row(Technique::Ssao, 10.0).occlusion_ms_per_eye(), 6.0);
+        assert_eq!(row(Technique::Ssao, 10.0, 0.1).occlusion_ms_per_eye(), 6.0);
     }
 
     #[test]
-    fn csv_and_markdown_hold_every_row() {
-        let rows = [row(Technique::Ssao, 10.0), row(Technique::Hbao, 12.0)];
-        let csv = to_csv(&rows);
+    fn the_pareto_front_keeps_rows_no_other_row_beats_in_both_time_and_error() {
+        // ssao: 6 ms, 0.10; hbao: 7 ms, 0.05; ssdo: 8 ms, 0.07 (slower and worse than hbao).
+        let rows = [row(Technique::Ssao, 10.0, 0.10), row(Technique::Hbao, 12.0, 0.05), row(Technique::Ssdo, 14.0, 0.07)];
+        let pareto: Vec<bool> = records(&rows).iter().map(|r| r.pareto).collect();
+        assert_eq!(pareto, [true, true, false]);
+    }
+
+    #[test]
+    fn csv_markdown_and_json_hold_every_row() {
+        let rows = [row(Technique::Ssao, 10.0, 0.1), row(Technique::Hbao, 12.0, 0.2)];
+        let recs = records(&rows);
+        let csv = to_csv(&recs);
         assert_eq!(csv.lines().count(), 3);
-        assert!(csv.lines().nth(2).unwrap().starts_with("hbao,12,0.5,full,6.000,1.000,0.000,7.000"));
-        assert_eq!(to_markdown(&rows).lines().count(), 4);
+        assert!(csv.lines().nth(2).unwrap().starts_with("hbao,12,0.5,full,6.000,1.000,0.000,7.000,1.000,0.2000,0.9000,,"));
+        assert_eq!(to_markdown(&recs).lines().count(), 4);
+        let json = to_json(&file(recs.clone()));
+        let back: BenchFile = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.records, recs);
     }
 }

@@ -18,6 +18,8 @@ pub enum Error {
     Gpu(String),
     /// Writing an output failed.
     Output { path: PathBuf, message: String },
+    /// The run finished but did not fit its frame budget (`vrao budget`).
+    OverBudget(String),
 }
 
 impl Error {
@@ -34,6 +36,7 @@ impl Error {
         match self {
             Error::Input { .. } | Error::Device(_) => EXIT_INPUT,
             Error::Gpu(_) | Error::Output { .. } => 1,
+            Error::OverBudget(_) => EXIT_OVER_BUDGET,
         }
     }
 }
@@ -51,6 +54,7 @@ impl fmt::Display for Error {
             Error::Device(m) => write!(f, "no usable GPU: {m}"),
             Error::Gpu(m) => write!(f, "GPU error: {m}"),
             Error::Output { path, message } => write!(f, "{}: {}", path.display(), message),
+            Error::OverBudget(m) => write!(f, "{m}"),
         }
     }
 }

@@ -4,12 +4,19 @@
 //! [`Renderer`] with [`Settings`], and render an [`EyePair`] into layered targets.
 
 pub mod analytic;
+pub mod app;
 pub mod bench;
+pub mod display;
+pub mod budget;
 pub mod error;
 pub mod gpu;
 pub mod graph;
+pub mod headset;
+pub mod metrics;
 pub mod output;
 pub mod passes;
+pub mod plot;
+pub mod reference;
 pub mod renderer;
 pub mod sampling;
 pub mod scene;

@@ -27,8 +27,118 @@ enum Command {
     Info,
     /// Render both eyes of a scene to left.png and right.png.
     Render(RenderArgs),
-    /// Sweep technique × samples × radius × resolution: median GPU ms per eye per pass.
+    /// Sweep technique × samples × radius × resolution: median ms per eye per pass and
+    /// error against the reference tracer; writes CSV, JSON, Markdown and a PNG plot.
     Bench(BenchArgs),
+    /// Run a headset session: OpenXR when a runtime is present, otherwise the simulated
+    /// headset; with a desktop window for --display mirror or single-pass.
+    Run(RunArgs),
+    /// Reprojection quality: warp a frame to moved head poses (rotations 1–10°,
+    /// translations 1–10 cm) in both modes and compare with fresh renders.
+    Reprojection(ReprojectionArgs),
+    /// Headless per-eye budget test: per-pass medians against the frame budget; exit 0
+    /// within budget, 3 over it.
+    Budget(BudgetArgs),
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// A scene file (.toml), a bare .obj, or builtin:NAME.
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// Headset: auto (OpenXR if a runtime answers, else simulated), openxr or simulated.
+    #[arg(long, default_value = "auto")]
+    headset: vrao::app::HeadsetChoice,
+    /// Desktop window: none, mirror (both eyes side by side) or single-pass (mono view).
+    #[arg(long, default_value = "mirror")]
+    display: vrao::settings::DisplayMode,
+    /// Stop after this many frames (default: until the window is closed; 600 without one).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    frames: Option<u64>,
+    /// Simulated head motion: static, yaw-sweep, figure-eight or head-roll.
+    #[arg(long, default_value = "static")]
+    motion: vrao::headset::motion::HeadMotion,
+    /// Simulated compositor reprojection: rotational or depth.
+    #[arg(long, default_value = "depth")]
+    reprojection: vrao::headset::reproject::ReprojectionMode,
+    /// Run the simulated headset in virtual time, each frame taking these render times
+    /// in ms (cycled): deterministic counters.
+    #[arg(long, value_delimiter = ',')]
+    virtual_time: Vec<f64>,
+    /// Simulated per-eye width (default: Vive-class 1080).
+    #[arg(long, default_value_t = 1080)]
+    width: u32,
+    /// Simulated per-eye height (default: Vive-class 1200).
+    #[arg(long, default_value_t = 1200)]
+    height: u32,
+    /// Window size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720")]
+    window: String,
+    /// Save a screenshot of the window to this PNG after the last frame.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    /// Write the frame counters and per-pass medians to this JSON file.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    #[command(flatten)]
+    ao: AoArgs,
+}
+
+#[derive(Args)]
+struct ReprojectionArgs {
+    /// A scene file (.toml), a bare .obj, or builtin:NAME.
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// Per-eye width in pixels.
+    #[arg(long, default_value_t = 1080)]
+    width: u32,
+    /// Per-eye height in pixels.
+    #[arg(long, default_value_t = 1200)]
+    height: u32,
+    /// Write the rows as JSON here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    ao: AoArgs,
+}
+
+#[derive(Args)]
+struct BudgetArgs {
+    /// A scene file (.toml), a bare .obj, or builtin:NAME.
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// Per-eye width in pixels.
+    #[arg(long, default_value_t = 1080)]
+    width: u32,
+    /// Per-eye height in pixels.
+    #[arg(long, default_value_t = 1200)]
+    height: u32,
+    /// Measured frames (each: the stereo frame, then each eye alone), after warm-up.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    frames: u32,
+    /// Warm-up frames (not measured).
+    #[arg(long, default_value_t = 3)]
+    warmup: u32,
+    /// Budget of one stereo frame in ms (default: the headset's refresh interval, 11.1 ms
+    /// at 90 Hz); each eye gets half.
+    #[arg(long, allow_negative_numbers = true)]
+    budget_ms: Option<f64>,
+    /// What each frame produces: frame (the eye colour, every pass) or occlusion (the
+    /// occlusion passes alone).
+    #[arg(long, default_value = "frame")]
+    measure: String,
+    /// Timing: pipelined, serial or auto (serial on CPU adapters).
+    #[arg(long, default_value = "auto")]
+    timing: TimingArg,
+    /// Pick the occlusion setting from this bench JSON (made by `vrao bench` on this
+    /// device) with the least error that fits the budget, then measure it.
+    #[arg(long)]
+    fit: Option<PathBuf>,
+    /// Where to write the JSON report.
+    #[arg(long, default_value = "budget.json")]
+    out: PathBuf,
+    #[command(flatten)]
+    ao: AoArgs,
 }
 
 #[derive(Args)]
@@ -65,9 +175,24 @@ struct BenchArgs {
     /// whose timestamps misattribute work between passes; pipelined on GPUs).
     #[arg(long, default_value = "auto")]
     timing: TimingArg,
-    /// Output directory for bench.csv and bench.md.
+    /// Output directory for bench.csv, bench.json, bench.md and bench.png.
     #[arg(long, default_value = "bench")]
     out: PathBuf,
+    /// Reference rays per traced pixel (cosine-weighted, stratified).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    rays: u32,
+    /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    stride: u32,
+    /// Skip the reference: time only, no error columns.
+    #[arg(long)]
+    no_reference: bool,
+    /// Directory of cached reference images (default: $XDG_CACHE_HOME/vrao or ~/.cache/vrao).
+    #[arg(long)]
+    cache: Option<PathBuf>,
+    /// Budget per stereo frame in ms for the plot's budget line (each eye gets half).
+    #[arg(long, default_value_t = 1000.0 / 90.0)]
+    budget_ms: f64,
 }
 
 #[derive(Args)]
@@ -303,7 +428,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
 }
 
 fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
-    use vrao::bench::{sweep, to_csv, to_markdown, BenchCase, Measurement};
+    use vrao::bench::{plot, records, sweep, to_csv, to_json, to_markdown, BenchCase, BenchFile, Measurement};
     let scene = Scene::load(&args.scene)?;
     let resolutions: &[bool] = match args.resolution.as_str() {
         "full" => &[false],
@@ -341,6 +466,44 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     let gpu = Arc::new(Gpu::new(backend)?);
     let info = gpu.adapter.get_info();
     let timing = args.timing.resolve(&gpu);
+    let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+    let mut references = Vec::new();
+    let mut reference_info = None;
+    if !args.no_reference {
+        let cache = args.cache.clone().unwrap_or_else(default_cache_dir);
+        let (mut noise, mut rays, mut seconds) = (0.0f64, 0u64, 0.0f64);
+        for &radius in &radii {
+            let reference_settings = vrao::reference::ReferenceSettings {
+                radius: radius as f64,
+                rays_per_pixel: args.rays,
+                stride: args.stride,
+                near: settings.near,
+            };
+            eprintln!("reference: r = {radius} m, {} rays per pixel, every {} pixels", args.rays, args.stride);
+            let mut bar = vrao::reference::ProgressBar::new("reference");
+            let image = vrao::reference::trace_cached(
+                &cache,
+                &scene,
+                &eyes.eyes,
+                (args.width, args.height),
+                &reference_settings,
+                &mut |p| bar.update(p),
+            )?;
+            bar.finish();
+            noise = noise.max(image.stats.noise);
+            if !image.stats.from_cache {
+                rays += image.stats.rays;
+                seconds += image.stats.seconds;
+            }
+            references.push((radius, image));
+        }
+        reference_info = Some(vrao::bench::ReferenceInfo {
+            rays_per_pixel: args.rays,
+            stride: args.stride,
+            ao_noise_rms: noise,
+            rays_per_second: (seconds > 0.0).then(|| rays as f64 / seconds),
+        });
+    }
     eprintln!(
         "bench: {} cases on '{}' ({}), {}x{} per eye, {} frames each, {timing:?} timing",
         cases.len(),
@@ -357,33 +520,284 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         &settings,
         &cases,
         Measurement { timing, warmup: args.warmup, frames: args.frames },
+        &references,
         |done, total, row| {
             let elapsed = started.elapsed().as_secs_f64();
             let eta = elapsed / done as f64 * (total - done) as f64;
+            let error = row.error.as_ref().map_or(String::new(), |e| format!("  AO RMSE {:.4}", e.ao_rmse));
             eprintln!(
-            "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
-            row.case.technique.name(),
-            row.case.samples,
-            row.case.radius,
-            if row.case.half_res { "half" } else { "full" },
-            row.occlusion_ms_per_eye()
-        );
+                "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
+                row.case.technique.name(),
+                row.case.samples,
+                row.case.radius,
+                if row.case.half_res { "half" } else { "full" },
+                row.occlusion_ms_per_eye()
+            );
         },
     )?;
+    let file = BenchFile {
+        scene: scene.name.clone(),
+        adapter: info.name.clone(),
+        backend: format!("{:?}", info.backend),
+        driver: info.driver_info.clone(),
+        width: args.width,
+        height: args.height,
+        timing: format!("{timing:?}").to_lowercase(),
+        warmup: args.warmup,
+        frames: args.frames,
+        reference: reference_info,
+        records: records(&rows),
+    };
     std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
-    for (name, text) in [("bench.csv", to_csv(&rows)), ("bench.md", to_markdown(&rows))] {
+    let write = |name: &str, text: String| {
         let path = args.out.join(name);
-        std::fs::write(&path, text).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
+        std::fs::write(&path, text).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })
+    };
+    write("bench.csv", to_csv(&file.records))?;
+    write("bench.md", to_markdown(&file.records))?;
+    write("bench.json", to_json(&file))?;
+    let mut written = "bench.csv, bench.json, bench.md".to_string();
+    if file.reference.is_some() {
+        let path = args.out.join("bench.png");
+        plot(&file, args.budget_ms / 2.0).save_png(&path, 1280, 800)?;
+        written += " and bench.png";
     }
-    println!("{}", to_markdown(&rows));
-    println!(
-        "adapter: {} ({:?}, {}); wrote {}/bench.csv and bench.md",
-        info.name,
-        info.backend,
-        info.driver_info,
-        args.out.display()
-    );
+    println!("{}", to_markdown(&file.records));
+    if let Some(r) = &file.reference {
+        println!(
+            "reference: {} rays per pixel at every {} pixels; its AO noise (RMS standard error) {:.4}{}",
+            r.rays_per_pixel,
+            r.stride,
+            r.ao_noise_rms,
+            r.rays_per_second.map_or(String::new(), |s| format!("; traced at {:.2} Mrays/s", s / 1e6))
+        );
+        let front: Vec<String> = file.records.iter().filter(|r| r.pareto).map(|r| r.setting()).collect();
+        println!("Pareto front (fastest first): {}", front.join("; "));
+    }
+    println!("adapter: {} ({:?}, {}); wrote {written} in {}", info.name, info.backend, info.driver_info, args.out.display());
     Ok(())
+}
+
+/// Where reference images are cached between runs.
+fn default_cache_dir() -> PathBuf {
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(std::env::temp_dir);
+    base.join("vrao").join("reference")
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let parsed = s.split_once('x').and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
+        _ => Err(Error::input(format!("--window '{s}' is not WIDTHxHEIGHT within 1..=16384"))),
+    }
+}
+
+fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
+    use vrao::headset::simulated::{SimulatedOptions, TimeMode};
+    use vrao::settings::DisplayMode;
+    let scene = Scene::load(&args.scene)?;
+    let settings = Settings {
+        profile: HeadsetProfile::with_size("vive", args.width, args.height),
+        ao: args.ao.settings(&scene),
+        ..Settings::default()
+    };
+    settings.validate()?;
+    let window_size = parse_size(&args.window)?;
+    let frames = args.frames.or((args.display == DisplayMode::None).then_some(600));
+    let simulated = SimulatedOptions {
+        profile: settings.profile,
+        near: settings.near,
+        path: scene.head.clone(),
+        motion: args.motion,
+        time: if args.virtual_time.is_empty() {
+            TimeMode::Real
+        } else {
+            TimeMode::Virtual { render_ms: args.virtual_time.clone() }
+        },
+        reprojection: args.reprojection,
+        compose: args.display == DisplayMode::Mirror,
+        frames,
+    };
+    let (headset, message) = vrao::app::open_headset(args.headset, simulated)?;
+    println!("headset: {message}");
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let mut frame_loop = vrao::app::FrameLoop::new(gpu.clone(), &scene, &settings, headset)?;
+    let summary = if args.display == DisplayMode::None {
+        while frame_loop.step()?.is_some() {}
+        frame_loop.end()?;
+        vrao::app::RunSummary::of(&frame_loop)
+    } else {
+        vrao::display::run_window(
+            frame_loop,
+            &scene,
+            vrao::display::WindowOptions { mode: args.display, size: window_size, screenshot: args.screenshot.clone() },
+        )?
+    };
+    println!("{}", summary.to_text());
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&summary).expect("run summary serialises");
+        std::fs::write(path, json).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
+    }
+    Ok(())
+}
+
+fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
+    use vrao::headset::reprojection_bench::{default_movements, measure, to_markdown};
+    let scene = Scene::load(&args.scene)?;
+    let settings = Settings {
+        profile: HeadsetProfile::with_size("vive", args.width, args.height),
+        ao: args.ao.settings(&scene),
+        ..Settings::default()
+    };
+    settings.validate()?;
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;
+    let rows = measure(&mut renderer, &scene.head.pose_at(0.0), &default_movements())?;
+    println!(
+        "reprojection of '{}' at {}x{} per eye on {}: RMSE of colour (0..1, both eyes) against a fresh render",
+        scene.name,
+        args.width,
+        args.height,
+        gpu.adapter.get_info().name
+    );
+    print!("{}", to_markdown(&rows));
+    if let Some(path) = &args.out {
+        let json = serde_json::to_string_pretty(&rows).expect("rows serialise");
+        std::fs::write(path, json).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
+    }
+    Ok(())
+}
+
+fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
+    use vrao::budget::{run, BudgetRun};
+    let scene = Scene::load(&args.scene)?;
+    let mut settings = Settings {
+        profile: HeadsetProfile::with_size("vive", args.width, args.height),
+        ao: args.ao.settings(&scene),
+        ..Settings::default()
+    };
+    let budget_ms = args.budget_ms.unwrap_or(settings.profile.budget_ms());
+    if !(budget_ms.is_finite() && budget_ms > 0.0) {
+        return Err(Error::input(format!("--budget-ms {budget_ms} must be a positive number of milliseconds")));
+    }
+    let occlusion_only = match args.measure.as_str() {
+        "frame" => false,
+        "occlusion" => true,
+        other => return Err(Error::input(format!("--measure '{other}' is not frame or occlusion"))),
+    };
+    settings.validate()?;
+    let fit_file = match &args.fit {
+        Some(path) => Some(vrao::bench::read_json(path)?),
+        None => None,
+    };
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let timing = args.timing.resolve(&gpu);
+    let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+    let measure = |settings: &Settings, frames: u32| -> Result<vrao::budget::BudgetReport> {
+        let output = if occlusion_only {
+            vrao::passes::final_occlusion(settings)
+                .ok_or_else(|| Error::input("--measure occlusion needs an occlusion technique"))?
+        } else {
+            Resource::Color
+        };
+        let mut renderer = Renderer::new(gpu.clone(), &scene, settings)?;
+        run(&mut renderer, &eyes, BudgetRun { timing, warmup: args.warmup, frames, budget_ms, output })
+    };
+    if let (Some(file), Some(path)) = (&fit_file, &args.fit) {
+        settings.ao = fit_setting(file, path, &gpu, &settings, budget_ms, occlusion_only, |s, frames| measure(s, frames))?;
+    }
+    let report = measure(&settings, args.frames)?;
+    print!("{}", report.to_text());
+    let json = serde_json::to_string_pretty(&report).expect("budget report serialises");
+    std::fs::write(&args.out, json).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
+    println!("wrote {}", args.out.display());
+    if report.within_budget() {
+        Ok(())
+    } else {
+        Err(Error::OverBudget(format!(
+            "{} over the {budget_ms:.3} ms stereo frame budget",
+            report.verdicts.iter().filter(|v| !v.pass).map(|v| v.what.as_str()).collect::<Vec<_>>().join(", ")
+        )))
+    }
+}
+
+/// `--fit`: the bench row with the least AO error whose occlusion cost fits what the
+/// budget leaves per eye after the passes every frame pays (measured here with no
+/// occlusion), returned as the settings to measure.
+fn fit_setting(
+    file: &vrao::bench::BenchFile,
+    path: &std::path::Path,
+    gpu: &Gpu,
+    settings: &Settings,
+    budget_ms: f64,
+    occlusion_only: bool,
+    measure: impl Fn(&Settings, u32) -> Result<vrao::budget::BudgetReport>,
+) -> Result<AoSettings> {
+    let adapter = gpu.adapter.get_info().name;
+    if file.adapter != adapter {
+        return Err(Error::in_file(
+            path,
+            format!("was measured on '{}', not on this device '{adapter}'; run vrao bench here first", file.adapter),
+        ));
+    }
+    if (file.width, file.height) != (settings.profile.width, settings.profile.height) {
+        eprintln!(
+            "warning: {} was measured at {}x{} per eye, this budget is for {}x{}",
+            path.display(),
+            file.width,
+            file.height,
+            settings.profile.width,
+            settings.profile.height
+        );
+    }
+    // What every frame pays besides the occlusion, per eye (eyes measured alone).
+    let base_ms = if occlusion_only {
+        0.0
+    } else {
+        let mut base = settings.clone();
+        base.ao.technique = Technique::None;
+        let report = measure(&base, 5)?;
+        report.verdicts.iter().filter(|v| v.what != "stereo frame").map(|v| v.ms).fold(0.0, f64::max)
+    };
+    let left_per_eye = budget_ms / 2.0 - base_ms;
+    let with_error: Vec<_> = file.records.iter().filter(|r| r.ao_rmse.is_some_and(f64::is_finite)).collect();
+    if with_error.is_empty() {
+        return Err(Error::in_file(path, "has no rows with an error against the reference"));
+    }
+    let fitting: Vec<_> = with_error.iter().filter(|r| r.occlusion_ms_per_eye <= left_per_eye).collect();
+    let chosen = match fitting.iter().min_by(|a, b| a.ao_rmse.unwrap().total_cmp(&b.ao_rmse.unwrap())) {
+        Some(r) => {
+            println!(
+                "fit: {} — AO RMSE {:.4}, the least of the {} of {} bench rows whose occlusion ({:.3} ms per eye) fits the {:.3} ms per eye left after {:.3} ms of the other passes",
+                r.setting(),
+                r.ao_rmse.unwrap(),
+                fitting.len(),
+                with_error.len(),
+                r.occlusion_ms_per_eye,
+                left_per_eye,
+                base_ms
+            );
+            r
+        }
+        None => {
+            let cheapest =
+                with_error.iter().min_by(|a, b| a.occlusion_ms_per_eye.total_cmp(&b.occlusion_ms_per_eye)).unwrap();
+            println!(
+                "fit: no bench row fits the {:.3} ms per eye left after {:.3} ms of the other passes; the cheapest, {} ({:.3} ms per eye), is measured",
+                left_per_eye, base_ms, cheapest.setting(), cheapest.occlusion_ms_per_eye
+            );
+            cheapest
+        }
+    };
+    let mut ao = settings.ao.clone();
+    ao.technique = chosen.technique.parse().map_err(|e: String| Error::in_file(path, e))?;
+    ao.samples = chosen.samples;
+    ao.radius = chosen.radius_m;
+    ao.half_res = chosen.resolution == "half";
+    Ok(ao)
 }
 
 fn main() -> ExitCode {
@@ -399,6 +813,9 @@ fn main() -> ExitCode {
         Some(Command::Info) => info(cli.backend),
         Some(Command::Render(args)) => render(cli.backend, args),
         Some(Command::Bench(args)) => bench(cli.backend, args),
+        Some(Command::Budget(args)) => budget(cli.backend, args),
+        Some(Command::Run(args)) => run(cli.backend, args),
+        Some(Command::Reprojection(args)) => reprojection(cli.backend, args),
         None => {
             use clap::CommandFactory;
             let _ = Cli::command().print_help();

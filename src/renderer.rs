@@ -131,6 +131,17 @@ impl Renderer {
         &self.settings
     }
 
+    /// Switches to new settings (technique, quality, radius, …) for the next frame. The
+    /// passes hold every variant, so nothing is rebuilt; targets follow the next plan.
+    pub fn set_settings(&mut self, settings: &Settings) -> Result<()> {
+        settings.validate()?;
+        if settings.stereo != self.settings.stereo {
+            return Err(Error::input("the stereo mode cannot change on a running renderer"));
+        }
+        self.settings = settings.clone();
+        Ok(())
+    }
+
     pub fn set_timing(&mut self, timing: Timing) {
         self.timing = timing;
     }

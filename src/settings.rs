@@ -27,6 +27,39 @@ impl std::str::FromStr for StereoMode {
     }
 }
 
+/// What the desktop window shows (seed 003 §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DisplayMode {
+    /// No window: the headset alone.
+    #[default]
+    None,
+    /// Both eye images side by side, as the headset shows them.
+    Mirror,
+    /// The scene rendered once more in mono from the head's viewpoint at the window's size.
+    SinglePass,
+}
+
+impl DisplayMode {
+    pub const ALL: [DisplayMode; 3] = [DisplayMode::None, DisplayMode::Mirror, DisplayMode::SinglePass];
+    pub fn name(self) -> &'static str {
+        match self {
+            DisplayMode::None => "none",
+            DisplayMode::Mirror => "mirror",
+            DisplayMode::SinglePass => "single-pass",
+        }
+    }
+}
+
+impl std::str::FromStr for DisplayMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        DisplayMode::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown display mode '{s}' (expected none, mirror or single-pass)"))
+    }
+}
+
 /// The occlusion technique.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Technique {

@@ -25,6 +25,8 @@ const SHADERS: &[(&str, &str)] = &[
     ("multiview_probe.wgsl", include_str!("../../shaders/multiview_probe.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+    ("reproject.wgsl", include_str!("../../shaders/reproject.wgsl")),
+    ("mirror.wgsl", include_str!("../../shaders/mirror.wgsl")),
 ];
 
 /// A shader module made of the named files, concatenated in order (common first), so
@@ -53,6 +55,8 @@ pub enum Slot {
     Depth,
     /// `texture_2d_array<f32>`, read with `textureLoad`.
     Layers,
+    /// `texture_2d_array<f32>`, filterable, read with a sampler.
+    FilterableLayers,
     /// `texture_2d<f32>`, filterable (environment map).
     Texture2d,
     /// A filtering sampler.
@@ -63,6 +67,8 @@ pub enum Slot {
     Uniform,
     /// `var<storage, read>`.
     ReadBuffer,
+    /// `var<storage, read_write>` (atomics).
+    ReadWriteBuffer,
 }
 
 impl Slot {
@@ -75,6 +81,11 @@ impl Slot {
             },
             Slot::Layers => wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::FilterableLayers => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
                 view_dimension: wgpu::TextureViewDimension::D2Array,
                 multisampled: false,
             },
@@ -96,6 +107,11 @@ impl Slot {
             },
             Slot::ReadBuffer => wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Slot::ReadWriteBuffer => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
                 has_dynamic_offset: false,
                 min_binding_size: None,
             },

@@ -123,7 +123,7 @@ impl GpuTimer {
 }
 
 /// One span's times over many frames.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SpanSummary {
     pub label: String,
     pub frames: usize,

@@ -7,12 +7,31 @@ use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 use vrao::scene::{HeadPath, Material, Mesh, Scene};
 use vrao::{BackendChoice, Gpu};
 
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Holds the GPU for one test (also for tests that run the `vrao` binary).
+pub fn gpu_lock() -> MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A fresh, empty directory for one test's files.
+pub fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("vrao-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 pub fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
     static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
-    static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-    let guard = ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    let gpu =
-        GPU.get_or_init(|| Arc::new(Gpu::new(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests")));
+    let guard = gpu_lock();
+    let gpu = GPU.get_or_init(|| {
+        // As the CLI does: Mesa's WSI probe complains on headless machines without it.
+        if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+            std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+        }
+        Arc::new(Gpu::new(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests"))
+    });
     (gpu.clone(), guard)
 }
 

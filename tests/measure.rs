@@ -1,0 +1,184 @@
+//! `vrao budget` and `vrao bench` as a user runs them: verdicts, exit codes and the files
+//! they write. Small sizes: this checks the mechanism; the figures are for the reports.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+/// The GPU commands run one at a time (two cores, a CPU rasteriser).
+static SERIAL: Mutex<()> = Mutex::new(());
+
+fn vrao(args: &[&str]) -> Output {
+    let _one_at_a_time = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    Command::new(env!("CARGO_BIN_EXE_vrao")).args(args).output().expect("vrao runs")
+}
+
+fn text(out: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("vrao-measure-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn budget(dir: &std::path::Path, budget_ms: &str, extra: &[&str]) -> (Output, serde_json::Value) {
+    let json = dir.join(format!("budget-{budget_ms}.json"));
+    let mut args = vec![
+        "budget",
+        "--scene",
+        "builtin:room",
+        "--width",
+        "48",
+        "--height",
+        "40",
+        "--frames",
+        "3",
+        "--warmup",
+        "1",
+        "--samples",
+        "8",
+        "--budget-ms",
+        budget_ms,
+        "--out",
+        json.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let out = vrao(&args);
+    let report = std::fs::read_to_string(&json).map(|t| serde_json::from_str(&t).unwrap()).unwrap_or_default();
+    (out, report)
+}
+
+#[test]
+fn budget_passes_a_generous_budget_with_exit_0_and_fails_a_tiny_one_with_exit_3() {
+    let dir = temp_dir("budget");
+    let (out, report) = budget(&dir, "1000000", &[]);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{t}");
+    assert!(t.contains("left eye") && t.contains("right eye") && t.contains("PASS") && !t.contains("FAIL"), "{t}");
+    // Every pass of the frame, with stereo and per-eye medians over 3 frames.
+    let passes = report["passes"].as_array().expect("passes");
+    let names: Vec<&str> = passes.iter().map(|p| p["pass"].as_str().unwrap()).collect();
+    for pass in ["gbuffer", "direct", "ssao", "blur", "composite", "tonemap"] {
+        assert!(names.contains(&pass), "{pass} missing from {names:?}");
+    }
+    for p in passes {
+        for key in ["stereo", "left", "right"] {
+            assert_eq!(p[key]["frames"], 3, "{p}");
+            assert!(p[key]["median_ms"].as_f64().unwrap() > 0.0, "{p}");
+        }
+    }
+    assert_eq!(report["verdicts"].as_array().unwrap().len(), 3);
+    assert_eq!(report["cpu_encode"].as_array().unwrap().len(), 3);
+
+    let (out, report) = budget(&dir, "0.001", &[]);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{t}");
+    assert!(t.contains("FAIL") && !t.contains("panicked"), "{t}");
+    assert!(report["verdicts"].as_array().unwrap().iter().all(|v| v["pass"] == false), "{report}");
+}
+
+#[test]
+fn budget_rejects_a_budget_that_is_not_a_positive_number() {
+    for bad in ["0", "-5", "nan"] {
+        let out = vrao(&["budget", "--budget-ms", bad, "--width", "8", "--height", "8"]);
+        assert_eq!(out.status.code(), Some(2), "--budget-ms {bad}: {}", text(&out));
+    }
+}
+
+#[test]
+fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_it() {
+    let dir = temp_dir("bench");
+    let out_dir = dir.join("bench");
+    let cache = dir.join("cache");
+    let args = [
+        "bench",
+        "--scene",
+        "builtin:crease",
+        "--width",
+        "48",
+        "--height",
+        "40",
+        "--techniques",
+        "ssao,hbao,ssdo",
+        "--samples",
+        "8,16",
+        "--radii",
+        "0.5",
+        "--resolution",
+        "both",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--rays",
+        "64",
+        "--stride",
+        "2",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--cache",
+        cache.to_str().unwrap(),
+    ];
+    let out = vrao(&args);
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    let rows = 3 * 2 * 2;
+    let csv = std::fs::read_to_string(out_dir.join("bench.csv")).unwrap();
+    assert_eq!(csv.lines().count(), rows + 1, "{csv}");
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    for line in csv.lines().skip(1) {
+        assert_eq!(line.split(',').count(), header.len(), "{line}");
+    }
+    let markdown = std::fs::read_to_string(out_dir.join("bench.md")).unwrap();
+    assert_eq!(markdown.lines().count(), rows + 2);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("bench.json")).unwrap()).unwrap();
+    let records = json["records"].as_array().unwrap();
+    assert_eq!(records.len(), rows);
+    for r in records {
+        let rmse = r["ao_rmse"].as_f64().expect("every row has an error");
+        let ssim = r["ao_ssim"].as_f64().unwrap();
+        assert!((0.0..0.5).contains(&rmse) && (-1.0..=1.0).contains(&ssim), "{r}");
+        assert!(r["occlusion_ms_per_eye"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    assert!(records.iter().any(|r| r["pareto"] == true));
+    assert!(json["reference"]["ao_noise_rms"].as_f64().unwrap() > 0.0);
+    let png = image::open(out_dir.join("bench.png")).expect("bench.png is an image");
+    assert_eq!((png.width(), png.height()), (1280, 800));
+    // The second run finds the reference in the cache.
+    let cached: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
+    assert_eq!(cached.len(), 1, "one radius, one cached reference");
+
+    // --fit picks the least-error row that fits a generous budget and measures it.
+    let best = records
+        .iter()
+        .min_by(|a, b| a["ao_rmse"].as_f64().unwrap().total_cmp(&b["ao_rmse"].as_f64().unwrap()))
+        .unwrap();
+    let fit_json = dir.join("fit.json");
+    let out = vrao(&[
+        "budget",
+        "--scene",
+        "builtin:crease",
+        "--width",
+        "48",
+        "--height",
+        "40",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--budget-ms",
+        "1000000",
+        "--fit",
+        out_dir.join("bench.json").to_str().unwrap(),
+        "--out",
+        fit_json.to_str().unwrap(),
+    ]);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{t}");
+    let expected = format!("fit: {} N={}", best["technique"].as_str().unwrap(), best["samples"]);
+    assert!(t.contains(&expected), "expected '{expected}' in:\n{t}");
+}
