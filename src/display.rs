@@ -610,7 +610,11 @@ fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
     let latest = history.frames.back();
     for (k, pass) in passes.iter().enumerate() {
         let ms = latest.and_then(|f| f.iter().find(|(n, _)| n == pass)).map_or(0.0, |(_, ms)| *ms);
-        ui.colored_label(pass_colour(k), format!("■ {pass}: {ms:.2} ms"));
+        ui.horizontal(|ui| {
+            let (swatch, painter) = ui.allocate_painter(egui::vec2(10.0, 10.0), egui::Sense::hover());
+            painter.rect_filled(swatch.rect, 0.0, pass_colour(k));
+            ui.label(format!("{pass}: {ms:.2} ms"));
+        });
     }
     if passes.is_empty() {
         ui.label("(no GPU timestamps on this adapter)");

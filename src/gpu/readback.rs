@@ -8,7 +8,10 @@ use crate::error::{Error, Result};
 /// Bytes of one texel for the formats vrao reads back.
 fn texel_bytes(format: wgpu::TextureFormat) -> u32 {
     match format {
-        wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Rgba8UnormSrgb => 4,
+        wgpu::TextureFormat::Rgba8Unorm
+        | wgpu::TextureFormat::Rgba8UnormSrgb
+        | wgpu::TextureFormat::Bgra8Unorm
+        | wgpu::TextureFormat::Bgra8UnormSrgb => 4,
         wgpu::TextureFormat::R32Float | wgpu::TextureFormat::Depth32Float => 4,
         wgpu::TextureFormat::Rgba16Float => 8,
         wgpu::TextureFormat::R16Float => 2,

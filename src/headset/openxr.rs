@@ -31,6 +31,11 @@ const LOADER_NAMES: [&str; 2] = ["libopenxr_loader.so", "libopenxr_loader.so.1"]
 /// Opens the OpenXR loader.
 #[cfg(feature = "xr")]
 pub fn load_entry() -> Result<openxr::Entry, Unavailable> {
+    // The loader prints its own multi-line errors to stderr when no runtime is installed;
+    // vrao says why in one line instead. XR_LOADER_DEBUG set by the user still wins.
+    if std::env::var_os("XR_LOADER_DEBUG").is_none() {
+        std::env::set_var("XR_LOADER_DEBUG", "none");
+    }
     let mut errors = Vec::new();
     for name in LOADER_NAMES {
         // SAFETY: loading the Khronos loader runs its initialisers; it is the library

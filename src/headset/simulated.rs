@@ -262,6 +262,10 @@ impl Headset for SimulatedHeadset {
 
     fn end(&mut self, _gpu: &Gpu) -> Result<()> {
         if !self.ended {
+            // The display shows what was submitted last before the session closes.
+            let last = self.compositor.vsync_after(self.clock.now()) + 1;
+            self.clock.wait_until(self.compositor.vsync_time(last));
+            self.compositor.advance_to(self.clock.now());
             self.compositor.finish();
             self.ended = true;
         }
