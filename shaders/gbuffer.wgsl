@@ -55,7 +55,7 @@ fn fs_main(in: VertexOut) -> GBufferOut {
     }
     var albedo = material.diffuse.rgb;
     if (material.diffuse.w > 0.5) {
-        albedo = albedo * textureSample(diffuse_texture, diffuse_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y)).rgb;
+        albedo = albedo * textureSample(diffuse_texture, diffuse_sampler, in.uv).rgb;
     }
     var out: GBufferOut;
     out.normal = vec4<f32>(finite_or_zero3(n), 0.0);

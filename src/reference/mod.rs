@@ -35,11 +35,14 @@
 //! Geometry: every triangle in f32 relative to an f64 anchor at the mean eye position
 //! (exact to about 1e-7 of the distance from the eyes wherever the scene sits in the
 //! world), in a BVH from the [`obvhs`] crate. Of the two maintained Rust BVH crates,
-//! obvhs builds with PLOC plus reinsertion and traverses an 8-wide compressed BVH (CWBVH)
-//! with SSE, takes a closure for the primitive test (so ours is a watertight one,
-//! `geometry.rs`) and uses glam 0.34 itself; `bvh` (0.13) is built on nalgebra, traverses a
-//! binary tree and returns candidate lists rather than a closest hit. Pixel rows are the
-//! work units of a rayon parallel iterator over all cores.
+//! obvhs (0.4) builds with PLOC plus reinsertion, traverses an 8-wide compressed BVH (CWBVH)
+//! with SSE, shrinks the ray's tmax as hits are found, takes a closure for the primitive
+//! test (so ours is a watertight one, `geometry.rs`) and uses glam 0.34 itself. `bvh`
+//! (0.13) is built on nalgebra and hands out candidate primitives (a list, or an iterator
+//! in box order) with no ray extent, so a ray of length r cannot stop early. Measured here
+//! on Sibenik (75k triangles, one core, 1 m rays from inside the nave): both build in about
+//! 0.05 s; obvhs traces 6.2 Mrays/s, `bvh`'s nearest-first iterator 0.33 Mrays/s. Pixel rows
+//! are the work units of a rayon parallel iterator over all cores.
 //!
 //! [`trace_cached`] keeps results on disk keyed by an FNV-1a hash of everything that
 //! determines them; [`ProgressBar`] shows progress on a terminal.
