@@ -83,6 +83,16 @@ impl Gpu {
     }
 
     fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu> {
+        let desc = Self::device_descriptor(&adapter);
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|e| Error::Device(format!("{} refused a device: {e}", adapter.get_info().name)))?;
+        Ok(Self::from_device(instance, adapter, device, queue))
+    }
+
+    /// The features and limits vrao asks of `adapter`: multiview and timestamp queries
+    /// when offered, and limits large enough for full-size layered targets. Devices that
+    /// others create for us (the OpenXR runtime's) are opened with the same descriptor.
+    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         let available = adapter.features();
         let adapter_limits = adapter.limits();
         let multiview = available.contains(wgpu::Features::MULTIVIEW) && adapter_limits.max_multiview_view_count >= 2;
@@ -107,15 +117,24 @@ impl Gpu {
         if multiview {
             limits.max_multiview_view_count = 2;
         }
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        wgpu::DeviceDescriptor {
             label: Some("vrao"),
             required_features: features,
             required_limits: limits,
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| Error::Device(format!("{} refused a device: {e}", adapter.get_info().name)))?;
+        }
+    }
+
+    /// The `Gpu` for a device opened with [`Gpu::device_descriptor`] (by wgpu, or wrapped
+    /// from a device an OpenXR runtime created): capabilities from the device's features,
+    /// GPU errors kept for [`Gpu::take_error`], and the multiview probe run.
+    pub fn from_device(instance: wgpu::Instance, adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Gpu {
+        let features = device.features();
+        let multiview = features.contains(wgpu::Features::MULTIVIEW);
+        let timestamps =
+            features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
         let uncaptured = std::sync::Arc::new(std::sync::Mutex::new(None));
         let sink = uncaptured.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
@@ -126,7 +145,7 @@ impl Gpu {
         let caps = Capabilities { multiview, multiview_reliable: false, timestamps };
         let mut gpu = Gpu { instance, adapter, device, queue, caps, uncaptured };
         gpu.caps.multiview_reliable = multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
-        Ok(gpu)
+        gpu
     }
 
     /// The first GPU error since the last call, as `Error::Gpu` (then cleared).

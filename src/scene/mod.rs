@@ -7,6 +7,7 @@
 pub mod builtin;
 pub mod environment;
 pub mod file;
+pub mod fuzz;
 pub mod normals;
 pub mod obj;
 

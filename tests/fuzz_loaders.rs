@@ -1,0 +1,105 @@
+//! Bounded fuzzing of the OBJ, MTL and scene-file loaders on stable Rust: seeded
+//! mutations of valid files (and of the shared scenes' own OBJ and MTL when present),
+//! each loaded through `Scene::load`. Any `Ok` or `Err` is fine; a panic fails the test
+//! and the input is saved under `target/fuzz-crashes/` to become a regression file in
+//! `tests/fuzz_regressions/`. `cargo fuzz` runs the same targets without a bound
+//! (`fuzz/`, nightly).
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::time::{Duration, Instant};
+use vrao::scene::fuzz::{load_bytes, Mutator, Target, VALID_MTL, VALID_OBJ, VALID_SCENE};
+
+/// Time per target; `VRAO_FUZZ_SECONDS` overrides it for longer runs.
+fn budget() -> Duration {
+    let seconds = std::env::var("VRAO_FUZZ_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(8.0);
+    Duration::from_secs_f64(seconds)
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("vrao-fuzz-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn seeds(target: Target) -> Vec<Vec<u8>> {
+    let mut seeds = vec![match target {
+        Target::Obj => VALID_OBJ.as_bytes().to_vec(),
+        Target::Mtl => VALID_MTL.as_bytes().to_vec(),
+        Target::SceneFile => VALID_SCENE.as_bytes().to_vec(),
+    }];
+    let cornell = |ext: &str| vrao::scene::shared_scene_for_test(&format!("cornell_box/CornellBox-Original.{ext}"));
+    match target {
+        Target::Obj => seeds.extend(cornell("obj").and_then(|p| std::fs::read(p).ok())),
+        Target::Mtl => seeds.extend(cornell("mtl").and_then(|p| std::fs::read(p).ok())),
+        Target::SceneFile => seeds.push(include_bytes!("../assets/scenes/cornell.toml").to_vec()),
+    }
+    seeds
+}
+
+fn save_crash(target: Target, input: &[u8]) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz-crashes");
+    std::fs::create_dir_all(&dir).unwrap();
+    let hash = input.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+    let path = dir.join(format!("crash-{hash:016x}.{}", target.extension()));
+    std::fs::write(&path, input).unwrap();
+    path
+}
+
+#[test]
+fn mutated_obj_mtl_and_scene_files_never_panic() {
+    // Panics are caught and reported below; keep the default hook from printing each.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut report = Vec::new();
+    for target in Target::ALL {
+        let dir = scratch(target.extension());
+        let seeds = seeds(target);
+        let mut rng = Mutator::new(0x5eed ^ target as u64);
+        let (started, mut runs, mut errors) = (Instant::now(), 0u64, 0u64);
+        let mut crashes = Vec::new();
+        while started.elapsed() < budget() {
+            let mut input = seeds[runs as usize % seeds.len()].clone();
+            // A few rounds of mutation, so inputs drift further from the seeds.
+            for _ in 0..1 + runs % 4 {
+                rng.mutate(&mut input);
+            }
+            match catch_unwind(AssertUnwindSafe(|| load_bytes(target, &input, &dir))) {
+                Ok(Ok(_)) => {}
+                Ok(Err(e)) => {
+                    errors += 1;
+                    // Errors must say where: the file, and for parse errors the line.
+                    let message = e.to_string();
+                    assert!(message.contains("fuzz."), "an error that names no file: {message}");
+                }
+                Err(_) => crashes.push(save_crash(target, &input)),
+            }
+            runs += 1;
+        }
+        report.push(format!("{}: {runs} inputs, {errors} rejected, {} panics", target.extension(), crashes.len()));
+        assert!(crashes.is_empty(), "{target:?} panicked on {crashes:?}");
+        assert!(runs > 50, "{target:?}: only {runs} inputs in the time");
+    }
+    std::panic::set_hook(default_hook);
+    eprintln!("{}", report.join("\n"));
+}
+
+#[test]
+fn every_saved_regression_input_loads_or_errs_without_a_panic() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_regressions");
+    let scratch = scratch("regressions");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let target = match path.extension().and_then(|e| e.to_str()) {
+            Some("obj") => Target::Obj,
+            Some("mtl") => Target::Mtl,
+            Some("toml") => Target::SceneFile,
+            _ => continue,
+        };
+        let input = std::fs::read(&path).unwrap();
+        let result = catch_unwind(AssertUnwindSafe(|| load_bytes(target, &input, &scratch)));
+        assert!(result.is_ok(), "{} panics", path.display());
+        checked += 1;
+    }
+    assert!(checked > 0, "no regression inputs in {}", dir.display());
+}
