@@ -11,9 +11,6 @@
 @group(0) @binding(3) var occlusion_in: texture_2d_array<f32>;
 @group(0) @binding(4) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
 
-// Tangent-plane distance, as a fraction of the centre's distance, that halves a weight.
-const PLANE_SIGMA: f32 = 0.02;
-
 fn blur(id: vec3<u32>, axis: vec2<i32>) {
     if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
         return;
@@ -31,7 +28,10 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
     let n = centre.xyz;
     let radius = i32(ao.blur_radius);
     let sigma = max(f32(radius) * 0.5, 0.5);
-    let plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
+    // Off-plane distance in units of the depth-edge width (`ao.blur_plane_sigma` of the
+    // centre's distance). A sigma near 0 makes this huge: neighbours off the plane get
+    // weight 0 (or NaN, skipped below) and the centre value stays.
+    let plane_scale = 1.0 / max(ao.blur_plane_sigma * -position.z, 1e-30);
     let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
     var sum = vec4<f32>(0.0);
     var total = 0.0;

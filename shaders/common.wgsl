@@ -94,7 +94,8 @@ struct AoParams {
     _pad: u32,
     // Bilateral blur radius in occlusion pixels (5 → 11×11 at full resolution).
     blur_radius: u32,
-    _pad2: u32,
+    // Depth-edge width of the blur, as a fraction of the centre's distance.
+    blur_plane_sigma: f32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

@@ -31,6 +31,12 @@ struct Reproject {
 
 override POSITIONAL: bool = true;
 
+// A usable reversed-Z depth: in (0, 1]. 0 is the sky; NaN, Inf, negatives or values past
+// the near plane (a corrupted history) count as no depth at all.
+fn valid_depth(d: f32) -> bool {
+    return d > 0.0 && d <= 1.0;
+}
+
 fn splat_index(p: vec2<i32>, layer: u32) -> u32 {
     return (layer * warp.size.y + u32(p.y)) * warp.size.x + u32(p.x);
 }
@@ -44,7 +50,7 @@ fn splat(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let depth = textureLoad(source_depth, vec2<i32>(id.xy), i32(id.z), 0);
-    if (!(depth > 0.0)) {
+    if (!valid_depth(depth)) {
         return;
     }
     let in_source = view_position_from_depth(pixel_uv(id.xy, warp.size), depth, warp.source_tangents[id.z], warp.near);
@@ -87,7 +93,7 @@ fn target_depth(p: vec2<i32>, layer: u32) -> f32 {
     let at_infinity = rotational_uv(pixel_uv(vec2<u32>(p), warp.size), layer);
     if (all(at_infinity >= vec2<f32>(0.0)) && all(at_infinity < vec2<f32>(1.0))) {
         let q = min(vec2<u32>(at_infinity * vec2<f32>(warp.size)), warp.size - vec2<u32>(1u));
-        if (!(textureLoad(source_depth, vec2<i32>(q), i32(layer), 0) > 0.0)) {
+        if (!valid_depth(textureLoad(source_depth, vec2<i32>(q), i32(layer), 0))) {
             return 0.0;
         }
     }

@@ -3,14 +3,15 @@
 //! depth. The desktop window (`display.rs`) drives the same loop one step per redraw.
 
 use crate::error::{Error, Result};
-use crate::gpu::Gpu;
+use crate::gpu::{BackendChoice, Gpu};
 use crate::graph::Resource;
-use crate::headset::openxr::probe_runtime;
+use crate::headset::openxr::{self, OpenXrOptions, Unavailable};
 use crate::headset::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::headset::{FrameRequest, Headset, SubmittedFrame};
 use crate::renderer::{FrameReport, Renderer};
 use crate::scene::Scene;
 use crate::settings::Settings;
+use crate::stereo::HeadsetProfile;
 use std::collections::VecDeque;
 use std::sync::Arc;
 
@@ -38,27 +39,40 @@ impl std::str::FromStr for HeadsetChoice {
     }
 }
 
-/// Opens the chosen headset; the message says which one and, on fall back, why.
-pub fn open_headset(choice: HeadsetChoice, simulated: SimulatedOptions) -> Result<(Box<dyn Headset>, String)> {
-    let simulated_headset = |why: String| -> Result<(Box<dyn Headset>, String)> {
+/// Opens the chosen headset and the GPU to render for it; the message says which one
+/// and, on fall back, why. An OpenXR session brings its own GPU (the runtime creates the
+/// Vulkan device); the simulated headset renders on `Gpu::new(backend)`.
+///
+/// The OpenXR headset renders at the runtime's recommended per-eye size unless the
+/// simulated profile asks for another size than the Vive-class default (`vrao run
+/// --width/--height`); it falls back to the simulated headset if its session is lost.
+pub fn open_headset(
+    choice: HeadsetChoice,
+    simulated: SimulatedOptions,
+    backend: BackendChoice,
+) -> Result<(Box<dyn Headset>, Arc<Gpu>, String)> {
+    let simulated_headset = |why: String| -> Result<(Box<dyn Headset>, Arc<Gpu>, String)> {
         let headset = SimulatedHeadset::new(simulated.clone())?;
+        let gpu = Arc::new(Gpu::new(backend)?);
         let message = format!("{why}: using the {}", headset.describe());
-        Ok((Box::new(headset), message))
+        Ok((Box::new(headset), gpu, message))
+    };
+    let openxr = || {
+        if backend == BackendChoice::Gl {
+            return Err(Unavailable::Unsupported("OpenXR sessions need the Vulkan backend, not --backend gl".into()));
+        }
+        let vive = HeadsetProfile::vive();
+        let size = (simulated.profile.width, simulated.profile.height);
+        let size = (size != (vive.width, vive.height)).then_some(size);
+        openxr::open_headset(OpenXrOptions::from_simulated(&simulated, size))
     };
     match choice {
         HeadsetChoice::Simulated => simulated_headset("--headset simulated".into()),
-        HeadsetChoice::Auto => match probe_runtime() {
-            Ok(runtime) => simulated_headset(format!(
-                "OpenXR runtime {runtime} answered, but this build has no OpenXR session yet"
-            )),
+        HeadsetChoice::Auto => match openxr() {
+            Ok(opened) => Ok(opened),
             Err(why) => simulated_headset(why.to_string()),
         },
-        HeadsetChoice::OpenXr => match probe_runtime() {
-            Ok(runtime) => Err(Error::Device(format!(
-                "--headset openxr: runtime {runtime} answered, but this build has no OpenXR session yet"
-            ))),
-            Err(why) => Err(Error::Device(format!("--headset openxr: {why}"))),
-        },
+        HeadsetChoice::OpenXr => openxr().map_err(|why| Error::Device(format!("--headset openxr: {why}"))),
     }
 }
 

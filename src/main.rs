@@ -276,6 +276,9 @@ struct AoArgs {
     /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns the blur off.
     #[arg(long, default_value_t = 5)]
     blur: u32,
+    /// Blur depth-edge width as a fraction of the pixel's distance (smaller keeps sharper edges).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    blur_sigma: f32,
     /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
     #[arg(long, default_value = "halton")]
     noise: Noise,
@@ -297,6 +300,7 @@ impl AoArgs {
             noise: self.noise,
             half_res: self.half_res,
             blur_radius: self.blur,
+            blur_plane_sigma: self.blur_sigma,
         }
     }
 }
@@ -621,9 +625,8 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         compose: args.display == DisplayMode::Mirror,
         frames,
     };
-    let (headset, message) = vrao::app::open_headset(args.headset, simulated)?;
+    let (headset, gpu, message) = vrao::app::open_headset(args.headset, simulated, backend)?;
     println!("headset: {message}");
-    let gpu = Arc::new(Gpu::new(backend)?);
     let mut frame_loop = vrao::app::FrameLoop::new(gpu.clone(), &scene, &settings, headset)?;
     let summary = if args.display == DisplayMode::None {
         while frame_loop.step()?.is_some() {}

@@ -194,6 +194,10 @@ pub struct AoSettings {
     /// (5 = 11×11; at half resolution 3 taps either side cover the same footprint);
     /// 0 turns it off.
     pub blur_radius: u32,
+    /// The blur's depth edge: a neighbour this far off the centre's tangent plane, as a
+    /// fraction of the centre's distance, loses most of its weight. Near 0 every
+    /// neighbour's weight vanishes and the centre value is kept.
+    pub blur_plane_sigma: f32,
 }
 
 impl Default for AoSettings {
@@ -209,6 +213,7 @@ impl Default for AoSettings {
             noise: Noise::Halton,
             half_res: false,
             blur_radius: 5,
+            blur_plane_sigma: 0.02,
         }
     }
 }
@@ -229,6 +234,9 @@ impl AoSettings {
         }
         if !(self.bounce.is_finite() && (0.0..=100.0).contains(&self.bounce)) {
             return Err(Error::input(format!("bounce {} is not within 0..=100", self.bounce)));
+        }
+        if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
+            return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
         }
         if self.blur_radius > 16 {
             return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));

@@ -58,7 +58,7 @@ pub struct AoParamsUniform {
     pub bounce: f32,
     pub _pad: u32,
     pub blur_radius: u32,
-    pub _pad2: u32,
+    pub blur_plane_sigma: f32,
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).
@@ -152,7 +152,7 @@ impl FrameBuffers {
             // The blur radius is in full-resolution pixels: at half resolution the same
             // screen footprint takes half as many taps.
             blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
-            _pad2: 0,
+            blur_plane_sigma: ao.blur_plane_sigma,
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
         queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));

@@ -107,8 +107,10 @@ impl Chain {
             let images = swapchain.enumerate_images()?;
             let label = if depth { "openxr depth swapchain" } else { "openxr colour swapchain" };
             let size = wgpu::Extent3d { width, height, depth_or_array_layers: layers };
-            let textures: Vec<wgpu::Texture> =
-                images.iter().map(|&image| wrap_image(gpu, vk::Image::from_raw(image), label, size, format, uses)).collect();
+            let textures: Vec<wgpu::Texture> = images
+                .iter()
+                .map(|&image| wrap_image(gpu, vk::Image::from_raw(image), label, size, format, uses))
+                .collect();
             let views = textures
                 .iter()
                 .map(|texture| {
@@ -180,7 +182,12 @@ fn wrap_image(
         // SAFETY: `image` is a swapchain image of this device, created with `size`,
         // `format`, one mip level and one sample; its memory belongs to the runtime.
         unsafe {
-            hal_device.texture_from_raw(image, &hal_desc, Some(Box::new(|| {})), wgpu::hal::vulkan::TextureMemory::External)
+            hal_device.texture_from_raw(
+                image,
+                &hal_desc,
+                Some(Box::new(|| {})),
+                wgpu::hal::vulkan::TextureMemory::External,
+            )
         }
     };
     let desc = wgpu::TextureDescriptor {
@@ -198,14 +205,18 @@ fn wrap_image(
     unsafe { gpu.device.create_texture_from_hal::<HalVulkan>(hal_texture, &desc, uses) }
 }
 
-/// The render pipeline that copies one eye into a swapchain image.
-struct Blit {
+/// The render pipeline that copies one eye of the renderer's colour (sRGB-encoded
+/// Rgba8Unorm) and depth into a colour view of any format (decoding to linear; an sRGB
+/// view encodes again) and, optionally, a depth view. Public so it can be tested
+/// against ordinary textures.
+pub struct EyeBlit {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
+    depth: bool,
 }
 
-impl Blit {
-    fn new(device: &wgpu::Device, color: wgpu::TextureFormat, depth: Option<wgpu::TextureFormat>) -> Blit {
+impl EyeBlit {
+    pub fn new(device: &wgpu::Device, color: wgpu::TextureFormat, depth: Option<wgpu::TextureFormat>) -> EyeBlit {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("openxr blit"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/xr_blit.wgsl").into()),
@@ -259,7 +270,65 @@ impl Blit {
             multiview_mask: None,
             cache: None,
         });
-        Blit { layout, pipeline }
+        EyeBlit { layout, pipeline, depth: depth.is_some() }
+    }
+
+    /// Records the copy of layer `eye` of `color` and `depth` into `color_view` (and
+    /// `depth_view`, which must be given exactly when the blit was made with a depth
+    /// format), over `width` × `height` pixels from the top-left.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        color: &LayeredTarget,
+        depth: &LayeredTarget,
+        eye: usize,
+        color_view: &wgpu::TextureView,
+        depth_view: Option<&wgpu::TextureView>,
+        (width, height): (u32, u32),
+    ) {
+        assert_eq!(depth_view.is_some(), self.depth, "a depth view exactly when the blit writes depth");
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("openxr blit"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(
+                        &color.layer_views[eye.min(color.layers as usize - 1)],
+                    ),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(
+                        &depth.layer_views[eye.min(depth.layers as usize - 1)],
+                    ),
+                },
+            ],
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("openxr swapchain blit"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: depth_view.map(|view| wgpu::RenderPassDepthStencilAttachment {
+                view,
+                // Reversed-Z: 0 is infinitely far.
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_viewport(0.0, 0.0, width as f32, height as f32, 0.0, 1.0);
+        pass.draw(0..3, 0..1);
     }
 }
 
@@ -276,7 +345,7 @@ pub struct SubImage {
 pub struct EyeSwapchains {
     color: Chain,
     depth: Option<Chain>,
-    blit: Blit,
+    blit: EyeBlit,
     pub layout: SwapchainLayout,
     pub size: (u32, u32),
 }
@@ -291,8 +360,7 @@ impl EyeSwapchains {
         size: (u32, u32),
         with_depth: bool,
     ) -> Result<EyeSwapchains, String> {
-        let offered =
-            session.enumerate_swapchain_formats().map_err(|e| format!("xrEnumerateSwapchainFormats: {e}"))?;
+        let offered = session.enumerate_swapchain_formats().map_err(|e| format!("xrEnumerateSwapchainFormats: {e}"))?;
         let color_format = pick(&offered, &COLOR_FORMATS).ok_or_else(|| {
             format!("the runtime offers no colour swapchain format vrao can fill (offered Vulkan formats {offered:?})")
         })?;
@@ -305,7 +373,7 @@ impl EyeSwapchains {
             });
             match chains {
                 Ok((color, depth)) => {
-                    let blit = Blit::new(&gpu.device, color.format, depth.as_ref().map(|d| d.format));
+                    let blit = EyeBlit::new(&gpu.device, color.format, depth.as_ref().map(|d| d.format));
                     return Ok(EyeSwapchains { color, depth, blit, layout, size });
                 }
                 Err(e) => {
@@ -373,42 +441,7 @@ impl EyeSwapchains {
                 (Some(chain), Some(indices)) => Some(&chain.views[swapchain][indices[swapchain]][layer as usize]),
                 _ => None,
             };
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("openxr blit"),
-                layout: &self.blit.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&color.layer_views[eye.min(color.layers as usize - 1)]),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&depth.layer_views[eye.min(depth.layers as usize - 1)]),
-                    },
-                ],
-            });
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("openxr swapchain blit"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: depth_view.map(|view| wgpu::RenderPassDepthStencilAttachment {
-                    view,
-                    // Reversed-Z: 0 is infinitely far.
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.blit.pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.set_viewport(0.0, 0.0, width as f32, height as f32, 0.0, 1.0);
-            pass.draw(0..3, 0..1);
+            self.blit.record(&gpu.device, &mut encoder, color, depth, eye, color_view, depth_view, (width, height));
         }
         gpu.queue.submit([encoder.finish()]);
         let gpu_error = gpu.take_error();

@@ -83,8 +83,9 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
         .engine_name(c"vrao")
         .engine_version(1)
         .api_version(version);
-    let instance_info =
-        vk::InstanceCreateInfo::default().application_info(&app_info).enabled_extension_names(&instance_extension_names);
+    let instance_info = vk::InstanceCreateInfo::default()
+        .application_info(&app_info)
+        .enabled_extension_names(&instance_extension_names);
     // SAFETY: the two function-pointer types have the same ABI (instance handle and name
     // in, optional function pointer out); openxr-sys spells the handle as a pointer.
     let get_instance_proc_addr: openxr::sys::platform::VkGetInstanceProcAddr =
@@ -92,11 +93,12 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
 
     // SAFETY: the create info and everything it points to live until the call returns;
     // the graphics requirements were queried above, as enable2 requires.
-    let raw_instance = unsafe {
-        xr.create_vulkan_instance(system, get_instance_proc_addr, &instance_info as *const _ as *const _)
-    }
-    .map_err(|e| format!("xrCreateVulkanInstanceKHR: {e}"))?
-    .map_err(|e| format!("xrCreateVulkanInstanceKHR: vkCreateInstance returned {:?}", vk::Result::from_raw(e)))?;
+    let raw_instance =
+        unsafe { xr.create_vulkan_instance(system, get_instance_proc_addr, &instance_info as *const _ as *const _) }
+            .map_err(|e| format!("xrCreateVulkanInstanceKHR: {e}"))?
+            .map_err(|e| {
+                format!("xrCreateVulkanInstanceKHR: vkCreateInstance returned {:?}", vk::Result::from_raw(e))
+            })?;
     let vk_instance = vk::Instance::from_raw(raw_instance as usize as u64);
     // SAFETY: the instance was just created through this entry's vkGetInstanceProcAddr.
     let ash_instance = unsafe { ash::Instance::load(entry.static_fn(), vk_instance) };
@@ -139,7 +141,8 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
     let queue_family_index = families
         .iter()
         .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
-        .ok_or_else(|| format!("{adapter_name} has no graphics and compute queue"))? as u32;
+        .ok_or_else(|| format!("{adapter_name} has no graphics and compute queue"))?
+        as u32;
 
     let open = {
         // SAFETY: the adapter is a Vulkan adapter.
@@ -149,11 +152,12 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
         let mut device_features = hal_adapter.physical_device_features(&device_extensions, desc.required_features);
         let device_extension_names = names(&device_extensions);
         let priorities = [1.0f32];
-        let queues = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(queue_family_index)
-            .queue_priorities(&priorities)];
+        let queues =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family_index).queue_priorities(&priorities)];
         let device_info = device_features.add_to_device_create(
-            vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_extension_names(&device_extension_names),
+            vk::DeviceCreateInfo::default()
+                .queue_create_infos(&queues)
+                .enabled_extension_names(&device_extension_names),
         );
         // SAFETY: the create info and its feature chain live until the call returns; the
         // physical device is the one the runtime chose.

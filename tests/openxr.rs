@@ -1,0 +1,344 @@
+//! The OpenXR headset: the fall back without a runtime (CI: the real loader, no runtime),
+//! the swapchain blit's colour encoding and depth copy, and — when `XR_RUNTIME_JSON`
+//! names a runtime (Monado with `XRT_COMPOSITOR_NULL=1` runs headless on lavapipe) — a
+//! real session of a few hundred frames, and a lost session's fall back.
+//!
+//! A process may hold one OpenXR instance at a time, and these tests change
+//! `XR_RUNTIME_JSON`: every test holds the one GPU lock for its whole run.
+
+#![cfg(feature = "xr")]
+
+mod common;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use vrao::gpu::readback::{read_layers, read_layers_f32};
+use vrao::gpu::targets::LayeredTarget;
+use vrao::graph::Resource;
+use vrao::headset::openxr::{probe_runtime, EyeBlit, OpenXrHeadset, OpenXrOptions, SessionPhase, Unavailable};
+use vrao::headset::simulated::{SimulatedOptions, TimeMode};
+use vrao::headset::{Headset, SubmittedFrame};
+use vrao::scene::Scene;
+use vrao::settings::Settings;
+use vrao::stereo::HeadsetProfile;
+use vrao::{BackendChoice, Gpu};
+
+const RUNTIME_VAR: &str = "XR_RUNTIME_JSON";
+
+/// Points the loader at a runtime manifest that does not exist (so no runtime answers,
+/// whatever is installed) until dropped.
+struct NoRuntime(Option<std::ffi::OsString>);
+
+impl NoRuntime {
+    fn set() -> NoRuntime {
+        let saved = std::env::var_os(RUNTIME_VAR);
+        std::env::set_var(RUNTIME_VAR, "/nonexistent/vrao-test/no_runtime.json");
+        NoRuntime(saved)
+    }
+}
+
+impl Drop for NoRuntime {
+    fn drop(&mut self) {
+        match self.0.take() {
+            Some(value) => std::env::set_var(RUNTIME_VAR, value),
+            None => std::env::remove_var(RUNTIME_VAR),
+        }
+    }
+}
+
+/// The runtime manifest to test against, or `None` (the session tests are skipped).
+fn runtime_manifest() -> Option<PathBuf> {
+    let path = PathBuf::from(std::env::var_os(RUNTIME_VAR)?);
+    path.is_file().then_some(path)
+}
+
+fn small_simulated(frames: Option<u64>) -> SimulatedOptions {
+    let scene = Scene::load("builtin:room").unwrap();
+    SimulatedOptions {
+        profile: HeadsetProfile::with_size("vive", 48, 40),
+        near: 0.05,
+        path: scene.head.clone(),
+        motion: Default::default(),
+        time: TimeMode::Virtual { render_ms: vec![5.0] },
+        reprojection: Default::default(),
+        compose: false,
+        frames,
+    }
+}
+
+#[test]
+fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_headset() {
+    let _one_at_a_time = common::gpu_lock();
+    let _no_runtime = NoRuntime::set();
+    let ci = std::env::var_os("CI").is_some();
+    let expect_no_runtime = |what: &str, why: &Unavailable| match why {
+        Unavailable::NoRuntime(_) => {}
+        // Without CI's loader package, a missing loader is the other honest answer.
+        Unavailable::NoLoader(_) if !ci => {}
+        other => panic!("{what}: expected 'no OpenXR runtime', got {other:?}"),
+    };
+    expect_no_runtime("probe", &probe_runtime().unwrap_err());
+    let options = OpenXrOptions::from_simulated(&small_simulated(Some(3)), None);
+    match OpenXrHeadset::open(options) {
+        Ok(_) => panic!("an OpenXR headset opened with no runtime"),
+        Err(why) => expect_no_runtime("open", &why),
+    }
+
+    let (mut headset, gpu, message) =
+        vrao::app::open_headset(vrao::app::HeadsetChoice::Auto, small_simulated(Some(3)), BackendChoice::Auto)
+            .expect("the fall back opens");
+    assert!(message.contains("using the simulated headset"), "{message}");
+    assert!(message.contains(if ci { "no OpenXR runtime" } else { "no OpenXR" }), "{message}");
+    assert_eq!(message.lines().count(), 1, "one line: {message}");
+    assert!(headset.describe().starts_with("simulated headset"), "{}", headset.describe());
+    let mut frames = 0;
+    while let Some(request) = headset.wait_frame(&gpu).unwrap() {
+        headset.submit(&gpu, &request, None).unwrap();
+        frames += 1;
+    }
+    assert_eq!(frames, 3);
+    headset.end(&gpu).unwrap();
+
+    let err = vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), BackendChoice::Auto)
+        .err()
+        .expect("--headset openxr without a runtime is an error");
+    assert_eq!(err.exit_code(), 2, "{err}");
+    let text = err.to_string();
+    assert!(text.contains("--headset openxr") && text.contains("no OpenXR"), "{text}");
+}
+
+/// 2-layer colour (sRGB-encoded bytes in Rgba8Unorm) and depth targets with every byte
+/// value and a spread of depths, as the renderer would hand them over.
+fn eye_targets(gpu: &Gpu, (width, height): (u32, u32)) -> (LayeredTarget, LayeredTarget, Vec<Vec<u8>>, Vec<Vec<f32>>) {
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+    let color = LayeredTarget::new(&gpu.device, "eye colour", Resource::Color.format(), (width, height, 2), usage);
+    let depth = LayeredTarget::new(&gpu.device, "eye depth", Resource::Depth.format(), (width, height, 2), usage);
+    let texels = (width * height) as usize;
+    let color_bytes: Vec<Vec<u8>> = (0..2)
+        .map(|layer| {
+            (0..texels)
+                .flat_map(|i| {
+                    let v = (i * 7 + layer * 101) as u8;
+                    [v, v.wrapping_add(85), v.wrapping_add(170), 255]
+                })
+                .collect()
+        })
+        .collect();
+    let depths: Vec<Vec<f32>> = (0..2)
+        .map(|layer| (0..texels).map(|i| ((i + layer * 13) % 97) as f32 / 96.0 * (1.0 - 1e-7 * i as f32)).collect())
+        .collect();
+    for layer in 0..2 {
+        let origin = wgpu::Origin3d { x: 0, y: 0, z: layer as u32 };
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &color.texture,
+                mip_level: 0,
+                origin,
+                aspect: wgpu::TextureAspect::All,
+            },
+            &color_bytes[layer],
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
+            size,
+        );
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &depth.texture,
+                mip_level: 0,
+                origin,
+                aspect: wgpu::TextureAspect::DepthOnly,
+            },
+            bytemuck::cast_slice(&depths[layer]),
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
+            size,
+        );
+    }
+    (color, depth, color_bytes, depths)
+}
+
+fn blit_both_eyes(
+    gpu: &Gpu,
+    color: &LayeredTarget,
+    depth: &LayeredTarget,
+    out_format: wgpu::TextureFormat,
+) -> (LayeredTarget, LayeredTarget) {
+    let size = (color.width, color.height, 2);
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let out_color = LayeredTarget::new(&gpu.device, "swapchain colour", out_format, size, usage);
+    let out_depth = LayeredTarget::new(&gpu.device, "swapchain depth", wgpu::TextureFormat::Depth32Float, size, usage);
+    let blit = EyeBlit::new(&gpu.device, out_format, Some(wgpu::TextureFormat::Depth32Float));
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    for eye in 0..2 {
+        blit.record(
+            &gpu.device,
+            &mut encoder,
+            color,
+            depth,
+            eye,
+            &out_color.layer_views[eye],
+            Some(&out_depth.layer_views[eye]),
+            (color.width, color.height),
+        );
+    }
+    gpu.queue.submit([encoder.finish()]);
+    gpu.take_error().unwrap();
+    (out_color, out_depth)
+}
+
+fn srgb_to_linear(byte: u8) -> f32 {
+    let c = byte as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[test]
+fn the_swapchain_blit_keeps_srgb_bytes_and_depth_exact_and_decodes_for_linear_swapchains() {
+    let (gpu, _one_at_a_time) = common::gpu();
+    let (color, depth, color_bytes, depths) = eye_targets(&gpu, (64, 40));
+
+    // An sRGB swapchain (the format vrao prefers) ends up with the renderer's bytes.
+    let (out_color, out_depth) = blit_both_eyes(&gpu, &color, &depth, wgpu::TextureFormat::Rgba8UnormSrgb);
+    let got = read_layers(&gpu, &out_color).unwrap();
+    for layer in 0..2 {
+        let mismatches = got[layer].iter().zip(&color_bytes[layer]).filter(|(a, b)| a != b).count();
+        assert_eq!(mismatches, 0, "layer {layer}: sRGB bytes changed in {mismatches} channels");
+    }
+    // Reversed-Z depth is copied bit for bit, per eye.
+    let got_depth = read_layers_f32(&gpu, &out_depth).unwrap();
+    assert_eq!(got_depth, depths);
+
+    // A linear swapchain (float16) holds decoded values: the runtime reads it as linear.
+    let (linear, _) = blit_both_eyes(&gpu, &color, &depth, wgpu::TextureFormat::Rgba16Float);
+    let values = read_layers_f32(&gpu, &linear).unwrap();
+    for layer in 0..2 {
+        for (i, (&got, &byte)) in values[layer].iter().zip(&color_bytes[layer]).enumerate() {
+            let expected = if i % 4 == 3 { 1.0 } else { srgb_to_linear(byte) };
+            assert!((got - expected).abs() <= 1e-3 + expected * 1e-3, "layer {layer} channel {i}: {got} vs {expected}");
+        }
+    }
+    // BGRA swapchains too: same colours, swapped channel order.
+    let (bgra, _) = blit_both_eyes(&gpu, &color, &depth, wgpu::TextureFormat::Bgra8UnormSrgb);
+    let got = read_layers(&gpu, &bgra).unwrap();
+    for (texel, expected) in got[1].chunks_exact(4).zip(color_bytes[1].chunks_exact(4)) {
+        assert_eq!([texel[2], texel[1], texel[0], texel[3]], [expected[0], expected[1], expected[2], expected[3]]);
+    }
+}
+
+/// Renders and submits `frames` frames; returns how many were rendered.
+fn run_frames(headset: &mut dyn Headset, gpu: &Arc<Gpu>, renderer: &mut vrao::renderer::Renderer, frames: u64) -> u64 {
+    let mut rendered = 0;
+    for _ in 0..frames {
+        let Some(request) = headset.wait_frame(gpu).expect("wait_frame") else { break };
+        if !request.should_render {
+            headset.submit(gpu, &request, None).expect("submit");
+            continue;
+        }
+        for eye in &request.eyes.eyes {
+            eye.fov.validate().expect("the runtime's fov is a valid frustum");
+            assert!(eye.pose.position.is_finite());
+        }
+        renderer.render(&request.eyes.eyes, &[Resource::Color, Resource::Depth]).expect("render");
+        let color = renderer.target(Resource::Color).unwrap();
+        let depth = renderer.target(Resource::Depth).unwrap();
+        let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
+        headset.submit(gpu, &request, Some(frame)).expect("submit");
+        rendered += 1;
+    }
+    rendered
+}
+
+fn session_options(fallback: Option<SimulatedOptions>) -> OpenXrOptions {
+    let simulated = small_simulated(None);
+    OpenXrOptions { size: Some((96, 80)), report: false, fallback, ..OpenXrOptions::from_simulated(&simulated, None) }
+}
+
+fn renderer_for(headset: &OpenXrHeadset, gpu: &Arc<Gpu>) -> vrao::renderer::Renderer {
+    let scene = Scene::load("builtin:room").unwrap();
+    let (width, height) = headset.recommended_size();
+    let settings = Settings { profile: HeadsetProfile::with_size("openxr", width, height), ..Settings::default() };
+    vrao::renderer::Renderer::new(gpu.clone(), &scene, &settings).unwrap()
+}
+
+/// `want` appears in `seen` in order (other states may come between).
+fn in_order(seen: &[SessionPhase], want: &[SessionPhase]) -> bool {
+    let mut rest = seen.iter();
+    want.iter().all(|w| rest.any(|s| s == w))
+}
+
+#[test]
+fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
+    let _one_at_a_time = common::gpu_lock();
+    let Some(manifest) = runtime_manifest() else {
+        eprintln!(
+            "skipped: set {RUNTIME_VAR} to an OpenXR runtime's manifest (e.g. Monado's, with XRT_COMPOSITOR_NULL=1)"
+        );
+        return;
+    };
+    let (mut headset, gpu) = OpenXrHeadset::open(session_options(None))
+        .unwrap_or_else(|e| panic!("the runtime at {} did not open a session: {e}", manifest.display()));
+    eprintln!("{}", headset.describe());
+    assert_eq!(headset.recommended_size(), (96, 80));
+    let mut renderer = renderer_for(&headset, &gpu);
+
+    const FRAMES: u64 = 300;
+    let rendered = run_frames(&mut headset, &gpu, &mut renderer, FRAMES);
+    assert!(rendered > FRAMES / 2, "only {rendered} of {FRAMES} frames were rendered");
+    assert!(headset.phases().contains(&SessionPhase::Focused), "{:?}", headset.phases());
+
+    // Ask to leave: the runtime walks STOPPING → (xrEndSession) → IDLE → EXITING.
+    headset.request_exit().unwrap();
+    let mut after_exit = 0;
+    while let Some(request) = headset.wait_frame(&gpu).unwrap() {
+        headset.submit(&gpu, &request, None).unwrap();
+        after_exit += 1;
+        assert!(after_exit < 1000, "the session did not end after xrRequestExitSession");
+    }
+    headset.end(&gpu).unwrap();
+
+    use SessionPhase::*;
+    let phases = headset.phases().to_vec();
+    assert!(
+        in_order(&phases, &[Idle, Ready, Synchronized, Visible, Focused, Stopping, Idle, Exiting]),
+        "session states: {phases:?}"
+    );
+    assert!(!phases.contains(&LossPending) && headset.lost().is_none(), "{phases:?} {:?}", headset.lost());
+    let stats = headset.stats();
+    let counters = headset.counters();
+    eprintln!("states {phases:?}\nstats {stats:?}\ncounters {counters:?}");
+    assert_eq!(counters.submitted, rendered);
+    assert_eq!(stats.layers, rendered, "every rendered frame ends with the projection layer");
+    assert_eq!(counters.presented, stats.layers);
+    assert!(headset.submits_depth(), "Monado has XR_KHR_composition_layer_depth: {}", headset.swapchains());
+    assert_eq!(stats.layers_with_depth, stats.layers, "every layer carries depth");
+    assert_eq!(counters.reprojected, 0, "reprojection is the runtime's and not counted");
+    drop(renderer);
+    drop(headset);
+    // The instance is gone: another may be made.
+    probe_runtime().expect("a new instance after the session ended");
+}
+
+#[test]
+fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
+    let _one_at_a_time = common::gpu_lock();
+    if runtime_manifest().is_none() {
+        eprintln!("skipped: set {RUNTIME_VAR} to an OpenXR runtime's manifest");
+        return;
+    }
+    let (mut headset, gpu) = OpenXrHeadset::open(session_options(Some(small_simulated(None)))).expect("session");
+    let mut renderer = renderer_for(&headset, &gpu);
+    let before = run_frames(&mut headset, &gpu, &mut renderer, 20);
+    assert!(before > 0);
+    headset.simulate_loss("test: LOSS_PENDING");
+    assert_eq!(headset.lost(), Some("test: LOSS_PENDING"));
+    assert!(headset.describe().starts_with("simulated headset"), "{}", headset.describe());
+    assert_eq!(headset.recommended_size(), (96, 80), "the fall back keeps the render size");
+    // The runtime's instance is gone; the GPU it made keeps rendering.
+    probe_runtime().expect("the OpenXR instance was released");
+    let after = run_frames(&mut headset, &gpu, &mut renderer, 10);
+    assert_eq!(after, 10);
+    assert_eq!(headset.counters().submitted, before + after);
+    headset.end(&gpu).unwrap();
+}
