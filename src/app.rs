@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::{BackendChoice, Gpu};
 use crate::graph::Resource;
-use crate::headset::openxr::{self, OpenXrOptions, Unavailable};
+use crate::headset::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::headset::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::headset::{FrameRequest, Headset, SubmittedFrame};
 use crate::renderer::{FrameReport, Renderer};
@@ -50,8 +50,8 @@ pub fn open_headset(
     choice: HeadsetChoice,
     simulated: SimulatedOptions,
     backend: BackendChoice,
-) -> Result<(Box<dyn Headset>, Arc<Gpu>, String)> {
-    let simulated_headset = |why: String| -> Result<(Box<dyn Headset>, Arc<Gpu>, String)> {
+) -> Result<OpenedHeadset> {
+    let simulated_headset = |why: String| -> Result<OpenedHeadset> {
         let headset = SimulatedHeadset::new(simulated.clone())?;
         let gpu = Arc::new(Gpu::new(backend)?);
         let message = format!("{why}: using the {}", headset.describe());

@@ -15,7 +15,9 @@ use std::sync::Arc;
 use vrao::gpu::readback::{read_layers, read_layers_f32};
 use vrao::gpu::targets::LayeredTarget;
 use vrao::graph::Resource;
-use vrao::headset::openxr::{probe_runtime, EyeBlit, OpenXrHeadset, OpenXrOptions, SessionPhase, Unavailable};
+use vrao::headset::openxr::{
+    probe_runtime, EyeBlit, OpenXrHeadset, OpenXrOptions, SessionPhase, SwapchainLayout, Unavailable,
+};
 use vrao::headset::simulated::{SimulatedOptions, TimeMode};
 use vrao::headset::{Headset, SubmittedFrame};
 use vrao::scene::Scene;
@@ -48,6 +50,10 @@ impl Drop for NoRuntime {
 
 /// The runtime manifest to test against, or `None` (the session tests are skipped).
 fn runtime_manifest() -> Option<PathBuf> {
+    // As the CLI does: Mesa's WSI probe complains on headless machines without it.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
     let path = PathBuf::from(std::env::var_os(RUNTIME_VAR)?);
     path.is_file().then_some(path)
 }
@@ -107,12 +113,81 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
     assert!(text.contains("--headset openxr") && text.contains("no OpenXR"), "{text}");
 }
 
+/// Depth32Float cannot be written by copies: a full-screen pass writes a different
+/// spread of depths in (0, 1] into each layer.
+fn fill_depth(gpu: &Gpu, depth: &LayeredTarget) {
+    let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("test depth"),
+        source: wgpu::ShaderSource::Wgsl(
+            "struct L { layer: f32 }
+             @vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+                 let c = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+                 return vec4<f32>(c * 2.0 - 1.0, 0.0, 1.0);
+             }
+             @fragment fn fs_left(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {
+                 return 1.0 / (1.0 + 0.37 * floor(p.x) + 2.9 * floor(p.y));
+             }
+             @fragment fn fs_right(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {
+                 return fract(0.013 * floor(p.x) + 0.071 * floor(p.y)) * 0.999 + 1e-4;
+             }"
+            .into(),
+        ),
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    for (layer, entry) in ["fs_left", "fs_right"].into_iter().enumerate() {
+        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("test depth"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("test depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth.layer_views[layer],
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.draw(0..3, 0..1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    gpu.take_error().unwrap();
+}
+
 /// 2-layer colour (sRGB-encoded bytes in Rgba8Unorm) and depth targets with every byte
 /// value and a spread of depths, as the renderer would hand them over.
 fn eye_targets(gpu: &Gpu, (width, height): (u32, u32)) -> (LayeredTarget, LayeredTarget, Vec<Vec<u8>>, Vec<Vec<f32>>) {
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
     let color = LayeredTarget::new(&gpu.device, "eye colour", Resource::Color.format(), (width, height, 2), usage);
-    let depth = LayeredTarget::new(&gpu.device, "eye depth", Resource::Depth.format(), (width, height, 2), usage);
+    let depth_usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let depth = LayeredTarget::new(&gpu.device, "eye depth", Resource::Depth.format(), (width, height, 2), depth_usage);
     let texels = (width * height) as usize;
     let color_bytes: Vec<Vec<u8>> = (0..2)
         .map(|layer| {
@@ -124,10 +199,7 @@ fn eye_targets(gpu: &Gpu, (width, height): (u32, u32)) -> (LayeredTarget, Layere
                 .collect()
         })
         .collect();
-    let depths: Vec<Vec<f32>> = (0..2)
-        .map(|layer| (0..texels).map(|i| ((i + layer * 13) % 97) as f32 / 96.0 * (1.0 - 1e-7 * i as f32)).collect())
-        .collect();
-    for layer in 0..2 {
+    for (layer, bytes) in color_bytes.iter().enumerate() {
         let origin = wgpu::Origin3d { x: 0, y: 0, z: layer as u32 };
         let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
         gpu.queue.write_texture(
@@ -137,22 +209,13 @@ fn eye_targets(gpu: &Gpu, (width, height): (u32, u32)) -> (LayeredTarget, Layere
                 origin,
                 aspect: wgpu::TextureAspect::All,
             },
-            &color_bytes[layer],
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
-            size,
-        );
-        gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &depth.texture,
-                mip_level: 0,
-                origin,
-                aspect: wgpu::TextureAspect::DepthOnly,
-            },
-            bytemuck::cast_slice(&depths[layer]),
+            bytes,
             wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 4), rows_per_image: Some(height) },
             size,
         );
     }
+    fill_depth(gpu, &depth);
+    let depths = read_layers_f32(gpu, &depth).unwrap();
     (color, depth, color_bytes, depths)
 }
 
@@ -341,4 +404,23 @@ fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
     assert_eq!(after, 10);
     assert_eq!(headset.counters().submitted, before + after);
     headset.end(&gpu).unwrap();
+}
+
+#[test]
+fn one_swapchain_per_eye_works_too() {
+    let _one_at_a_time = common::gpu_lock();
+    if runtime_manifest().is_none() {
+        eprintln!("skipped: set {RUNTIME_VAR} to an OpenXR runtime's manifest");
+        return;
+    }
+    let options = OpenXrOptions { layout: Some(SwapchainLayout::PerEye), ..session_options(None) };
+    let (mut headset, gpu) = OpenXrHeadset::open(options).expect("session");
+    assert!(headset.swapchains().contains("one swapchain per eye"), "{}", headset.swapchains());
+    let mut renderer = renderer_for(&headset, &gpu);
+    let rendered = run_frames(&mut headset, &gpu, &mut renderer, 40);
+    assert!(rendered > 20, "{rendered}");
+    headset.end(&gpu).unwrap();
+    assert!(headset.phases().contains(&SessionPhase::Exiting), "end() walks to EXITING: {:?}", headset.phases());
+    assert_eq!(headset.stats().layers_with_depth, rendered);
+    assert!(headset.lost().is_none());
 }

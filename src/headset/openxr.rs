@@ -114,6 +114,10 @@ pub struct OpenXrOptions {
     pub frames: Option<u64>,
     /// Print session state changes and a lost session's fall back to stderr.
     pub report: bool,
+    /// Force one swapchain layout (`None`: a 2-layer array when the runtime accepts
+    /// one, otherwise one swapchain per eye).
+    #[cfg(feature = "xr")]
+    pub layout: Option<SwapchainLayout>,
     /// What to continue with when the session is lost (LOSS_PENDING, a lost instance or
     /// a failing runtime); `None` ends the run instead.
     pub fallback: Option<SimulatedOptions>,
@@ -131,6 +135,8 @@ impl OpenXrOptions {
             size,
             frames: simulated.frames,
             report: true,
+            #[cfg(feature = "xr")]
+            layout: None,
             fallback: Some(simulated.clone()),
         }
     }
@@ -229,22 +235,20 @@ pub fn probe_runtime() -> Result<String, Unavailable> {
     Err(Unavailable::NotBuilt)
 }
 
-/// Opens the OpenXR headset and the GPU its session runs on, for `vrao run`: the
-/// headset, the GPU and one line saying what answered.
+/// A headset, the GPU to render for it, and one line saying what was opened.
+pub type OpenedHeadset = (Box<dyn super::Headset>, std::sync::Arc<crate::gpu::Gpu>, String);
+
+/// Opens the OpenXR headset and the GPU its session runs on, for `vrao run`.
 #[cfg(feature = "xr")]
-pub fn open_headset(
-    options: OpenXrOptions,
-) -> Result<(Box<dyn super::Headset>, std::sync::Arc<crate::gpu::Gpu>, String), Unavailable> {
+pub fn open_headset(options: OpenXrOptions) -> Result<OpenedHeadset, Unavailable> {
     use super::Headset as _;
     let (headset, gpu) = OpenXrHeadset::open(options)?;
-    let message = format!("OpenXR runtime {} answered: using the {}", headset.runtime(), headset.describe());
+    let message = format!("an OpenXR runtime answered: using the {}", headset.describe());
     Ok((Box::new(headset), gpu, message))
 }
 
 #[cfg(not(feature = "xr"))]
-pub fn open_headset(
-    _options: OpenXrOptions,
-) -> Result<(Box<dyn super::Headset>, std::sync::Arc<crate::gpu::Gpu>, String), Unavailable> {
+pub fn open_headset(_options: OpenXrOptions) -> Result<OpenedHeadset, Unavailable> {
     Err(Unavailable::NotBuilt)
 }
 

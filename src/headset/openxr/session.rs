@@ -83,6 +83,10 @@ pub struct OpenXrHeadset {
     runtime: String,
     system: String,
     recommended: (u32, u32),
+    /// The per-eye render and swapchain size (kept for the fall back after a loss).
+    size: (u32, u32),
+    /// Whether layers carry depth (XR_KHR_composition_layer_depth and a depth format).
+    depth: bool,
     swapchain_text: String,
     phases: Vec<SessionPhase>,
     stats: OpenXrStats,
@@ -168,9 +172,11 @@ impl OpenXrHeadset {
         let space = session
             .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
             .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
-        let swapchains = EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth)
-            .map_err(Unavailable::Failed)?;
+        let swapchains =
+            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)
+                .map_err(Unavailable::Failed)?;
         let swapchain_text = swapchains.describe();
+        let depth = swapchains.has_depth();
         let xr = Xr {
             swapchains,
             space,
@@ -191,6 +197,8 @@ impl OpenXrHeadset {
             runtime,
             system: system_name,
             recommended,
+            size,
+            depth,
             swapchain_text,
             phases: Vec::new(),
             stats: OpenXrStats::default(),
@@ -230,7 +238,7 @@ impl OpenXrHeadset {
     /// Whether frames carry depth (the runtime has XR_KHR_composition_layer_depth and a
     /// depth format vrao can fill).
     pub fn submits_depth(&self) -> bool {
-        self.xr.as_ref().is_some_and(|xr| xr.swapchains.has_depth())
+        self.depth
     }
 
     /// The swapchains: size, layout and formats.
@@ -640,7 +648,7 @@ impl Headset for OpenXrHeadset {
     fn recommended_size(&self) -> (u32, u32) {
         match &self.fallback {
             Some(simulated) => simulated.recommended_size(),
-            None => self.xr.as_ref().map_or(self.recommended, |xr| xr.swapchains.size),
+            None => self.size,
         }
     }
 

@@ -352,13 +352,15 @@ pub struct EyeSwapchains {
 
 impl EyeSwapchains {
     /// Picks formats from what the session offers and creates the swapchains: one 2-layer
-    /// array per kind when the runtime accepts it, otherwise one per eye. `with_depth` is
-    /// false when the runtime lacks XR_KHR_composition_layer_depth.
+    /// array per kind when the runtime accepts it, otherwise one per eye (or only the
+    /// given `layout`). `with_depth` is false when the runtime lacks
+    /// XR_KHR_composition_layer_depth.
     pub fn create(
         gpu: &Gpu,
         session: &xr::Session<xr::Vulkan>,
         size: (u32, u32),
         with_depth: bool,
+        layout: Option<SwapchainLayout>,
     ) -> Result<EyeSwapchains, String> {
         let offered = session.enumerate_swapchain_formats().map_err(|e| format!("xrEnumerateSwapchainFormats: {e}"))?;
         let color_format = pick(&offered, &COLOR_FORMATS).ok_or_else(|| {
@@ -366,7 +368,11 @@ impl EyeSwapchains {
         })?;
         let depth_format = if with_depth { pick(&offered, &DEPTH_FORMATS) } else { None };
         let mut last_error = None;
-        for layout in [SwapchainLayout::Array, SwapchainLayout::PerEye] {
+        let layouts = match layout {
+            Some(layout) => vec![layout],
+            None => vec![SwapchainLayout::Array, SwapchainLayout::PerEye],
+        };
+        for layout in layouts {
             let chains = Chain::create(gpu, session, layout, color_format, size).and_then(|color| {
                 let depth = depth_format.map(|format| Chain::create(gpu, session, layout, format, size)).transpose()?;
                 Ok((color, depth))
