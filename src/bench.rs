@@ -265,12 +265,28 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
             }
         })
         .collect();
-    let points: Vec<(f64, f64)> =
-        out.iter().map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
-    for i in metrics::pareto_front(&points) {
-        out[i].pareto = true;
-    }
+    mark_pareto(&mut out);
     out
+}
+
+/// Marks each record on the Pareto front of AO RMSE against occlusion ms per eye. Each
+/// radius is its own target quantity (AO within r), so errors compare only within one
+/// radius: one front per radius.
+pub fn mark_pareto(out: &mut [BenchRecord]) {
+    out.iter_mut().for_each(|r| r.pareto = false);
+    let mut radii: Vec<f32> = out.iter().map(|r| r.radius_m).collect();
+    radii.sort_by(f32::total_cmp);
+    radii.dedup();
+    for radius in radii {
+        let members: Vec<usize> = (0..out.len()).filter(|&i| out[i].radius_m == radius).collect();
+        let points: Vec<(f64, f64)> = members
+            .iter()
+            .map(|&i| (out[i].occlusion_ms_per_eye, out[i].ao_rmse.unwrap_or(f64::NAN)))
+            .collect();
+        for k in metrics::pareto_front(&points) {
+            out[members[k]].pareto = true;
+        }
+    }
 }
 
 const COLUMNS: [&str; 13] = [
@@ -334,11 +350,22 @@ pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
     serde_json::from_str(&text).map_err(|e| Error::at_line(path, e.line(), format!("not a vrao bench file: {e}")))
 }
 
-/// The plot of error against per-eye ms with the Pareto front and the budget line.
-pub fn plot(file: &BenchFile, budget_ms_per_eye: f64) -> ScatterPlot {
-    const COLOURS: [[u8; 3]; 6] = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189], [140, 86, 75]];
+/// The plot of error against per-eye ms for the rows of one radius, with that radius's
+/// Pareto front and the budget line.
+pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterPlot {
+    const COLOURS: [[u8; 3]; 8] = [
+        [31, 119, 180],
+        [255, 127, 14],
+        [44, 160, 44],
+        [214, 39, 40],
+        [148, 103, 189],
+        [140, 86, 75],
+        [23, 190, 207],
+        [188, 189, 34],
+    ];
+    let rows: Vec<&BenchRecord> = file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
     let mut series: Vec<Series> = Vec::new();
-    for r in file.records.iter().filter(|r| r.ao_rmse.is_some()) {
+    for r in &rows {
         let label = format!("{} {}", r.technique, r.resolution);
         let point = (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN));
         match series.iter_mut().find(|s| s.label == label) {
@@ -349,15 +376,14 @@ pub fn plot(file: &BenchFile, budget_ms_per_eye: f64) -> ScatterPlot {
             }
         }
     }
-    let mut pareto: Vec<(f64, f64)> = file
-        .records
-        .iter()
-        .filter(|r| r.pareto)
-        .map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN)))
-        .collect();
+    let mut pareto: Vec<(f64, f64)> =
+        rows.iter().filter(|r| r.pareto).map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
     pareto.sort_by(|a, b| a.0.total_cmp(&b.0));
     ScatterPlot {
-        title: format!("{}: AO error against time, {}x{} per eye, {}", file.scene, file.width, file.height, file.adapter),
+        title: format!(
+            "{}: AO error against time, r = {radius_m} m, {}x{} per eye, {}",
+            file.scene, file.width, file.height, file.adapter
+        ),
         x_label: "occlusion ms per eye (technique + blur + upsample)".into(),
         y_label: "AO RMSE vs reference".into(),
         series,

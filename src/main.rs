@@ -193,6 +193,10 @@ struct BenchArgs {
     /// Budget per stereo frame in ms for the plot's budget line (each eye gets half).
     #[arg(long, default_value_t = 1000.0 / 90.0)]
     budget_ms: f64,
+    /// Measure nothing: rewrite the table, CSV, Markdown and plots of this bench.json
+    /// (Pareto fronts recomputed) into --out.
+    #[arg(long)]
+    replot: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -432,7 +436,16 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
 }
 
 fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
-    use vrao::bench::{plot, records, sweep, to_csv, to_json, to_markdown, BenchCase, BenchFile, Measurement};
+    use vrao::bench::{records, sweep, BenchCase, BenchFile, Measurement};
+    if let Some(path) = &args.replot {
+        let mut file = vrao::bench::read_json(path)?;
+        vrao::bench::mark_pareto(&mut file.records);
+        let mut radii: Vec<f32> = file.records.iter().map(|r| r.radius_m).collect();
+        radii.sort_by(f32::total_cmp);
+        radii.dedup();
+        let adapter = format!("{} ({}, {})", file.adapter, file.backend, file.driver);
+        return write_bench(&args, &file, &radii, &adapter);
+    }
     let scene = Scene::load(&args.scene)?;
     let resolutions: &[bool] = match args.resolution.as_str() {
         "full" => &[false],
@@ -440,6 +453,9 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         "both" => &[false, true],
         other => return Err(Error::input(format!("--resolution '{other}' is not full, half or both"))),
     };
+    if !(args.budget_ms.is_finite() && args.budget_ms > 0.0) {
+        return Err(Error::input(format!("--budget-ms {} must be a positive number of milliseconds", args.budget_ms)));
+    }
     let base_radius = scene.suggested_ao_radius();
     let radii = if args.radii.is_empty() {
         vec![base_radius * 0.5, base_radius, base_radius * 2.0]
@@ -552,6 +568,13 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         reference: reference_info,
         records: records(&rows),
     };
+    let adapter = format!("{} ({:?}, {})", info.name, info.backend, info.driver_info);
+    write_bench(&args, &file, &radii, &adapter)
+}
+
+/// Writes a bench's table, CSV, JSON, Markdown and plots into `args.out` and prints them.
+fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], adapter: &str) -> Result<()> {
+    use vrao::bench::{plot, to_csv, to_json, to_markdown};
     std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
     let write = |name: &str, text: String| {
         let path = args.out.join(name);
@@ -559,12 +582,16 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     };
     write("bench.csv", to_csv(&file.records))?;
     write("bench.md", to_markdown(&file.records))?;
-    write("bench.json", to_json(&file))?;
+    write("bench.json", to_json(file))?;
     let mut written = "bench.csv, bench.json, bench.md".to_string();
     if file.reference.is_some() {
-        let path = args.out.join("bench.png");
-        plot(&file, args.budget_ms / 2.0).save_png(&path, 1280, 800)?;
-        written += " and bench.png";
+        // One plot per radius (errors compare only within a radius); bench.png is the
+        // middle radius, the scene's suggested one by default.
+        for (i, &radius) in radii.iter().enumerate() {
+            let name = if i == radii.len() / 2 { "bench.png".to_string() } else { format!("bench-r{radius}.png") };
+            plot(file, radius, args.budget_ms / 2.0).save_png(&args.out.join(&name), 1280, 800)?;
+            written += &format!(", {name}");
+        }
     }
     println!("{}", to_markdown(&file.records));
     if let Some(r) = &file.reference {
@@ -575,12 +602,21 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             r.ao_noise_rms,
             r.rays_per_second.map_or(String::new(), |s| format!("; traced at {:.2} Mrays/s", s / 1e6))
         );
-        let front: Vec<String> = file.records.iter().filter(|r| r.pareto).map(|r| r.setting()).collect();
-        println!("Pareto front (fastest first): {}", front.join("; "));
+        for &radius in radii {
+            let mut front: Vec<&vrao::bench::BenchRecord> =
+                file.records.iter().filter(|r| r.pareto && r.radius_m == radius).collect();
+            front.sort_by(|a, b| a.occlusion_ms_per_eye.total_cmp(&b.occlusion_ms_per_eye));
+            let front: Vec<String> = front
+                .iter()
+                .map(|r| format!("{} ({:.1} ms, {:.4})", r.setting(), r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN)))
+                .collect();
+            println!("Pareto front at r = {radius} m (fastest first): {}", front.join("; "));
+        }
     }
-    println!("adapter: {} ({:?}, {}); wrote {written} in {}", info.name, info.backend, info.driver_info, args.out.display());
+    println!("adapter: {adapter}; wrote {written} in {}", args.out.display());
     Ok(())
 }
+
 
 /// Where reference images are cached between runs.
 fn default_cache_dir() -> PathBuf {
@@ -766,10 +802,20 @@ fn fit_setting(
         report.verdicts.iter().filter(|v| v.what != "stereo frame").map(|v| v.ms).fold(0.0, f64::max)
     };
     let left_per_eye = budget_ms / 2.0 - base_ms;
-    let with_error: Vec<_> = file.records.iter().filter(|r| r.ao_rmse.is_some_and(f64::is_finite)).collect();
-    if with_error.is_empty() {
+    // Errors compare only within one radius (each radius is its own target quantity):
+    // take the rows of the radius asked for, or of the bench radius nearest to it.
+    let measured: Vec<_> = file.records.iter().filter(|r| r.ao_rmse.is_some_and(f64::is_finite)).collect();
+    let Some(radius) = measured
+        .iter()
+        .map(|r| r.radius_m)
+        .min_by(|a, b| (a - settings.ao.radius).abs().total_cmp(&(b - settings.ao.radius).abs()))
+    else {
         return Err(Error::in_file(path, "has no rows with an error against the reference"));
+    };
+    if radius != settings.ao.radius {
+        println!("fit: the bench has no rows at r = {} m; using its nearest radius, {radius} m", settings.ao.radius);
     }
+    let with_error: Vec<_> = measured.into_iter().filter(|r| r.radius_m == radius).collect();
     let fitting: Vec<_> = with_error.iter().filter(|r| r.occlusion_ms_per_eye <= left_per_eye).collect();
     let chosen = match fitting.iter().min_by(|a, b| a.ao_rmse.unwrap().total_cmp(&b.ao_rmse.unwrap())) {
         Some(r) => {

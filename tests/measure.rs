@@ -152,7 +152,8 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     let cached: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
     assert_eq!(cached.len(), 1, "one radius, one cached reference");
 
-    // --fit picks the least-error row that fits a generous budget and measures it.
+    // --fit picks the least-error row (at the bench's radius) that fits a generous
+    // budget and measures it.
     let best = records
         .iter()
         .min_by(|a, b| a["ao_rmse"].as_f64().unwrap().total_cmp(&b["ao_rmse"].as_f64().unwrap()))
@@ -172,6 +173,8 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
         "1",
         "--budget-ms",
         "1000000",
+        "--radius",
+        "0.5",
         "--fit",
         out_dir.join("bench.json").to_str().unwrap(),
         "--out",
