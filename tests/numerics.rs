@@ -382,3 +382,42 @@ fn a_reprojection_history_without_usable_depth_falls_back_to_the_rotational_warp
     let warped = warp(&at_near, ReprojectionMode::Depth);
     assert!(warped.iter().flatten().skip(3).step_by(4).all(|&a| a == 255));
 }
+
+#[test]
+fn error_against_the_reference_does_not_grow_when_the_scene_moves_1e5_m_out() {
+    use vrao::reference::{trace, ReferenceSettings};
+    let (gpu, _lock) = common::gpu();
+    let size = (96, 80);
+    let crease = Scene::load("builtin:crease").unwrap();
+    let offset = DVec3::new(1e5, 0.0, -1e5);
+    let mut far = crease.clone();
+    far.meshes.iter_mut().for_each(|m| m.origin += offset);
+    let head = crease.head.pose_at(0.0);
+    let far_head = HeadPose { position: head.position + offset, orientation: head.orientation };
+    let mut errors = Vec::new();
+    for (scene, head) in [(&crease, head), (&far, far_head)] {
+        let s = settings(size, AoSettings { radius: 0.5, ..AoSettings::default() });
+        let eyes = s.profile.eyes(&head, s.near);
+        let reference = trace(
+            scene,
+            &eyes.eyes,
+            size,
+            &ReferenceSettings { radius: 0.5, rays_per_pixel: 64, stride: 2, near: s.near },
+            &mut |_| {},
+        )
+        .unwrap();
+        for technique in TECHNIQUES {
+            let s = settings(size, AoSettings { technique, radius: 0.5, ..AoSettings::default() });
+            let output = vrao::passes::final_occlusion(&s).unwrap();
+            let mut renderer = Renderer::new(gpu.clone(), scene, &s).unwrap();
+            renderer.render(&eyes.eyes, &[output]).unwrap();
+            let e = vrao::bench::error_figures(technique, &renderer.read_f32(output).unwrap(), &reference);
+            errors.push((technique, e.ao_rmse));
+        }
+    }
+    let (near_origin, far_away) = errors.split_at(TECHNIQUES.len());
+    for ((t, a), (_, b)) in near_origin.iter().zip(far_away) {
+        assert!(a.is_finite() && b.is_finite() && *a < 0.1, "{}: {a} {b}", t.name());
+        assert!((a - b).abs() < 0.01, "{}: AO RMSE {a} at the origin, {b} at 1e5 m", t.name());
+    }
+}
