@@ -91,11 +91,17 @@ struct AoParams {
     range_check: u32,
     // SSDO bounce strength (0: no bounce work).
     bounce: f32,
-    _pad: u32,
+    // Extra kernel rotation this frame (temporal accumulation), radians.
+    frame_angle: f32,
     // Bilateral blur radius in occlusion pixels (5 → 11×11 at full resolution).
     blur_radius: u32,
     // Depth-edge width of the blur, as a fraction of the centre's distance.
     blur_plane_sigma: f32,
+    // Sample-length scale this frame (temporal range jitter; 1 otherwise).
+    range_scale: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

@@ -19,8 +19,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let steps = max(ao.steps, 1u);
     let directions = max(ao.directions, 1u);
     // Never step less than a pixel; never further than the screen.
-    let step_px = clamp(radius_px / f32(steps + 1u), 1.0, f32(max(frame.size.x, frame.size.y)));
-    let rotation = kernel_rotation(r.pixel, ao.noise);
+    let step_px = clamp(radius_px * ao.range_scale / f32(steps + 1u), 1.0, f32(max(frame.size.x, frame.size.y)));
+    let rotation = kernel_rotation(r.pixel, ao.noise) + ao.frame_angle;
     let jitter = fract(rotation * 0.1591549 * 7.0);
     // Angle bias: horizons below this elevation do not count (tessellation, noise).
     let sin_bias = min(5.0 * ao.bias, 0.9);

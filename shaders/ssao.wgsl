@@ -10,13 +10,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.valid) {
         return;
     }
-    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise));
+    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise) + ao.frame_angle);
     let bias = ao.bias * ao.radius;
     let origin = r.position + r.normal * bias;
     var occlusion = 0.0;
     for (var i = 0u; i < ao.samples; i++) {
         let k = kernel[i];
-        let s = origin + frame_rot * k.xyz * (k.w * ao.radius);
+        let s = origin + frame_rot * k.xyz * (k.w * ao.range_scale * ao.radius);
         let probe = probe_depth(depth_layers, r.layer, s, r.eye);
         if (occludes(probe, s, r.position, r.normal, r.eye, bias)) {
             var weight = 1.0;

@@ -34,13 +34,27 @@ fn gathered_radiance(m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>, r:
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the variant without).
 override BOUNCE: bool = false;
 
+// Depth peeling (seed 002 §4, passes/peel.rs): the second depth layer, the nearest surface
+// behind the first. With PEEL a sample is an occluder only between the two layers, inside
+// the object the first layer sees, not merely behind it: no halo around thin objects in
+// front of a background. That inside test also replaces the range check: a sample inside
+// an object is within r of the receiver, so the object is a neighbour however far its
+// front face is. Nothing behind the first layer (depth 0) counts as infinitely thick.
+override PEEL: bool = false;
+@group(0) @binding(8) var second_layers: texture_depth_2d_array;
+
+fn in_front_of_second_layer(probe: DepthProbe, layer: u32, s: vec3<f32>) -> bool {
+    let second = textureLoad(second_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+    return -s.z * second < frame.near;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let r = begin_receiver(id);
     if (!r.valid) {
         return;
     }
-    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise));
+    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise) + ao.frame_angle);
     let world_from_view = mat3x3<f32>(r.eye.world_from_view[0].xyz, r.eye.world_from_view[1].xyz, r.eye.world_from_view[2].xyz);
     let bias = ao.bias * ao.radius;
     let origin = r.position + r.normal * bias;
@@ -70,10 +84,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         all_diag += diag;
         all_off += off;
         weight_all += cos_theta;
-        let s = origin + omega * (k.w * ao.radius);
+        let s = origin + omega * (k.w * ao.range_scale * ao.radius);
         let probe = probe_depth(depth_layers, r.layer, s, r.eye);
         var blocked = occludes(probe, s, r.position, r.normal, r.eye, bias);
-        if (blocked && ao.range_check != 0u && abs(-r.position.z - probe.distance) > ao.radius) {
+        if (PEEL) {
+            blocked = blocked && in_front_of_second_layer(probe, r.layer, s);
+        } else if (blocked && ao.range_check != 0u && abs(-r.position.z - probe.distance) > ao.radius) {
             // A surface far in front is not a neighbour: the direction stays open.
             blocked = false;
         }

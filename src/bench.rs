@@ -24,6 +24,8 @@ pub struct BenchCase {
     pub samples: u32,
     pub radius: f32,
     pub half_res: bool,
+    /// SSDO with depth peeling (a second depth layer; its pass counts as occlusion cost).
+    pub depth_peeling: bool,
 }
 
 /// How each case is run: frames (after warm-up) and the timing mode.
@@ -53,9 +55,10 @@ impl BenchRow {
         self.spans.iter().find(|s| s.label == span).map_or(0.0, |s| s.median_ms)
     }
 
-    /// Occlusion cost per eye: technique + blur + upsample, both-eye dispatches halved.
+    /// Occlusion cost per eye: technique (+ depth peel) + blur + upsample, both-eye
+    /// dispatches halved.
     pub fn occlusion_ms_per_eye(&self) -> f64 {
-        let passes = [self.pass, "blur", "upsample"];
+        let passes = [self.pass, "depth-peel", "blur", "upsample"];
         passes.iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
     }
 }
@@ -77,6 +80,7 @@ pub fn measure(
     settings.ao.samples = case.samples;
     settings.ao.radius = case.radius;
     settings.ao.half_res = case.half_res;
+    settings.ao.depth_peeling = case.depth_peeling;
     let output = final_occlusion(&settings).ok_or_else(|| Error::input("bench needs an occlusion technique"))?;
     let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
     renderer.set_timing(timing);
@@ -204,11 +208,17 @@ pub struct BenchRecord {
     pub ambient_rel_rmse: Option<f64>,
     /// On the Pareto front of AO RMSE against occlusion ms per eye.
     pub pareto: bool,
+    /// SSDO with depth peeling; its second-layer pass is in `occlusion_ms_per_eye`.
+    #[serde(default)]
+    pub depth_peeling: bool,
+    #[serde(default)]
+    pub peel_ms_per_eye: f64,
 }
 
 impl BenchRecord {
     pub fn setting(&self) -> String {
-        format!("{} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
+        let peel = if self.depth_peeling { " peeled" } else { "" };
+        format!("{}{peel} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
     }
 }
 
@@ -262,6 +272,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 ao_ssim: row.error.as_ref().map(|e| e.ao_ssim),
                 ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
                 pareto: false,
+                depth_peeling: c.depth_peeling,
+                peel_ms_per_eye: per_eye("depth-peel"),
             }
         })
         .collect();
@@ -289,7 +301,7 @@ pub fn mark_pareto(out: &mut [BenchRecord]) {
     }
 }
 
-const COLUMNS: [&str; 13] = [
+const COLUMNS: [&str; 15] = [
     "technique",
     "samples",
     "radius_m",
@@ -303,9 +315,11 @@ const COLUMNS: [&str; 13] = [
     "ao_ssim",
     "ambient_rel_rmse",
     "pareto",
+    "depth_peeling",
+    "peel_ms_per_eye",
 ];
 
-fn record_values(r: &BenchRecord) -> [String; 13] {
+fn record_values(r: &BenchRecord) -> [String; 15] {
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.4}"));
     [
         r.technique.clone(),
@@ -321,6 +335,8 @@ fn record_values(r: &BenchRecord) -> [String; 13] {
         optional(r.ao_ssim),
         optional(r.ambient_rel_rmse),
         if r.pareto { "yes" } else { "" }.to_string(),
+        if r.depth_peeling { "yes" } else { "" }.to_string(),
+        format!("{:.3}", r.peel_ms_per_eye),
     ]
 }
 
@@ -366,7 +382,7 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
     let rows: Vec<&BenchRecord> = file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
     let mut series: Vec<Series> = Vec::new();
     for r in &rows {
-        let label = format!("{} {}", r.technique, r.resolution);
+        let label = format!("{}{} {}", r.technique, if r.depth_peeling { " peeled" } else { "" }, r.resolution);
         let point = (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN));
         match series.iter_mut().find(|s| s.label == label) {
             Some(s) => s.points.push(point),
@@ -408,7 +424,7 @@ mod tests {
             max_ms: median_ms,
         };
         BenchRow {
-            case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false },
+            case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false, depth_peeling: false },
             spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
             views: 2,
             pass: technique.name(),

@@ -11,6 +11,9 @@ use std::fmt;
 pub enum Resource {
     /// Reversed-Z depth, `Depth32Float`.
     Depth,
+    /// Depth peeling's second layer (SSDO's quality mode): the nearest surface behind
+    /// `Depth`, reversed-Z `Depth32Float`, 0 where nothing lies behind.
+    DepthLayer2,
     /// View-space unit normals, `Rgba16Float` (w unused).
     Normals,
     /// Diffuse albedo, `Rgba8UnormSrgb` (reads back linear).
@@ -38,22 +41,71 @@ pub enum Resource {
     Hdr,
     /// Tone-mapped, sRGB-encoded eye colour, `Rgba8Unorm`.
     Color,
+    /// Occlusion accumulated over frames by reverse reprojection (temporal pass), at AO
+    /// resolution, `Rgba16Float`, laid out as `AoRaw`.
+    AoAccumulated,
+    /// The temporal history, ping-ponged between frames: accumulated value (`Rgba16Float`)
+    /// and world position relative to the scene anchor with the accumulated frame count
+    /// in w (`Rgba32Float`). These persist from one frame to the next.
+    HistoryValueA,
+    HistoryValueB,
+    HistoryPositionA,
+    HistoryPositionB,
+    /// Light-space depth of each shadowed directional light (one layer per light, square,
+    /// `--shadow-size` texels a side), `Depth32Float`, 0 nearest the light, 1 = nothing.
+    ShadowMap,
+    /// Reflective shadow map: light-view normal per light-space texel, `Rgba16Float`.
+    RsmNormal,
+    /// Reflective shadow map: flux density (albedo × light irradiance) per texel, `Rgba16Float`.
+    RsmFlux,
+    /// One-bounce irradiance gathered from the reflective shadow maps, half resolution
+    /// per axis, `Rgba16Float` (rgb).
+    RsmIndirect,
+    /// Normal (xyz) and view distance (w) at each `RsmIndirect` pixel, `Rgba32Float`, for
+    /// the composite's joint bilateral upsampling.
+    RsmGeometry,
 }
 
 impl Resource {
     /// Resources that live at the occlusion resolution (half per axis with `--half-res`).
     pub fn at_ao_resolution(self) -> bool {
-        matches!(self, Resource::AoRaw | Resource::AoGeometry | Resource::AoBlurH | Resource::AoBlurred)
+        matches!(
+            self,
+            Resource::AoRaw
+                | Resource::AoGeometry
+                | Resource::AoBlurH
+                | Resource::AoBlurred
+                | Resource::AoAccumulated
+                | Resource::HistoryValueA
+                | Resource::HistoryValueB
+                | Resource::HistoryPositionA
+                | Resource::HistoryPositionB
+        )
     }
 
     /// Written by render passes (attachments) rather than by compute kernels.
     pub fn is_attachment(self) -> bool {
-        matches!(self, Resource::Depth | Resource::Normals | Resource::Albedo | Resource::Emission)
+        matches!(
+            self,
+            Resource::Depth | Resource::DepthLayer2 | Resource::Normals | Resource::Albedo | Resource::Emission
+        ) || self.in_light_space()
+    }
+
+    /// Resources of the directional lights' maps (sized by the shadow settings, one
+    /// layer per shadowed light) rather than of the eyes.
+    pub fn in_light_space(self) -> bool {
+        matches!(self, Resource::ShadowMap | Resource::RsmNormal | Resource::RsmFlux)
+    }
+
+    /// Resources always at half resolution per axis (rounded up), whatever `--half-res` says.
+    pub fn at_half_resolution(self) -> bool {
+        matches!(self, Resource::RsmIndirect | Resource::RsmGeometry)
     }
 
     pub fn name(self) -> &'static str {
         match self {
             Resource::Depth => "depth",
+            Resource::DepthLayer2 => "depth-layer-2",
             Resource::Normals => "normals",
             Resource::Albedo => "albedo",
             Resource::Emission => "emission",
@@ -65,22 +117,40 @@ impl Resource {
             Resource::AoFull => "ao-full",
             Resource::Hdr => "hdr",
             Resource::Color => "color",
+            Resource::AoAccumulated => "ao-accumulated",
+            Resource::HistoryValueA => "history-value-a",
+            Resource::HistoryValueB => "history-value-b",
+            Resource::HistoryPositionA => "history-position-a",
+            Resource::HistoryPositionB => "history-position-b",
+            Resource::ShadowMap => "shadow-map",
+            Resource::RsmNormal => "rsm-normal",
+            Resource::RsmFlux => "rsm-flux",
+            Resource::RsmIndirect => "rsm-indirect",
+            Resource::RsmGeometry => "rsm-geometry",
         }
     }
 
     pub fn format(self) -> wgpu::TextureFormat {
         match self {
-            Resource::Depth => wgpu::TextureFormat::Depth32Float,
+            Resource::Depth | Resource::DepthLayer2 => wgpu::TextureFormat::Depth32Float,
             Resource::Normals
             | Resource::Emission
             | Resource::AoRaw
             | Resource::AoBlurH
             | Resource::AoBlurred
             | Resource::AoFull
+            | Resource::AoAccumulated
+            | Resource::HistoryValueA
+            | Resource::HistoryValueB
             | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
             Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
-            Resource::AoGeometry | Resource::Direct => wgpu::TextureFormat::Rgba32Float,
+            Resource::AoGeometry | Resource::Direct | Resource::HistoryPositionA | Resource::HistoryPositionB => {
+                wgpu::TextureFormat::Rgba32Float
+            }
             Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
+            Resource::ShadowMap => wgpu::TextureFormat::Depth32Float,
+            Resource::RsmNormal | Resource::RsmFlux | Resource::RsmIndirect => wgpu::TextureFormat::Rgba16Float,
+            Resource::RsmGeometry => wgpu::TextureFormat::Rgba32Float,
         }
     }
 }

@@ -36,6 +36,9 @@ enum Command {
     /// Reprojection quality: warp a frame to moved head poses (rotations 1–10°,
     /// translations 1–10 cm) in both modes and compare with fresh renders.
     Reprojection(ReprojectionArgs),
+    /// Temporal accumulation: AO error against the reference after 1, 2, 4, 8 and 16
+    /// frames (static head and yaw sweep) next to spatial-only settings.
+    Temporal(TemporalArgs),
     /// Headless per-eye budget test: per-pass medians against the frame budget; exit 0
     /// within budget, 3 over it.
     Budget(BudgetArgs),
@@ -103,6 +106,27 @@ struct ReprojectionArgs {
 }
 
 #[derive(Args)]
+struct TemporalArgs {
+    /// A scene file (.toml), a bare .obj, or builtin:NAME.
+    #[arg(long, default_value = "builtin:room")]
+    scene: String,
+    /// Per-eye width in pixels.
+    #[arg(long, default_value_t = 270)]
+    width: u32,
+    /// Per-eye height in pixels.
+    #[arg(long, default_value_t = 300)]
+    height: u32,
+    /// Reference rays per traced pixel.
+    #[arg(long, default_value_t = 256)]
+    rays: u32,
+    /// Write the points as JSON here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    ao: AoArgs,
+}
+
+#[derive(Args)]
 struct BudgetArgs {
     /// A scene file (.toml), a bare .obj, or builtin:NAME.
     #[arg(long, default_value = "builtin:room")]
@@ -158,6 +182,10 @@ struct BenchArgs {
     /// Resolutions: full, half or both.
     #[arg(long, default_value = "both")]
     resolution: String,
+    /// SSDO depth peeling: off, on or both (each SSDO case with and without; other
+    /// techniques never peel).
+    #[arg(long, default_value = "off")]
+    depth_peeling: String,
     /// Measured frames per case, after warm-up.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
@@ -277,6 +305,11 @@ struct AoArgs {
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
+    /// SSDO quality mode (seed 002 §4): peel a second depth layer per eye; a sample then
+    /// occludes only inside an object (between the layers), which removes the halos of
+    /// thin objects in front of a background. Assumes closed geometry.
+    #[arg(long)]
+    depth_peeling: bool,
     /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns the blur off.
     #[arg(long, default_value_t = 5)]
     blur: u32,
@@ -289,6 +322,19 @@ struct AoArgs {
     /// Turn SSAO's range check (depth constraint) off.
     #[arg(long)]
     no_range_check: bool,
+    /// Accumulate occlusion over frames by reverse reprojection (seed 001); the sampling
+    /// pattern turns by the golden angle every frame, and its range jitters.
+    #[arg(long)]
+    temporal: bool,
+    /// Temporal disocclusion threshold in metres (plus two pixel footprints).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    temporal_epsilon: f32,
+    /// Temporal blend: average (running mean) or confidence (seed 001 eqs. 4–5).
+    #[arg(long, default_value = "average")]
+    temporal_blend: vrao::settings::TemporalBlend,
+    /// Frames after which a pixel counts as converged.
+    #[arg(long, default_value_t = 16)]
+    temporal_frames: u32,
 }
 
 impl AoArgs {
@@ -303,8 +349,16 @@ impl AoArgs {
             bounce: self.bounce,
             noise: self.noise,
             half_res: self.half_res,
+            depth_peeling: self.depth_peeling,
             blur_radius: self.blur,
             blur_plane_sigma: self.blur_sigma,
+            temporal: vrao::settings::Temporal {
+                enabled: self.temporal,
+                epsilon_m: self.temporal_epsilon,
+                blend: self.temporal_blend,
+                max_frames: self.temporal_frames,
+                ..Default::default()
+            },
         }
     }
 }
@@ -453,6 +507,12 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         "both" => &[false, true],
         other => return Err(Error::input(format!("--resolution '{other}' is not full, half or both"))),
     };
+    let peeling: &[bool] = match args.depth_peeling.as_str() {
+        "off" => &[false],
+        "on" => &[true],
+        "both" => &[false, true],
+        other => return Err(Error::input(format!("--depth-peeling '{other}' is not off, on or both"))),
+    };
     if !(args.budget_ms.is_finite() && args.budget_ms > 0.0) {
         return Err(Error::input(format!("--budget-ms {} must be a positive number of milliseconds", args.budget_ms)));
     }
@@ -469,15 +529,20 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         for &samples in &args.samples {
             for &radius in &radii {
                 for &half_res in resolutions {
-                    cases.push(BenchCase { technique, samples, radius, half_res });
+                    for &depth_peeling in peeling {
+                        if depth_peeling && !matches!(technique, Technique::Ssdo | Technique::SsdoBounce) {
+                            continue;
+                        }
+                        cases.push(BenchCase { technique, samples, radius, half_res, depth_peeling });
+                    }
                 }
             }
         }
     }
     for case in &cases {
         let mut s = settings.clone();
-        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res) =
-            (case.technique, case.samples, case.radius, case.half_res);
+        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res, s.ao.depth_peeling) =
+            (case.technique, case.samples, case.radius, case.half_res, case.depth_peeling);
         s.validate()?;
         if case.technique == Technique::None {
             return Err(Error::input("--techniques: none has no occlusion to measure"));
@@ -547,7 +612,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             let error = row.error.as_ref().map_or(String::new(), |e| format!("  AO RMSE {:.4}", e.ao_rmse));
             eprintln!(
                 "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
-                row.case.technique.name(),
+                format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
                 row.case.samples,
                 row.case.radius,
                 if row.case.half_res { "half" } else { "full" },
@@ -710,6 +775,73 @@ fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     Ok(())
 }
 
+fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
+    use vrao::headset::motion::HeadMotion;
+    use vrao::settings::TemporalBlend;
+    let scene = Scene::load(&args.scene)?;
+    let base = Settings {
+        profile: HeadsetProfile::with_size("vive", args.width, args.height),
+        ao: args.ao.settings(&scene),
+        ..Settings::default()
+    };
+    base.validate()?;
+    let n = base.ao.samples;
+    let with = |temporal: bool, blend: TemporalBlend, samples: u32, blur: u32| {
+        let mut s = base.clone();
+        s.ao.samples = samples;
+        s.ao.blur_radius = blur;
+        s.ao.temporal.enabled = temporal;
+        s.ao.temporal.blend = blend;
+        s
+    };
+    let configurations = vec![
+        (format!("spatial N={n}, blur"), with(false, TemporalBlend::Average, n, base.ao.blur_radius)),
+        (format!("spatial N={n}, no blur"), with(false, TemporalBlend::Average, n, 0)),
+        (format!("spatial N={}, blur (4× the samples)", 4 * n), with(false, TemporalBlend::Average, 4 * n, base.ao.blur_radius)),
+        (format!("temporal N={n}, no blur"), with(true, TemporalBlend::Average, n, 0)),
+        (format!("temporal N={n}, blur"), with(true, TemporalBlend::Average, n, base.ao.blur_radius)),
+        (format!("temporal N={n}, confidence blend, no blur"), with(true, TemporalBlend::Confidence, n, 0)),
+    ];
+    for (_, s) in &configurations {
+        s.validate()?;
+    }
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let reference = vrao::reference::ReferenceSettings {
+        radius: base.ao.radius as f64,
+        rays_per_pixel: args.rays,
+        stride: 2,
+        near: base.near,
+    };
+    let mut points = Vec::new();
+    for motion in [HeadMotion::Static, HeadMotion::YawSweep] {
+        eprintln!("temporal: {} ({} configurations × 16 frames)", motion.name(), configurations.len());
+        points.extend(vrao::temporal_bench::convergence(
+            &gpu,
+            &scene,
+            &configurations,
+            motion,
+            &reference,
+            &default_cache_dir(),
+        )?);
+    }
+    println!(
+        "AO RMSE against the reference ({} rays, every 2nd pixel) after k frames; '{}' at {}x{} per eye, {} r = {} m, on {}",
+        args.rays,
+        scene.name,
+        args.width,
+        args.height,
+        base.ao.technique.name(),
+        base.ao.radius,
+        gpu.adapter.get_info().name
+    );
+    print!("{}", vrao::temporal_bench::to_markdown(&points));
+    if let Some(path) = &args.out {
+        let json = serde_json::to_string_pretty(&points).expect("points serialise");
+        std::fs::write(path, json).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
+    }
+    Ok(())
+}
+
 fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
     use vrao::budget::{run, BudgetRun};
     let scene = Scene::load(&args.scene)?;
@@ -846,6 +978,7 @@ fn fit_setting(
     ao.samples = chosen.samples;
     ao.radius = chosen.radius_m;
     ao.half_res = chosen.resolution == "half";
+    ao.depth_peeling = chosen.depth_peeling;
     Ok(ao)
 }
 
@@ -864,6 +997,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(args)) => bench(cli.backend, args),
         Some(Command::Budget(args)) => budget(cli.backend, args),
         Some(Command::Run(args)) => run(cli.backend, args),
+        Some(Command::Temporal(args)) => temporal(cli.backend, args),
         Some(Command::Reprojection(args)) => reprojection(cli.backend, args),
         None => {
             use clap::CommandFactory;

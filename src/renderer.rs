@@ -16,7 +16,11 @@ use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectLightPass;
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::occlusion::OcclusionPass;
+use crate::passes::peel::DepthPeelPass;
+use crate::passes::rsm::RsmPass;
+use crate::passes::shadow::{LightSpace, ShadowPass};
 use crate::passes::ssdo::SsdoPass;
+use crate::passes::temporal::TemporalPass;
 use crate::passes::tonemap::TonemapPass;
 use crate::passes::upsample::UpsamplePass;
 use crate::passes::{FrameContext, FrameSetup, Pass};
@@ -69,6 +73,9 @@ pub struct Renderer {
     targets: BTreeMap<Resource, LayeredTarget>,
     timer: GpuTimer,
     timing: Timing,
+    /// Frames rendered so far, and the views of the last one (temporal reuse).
+    frame_index: u64,
+    previous_views: Vec<Eye>,
 }
 
 impl Renderer {
@@ -94,14 +101,20 @@ impl Renderer {
         };
         let gpu_scene = GpuScene::upload(&gpu, scene);
         let frame = FrameBuffers::new(&gpu.device, scene.lights.len());
+        // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
+        let light_space = Arc::new(LightSpace::new(&gpu, scene, gpu_scene.anchor));
         // Declaration order is execution order.
         let passes: Vec<Box<dyn Pass>> = vec![
             Box::new(GBufferPass::new(&gpu, &gpu_scene, &frame)),
-            Box::new(DirectLightPass::new(&gpu)),
+            Box::new(ShadowPass::new(&gpu, &gpu_scene, light_space.clone())),
+            Box::new(DirectLightPass::new(&gpu, light_space.clone())),
+            Box::new(RsmPass::new(&gpu, light_space.clone())),
             Box::new(OcclusionPass::ssao(&gpu)),
             Box::new(OcclusionPass::hbao(&gpu)),
+            Box::new(DepthPeelPass::new(&gpu, &frame)),
             Box::new(SsdoPass::new(&gpu)),
             Box::new(OcclusionPass::fetch_only(&gpu)),
+            Box::new(TemporalPass::new(&gpu)),
             Box::new(BlurPass::new(&gpu)),
             Box::new(UpsamplePass::new(&gpu)),
             Box::new(CompositePass::new(&gpu)),
@@ -120,6 +133,8 @@ impl Renderer {
             targets: BTreeMap::new(),
             timer,
             timing: Timing::Pipelined,
+            frame_index: 0,
+            previous_views: Vec::new(),
         })
     }
 
@@ -138,6 +153,10 @@ impl Renderer {
         if settings.stereo != self.settings.stereo {
             return Err(Error::input("the stereo mode cannot change on a running renderer"));
         }
+        if settings.ao != self.settings.ao {
+            // Accumulated occlusion of other settings is not this one's history.
+            self.previous_views.clear();
+        }
         self.settings = settings.clone();
         Ok(())
     }
@@ -152,7 +171,15 @@ impl Renderer {
     }
 
     fn setup(&self, views: u32) -> FrameSetup<'_> {
-        FrameSetup { scene: &self.scene, settings: &self.settings, views, multiview: self.multiview }
+        FrameSetup {
+            scene: &self.scene,
+            settings: &self.settings,
+            views,
+            multiview: self.multiview,
+            frame_index: self.frame_index,
+            current_views: &[],
+            previous_views: (self.previous_views.len() == views as usize).then_some(&self.previous_views[..]),
+        }
     }
 
     /// The plan for a frame of `views` layers that must produce `outputs`.
@@ -172,10 +199,17 @@ impl Renderer {
         let plan = self.plan(layers, outputs)?;
         self.allocate_targets(&plan, layers);
         self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
-        self.frame.update_ao(&self.gpu.queue, &self.settings);
+        self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
         self.timer.reset();
-        let setup =
-            FrameSetup { scene: &self.scene, settings: &self.settings, views: layers, multiview: self.multiview };
+        let setup = FrameSetup {
+            scene: &self.scene,
+            settings: &self.settings,
+            views: layers,
+            multiview: self.multiview,
+            frame_index: self.frame_index,
+            current_views: views,
+            previous_views: (self.previous_views.len() == views.len()).then_some(&self.previous_views[..]),
+        };
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut wall_ms = Vec::new();
@@ -210,6 +244,8 @@ impl Renderer {
         self.gpu.queue.submit([encoder.finish()]);
         let gpu_ms = self.timer.read(&self.gpu)?;
         self.gpu.wait_idle()?;
+        self.frame_index += 1;
+        self.previous_views = views.to_vec();
         Ok(FrameReport { plan, gpu_ms, cpu_encode_ms, wall_ms })
     }
 
@@ -218,8 +254,18 @@ impl Renderer {
     fn allocate_targets(&mut self, plan: &Plan, layers: u32) {
         let p = &self.settings.profile;
         let (ao_w, ao_h) = ao_extent(p.width, p.height, self.settings.ao.half_res);
+        let (half_w, half_h) = ao_extent(p.width, p.height, true);
+        let light = crate::passes::shadow::light_extent(
+            &self.scene,
+            &self.settings,
+            self.gpu.device.limits().max_texture_dimension_2d,
+        );
         let extent_of = |r: Resource| {
-            if r.at_ao_resolution() {
+            if r.in_light_space() {
+                light
+            } else if r.at_half_resolution() {
+                (half_w, half_h, layers)
+            } else if r.at_ao_resolution() {
                 (ao_w, ao_h, layers)
             } else {
                 (p.width, p.height, layers)

@@ -190,6 +190,9 @@ pub struct AoSettings {
     pub noise: Noise,
     /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
     pub half_res: bool,
+    /// Depth peeling for SSDO (seed 002 §4): a second depth layer, and a sample occludes
+    /// only between the first and second layer (inside an object). Off by default.
+    pub depth_peeling: bool,
     /// Separable geometry-aware bilateral blur radius in full-resolution pixels
     /// (5 = 11×11; at half resolution 3 taps either side cover the same footprint);
     /// 0 turns it off.
@@ -198,6 +201,53 @@ pub struct AoSettings {
     /// fraction of the centre's distance, loses most of its weight. Near 0 every
     /// neighbour's weight vanishes and the centre value is kept.
     pub blur_plane_sigma: f32,
+    /// Temporal accumulation by reverse reprojection (seed 001 §3.1).
+    pub temporal: Temporal,
+}
+
+/// How the temporal pass blends the new frame into the history.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TemporalBlend {
+    /// The running mean of the last `max_frames` frames: each frame's rotated pattern
+    /// counts equally, so N frames of n samples approach one frame of N·n.
+    #[default]
+    Average,
+    /// Seed 001 eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
+    /// V = c·V_{t−1} + (1 − c)·V_t.
+    Confidence,
+}
+
+impl std::str::FromStr for TemporalBlend {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "average" => Ok(TemporalBlend::Average),
+            "confidence" => Ok(TemporalBlend::Confidence),
+            other => Err(format!("unknown temporal blend '{other}' (expected average or confidence)")),
+        }
+    }
+}
+
+/// Temporal accumulation settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Temporal {
+    pub enabled: bool,
+    /// Disocclusion threshold ε in metres on the world-position distance (seed 001 eq. 3).
+    /// The pass also allows two pixel footprints at the pixel's distance (an extension:
+    /// a fixed ε would reject every distant pixel, whose neighbour is centimetres away).
+    pub epsilon_m: f32,
+    pub blend: TemporalBlend,
+    /// Frames after which a pixel counts as converged: the mean stops growing and
+    /// becomes a moving average over this many frames.
+    pub max_frames: u32,
+    /// Seed 001's confidence bias (only for the confidence blend).
+    pub confidence_bias: f32,
+}
+
+impl Default for Temporal {
+    fn default() -> Self {
+        Temporal { enabled: false, epsilon_m: 0.02, blend: TemporalBlend::Average, max_frames: 16, confidence_bias: 0.1 }
+    }
 }
 
 impl Default for AoSettings {
@@ -212,8 +262,10 @@ impl Default for AoSettings {
             bounce: 1.0,
             noise: Noise::Halton,
             half_res: false,
+            depth_peeling: false,
             blur_radius: 5,
             blur_plane_sigma: 0.02,
+            temporal: Temporal::default(),
         }
     }
 }
@@ -234,6 +286,16 @@ impl AoSettings {
         }
         if !(self.bounce.is_finite() && (0.0..=100.0).contains(&self.bounce)) {
             return Err(Error::input(format!("bounce {} is not within 0..=100", self.bounce)));
+        }
+        let t = &self.temporal;
+        if !(t.epsilon_m.is_finite() && t.epsilon_m >= 0.0) {
+            return Err(Error::input(format!("temporal epsilon {} m must be finite and ≥ 0", t.epsilon_m)));
+        }
+        if !(1..=1024).contains(&t.max_frames) {
+            return Err(Error::input(format!("temporal frame cap {} is not within 1..=1024", t.max_frames)));
+        }
+        if !(t.confidence_bias.is_finite() && t.confidence_bias >= 0.0) {
+            return Err(Error::input(format!("temporal confidence bias {} must be finite and ≥ 0", t.confidence_bias)));
         }
         if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
             return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
@@ -271,6 +333,46 @@ pub struct Settings {
     /// Reinhard's L_white: the smallest (exposed) luminance mapped to white.
     pub white_point: f32,
     pub ao: AoSettings,
+    /// Shadow maps and reflective shadow maps of directional lights.
+    pub shadows: ShadowSettings,
+}
+
+/// Shadow maps with PCF (seed 000) and reflective shadow maps (seed 001) for the
+/// scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
+/// directional light has neither, whatever these say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Shadow the directional lights' direct light (`--shadows on|off`).
+    pub enabled: bool,
+    /// Texels along each side of the square light-space maps (`--shadow-size`).
+    pub size: u32,
+    /// Add one bounce of the directional lights from reflective shadow maps (`--rsm on|off`).
+    pub rsm: bool,
+    /// Virtual point lights gathered per pixel and light (`--rsm-samples`).
+    pub rsm_samples: u32,
+    /// Gather radius around each pixel in the light's image plane, metres (`--rsm-radius`).
+    pub rsm_radius: f32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: 1.0 }
+    }
+}
+
+impl ShadowSettings {
+    pub fn validate(&self) -> Result<()> {
+        if !(16..=8192).contains(&self.size) {
+            return Err(Error::input(format!("shadow map size {} is not within 16..=8192", self.size)));
+        }
+        if !(1..=1024).contains(&self.rsm_samples) {
+            return Err(Error::input(format!("RSM samples {} is not within 1..=1024", self.rsm_samples)));
+        }
+        if !(self.rsm_radius.is_finite() && self.rsm_radius > 0.0 && self.rsm_radius <= 1e6) {
+            return Err(Error::input(format!("RSM radius {} m must be a finite number in (0, 1e6]", self.rsm_radius)));
+        }
+        Ok(())
+    }
 }
 
 impl Default for Settings {
@@ -282,6 +384,7 @@ impl Default for Settings {
             exposure: 1.0,
             white_point: 4.0,
             ao: AoSettings::default(),
+            shadows: ShadowSettings::default(),
         }
     }
 }
@@ -308,6 +411,7 @@ impl Settings {
         if !(self.white_point.is_finite() && self.white_point > 0.0) {
             return Err(Error::input(format!("white point {} must be a positive finite number", self.white_point)));
         }
-        self.ao.validate()
+        self.ao.validate()?;
+        self.shadows.validate()
     }
 }

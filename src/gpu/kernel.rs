@@ -22,11 +22,17 @@ const SHADERS: &[(&str, &str)] = &[
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("gbuffer_multiview.wgsl", include_str!("../../shaders/gbuffer_multiview.wgsl")),
     ("gbuffer_multipass.wgsl", include_str!("../../shaders/gbuffer_multipass.wgsl")),
+    ("peel.wgsl", include_str!("../../shaders/peel.wgsl")),
     ("multiview_probe.wgsl", include_str!("../../shaders/multiview_probe.wgsl")),
     ("direct.wgsl", include_str!("../../shaders/direct.wgsl")),
+    ("shadow.wgsl", include_str!("../../shaders/shadow.wgsl")),
+    ("shadow_map.wgsl", include_str!("../../shaders/shadow_map.wgsl")),
+    ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
+    ("rsm_upsample.wgsl", include_str!("../../shaders/rsm_upsample.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     ("reproject.wgsl", include_str!("../../shaders/reproject.wgsl")),
     ("mirror.wgsl", include_str!("../../shaders/mirror.wgsl")),
+    ("temporal.wgsl", include_str!("../../shaders/temporal.wgsl")),
 ];
 
 /// A shader module made of the named files, concatenated in order (common first), so
@@ -61,6 +67,8 @@ pub enum Slot {
     Texture2d,
     /// A filtering sampler.
     Sampler,
+    /// A comparison sampler (`sampler_comparison`, shadow maps).
+    ComparisonSampler,
     /// `texture_storage_2d_array<FORMAT, write>`.
     Output(wgpu::TextureFormat),
     /// `var<uniform>`.
@@ -95,6 +103,7 @@ impl Slot {
                 multisampled: false,
             },
             Slot::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            Slot::ComparisonSampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
             Slot::Output(format) => wgpu::BindingType::StorageTexture {
                 access: wgpu::StorageTextureAccess::WriteOnly,
                 format,

@@ -1,7 +1,7 @@
 //! Separable geometry-aware bilateral blur of the occlusion, at occlusion resolution:
 //! a horizontal then a vertical dispatch (shaders/bilateral.wgsl), each layer alone.
 
-use super::{occlusion_before_upsample, FrameContext, FrameSetup, Pass};
+use super::{occlusion_before_upsample, occlusion_source, FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
@@ -29,7 +29,7 @@ impl Pass for BlurPass {
         let ao = &setup.settings.ao;
         PassDecl::new("blur")
             .read(Resource::AoGeometry)
-            .read(Resource::AoRaw)
+            .read(occlusion_source(setup.settings))
             .write(Resource::AoBlurH)
             .write(Resource::AoBlurred)
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to blur")
@@ -40,7 +40,7 @@ impl Pass for BlurPass {
         debug_assert_eq!(occlusion_before_upsample(ctx.setup.settings), Some(Resource::AoBlurred));
         let extent = ctx.ao_extent();
         for (kernel, input, output) in [
-            (&self.horizontal, Resource::AoRaw, Resource::AoBlurH),
+            (&self.horizontal, occlusion_source(ctx.setup.settings), Resource::AoBlurH),
             (&self.vertical, Resource::AoBlurH, Resource::AoBlurred),
         ] {
             let resources = [

@@ -6,7 +6,11 @@ pub mod composite;
 pub mod direct;
 pub mod gbuffer;
 pub mod occlusion;
+pub mod peel;
+pub mod rsm;
+pub mod shadow;
 pub mod ssdo;
+pub mod temporal;
 pub mod tonemap;
 pub mod upsample;
 
@@ -29,6 +33,12 @@ pub struct FrameSetup<'a> {
     pub views: u32,
     /// Whether the G-buffer draws both layers in one multiview pass.
     pub multiview: bool,
+    /// Frames this renderer has rendered before this one (turns sampling patterns).
+    pub frame_index: u64,
+    /// This frame's views (empty when only planning).
+    pub current_views: &'a [crate::stereo::Eye],
+    /// The previous frame's views, when it had as many as this one (temporal reuse).
+    pub previous_views: Option<&'a [crate::stereo::Eye]>,
 }
 
 /// Everything a pass records with.
@@ -66,11 +76,20 @@ impl<'a> FrameContext<'a> {
     }
 }
 
+/// The occlusion the blur reads: the technique's own, or its temporal accumulation.
+pub fn occlusion_source(settings: &Settings) -> Resource {
+    if settings.ao.temporal.enabled {
+        Resource::AoAccumulated
+    } else {
+        Resource::AoRaw
+    }
+}
+
 /// The occlusion the blur-and-upsample chain starts from, if any technique runs.
 pub fn occlusion_before_upsample(settings: &Settings) -> Option<Resource> {
     match (settings.ao.technique, settings.ao.blur_radius) {
         (Technique::None, _) => None,
-        (_, 0) => Some(Resource::AoRaw),
+        (_, 0) => Some(occlusion_source(settings)),
         _ => Some(Resource::AoBlurred),
     }
 }

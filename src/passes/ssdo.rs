@@ -16,10 +16,15 @@ pub struct SsdoPass {
     with_bounce: Kernel,
     /// Bound in place of the direct light when the bounce is off (never read then).
     no_direct: LayeredTarget,
+    /// The same two with depth peeling (`PEEL`, binding 8 read): [without, with] bounce.
+    peeled: [Kernel; 2],
+    /// Bound in place of the second depth layer when peeling is off (never read then).
+    no_second_layer: LayeredTarget,
 }
 
-/// The shared occlusion bindings plus the direct light (binding 7, the bounce's senders).
-const SLOTS: [Slot; 8] = [
+/// The shared occlusion bindings plus the direct light (binding 7, the bounce's senders)
+/// and the second depth layer (binding 8, depth peeling).
+const SLOTS: [Slot; 9] = [
     occlusion::SLOTS[0],
     occlusion::SLOTS[1],
     occlusion::SLOTS[2],
@@ -28,16 +33,26 @@ const SLOTS: [Slot; 8] = [
     occlusion::SLOTS[5],
     occlusion::SLOTS[6],
     Slot::Layers,
+    Slot::Depth,
 ];
 
 impl SsdoPass {
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
         let no_direct = LayeredTarget::placeholder(&gpu.device, "no direct light", Resource::Direct.format());
+        let peeled = |label, bounce| {
+            Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &[("BOUNCE", bounce), ("PEEL", 1.0)])
+        };
         SsdoPass {
             without_bounce: Kernel::with_constants(gpu, "ssdo", &files, "main", &SLOTS, &[("BOUNCE", 0.0)]),
             with_bounce: Kernel::with_constants(gpu, "ssdo-bounce", &files, "main", &SLOTS, &[("BOUNCE", 1.0)]),
             no_direct,
+            peeled: [peeled("ssdo peeled", 0.0), peeled("ssdo-bounce peeled", 1.0)],
+            no_second_layer: LayeredTarget::placeholder(
+                &gpu.device,
+                "no second depth layer",
+                Resource::DepthLayer2.format(),
+            ),
         }
     }
 }
@@ -52,6 +67,11 @@ impl Pass for SsdoPass {
         } else if chosen == Technique::SsdoBounce {
             decl = decl.note("bounce left out: bounce strength is 0");
         }
+        if ao.depth_peeling {
+            decl = decl.read(Resource::DepthLayer2);
+            let peel = "depth peeling: occluders only between the first and second depth layer";
+            decl.note = Some(decl.note.map_or(peel.to_string(), |n| format!("{n}; {peel}")));
+        }
         technique_decl(decl, &[Technique::Ssdo, Technique::SsdoBounce], setup)
     }
 
@@ -62,10 +82,21 @@ impl Pass for SsdoPass {
         } else {
             wgpu::BindingResource::TextureView(&self.no_direct.array_view)
         };
+        let peel = ctx.setup.settings.ao.depth_peeling;
+        let second = if peel {
+            ctx.view(Resource::DepthLayer2)
+        } else {
+            wgpu::BindingResource::TextureView(&self.no_second_layer.array_view)
+        };
         let mut resources = occlusion::bindings(ctx);
         resources.push(direct);
+        resources.push(second);
         let extent = ctx.ao_extent();
-        let kernel = if bounce { &self.with_bounce } else { &self.without_bounce };
+        let kernel = match (bounce, peel) {
+            (false, false) => &self.without_bounce,
+            (true, false) => &self.with_bounce,
+            (bounce, true) => &self.peeled[bounce as usize],
+        };
         kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
     }
 }

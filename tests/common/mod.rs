@@ -88,3 +88,30 @@ pub fn bare_scene(meshes: Vec<Mesh>) -> Scene {
         head: HeadPath::fixed(vrao::HeadPose::IDENTITY),
     }
 }
+
+/// A closed axis-aligned box of `size` (x, y, z extents) centred on `center`: six faces,
+/// normals facing out (a two-manifold solid, as depth peeling assumes).
+pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize) -> Mesh {
+    let h = size * 0.5;
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut indices = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut n = glam::Vec3::ZERO;
+            n[axis] = sign;
+            // Two in-plane axes ordered so (u × v) = n: counter-clockwise seen from outside.
+            let (mut u, mut v) = (glam::Vec3::ZERO, glam::Vec3::ZERO);
+            u[(axis + 1) % 3] = 1.0;
+            v[(axis + 2) % 3] = sign;
+            let base = positions.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                positions.push((n + u * a + v * b) * h);
+                normals.push(n);
+            }
+            indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+    let uvs = vec![glam::Vec2::ZERO; positions.len()];
+    Mesh { name: name.into(), origin: center, positions, normals, uvs, indices, material }
+}

@@ -1,0 +1,36 @@
+// Depth peeling (seed 002 §4, Everitt 2001): the second depth layer of each eye, the
+// nearest surface lying behind the G-buffer's depth (the first layer). Depth only, one
+// render pass per eye layer; a fragment not farther than the first layer by PEEL_GAP is
+// discarded, so the depth test keeps the nearest of the rest. On closed geometry the
+// second layer is the back face of the object the first layer sees: SSDO then counts a
+// sample as an occluder only between the two (inside that object).
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+
+struct PeelEye {
+    index: u32,
+};
+@group(1) @binding(0) var<uniform> peel_eye: PeelEye;
+@group(1) @binding(1) var first_layer: texture_depth_2d_array;
+
+// How much farther than the first layer (as a fraction of its distance) a surface must
+// be to count as the next layer: absorbs coincident duplicates and rounding between the
+// two rasterisations (1 mm at 1 m), far below any thickness SSDO's bias can resolve.
+override PEEL_GAP: f32 = 1e-3;
+
+// The G-buffer's transform (gbuffer.wgsl `transform_vertex`), position only.
+@vertex
+fn vs_peel(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return frame.eyes[peel_eye.index].clip_from_anchored * vec4<f32>(position, 1.0);
+}
+
+@fragment
+fn fs_peel(@builtin(position) p: vec4<f32>) {
+    // Reversed Z with an infinite far plane: distance = near / depth, so "farther than
+    // the first layer by the gap" is depth × (1 + gap) < first depth. On the sky (first
+    // depth 0) nothing is behind.
+    let first = textureLoad(first_layer, vec2<i32>(p.xy), i32(peel_eye.index), 0);
+    if (!(p.z * (1.0 + PEEL_GAP) < first)) {
+        discard;
+    }
+}

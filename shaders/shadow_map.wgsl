@@ -1,0 +1,62 @@
+// The light-space pass: the scene seen from one directional light through its
+// orthographic fit (passes/shadow.rs). Depth always (the shadow map); with reflective
+// shadow maps also each texel's normal and flux (seed 001 §3.3: every texel a virtual
+// point light). Positions come back from the depth and the texel, so none is stored.
+
+@group(0) @binding(0) var<uniform> light: ShadowLight;
+
+struct Material {
+    diffuse: vec4<f32>,   // rgb linear; w = 1 when a texture modulates it
+    emission: vec4<f32>,
+};
+@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(1) var diffuse_texture: texture_2d<f32>;
+@group(1) @binding(2) var diffuse_sampler: sampler;
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,   // relative to the scene anchor
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+};
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    // Normal in light view (+z towards the light).
+    @location(0) normal: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+};
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    out.clip = light.clip_from_anchored * vec4<f32>(v.position, 1.0);
+    out.normal = (light.view_from_anchored * vec4<f32>(v.normal, 0.0)).xyz;
+    out.uv = v.uv;
+    return out;
+}
+
+struct RsmOut {
+    @location(0) normal: vec4<f32>,
+    @location(1) flux: vec4<f32>,
+};
+
+// Reflective shadow map texel: the normal, turned towards the light as the G-buffer
+// turns normals towards the eye (surfaces are two-sided), and the flux density
+// ρ · E: an orthographic texel covers p² of the light's cross-section whatever the
+// surface's slope, so its flux is ρ · E · p² (the gather multiplies by the area).
+@fragment
+fn fs_rsm(in: VertexOut) -> RsmOut {
+    var n = in.normal;
+    let len2 = dot(n, n);
+    n = select(vec3<f32>(0.0, 0.0, 1.0), n * inverseSqrt(len2), len2 > 1e-20 && len2 == len2);
+    if (n.z < 0.0) {
+        n = -n;
+    }
+    // Sampled in uniform control flow (see gbuffer.wgsl).
+    let texel = textureSample(diffuse_texture, diffuse_sampler, in.uv).rgb;
+    let albedo = clamp(material.diffuse.rgb * select(vec3<f32>(1.0), texel, material.diffuse.w > 0.5), vec3<f32>(0.0), vec3<f32>(1.0));
+    var out: RsmOut;
+    out.normal = vec4<f32>(finite_or_zero3(n), 0.0);
+    out.flux = vec4<f32>(finite_or_zero3(albedo * light.radiance.rgb), 0.0);
+    return out;
+}

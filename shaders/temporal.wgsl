@@ -1,0 +1,100 @@
+// Temporal accumulation of the occlusion by reverse reprojection (seed 001 §3.1). Each
+// occlusion pixel is carried to where its surface point was in the previous frame
+// (C = P_{t−1} V_{t−1} W_t); the history there is reused when it holds the same point,
+// ‖W_t − W_{t−1}‖ ≤ ε (seed 001 eq. 3, plus two pixel footprints at the pixel's
+// distance), and blended with this frame's value. The technique turns its sampling
+// pattern each frame, so the blend averages different patterns. Disoccluded,
+// off-screen or non-finite history is discarded: the pixel starts again from this frame.
+
+struct Temporal {
+    // Current frame, per layer: view space → the scene's anchored world frame.
+    anchored_from_view: array<mat4x4<f32>, 2>,
+    // Previous frame, per layer: anchored world frame → clip space.
+    previous_clip_from_anchored: array<mat4x4<f32>, 2>,
+    epsilon: f32,
+    confidence_bias: f32,
+    max_frames: f32,
+    // 0: running mean of up to max_frames frames; 1: seed 001's confidence blend.
+    blend: u32,
+    // 0 when there is no usable previous frame (first frame, settings changed).
+    history_valid: u32,
+    // Tangent span of one occlusion pixel (for the footprint term of ε).
+    pixel_tangent: f32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<uniform> ao: AoParams;
+@group(0) @binding(2) var<uniform> temporal: Temporal;
+@group(0) @binding(3) var geometry_layers: texture_2d_array<f32>;
+@group(0) @binding(4) var current_layers: texture_2d_array<f32>;
+@group(0) @binding(5) var history_value: texture_2d_array<f32>;
+@group(0) @binding(6) var history_position: texture_2d_array<f32>;
+@group(0) @binding(7) var accumulated_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(8) var history_value_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(9) var history_position_out: texture_storage_2d_array<rgba32float, write>;
+
+fn all_finite4(v: vec4<f32>) -> bool {
+    return all(v == v) && all(abs(v) <= vec4<f32>(3.0e38));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
+        return;
+    }
+    let p = vec2<i32>(id.xy);
+    let layer = i32(id.z);
+    let current = textureLoad(current_layers, p, layer, 0);
+    let geometry = textureLoad(geometry_layers, p, layer, 0);
+    if (!(geometry.w > 0.0)) {
+        // Sky: nothing to accumulate.
+        textureStore(accumulated_out, p, layer, current);
+        textureStore(history_value_out, p, layer, current);
+        textureStore(history_position_out, p, layer, vec4<f32>(0.0));
+        return;
+    }
+    let eye = frame.eyes[id.z];
+    let uv = pixel_uv(full_res_pixel(id.xy, ao.scale, frame.size), frame.size);
+    let view_position = view_position_from_distance(uv, geometry.w, eye.tangents);
+    let world = (temporal.anchored_from_view[id.z] * vec4<f32>(view_position, 1.0)).xyz;
+
+    var count = 0.0;
+    var previous = vec4<f32>(0.0);
+    if (temporal.history_valid != 0u) {
+        let clip = temporal.previous_clip_from_anchored[id.z] * vec4<f32>(world, 1.0);
+        if (clip.w > 0.0) {
+            let ndc = clip.xy / clip.w;
+            let previous_uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+            if (all(previous_uv >= vec2<f32>(0.0)) && all(previous_uv < vec2<f32>(1.0))) {
+                let q = min(vec2<i32>(previous_uv * vec2<f32>(ao.ao_size)), vec2<i32>(ao.ao_size) - vec2<i32>(1));
+                let stored = textureLoad(history_position, q, layer, 0);
+                let value = textureLoad(history_value, q, layer, 0);
+                let footprint = geometry.w * temporal.pixel_tangent;
+                let same_point = distance(stored.xyz, world) <= temporal.epsilon + 2.0 * footprint;
+                if (stored.w >= 1.0 && same_point && all_finite4(stored) && all_finite4(value)) {
+                    count = stored.w;
+                    previous = value;
+                }
+            }
+        }
+    }
+
+    var result = current;
+    if (count >= 1.0) {
+        if (temporal.blend == 0u) {
+            // Running mean: the history holds the mean of `count` frames.
+            let n = min(count, temporal.max_frames - 1.0);
+            result = previous + (current - previous) / (n + 1.0);
+        } else {
+            let confidence = 1.0 - clamp(abs(previous.a - current.a), 0.0, 1.0) / (1.0 + temporal.confidence_bias);
+            result = confidence * previous + (1.0 - confidence) * current;
+        }
+    }
+    result = vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
+    let next_count = min(count + 1.0, temporal.max_frames);
+    textureStore(accumulated_out, p, layer, result);
+    textureStore(history_value_out, p, layer, result);
+    textureStore(history_position_out, p, layer, vec4<f32>(world, next_count));
+}
