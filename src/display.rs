@@ -556,6 +556,7 @@ fn panel_ui(
         ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
         ui.add(egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
         ui.checkbox(&mut ao.half_res, "half resolution");
+        ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
         ui.checkbox(&mut ao.depth_peeling, "depth peeling (SSDO)");
         ui.separator();
         ui.label("display");

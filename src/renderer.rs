@@ -277,7 +277,8 @@ impl Renderer {
                 let usage = if r.is_attachment() {
                     wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
                 } else {
-                    wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING
+                    // COPY_DST: tests poison histories and targets by writing them.
+                    wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST
                 };
                 LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent_of(r), usage)
             });

@@ -1,0 +1,145 @@
+//! Temporal accumulation: the noise falls as frames accumulate with a static head, a
+//! jump to a new view discards the history instead of smearing it, a history holding
+//! NaN is discarded, and the graph leaves the pass out when it is off.
+
+mod common;
+
+use glam::DVec3;
+use vrao::graph::Resource;
+use vrao::settings::{AoSettings, Technique};
+use vrao::stereo::HeadPose;
+use vrao::{HeadsetProfile, Renderer, Scene, Settings};
+
+const SIZE: (u32, u32) = (96, 80);
+
+fn settings(temporal: bool, samples: u32) -> Settings {
+    let mut ao = AoSettings { technique: Technique::Ssao, samples, blur_radius: 0, ..AoSettings::default() };
+    ao.temporal.enabled = temporal;
+    Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ao, ..Settings::default() }
+}
+
+fn ao_of(layers: &[Vec<f32>]) -> Vec<f32> {
+    layers.iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect()
+}
+
+fn rmse(a: &[f32], b: &[f32]) -> f64 {
+    vrao::metrics::rmse(a, b, None).unwrap()
+}
+
+#[test]
+fn with_a_static_head_the_noise_falls_as_frames_accumulate() {
+    let (gpu, _lock) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let head = scene.head.pose_at(0.0);
+    // What the estimator converges to: many samples, no reuse, no blur.
+    let mut converged = Renderer::new(gpu.clone(), &scene, &settings(false, 256)).unwrap();
+    let eyes = settings(false, 256).profile.eyes(&head, settings(false, 256).near);
+    converged.render(&eyes.eyes, &[Resource::AoRaw]).unwrap();
+    let target = ao_of(&converged.read_f32(Resource::AoRaw).unwrap());
+    let mut renderer = Renderer::new(gpu.clone(), &scene, &settings(true, 8)).unwrap();
+    let mut noise = Vec::new();
+    for _ in 0..8 {
+        renderer.render(&eyes.eyes, &[Resource::AoAccumulated]).unwrap();
+        let accumulated = renderer.read_f32(Resource::AoAccumulated).unwrap();
+        assert!(accumulated.iter().flatten().all(|v| v.is_finite()));
+        noise.push(rmse(&ao_of(&accumulated), &target));
+    }
+    // Eight independent patterns would divide the noise by √8 ≈ 2.8; ask for 2.
+    assert!(noise[7] < 0.5 * noise[0], "noise per frame: {noise:?}");
+    assert!(noise.windows(2).filter(|w| w[1] > w[0] * 1.05).count() <= 1, "not falling: {noise:?}");
+}
+
+/// AO of the pixels that see geometry (sky pixels hold 1 whatever happens).
+fn surface_ao(renderer: &Renderer, r: Resource) -> Vec<f32> {
+    let geometry = renderer.read_f32(Resource::AoGeometry).unwrap();
+    let values = renderer.read_f32(r).unwrap();
+    geometry
+        .iter()
+        .zip(&values)
+        .flat_map(|(g, v)| g.chunks(4).zip(v.chunks(4)).filter(|(g, _)| g[3] > 0.0).map(|(_, v)| v[3]).collect::<Vec<_>>())
+        .collect()
+}
+
+#[test]
+fn a_jump_to_a_new_view_discards_the_history_instead_of_smearing_it() {
+    let (gpu, _lock) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let s = settings(true, 8);
+    let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
+    // Looking at the back wall, then from the left side at the right wall: none of the
+    // surfaces now seen sat at the same place in the previous frame's view.
+    let back = HeadPose::look_at(DVec3::new(0.0, 1.6, -0.5), DVec3::new(0.0, 1.2, -4.0)).unwrap();
+    let side = HeadPose::look_at(DVec3::new(-1.8, 1.6, -2.0), DVec3::new(2.0, 1.0, -2.0)).unwrap();
+    let outputs = [Resource::AoAccumulated, Resource::AoRaw, Resource::AoGeometry];
+    for _ in 0..6 {
+        renderer.render(&s.profile.eyes(&back, s.near).eyes, &outputs).unwrap();
+    }
+    renderer.render(&s.profile.eyes(&side, s.near).eyes, &outputs).unwrap();
+    let raw = surface_ao(&renderer, Resource::AoRaw);
+    let accumulated = surface_ao(&renderer, Resource::AoAccumulated);
+    // Only points seen in both views (parts of the floor and ceiling) may reuse their
+    // history; what they reuse must be their own (it brings them closer to the converged
+    // value), never another surface's (which would pull them away).
+    let mut converged = Renderer::new(gpu.clone(), &scene, &settings(false, 256)).unwrap();
+    converged.render(&s.profile.eyes(&side, s.near).eyes, &[Resource::AoRaw, Resource::AoGeometry]).unwrap();
+    let target = surface_ao(&converged, Resource::AoRaw);
+    let mean_error = |v: &[f32]| v.iter().zip(&target).map(|(a, b)| (a - b).abs() as f64).sum::<f64>() / v.len() as f64;
+    let fresh = raw.iter().zip(&accumulated).filter(|(a, b)| (*a - *b).abs() < 1e-3).count();
+    assert!(fresh as f64 > 0.7 * raw.len() as f64, "{fresh} of {} surface pixels started afresh", raw.len());
+    assert!(mean_error(&accumulated) <= mean_error(&raw) + 1e-3, "{} vs {}", mean_error(&accumulated), mean_error(&raw));
+    // A 1 cm step keeps the history of nearly every surface pixel.
+    let stepped = HeadPose { position: side.position + DVec3::new(0.0, 0.0, 0.01), orientation: side.orientation };
+    renderer.render(&s.profile.eyes(&stepped, s.near).eyes, &outputs).unwrap();
+    let raw = surface_ao(&renderer, Resource::AoRaw);
+    let accumulated = surface_ao(&renderer, Resource::AoAccumulated);
+    // Reused pixels hold the mean of two frames' patterns, which differ.
+    let reused = raw.iter().zip(&accumulated).filter(|(a, b)| (*a - *b).abs() > 1e-4).count();
+    let occluded = raw.iter().filter(|a| **a < 0.999).count();
+    assert!(reused as f64 > 0.5 * occluded as f64, "only {reused} of {occluded} occluded pixels reused their history");
+}
+
+#[test]
+fn a_history_holding_nan_is_discarded() {
+    let (gpu, _lock) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let s = settings(true, 8);
+    let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
+    let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
+    renderer.render(&eyes.eyes, &[Resource::AoAccumulated]).unwrap();
+    // Poison both history pairs: NaN values (f16 0x7E00) and NaN positions.
+    for r in [Resource::HistoryValueA, Resource::HistoryValueB, Resource::HistoryPositionA, Resource::HistoryPositionB] {
+        let target = renderer.target(r).expect("the temporal pass keeps its history");
+        let texel: Vec<u8> = if r.format() == wgpu::TextureFormat::Rgba16Float {
+            std::iter::repeat_n(0x7E00u16.to_le_bytes(), 4).flatten().collect()
+        } else {
+            std::iter::repeat_n(f32::NAN.to_le_bytes(), 4).flatten().collect()
+        };
+        let bytes: Vec<u8> = texel.iter().copied().cycle().take(texel.len() * (target.width * target.height * target.layers) as usize).collect();
+        gpu.queue.write_texture(
+            target.texture.as_image_copy(),
+            &bytes,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(texel.len() as u32 * target.width),
+                rows_per_image: Some(target.height),
+            },
+            target.texture.size(),
+        );
+    }
+    renderer.render(&eyes.eyes, &[Resource::AoAccumulated, Resource::AoRaw]).unwrap();
+    let accumulated = renderer.read_f32(Resource::AoAccumulated).unwrap();
+    assert!(accumulated.iter().flatten().all(|v| v.is_finite()), "NaN history leaked into the output");
+    assert_eq!(ao_of(&accumulated), ao_of(&renderer.read_f32(Resource::AoRaw).unwrap()), "NaN history was reused");
+}
+
+#[test]
+fn the_graph_leaves_the_temporal_pass_out_when_it_is_off() {
+    let (gpu, _lock) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let off = Renderer::new(gpu.clone(), &scene, &settings(false, 8)).unwrap();
+    let plan = off.plan(2, &[Resource::Color]).unwrap();
+    assert!(!plan.names.contains(&"temporal"));
+    assert!(plan.left_out.iter().any(|(name, why)| *name == "temporal" && why.contains("--temporal")), "{plan}");
+    let on = Renderer::new(gpu, &scene, &settings(true, 8)).unwrap();
+    assert!(on.plan(2, &[Resource::Color]).unwrap().names.contains(&"temporal"));
+}
