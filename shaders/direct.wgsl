@@ -10,6 +10,23 @@
 @group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var emission_layers: texture_2d_array<f32>;
 @group(0) @binding(6) var direct_out: texture_storage_2d_array<rgba32float, write>;
+// Shadow maps of the directional lights (shadow.wgsl); `shadows.count` is 0 when off.
+@group(0) @binding(7) var<uniform> shadows: Shadows;
+@group(0) @binding(8) var shadow_map: texture_depth_2d_array;
+@group(0) @binding(9) var shadow_sampler: sampler_comparison;
+
+// Fraction of directional light `i` reaching view-space `position` (normal `n`) of `eye`:
+// its shadow map's 3×3 PCF when it has one, else 1.
+fn directional_visibility(i: u32, eye: Eye, position: vec3<f32>, n: vec3<f32>) -> f32 {
+    for (var s = 0u; s < shadows.count; s++) {
+        if (shadows.lights[s].index.x == i) {
+            let pa = anchored_from_view_point(eye, position);
+            let na = anchored_from_view_vector(eye, n);
+            return pcf_visibility(shadow_map, shadow_sampler, shadows.lights[s], s, shadows.size, pa, na);
+        }
+    }
+    return 1.0;
+}
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -31,7 +48,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var i = 0u; i < frame.light_count; i++) {
             let light = lights[layer * frame.light_count + i];
             if (light.kind.x == 0u) {
-                irradiance += light.radiance.rgb * max(dot(n, -light.pos_or_dir.xyz), 0.0);
+                let cos_l = max(dot(n, -light.pos_or_dir.xyz), 0.0);
+                if (cos_l > 0.0) {
+                    irradiance += light.radiance.rgb * cos_l * directional_visibility(i, eye, position, n);
+                }
             } else {
                 let to_light = light.pos_or_dir.xyz - position;
                 // Clamp the distance so a light on a surface does not blow up to Inf.

@@ -47,6 +47,9 @@ pub struct BenchRow {
     pub pass: &'static str,
     /// Error against the reference, when one was traced for this row's radius.
     pub error: Option<ErrorFigures>,
+    /// Error of the one-bounce irradiance against the reference's `bounce` (ssdo-bounce
+    /// and rsm rows, with a reference).
+    pub bounce: Option<BounceFigures>,
 }
 
 impl BenchRow {
@@ -57,7 +60,12 @@ impl BenchRow {
 
     /// Occlusion cost per eye: technique (+ depth peel) + blur + upsample, both-eye
     /// dispatches halved.
+    /// Reflective shadow maps (pass `rsm`): the gather plus the light-space pass that
+    /// renders the maps.
     pub fn occlusion_ms_per_eye(&self) -> f64 {
+        if self.pass == RSM_PASS {
+            return (self.median_ms(RSM_PASS) + self.median_ms("shadow")) / self.views as f64;
+        }
         let passes = [self.pass, "depth-peel", "blur", "upsample"];
         passes.iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
     }
@@ -103,7 +111,125 @@ pub fn measure(
         Some(reference) => Some(error_figures(case.technique, &renderer.read_f32(output)?, reference)),
         None => None,
     };
-    Ok(BenchRow { case: case.clone(), spans: summarize(&timings), views: 2, pass: settings.ao.pass_name(), error })
+    // SSDO's bounce alone: the same frame without the bounce (same pattern, and the blur
+    // is linear with geometry-only weights), subtracted.
+    let bounce = match reference {
+        Some(reference) if settings.ao.bounce_active() => {
+            let with = renderer.read_f32(output)?;
+            let mut without = settings.clone();
+            without.ao.technique = Technique::Ssdo;
+            renderer.set_settings(&without)?;
+            renderer.render(&eyes.eyes, &[output])?;
+            let difference: Vec<Vec<f32>> = with
+                .iter()
+                .zip(renderer.read_f32(output)?)
+                .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a - b).collect())
+                .collect();
+            bounce_figures(&difference, settings.profile.width, 1, reference)
+        }
+        _ => None,
+    };
+    Ok(BenchRow {
+        case: case.clone(),
+        spans: summarize(&timings),
+        views: 2,
+        pass: settings.ao.pass_name(),
+        error,
+        bounce,
+    })
+}
+
+/// The graph pass of reflective shadow maps' gather (bench rows of technique "rsm").
+pub const RSM_PASS: &str = "rsm";
+
+/// Reflective shadow maps with `samples` VPLs per pixel within `radius` (the reference's
+/// radius, so both gather the bounce from about the same neighbourhood): per-pass medians
+/// of the light-space pass and the gather, and with a reference the error of the last
+/// frame's half-resolution irradiance against the reference's bounce.
+pub fn measure_rsm(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    base: &Settings,
+    samples: u32,
+    radius: f32,
+    how: Measurement,
+    reference: Option<&ReferenceImage>,
+) -> Result<BenchRow> {
+    let Measurement { timing, warmup, frames } = how;
+    if crate::passes::shadow::shadow_casters(scene).is_empty() {
+        return Err(Error::input(format!("reflective shadow maps need a directional light; '{}' has none", scene.name)));
+    }
+    let mut settings = base.clone();
+    settings.shadows.rsm = true;
+    settings.shadows.rsm_samples = samples;
+    settings.shadows.rsm_radius = radius;
+    settings.validate()?;
+    let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
+    renderer.set_timing(timing);
+    let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+    let mut timings = Vec::new();
+    for frame in 0..warmup + frames {
+        let report = renderer.render(&eyes.eyes, &[crate::graph::Resource::RsmIndirect])?;
+        if frame >= warmup {
+            timings.push(if timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
+        }
+    }
+    let bounce = match reference {
+        Some(reference) => {
+            let irradiance = renderer.read_f32(crate::graph::Resource::RsmIndirect)?;
+            bounce_figures(&irradiance, settings.profile.width.div_ceil(2), 2, reference)
+        }
+        None => None,
+    };
+    let case = BenchCase { technique: Technique::None, samples, radius, half_res: true, depth_peeling: false };
+    Ok(BenchRow { case, spans: summarize(&timings), views: 2, pass: RSM_PASS, error: None, bounce })
+}
+
+/// A one-bounce irradiance estimate against the reference's `bounce`, by luminance over
+/// the reference's hit pixels (both eyes), relative to the reference's mean.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BounceFigures {
+    /// RMSE / mean of the reference.
+    pub rel_rmse: f64,
+    /// (mean of the estimate − mean of the reference) / mean of the reference.
+    pub rel_bias: f64,
+}
+
+/// Compares irradiance images (per layer, RGBA, `width` texels a row, each texel standing
+/// for `scale`×`scale` full-resolution pixels) with the reference's bounce. `None` when
+/// the reference sees no bounce at all.
+pub fn bounce_figures(
+    estimate: &[Vec<f32>],
+    width: u32,
+    scale: u32,
+    reference: &ReferenceImage,
+) -> Option<BounceFigures> {
+    let (gw, gh) = reference.grid_size();
+    let (mut n, mut sum_ref, mut sum_est, mut sum_sq) = (0usize, 0f64, 0f64, 0f64);
+    for (layer, image) in estimate.iter().enumerate().take(reference.layers.len()) {
+        let height = image.len() / 4 / width.max(1) as usize;
+        for j in 0..gh {
+            for i in 0..gw {
+                let r = reference.get(layer, i, j);
+                if !r.hit {
+                    continue;
+                }
+                let (x, y) = reference.pixel_of(i, j);
+                let (x, y) = (((x / scale) as usize).min(width as usize - 1), ((y / scale) as usize).min(height - 1));
+                let t = &image[(y * width as usize + x) * 4..][..3];
+                let (e, truth) = (luminance([t[0], t[1], t[2]]), luminance(r.bounce));
+                n += 1;
+                sum_ref += truth;
+                sum_est += e;
+                sum_sq += (e - truth) * (e - truth);
+            }
+        }
+    }
+    let mean = sum_ref / n.max(1) as f64;
+    (n > 0 && mean > 1e-9).then(|| BounceFigures {
+        rel_rmse: (sum_sq / n as f64).sqrt() / mean,
+        rel_bias: (sum_est - sum_ref) / n as f64 / mean,
+    })
 }
 
 /// Runs every case, calling `progress(done, total, row)` after each. `references` holds
@@ -213,6 +339,11 @@ pub struct BenchRecord {
     pub depth_peeling: bool,
     #[serde(default)]
     pub peel_ms_per_eye: f64,
+    /// One-bounce irradiance against the reference's bounce (ssdo-bounce, rsm rows).
+    #[serde(default)]
+    pub bounce_rel_rmse: Option<f64>,
+    #[serde(default)]
+    pub bounce_rel_bias: Option<f64>,
 }
 
 impl BenchRecord {
@@ -259,7 +390,7 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
             let spread = row.spans.iter().find(|s| s.label == name).map_or(0.0, |s| s.p75_ms / s.p25_ms.max(1e-9));
             let per_eye = |p: &str| row.median_ms(p) / row.views as f64;
             BenchRecord {
-                technique: c.technique.name().to_string(),
+                technique: if name == RSM_PASS { RSM_PASS.to_string() } else { c.technique.name().to_string() },
                 samples: c.samples,
                 radius_m: c.radius,
                 resolution: if c.half_res { "half" } else { "full" }.to_string(),
@@ -274,6 +405,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 pareto: false,
                 depth_peeling: c.depth_peeling,
                 peel_ms_per_eye: per_eye("depth-peel"),
+                bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
+                bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
             }
         })
         .collect();
@@ -301,7 +434,7 @@ pub fn mark_pareto(out: &mut [BenchRecord]) {
     }
 }
 
-const COLUMNS: [&str; 15] = [
+const COLUMNS: [&str; 17] = [
     "technique",
     "samples",
     "radius_m",
@@ -317,9 +450,11 @@ const COLUMNS: [&str; 15] = [
     "pareto",
     "depth_peeling",
     "peel_ms_per_eye",
+    "bounce_rel_rmse",
+    "bounce_rel_bias",
 ];
 
-fn record_values(r: &BenchRecord) -> [String; 15] {
+fn record_values(r: &BenchRecord) -> [String; 17] {
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.4}"));
     [
         r.technique.clone(),
@@ -337,6 +472,8 @@ fn record_values(r: &BenchRecord) -> [String; 15] {
         if r.pareto { "yes" } else { "" }.to_string(),
         if r.depth_peeling { "yes" } else { "" }.to_string(),
         format!("{:.3}", r.peel_ms_per_eye),
+        optional(r.bounce_rel_rmse),
+        optional(r.bounce_rel_bias),
     ]
 }
 
@@ -429,6 +566,7 @@ mod tests {
             views: 2,
             pass: technique.name(),
             error: Some(ErrorFigures { ao_rmse, ao_ssim: 0.9, ambient_rel_rmse: None }),
+            bounce: None,
         }
     }
 

@@ -532,7 +532,7 @@ fn panel_ui(
     history: &crate::app::PassHistory,
     counters: &crate::headset::FrameCounters,
 ) -> bool {
-    let before = (panel.settings.ao.clone(), panel.quality);
+    let before = (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone());
     egui::Panel::left("vrao panel").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
         ui.heading("vrao");
         let ao = &mut panel.settings.ao;
@@ -558,6 +558,8 @@ fn panel_ui(
         ui.checkbox(&mut ao.half_res, "half resolution");
         ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
         ui.checkbox(&mut ao.depth_peeling, "depth peeling (SSDO)");
+        ui.checkbox(&mut panel.settings.shadows.enabled, "shadows (directional lights)");
+        ui.checkbox(&mut panel.settings.shadows.rsm, "reflective shadow maps (sun bounce)");
         ui.separator();
         ui.label("display");
         ui.horizontal(|ui| {
@@ -577,7 +579,7 @@ fn panel_ui(
         ui.separator();
         profiler_ui(ui, history);
     });
-    (panel.settings.ao.clone(), panel.quality) != before
+    (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone()) != before
 }
 
 /// Seed 003's profiler: one stacked bar per recent frame, a colour per pass.

@@ -186,6 +186,12 @@ struct BenchArgs {
     /// techniques never peel).
     #[arg(long, default_value = "off")]
     depth_peeling: String,
+    /// Also measure reflective shadow maps (one bounce of the directional lights) with
+    /// these VPL counts, comma-separated, gathering within each radius: rows "rsm", whose
+    /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
+    /// given for ssdo-bounce rows.
+    #[arg(long, value_delimiter = ',')]
+    rsm_samples: Vec<u32>,
     /// Measured frames per case, after warm-up.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
@@ -277,9 +283,53 @@ struct RenderArgs {
     ao: AoArgs,
 }
 
+/// Shadow options for directional lights (part of every command that renders).
+#[derive(Args, Clone)]
+#[command(next_help_heading = "Shadows and reflective shadow maps")]
+struct LightArgs {
+    /// Shadow maps with 3×3 PCF for the directional lights: on or off (a scene with no
+    /// directional light has none either way).
+    #[arg(long, default_value = "on", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    shadows: bool,
+    /// Texels along each side of the square light-space maps.
+    #[arg(long, default_value_t = 2048)]
+    shadow_size: u32,
+    /// One bounce of the directional lights from reflective shadow maps: on or off.
+    #[arg(long, default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    rsm: bool,
+    /// Virtual point lights gathered per pixel and light by the reflective shadow maps.
+    #[arg(long, default_value_t = 64)]
+    rsm_samples: u32,
+    /// RSM gather radius in metres (default: a quarter of the scene's diagonal, within 0.1..=4 m).
+    #[arg(long, allow_negative_numbers = true)]
+    rsm_radius: Option<f32>,
+}
+
+impl LightArgs {
+    fn settings(&self, scene: &Scene) -> vrao::settings::ShadowSettings {
+        vrao::settings::ShadowSettings {
+            enabled: self.shadows,
+            size: self.shadow_size,
+            rsm: self.rsm,
+            rsm_samples: self.rsm_samples,
+            rsm_radius: self.rsm_radius.unwrap_or_else(|| vrao::passes::shadow::suggested_rsm_radius(scene)),
+        }
+    }
+}
+
+fn parse_on_off(s: &str) -> std::result::Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        other => Err(format!("'{other}' is not on or off")),
+    }
+}
+
 /// Occlusion options (shared by every command that renders).
 #[derive(Args, Clone)]
 struct AoArgs {
+    #[command(flatten)]
+    lights: LightArgs,
     /// Occlusion technique: none, ssao, hbao, ssdo or ssdo-bounce (fetch-only: the
     /// benchmark baseline with SSAO's depth taps and no occlusion arithmetic).
     #[arg(long, default_value = "ssao")]
@@ -427,6 +477,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         exposure: args.exposure,
         white_point: args.white_point,
         ao: args.ao.settings(&scene),
+        shadows: args.ao.lights.settings(&scene),
         ..Settings::default()
     };
     settings.validate()?;
@@ -599,7 +650,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         args.frames
     );
     let started = std::time::Instant::now();
-    let rows = sweep(
+    let mut rows = sweep(
         &gpu,
         &scene,
         &settings,
@@ -620,6 +671,16 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             );
         },
     )?;
+    for &samples in &args.rsm_samples {
+        for &radius in &radii {
+            let reference = references.iter().find(|(r, _)| *r == radius).map(|(_, image)| image);
+            let how = Measurement { timing, warmup: args.warmup, frames: args.frames };
+            let row = vrao::bench::measure_rsm(&gpu, &scene, &settings, samples, radius, how, reference)?;
+            let error = row.bounce.map_or(String::new(), |b| format!("  bounce rel RMSE {:.4}", b.rel_rmse));
+            eprintln!("[rsm] N={samples:<3} r={radius:<7} half {:>9.3} ms/eye{error}", row.occlusion_ms_per_eye());
+            rows.push(row);
+        }
+    }
     let file = BenchFile {
         scene: scene.name.clone(),
         adapter: info.name.clone(),
@@ -707,6 +768,7 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     let settings = Settings {
         profile: HeadsetProfile::with_size("vive", args.width, args.height),
         ao: args.ao.settings(&scene),
+        shadows: args.ao.lights.settings(&scene),
         ..Settings::default()
     };
     settings.validate()?;
@@ -754,6 +816,7 @@ fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     let settings = Settings {
         profile: HeadsetProfile::with_size("vive", args.width, args.height),
         ao: args.ao.settings(&scene),
+        shadows: args.ao.lights.settings(&scene),
         ..Settings::default()
     };
     settings.validate()?;
@@ -782,6 +845,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
     let base = Settings {
         profile: HeadsetProfile::with_size("vive", args.width, args.height),
         ao: args.ao.settings(&scene),
+        shadows: args.ao.lights.settings(&scene),
         ..Settings::default()
     };
     base.validate()?;
@@ -848,6 +912,7 @@ fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
     let mut settings = Settings {
         profile: HeadsetProfile::with_size("vive", args.width, args.height),
         ao: args.ao.settings(&scene),
+        shadows: args.ao.lights.settings(&scene),
         ..Settings::default()
     };
     let budget_ms = args.budget_ms.unwrap_or(settings.profile.budget_ms());

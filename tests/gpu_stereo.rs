@@ -200,7 +200,21 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
     let left_out: Vec<_> = report.plan.left_out.iter().map(|(n, _)| *n).collect();
     assert_eq!(
         left_out,
-        vec!["direct", "ssao", "hbao", "ssdo", "fetch-only", "blur", "upsample", "composite", "tonemap"]
+        vec![
+            "shadow",
+            "direct",
+            "rsm",
+            "ssao",
+            "hbao",
+            "depth-peel",
+            "ssdo",
+            "fetch-only",
+            "temporal",
+            "blur",
+            "upsample",
+            "composite",
+            "tonemap",
+        ]
     );
     assert!(renderer.target(Resource::Hdr).is_none(), "no HDR target is allocated when nothing needs it");
     if gpu.caps.timestamps {

@@ -2,21 +2,28 @@
 //! produced (or unoccluded when the technique is none), and the sky. Half-resolution
 //! occlusion is upsampled here, per pixel (3×3 joint bilateral, shared with the
 //! upsample pass), so a frame writes and reads no full-resolution occlusion target.
+//! With reflective shadow maps, their half-resolution one-bounce irradiance is upsampled
+//! the same way (shaders/rsm_upsample.wgsl) and added to the ambient.
 
+use super::shadow::rsm_active;
 use super::{occlusion_before_upsample, FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::targets::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
+use wgpu::util::DeviceExt;
 
 pub struct CompositePass {
     full_res: Kernel,
     half_res: Kernel,
     /// Bound in place of occlusion or its geometry where the shader does not read them.
     unused: LayeredTarget,
+    /// `vec4<u32>` uniforms: x = 1 adds the RSM bounce, 0 leaves it out.
+    rsm_on: wgpu::Buffer,
+    rsm_off: wgpu::Buffer,
 }
 
-const SLOTS: [Slot; 11] = [
+const SLOTS: [Slot; 14] = [
     Slot::Uniform,
     Slot::Uniform,
     Slot::Depth,
@@ -28,18 +35,31 @@ const SLOTS: [Slot; 11] = [
     Slot::Sampler,
     Slot::Output(wgpu::TextureFormat::Rgba16Float),
     Slot::Layers,
+    Slot::Uniform,
+    Slot::Layers,
+    Slot::Layers,
 ];
 
 impl CompositePass {
     pub fn new(gpu: &Gpu) -> Self {
-        let files = ["common.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
+        let files = ["common.wgsl", "joint_upsample.wgsl", "rsm_upsample.wgsl", "composite.wgsl"];
         let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
         CompositePass {
             full_res: Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &[("HALF_RES", 0.0)]),
             half_res: Kernel::with_constants(gpu, "composite half-res", &files, "main", &SLOTS, &[("HALF_RES", 1.0)]),
             unused,
+            rsm_on: flag(gpu, 1),
+            rsm_off: flag(gpu, 0),
         }
     }
+}
+
+fn flag(gpu: &Gpu, value: u32) -> wgpu::Buffer {
+    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("composite rsm flag"),
+        contents: bytemuck::cast_slice(&[value, 0, 0, 0]),
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
 }
 
 impl Pass for CompositePass {
@@ -50,19 +70,25 @@ impl Pass for CompositePass {
             .read(Resource::Albedo)
             .read(Resource::Direct)
             .write(Resource::Hdr);
-        match occlusion_before_upsample(setup.settings) {
+        let decl = match occlusion_before_upsample(setup.settings) {
             None => decl,
             Some(occlusion) if setup.settings.ao.half_res => decl
                 .read(occlusion)
                 .read(Resource::AoGeometry)
                 .note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)"),
             Some(occlusion) => decl.read(occlusion),
+        };
+        if rsm_active(setup.scene, setup.settings) {
+            decl.read(Resource::RsmIndirect).read(Resource::RsmGeometry)
+        } else {
+            decl
         }
     }
 
     fn record(&self, ctx: &mut FrameContext) {
         let unused = || wgpu::BindingResource::TextureView(&self.unused.array_view);
         let half_res = ctx.setup.settings.ao.half_res;
+        let rsm = rsm_active(ctx.setup.scene, ctx.setup.settings);
         let (occlusion, geometry) = match occlusion_before_upsample(ctx.setup.settings) {
             Some(occlusion) if half_res => (ctx.view(occlusion), ctx.view(Resource::AoGeometry)),
             Some(occlusion) => (ctx.view(occlusion), unused()),
@@ -80,6 +106,10 @@ impl Pass for CompositePass {
             wgpu::BindingResource::Sampler(&ctx.scene.sampler),
             ctx.view(Resource::Hdr),
             geometry,
+            // One bounce from reflective shadow maps (passes/rsm.rs), when on.
+            if rsm { self.rsm_on.as_entire_binding() } else { self.rsm_off.as_entire_binding() },
+            if rsm { ctx.view(Resource::RsmIndirect) } else { unused() },
+            if rsm { ctx.view(Resource::RsmGeometry) } else { unused() },
         ];
         let extent = ctx.extent();
         let kernel = if half_res { &self.half_res } else { &self.full_res };

@@ -43,7 +43,8 @@ impl Pass for DirectLightPass {
             .read(Resource::Emission)
             .write(Resource::Direct);
         if shadows_active(setup.scene, setup.settings) {
-            decl.read(Resource::ShadowMap).note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
+            decl.read(Resource::ShadowMap)
+                .note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
         } else {
             decl
         }
@@ -60,7 +61,11 @@ impl Pass for DirectLightPass {
             ctx.view(Resource::Emission),
             ctx.view(Resource::Direct),
             // Shadows (shaders/shadow.wgsl): every light's map, or no light and a placeholder.
-            if shadowed { self.light_space.uniform.as_entire_binding() } else { self.light_space.none.as_entire_binding() },
+            if shadowed {
+                self.light_space.uniform.as_entire_binding()
+            } else {
+                self.light_space.none.as_entire_binding()
+            },
             if shadowed {
                 ctx.view(Resource::ShadowMap)
             } else {

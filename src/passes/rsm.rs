@@ -87,13 +87,8 @@ impl Pass for RsmPass {
         let s = &ctx.setup.settings.shadows;
         let frame = self.frame.get();
         self.frame.set(frame.wrapping_add(1));
-        let params = RsmParamsUniform {
-            low_size: [w, h],
-            samples: s.rsm_samples,
-            frame,
-            radius: s.rsm_radius,
-            _pad: [0.0; 3],
-        };
+        let params =
+            RsmParamsUniform { low_size: [w, h], samples: s.rsm_samples, frame, radius: s.rsm_radius, _pad: [0.0; 3] };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let resources = [
             ctx.frame.frame.as_entire_binding(),

@@ -10,8 +10,10 @@
 //! - `environment_visible`: ∫ L_env(ω) [no hit within r] cos θ dω from the real lat-long
 //!   map ([`Environment::sample`](crate::scene::Environment::sample)), what SSDO approximates;
 //! - `bounce`: ∫ [hit within r] L_direct(hit, towards the receiver) cos θ dω, one bounce of
-//!   the direct model of `shaders/direct.wgsl` (albedo/π · Σ unshadowed light irradiance +
-//!   emission, at the hit triangle's interpolated normal and albedo; zero on a back face);
+//!   the direct model of `shaders/direct.wgsl` (albedo/π · Σ light irradiance + emission, at
+//!   the hit triangle's interpolated normal and albedo; zero on a back face), directional
+//!   lights shadowed by a shadow ray from the hit (the truth the GPU's shadow maps
+//!   approximate; with `--shadows off` on the GPU the difference shows up as error);
 //! - `unoccluded`: the environment's SH9 irradiance E(n) the GPU uses (0 without one).
 //!
 //! Conventions, chosen to match the G-buffer: the shading normal (interpolated vertex
@@ -69,7 +71,7 @@ use std::time::{Duration, Instant};
 
 /// Bumped whenever the tracer's results change for the same inputs (it is part of the
 /// cache key, so older cache files are recomputed).
-pub const TRACER_VERSION: u32 = 1;
+pub const TRACER_VERSION: u32 = 2;
 
 /// Most rays per pixel accepted.
 pub const MAX_RAYS_PER_PIXEL: u32 = 65_536;

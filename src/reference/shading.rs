@@ -1,5 +1,7 @@
 //! The estimators at one surface point: stratified cosine-weighted directions, one ray
-//! each, and the direct-light model of `shaders/direct.wgsl` at the points they hit.
+//! each, and the direct-light model of `shaders/direct.wgsl` at the points they hit,
+//! with directional light shadowed by a shadow ray (what the GPU's shadow maps
+//! approximate).
 
 use super::geometry::{sample_texture, SceneGeometry, Surface};
 use crate::scene::{Environment, Light, Scene};
@@ -143,14 +145,29 @@ impl<'a> Lighting<'a> {
         Lighting { lights, environment: scene.environment.as_ref() }
     }
 
-    /// Irradiance from the lights (unshadowed) on a surface at `p` with unit normal `n`.
-    pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
+    /// Irradiance from the lights at `surface` as the direct pass computes it with shadows
+    /// on: each directional light that faces the surface counts only when a shadow ray
+    /// towards it (leaving along the geometric normal on the light's side, past the
+    /// surface's own triangle) hits nothing. Point lights have no shadow maps on the GPU
+    /// and none here either.
+    pub fn shadowed_irradiance(&self, geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
+        let n = surface.shading;
+        let offset = OFFSET_ULPS * surface.magnitude.max(f32::MIN_POSITIVE);
         let mut e = Vec3::ZERO;
         for light in &self.lights {
             match *light {
-                AnchoredLight::Directional { towards, radiance } => e += radiance * n.dot(towards).max(0.0),
+                AnchoredLight::Directional { towards, radiance } => {
+                    let cos = n.dot(towards);
+                    if cos > 0.0 {
+                        let side = if surface.geometric.dot(towards) >= 0.0 { 1.0 } else { -1.0 };
+                        let origin = surface.position + surface.geometric * (side * offset);
+                        if geometry.closest(origin, towards, 0.0, f32::INFINITY, surface.prim).is_none() {
+                            e += radiance * cos;
+                        }
+                    }
+                }
                 AnchoredLight::Point { position, radiance } => {
-                    let to_light = position - p;
+                    let to_light = position - surface.position;
                     let d2 = to_light.length_squared().max(1e-4);
                     e += radiance * n.dot(to_light / d2.sqrt()).max(0.0) / d2;
                 }
@@ -177,14 +194,15 @@ pub(crate) fn albedo(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
 }
 
 /// Outgoing radiance of the direct model at a surface seen along `dir` (from the point
-/// that looks at it): albedo/π · Σ E + emission; zero on a back face (the ray arrives from
-/// the side its geometric normal, oriented like the vertex normal, points away from).
+/// that looks at it): albedo/π · Σ E (directional lights shadowed) + emission; zero on a
+/// back face (the ray arrives from the side its geometric normal, oriented like the
+/// vertex normal, points away from).
 pub(crate) fn direct_out(geometry: &SceneGeometry, lighting: &Lighting, surface: &Surface, dir: Vec3) -> Vec3 {
     let front = if surface.geometric.dot(surface.shading) >= 0.0 { surface.geometric } else { -surface.geometric };
     if front.dot(dir) >= 0.0 {
         return Vec3::ZERO;
     }
-    let irradiance = lighting.irradiance(surface.position, surface.shading);
+    let irradiance = lighting.shadowed_irradiance(geometry, surface);
     let emission = geometry.materials[surface.material].emissive;
     let l = albedo(geometry, surface) / std::f32::consts::PI * irradiance + emission;
     if l.is_finite() {

@@ -297,6 +297,30 @@ fn red_wall_bleeds_red_onto_the_floor_within_reach_only() {
 }
 
 #[test]
+fn a_sender_in_a_directional_lights_shadow_gets_none_of_it() {
+    // The unit box on the floor under a sun travelling +X and down at 45°: a floor point
+    // 0.2 m beside its +X face has the box between it and the sun, one 2 m away does not.
+    let mut scene = Scene::load("builtin:box").unwrap();
+    let direction = Vec3::new(1.0, -1.0, 0.0).normalize();
+    scene.lights = vec![
+        Light::Directional { direction, color: Vec3::ONE, intensity: 2.0 },
+        Light::Point { position: DVec3::new(0.7, 3.0, 0.0), color: Vec3::ONE, intensity: 9.0 },
+    ];
+    let geometry = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    let lighting = Lighting::new(&scene, DVec3::ZERO);
+    let floor_at = |x: f32| {
+        let hit = geometry.closest(Vec3::new(x, 5.0, 0.0), Vec3::NEG_Y, 0.0, 10.0, u32::MAX).unwrap();
+        geometry.surface(&hit)
+    };
+    let sun = 2.0 * std::f32::consts::FRAC_1_SQRT_2;
+    let point = |x: f32| 9.0 * 3.0 / ((0.7 - x) * (0.7 - x) + 9.0f32).powf(1.5);
+    let shadowed = lighting.shadowed_irradiance(&geometry, &floor_at(0.7));
+    assert!((shadowed - Vec3::splat(point(0.7))).abs().max_element() < 1e-4, "{shadowed}: only the point light");
+    let lit = lighting.shadowed_irradiance(&geometry, &floor_at(2.7));
+    assert!((lit - Vec3::splat(sun + point(2.7))).abs().max_element() < 1e-4, "{lit}");
+}
+
+#[test]
 fn back_faces_send_no_bounce() {
     // Seen from behind the wall (z < wall), the wall's back faces the floor behind it.
     let (mut scene, _) = red_wall_crease();
