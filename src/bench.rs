@@ -26,6 +26,9 @@ pub struct BenchCase {
     pub half_res: bool,
     /// SSDO with depth peeling (a second depth layer; its pass counts as occlusion cost).
     pub depth_peeling: bool,
+    /// Temporal accumulation (its pass counts as occlusion cost; the error is taken
+    /// after the warm-up and measured frames, with a static head: converged).
+    pub temporal: bool,
 }
 
 /// How each case is run: frames (after warm-up) and the timing mode.
@@ -66,7 +69,7 @@ impl BenchRow {
         if self.pass == RSM_PASS {
             return (self.median_ms(RSM_PASS) + self.median_ms("shadow")) / self.views as f64;
         }
-        let passes = [self.pass, "depth-peel", "blur", "upsample"];
+        let passes = [self.pass, "depth-peel", "temporal", "blur", "upsample"];
         passes.iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
     }
 }
@@ -89,6 +92,7 @@ pub fn measure(
     settings.ao.radius = case.radius;
     settings.ao.half_res = case.half_res;
     settings.ao.depth_peeling = case.depth_peeling;
+    settings.ao.temporal.enabled = case.temporal;
     let output = final_occlusion(&settings).ok_or_else(|| Error::input("bench needs an occlusion technique"))?;
     let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
     renderer.set_timing(timing);
@@ -181,7 +185,8 @@ pub fn measure_rsm(
         }
         None => None,
     };
-    let case = BenchCase { technique: Technique::None, samples, radius, half_res: true, depth_peeling: false };
+    let case =
+        BenchCase { technique: Technique::None, samples, radius, half_res: true, depth_peeling: false, temporal: false };
     Ok(BenchRow { case, spans: summarize(&timings), views: 2, pass: RSM_PASS, error: None, bounce })
 }
 
@@ -344,12 +349,16 @@ pub struct BenchRecord {
     pub bounce_rel_rmse: Option<f64>,
     #[serde(default)]
     pub bounce_rel_bias: Option<f64>,
+    /// Temporal accumulation on; its pass is in `occlusion_ms_per_eye`.
+    #[serde(default)]
+    pub temporal: bool,
 }
 
 impl BenchRecord {
     pub fn setting(&self) -> String {
         let peel = if self.depth_peeling { " peeled" } else { "" };
-        format!("{}{peel} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
+        let temporal = if self.temporal { " temporal" } else { "" };
+        format!("{}{peel}{temporal} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
     }
 }
 
@@ -407,6 +416,7 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 peel_ms_per_eye: per_eye("depth-peel"),
                 bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
                 bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
+                temporal: c.temporal,
             }
         })
         .collect();
@@ -434,7 +444,7 @@ pub fn mark_pareto(out: &mut [BenchRecord]) {
     }
 }
 
-const COLUMNS: [&str; 17] = [
+const COLUMNS: [&str; 18] = [
     "technique",
     "samples",
     "radius_m",
@@ -452,9 +462,10 @@ const COLUMNS: [&str; 17] = [
     "peel_ms_per_eye",
     "bounce_rel_rmse",
     "bounce_rel_bias",
+    "temporal",
 ];
 
-fn record_values(r: &BenchRecord) -> [String; 17] {
+fn record_values(r: &BenchRecord) -> [String; 18] {
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.4}"));
     [
         r.technique.clone(),
@@ -474,6 +485,7 @@ fn record_values(r: &BenchRecord) -> [String; 17] {
         format!("{:.3}", r.peel_ms_per_eye),
         optional(r.bounce_rel_rmse),
         optional(r.bounce_rel_bias),
+        if r.temporal { "yes" } else { "" }.to_string(),
     ]
 }
 
@@ -519,7 +531,13 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
     let rows: Vec<&BenchRecord> = file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
     let mut series: Vec<Series> = Vec::new();
     for r in &rows {
-        let label = format!("{}{} {}", r.technique, if r.depth_peeling { " peeled" } else { "" }, r.resolution);
+        let label = format!(
+            "{}{}{} {}",
+            r.technique,
+            if r.depth_peeling { " peeled" } else { "" },
+            if r.temporal { " temporal" } else { "" },
+            r.resolution
+        );
         let point = (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN));
         match series.iter_mut().find(|s| s.label == label) {
             Some(s) => s.points.push(point),
@@ -561,7 +579,7 @@ mod tests {
             max_ms: median_ms,
         };
         BenchRow {
-            case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false, depth_peeling: false },
+            case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false, depth_peeling: false, temporal: false },
             spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
             views: 2,
             pass: technique.name(),

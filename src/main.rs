@@ -186,6 +186,10 @@ struct BenchArgs {
     /// techniques never peel).
     #[arg(long, default_value = "off")]
     depth_peeling: String,
+    /// Temporal accumulation: off, on or both (the error of a temporal row is its
+    /// converged value after warm-up + frames with a static head).
+    #[arg(long, default_value = "off")]
+    temporal: String,
     /// Also measure reflective shadow maps (one bounce of the directional lights) with
     /// these VPL counts, comma-separated, gathering within each radius: rows "rsm", whose
     /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
@@ -284,24 +288,27 @@ struct RenderArgs {
 }
 
 /// Shadow options for directional lights (part of every command that renders).
+const SHADOW_HEADING: &str = "Shadows and reflective shadow maps";
+
 #[derive(Args, Clone)]
-#[command(next_help_heading = "Shadows and reflective shadow maps")]
 struct LightArgs {
     /// Shadow maps with 3×3 PCF for the directional lights: on or off (a scene with no
     /// directional light has none either way).
-    #[arg(long, default_value = "on", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    #[arg(long, help_heading = SHADOW_HEADING, default_value = "on")]
+    #[arg(value_parser = parse_on_off, action = clap::ArgAction::Set)]
     shadows: bool,
     /// Texels along each side of the square light-space maps.
-    #[arg(long, default_value_t = 2048)]
+    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = 2048)]
     shadow_size: u32,
     /// One bounce of the directional lights from reflective shadow maps: on or off.
-    #[arg(long, default_value = "off", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+    #[arg(long, help_heading = SHADOW_HEADING, default_value = "off")]
+    #[arg(value_parser = parse_on_off, action = clap::ArgAction::Set)]
     rsm: bool,
     /// Virtual point lights gathered per pixel and light by the reflective shadow maps.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = 64)]
     rsm_samples: u32,
     /// RSM gather radius in metres (default: a quarter of the scene's diagonal, within 0.1..=4 m).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, help_heading = SHADOW_HEADING, allow_negative_numbers = true)]
     rsm_radius: Option<f32>,
 }
 
@@ -564,6 +571,12 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         "both" => &[false, true],
         other => return Err(Error::input(format!("--depth-peeling '{other}' is not off, on or both"))),
     };
+    let temporal_modes: &[bool] = match args.temporal.as_str() {
+        "off" => &[false],
+        "on" => &[true],
+        "both" => &[false, true],
+        other => return Err(Error::input(format!("--temporal '{other}' is not off, on or both"))),
+    };
     if !(args.budget_ms.is_finite() && args.budget_ms > 0.0) {
         return Err(Error::input(format!("--budget-ms {} must be a positive number of milliseconds", args.budget_ms)));
     }
@@ -584,7 +597,9 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
                         if depth_peeling && !matches!(technique, Technique::Ssdo | Technique::SsdoBounce) {
                             continue;
                         }
-                        cases.push(BenchCase { technique, samples, radius, half_res, depth_peeling });
+                        for &temporal in temporal_modes {
+                            cases.push(BenchCase { technique, samples, radius, half_res, depth_peeling, temporal });
+                        }
                     }
                 }
             }
@@ -598,6 +613,12 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         if case.technique == Technique::None {
             return Err(Error::input("--techniques: none has no occlusion to measure"));
         }
+    }
+    if !args.rsm_samples.is_empty() && vrao::passes::shadow::shadow_casters(&scene).is_empty() {
+        return Err(Error::input(format!("--rsm-samples: '{}' has no directional light to bounce", scene.name)));
+    }
+    if let Some(n) = args.rsm_samples.iter().find(|n| !(1..=1024).contains(*n)) {
+        return Err(Error::input(format!("--rsm-samples {n} is not within 1..=1024")));
     }
     let gpu = Arc::new(Gpu::new(backend)?);
     let info = gpu.adapter.get_info();
