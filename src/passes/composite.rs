@@ -11,19 +11,16 @@ use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::targets::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
-use wgpu::util::DeviceExt;
 
 pub struct CompositePass {
-    full_res: Kernel,
-    half_res: Kernel,
+    /// Variants by (half resolution, RSM bounce): pipeline constants, so a frame without
+    /// them runs none of their code.
+    kernels: [[Kernel; 2]; 2],
     /// Bound in place of occlusion or its geometry where the shader does not read them.
     unused: LayeredTarget,
-    /// `vec4<u32>` uniforms: x = 1 adds the RSM bounce, 0 leaves it out.
-    rsm_on: wgpu::Buffer,
-    rsm_off: wgpu::Buffer,
 }
 
-const SLOTS: [Slot; 14] = [
+const SLOTS: [Slot; 13] = [
     Slot::Uniform,
     Slot::Uniform,
     Slot::Depth,
@@ -35,7 +32,6 @@ const SLOTS: [Slot; 14] = [
     Slot::Sampler,
     Slot::Output(wgpu::TextureFormat::Rgba16Float),
     Slot::Layers,
-    Slot::Uniform,
     Slot::Layers,
     Slot::Layers,
 ];
@@ -44,22 +40,15 @@ impl CompositePass {
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "joint_upsample.wgsl", "rsm_upsample.wgsl", "composite.wgsl"];
         let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
+        let variant = |half_res: bool, rsm: bool| {
+            let constants = [("HALF_RES", half_res as u8 as f64), ("RSM", rsm as u8 as f64)];
+            Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &constants)
+        };
         CompositePass {
-            full_res: Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &[("HALF_RES", 0.0)]),
-            half_res: Kernel::with_constants(gpu, "composite half-res", &files, "main", &SLOTS, &[("HALF_RES", 1.0)]),
+            kernels: [[variant(false, false), variant(false, true)], [variant(true, false), variant(true, true)]],
             unused,
-            rsm_on: flag(gpu, 1),
-            rsm_off: flag(gpu, 0),
         }
     }
-}
-
-fn flag(gpu: &Gpu, value: u32) -> wgpu::Buffer {
-    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("composite rsm flag"),
-        contents: bytemuck::cast_slice(&[value, 0, 0, 0]),
-        usage: wgpu::BufferUsages::UNIFORM,
-    })
 }
 
 impl Pass for CompositePass {
@@ -107,12 +96,11 @@ impl Pass for CompositePass {
             ctx.view(Resource::Hdr),
             geometry,
             // One bounce from reflective shadow maps (passes/rsm.rs), when on.
-            if rsm { self.rsm_on.as_entire_binding() } else { self.rsm_off.as_entire_binding() },
             if rsm { ctx.view(Resource::RsmIndirect) } else { unused() },
             if rsm { ctx.view(Resource::RsmGeometry) } else { unused() },
         ];
         let extent = ctx.extent();
-        let kernel = if half_res { &self.half_res } else { &self.full_res };
+        let kernel = &self.kernels[half_res as usize][rsm as usize];
         kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
     }
 }
