@@ -160,7 +160,10 @@ impl RunSummary {
             headset: frame_loop.headset.describe(),
             frames: frame_loop.frames,
             counters: frame_loop.headset.counters(),
-            pass_medians_ms: crate::gpu::timing::summarize(&frames).into_iter().map(|s| (s.label, s.median_ms)).collect(),
+            pass_medians_ms: crate::gpu::timing::summarize(&frames)
+                .into_iter()
+                .map(|s| (s.label, s.median_ms))
+                .collect(),
         }
     }
 

@@ -2,17 +2,17 @@
 //! pass per eye over many frames, as a table, CSV and Markdown. (Error against the
 //! reference tracer joins these rows when the tracer exists.)
 
+use crate::analytic::luminance;
 use crate::error::{Error, Result};
 use crate::gpu::timing::{summarize, SpanSummary};
 use crate::gpu::Gpu;
+use crate::metrics;
 use crate::passes::final_occlusion;
+use crate::plot::{ScatterPlot, Series};
+use crate::reference::ReferenceImage;
 use crate::renderer::{Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::{Settings, Technique};
-use crate::analytic::luminance;
-use crate::metrics;
-use crate::plot::{ScatterPlot, Series};
-use crate::reference::ReferenceImage;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -161,7 +161,10 @@ pub fn measure_rsm(
 ) -> Result<BenchRow> {
     let Measurement { timing, warmup, frames } = how;
     if crate::passes::shadow::shadow_casters(scene).is_empty() {
-        return Err(Error::input(format!("reflective shadow maps need a directional light; '{}' has none", scene.name)));
+        return Err(Error::input(format!(
+            "reflective shadow maps need a directional light; '{}' has none",
+            scene.name
+        )));
     }
     let mut settings = base.clone();
     settings.shadows.rsm = true;
@@ -185,8 +188,14 @@ pub fn measure_rsm(
         }
         None => None,
     };
-    let case =
-        BenchCase { technique: Technique::None, samples, radius, half_res: true, depth_peeling: false, temporal: false };
+    let case = BenchCase {
+        technique: Technique::None,
+        samples,
+        radius,
+        half_res: true,
+        depth_peeling: false,
+        temporal: false,
+    };
     Ok(BenchRow { case, spans: summarize(&timings), views: 2, pass: RSM_PASS, error: None, bounce })
 }
 
@@ -306,14 +315,14 @@ pub fn error_figures(technique: Technique, occlusion: &[Vec<f32>], reference: &R
             }
         }
         let range = first..gpu_ao.len();
-        ssim_sum +=
-            metrics::ssim(&gpu_ao[range.clone()], &ref_ao[range.clone()], gw, gh, Some(&mask[range]), 1.0).unwrap_or(0.0);
+        ssim_sum += metrics::ssim(&gpu_ao[range.clone()], &ref_ao[range.clone()], gw, gh, Some(&mask[range]), 1.0)
+            .unwrap_or(0.0);
     }
     let hits = mask.iter().filter(|&&m| m).count().max(1) as f64;
     let noise = (noise2.iter().sum::<f64>() / hits).sqrt();
-    let ao_rmse = metrics::noise_corrected_rmse(metrics::rmse(&gpu_ao, &ref_ao, Some(&mask)).unwrap_or(f64::NAN), noise);
-    let mean_ambient =
-        ref_ambient.iter().zip(&mask).filter(|(_, &m)| m).map(|(&a, _)| a as f64).sum::<f64>() / hits;
+    let ao_rmse =
+        metrics::noise_corrected_rmse(metrics::rmse(&gpu_ao, &ref_ao, Some(&mask)).unwrap_or(f64::NAN), noise);
+    let mean_ambient = ref_ambient.iter().zip(&mask).filter(|(_, &m)| m).map(|(&a, _)| a as f64).sum::<f64>() / hits;
     let ambient_rel_rmse = (mean_ambient > 1e-12)
         .then(|| metrics::rmse(&gpu_ambient, &ref_ambient, Some(&mask)).map(|e| e / mean_ambient))
         .flatten();
@@ -434,10 +443,8 @@ pub fn mark_pareto(out: &mut [BenchRecord]) {
     radii.dedup();
     for radius in radii {
         let members: Vec<usize> = (0..out.len()).filter(|&i| out[i].radius_m == radius).collect();
-        let points: Vec<(f64, f64)> = members
-            .iter()
-            .map(|&i| (out[i].occlusion_ms_per_eye, out[i].ao_rmse.unwrap_or(f64::NAN)))
-            .collect();
+        let points: Vec<(f64, f64)> =
+            members.iter().map(|&i| (out[i].occlusion_ms_per_eye, out[i].ao_rmse.unwrap_or(f64::NAN))).collect();
         for k in metrics::pareto_front(&points) {
             out[members[k]].pareto = true;
         }
@@ -528,7 +535,8 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
         [23, 190, 207],
         [188, 189, 34],
     ];
-    let rows: Vec<&BenchRecord> = file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
+    let rows: Vec<&BenchRecord> =
+        file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
     let mut series: Vec<Series> = Vec::new();
     for r in &rows {
         let label = format!(
@@ -579,7 +587,14 @@ mod tests {
             max_ms: median_ms,
         };
         BenchRow {
-            case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false, depth_peeling: false, temporal: false },
+            case: BenchCase {
+                technique,
+                samples: 12,
+                radius: 0.5,
+                half_res: false,
+                depth_peeling: false,
+                temporal: false,
+            },
             spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
             views: 2,
             pass: technique.name(),
@@ -612,7 +627,8 @@ mod tests {
     #[test]
     fn the_pareto_front_keeps_rows_no_other_row_beats_in_both_time_and_error() {
         // ssao: 6 ms, 0.10; hbao: 7 ms, 0.05; ssdo: 8 ms, 0.07 (slower and worse than hbao).
-        let rows = [row(Technique::Ssao, 10.0, 0.10), row(Technique::Hbao, 12.0, 0.05), row(Technique::Ssdo, 14.0, 0.07)];
+        let rows =
+            [row(Technique::Ssao, 10.0, 0.10), row(Technique::Hbao, 12.0, 0.05), row(Technique::Ssdo, 14.0, 0.07)];
         let pareto: Vec<bool> = records(&rows).iter().map(|r| r.pareto).collect();
         assert_eq!(pareto, [true, true, false]);
     }
@@ -623,7 +639,11 @@ mod tests {
         let recs = records(&rows);
         let csv = to_csv(&recs);
         assert_eq!(csv.lines().count(), 3);
-        assert!(csv.lines().nth(2).unwrap().starts_with("hbao,12,0.5,full,6.000,1.000,0.000,7.000,1.000,0.2000,0.9000,,"));
+        assert!(csv
+            .lines()
+            .nth(2)
+            .unwrap()
+            .starts_with("hbao,12,0.5,full,6.000,1.000,0.000,7.000,1.000,0.2000,0.9000,,"));
         assert_eq!(to_markdown(&recs).lines().count(), 4);
         let json = to_json(&file(recs.clone()));
         let back: BenchFile = serde_json::from_str(&json).unwrap();

@@ -71,13 +71,25 @@ impl BudgetReport {
             Some(s) => format!("{:.3} ({:.3}–{:.3})", s.median_ms, s.p25_ms, s.p75_ms),
             None => "-".to_string(),
         };
-        let _ = writeln!(s, "  {:<14} {:>30} {:>30} {:>30}", "pass ms", "stereo frame", "left eye alone", "right eye alone");
+        let _ = writeln!(
+            s,
+            "  {:<14} {:>30} {:>30} {:>30}",
+            "pass ms", "stereo frame", "left eye alone", "right eye alone"
+        );
         for p in &self.passes {
-            let _ = writeln!(s, "  {:<14} {:>30} {:>30} {:>30}", p.pass, cell(&p.stereo), cell(&p.left), cell(&p.right));
+            let _ =
+                writeln!(s, "  {:<14} {:>30} {:>30} {:>30}", p.pass, cell(&p.stereo), cell(&p.left), cell(&p.right));
         }
         let encode: Vec<Option<SpanSummary>> = self.cpu_encode.iter().cloned().map(Some).collect();
         if encode.len() == 3 {
-            let _ = writeln!(s, "  {:<14} {:>30} {:>30} {:>30}", "cpu encode", cell(&encode[0]), cell(&encode[1]), cell(&encode[2]));
+            let _ = writeln!(
+                s,
+                "  {:<14} {:>30} {:>30} {:>30}",
+                "cpu encode",
+                cell(&encode[0]),
+                cell(&encode[1]),
+                cell(&encode[2])
+            );
         }
         for v in &self.verdicts {
             let _ = writeln!(
@@ -143,7 +155,8 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         .collect();
     let total = |k: usize| summaries[k].iter().map(|s| s.median_ms).sum::<f64>();
     let per_eye_budget = how.budget_ms / 2.0;
-    let verdict = |what: &str, ms: f64, budget_ms: f64| Verdict { what: what.into(), ms, budget_ms, pass: ms <= budget_ms };
+    let verdict =
+        |what: &str, ms: f64, budget_ms: f64| Verdict { what: what.into(), ms, budget_ms, pass: ms <= budget_ms };
     let verdicts = vec![
         verdict("left eye", total(1), per_eye_budget),
         verdict("right eye", total(2), per_eye_budget),
@@ -168,7 +181,11 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         timing: format!("{:?}", how.timing).to_lowercase(),
         warmup: how.warmup,
         frames: how.frames,
-        output: if how.output == Resource::Color { "whole frame".into() } else { format!("{} only", how.output.name()) },
+        output: if how.output == Resource::Color {
+            "whole frame".into()
+        } else {
+            format!("{} only", how.output.name())
+        },
         budget_ms: how.budget_ms,
         passes,
         cpu_encode,

@@ -163,13 +163,10 @@ impl WindowState {
             .map_err(|e| Error::Device(format!("cannot draw into the window: {e}")))?;
         let caps = surface.get_capabilities(&gpu.adapter);
         // The eye images hold sRGB-encoded values: a non-sRGB surface shows them as they are.
-        let format = caps
-            .formats
-            .iter()
-            .copied()
-            .find(|f| !f.is_srgb())
-            .or_else(|| caps.formats.first().copied())
-            .ok_or_else(|| Error::Device(format!("{} cannot present to this window", gpu.adapter.get_info().name)))?;
+        let format =
+            caps.formats.iter().copied().find(|f| !f.is_srgb()).or_else(|| caps.formats.first().copied()).ok_or_else(
+                || Error::Device(format!("{} cannot present to this window", gpu.adapter.get_info().name)),
+            )?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -186,8 +183,14 @@ impl WindowState {
             surface.configure(&gpu.device, &config);
         }
         let egui_ctx = egui::Context::default();
-        let egui_winit =
-            egui_winit::State::new(egui_ctx.clone(), egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, None);
+        let egui_winit = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            None,
+        );
         let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         let settings = frame_loop.renderer.settings().clone();
         let quality = Quality::ALL.into_iter().find(|q| q.samples() == settings.ao.samples);
@@ -246,10 +249,12 @@ impl WindowState {
         // The head: midway between the eyes, looking their way; the headset's vertical
         // field of view, and the horizontal one the window's aspect gives.
         let [left, right] = eyes.eyes;
-        let head = HeadPose { position: (left.pose.position + right.pose.position) * 0.5, orientation: left.pose.orientation };
+        let head =
+            HeadPose { position: (left.pose.position + right.pose.position) * 0.5, orientation: left.pose.orientation };
         let tan_up = (left.fov.up as f64).tan();
         let tan_side = tan_up * w as f64 / h as f64;
-        let fov = Fov { left: -(tan_side.atan() as f32), right: tan_side.atan() as f32, up: left.fov.up, down: -left.fov.up };
+        let fov =
+            Fov { left: -(tan_side.atan() as f32), right: tan_side.atan() as f32, up: left.fov.up, down: -left.fov.up };
         mono.render(&[EyePair::mono(&head, fov)], &[Resource::Color])?;
         Ok(())
     }
@@ -277,7 +282,8 @@ impl WindowState {
         }
         let pixels_per_point = full_output.pixels_per_point;
         let paint_jobs = self.egui_ctx.tessellate(full_output.shapes, pixels_per_point);
-        let screen = egui_wgpu::ScreenDescriptor { size_in_pixels: [self.config.width, self.config.height], pixels_per_point };
+        let screen =
+            egui_wgpu::ScreenDescriptor { size_in_pixels: [self.config.width, self.config.height], pixels_per_point };
         for (id, deltas) in &full_output.textures_delta.set {
             for delta in deltas {
                 self.egui_renderer.update_texture(&gpu.device, &gpu.queue, *id, delta);
@@ -324,8 +330,7 @@ impl WindowState {
             },
             _ => {
                 // What the headset shows (the compositor's output), else the eye buffers.
-                let target =
-                    frame_loop.headset.display_image().or_else(|| frame_loop.renderer.target(Resource::Color));
+                let target = frame_loop.headset.display_image().or_else(|| frame_loop.renderer.target(Resource::Color));
                 target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default()
             }
         }
@@ -374,7 +379,8 @@ impl WindowState {
                 // Each image gets an equal slot; within it, the largest rectangle of its aspect.
                 let aspect = if self.panel.mode == DisplayMode::SinglePass { aw / ah } else { eye_aspect };
                 let (slot_w, slot_h) = (aw / count, ah);
-                let (w, h) = if slot_w / slot_h > aspect { (slot_h * aspect, slot_h) } else { (slot_w, slot_w / aspect) };
+                let (w, h) =
+                    if slot_w / slot_h > aspect { (slot_h * aspect, slot_h) } else { (slot_w, slot_w / aspect) };
                 let x = ax + slot_w * i as f32 + (slot_w - w) * 0.5;
                 let y = ay + (slot_h - h) * 0.5;
                 pass.set_viewport(x, y, w.max(1.0), h.max(1.0), 0.0, 1.0);
@@ -592,7 +598,8 @@ fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
             }
         }
     }
-    let total = |frame: &Vec<(String, f64)>| frame.iter().filter(|(n, _)| passes.contains(n)).map(|(_, ms)| ms).sum::<f64>();
+    let total =
+        |frame: &Vec<(String, f64)>| frame.iter().filter(|(n, _)| passes.contains(n)).map(|(_, ms)| ms).sum::<f64>();
     let max_ms = history.frames.iter().map(total).fold(0.0, f64::max).max(1e-3);
     ui.label(format!("GPU ms per frame, both eyes (top {max_ms:.1} ms)"));
     let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width(), 120.0), egui::Sense::hover());

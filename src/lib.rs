@@ -6,8 +6,8 @@
 pub mod analytic;
 pub mod app;
 pub mod bench;
-pub mod display;
 pub mod budget;
+pub mod display;
 pub mod error;
 pub mod gpu;
 pub mod graph;

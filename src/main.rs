@@ -755,7 +755,9 @@ fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], a
             front.sort_by(|a, b| a.occlusion_ms_per_eye.total_cmp(&b.occlusion_ms_per_eye));
             let front: Vec<String> = front
                 .iter()
-                .map(|r| format!("{} ({:.1} ms, {:.4})", r.setting(), r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN)))
+                .map(|r| {
+                    format!("{} ({:.1} ms, {:.4})", r.setting(), r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))
+                })
                 .collect();
             println!("Pareto front at r = {radius} m (fastest first): {}", front.join("; "));
         }
@@ -763,7 +765,6 @@ fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], a
     println!("adapter: {adapter}; wrote {written} in {}", args.out.display());
     Ok(())
 }
-
 
 /// Where reference images are cached between runs.
 fn default_cache_dir() -> PathBuf {
@@ -775,7 +776,8 @@ fn default_cache_dir() -> PathBuf {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {
-    let parsed = s.split_once('x').and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    let parsed =
+        s.split_once('x').and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
     match parsed {
         Some((w, h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
         _ => Err(Error::input(format!("--window '{s}' is not WIDTHxHEIGHT within 1..=16384"))),
@@ -882,7 +884,10 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
     let configurations = vec![
         (format!("spatial N={n}, blur"), with(false, TemporalBlend::Average, n, base.ao.blur_radius)),
         (format!("spatial N={n}, no blur"), with(false, TemporalBlend::Average, n, 0)),
-        (format!("spatial N={}, blur (4× the samples)", 4 * n), with(false, TemporalBlend::Average, 4 * n, base.ao.blur_radius)),
+        (
+            format!("spatial N={}, blur (4× the samples)", 4 * n),
+            with(false, TemporalBlend::Average, 4 * n, base.ao.blur_radius),
+        ),
         (format!("temporal N={n}, no blur"), with(true, TemporalBlend::Average, n, 0)),
         (format!("temporal N={n}, blur"), with(true, TemporalBlend::Average, n, base.ao.blur_radius)),
         (format!("temporal N={n}, confidence blend, no blur"), with(true, TemporalBlend::Confidence, n, 0)),
@@ -964,7 +969,8 @@ fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
         run(&mut renderer, &eyes, BudgetRun { timing, warmup: args.warmup, frames, budget_ms, output })
     };
     if let (Some(file), Some(path)) = (&fit_file, &args.fit) {
-        settings.ao = fit_setting(file, path, &gpu, &settings, budget_ms, occlusion_only, |s, frames| measure(s, frames))?;
+        settings.ao =
+            fit_setting(file, path, &gpu, &settings, budget_ms, occlusion_only, |s, frames| measure(s, frames))?;
     }
     let report = measure(&settings, args.frames)?;
     print!("{}", report.to_text());

@@ -246,7 +246,13 @@ pub struct Temporal {
 
 impl Default for Temporal {
     fn default() -> Self {
-        Temporal { enabled: false, epsilon_m: 0.02, blend: TemporalBlend::Average, max_frames: 16, confidence_bias: 0.1 }
+        Temporal {
+            enabled: false,
+            epsilon_m: 0.02,
+            blend: TemporalBlend::Average,
+            max_frames: 16,
+            confidence_bias: 0.1,
+        }
     }
 }
 

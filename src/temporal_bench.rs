@@ -81,7 +81,9 @@ pub fn convergence(
             let e = error_figures(settings.ao.technique, &image, reference);
             converged.render(&eyes.eyes, &[converged_output])?;
             let target = converged.read_f32(converged_output)?;
-            let ao = |layers: &[Vec<f32>]| layers.iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>();
+            let ao = |layers: &[Vec<f32>]| {
+                layers.iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>()
+            };
             let noise_rmse = crate::metrics::rmse(&ao(&image), &ao(&target), None).unwrap_or(f64::NAN);
             let mut sorted = times.clone();
             sorted.sort_by(f64::total_cmp);

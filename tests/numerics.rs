@@ -109,7 +109,12 @@ fn near_plane_1e_minus_4_with_geometry_from_a_millimetre_to_a_thousand_kilometre
     let mut meshes = Vec::new();
     for (i, distance) in [1e-3, 1.0, 1e3, 1e6].into_iter().enumerate() {
         let x = (i as f64 - 1.5) * 0.4 * distance;
-        meshes.push(common::square(&format!("at {distance} m"), DVec3::new(x, 0.0, -distance), (0.5 * distance) as f32, 0));
+        meshes.push(common::square(
+            &format!("at {distance} m"),
+            DVec3::new(x, 0.0, -distance),
+            (0.5 * distance) as f32,
+            0,
+        ));
     }
     let scene = common::bare_scene(meshes);
     let head = HeadPose::look_at(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0)).unwrap();
@@ -219,7 +224,13 @@ fn sizes_1x1_3x5_and_1081x1199_at_half_resolution() {
     let (gpu, _lock) = common::gpu();
     let scene = room();
     for size in [(1, 1), (3, 5)] {
-        every_technique(&gpu, &format!("{}x{}", size.0, size.1), &scene, &settings(size, AoSettings::default()), &room_head());
+        every_technique(
+            &gpu,
+            &format!("{}x{}", size.0, size.1),
+            &scene,
+            &settings(size, AoSettings::default()),
+            &room_head(),
+        );
     }
     for technique in TECHNIQUES {
         let s = settings((1081, 1199), AoSettings { technique, half_res: true, samples: 8, ..AoSettings::default() });
@@ -262,7 +273,9 @@ fn light_and_emission_of_1e30_stay_finite_through_tone_mapping() {
     scene.materials.push(Material { emissive: Vec3::splat(1e30), ..Material::plain("sun-hot", Vec3::ONE) });
     let hot = scene.materials.len() - 1;
     scene.meshes.push(common::square("hot", DVec3::new(0.5, 1.5, -3.9), 0.5, hot));
-    for out in every_technique(&gpu, "1e30 light and emission", &scene, &settings(SMALL, AoSettings::default()), &room_head()) {
+    for out in
+        every_technique(&gpu, "1e30 light and emission", &scene, &settings(SMALL, AoSettings::default()), &room_head())
+    {
         // The hottest pixels saturate to white instead of overflowing.
         assert!(out.color.iter().flatten().any(|&c| c == 255), "no saturated pixel");
         assert!(out.hdr.iter().flatten().all(|v| *v <= 65504.0));
@@ -281,7 +294,8 @@ fn ipd_0_and_0_3_m_and_extreme_asymmetric_fields_of_view() {
             // Both eyes at one point with mirrored frusta: the left eye's image is the right
             // eye's mirrored only for symmetric content, so compare AO statistics instead.
             for out in outs {
-                let mean = |l: &Vec<f32>| l.iter().skip(3).step_by(4).map(|&a| a as f64).sum::<f64>() / (l.len() / 4) as f64;
+                let mean =
+                    |l: &Vec<f32>| l.iter().skip(3).step_by(4).map(|&a| a as f64).sum::<f64>() / (l.len() / 4) as f64;
                 assert!((mean(&out.ao[0]) - mean(&out.ao[1])).abs() < 0.1);
             }
         }
@@ -304,12 +318,15 @@ fn a_head_pose_with_an_unnormalised_quaternion_renders_as_the_normalised_one() {
     let (gpu, _lock) = common::gpu();
     let scene = room();
     let head = room_head();
-    let scaled = HeadPose { position: head.position, orientation: DQuat::from_xyzw(
-        head.orientation.x * 3.7,
-        head.orientation.y * 3.7,
-        head.orientation.z * 3.7,
-        head.orientation.w * 3.7,
-    ) };
+    let scaled = HeadPose {
+        position: head.position,
+        orientation: DQuat::from_xyzw(
+            head.orientation.x * 3.7,
+            head.orientation.y * 3.7,
+            head.orientation.z * 3.7,
+            head.orientation.w * 3.7,
+        ),
+    };
     let s = settings(SMALL, AoSettings::default());
     let a = render_checked(&gpu, "normalised", &scene, &s, &head);
     let b = render_checked(&gpu, "quaternion × 3.7", &scene, &s, &scaled);

@@ -15,8 +15,7 @@ const RADIUS: f32 = 0.5;
 fn errors(technique: Technique, samples: u32, reference: &vrao::reference::ReferenceImage) -> ErrorFigures {
     let (gpu, _one_at_a_time) = common::gpu();
     let scene = Scene::load("builtin:crease").unwrap();
-    let mut settings =
-        Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ..Settings::default() };
+    let mut settings = Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ..Settings::default() };
     settings.ao.technique = technique;
     settings.ao.samples = samples;
     settings.ao.radius = RADIUS;
@@ -32,7 +31,8 @@ fn every_technique_stays_within_its_stated_error_of_the_reference_on_the_crease(
     let scene = Scene::load("builtin:crease").unwrap();
     let settings = Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ..Settings::default() };
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
-    let reference_settings = ReferenceSettings { radius: RADIUS as f64, rays_per_pixel: 256, stride: 2, near: settings.near };
+    let reference_settings =
+        ReferenceSettings { radius: RADIUS as f64, rays_per_pixel: 256, stride: 2, near: settings.near };
     let reference = trace(&scene, &eyes.eyes, SIZE, &reference_settings, &mut |_| {}).unwrap();
     assert!(reference.stats.noise < 0.01, "reference noise {}", reference.stats.noise);
     let mut ambient = Vec::new();
@@ -40,7 +40,11 @@ fn every_technique_stays_within_its_stated_error_of_the_reference_on_the_crease(
         for samples in [12, 36] {
             let e = errors(technique, samples, &reference);
             println!("{} N={samples}: {e:?}", technique.name());
-            assert!(e.ao_rmse.is_finite() && e.ao_rmse < bound, "{} N={samples}: {e:?} (bound {bound})", technique.name());
+            assert!(
+                e.ao_rmse.is_finite() && e.ao_rmse < bound,
+                "{} N={samples}: {e:?} (bound {bound})",
+                technique.name()
+            );
             assert!(e.ao_ssim > 0.8, "{} N={samples}: {e:?}", technique.name());
             ambient.push((technique, samples, e.ambient_rel_rmse.expect("the crease has an environment")));
         }

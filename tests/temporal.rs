@@ -56,7 +56,9 @@ fn surface_ao(renderer: &Renderer, r: Resource) -> Vec<f32> {
     geometry
         .iter()
         .zip(&values)
-        .flat_map(|(g, v)| g.chunks(4).zip(v.chunks(4)).filter(|(g, _)| g[3] > 0.0).map(|(_, v)| v[3]).collect::<Vec<_>>())
+        .flat_map(|(g, v)| {
+            g.chunks(4).zip(v.chunks(4)).filter(|(g, _)| g[3] > 0.0).map(|(_, v)| v[3]).collect::<Vec<_>>()
+        })
         .collect()
 }
 
@@ -86,7 +88,12 @@ fn a_jump_to_a_new_view_discards_the_history_instead_of_smearing_it() {
     let mean_error = |v: &[f32]| v.iter().zip(&target).map(|(a, b)| (a - b).abs() as f64).sum::<f64>() / v.len() as f64;
     let fresh = raw.iter().zip(&accumulated).filter(|(a, b)| (*a - *b).abs() < 1e-3).count();
     assert!(fresh as f64 > 0.7 * raw.len() as f64, "{fresh} of {} surface pixels started afresh", raw.len());
-    assert!(mean_error(&accumulated) <= mean_error(&raw) + 1e-3, "{} vs {}", mean_error(&accumulated), mean_error(&raw));
+    assert!(
+        mean_error(&accumulated) <= mean_error(&raw) + 1e-3,
+        "{} vs {}",
+        mean_error(&accumulated),
+        mean_error(&raw)
+    );
     // A 1 cm step keeps the history of nearly every surface pixel.
     let stepped = HeadPose { position: side.position + DVec3::new(0.0, 0.0, 0.01), orientation: side.orientation };
     renderer.render(&s.profile.eyes(&stepped, s.near).eyes, &outputs).unwrap();
@@ -107,14 +114,20 @@ fn a_history_holding_nan_is_discarded() {
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     renderer.render(&eyes.eyes, &[Resource::AoAccumulated]).unwrap();
     // Poison both history pairs: NaN values (f16 0x7E00) and NaN positions.
-    for r in [Resource::HistoryValueA, Resource::HistoryValueB, Resource::HistoryPositionA, Resource::HistoryPositionB] {
+    for r in [Resource::HistoryValueA, Resource::HistoryValueB, Resource::HistoryPositionA, Resource::HistoryPositionB]
+    {
         let target = renderer.target(r).expect("the temporal pass keeps its history");
         let texel: Vec<u8> = if r.format() == wgpu::TextureFormat::Rgba16Float {
             std::iter::repeat_n(0x7E00u16.to_le_bytes(), 4).flatten().collect()
         } else {
             std::iter::repeat_n(f32::NAN.to_le_bytes(), 4).flatten().collect()
         };
-        let bytes: Vec<u8> = texel.iter().copied().cycle().take(texel.len() * (target.width * target.height * target.layers) as usize).collect();
+        let bytes: Vec<u8> = texel
+            .iter()
+            .copied()
+            .cycle()
+            .take(texel.len() * (target.width * target.height * target.layers) as usize)
+            .collect();
         gpu.queue.write_texture(
             target.texture.as_image_copy(),
             &bytes,

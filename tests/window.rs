@@ -71,7 +71,19 @@ fn mirror_and_single_pass_windows_show_the_panel_and_the_scene() {
 fn display_none_needs_no_window_system() {
     let _one_at_a_time = common::gpu_lock();
     let out = Command::new(env!("CARGO_BIN_EXE_vrao"))
-        .args(["run", "--headset", "simulated", "--display", "none", "--frames", "2", "--width", "32", "--height", "32"])
+        .args([
+            "run",
+            "--headset",
+            "simulated",
+            "--display",
+            "none",
+            "--frames",
+            "2",
+            "--width",
+            "32",
+            "--height",
+            "32",
+        ])
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
         .output()

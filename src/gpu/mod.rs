@@ -130,7 +130,12 @@ impl Gpu {
     /// The `Gpu` for a device opened with [`Gpu::device_descriptor`] (by wgpu, or wrapped
     /// from a device an OpenXR runtime created): capabilities from the device's features,
     /// GPU errors kept for [`Gpu::take_error`], and the multiview probe run.
-    pub fn from_device(instance: wgpu::Instance, adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Gpu {
+    pub fn from_device(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Gpu {
         let features = device.features();
         let multiview = features.contains(wgpu::Features::MULTIVIEW);
         let timestamps =

@@ -20,7 +20,8 @@ pub enum HeadMotion {
 }
 
 impl HeadMotion {
-    pub const ALL: [HeadMotion; 4] = [HeadMotion::Static, HeadMotion::YawSweep, HeadMotion::FigureEight, HeadMotion::HeadRoll];
+    pub const ALL: [HeadMotion; 4] =
+        [HeadMotion::Static, HeadMotion::YawSweep, HeadMotion::FigureEight, HeadMotion::HeadRoll];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -37,9 +38,7 @@ impl HeadMotion {
         let base = path.pose_at(t).sanitized();
         let (offset, turn) = match self {
             HeadMotion::Static => (DVec3::ZERO, DQuat::IDENTITY),
-            HeadMotion::YawSweep => {
-                (DVec3::ZERO, DQuat::from_rotation_y(30f64.to_radians() * (TAU * t / 4.0).sin()))
-            }
+            HeadMotion::YawSweep => (DVec3::ZERO, DQuat::from_rotation_y(30f64.to_radians() * (TAU * t / 4.0).sin())),
             HeadMotion::FigureEight => {
                 let w = TAU * t / 8.0;
                 (DVec3::new(0.5 * w.sin(), 0.0, 0.25 * (2.0 * w).sin()), DQuat::IDENTITY)
@@ -58,9 +57,10 @@ impl HeadMotion {
 impl std::str::FromStr for HeadMotion {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        HeadMotion::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            format!("unknown head motion '{s}' (expected static, yaw-sweep, figure-eight or head-roll)")
-        })
+        HeadMotion::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown head motion '{s}' (expected static, yaw-sweep, figure-eight or head-roll)"))
     }
 }
 

@@ -26,9 +26,10 @@ impl HeadMove {
                 position: pose.position,
                 orientation: (DQuat::from_rotation_y(deg.to_radians()) * pose.orientation).normalize(),
             },
-            HeadMove::TranslateCm(cm) => {
-                HeadPose { position: pose.position + pose.orientation * DVec3::X * (cm / 100.0), orientation: pose.orientation }
-            }
+            HeadMove::TranslateCm(cm) => HeadPose {
+                position: pose.position + pose.orientation * DVec3::X * (cm / 100.0),
+                orientation: pose.orientation,
+            },
         }
     }
 
@@ -76,12 +77,18 @@ pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove])
     // Keep the source frame: the fresh renders below reuse the renderer's targets.
     let extent = renderer.target(Resource::Color).expect("rendered").extent();
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-    let color = crate::gpu::targets::LayeredTarget::new(&gpu.device, "source colour", Resource::Color.format(), extent, usage);
-    let depth = crate::gpu::targets::LayeredTarget::new(&gpu.device, "source depth", Resource::Depth.format(), extent, usage);
+    let color =
+        crate::gpu::targets::LayeredTarget::new(&gpu.device, "source colour", Resource::Color.format(), extent, usage);
+    let depth =
+        crate::gpu::targets::LayeredTarget::new(&gpu.device, "source depth", Resource::Depth.format(), extent, usage);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     for (resource, copy) in [(Resource::Color, &color), (Resource::Depth, &depth)] {
         let from = renderer.target(resource).expect("rendered");
-        encoder.copy_texture_to_texture(from.texture.as_image_copy(), copy.texture.as_image_copy(), from.texture.size());
+        encoder.copy_texture_to_texture(
+            from.texture.as_image_copy(),
+            copy.texture.as_image_copy(),
+            from.texture.size(),
+        );
     }
     gpu.queue.submit([encoder.finish()]);
     let output = output_target(&gpu, extent);

@@ -126,7 +126,8 @@ impl SimulatedHeadset {
             self.output = Some(output_target(gpu, extent));
         }
         let output = self.output.as_ref().expect("allocated above");
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("compositor") });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("compositor") });
         match outcome {
             VsyncOutcome::Presented { .. } => encoder.copy_texture_to_texture(
                 held.color.texture.as_image_copy(),
@@ -185,9 +186,14 @@ impl SimulatedHeadset {
         let held = &mut self.held[slot];
         held.frame = index;
         held.eyes = *frame.eyes;
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hold frame") });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hold frame") });
         for (from, to) in [(frame.color, &held.color), (frame.depth, &held.depth)] {
-            encoder.copy_texture_to_texture(from.texture.as_image_copy(), to.texture.as_image_copy(), from.texture.size());
+            encoder.copy_texture_to_texture(
+                from.texture.as_image_copy(),
+                to.texture.as_image_copy(),
+                from.texture.size(),
+            );
         }
         gpu.queue.submit([encoder.finish()]);
     }

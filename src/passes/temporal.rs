@@ -79,7 +79,8 @@ impl Pass for TemporalPass {
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to accumulate")
             .disabled_if(!ao.temporal.enabled, "temporal accumulation is off (--temporal)");
         // Both history pairs are read and written (their roles swap every frame).
-        for r in [Resource::HistoryValueA, Resource::HistoryPositionA, Resource::HistoryValueB, Resource::HistoryPositionB]
+        for r in
+            [Resource::HistoryValueA, Resource::HistoryPositionA, Resource::HistoryValueB, Resource::HistoryPositionB]
         {
             decl = decl.read(r).write(r);
         }
@@ -99,7 +100,8 @@ impl Pass for TemporalPass {
             let anchored_from_view = DMat4::from_translation(-anchor) * world_from_view;
             u.anchored_from_view[layer] = anchored_from_view.as_mat4().to_cols_array_2d();
             if let Some(previous) = setup.previous_views {
-                u.previous_clip_from_anchored[layer] = previous[layer].clip_from_anchored(anchor, near).to_cols_array_2d();
+                u.previous_clip_from_anchored[layer] =
+                    previous[layer].clip_from_anchored(anchor, near).to_cols_array_2d();
             }
         }
         u.epsilon = t.epsilon_m;

@@ -43,7 +43,8 @@ pub const VALID_SCENE: &str = "name = \"fuzz\"\n\n[[mesh]]\nobj = \"fuzz.obj\"\n
 /// Writes `data` as the `target` file beside valid companions in `dir` and loads it.
 pub fn load_bytes(target: Target, data: &[u8], dir: &Path) -> Result<Scene> {
     let write = |name: &str, bytes: &[u8]| {
-        std::fs::write(dir.join(name), bytes).map_err(|e| crate::Error::Output { path: dir.join(name), message: e.to_string() })
+        std::fs::write(dir.join(name), bytes)
+            .map_err(|e| crate::Error::Output { path: dir.join(name), message: e.to_string() })
     };
     write("fuzz.obj", if target == Target::Obj { data } else { VALID_OBJ.as_bytes() })?;
     write("fuzz.mtl", if target == Target::Mtl { data } else { VALID_MTL.as_bytes() })?;
@@ -61,7 +62,11 @@ fn check_finite(scene: &Scene) {
         assert!(mesh.positions.iter().all(|p| p.is_finite()), "mesh {} has a non-finite position", mesh.name);
         assert!(mesh.normals.iter().all(|n| n.is_finite()), "mesh {} has a non-finite normal", mesh.name);
         assert!(mesh.uvs.iter().all(|t| t.is_finite()), "mesh {} has a non-finite uv", mesh.name);
-        assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()), "mesh {} index out of range", mesh.name);
+        assert!(
+            mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()),
+            "mesh {} index out of range",
+            mesh.name
+        );
         assert!(mesh.material < scene.materials.len(), "mesh {} material out of range", mesh.name);
     }
     for m in &scene.materials {
@@ -71,11 +76,57 @@ fn check_finite(scene: &Scene) {
 
 /// Tokens a mutation inserts: what OBJ, MTL and TOML parsers trip over.
 const TOKENS: &[&[u8]] = &[
-    b"nan", b"inf", b"-inf", b"1e39", b"-1e39", b"1e-45", b"0", b"-1", b"-2147483649", b"4294967296", b"18446744073709551616",
-    b"\n", b"\r\n", b" ", b"/", b"//", b"#", b"\\", b"\"", b"'", b"[", b"]", b"{", b"}", b"=", b",", b".",
-    b"f ", b"v ", b"vt ", b"vn ", b"o ", b"g ", b"s ", b"usemtl ", b"mtllib ", b"newmtl ", b"Kd ", b"Ke ", b"map_Kd ",
-    b"[[mesh]]\n", b"[[light]]\n", b"[head]\n", b"[environment]\n", b"obj = ", b"type = ", b"path = ", b"t = ",
-    b"\xff", b"\x00", b"\xe2\x80\xa8",
+    b"nan",
+    b"inf",
+    b"-inf",
+    b"1e39",
+    b"-1e39",
+    b"1e-45",
+    b"0",
+    b"-1",
+    b"-2147483649",
+    b"4294967296",
+    b"18446744073709551616",
+    b"\n",
+    b"\r\n",
+    b" ",
+    b"/",
+    b"//",
+    b"#",
+    b"\\",
+    b"\"",
+    b"'",
+    b"[",
+    b"]",
+    b"{",
+    b"}",
+    b"=",
+    b",",
+    b".",
+    b"f ",
+    b"v ",
+    b"vt ",
+    b"vn ",
+    b"o ",
+    b"g ",
+    b"s ",
+    b"usemtl ",
+    b"mtllib ",
+    b"newmtl ",
+    b"Kd ",
+    b"Ke ",
+    b"map_Kd ",
+    b"[[mesh]]\n",
+    b"[[light]]\n",
+    b"[head]\n",
+    b"[environment]\n",
+    b"obj = ",
+    b"type = ",
+    b"path = ",
+    b"t = ",
+    b"\xff",
+    b"\x00",
+    b"\xe2\x80\xa8",
 ];
 
 /// A small deterministic generator (xorshift64*), so a failing run can be replayed.
@@ -131,7 +182,8 @@ impl Mutator {
                 _ => {
                     // Replace the number (or word) at `at` by a token.
                     let start = at.min(data.len());
-                    let end = data[start..].iter().position(|b| b.is_ascii_whitespace()).map_or(data.len(), |k| start + k);
+                    let end =
+                        data[start..].iter().position(|b| b.is_ascii_whitespace()).map_or(data.len(), |k| start + k);
                     let token = TOKENS[self.below(TOKENS.len())];
                     data.splice(start..end, token.iter().copied());
                 }
