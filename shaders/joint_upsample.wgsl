@@ -5,7 +5,8 @@
 // neighbour is weighted by its distance to the pixel and by how well its geometry
 // (normal and distance in AoGeometry, from the full-res pixel it was computed at)
 // matches: tangent-plane distance and normal. Odd sizes work because low-res pixel q
-// stands for full-res pixel min(2q, size − 1).
+// stands for full-res pixel min(2q, size − 1). The low-res size is the texture's own, so
+// any half-resolution target (occlusion, the RSM bounce) upsamples with it.
 
 const PLANE_SIGMA: f32 = 0.02;
 // Below this plane-and-normal agreement of any of the 2×2 nearest samples, the pixel is
@@ -34,7 +35,7 @@ fn upsample_tap(
     var t: Tap;
     t.weight = 0.0;
     t.agreement = 0.0;
-    if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(ao.ao_size))) {
+    if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(textureDimensions(occlusion_low)))) {
         return t;
     }
     let geometry = textureLoad(geometry_low, q, i32(id.z), 0);
@@ -88,7 +89,7 @@ fn joint_upsample(
         }
     }
     // When every weight vanishes, the nearest low-res sample.
-    var result = textureLoad(occlusion_low, min(base, vec2<i32>(ao.ao_size) - 1), i32(id.z), 0);
+    var result = textureLoad(occlusion_low, min(base, vec2<i32>(textureDimensions(occlusion_low)) - 1), i32(id.z), 0);
     if (total > 1e-20) {
         result = sum / total;
     }

@@ -395,6 +395,17 @@ struct AoArgs {
 }
 
 impl AoArgs {
+    /// Settings for a Vive-class headset at `width`×`height` per eye with these occlusion,
+    /// shadow and RSM options (the commands that render frames share this).
+    fn eye_settings(&self, scene: &Scene, width: u32, height: u32) -> Settings {
+        Settings {
+            profile: HeadsetProfile::with_size("vive", width, height),
+            ao: self.settings(scene),
+            shadows: self.lights.settings(scene),
+            ..Settings::default()
+        }
+    }
+
     fn settings(&self, scene: &Scene) -> AoSettings {
         AoSettings {
             technique: self.technique,
@@ -788,12 +799,7 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     use vrao::headset::simulated::{SimulatedOptions, TimeMode};
     use vrao::settings::DisplayMode;
     let scene = Scene::load(&args.scene)?;
-    let settings = Settings {
-        profile: HeadsetProfile::with_size("vive", args.width, args.height),
-        ao: args.ao.settings(&scene),
-        shadows: args.ao.lights.settings(&scene),
-        ..Settings::default()
-    };
+    let settings = args.ao.eye_settings(&scene, args.width, args.height);
     settings.validate()?;
     let window_size = parse_size(&args.window)?;
     let frames = args.frames.or((args.display == DisplayMode::None).then_some(600));
@@ -836,12 +842,7 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
 fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     use vrao::headset::reprojection_bench::{default_movements, measure, to_markdown};
     let scene = Scene::load(&args.scene)?;
-    let settings = Settings {
-        profile: HeadsetProfile::with_size("vive", args.width, args.height),
-        ao: args.ao.settings(&scene),
-        shadows: args.ao.lights.settings(&scene),
-        ..Settings::default()
-    };
+    let settings = args.ao.eye_settings(&scene, args.width, args.height);
     settings.validate()?;
     let gpu = Arc::new(Gpu::new(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;
@@ -865,12 +866,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
     use vrao::headset::motion::HeadMotion;
     use vrao::settings::TemporalBlend;
     let scene = Scene::load(&args.scene)?;
-    let base = Settings {
-        profile: HeadsetProfile::with_size("vive", args.width, args.height),
-        ao: args.ao.settings(&scene),
-        shadows: args.ao.lights.settings(&scene),
-        ..Settings::default()
-    };
+    let base = args.ao.eye_settings(&scene, args.width, args.height);
     base.validate()?;
     let n = base.ao.samples;
     let with = |temporal: bool, blend: TemporalBlend, samples: u32, blur: u32| {
@@ -935,12 +931,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
 fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
     use vrao::budget::{run, BudgetRun};
     let scene = Scene::load(&args.scene)?;
-    let mut settings = Settings {
-        profile: HeadsetProfile::with_size("vive", args.width, args.height),
-        ao: args.ao.settings(&scene),
-        shadows: args.ao.lights.settings(&scene),
-        ..Settings::default()
-    };
+    let mut settings = args.ao.eye_settings(&scene, args.width, args.height);
     let budget_ms = args.budget_ms.unwrap_or(settings.profile.budget_ms());
     if !(budget_ms.is_finite() && budget_ms > 0.0) {
         return Err(Error::input(format!("--budget-ms {budget_ms} must be a positive number of milliseconds")));
