@@ -43,12 +43,30 @@ pub struct GpuScene {
     pub indices: wgpu::Buffer,
     pub draws: Vec<Draw>,
     pub materials: Vec<GpuMaterial>,
+    /// Layout of a material's bind group (uniform, diffuse texture, sampler; fragment
+    /// stage), and one bind group per material: the G-buffer and the light-space pass
+    /// both draw the scene with them.
+    pub material_layout: wgpu::BindGroupLayout,
+    pub material_groups: Vec<wgpu::BindGroup>,
     /// The environment as a filterable equirectangular texture (1×1 black without one).
     pub environment: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
 }
 
 impl GpuScene {
+    /// Records every draw of the scene into `pass`, binding each draw's material at
+    /// `material_group` (or none, for passes that read positions only).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, material_group: Option<u32>) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for draw in self.draws.iter().filter(|d| !d.indices.is_empty()) {
+            if let Some(group) = material_group {
+                pass.set_bind_group(group, &self.material_groups[draw.material], &[]);
+            }
+            pass.draw_indexed(draw.indices.clone(), 0, 0..1);
+        }
+    }
+
     pub fn upload(gpu: &Gpu, scene: &Scene) -> GpuScene {
         let bounds = scene.bounds();
         let anchor = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
@@ -85,7 +103,7 @@ impl GpuScene {
             contents: bytemuck::cast_slice(&indices),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let materials = scene
+        let materials: Vec<GpuMaterial> = scene
             .materials
             .iter()
             .map(|m| {
@@ -117,12 +135,29 @@ impl GpuScene {
             mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
         });
+        let material_layout = material_layout(device);
+        let material_groups = materials
+            .iter()
+            .map(|m| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("material"),
+                    layout: &material_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
+                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&sampler) },
+                    ],
+                })
+            })
+            .collect();
         GpuScene {
             anchor,
             vertices: vertex_buffer,
             indices: index_buffer,
             draws,
             materials,
+            material_layout,
+            material_groups,
             environment: environment_texture(gpu, scene.environment.as_ref()),
             sampler,
         }
@@ -172,4 +207,40 @@ fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureVie
         bytemuck::cast_slice(&data),
     );
     texture.create_view(&Default::default())
+}
+
+/// The bind-group layout of one material: its uniform, diffuse texture and sampler.
+fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let fragment = wgpu::ShaderStages::FRAGMENT;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("material"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: fragment,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: fragment,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: fragment,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    })
 }

@@ -15,8 +15,6 @@ const COLOR_TARGETS: [Resource; 3] = [Resource::Normals, Resource::Albedo, Resou
 
 pub struct GBufferPass {
     frame_group: wgpu::BindGroup,
-    /// One bind group per scene material, made once.
-    materials: Vec<wgpu::BindGroup>,
     /// One pass for both layers; `None` when the adapter lacks multiview.
     multiview: Option<wgpu::RenderPipeline>,
     multipass: wgpu::RenderPipeline,
@@ -42,28 +40,6 @@ impl GBufferPass {
             label: Some("gbuffer frame"),
             entries: &[uniform_entry(0, vs_fs)],
         });
-        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gbuffer material"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
         let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer eye select"),
             entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
@@ -83,7 +59,7 @@ impl GBufferPass {
         let multiview = gpu.caps.multiview.then(|| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("gbuffer multiview"),
-                bind_group_layouts: &[Some(&frame_layout), Some(&material_layout)],
+                bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout)],
                 immediate_size: 0,
             });
             let module =
@@ -92,7 +68,7 @@ impl GBufferPass {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer multipass"),
-            bind_group_layouts: &[Some(&frame_layout), Some(&material_layout), Some(&eye_layout)],
+            bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
         let module =
@@ -103,22 +79,7 @@ impl GBufferPass {
             layout: &frame_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.frame.as_entire_binding() }],
         });
-        let materials = scene
-            .materials
-            .iter()
-            .map(|m| {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("material"),
-                    layout: &material_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
-                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&scene.sampler) },
-                    ],
-                })
-            })
-            .collect();
-        GBufferPass { frame_group, materials, multiview, multipass, eye_select }
+        GBufferPass { frame_group, multiview, multipass, eye_select }
     }
 }
 
@@ -181,7 +142,7 @@ impl Pass for GBufferPass {
             let mut pass = begin(ctx.encoder, views, NonZeroU32::new(0b11));
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &self.frame_group, &[]);
-            draw_scene(&mut pass, ctx.scene, &self.materials);
+            ctx.scene.draw(&mut pass, Some(1));
         } else {
             for layer in 0..ctx.setup.views as usize {
                 let label = if layer == 0 { "gbuffer left" } else { "gbuffer right" };
@@ -192,7 +153,7 @@ impl Pass for GBufferPass {
                     pass.set_pipeline(&self.multipass);
                     pass.set_bind_group(0, &self.frame_group, &[]);
                     pass.set_bind_group(2, &self.eye_select[layer], &[]);
-                    draw_scene(&mut pass, ctx.scene, &self.materials);
+                    ctx.scene.draw(&mut pass, Some(1));
                 }
                 ctx.timer.end(ctx.encoder, span);
             }
@@ -226,16 +187,4 @@ fn begin<'e, 't>(
         occlusion_query_set: None,
         multiview_mask,
     })
-}
-
-fn draw_scene(pass: &mut wgpu::RenderPass, scene: &GpuScene, materials: &[wgpu::BindGroup]) {
-    pass.set_vertex_buffer(0, scene.vertices.slice(..));
-    pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-    for draw in &scene.draws {
-        if draw.indices.is_empty() {
-            continue;
-        }
-        pass.set_bind_group(1, &materials[draw.material], &[]);
-        pass.draw_indexed(draw.indices.clone(), 0, 0..1);
-    }
 }

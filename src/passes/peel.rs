@@ -10,7 +10,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::gpu::frame::FrameBuffers;
 use crate::gpu::kernel::shader_module;
-use crate::gpu::scene::{GpuScene, Vertex};
+use crate::gpu::scene::Vertex;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::settings::Technique;
@@ -160,20 +160,9 @@ impl Pass for DepthPeelPass {
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.frame_group, &[]);
                 pass.set_bind_group(1, &eye_group, &[]);
-                draw_geometry(&mut pass, ctx.scene);
+                ctx.scene.draw(&mut pass, None);
             }
             ctx.timer.end(ctx.encoder, span);
-        }
-    }
-}
-
-/// Every draw of the scene, positions only (no material is read).
-fn draw_geometry(pass: &mut wgpu::RenderPass, scene: &GpuScene) {
-    pass.set_vertex_buffer(0, scene.vertices.slice(..));
-    pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-    for draw in &scene.draws {
-        if !draw.indices.is_empty() {
-            pass.draw_indexed(draw.indices.clone(), 0, 0..1);
         }
     }
 }

@@ -264,7 +264,6 @@ pub struct ShadowPass {
     /// One uniform (`ShadowLight`) and bind group per fitted light.
     light_buffers: Vec<wgpu::Buffer>,
     light_groups: Vec<wgpu::BindGroup>,
-    materials: Vec<wgpu::BindGroup>,
 }
 
 impl ShadowPass {
@@ -284,31 +283,9 @@ impl ShadowPass {
             label: Some("shadow light"),
             entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
         });
-        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow material"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow"),
-            bind_group_layouts: &[Some(&light_layout), Some(&material_layout)],
+            bind_group_layouts: &[Some(&light_layout), Some(&scene.material_layout)],
             immediate_size: 0,
         });
         let module = shader_module(device, "shadow map", &["common.wgsl", "shadow.wgsl", "shadow_map.wgsl"]);
@@ -336,22 +313,7 @@ impl ShadowPass {
                 })
             })
             .collect();
-        let materials = scene
-            .materials
-            .iter()
-            .map(|m| {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("shadow material"),
-                    layout: &material_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
-                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&scene.sampler) },
-                    ],
-                })
-            })
-            .collect();
-        ShadowPass { light_space, depth_only, reflective, light_buffers, light_groups, materials }
+        ShadowPass { light_space, depth_only, reflective, light_buffers, light_groups }
     }
 }
 
@@ -455,15 +417,7 @@ impl Pass for ShadowPass {
             });
             pass.set_pipeline(if reflective { &self.reflective } else { &self.depth_only });
             pass.set_bind_group(0, group, &[]);
-            pass.set_vertex_buffer(0, ctx.scene.vertices.slice(..));
-            pass.set_index_buffer(ctx.scene.indices.slice(..), wgpu::IndexFormat::Uint32);
-            for draw in &ctx.scene.draws {
-                if draw.indices.is_empty() {
-                    continue;
-                }
-                pass.set_bind_group(1, &self.materials[draw.material], &[]);
-                pass.draw_indexed(draw.indices.clone(), 0, 0..1);
-            }
+            ctx.scene.draw(&mut pass, Some(1));
         }
     }
 }
