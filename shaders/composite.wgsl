@@ -10,7 +10,7 @@
 @group(0) @binding(2) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
-@group(0) @binding(5) var direct_layers: texture_2d_array<f32>;
+@group(0) @binding(5) var direct_layers: texture_2d_array<u32>;
 @group(0) @binding(6) var occlusion_layers: texture_2d_array<f32>;
 @group(0) @binding(7) var environment: texture_2d<f32>;
 @group(0) @binding(8) var environment_sampler: sampler;
@@ -67,7 +67,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             let position = view_position_from_depth(pixel_uv(id.xy, frame.size), depth, eye.tangents, frame.near);
             ambient += rsm_upsample(rsm_geometry, rsm_indirect, id, eye, position, safe_normal(n, position));
         }
-        radiance = textureLoad(direct_layers, p, layer, 0).rgb + albedo / PI * ambient;
+        radiance = direct_radiance(textureLoad(direct_layers, p, layer, 0)) + albedo / PI * ambient;
     }
     textureStore(hdr_out, p, layer, vec4<f32>(finite_or_zero3(radiance), 1.0));
 }

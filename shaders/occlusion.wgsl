@@ -71,7 +71,9 @@ struct DepthProbe {
     distance: f32,
 };
 
-fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, eye: Eye) -> DepthProbe {
+// The full-res pixel where view-space point `s` projects, if on screen and in front of
+// the eye (`valid`; `distance` is left for the caller's fetch).
+fn probe_target(s: vec3<f32>, eye: Eye) -> DepthProbe {
     var probe: DepthProbe;
     probe.valid = false;
     if (!(-s.z > frame.near * 0.5)) {
@@ -82,6 +84,15 @@ fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, e
         return probe;
     }
     probe.pixel = min(vec2<u32>(uv * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
+    probe.valid = true;
+    return probe;
+}
+
+fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, eye: Eye) -> DepthProbe {
+    var probe = probe_target(s, eye);
+    if (!probe.valid) {
+        return probe;
+    }
     let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(layer), 0);
     probe.valid = d > 0.0;
     probe.distance = frame.near / max(d, 1e-30);

@@ -11,7 +11,27 @@
 // Output: rgb = irradiance to multiply by albedo/π; a = cosine-weighted visibility.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
-@group(0) @binding(7) var direct_layers: texture_2d_array<f32>;
+@group(0) @binding(7) var direct_layers: texture_2d_array<u32>;
+
+// With the bounce, the occluder probe reads the packed direct light (common.wgsl
+// `pack_direct`), which carries the view distance as well as the sender's radiance and
+// normal: one fetch per sample, as without the bounce.
+struct SenderProbe {
+    probe: DepthProbe,
+    texel: vec4<u32>,
+};
+
+fn probe_sender(layer: u32, s: vec3<f32>, eye: Eye) -> SenderProbe {
+    var sp: SenderProbe;
+    sp.probe = probe_target(s, eye);
+    if (!sp.probe.valid) {
+        return sp;
+    }
+    sp.texel = textureLoad(direct_layers, vec2<i32>(sp.probe.pixel), i32(layer), 0);
+    sp.probe.distance = direct_distance(sp.texel);
+    sp.probe.valid = sp.probe.distance > 0.0;
+    return sp;
+}
 
 // Σ_i c_i L(ω_i) from the moments m0 = Σc, m1 = Σcω, and Σcωωᵀ (diagonal, and
 // off-diagonal as xy, xz, yz), all in view space; `r` turns view into world directions.
@@ -85,7 +105,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         all_off += off;
         weight_all += cos_theta;
         let s = origin + omega * (k.w * ao.range_scale * ao.radius);
-        let probe = probe_depth(depth_layers, r.layer, s, r.eye);
+        var fetched: SenderProbe;
+        if (BOUNCE) {
+            fetched = probe_sender(r.layer, s, r.eye);
+        } else {
+            fetched.probe = probe_depth(depth_layers, r.layer, s, r.eye);
+        }
+        let probe = fetched.probe;
         var blocked = occludes(probe, s, r.position, r.normal, r.eye, bias);
         if (PEEL) {
             blocked = blocked && in_front_of_second_layer(probe, r.layer, s);
@@ -100,14 +126,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             weight_visible += cos_theta;
         } else if (BOUNCE) {
             let sender = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, r.eye.tangents);
-            let sender_light = textureLoad(direct_layers, vec2<i32>(probe.pixel), i32(r.layer), 0);
-            let sender_n = unpack_normal(sender_light.a);
+            let sender_n = direct_normal(fetched.texel);
             let to_receiver = r.position - sender;
             let d2 = max(dot(to_receiver, to_receiver), min_d2);
             let dir = to_receiver * inverseSqrt(max(dot(to_receiver, to_receiver), 1e-30));
             let cos_sender = max(dot(sender_n, dir), 0.0);
             let cos_receiver = max(dot(r.normal, -dir), 0.0);
-            bounce += max(sender_light.rgb, vec3<f32>(0.0)) * (cos_sender * cos_receiver / d2);
+            bounce += direct_radiance(fetched.texel) * (cos_sender * cos_receiver / d2);
         }
     }
     // Eq. 1 with Δω = 2π/N estimates ∫ L V cos dω; its N-sample quadrature error (+16 %

@@ -85,62 +85,97 @@ pub fn measure(
     how: Measurement,
     reference: Option<&ReferenceImage>,
 ) -> Result<BenchRow> {
-    let Measurement { timing, warmup, frames } = how;
-    let mut settings = base.clone();
-    settings.ao.technique = case.technique;
-    settings.ao.samples = case.samples;
-    settings.ao.radius = case.radius;
-    settings.ao.half_res = case.half_res;
-    settings.ao.depth_peeling = case.depth_peeling;
-    settings.ao.temporal.enabled = case.temporal;
-    let output = final_occlusion(&settings).ok_or_else(|| Error::input("bench needs an occlusion technique"))?;
-    let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
-    renderer.set_timing(timing);
-    if timing == Timing::Pipelined && !gpu.caps.timestamps {
-        return Err(Error::Device(format!(
-            "{} has no timestamp queries; use serial timing",
-            gpu.adapter.get_info().name
-        )));
+    let mut run = CaseRun::new(gpu, scene, base, case, how.timing)?;
+    for _ in 0..how.warmup {
+        run.frame()?;
     }
-    let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
-    let mut timings = Vec::new();
-    for frame in 0..warmup + frames {
-        let report = renderer.render(&eyes.eyes, &[output])?;
-        if frame >= warmup {
-            // Serial timing reports each pass's wall-clock time; pipelined, its timestamps.
-            timings.push(if timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
-        }
+    for _ in 0..how.frames {
+        run.timed_frame()?;
     }
-    let error = match reference {
-        Some(reference) => Some(error_figures(case.technique, &renderer.read_f32(output)?, reference)),
-        None => None,
-    };
-    // SSDO's bounce alone: the same frame without the bounce (same pattern, and the blur
-    // is linear with geometry-only weights), subtracted.
-    let bounce = match reference {
-        Some(reference) if settings.ao.bounce_active() => {
-            let with = renderer.read_f32(output)?;
-            let mut without = settings.clone();
-            without.ao.technique = Technique::Ssdo;
-            renderer.set_settings(&without)?;
-            renderer.render(&eyes.eyes, &[output])?;
-            let difference: Vec<Vec<f32>> = with
-                .iter()
-                .zip(renderer.read_f32(output)?)
-                .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a - b).collect())
-                .collect();
-            bounce_figures(&difference, settings.profile.width, 1, reference)
+    run.finish(reference)
+}
+
+/// One case being measured: its renderer, and the per-pass times of its frames so far.
+/// Kept apart from the loop so that a sweep can interleave cases frame by frame.
+struct CaseRun {
+    case: BenchCase,
+    settings: Settings,
+    output: crate::graph::Resource,
+    renderer: Renderer,
+    eyes: crate::stereo::EyePair,
+    timing: Timing,
+    timings: Vec<Vec<(String, f64)>>,
+}
+
+impl CaseRun {
+    fn new(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, case: &BenchCase, timing: Timing) -> Result<CaseRun> {
+        let mut settings = base.clone();
+        settings.ao.technique = case.technique;
+        settings.ao.samples = case.samples;
+        settings.ao.radius = case.radius;
+        settings.ao.half_res = case.half_res;
+        settings.ao.depth_peeling = case.depth_peeling;
+        settings.ao.temporal.enabled = case.temporal;
+        let output = final_occlusion(&settings).ok_or_else(|| Error::input("bench needs an occlusion technique"))?;
+        if timing == Timing::Pipelined && !gpu.caps.timestamps {
+            return Err(Error::Device(format!(
+                "{} has no timestamp queries; use serial timing",
+                gpu.adapter.get_info().name
+            )));
         }
-        _ => None,
-    };
-    Ok(BenchRow {
-        case: case.clone(),
-        spans: summarize(&timings),
-        views: 2,
-        pass: settings.ao.pass_name(),
-        error,
-        bounce,
-    })
+        let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
+        renderer.set_timing(timing);
+        let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+        Ok(CaseRun { case: case.clone(), settings, output, renderer, eyes, timing, timings: Vec::new() })
+    }
+
+    /// One frame, not measured (warm-up).
+    fn frame(&mut self) -> Result<crate::renderer::FrameReport> {
+        self.renderer.render(&self.eyes.eyes, &[self.output])
+    }
+
+    /// One measured frame: serial timing keeps each pass's wall-clock time; pipelined,
+    /// its timestamps.
+    fn timed_frame(&mut self) -> Result<()> {
+        let report = self.frame()?;
+        self.timings.push(if self.timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
+        Ok(())
+    }
+
+    /// The row: medians of the measured frames, and the last frame's error.
+    fn finish(mut self, reference: Option<&ReferenceImage>) -> Result<BenchRow> {
+        let (settings, output) = (&self.settings, self.output);
+        let error = match reference {
+            Some(reference) => Some(error_figures(self.case.technique, &self.renderer.read_f32(output)?, reference)),
+            None => None,
+        };
+        // SSDO's bounce alone: the same frame without the bounce (same pattern, and the
+        // blur is linear with geometry-only weights), subtracted.
+        let bounce = match reference {
+            Some(reference) if settings.ao.bounce_active() => {
+                let with = self.renderer.read_f32(output)?;
+                let mut without = settings.clone();
+                without.ao.technique = Technique::Ssdo;
+                self.renderer.set_settings(&without)?;
+                self.renderer.render(&self.eyes.eyes, &[output])?;
+                let difference: Vec<Vec<f32>> = with
+                    .iter()
+                    .zip(self.renderer.read_f32(output)?)
+                    .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a - b).collect())
+                    .collect();
+                bounce_figures(&difference, settings.profile.width, 1, reference)
+            }
+            _ => None,
+        };
+        Ok(BenchRow {
+            spans: summarize(&self.timings),
+            views: 2,
+            pass: settings.ao.pass_name(),
+            error,
+            bounce,
+            case: self.case,
+        })
+    }
 }
 
 /// The graph pass of reflective shadow maps' gather (bench rows of technique "rsm").
@@ -248,21 +283,40 @@ pub fn bounce_figures(
 
 /// Runs every case, calling `progress(done, total, row)` after each. `references` holds
 /// a reference image per radius (cases whose radius has none get no error figures).
+/// `interleave` cases at a time are measured round-robin, one frame each per round, so
+/// that a slow drift of the machine (other load, clocks, heat) falls on all of them alike
+/// and their ratios stay fair; 1 measures each case on its own, in a row.
 pub fn sweep(
     gpu: &Arc<Gpu>,
     scene: &Scene,
     base: &Settings,
     cases: &[BenchCase],
     how: Measurement,
+    interleave: usize,
     references: &[(f32, ReferenceImage)],
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
-    for (i, case) in cases.iter().enumerate() {
-        let reference = references.iter().find(|(r, _)| *r == case.radius).map(|(_, image)| image);
-        let row = measure(gpu, scene, base, case, how, reference)?;
-        progress(i + 1, cases.len(), &row);
-        rows.push(row);
+    for group in cases.chunks(interleave.max(1)) {
+        let mut runs = Vec::with_capacity(group.len());
+        for case in group {
+            let mut run = CaseRun::new(gpu, scene, base, case, how.timing)?;
+            for _ in 0..how.warmup {
+                run.frame()?;
+            }
+            runs.push(run);
+        }
+        for _ in 0..how.frames {
+            for run in &mut runs {
+                run.timed_frame()?;
+            }
+        }
+        for run in runs {
+            let reference = references.iter().find(|(r, _)| *r == run.case.radius).map(|(_, image)| image);
+            let row = run.finish(reference)?;
+            progress(rows.len() + 1, cases.len(), &row);
+            rows.push(row);
+        }
     }
     Ok(rows)
 }

@@ -144,13 +144,14 @@ impl Resource {
             | Resource::HistoryValueB
             | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
             Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
-            Resource::AoGeometry | Resource::Direct | Resource::HistoryPositionA | Resource::HistoryPositionB => {
+            Resource::AoGeometry | Resource::HistoryPositionA | Resource::HistoryPositionB => {
                 wgpu::TextureFormat::Rgba32Float
             }
             Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
             Resource::ShadowMap => wgpu::TextureFormat::Depth32Float,
             Resource::RsmNormal | Resource::RsmFlux | Resource::RsmIndirect => wgpu::TextureFormat::Rgba16Float,
             Resource::RsmGeometry => wgpu::TextureFormat::Rgba32Float,
+            Resource::Direct => wgpu::TextureFormat::Rgba32Uint,
         }
     }
 }

@@ -202,6 +202,11 @@ struct BenchArgs {
     /// Warm-up frames per case (not measured).
     #[arg(long, default_value_t = 3)]
     warmup: u32,
+    /// Measure this many cases at a time, round-robin one frame each, so that the
+    /// machine's drift during a long sweep falls on all of them alike (fair ratios
+    /// between techniques); each needs its own targets in memory at once.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    interleave: u32,
     /// Per-eye width in pixels.
     #[arg(long, default_value_t = 1080)]
     width: u32,
@@ -688,6 +693,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         &settings,
         &cases,
         Measurement { timing, warmup: args.warmup, frames: args.frames },
+        args.interleave as usize,
         &references,
         |done, total, row| {
             let elapsed = started.elapsed().as_secs_f64();

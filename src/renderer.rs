@@ -298,9 +298,13 @@ impl Renderer {
         readback::read_layers(&self.gpu, target)
     }
 
-    /// Values per layer (channels interleaved) of a float or depth resource.
+    /// Values per layer (channels interleaved) of a float or depth resource; `Direct`
+    /// decodes to rgba radiance (a = 0).
     pub fn read_f32(&self, r: Resource) -> Result<Vec<Vec<f32>>> {
         let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        if r == Resource::Direct {
+            return Ok(readback::decode_direct(readback::read_layers(&self.gpu, target)?));
+        }
         readback::read_layers_f32(&self.gpu, target)
     }
 }

@@ -797,6 +797,14 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
             .fold(0f32, f32::max);
         assert!(worst <= 1e-3, "ssdo-bounce with bounce 0 differs from ssdo in {} by {worst}", r.name());
     }
+    // With the bounce, the occluder probe reads distances packed with the direct light
+    // instead of the depth buffer (one fetch for both): it must block exactly the same
+    // directions, so the visibility (AoRaw alpha) is SSDO's to the f16 target's precision.
+    let alpha = |f: &Frame| {
+        f.outputs[&Resource::AoRaw].iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>()
+    };
+    let worst = alpha(&ssdo).iter().zip(alpha(&bounce)).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
+    assert!(worst <= 1e-3, "the bounce changed which directions are blocked: visibility differs by {worst}");
 }
 
 // ---------------------------------------------------------------------------------------

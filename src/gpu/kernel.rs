@@ -61,6 +61,8 @@ pub enum Slot {
     Depth,
     /// `texture_2d_array<f32>`, read with `textureLoad`.
     Layers,
+    /// `texture_2d_array<u32>`, read with `textureLoad` (packed data such as `Direct`).
+    UintLayers,
     /// `texture_2d_array<f32>`, filterable, read with a sampler.
     FilterableLayers,
     /// `texture_2d<f32>`, filterable (environment map).
@@ -89,6 +91,11 @@ impl Slot {
             },
             Slot::Layers => wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::UintLayers => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
                 view_dimension: wgpu::TextureViewDimension::D2Array,
                 multisampled: false,
             },

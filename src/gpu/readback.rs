@@ -15,7 +15,7 @@ fn texel_bytes(format: wgpu::TextureFormat) -> u32 {
         wgpu::TextureFormat::R32Float | wgpu::TextureFormat::Depth32Float => 4,
         wgpu::TextureFormat::Rgba16Float => 8,
         wgpu::TextureFormat::R16Float => 2,
-        wgpu::TextureFormat::Rgba32Float => 16,
+        wgpu::TextureFormat::Rgba32Float | wgpu::TextureFormat::Rgba32Uint => 16,
         other => panic!("readback of {other:?} is not supported"), // programming error, not input
     }
 }
@@ -87,4 +87,23 @@ pub fn read_layers_f32(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<f32>
             }
         })
         .collect())
+}
+
+/// The `Direct` resource's packed texels (rgba32uint, common.wgsl `pack_direct`) as
+/// rgba f32 values per layer: the three f16 radiance channels, and 0 in alpha (the
+/// packed normal and distance are the bounce's business only).
+pub fn decode_direct(raw: Vec<Vec<u8>>) -> Vec<Vec<f32>> {
+    let half = |bits: u32| f16_to_f32((bits & 0xffff) as u16);
+    raw.into_iter()
+        .map(|bytes| {
+            bytes
+                .chunks_exact(16)
+                .flat_map(|t| {
+                    let y = u32::from_le_bytes([t[4], t[5], t[6], t[7]]);
+                    let z = u32::from_le_bytes([t[8], t[9], t[10], t[11]]);
+                    [half(y), half(y >> 16), half(z), 0.0]
+                })
+                .collect()
+        })
+        .collect()
 }

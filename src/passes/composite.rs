@@ -26,7 +26,7 @@ const SLOTS: [Slot; 13] = [
     Slot::Depth,
     Slot::Layers,
     Slot::Layers,
-    Slot::Layers,
+    Slot::UintLayers,
     Slot::Layers,
     Slot::Texture2d,
     Slot::Sampler,

@@ -32,7 +32,7 @@ const SLOTS: [Slot; 9] = [
     occlusion::SLOTS[4],
     occlusion::SLOTS[5],
     occlusion::SLOTS[6],
-    Slot::Layers,
+    Slot::UintLayers,
     Slot::Depth,
 ];
 
