@@ -20,9 +20,13 @@ struct Temporal {
     history_valid: u32,
     // Tangent span of one occlusion pixel (for the footprint term of ε).
     pixel_tangent: f32,
-    _pad0: u32,
-    _pad1: u32,
+    // Motion-adaptive window (settings.rs `Temporal::motion_px`); 0 = off.
+    motion_px: f32,
+    _pad: u32,
 };
+
+// The shortest window motion may impose: below it the mean barely removes noise.
+const MIN_MOTION_WINDOW: f32 = 4.0;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -62,6 +66,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
     var count = 0.0;
     var previous = vec4<f32>(0.0);
+    var window = temporal.max_frames;
     if (temporal.history_valid != 0u) {
         let clip = temporal.previous_clip_from_anchored[id.z] * vec4<f32>(world, 1.0);
         if (clip.w > 0.0) {
@@ -76,6 +81,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 if (stored.w >= 1.0 && same_point && all_finite4(stored) && all_finite4(value)) {
                     count = stored.w;
                     previous = value;
+                    if (temporal.motion_px > 0.0) {
+                        let moved = length((previous_uv - uv) * vec2<f32>(ao.ao_size));
+                        let shortened = temporal.max_frames / (1.0 + moved / temporal.motion_px);
+                        window = clamp(shortened, min(MIN_MOTION_WINDOW, temporal.max_frames), temporal.max_frames);
+                    }
                 }
             }
         }
@@ -84,9 +94,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var result = current;
     if (count >= 1.0) {
         if (temporal.blend == 0u) {
-            // Running mean: the history holds the mean of `count` frames.
-            let n = min(count, temporal.max_frames - 1.0);
-            result = previous + (current - previous) / (n + 1.0);
+            // Running mean: the history holds the mean of `count` frames, of which at
+            // most window − 1 are kept (the count stored below is what was kept).
+            count = min(count, window - 1.0);
+            result = previous + (current - previous) / (count + 1.0);
         } else {
             let confidence = 1.0 - clamp(abs(previous.a - current.a), 0.0, 1.0) / (1.0 + temporal.confidence_bias);
             result = confidence * previous + (1.0 - confidence) * current;

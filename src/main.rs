@@ -397,6 +397,10 @@ struct AoArgs {
     /// Frames after which a pixel counts as converged.
     #[arg(long, default_value_t = 16)]
     temporal_frames: u32,
+    /// Motion-adaptive temporal window: a pixel that moved m pixels since the last frame
+    /// averages at most frames / (1 + m / this) frames (at least 4); 0 turns it off.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
+    temporal_motion_px: f32,
 }
 
 impl AoArgs {
@@ -430,6 +434,7 @@ impl AoArgs {
                 epsilon_m: self.temporal_epsilon,
                 blend: self.temporal_blend,
                 max_frames: self.temporal_frames,
+                motion_px: self.temporal_motion_px,
                 ..Default::default()
             },
         }

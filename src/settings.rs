@@ -242,6 +242,11 @@ pub struct Temporal {
     pub max_frames: u32,
     /// Seed 001's confidence bias (only for the confidence blend).
     pub confidence_bias: f32,
+    /// Motion-adaptive window of the running mean: a pixel that moved m occlusion
+    /// pixels since the last frame keeps at most max_frames / (1 + m / motion_px)
+    /// frames (at least 4). Screen-space occlusion changes with the view, so a long
+    /// mean lags a turning head (ghosting); a still head keeps the whole window. 0 = off.
+    pub motion_px: f32,
 }
 
 impl Default for Temporal {
@@ -252,6 +257,7 @@ impl Default for Temporal {
             blend: TemporalBlend::Average,
             max_frames: 16,
             confidence_bias: 0.1,
+            motion_px: 0.5,
         }
     }
 }
@@ -299,6 +305,9 @@ impl AoSettings {
         }
         if !(1..=1024).contains(&t.max_frames) {
             return Err(Error::input(format!("temporal frame cap {} is not within 1..=1024", t.max_frames)));
+        }
+        if !(t.motion_px.is_finite() && t.motion_px >= 0.0) {
+            return Err(Error::input(format!("temporal motion scale {} px must be finite and ≥ 0", t.motion_px)));
         }
         if !(t.confidence_bias.is_finite() && t.confidence_bias >= 0.0) {
             return Err(Error::input(format!("temporal confidence bias {} must be finite and ≥ 0", t.confidence_bias)));

@@ -1,10 +1,11 @@
 //! Temporal accumulation: the noise falls as frames accumulate with a static head, a
-//! jump to a new view discards the history instead of smearing it, a history holding
-//! NaN is discarded, and the graph leaves the pass out when it is off.
+//! jump to a new view discards the history instead of smearing it, a turning head
+//! shortens the window, a history holding NaN is discarded, and the graph leaves the
+//! pass out when it is off.
 
 mod common;
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use vrao::graph::Resource;
 use vrao::settings::{AoSettings, Technique};
 use vrao::stereo::HeadPose;
@@ -103,6 +104,53 @@ fn a_jump_to_a_new_view_discards_the_history_instead_of_smearing_it() {
     let reused = raw.iter().zip(&accumulated).filter(|(a, b)| (*a - *b).abs() > 1e-4).count();
     let occluded = raw.iter().filter(|a| **a < 0.999).count();
     assert!(reused as f64 > 0.5 * occluded as f64, "only {reused} of {occluded} occluded pixels reused their history");
+}
+
+/// The largest accumulated frame count over both history buffers (one holds this
+/// frame's counts, the other the last frame's), on surface pixels.
+fn largest_count(renderer: &Renderer) -> f32 {
+    [Resource::HistoryPositionA, Resource::HistoryPositionB]
+        .iter()
+        .flat_map(|&r| renderer.read_f32(r).unwrap().into_iter().flatten().skip(3).step_by(4))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn a_turning_head_shortens_the_window_and_a_still_one_keeps_it() {
+    let (gpu, _lock) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let head = scene.head.pose_at(0.0);
+    // 6° of yaw per frame: 4–6 occlusion pixels of motion at 96 px over the test
+    // profile's field of view, but under 1 px near the point the image turns about (the
+    // head looks down, so world-vertical converges inside the view): windows of
+    // 16 / (1 + m / 0.5) from the shortest allowed (4) to about 5.5 frames.
+    let turned = |k: u32| HeadPose {
+        position: head.position,
+        orientation: DQuat::from_rotation_y((6.0 * k as f64).to_radians()) * head.orientation,
+    };
+    for motion_px in [0.5f32, 0.0] {
+        let mut s = settings(true, 8);
+        s.ao.temporal.motion_px = motion_px;
+        let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
+        for _ in 0..20 {
+            renderer.render(&s.profile.eyes(&head, s.near).eyes, &[Resource::AoAccumulated]).unwrap();
+        }
+        let still = largest_count(&renderer);
+        for k in 1..=8 {
+            renderer.render(&s.profile.eyes(&turned(k), s.near).eyes, &[Resource::AoAccumulated]).unwrap();
+            let values = renderer.read_f32(Resource::AoAccumulated).unwrap();
+            assert!(values.iter().flatten().all(|v| v.is_finite()));
+        }
+        let turning = largest_count(&renderer);
+        eprintln!("motion_px {motion_px}: largest count still {still}, after 8 turning frames {turning}");
+        assert_eq!(still, 16.0, "a still head keeps the whole window (motion_px {motion_px})");
+        if motion_px > 0.0 {
+            assert!(turning <= 6.0, "the window did not shorten while turning: {turning}");
+        } else {
+            // Without the motion term a turn only loses what leaves the view or fails ε.
+            assert_eq!(turning, 16.0, "with motion_px 0 a rotation keeps the whole window");
+        }
+    }
 }
 
 #[test]

@@ -24,7 +24,8 @@ struct TemporalUniform {
     blend: u32,
     history_valid: u32,
     pixel_tangent: f32,
-    _pad: [u32; 2],
+    motion_px: f32,
+    _pad: u32,
 }
 
 pub struct TemporalPass {
@@ -107,6 +108,7 @@ impl Pass for TemporalPass {
         u.epsilon = t.epsilon_m;
         u.confidence_bias = t.confidence_bias;
         u.max_frames = t.max_frames as f32;
+        u.motion_px = t.motion_px;
         u.blend = match t.blend {
             TemporalBlend::Average => 0,
             TemporalBlend::Confidence => 1,
