@@ -152,6 +152,26 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     let cached: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
     assert_eq!(cached.len(), 1, "one radius, one cached reference");
 
+    // Interleaved in groups of 5 (the last group short), every case keeps its own
+    // renderer: the same rows in the same order with the same errors (the frames are
+    // deterministic), only the times measured round-robin.
+    let interleaved_dir = dir.join("interleaved");
+    let mut interleaved_args: Vec<&str> = args.to_vec();
+    let out_index = interleaved_args.iter().position(|a| *a == "--out").unwrap() + 1;
+    interleaved_args[out_index] = interleaved_dir.to_str().unwrap();
+    interleaved_args.extend(["--interleave", "5"]);
+    let out = vrao(&interleaved_args);
+    assert!(out.status.success(), "{}", text(&out));
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(interleaved_dir.join("bench.json")).unwrap()).unwrap();
+    let again = again["records"].as_array().unwrap();
+    assert_eq!(again.len(), rows);
+    for (a, b) in records.iter().zip(again) {
+        for key in ["technique", "samples", "resolution", "ao_rmse", "ao_ssim"] {
+            assert_eq!(a[key], b[key], "{key}: {a} vs {b}");
+        }
+    }
+
     // --fit picks the least-error row (at the bench's radius) that fits a generous
     // budget and measures it.
     let best = records
