@@ -6,8 +6,10 @@
 // polynomial in ω, so Σ L(ω_i) cos θ_i needs only the samples' moments Σc, Σcω, Σcωωᵀ:
 // ten multiply-adds per sample, and the colour is evaluated once per pixel.
 // With the bounce (seed 002 eq. 2; seed 003 §4.2), in the same loop, each blocking
-// sample's surface becomes a sender patch of area π r_max²/N × bounce strength that
-// reflects the direct light stored at its pixel towards P.
+// sample's surface sends the direct light stored at its pixel towards P: as eq. 2's
+// patch of area π r_max²/N (BOUNCE_PATCH), or through the blocked direction's share of
+// the hemisphere, 2π/N, with the receiver's cosine towards the sender (the default;
+// settings.rs `BounceForm`). Both scale by the bounce strength.
 // Output: rgb = irradiance to multiply by albedo/π; a = cosine-weighted visibility.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
@@ -51,8 +53,20 @@ fn gathered_radiance(m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>, r:
     return max(sum, vec3<f32>(0.0));
 }
 
+// Solid angle of a disc of radius² `a` seen on its axis from distance² `d2`:
+// 2π (1 − d / √(d² + a)), written without the cancellation at large d. It is the
+// patch's A/d² far away and at most 2π (a hemisphere) when the sender touches the
+// receiver, where A/d² diverges: seed 002 clamps d_i there, and a clamp at the patch's
+// own size cut the bounce from the nearest senders, which carry most of it, by up to 6×.
+fn disc_solid_angle(d2: f32, a: f32) -> f32 {
+    let s = sqrt(d2 + a);
+    return 2.0 * PI * a / (s * (s + sqrt(d2)));
+}
+
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the variant without).
 override BOUNCE: bool = false;
+// Seed 002 eq. 2's patch form of the bounce instead of the direction form.
+override BOUNCE_PATCH: bool = false;
 
 // Depth peeling (seed 002 §4, passes/peel.rs): the second depth layer, the nearest surface
 // behind the first. With PEEL a sample is an occluder only between the two layers, inside
@@ -79,10 +93,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let bias = ao.bias * ao.radius;
     let origin = r.position + r.normal * bias;
     let samples = max(ao.samples, 1u);
-    // Sender patch area (π r_max² / N) scaled by the bounce strength; distances are
-    // clamped to the patch's own size so the 1/d² form factor stays bounded.
-    let patch_area = PI * ao.radius * ao.radius / f32(samples);
-    let min_d2 = patch_area;
+    // Direction form: each direction covers 2π/N of the hemisphere. Patch form: each
+    // sender is a patch of area π r_max² / N (seed 002), seen as a disc of that area
+    // facing the receiver, `disc_radius2` its radius².
+    let direction_solid_angle = 2.0 * PI / f32(samples);
+    let disc_radius2 = ao.radius * ao.radius / f32(samples);
     // Cosine-weighted moments of all and of unblocked directions (view space).
     var all_m1 = vec3<f32>(0.0);
     var all_diag = vec3<f32>(0.0);
@@ -126,13 +141,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             weight_visible += cos_theta;
         } else if (BOUNCE) {
             let sender = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, r.eye.tangents);
-            let sender_n = direct_normal(fetched.texel);
             let to_receiver = r.position - sender;
-            let d2 = max(dot(to_receiver, to_receiver), min_d2);
-            let dir = to_receiver * inverseSqrt(max(dot(to_receiver, to_receiver), 1e-30));
-            let cos_sender = max(dot(sender_n, dir), 0.0);
+            let d2 = dot(to_receiver, to_receiver);
+            let dir = to_receiver * inverseSqrt(max(d2, 1e-30));
             let cos_receiver = max(dot(r.normal, -dir), 0.0);
-            bounce += direct_radiance(fetched.texel) * (cos_sender * cos_receiver / d2);
+            var weight = cos_receiver * direction_solid_angle;
+            if (BOUNCE_PATCH) {
+                let cos_sender = max(dot(direct_normal(fetched.texel), dir), 0.0);
+                weight = cos_sender * cos_receiver * disc_solid_angle(d2, disc_radius2);
+            }
+            bounce += direct_radiance(fetched.texel) * weight;
         }
     }
     // Eq. 1 with Δω = 2π/N estimates ∫ L V cos dω; its N-sample quadrature error (+16 %
@@ -149,7 +167,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         unoccluded = sh_eval(frame.irradiance_sh, world_from_view * r.normal);
     }
     let direct_occlusion = mix(unoccluded, unoccluded * share, clamp(ao.strength, 0.0, 1.0));
-    let irradiance = direct_occlusion + bounce * (patch_area * ao.bounce);
+    let irradiance = direct_occlusion + bounce * ao.bounce;
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
     textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(finite_or_zero3(irradiance), result));
 }

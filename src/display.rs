@@ -14,7 +14,7 @@ use crate::gpu::Gpu;
 use crate::graph::Resource;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
-use crate::settings::{DisplayMode, Quality, Settings, Technique};
+use crate::settings::{BounceForm, DisplayMode, Quality, Settings, Technique};
 use crate::stereo::{EyePair, Fov, HeadPose};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -561,6 +561,10 @@ fn panel_ui(
         ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
         ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
         ui.add(egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
+        let mut patch = ao.bounce_form == BounceForm::Patch;
+        if ui.checkbox(&mut patch, "bounce as seed 002's patches").changed() {
+            ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
+        }
         ui.checkbox(&mut ao.half_res, "half resolution");
         ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
         ui.checkbox(&mut ao.depth_peeling, "depth peeling (SSDO)");

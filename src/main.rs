@@ -202,6 +202,9 @@ struct BenchArgs {
     /// Warm-up frames per case (not measured).
     #[arg(long, default_value_t = 3)]
     warmup: u32,
+    /// How ssdo-bounce rows weigh their senders: direction or patch (seed 002 eq. 2).
+    #[arg(long, default_value = "direction")]
+    bounce_form: vrao::settings::BounceForm,
     /// Measure this many cases at a time, round-robin one frame each, so that the
     /// machine's drift during a long sweep falls on all of them alike (fair ratios
     /// between techniques); each needs its own targets in memory at once.
@@ -364,6 +367,10 @@ struct AoArgs {
     /// SSDO bounce strength (ssdo-bounce); 0 leaves the bounce out.
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     bounce: f32,
+    /// How the bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
+    /// the receiver cosine) or patch (seed 002 eq. 2: area π r²/N, both cosines, 1/d²).
+    #[arg(long, default_value = "direction")]
+    bounce_form: vrao::settings::BounceForm,
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
@@ -424,6 +431,7 @@ impl AoArgs {
             bias: self.bias,
             range_check: !self.no_range_check,
             bounce: self.bounce,
+            bounce_form: self.bounce_form,
             noise: self.noise,
             half_res: self.half_res,
             depth_peeling: self.depth_peeling,
@@ -607,8 +615,9 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     } else {
         args.radii.clone()
     };
-    let settings =
+    let mut settings =
         Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
+    settings.ao.bounce_form = args.bounce_form;
     let mut cases = Vec::new();
     for &technique in &args.techniques {
         for &samples in &args.samples {

@@ -17,7 +17,7 @@ use vrao::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
 use vrao::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
 use vrao::scene::builtin::{CREASE_WALL_Z, ROOM_MAX, ROOM_MIN};
 use vrao::scene::{environment, Environment, Scene};
-use vrao::settings::{AoSettings, Noise, Technique};
+use vrao::settings::{AoSettings, BounceForm, Noise, Technique};
 use vrao::stereo::{view_position_from_depth, HeadsetProfile};
 use vrao::{EyePair, FrameReport, Gpu, HeadPose, Renderer, Resource, Settings};
 
@@ -737,14 +737,17 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     let scene = Scene::load("builtin:room").unwrap();
     // Looking down at the foot of the red (−X) wall, from the middle of the room.
     let head = HeadPose::look_at(DVec3::new(0.6, 1.6, -0.8), DVec3::new(ROOM_MIN.x + 0.3, 0.0, -2.6)).unwrap();
-    let run = |technique: Technique, bounce: f32| {
+    let run_form = |technique: Technique, bounce: f32, form: BounceForm| {
         let mut a = ao(technique, 64, 1.0);
         a.bounce = bounce;
+        a.bounce_form = form;
         render(&gpu, &scene, &settings(128, 144, a), &head, &[Resource::Hdr, Resource::AoRaw])
     };
+    let run = |technique: Technique, bounce: f32| run_form(technique, bounce, BounceForm::Direction);
     let ssdo = run(Technique::Ssdo, 1.0);
     let bounce = run(Technique::SsdoBounce, 1.0);
     let bounce_off = run(Technique::SsdoBounce, 0.0);
+    let patch = run_form(Technique::SsdoBounce, 1.0, BounceForm::Patch);
     // Floor within 0.45 m of the red wall, away from the other walls.
     let near_red_wall =
         |p: DVec3| p.y.abs() < 1e-3 && p.x < ROOM_MIN.x + 0.45 && p.z < ROOM_MAX.z - 1.0 && p.z > ROOM_MIN.z + 0.5;
@@ -767,8 +770,17 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     let (ssdo_hdr, ssdo_raw) = measure(&ssdo);
     let (bounce_hdr, bounce_raw) = measure(&bounce);
     let (off_hdr, off_raw) = measure(&bounce_off);
+    let (_, patch_raw) = measure(&patch);
     let ratio = |c: [f64; 3]| c[0] / c[1];
     let gained: Vec<f64> = (0..3).map(|i| bounce_raw[i] - ssdo_raw[i]).collect();
+    // Seed 002's patch form carries the same red, less of it (tests/reference_error.rs
+    // compares both with the reference).
+    let patch_gained: Vec<f64> = (0..3).map(|i| patch_raw[i] - ssdo_raw[i]).collect();
+    eprintln!("bounce: patch form gained {patch_gained:.3?}");
+    assert!(
+        patch_gained[0] > 0.005 && patch_gained[0] > 3.0 * patch_gained[1].max(patch_gained[2]).max(0.0),
+        "the patch-form bounce is not red: {patch_gained:?}"
+    );
     eprintln!(
         "bounce: floor by the red wall, hdr r/g: ssdo {:.3}, ssdo-bounce {:.3}, bounce 0 {:.3}; \
          ao-raw rgb: ssdo {ssdo_raw:.3?}, ssdo-bounce {bounce_raw:.3?} (gained {gained:.3?}), bounce 0 {off_raw:.3?}",

@@ -9,15 +9,14 @@ use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::targets::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
-use crate::settings::Technique;
+use crate::settings::{BounceForm, Technique};
 
 pub struct SsdoPass {
-    without_bounce: Kernel,
-    with_bounce: Kernel,
+    /// Pipelines by [depth peeling][bounce: none, direction form, patch form]: pipeline
+    /// constants, so a frame runs no code of what it left out.
+    kernels: [[Kernel; 3]; 2],
     /// Bound in place of the direct light when the bounce is off (never read then).
     no_direct: LayeredTarget,
-    /// The same two with depth peeling (`PEEL`, binding 8 read): [without, with] bounce.
-    peeled: [Kernel; 2],
     /// Bound in place of the second depth layer when peeling is off (never read then).
     no_second_layer: LayeredTarget,
 }
@@ -40,14 +39,23 @@ impl SsdoPass {
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
         let no_direct = LayeredTarget::placeholder(&gpu.device, "no direct light", Resource::Direct.format());
-        let peeled = |label, bounce| {
-            Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &[("BOUNCE", bounce), ("PEEL", 1.0)])
-        };
+        let labels = [
+            ["ssdo", "ssdo-bounce", "ssdo-bounce patch"],
+            ["ssdo peeled", "ssdo-bounce peeled", "ssdo-bounce patch peeled"],
+        ];
+        let kernels = [0, 1].map(|peel| {
+            [0, 1, 2].map(|bounce| {
+                let constants = [
+                    ("PEEL", peel as f64),
+                    ("BOUNCE", (bounce > 0) as u8 as f64),
+                    ("BOUNCE_PATCH", (bounce == 2) as u8 as f64),
+                ];
+                Kernel::with_constants(gpu, labels[peel][bounce], &files, "main", &SLOTS, &constants)
+            })
+        });
         SsdoPass {
-            without_bounce: Kernel::with_constants(gpu, "ssdo", &files, "main", &SLOTS, &[("BOUNCE", 0.0)]),
-            with_bounce: Kernel::with_constants(gpu, "ssdo-bounce", &files, "main", &SLOTS, &[("BOUNCE", 1.0)]),
+            kernels,
             no_direct,
-            peeled: [peeled("ssdo peeled", 0.0), peeled("ssdo-bounce peeled", 1.0)],
             no_second_layer: LayeredTarget::placeholder(
                 &gpu.device,
                 "no second depth layer",
@@ -92,11 +100,12 @@ impl Pass for SsdoPass {
         resources.push(direct);
         resources.push(second);
         let extent = ctx.ao_extent();
-        let kernel = match (bounce, peel) {
-            (false, false) => &self.without_bounce,
-            (true, false) => &self.with_bounce,
-            (bounce, true) => &self.peeled[bounce as usize],
+        let form = match (bounce, ctx.setup.settings.ao.bounce_form) {
+            (false, _) => 0,
+            (true, BounceForm::Direction) => 1,
+            (true, BounceForm::Patch) => 2,
         };
+        let kernel = &self.kernels[peel as usize][form];
         kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
     }
 }
