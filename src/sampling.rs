@@ -30,7 +30,14 @@ pub enum HemisphereDensity {
 /// sits on the pole. SSAO lengths crowd towards the centre (lerp(0.1, 1, t²), seed 003
 /// §4.6); SSDO's λ is uniform in [0, r_max] (seed 002).
 pub fn hemisphere_kernel(n: u32, density: HemisphereDensity) -> Vec<[f32; 4]> {
-    (1..=n)
+    hemisphere_kernel_part(0, n, density)
+}
+
+/// Part `part` of a longer kernel: Halton points part·n + 1 ..= (part + 1)·n, so the
+/// parts 0..k together are the first k·n points, as stratified as one kernel of k·n.
+/// Temporal accumulation gives each frame of its window its own part.
+pub fn hemisphere_kernel_part(part: u32, n: u32, density: HemisphereDensity) -> Vec<[f32; 4]> {
+    (part * n + 1..=(part + 1) * n)
         .map(|i| {
             let azimuth = 2.0 * PI * halton(i, 2);
             let u = halton(i, 5);
@@ -63,6 +70,15 @@ pub fn hbao_directions_steps(samples: u32) -> (u32, u32) {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn kernel_parts_together_are_the_longer_kernel() {
+        for density in [HemisphereDensity::Cosine, HemisphereDensity::Uniform] {
+            let parts: Vec<[f32; 4]> = (0..4).flat_map(|p| hemisphere_kernel_part(p, 8, density)).collect();
+            assert_eq!(parts, hemisphere_kernel(32, density));
+            assert_ne!(hemisphere_kernel_part(1, 8, density), hemisphere_kernel_part(0, 8, density));
+        }
+    }
+
     use super::*;
 
     #[test]
