@@ -392,7 +392,8 @@ struct AoArgs {
     #[arg(long)]
     no_range_check: bool,
     /// Accumulate occlusion over frames by reverse reprojection (seed 001); the sampling
-    /// pattern turns by the golden angle every frame, and its range jitters.
+    /// pattern changes every frame (SSAO/SSDO: the next part of a longer Halton kernel;
+    /// HBAO: turned by the golden angle, its range jittered).
     #[arg(long)]
     temporal: bool,
     /// Temporal disocclusion threshold in metres (plus two pixel footprints).
