@@ -18,7 +18,7 @@ use vrao::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity
 use vrao::scene::builtin::{CREASE_WALL_Z, ROOM_MAX, ROOM_MIN};
 use vrao::scene::{environment, Environment, Scene};
 use vrao::settings::{AoSettings, BounceForm, Noise, Technique};
-use vrao::stereo::{view_position_from_depth, HeadsetProfile};
+use vrao::stereo::HeadsetProfile;
 use vrao::{EyePair, FrameReport, Gpu, HeadPose, Renderer, Resource, Settings};
 
 /// The techniques that compute occlusion.
@@ -54,22 +54,7 @@ fn render(gpu: &Arc<Gpu>, scene: &Scene, s: &Settings, head: &HeadPose, outputs:
     let report = renderer.render(&eyes.eyes, &wanted).unwrap();
     let depth = renderer.read_f32(Resource::Depth).unwrap();
     let (w, h) = (s.profile.width, s.profile.height);
-    let world = depth
-        .iter()
-        .zip(&eyes.eyes)
-        .map(|(layer, eye)| {
-            let world_from_view = eye.pose.world_from_local();
-            (0..w * h)
-                .map(|i| {
-                    let d = layer[i as usize] as f64;
-                    (d > 0.0).then(|| {
-                        let uv = [((i % w) as f64 + 0.5) / w as f64, ((i / w) as f64 + 0.5) / h as f64];
-                        world_from_view.transform_point3(view_position_from_depth(uv, d, &eye.fov, s.near))
-                    })
-                })
-                .collect()
-        })
-        .collect();
+    let world = common::world_positions(&depth, &eyes.eyes, w, h, s.near);
     let outputs = outputs.iter().map(|&r| (r, renderer.read_f32(r).unwrap())).collect();
     Frame { width: w, height: h, eyes, world, outputs, report }
 }

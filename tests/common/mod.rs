@@ -115,3 +115,31 @@ pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize
     let uvs = vec![glam::Vec2::ZERO; positions.len()];
     Mesh { name: name.into(), origin: center, positions, normals, uvs, indices, material }
 }
+
+/// The world position of every pixel of a depth readback (reversed-Z, one layer per eye,
+/// `width` × `height`), or None on the sky: what the GPU tests compare pixels by.
+pub fn world_positions(
+    depth: &[Vec<f32>],
+    eyes: &[vrao::stereo::Eye],
+    width: u32,
+    height: u32,
+    near: f64,
+) -> Vec<Vec<Option<glam::DVec3>>> {
+    depth
+        .iter()
+        .zip(eyes)
+        .map(|(layer, eye)| {
+            let world_from_view = eye.pose.world_from_local();
+            (0..width * height)
+                .map(|i| {
+                    let d = layer[i as usize] as f64;
+                    (d > 0.0).then(|| {
+                        let uv =
+                            [((i % width) as f64 + 0.5) / width as f64, ((i / width) as f64 + 0.5) / height as f64];
+                        world_from_view.transform_point3(vrao::stereo::view_position_from_depth(uv, d, &eye.fov, near))
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
