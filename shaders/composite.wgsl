@@ -47,7 +47,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let albedo = textureLoad(albedo_layers, p, layer, 0).rgb;
         var ambient = vec3<f32>(0.0);
         if (frame.has_environment != 0u) {
-            ambient = sh_eval(frame.irradiance_sh, (eye.world_from_view * vec4<f32>(n, 0.0)).xyz);
+            ambient = environment_irradiance(id.z, n);
         }
         var occlusion = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         if (ao.technique != 0u) {

@@ -1,8 +1,8 @@
 // Direct light: the scene's point and directional lights on diffuse surfaces, plus
 // emission, as outgoing radiance. The composite adds the ambient term on top, and
-// SSDO's bounce uses this as the sender radiance L_pixel (seed 002 eq. 2); the normal
-// and the view distance ride along (`pack_direct`) so that the bounce's occluder probe
-// reads distance, sender radiance and sender normal in one fetch.
+// SSDO's bounce uses this as the sender radiance L_pixel (seed 002 eq. 2); the view
+// distance rides along (`pack_direct`) so that the bounce's occluder probe reads
+// distance and sender radiance in one fetch.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
@@ -10,7 +10,7 @@
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var emission_layers: texture_2d_array<f32>;
-@group(0) @binding(6) var direct_out: texture_storage_2d_array<rgba32uint, write>;
+@group(0) @binding(6) var direct_out: texture_storage_2d_array<rg32uint, write>;
 // Shadow maps of the directional lights (shadow.wgsl); `shadows.count` is 0 when off.
 @group(0) @binding(7) var<uniform> shadows: Shadows;
 @group(0) @binding(8) var shadow_map: texture_depth_2d_array;
@@ -64,5 +64,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let emission = textureLoad(emission_layers, p, i32(layer), 0).rgb;
         radiance = albedo / PI * irradiance + emission;
     }
-    textureStore(direct_out, p, i32(layer), pack_direct(distance, finite_or_zero3(radiance), n));
+    textureStore(direct_out, p, i32(layer), pack_direct(distance, finite_or_zero3(radiance)));
 }

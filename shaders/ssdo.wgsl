@@ -16,8 +16,8 @@
 @group(0) @binding(7) var direct_layers: texture_2d_array<u32>;
 
 // With the bounce, the occluder probe reads the packed direct light (common.wgsl
-// `pack_direct`), which carries the view distance as well as the sender's radiance and
-// normal: one fetch per sample, as without the bounce.
+// `pack_direct`), which carries the view distance as well as the sender's radiance: one
+// fetch per sample, as without the bounce.
 struct SenderProbe {
     probe: DepthProbe,
     texel: vec4<u32>,
@@ -35,22 +35,11 @@ fn probe_sender(layer: u32, s: vec3<f32>, eye: Eye) -> SenderProbe {
     return sp;
 }
 
-// Σ_i c_i L(ω_i) from the moments m0 = Σc, m1 = Σcω, and Σcωωᵀ (diagonal, and
-// off-diagonal as xy, xz, yz), all in view space; `r` turns view into world directions.
-// Clamped at 0 as the quadratic can ring slightly negative opposite a bright sun.
-fn gathered_radiance(m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>, r: mat3x3<f32>) -> vec3<f32> {
-    let second = mat3x3<f32>(
-        vec3<f32>(diag.x, off.x, off.y),
-        vec3<f32>(off.x, diag.y, off.z),
-        vec3<f32>(off.y, off.z, diag.z),
-    );
-    let w1 = r * m1;
-    let w2 = r * second * transpose(r);
-    let q = frame.radiance_quadratic;
-    let sum = q[0].xyz * m0 + q[1].xyz * w1.x + q[2].xyz * w1.y + q[3].xyz * w1.z
-        + q[4].xyz * w2[0][0] + q[5].xyz * w2[1][1] + q[6].xyz * w2[2][2]
-        + q[7].xyz * w2[0][1] + q[8].xyz * w2[0][2] + q[9].xyz * w2[1][2];
-    return max(sum, vec3<f32>(0.0));
+// Σ_i c_i L(ω_i) from the view-space moments of the directions ω_i (irradiance.wgsl
+// `quadratic_sum`). Clamped at 0 as the quadratic can ring slightly negative opposite a
+// bright sun.
+fn gathered_radiance(layer: u32, m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>) -> vec3<f32> {
+    return max(quadratic_sum(RADIANCE, layer, m0, m1, diag, off), vec3<f32>(0.0));
 }
 
 // Solid angle of a disc of radius² `a` seen on its axis from distance² `d2`:
@@ -89,7 +78,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise) + ao.frame_angle);
-    let world_from_view = mat3x3<f32>(r.eye.world_from_view[0].xyz, r.eye.world_from_view[1].xyz, r.eye.world_from_view[2].xyz);
     let bias = ao.bias * ao.radius;
     let origin = r.position + r.normal * bias;
     let samples = max(ao.samples, 1u);
@@ -147,7 +135,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             let cos_receiver = max(dot(r.normal, -dir), 0.0);
             var weight = cos_receiver * direction_solid_angle;
             if (BOUNCE_PATCH) {
-                let cos_sender = max(dot(direct_normal(fetched.texel), dir), 0.0);
+                // The packed texel has no room for the normal: the patch form alone
+                // pays a second fetch for it, from the G-buffer.
+                let sender_normal = textureLoad(normal_layers, vec2<i32>(probe.pixel), i32(r.layer), 0).xyz;
+                let cos_sender = max(dot(safe_normal(sender_normal, sender), dir), 0.0);
                 weight = cos_sender * cos_receiver * disc_solid_angle(d2, disc_radius2);
             }
             bounce += direct_radiance(fetched.texel) * weight;
@@ -159,12 +150,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // is blocked, per colour channel, and that share scales the exact SH irradiance: an
     // open plane gets exactly the ambient of the other techniques, at any N.
     let visibility = select(1.0, weight_visible / weight_all, weight_all > 1e-20);
-    let gathered_all = gathered_radiance(weight_all, all_m1, all_diag, all_off, world_from_view);
-    let gathered_visible = gathered_radiance(weight_visible, visible_m1, visible_diag, visible_off, world_from_view);
+    let gathered_all = gathered_radiance(r.layer, weight_all, all_m1, all_diag, all_off);
+    let gathered_visible = gathered_radiance(r.layer, weight_visible, visible_m1, visible_diag, visible_off);
     let share = select(vec3<f32>(visibility), gathered_visible / gathered_all, gathered_all > vec3<f32>(1e-20));
     var unoccluded = vec3<f32>(0.0);
     if (frame.has_environment != 0u) {
-        unoccluded = sh_eval(frame.irradiance_sh, world_from_view * r.normal);
+        unoccluded = environment_irradiance(r.layer, r.normal);
     }
     let direct_occlusion = mix(unoccluded, unoccluded * share, clamp(ao.strength, 0.0, 1.0));
     let irradiance = direct_occlusion + bounce * ao.bounce;

@@ -20,9 +20,10 @@ pub enum Resource {
     Albedo,
     /// Emitted radiance, `Rgba16Float`.
     Emission,
-    /// Outgoing direct radiance (lights and emission) in rgb, and the view-space normal
-    /// packed into alpha (octahedral, 2×16 bits), `Rgba32Float`: the composite's base,
-    /// and sender radiance plus sender normal of SSDO's bounce in a single fetch.
+    /// Outgoing direct radiance (lights and emission) and the view distance, packed in
+    /// `Rg32Uint` (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the
+    /// composite's base, and depth test plus sender radiance of SSDO's bounce in a
+    /// single fetch.
     Direct,
     /// Occlusion as computed (at AO resolution), `Rgba16Float`: rgb = SSDO's gathered
     /// irradiance (environment through unblocked directions plus the bounce), a = AO.
@@ -151,7 +152,7 @@ impl Resource {
             Resource::ShadowMap => wgpu::TextureFormat::Depth32Float,
             Resource::RsmNormal | Resource::RsmFlux | Resource::RsmIndirect => wgpu::TextureFormat::Rgba16Float,
             Resource::RsmGeometry => wgpu::TextureFormat::Rgba32Float,
-            Resource::Direct => wgpu::TextureFormat::Rgba32Uint,
+            Resource::Direct => wgpu::TextureFormat::Rg32Uint,
         }
     }
 }

@@ -3,11 +3,12 @@
 
 use super::scene::GpuScene;
 use crate::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
+use crate::scene::environment::quadratic_in_view;
 use crate::scene::{Light, Scene};
 use crate::settings::{Noise, Settings, Technique};
 use crate::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, Mat4};
+use glam::{DMat4, Mat3, Mat4};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -29,8 +30,11 @@ pub struct FrameUniform {
     pub exposure: f32,
     pub white_point: f32,
     pub has_environment: u32,
-    pub irradiance_sh: [[f32; 4]; 9],
-    pub radiance_quadratic: [[f32; 4]; 10],
+    /// The environment light as quadratics in each eye's view-space direction
+    /// (`quadratic_in_view`; zero without an environment): [irradiance of eye 0, of
+    /// eye 1 (`Environment::irradiance_quadratic`), pre-filtered radiance of eye 0, of
+    /// eye 1 (`Environment::radiance_quadratic`, SSDO)].
+    pub environment_quadratics: [[[f32; 4]; 10]; 4],
 }
 
 #[repr(C)]
@@ -179,15 +183,24 @@ impl FrameBuffers {
     pub fn update(&self, queue: &wgpu::Queue, scene: &Scene, gpu_scene: &GpuScene, views: &[Eye], settings: &Settings) {
         let to_cols = |m: Mat4| m.to_cols_array_2d();
         let mut eyes = [EyeUniform::zeroed(); 2];
+        let mut environment_quadratics = [[[0.0; 4]; 10]; 4];
         let mut lights = Vec::with_capacity(self.light_capacity);
-        for (slot, eye) in eyes.iter_mut().zip(views) {
+        for (index, (slot, eye)) in eyes.iter_mut().zip(views).enumerate() {
             let view_from_world = eye.view_from_world();
             let view_from_anchored = view_from_world * DMat4::from_translation(gpu_scene.anchor);
             let [l, r, u, d] = eye.fov.tangents();
+            let world_from_view = eye.pose.orientation.as_quat();
+            if let Some(env) = &scene.environment {
+                let in_view = |q: [glam::Vec3; 10]| {
+                    quadratic_in_view(&q, Mat3::from_quat(world_from_view)).map(|c| c.extend(0.0).to_array())
+                };
+                environment_quadratics[index] = in_view(env.irradiance_quadratic());
+                environment_quadratics[2 + index] = in_view(env.radiance_quadratic());
+            }
             *slot = EyeUniform {
                 clip_from_anchored: to_cols(eye.clip_from_anchored(gpu_scene.anchor, settings.near)),
                 view_from_anchored: to_cols(view_from_anchored.as_mat4()),
-                world_from_view: to_cols(Mat4::from_quat(eye.pose.orientation.as_quat())),
+                world_from_view: to_cols(Mat4::from_quat(world_from_view)),
                 tangents: [l as f32, r as f32, u as f32, d as f32],
             };
             for light in &scene.lights {
@@ -210,13 +223,6 @@ impl FrameBuffers {
                 });
             }
         }
-        let (irradiance_sh, radiance_quadratic) = match &scene.environment {
-            Some(env) => (
-                env.irradiance_sh_scaled().map(|c| c.extend(0.0).to_array()),
-                env.radiance_quadratic().map(|c| c.extend(0.0).to_array()),
-            ),
-            None => ([[0.0; 4]; 9], [[0.0; 4]; 10]),
-        };
         let uniform = FrameUniform {
             eyes,
             size: [settings.profile.width, settings.profile.height],
@@ -226,8 +232,7 @@ impl FrameBuffers {
             exposure: settings.exposure,
             white_point: settings.white_point,
             has_environment: scene.environment.is_some() as u32,
-            irradiance_sh,
-            radiance_quadratic,
+            environment_quadratics,
         };
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));
         if !lights.is_empty() {

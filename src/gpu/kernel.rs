@@ -19,6 +19,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("joint_upsample.wgsl", include_str!("../../shaders/joint_upsample.wgsl")),
     ("upsample.wgsl", include_str!("../../shaders/upsample.wgsl")),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
+    ("irradiance.wgsl", include_str!("../../shaders/irradiance.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     ("gbuffer_multiview.wgsl", include_str!("../../shaders/gbuffer_multiview.wgsl")),
     ("gbuffer_multipass.wgsl", include_str!("../../shaders/gbuffer_multipass.wgsl")),

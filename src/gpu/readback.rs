@@ -15,7 +15,8 @@ fn texel_bytes(format: wgpu::TextureFormat) -> u32 {
         wgpu::TextureFormat::R32Float | wgpu::TextureFormat::Depth32Float => 4,
         wgpu::TextureFormat::Rgba16Float => 8,
         wgpu::TextureFormat::R16Float => 2,
-        wgpu::TextureFormat::Rgba32Float | wgpu::TextureFormat::Rgba32Uint => 16,
+        wgpu::TextureFormat::Rg32Uint => 8,
+        wgpu::TextureFormat::Rgba32Float => 16,
         other => panic!("readback of {other:?} is not supported"), // programming error, not input
     }
 }
@@ -89,21 +90,41 @@ pub fn read_layers_f32(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<f32>
         .collect())
 }
 
-/// The `Direct` resource's packed texels (rgba32uint, common.wgsl `pack_direct`) as
-/// rgba f32 values per layer: the three f16 radiance channels, and 0 in alpha (the
-/// packed normal and distance are the bounce's business only).
+/// The `Direct` resource's packed texels (rg32uint, common.wgsl `pack_direct`) as rgba
+/// f32 values per layer: the RGB9E5 radiance, and 0 in alpha (the packed distance is the
+/// bounce's business only).
 pub fn decode_direct(raw: Vec<Vec<u8>>) -> Vec<Vec<f32>> {
-    let half = |bits: u32| f16_to_f32((bits & 0xffff) as u16);
     raw.into_iter()
         .map(|bytes| {
             bytes
-                .chunks_exact(16)
+                .chunks_exact(8)
                 .flat_map(|t| {
-                    let y = u32::from_le_bytes([t[4], t[5], t[6], t[7]]);
-                    let z = u32::from_le_bytes([t[8], t[9], t[10], t[11]]);
-                    [half(y), half(y >> 16), half(z), 0.0]
+                    let [r, g, b] = unpack_rgb9e5(u32::from_le_bytes([t[4], t[5], t[6], t[7]]));
+                    [r, g, b, 0.0]
                 })
                 .collect()
         })
         .collect()
+}
+
+/// The shared-exponent RGB9E5 form of common.wgsl `pack_rgb9e5`: three 9-bit mantissas
+/// and a 5-bit exponent biased by 15.
+pub fn unpack_rgb9e5(bits: u32) -> [f32; 3] {
+    let scale = 2f32.powi((bits >> 27) as i32 - 24);
+    [bits & 511, (bits >> 9) & 511, (bits >> 18) & 511].map(|m| m as f32 * scale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unpack_rgb9e5;
+
+    #[test]
+    fn rgb9e5_decodes_the_shared_exponent_form() {
+        let texel = |m: [u32; 3], exponent: u32| m[0] | (m[1] << 9) | (m[2] << 18) | (exponent << 27);
+        // 1.0 is mantissa 256 at exponent 16 (2^(16 − 15 − 9) = 1/256).
+        assert_eq!(unpack_rgb9e5(texel([256, 128, 0], 16)), [1.0, 0.5, 0.0]);
+        // The largest value, 511 × 2^7, and the smallest step, 2^-24.
+        assert_eq!(unpack_rgb9e5(texel([511, 0, 1], 31)), [65408.0, 0.0, 128.0]);
+        assert_eq!(unpack_rgb9e5(texel([0, 1, 0], 0)), [0.0, 2f32.powi(-24), 0.0]);
+    }
 }

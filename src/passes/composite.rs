@@ -38,7 +38,7 @@ const SLOTS: [Slot; 13] = [
 
 impl CompositePass {
     pub fn new(gpu: &Gpu) -> Self {
-        let files = ["common.wgsl", "joint_upsample.wgsl", "rsm_upsample.wgsl", "composite.wgsl"];
+        let files = ["common.wgsl", "irradiance.wgsl", "joint_upsample.wgsl", "rsm_upsample.wgsl", "composite.wgsl"];
         let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
         let variant = |half_res: bool, rsm: bool| {
             let constants = [("HALF_RES", half_res as u8 as f64), ("RSM", rsm as u8 as f64)];

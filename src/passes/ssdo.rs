@@ -37,7 +37,7 @@ const SLOTS: [Slot; 9] = [
 
 impl SsdoPass {
     pub fn new(gpu: &Gpu) -> Self {
-        let files = ["common.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
+        let files = ["common.wgsl", "irradiance.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
         let no_direct = LayeredTarget::placeholder(&gpu.device, "no direct light", Resource::Direct.format());
         let labels = [
             ["ssdo", "ssdo-bounce", "ssdo-bounce patch"],

@@ -10,7 +10,7 @@
 //! usual HDRIs (Poly Haven, three.js examples) appear the right way round.
 
 use crate::error::{Error, Result};
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 use std::f32::consts::{PI, TAU};
 use std::path::Path;
 
@@ -147,24 +147,16 @@ impl Environment {
     }
 
     /// The pre-filtered radiance of [`Environment::radiance_sh_prefiltered`] as a
-    /// quadratic polynomial in the unit direction ω = (x, y, z), which nine SH terms are:
-    /// L(ω) = a + b·ω + qxx x² + qyy y² + qzz z² + qxy xy + qxz xz + qyz yz, returned as
-    /// [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz] (rgb each). A sum of L over
+    /// quadratic polynomial in the unit direction (see [`sh9_quadratic`]). A sum of L over
     /// weighted directions then needs only the directions' moments (SSDO).
     pub fn radiance_quadratic(&self) -> [Vec3; 10] {
-        let c = self.radiance_sh_prefiltered();
-        [
-            c[0] * 0.282_095 - c[6] * 0.315_392,
-            c[3] * 0.488_603,
-            c[1] * 0.488_603,
-            c[2] * 0.488_603,
-            c[8] * 0.546_274,
-            c[8] * -0.546_274,
-            c[6] * (3.0 * 0.315_392),
-            c[4] * 1.092_548,
-            c[7] * 1.092_548,
-            c[5] * 1.092_548,
-        ]
+        sh9_quadratic(&self.radiance_sh_prefiltered())
+    }
+
+    /// The irradiance of [`Environment::irradiance_sh_scaled`] as a quadratic polynomial
+    /// in the unit normal (see [`sh9_quadratic`]; clamp the result at 0).
+    pub fn irradiance_quadratic(&self) -> [Vec3; 10] {
+        sh9_quadratic(&self.irradiance_sh_scaled())
     }
 
     /// Irradiance E(n) (times `intensity`) on a surface with unit normal `n` that sees the
@@ -225,6 +217,60 @@ pub fn sh9_basis(d: Vec3) -> [f32; 9] {
     ]
 }
 
+/// Nine SH coefficients as the quadratic polynomial in the unit direction ω = (x, y, z)
+/// that they are: f(ω) = a + b·ω + qxx x² + qyy y² + qzz z² + qxy xy + qxz xz + qyz yz,
+/// returned as [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz] (rgb each).
+pub fn sh9_quadratic(c: &[Vec3; 9]) -> [Vec3; 10] {
+    [
+        c[0] * 0.282_095 - c[6] * 0.315_392,
+        c[3] * 0.488_603,
+        c[1] * 0.488_603,
+        c[2] * 0.488_603,
+        c[8] * 0.546_274,
+        c[8] * -0.546_274,
+        c[6] * (3.0 * 0.315_392),
+        c[4] * 1.092_548,
+        c[7] * 1.092_548,
+        c[5] * 1.092_548,
+    ]
+}
+
+/// A quadratic of [`sh9_quadratic`]'s form in the world direction, re-expressed in the
+/// direction v of a view whose world direction is `world_from_view` · v:
+/// f(R v) = a + (Rᵀb)·v + vᵀ(RᵀQR)v. Done once per eye, so the shaders evaluate
+/// environment light in view space without turning each pixel's vectors into the world.
+pub fn quadratic_in_view(q: &[Vec3; 10], world_from_view: Mat3) -> [Vec3; 10] {
+    let mut out = [Vec3::ZERO; 10];
+    out[0] = q[0];
+    for channel in 0..3 {
+        let c = |k: usize| q[k][channel];
+        let linear = world_from_view.transpose() * Vec3::new(c(1), c(2), c(3));
+        // The symmetric matrix of the quadratic part: a cross term's coefficient is
+        // shared by its two off-diagonal entries.
+        let symmetric = Mat3::from_cols(
+            Vec3::new(c(4), 0.5 * c(7), 0.5 * c(8)),
+            Vec3::new(0.5 * c(7), c(5), 0.5 * c(9)),
+            Vec3::new(0.5 * c(8), 0.5 * c(9), c(6)),
+        );
+        let turned = world_from_view.transpose() * symmetric * world_from_view;
+        let coefficients = [
+            linear.x,
+            linear.y,
+            linear.z,
+            turned.x_axis.x,
+            turned.y_axis.y,
+            turned.z_axis.z,
+            2.0 * turned.y_axis.x,
+            2.0 * turned.z_axis.x,
+            2.0 * turned.z_axis.y,
+        ];
+        for (k, value) in coefficients.into_iter().enumerate() {
+            out[k + 1][channel] = value;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -250,6 +296,27 @@ mod tests {
             let monomials = [1.0, x, y, z, x * x, y * y, z * z, x * y, x * z, y * z];
             let from_q: Vec3 = q.iter().zip(monomials).map(|(c, m)| *c * m).sum();
             assert!((from_sh - from_q).abs().max_element() < 1e-4 * (1.0 + from_sh.abs().max_element()), "{dir}");
+        }
+    }
+
+    #[test]
+    fn view_space_quadratic_is_the_world_one_turned() {
+        let texels: Vec<[f32; 3]> =
+            (0..32 * 16).map(|i| [(i % 7) as f32, (i % 5) as f32 * 0.3, (i % 11) as f32]).collect();
+        let env = Environment::from_texels(32, 16, texels, 1.5).unwrap();
+        let world_from_view = Mat3::from_quat(glam::Quat::from_euler(glam::EulerRot::YXZ, 0.7, -0.4, 0.2));
+        let (world, view) = (env.radiance_quadratic(), quadratic_in_view(&env.radiance_quadratic(), world_from_view));
+        let eval = |q: &[Vec3; 10], d: Vec3| {
+            let Vec3 { x, y, z } = d;
+            let monomials = [1.0, x, y, z, x * x, y * y, z * z, x * y, x * z, y * z];
+            q.iter().zip(monomials).map(|(c, m)| *c * m).sum::<Vec3>()
+        };
+        let irradiance = quadratic_in_view(&env.irradiance_quadratic(), world_from_view);
+        for v in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize(), Vec3::new(-0.7, 0.1, 0.2).normalize()] {
+            let (expected, got) = (eval(&world, world_from_view * v), eval(&view, v));
+            assert!((expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()), "{v}: {expected} vs {got}");
+            let (expected, got) = (env.irradiance(world_from_view * v), eval(&irradiance, v).max(Vec3::ZERO));
+            assert!((expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()), "E {v}: {expected} vs {got}");
         }
     }
 
