@@ -1,6 +1,8 @@
 // Composite: direct light plus the ambient term attenuated by occlusion, in HDR. With
-// HALF_RES the occlusion arrives at half resolution and is upsampled here, per pixel
-// (joint_upsample.wgsl), instead of in a pass of its own.
+// HALF_RES the occlusion arrives at half resolution and is upsampled here, instead of in
+// a pass of its own; so is the RSM bounce. Upsampling runs `main_quad`, one invocation
+// per quad of 2×2 pixels (joint_upsample.wgsl `upsample_quad`, each low-res sample
+// fetched once per quad); without it `main` shades one pixel per invocation.
 // technique 0: unoccluded ambient (SH irradiance of the environment);
 // 1: ambient × AO (SSAO, HBAO); 2: SSDO's gathered irradiance (rgb) replaces it.
 // Sky pixels show the environment.
@@ -18,7 +20,7 @@
 // AoGeometry of half-resolution occlusion (HALF_RES only).
 @group(0) @binding(10) var geometry_low: texture_2d_array<f32>;
 // One bounce of the directional lights from reflective shadow maps (rsm.wgsl): the
-// irradiance and its geometry at half resolution, upsampled in rsm_upsample.wgsl (RSM only).
+// irradiance and its geometry at half resolution, upsampled like the occlusion (RSM only).
 @group(0) @binding(11) var rsm_indirect: texture_2d_array<f32>;
 @group(0) @binding(12) var rsm_geometry: texture_2d_array<f32>;
 
@@ -27,47 +29,99 @@ override HALF_RES: bool = false;
 // uniform skips it (composite 122 → 213 ms at 1080×1200 on Sibenik).
 override RSM: bool = false;
 
+// Pixel `k` of the quad of invocation `id` (pixels past an odd edge repeat the last row
+// or column; their store is skipped).
+fn quad_pixel(id: vec3<u32>, k: u32) -> vec2<u32> {
+    return min(id.xy * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
+}
+
+// Outgoing radiance at `pixel`: the environment on the sky; else the direct light plus
+// albedo/π × the ambient, which `occlusion` attenuates (technique 1) or replaces
+// (technique 2, SSDO's irradiance), plus the RSM `bounce`.
+fn shade(pixel: vec2<u32>, layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) -> vec3<f32> {
+    let p = vec2<i32>(pixel);
+    let depth = textureLoad(depth_layers, p, i32(layer), 0);
+    if (depth <= 0.0) {
+        if (frame.has_environment == 0u) {
+            return vec3<f32>(0.0);
+        }
+        let dir = (eye.world_from_view * vec4<f32>(view_ray(pixel_uv(pixel, frame.size), eye.tangents), 0.0)).xyz;
+        return environment_radiance(environment, environment_sampler, dir);
+    }
+    let n = textureLoad(normal_layers, p, i32(layer), 0).xyz;
+    let albedo = textureLoad(albedo_layers, p, i32(layer), 0).rgb;
+    var ambient = vec3<f32>(0.0);
+    if (frame.has_environment != 0u) {
+        ambient = environment_irradiance(layer, n);
+    }
+    if (ao.technique == 1u) {
+        ambient *= saturate_ao(occlusion.a);
+    } else if (ao.technique == 2u) {
+        ambient = max(occlusion.rgb, vec3<f32>(0.0));
+    }
+    return direct_radiance(textureLoad(direct_layers, p, i32(layer), 0)) + albedo / PI * (ambient + bounce);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= frame.size.x || id.y >= frame.size.y || id.z >= frame.layers) {
         return;
     }
-    let layer = i32(id.z);
-    let eye = frame.eyes[id.z];
-    let p = vec2<i32>(id.xy);
-    let depth = textureLoad(depth_layers, p, layer, 0);
-    var radiance = vec3<f32>(0.0);
-    if (depth <= 0.0) {
-        if (frame.has_environment != 0u) {
-            let dir = (eye.world_from_view * vec4<f32>(view_ray(pixel_uv(id.xy, frame.size), eye.tangents), 0.0)).xyz;
-            radiance = environment_radiance(environment, environment_sampler, dir);
+    var occlusion = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    if (ao.technique != 0u) {
+        occlusion = textureLoad(occlusion_layers, vec2<i32>(id.xy), i32(id.z), 0);
+    }
+    let radiance = shade(id.xy, id.z, frame.eyes[id.z], occlusion, vec3<f32>(0.0));
+    textureStore(hdr_out, vec2<i32>(id.xy), i32(id.z), vec4<f32>(finite_or_zero3(radiance), 1.0));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
+        return;
+    }
+    let layer = id.z;
+    let eye = frame.eyes[layer];
+    let unoccluded = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
+    var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    if ((HALF_RES && ao.technique != 0u) || RSM) {
+        // The quad's positions and normals for the joint bilateral weights (a sky pixel
+        // gets a far-away one; its result is not used).
+        var pixels: array<UpsamplePixel, 4>;
+        for (var k = 0u; k < 4u; k++) {
+            let pixel = quad_pixel(id, k);
+            let depth = max(textureLoad(depth_layers, vec2<i32>(pixel), i32(layer), 0), 1e-30);
+            let position = view_position_from_depth(pixel_uv(pixel, frame.size), depth, eye.tangents, frame.near);
+            let n = safe_normal(textureLoad(normal_layers, vec2<i32>(pixel), i32(layer), 0).xyz, position);
+            pixels[k] = upsample_pixel(pixel, position, n);
         }
-    } else {
-        let n = textureLoad(normal_layers, p, layer, 0).xyz;
-        let albedo = textureLoad(albedo_layers, p, layer, 0).rgb;
-        var ambient = vec3<f32>(0.0);
-        if (frame.has_environment != 0u) {
-            ambient = environment_irradiance(id.z, n);
-        }
-        var occlusion = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-        if (ao.technique != 0u) {
-            if (HALF_RES) {
-                let position = view_position_from_depth(pixel_uv(id.xy, frame.size), depth, eye.tangents, frame.near);
-                occlusion = joint_upsample(geometry_low, occlusion_layers, id, eye, position, safe_normal(n, position));
-            } else {
-                occlusion = textureLoad(occlusion_layers, p, layer, 0);
+        let b = vec2<i32>(id.xy);
+        if (HALF_RES && ao.technique != 0u) {
+            let up = upsample_quad(geometry_low, occlusion_layers, b, layer, eye.tangents, pixels);
+            let nearest = textureLoad(occlusion_layers, b, i32(layer), 0);
+            for (var k = 0u; k < 4u; k++) {
+                occlusion[k] = upsampled(up[k], nearest);
             }
         }
-        if (ao.technique == 1u) {
-            ambient *= saturate_ao(occlusion.a);
-        } else if (ao.technique == 2u) {
-            ambient = max(occlusion.rgb, vec3<f32>(0.0));
-        }
         if (RSM) {
-            let position = view_position_from_depth(pixel_uv(id.xy, frame.size), depth, eye.tangents, frame.near);
-            ambient += rsm_upsample(rsm_geometry, rsm_indirect, id, eye, position, safe_normal(n, position));
+            let up = upsample_quad(rsm_geometry, rsm_indirect, b, layer, eye.tangents, pixels);
+            let nearest = textureLoad(rsm_indirect, b, i32(layer), 0);
+            for (var k = 0u; k < 4u; k++) {
+                bounce[k] = max(upsampled(up[k], nearest).rgb, vec3<f32>(0.0));
+            }
         }
-        radiance = direct_radiance(textureLoad(direct_layers, p, layer, 0)) + albedo / PI * ambient;
     }
-    textureStore(hdr_out, p, layer, vec4<f32>(finite_or_zero3(radiance), 1.0));
+    if (!HALF_RES && ao.technique != 0u) {
+        for (var k = 0u; k < 4u; k++) {
+            occlusion[k] = textureLoad(occlusion_layers, vec2<i32>(quad_pixel(id, k)), i32(layer), 0);
+        }
+    }
+    for (var k = 0u; k < 4u; k++) {
+        let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
+        if (all(pixel < frame.size)) {
+            let radiance = shade(pixel, layer, eye, occlusion[k], bounce[k]);
+            textureStore(hdr_out, vec2<i32>(pixel), i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
+        }
+    }
 }

@@ -1,5 +1,6 @@
-// The upsample pass: writes AoFull from half-resolution occlusion (joint_upsample.wgsl).
-// Frames do not need it (the composite upsamples inline); debug images and tests do.
+// The upsample pass: writes AoFull from half-resolution occlusion (joint_upsample.wgsl),
+// one invocation per quad of 2×2 full-res pixels, i.e. per low-res sample. Frames do
+// not need it (the composite upsamples inline); debug images and tests do.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -11,17 +12,29 @@
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= frame.size.x || id.y >= frame.size.y || id.z >= frame.layers) {
+    if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
     let eye = frame.eyes[id.z];
-    let p = vec2<i32>(id.xy);
-    let depth = textureLoad(depth_layers, p, i32(id.z), 0);
-    if (depth <= 0.0) {
-        textureStore(occlusion_out, p, i32(id.z), vec4<f32>(0.0, 0.0, 0.0, 1.0));
-        return;
+    let layer = i32(id.z);
+    var pixels: array<UpsamplePixel, 4>;
+    var sky = 0u;
+    for (var k = 0u; k < 4u; k++) {
+        // Pixels past an odd edge repeat the last row or column (their store is skipped).
+        let pixel = min(id.xy * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
+        let depth = textureLoad(depth_layers, vec2<i32>(pixel), layer, 0);
+        sky |= select(0u, 1u << k, depth <= 0.0);
+        let position = load_view_position(max(depth, 1e-30), pixel, eye, frame.size, frame.near);
+        let n = safe_normal(textureLoad(normal_layers, vec2<i32>(pixel), layer, 0).xyz, position);
+        pixels[k] = upsample_pixel(pixel, position, n);
     }
-    let position = load_view_position(depth, id.xy, eye, frame.size, frame.near);
-    let n = safe_normal(textureLoad(normal_layers, p, i32(id.z), 0).xyz, position);
-    textureStore(occlusion_out, p, i32(id.z), joint_upsample(geometry_low, occlusion_low, id, eye, position, n));
+    pixels = upsample_quad(geometry_low, occlusion_low, vec2<i32>(id.xy), id.z, eye.tangents, pixels);
+    let nearest = textureLoad(occlusion_low, vec2<i32>(id.xy), layer, 0);
+    for (var k = 0u; k < 4u; k++) {
+        let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
+        if (all(pixel < frame.size)) {
+            let value = select(upsampled(pixels[k], nearest), vec4<f32>(0.0, 0.0, 0.0, 1.0), (sky & (1u << k)) != 0u);
+            textureStore(occlusion_out, vec2<i32>(pixel), layer, value);
+        }
+    }
 }

@@ -29,7 +29,6 @@ const SHADERS: &[(&str, &str)] = &[
     ("shadow.wgsl", include_str!("../../shaders/shadow.wgsl")),
     ("shadow_map.wgsl", include_str!("../../shaders/shadow_map.wgsl")),
     ("rsm.wgsl", include_str!("../../shaders/rsm.wgsl")),
-    ("rsm_upsample.wgsl", include_str!("../../shaders/rsm_upsample.wgsl")),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
     ("reproject.wgsl", include_str!("../../shaders/reproject.wgsl")),
     ("mirror.wgsl", include_str!("../../shaders/mirror.wgsl")),

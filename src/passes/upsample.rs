@@ -61,7 +61,8 @@ impl Pass for UpsamplePass {
             ctx.view(input),
             ctx.view(Resource::AoFull),
         ];
-        let extent = ctx.extent();
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        // One invocation per quad of 2×2 full-res pixels (upsample.wgsl).
+        let (width, height, layers) = ctx.extent();
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (width.div_ceil(2), height.div_ceil(2), layers));
     }
 }
