@@ -99,16 +99,14 @@ fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
         let b = vec2<i32>(id.xy);
         if (HALF_RES && ao.technique != 0u) {
             let up = upsample_quad(geometry_low, occlusion_layers, b, layer, eye.tangents, pixels);
-            let nearest = textureLoad(occlusion_layers, b, i32(layer), 0);
             for (var k = 0u; k < 4u; k++) {
-                occlusion[k] = upsampled(up[k], nearest);
+                occlusion[k] = upsampled(up[k]);
             }
         }
         if (RSM) {
             let up = upsample_quad(rsm_geometry, rsm_indirect, b, layer, eye.tangents, pixels);
-            let nearest = textureLoad(rsm_indirect, b, i32(layer), 0);
             for (var k = 0u; k < 4u; k++) {
-                bounce[k] = max(upsampled(up[k], nearest).rgb, vec3<f32>(0.0));
+                bounce[k] = max(upsampled(up[k]).rgb, vec3<f32>(0.0));
             }
         }
     }

@@ -58,6 +58,8 @@ struct UpsamplePixel {
     total: f32,
     // The least geometric agreement of the samples so far (edge test).
     agree: f32,
+    // The value of low-res sample b itself, the answer when every weight vanishes.
+    nearest: vec4<f32>,
 };
 
 fn upsample_pixel(pixel: vec2<u32>, position: vec3<f32>, n: vec3<f32>) -> UpsamplePixel {
@@ -69,6 +71,7 @@ fn upsample_pixel(pixel: vec2<u32>, position: vec3<f32>, n: vec3<f32>) -> Upsamp
     px.sum = vec4<f32>(0.0);
     px.total = 0.0;
     px.agree = 1.0;
+    px.nearest = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     return px;
 }
 
@@ -87,9 +90,9 @@ fn add_sample(pixel: UpsamplePixel, s: LowResSample) -> UpsamplePixel {
     return px;
 }
 
-// The pixel's upsampled value; `nearest` when every weight vanished.
-fn upsampled(px: UpsamplePixel, nearest: vec4<f32>) -> vec4<f32> {
-    var result = nearest;
+// The pixel's upsampled value; the nearest sample's when every weight vanished.
+fn upsampled(px: UpsamplePixel) -> vec4<f32> {
+    var result = px.nearest;
     if (px.total > 1e-20) {
         result = px.sum / px.total;
     }
@@ -111,6 +114,9 @@ fn upsample_quad(
     for (var i = 0; i < 4; i++) {
         let s = low_res_sample(geometry_low, value_low, b + vec2<i32>(i & 1, i >> 1u), layer, tangents);
         for (var k = 0; k < 4; k++) {
+            if (i == 0) {
+                pixels[k].nearest = s.value;
+            }
             pixels[k] = add_sample(pixels[k], s);
         }
     }

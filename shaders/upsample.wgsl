@@ -29,11 +29,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         pixels[k] = upsample_pixel(pixel, position, n);
     }
     pixels = upsample_quad(geometry_low, occlusion_low, vec2<i32>(id.xy), id.z, eye.tangents, pixels);
-    let nearest = textureLoad(occlusion_low, vec2<i32>(id.xy), layer, 0);
     for (var k = 0u; k < 4u; k++) {
         let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
         if (all(pixel < frame.size)) {
-            let value = select(upsampled(pixels[k], nearest), vec4<f32>(0.0, 0.0, 0.0, 1.0), (sky & (1u << k)) != 0u);
+            let value = select(upsampled(pixels[k]), vec4<f32>(0.0, 0.0, 0.0, 1.0), (sky & (1u << k)) != 0u);
             textureStore(occlusion_out, vec2<i32>(pixel), layer, value);
         }
     }
