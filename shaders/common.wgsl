@@ -211,7 +211,7 @@ fn pack_rgb9e5(c: vec3<f32>) -> u32 {
     // rounds to zero in every channel.
     let exponent_floor = max(i32((bitcast<u32>(brightest) >> 23u) & 0xffu) - 127, -16);
     var exponent = exponent_floor + 16;
-    var scale = exp2(f32(24 - exponent));
+    var scale = power_of_two(24 - exponent);
     if (floor(brightest * scale + 0.5) >= 512.0) {
         exponent += 1;
         scale *= 0.5;
@@ -222,7 +222,13 @@ fn pack_rgb9e5(c: vec3<f32>) -> u32 {
 
 fn unpack_rgb9e5(bits: u32) -> vec3<f32> {
     let m = vec3<u32>(bits, bits >> 9u, bits >> 18u) & vec3<u32>(511u);
-    return vec3<f32>(m) * exp2(f32(i32(bits >> 27u) - 24));
+    return vec3<f32>(m) * power_of_two(i32(bits >> 27u) - 24);
+}
+
+// 2^e for −126 ≤ e ≤ 127, built from the exponent bits: exact, and a few integer
+// operations where exp2 is a polynomial on a CPU adapter.
+fn power_of_two(e: i32) -> f32 {
+    return bitcast<f32>(u32(e + 127) << 23u);
 }
 
 fn pack_direct(distance: f32, radiance: vec3<f32>) -> vec4<u32> {

@@ -128,7 +128,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             visible_off += off;
             weight_visible += cos_theta;
         } else if (BOUNCE) {
-            let sender = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, r.eye.tangents);
+            // The sender lies on the sample's view ray, at the stored distance.
+            let sender = s * (probe.distance / -s.z);
             let to_receiver = r.position - sender;
             let d2 = dot(to_receiver, to_receiver);
             let dir = to_receiver * inverseSqrt(max(d2, 1e-30));

@@ -120,8 +120,9 @@ impl Environment {
         top.lerp(bottom, fy) * self.intensity
     }
 
-    /// `irradiance_sh` times `intensity`: the coefficients a shader evaluates with
-    /// [`sh9_basis`] to get E(n) (clamp the result at 0, as [`Environment::irradiance`] does).
+    /// `irradiance_sh` times `intensity`: evaluate with [`sh9_basis`] to get E(n) (clamp
+    /// the result at 0, as [`Environment::irradiance`] does). The shaders take it as
+    /// [`Environment::irradiance_quadratic`].
     pub fn irradiance_sh_scaled(&self) -> [Vec3; 9] {
         self.irradiance_sh.map(|c| c * self.intensity)
     }
