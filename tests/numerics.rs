@@ -11,19 +11,18 @@ use std::sync::Arc;
 use vrao::gpu::targets::LayeredTarget;
 use vrao::graph::Resource;
 use vrao::headset::reproject::{output_target, ReprojectionMode, Reprojector};
-use vrao::scene::{Light, Material, Mesh, Scene};
+use vrao::scene::{Light, Material, Scene};
 use vrao::settings::{AoSettings, Technique};
 use vrao::stereo::{Fov, HeadPose};
 use vrao::{Gpu, HeadsetProfile, Renderer, Settings};
 
 const TECHNIQUES: [Technique; 4] = [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce];
 
-/// What one frame produced, per resource and layer (RGBA or depth values).
+/// What one frame produced, per resource and layer (RGBA values; depth is checked as it is read).
 struct Outputs {
     ao: Vec<Vec<f32>>,
     hdr: Vec<Vec<f32>>,
     color: Vec<Vec<u8>>,
-    depth: Vec<Vec<f32>>,
 }
 
 fn settings(size: (u32, u32), ao: AoSettings) -> Settings {
@@ -64,7 +63,7 @@ fn render_checked(gpu: &Arc<Gpu>, label: &str, scene: &Scene, s: &Settings, head
     let depth = renderer.read_f32(Resource::Depth).unwrap();
     assert!(depth.iter().flatten().all(|d| d.is_finite() && (0.0..=1.0).contains(d)), "{label}: depth");
     renderer.gpu().take_error().unwrap_or_else(|e| panic!("{label}: {e}"));
-    Outputs { ao, hdr, color, depth }
+    Outputs { ao, hdr, color }
 }
 
 /// Every technique, full and half resolution.
