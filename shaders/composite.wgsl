@@ -29,12 +29,6 @@ override HALF_RES: bool = false;
 // uniform skips it (composite 122 → 213 ms at 1080×1200 on Sibenik).
 override RSM: bool = false;
 
-// Pixel `k` of the quad of invocation `id` (pixels past an odd edge repeat the last row
-// or column; their store is skipped).
-fn quad_pixel(id: vec3<u32>, k: u32) -> vec2<u32> {
-    return min(id.xy * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
-}
-
 // Outgoing radiance at `pixel`: the environment on the sky; else the direct light plus
 // albedo/π × the ambient, which `occlusion` attenuates (technique 1) or replaces
 // (technique 2, SSDO's irradiance), plus the RSM `bounce`.
@@ -86,15 +80,12 @@ fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
     var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     if ((HALF_RES && ao.technique != 0u) || RSM) {
-        // The quad's positions and normals for the joint bilateral weights (a sky pixel
-        // gets a far-away one; its result is not used).
+        // The quad's positions and normals for the joint bilateral weights.
         var pixels: array<UpsamplePixel, 4>;
         for (var k = 0u; k < 4u; k++) {
-            let pixel = quad_pixel(id, k);
-            let depth = max(textureLoad(depth_layers, vec2<i32>(pixel), i32(layer), 0), 1e-30);
-            let position = view_position_from_depth(pixel_uv(pixel, frame.size), depth, eye.tangents, frame.near);
-            let n = safe_normal(textureLoad(normal_layers, vec2<i32>(pixel), i32(layer), 0).xyz, position);
-            pixels[k] = upsample_pixel(pixel, position, n);
+            let pixel = quad_pixel(id.xy, k);
+            let depth = textureLoad(depth_layers, vec2<i32>(pixel), i32(layer), 0);
+            pixels[k] = upsample_pixel(normal_layers, pixel, layer, eye, depth);
         }
         let b = vec2<i32>(id.xy);
         if (HALF_RES && ao.technique != 0u) {
@@ -112,7 +103,7 @@ fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     if (!HALF_RES && ao.technique != 0u) {
         for (var k = 0u; k < 4u; k++) {
-            occlusion[k] = textureLoad(occlusion_layers, vec2<i32>(quad_pixel(id, k)), i32(layer), 0);
+            occlusion[k] = textureLoad(occlusion_layers, vec2<i32>(quad_pixel(id.xy, k)), i32(layer), 0);
         }
     }
     for (var k = 0u; k < 4u; k++) {

@@ -5,9 +5,10 @@
 // pixels 2b + {0, 1}² of low-res sample b: all four have the same 2×2 (and 3×3)
 // low-res neighbourhood, so each sample is fetched once per quad instead of once per
 // pixel. On lavapipe the fetches, not the weights, are what upsampling costs: per pixel
-// it went from 18.2 to 11.5 ms at 540×600 (Sibenik). Each low-res neighbour is weighted by its distance to the pixel and by how well its geometry
-// (normal and distance in AoGeometry, from the full-res pixel it was computed at)
-// matches: tangent-plane distance and normal. Odd sizes work because low-res pixel q
+// it went from 18.2 to 11.5 ms at 540×600 (Sibenik). Each low-res neighbour is weighted
+// by its distance to the pixel and by how well its geometry (normal and distance in
+// AoGeometry, from the full-res pixel it was computed at) matches: tangent-plane
+// distance and normal. Odd sizes work because low-res pixel q
 // stands for full-res pixel min(2q, size − 1). The low-res size is the texture's own, so
 // any half-resolution target (occlusion, the RSM bounce) upsamples with it.
 
@@ -62,10 +63,20 @@ struct UpsamplePixel {
     nearest: vec4<f32>,
 };
 
-fn upsample_pixel(pixel: vec2<u32>, position: vec3<f32>, n: vec3<f32>) -> UpsamplePixel {
+// Pixel `k` (0..3) of the quad of low-res sample `b`. Pixels past an odd edge repeat the
+// last row or column; callers skip their store.
+fn quad_pixel(b: vec2<u32>, k: u32) -> vec2<u32> {
+    return min(b * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
+}
+
+// The running sum of full-res `pixel` of eye `eye`, whose stored depth is `depth`: its
+// view position and normal from the G-buffer. A sky pixel (depth 0) gets a far-away
+// position; its result is not used.
+fn upsample_pixel(normal_layers: texture_2d_array<f32>, pixel: vec2<u32>, layer: u32, eye: Eye, depth: f32) -> UpsamplePixel {
+    let position = load_view_position(max(depth, 1e-30), pixel, eye, frame.size, frame.near);
     var px: UpsamplePixel;
     px.position = position;
-    px.n = n;
+    px.n = safe_normal(textureLoad(normal_layers, vec2<i32>(pixel), i32(layer), 0).xyz, position);
     px.pixel = vec2<f32>(pixel);
     px.plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
     px.sum = vec4<f32>(0.0);

@@ -20,13 +20,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var pixels: array<UpsamplePixel, 4>;
     var sky = 0u;
     for (var k = 0u; k < 4u; k++) {
-        // Pixels past an odd edge repeat the last row or column (their store is skipped).
-        let pixel = min(id.xy * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
+        let pixel = quad_pixel(id.xy, k);
         let depth = textureLoad(depth_layers, vec2<i32>(pixel), layer, 0);
         sky |= select(0u, 1u << k, depth <= 0.0);
-        let position = load_view_position(max(depth, 1e-30), pixel, eye, frame.size, frame.near);
-        let n = safe_normal(textureLoad(normal_layers, vec2<i32>(pixel), layer, 0).xyz, position);
-        pixels[k] = upsample_pixel(pixel, position, n);
+        pixels[k] = upsample_pixel(normal_layers, pixel, id.z, eye, depth);
     }
     pixels = upsample_quad(geometry_low, occlusion_low, vec2<i32>(id.xy), id.z, eye.tangents, pixels);
     for (var k = 0u; k < 4u; k++) {

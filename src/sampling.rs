@@ -70,6 +70,8 @@ pub fn hbao_directions_steps(samples: u32) -> (u32, u32) {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn kernel_parts_together_are_the_longer_kernel() {
         for density in [HemisphereDensity::Cosine, HemisphereDensity::Uniform] {
@@ -78,8 +80,6 @@ mod tests {
             assert_ne!(hemisphere_kernel_part(1, 8, density), hemisphere_kernel_part(0, 8, density));
         }
     }
-
-    use super::*;
 
     #[test]
     fn halton_matches_its_definition() {

@@ -188,6 +188,7 @@ pub enum BounceForm {
 }
 
 impl BounceForm {
+    pub const ALL: [BounceForm; 2] = [BounceForm::Direction, BounceForm::Patch];
     pub fn name(self) -> &'static str {
         match self {
             BounceForm::Patch => "patch",
@@ -199,11 +200,10 @@ impl BounceForm {
 impl std::str::FromStr for BounceForm {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "patch" => Ok(BounceForm::Patch),
-            "direction" => Ok(BounceForm::Direction),
-            other => Err(format!("unknown bounce form '{other}' (expected direction or patch)")),
-        }
+        BounceForm::ALL
+            .into_iter()
+            .find(|f| f.name() == s)
+            .ok_or_else(|| format!("unknown bounce form '{s}' (expected direction or patch)"))
     }
 }
 

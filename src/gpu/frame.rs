@@ -8,7 +8,7 @@ use crate::scene::{Light, Scene};
 use crate::settings::{Noise, Settings, Technique};
 use crate::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, Mat3, Mat4};
+use glam::{DMat4, Mat3, Mat4, Vec3};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -191,7 +191,7 @@ impl FrameBuffers {
             let [l, r, u, d] = eye.fov.tangents();
             let world_from_view = eye.pose.orientation.as_quat();
             if let Some(env) = &scene.environment {
-                let in_view = |q: [glam::Vec3; 10]| {
+                let in_view = |q: [Vec3; 10]| {
                     quadratic_in_view(&q, Mat3::from_quat(world_from_view)).map(|c| c.extend(0.0).to_array())
                 };
                 environment_quadratics[index] = in_view(env.irradiance_quadratic());

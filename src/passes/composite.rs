@@ -107,13 +107,8 @@ impl Pass for CompositePass {
             if rsm { ctx.view(Resource::RsmIndirect) } else { unused() },
             if rsm { ctx.view(Resource::RsmGeometry) } else { unused() },
         ];
-        let (width, height, layers) = ctx.extent();
-        let extent = if upsamples(half_res, rsm) {
-            // One invocation per quad of 2×2 pixels (composite.wgsl `main_quad`).
-            (width.div_ceil(2), height.div_ceil(2), layers)
-        } else {
-            (width, height, layers)
-        };
+        // Upsampling runs one invocation per quad of 2×2 pixels (composite.wgsl `main_quad`).
+        let extent = if upsamples(half_res, rsm) { ctx.quad_extent() } else { ctx.extent() };
         let kernel = &self.kernels[half_res as usize][rsm as usize];
         kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
     }

@@ -68,6 +68,13 @@ impl<'a> FrameContext<'a> {
         (p.width, p.height, self.setup.views)
     }
 
+    /// Width × height × layers of the quads of 2×2 full-res pixels (rounded up), for the
+    /// passes that upsample one quad per invocation.
+    pub fn quad_extent(&self) -> (u32, u32, u32) {
+        let (width, height, layers) = self.extent();
+        (width.div_ceil(2), height.div_ceil(2), layers)
+    }
+
     /// Width × height × layers of the occlusion targets (half size with half-res).
     pub fn ao_extent(&self) -> (u32, u32, u32) {
         let p = &self.setup.settings.profile;

@@ -62,7 +62,6 @@ impl Pass for UpsamplePass {
             ctx.view(Resource::AoFull),
         ];
         // One invocation per quad of 2×2 full-res pixels (upsample.wgsl).
-        let (width, height, layers) = ctx.extent();
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (width.div_ceil(2), height.div_ceil(2), layers));
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.quad_extent());
     }
 }

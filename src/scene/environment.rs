@@ -315,9 +315,15 @@ mod tests {
         let irradiance = quadratic_in_view(&env.irradiance_quadratic(), world_from_view);
         for v in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize(), Vec3::new(-0.7, 0.1, 0.2).normalize()] {
             let (expected, got) = (eval(&world, world_from_view * v), eval(&view, v));
-            assert!((expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()), "{v}: {expected} vs {got}");
+            assert!(
+                (expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()),
+                "{v}: {expected} vs {got}"
+            );
             let (expected, got) = (env.irradiance(world_from_view * v), eval(&irradiance, v).max(Vec3::ZERO));
-            assert!((expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()), "E {v}: {expected} vs {got}");
+            assert!(
+                (expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()),
+                "E {v}: {expected} vs {got}"
+            );
         }
     }
 
