@@ -1,5 +1,5 @@
 // Environment light for the passes that bind `frame` (SSDO, composite): the irradiance
-// SH9 and the pre-filtered radiance SH9 are each a quadratic polynomial in the direction,
+// SH9 and the pre-filtered radiance (its first two bands) are polynomials in the direction,
 // stored per eye in its view space (`frame.environment_quadratics`), so a view-space
 // normal or a sum of view-space directions needs no turn into the world.
 
@@ -15,6 +15,13 @@ fn quadratic_sum(first: u32, layer: u32, m0: f32, m1: vec3<f32>, diag: vec3<f32>
     return q[0].xyz * m0 + q[1].xyz * m1.x + q[2].xyz * m1.y + q[3].xyz * m1.z
         + q[4].xyz * diag.x + q[5].xyz * diag.y + q[6].xyz * diag.z
         + q[7].xyz * off.x + q[8].xyz * off.y + q[9].xyz * off.z;
+}
+
+// Σ_i c_i f(ω_i) for a quadratic f whose second-order rows vanish (the pre-filtered
+// radiance, `Environment::radiance_sh_prefiltered`): m0 = Σc and m1 = Σcω are enough.
+fn linear_sum(first: u32, layer: u32, m0: f32, m1: vec3<f32>) -> vec3<f32> {
+    let q = &frame.environment_quadratics[first + layer];
+    return q[0].xyz * m0 + q[1].xyz * m1.x + q[2].xyz * m1.y + q[3].xyz * m1.z;
 }
 
 // The irradiance E(n) on a surface of view-space unit normal `n` in eye `layer` that sees

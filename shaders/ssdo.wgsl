@@ -36,10 +36,10 @@ fn probe_sender(layer: u32, s: vec3<f32>, eye: Eye) -> SenderProbe {
 }
 
 // Σ_i c_i L(ω_i) from the view-space moments of the directions ω_i (irradiance.wgsl
-// `quadratic_sum`). Clamped at 0 as the quadratic can ring slightly negative opposite a
-// bright sun.
-fn gathered_radiance(layer: u32, m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>) -> vec3<f32> {
-    return max(quadratic_sum(RADIANCE, layer, m0, m1, diag, off), vec3<f32>(0.0));
+// `linear_sum`). Clamped at 0 as the band-limited radiance can ring negative opposite
+// a bright sun.
+fn gathered_radiance(layer: u32, m0: f32, m1: vec3<f32>) -> vec3<f32> {
+    return max(linear_sum(RADIANCE, layer, m0, m1), vec3<f32>(0.0));
 }
 
 // Solid angle of a disc of radius² `a` seen on its axis from distance² `d2`:
@@ -88,11 +88,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let disc_radius2 = ao.radius * ao.radius / f32(samples);
     // Cosine-weighted moments of all and of unblocked directions (view space).
     var all_m1 = vec3<f32>(0.0);
-    var all_diag = vec3<f32>(0.0);
-    var all_off = vec3<f32>(0.0);
     var visible_m1 = vec3<f32>(0.0);
-    var visible_diag = vec3<f32>(0.0);
-    var visible_off = vec3<f32>(0.0);
     var bounce = vec3<f32>(0.0);
     var weight_all = 0.0;
     var weight_visible = 0.0;
@@ -101,11 +97,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let omega = frame_rot * k.xyz;
         let cos_theta = k.z;
         let m1 = omega * cos_theta;
-        let diag = omega * m1;
-        let off = vec3<f32>(m1.x * omega.y, m1.x * omega.z, m1.y * omega.z);
         all_m1 += m1;
-        all_diag += diag;
-        all_off += off;
         weight_all += cos_theta;
         let s = origin + omega * (k.w * ao.range_scale * ao.radius);
         var fetched: SenderProbe;
@@ -124,8 +116,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         if (!blocked) {
             visible_m1 += m1;
-            visible_diag += diag;
-            visible_off += off;
             weight_visible += cos_theta;
         } else if (BOUNCE) {
             // The sender lies on the sample's view ray, at the stored distance.
@@ -151,8 +141,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // is blocked, per colour channel, and that share scales the exact SH irradiance: an
     // open plane gets exactly the ambient of the other techniques, at any N.
     let visibility = select(1.0, weight_visible / weight_all, weight_all > 1e-20);
-    let gathered_all = gathered_radiance(r.layer, weight_all, all_m1, all_diag, all_off);
-    let gathered_visible = gathered_radiance(r.layer, weight_visible, visible_m1, visible_diag, visible_off);
+    let gathered_all = gathered_radiance(r.layer, weight_all, all_m1);
+    let gathered_visible = gathered_radiance(r.layer, weight_visible, visible_m1);
     let share = select(vec3<f32>(visibility), gathered_visible / gathered_all, gathered_all > vec3<f32>(1e-20));
     var unoccluded = vec3<f32>(0.0);
     if (frame.has_environment != 0u) {
