@@ -37,6 +37,9 @@ pub struct Measurement {
     pub timing: Timing,
     pub warmup: u32,
     pub frames: u32,
+    /// Render whole frames (direct light and composite too), not only the occlusion:
+    /// rows then time the composite, which upsamples half-resolution occlusion inline.
+    pub whole_frame: bool,
 }
 
 /// One measured row: the case and per-pass medians over the measured frames.
@@ -85,7 +88,7 @@ pub fn measure(
     how: Measurement,
     reference: Option<&ReferenceImage>,
 ) -> Result<BenchRow> {
-    let mut run = CaseRun::new(gpu, scene, base, case, how.timing)?;
+    let mut run = CaseRun::new(gpu, scene, base, case, how)?;
     for _ in 0..how.warmup {
         run.frame()?;
     }
@@ -101,6 +104,8 @@ struct CaseRun {
     case: BenchCase,
     settings: Settings,
     output: crate::graph::Resource,
+    /// What each frame renders: the occlusion, and with `whole_frame` the lit image.
+    outputs: Vec<crate::graph::Resource>,
     renderer: Renderer,
     eyes: crate::stereo::EyePair,
     timing: Timing,
@@ -108,7 +113,8 @@ struct CaseRun {
 }
 
 impl CaseRun {
-    fn new(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, case: &BenchCase, timing: Timing) -> Result<CaseRun> {
+    fn new(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, case: &BenchCase, how: Measurement) -> Result<CaseRun> {
+        let timing = how.timing;
         let mut settings = base.clone();
         settings.ao.technique = case.technique;
         settings.ao.samples = case.samples;
@@ -126,12 +132,16 @@ impl CaseRun {
         let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
         renderer.set_timing(timing);
         let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
-        Ok(CaseRun { case: case.clone(), settings, output, renderer, eyes, timing, timings: Vec::new() })
+        let mut outputs = vec![output];
+        if how.whole_frame {
+            outputs.push(crate::graph::Resource::Hdr);
+        }
+        Ok(CaseRun { case: case.clone(), settings, output, outputs, renderer, eyes, timing, timings: Vec::new() })
     }
 
     /// One frame, not measured (warm-up).
     fn frame(&mut self) -> Result<crate::renderer::FrameReport> {
-        self.renderer.render(&self.eyes.eyes, &[self.output])
+        self.renderer.render(&self.eyes.eyes, &self.outputs)
     }
 
     /// One measured frame: serial timing keeps each pass's wall-clock time; pipelined,
@@ -194,7 +204,7 @@ pub fn measure_rsm(
     how: Measurement,
     reference: Option<&ReferenceImage>,
 ) -> Result<BenchRow> {
-    let Measurement { timing, warmup, frames } = how;
+    let Measurement { timing, warmup, frames, .. } = how;
     if crate::passes::shadow::shadow_casters(scene).is_empty() {
         return Err(Error::input(format!(
             "reflective shadow maps need a directional light; '{}' has none",
@@ -300,7 +310,7 @@ pub fn sweep(
     for group in cases.chunks(interleave.max(1)) {
         let mut runs = Vec::with_capacity(group.len());
         for case in group {
-            let mut run = CaseRun::new(gpu, scene, base, case, how.timing)?;
+            let mut run = CaseRun::new(gpu, scene, base, case, how)?;
             for _ in 0..how.warmup {
                 run.frame()?;
             }
@@ -415,6 +425,15 @@ pub struct BenchRecord {
     /// Temporal accumulation on; its pass is in `occlusion_ms_per_eye`.
     #[serde(default)]
     pub temporal: bool,
+    /// The composite (bench `--frame`; 0 without). At half resolution it upsamples the
+    /// occlusion inline, as every frame does.
+    #[serde(default)]
+    pub composite_ms_per_eye: f64,
+    /// Half-resolution rows with `--frame`: what upsampling costs a frame, this row's
+    /// composite minus the composite of the same case at full resolution (measured in
+    /// the same sweep). Frames do not run the stand-alone upsample pass.
+    #[serde(default)]
+    pub frame_upsample_ms_per_eye: Option<f64>,
 }
 
 impl BenchRecord {
@@ -480,11 +499,26 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
                 bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
                 temporal: c.temporal,
+                composite_ms_per_eye: per_eye("composite"),
+                frame_upsample_ms_per_eye: None,
             }
         })
         .collect();
+    for half in 0..out.len() {
+        let partner = out.iter().find(|full| full.resolution == "full" && same_case(full, &out[half]));
+        if let Some(full) = partner.filter(|f| out[half].resolution == "half" && f.composite_ms_per_eye > 0.0) {
+            let increase = out[half].composite_ms_per_eye - full.composite_ms_per_eye;
+            out[half].frame_upsample_ms_per_eye = (out[half].composite_ms_per_eye > 0.0).then_some(increase);
+        }
+    }
     mark_pareto(&mut out);
     out
+}
+
+/// Whether two records measure the same technique and setting (at any resolution).
+fn same_case(a: &BenchRecord, b: &BenchRecord) -> bool {
+    (a.technique.as_str(), a.samples, a.radius_m, a.depth_peeling, a.temporal)
+        == (b.technique.as_str(), b.samples, b.radius_m, b.depth_peeling, b.temporal)
 }
 
 /// Marks each record on the Pareto front of AO RMSE against occlusion ms per eye. Each
@@ -505,7 +539,7 @@ pub fn mark_pareto(out: &mut [BenchRecord]) {
     }
 }
 
-const COLUMNS: [&str; 18] = [
+const COLUMNS: [&str; 20] = [
     "technique",
     "samples",
     "radius_m",
@@ -524,9 +558,11 @@ const COLUMNS: [&str; 18] = [
     "bounce_rel_rmse",
     "bounce_rel_bias",
     "temporal",
+    "composite_ms_per_eye",
+    "frame_upsample_ms_per_eye",
 ];
 
-fn record_values(r: &BenchRecord) -> [String; 18] {
+fn record_values(r: &BenchRecord) -> [String; 20] {
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.4}"));
     [
         r.technique.clone(),
@@ -547,6 +583,8 @@ fn record_values(r: &BenchRecord) -> [String; 18] {
         optional(r.bounce_rel_rmse),
         optional(r.bounce_rel_bias),
         if r.temporal { "yes" } else { "" }.to_string(),
+        format!("{:.3}", r.composite_ms_per_eye),
+        r.frame_upsample_ms_per_eye.map_or(String::new(), |v| format!("{v:.3}")),
     ]
 }
 
@@ -562,6 +600,64 @@ pub fn to_markdown(records: &[BenchRecord]) -> String {
     let mut s = format!("| {} |\n|{}\n", COLUMNS.join(" | "), "---|".repeat(COLUMNS.len()));
     for r in records {
         let _ = writeln!(s, "| {} |", record_values(r).join(" | "));
+    }
+    s
+}
+
+/// The ratios a sweep is judged by, as Markdown (empty when no row has a partner):
+/// - half / full resolution of each case: occlusion ms per eye (technique + blur + the
+///   stand-alone upsample pass) and, with `--frame`, the same with the frame's inline
+///   upsampling instead of the pass;
+/// - each technique's pass against SSAO's at the same setting and resolution;
+/// - each technique's pass against fetch-only's (the same depth taps, no arithmetic):
+///   how far it is from the memory limit.
+pub fn ratios_markdown(records: &[BenchRecord]) -> String {
+    let mut s = String::new();
+    let plain = |r: &&BenchRecord| !r.depth_peeling && !r.temporal;
+    let mut half_full = String::new();
+    for half in records.iter().filter(|r| r.resolution == "half") {
+        let Some(full) = records.iter().find(|f| f.resolution == "full" && same_case(f, half)) else {
+            continue;
+        };
+        let in_frame = half.frame_upsample_ms_per_eye.map_or(String::new(), |up| {
+            format!("{:.3}", (half.occlusion_ms_per_eye - half.upsample_ms_per_eye + up) / full.occlusion_ms_per_eye)
+        });
+        let _ = writeln!(
+            half_full,
+            "| {} | {} | {} | {:.3} | {in_frame} |",
+            half.technique,
+            half.samples,
+            half.radius_m,
+            half.occlusion_ms_per_eye / full.occlusion_ms_per_eye
+        );
+    }
+    if !half_full.is_empty() {
+        s += "\nHalf / full resolution, occlusion ms per eye (technique + blur + upsampling):\n\n";
+        s += "| technique | samples | radius_m | with the upsample pass | with the frame's inline upsampling |\n|---|---|---|---|---|\n";
+        s += &half_full;
+    }
+    for (against, title) in [
+        ("ssao", "Technique pass against SSAO's at the same setting and resolution"),
+        ("fetch-only", "Technique pass against fetch-only's (same depth taps, no arithmetic)"),
+    ] {
+        let mut table = String::new();
+        for r in records.iter().filter(plain).filter(|r| r.technique != against && r.technique != "rsm") {
+            let partner = records.iter().filter(plain).find(|b| {
+                b.technique == against && (b.samples, b.radius_m, &b.resolution) == (r.samples, r.radius_m, &r.resolution)
+            });
+            if let Some(b) = partner {
+                let ratio = r.technique_ms_per_eye / b.technique_ms_per_eye;
+                let occlusion = r.occlusion_ms_per_eye / b.occlusion_ms_per_eye;
+                let _ = writeln!(
+                    table,
+                    "| {} | {} | {} | {} | {ratio:.3} | {occlusion:.3} |",
+                    r.technique, r.samples, r.radius_m, r.resolution
+                );
+            }
+        }
+        if !table.is_empty() {
+            let _ = write!(s, "\n{title}:\n\n| technique | samples | radius_m | resolution | technique pass | occlusion (with blur, upsampling) |\n|---|---|---|---|---|---|\n{table}");
+        }
     }
     s
 }

@@ -210,6 +210,12 @@ struct BenchArgs {
     /// between techniques); each needs its own targets in memory at once.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     interleave: u32,
+    /// Render whole frames (direct light and composite too), not only the occlusion: the
+    /// composite is timed, and each half-resolution row gets the cost of upsampling as a
+    /// frame pays it, inline in the composite (its composite minus the full-resolution
+    /// row's; sweep --resolution both, ideally interleaved).
+    #[arg(long)]
+    frame: bool,
     /// Per-eye width in pixels.
     #[arg(long, default_value_t = 1080)]
     width: u32,
@@ -707,7 +713,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         &scene,
         &settings,
         &cases,
-        Measurement { timing, warmup: args.warmup, frames: args.frames },
+        Measurement { timing, warmup: args.warmup, frames: args.frames, whole_frame: args.frame },
         args.interleave as usize,
         &references,
         |done, total, row| {
@@ -727,7 +733,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     for &samples in &args.rsm_samples {
         for &radius in &radii {
             let reference = references.iter().find(|(r, _)| *r == radius).map(|(_, image)| image);
-            let how = Measurement { timing, warmup: args.warmup, frames: args.frames };
+            let how = Measurement { timing, warmup: args.warmup, frames: args.frames, whole_frame: args.frame };
             let row = vrao::bench::measure_rsm(&gpu, &scene, &settings, samples, radius, how, reference)?;
             let error = row.bounce.map_or(String::new(), |b| format!("  bounce rel RMSE {:.4}", b.rel_rmse));
             eprintln!("[rsm] N={samples:<3} r={radius:<7} half {:>9.3} ms/eye{error}", row.occlusion_ms_per_eye());
@@ -753,14 +759,15 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
 
 /// Writes a bench's table, CSV, JSON, Markdown and plots into `args.out` and prints them.
 fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], adapter: &str) -> Result<()> {
-    use vrao::bench::{plot, to_csv, to_json, to_markdown};
+    use vrao::bench::{plot, ratios_markdown, to_csv, to_json, to_markdown};
     std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
     let write = |name: &str, text: String| {
         let path = args.out.join(name);
         std::fs::write(&path, text).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })
     };
     write("bench.csv", to_csv(&file.records))?;
-    write("bench.md", to_markdown(&file.records))?;
+    let markdown = to_markdown(&file.records) + &ratios_markdown(&file.records);
+    write("bench.md", markdown.clone())?;
     write("bench.json", to_json(file))?;
     let mut written = "bench.csv, bench.json, bench.md".to_string();
     if file.reference.is_some() {
@@ -772,7 +779,7 @@ fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], a
             written += &format!(", {name}");
         }
     }
-    println!("{}", to_markdown(&file.records));
+    println!("{markdown}");
     if let Some(r) = &file.reference {
         println!(
             "reference: {} rays per pixel at every {} pixels; its AO noise (RMS standard error) {:.4}{}",

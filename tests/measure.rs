@@ -132,8 +132,16 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     for line in csv.lines().skip(1) {
         assert_eq!(line.split(',').count(), header.len(), "{line}");
     }
+    // The table of rows (header, rule, one line a row), then the ratios: half / full
+    // for each case, and HBAO and SSDO against SSAO at each setting and resolution.
     let markdown = std::fs::read_to_string(out_dir.join("bench.md")).unwrap();
-    assert_eq!(markdown.lines().count(), rows + 2);
+    assert_eq!(markdown.lines().take_while(|l| !l.is_empty()).count(), rows + 2, "{markdown}");
+    let ratio_rows = |title: &str| {
+        let section = markdown.split(title).nth(1).unwrap_or_else(|| panic!("no '{title}' in {markdown}"));
+        section.lines().skip(4).take_while(|l| l.starts_with("| ")).count()
+    };
+    assert_eq!(ratio_rows("Half / full resolution"), 3 * 2, "{markdown}");
+    assert_eq!(ratio_rows("against SSAO"), 2 * 2 * 2, "{markdown}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("bench.json")).unwrap()).unwrap();
     let records = json["records"].as_array().unwrap();
@@ -159,7 +167,9 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     let mut interleaved_args: Vec<&str> = args.to_vec();
     let out_index = interleaved_args.iter().position(|a| *a == "--out").unwrap() + 1;
     interleaved_args[out_index] = interleaved_dir.to_str().unwrap();
-    interleaved_args.extend(["--interleave", "5"]);
+    // Also with whole frames: the composite is timed and half-resolution rows get the
+    // frame's inline upsampling cost, from their full-resolution partner.
+    interleaved_args.extend(["--interleave", "5", "--frame"]);
     let out = vrao(&interleaved_args);
     assert!(out.status.success(), "{}", text(&out));
     let again: serde_json::Value =
@@ -170,6 +180,11 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
         for key in ["technique", "samples", "resolution", "ao_rmse", "ao_ssim"] {
             assert_eq!(a[key], b[key], "{key}: {a} vs {b}");
         }
+        assert_eq!(a["composite_ms_per_eye"].as_f64(), Some(0.0), "no composite without --frame: {a}");
+        assert!(a["frame_upsample_ms_per_eye"].is_null(), "{a}");
+        assert!(b["composite_ms_per_eye"].as_f64().unwrap() > 0.0, "{b}");
+        let half = b["resolution"] == "half";
+        assert_eq!(b["frame_upsample_ms_per_eye"].as_f64().is_some(), half, "only half rows: {b}");
     }
 
     // --fit picks the least-error row (at the bench's radius) that fits a generous
