@@ -29,12 +29,12 @@ override HALF_RES: bool = false;
 // uniform skips it (composite 122 → 213 ms at 1080×1200 on Sibenik).
 override RSM: bool = false;
 
-// Outgoing radiance at `pixel`: the environment on the sky; else the direct light plus
-// albedo/π × the ambient, which `occlusion` attenuates (technique 1) or replaces
-// (technique 2, SSDO's irradiance), plus the RSM `bounce`.
-fn shade(pixel: vec2<u32>, layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) -> vec3<f32> {
+// Outgoing radiance at `pixel`, whose stored depth and normal are `depth` and `n`: the
+// environment on the sky; else the direct light plus albedo/π × the ambient, which
+// `occlusion` attenuates (technique 1) or replaces (technique 2, SSDO's irradiance),
+// plus the RSM `bounce`.
+fn shade(pixel: vec2<u32>, layer: u32, eye: Eye, depth: f32, n: vec3<f32>, occlusion: vec4<f32>, bounce: vec3<f32>) -> vec3<f32> {
     let p = vec2<i32>(pixel);
-    let depth = textureLoad(depth_layers, p, i32(layer), 0);
     if (depth <= 0.0) {
         if (frame.has_environment == 0u) {
             return vec3<f32>(0.0);
@@ -42,7 +42,6 @@ fn shade(pixel: vec2<u32>, layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: v
         let dir = (eye.world_from_view * vec4<f32>(view_ray(pixel_uv(pixel, frame.size), eye.tangents), 0.0)).xyz;
         return environment_radiance(environment, environment_sampler, dir);
     }
-    let n = textureLoad(normal_layers, p, i32(layer), 0).xyz;
     let albedo = textureLoad(albedo_layers, p, i32(layer), 0).rgb;
     var ambient = vec3<f32>(0.0);
     if (frame.has_environment != 0u) {
@@ -65,7 +64,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (ao.technique != 0u) {
         occlusion = textureLoad(occlusion_layers, vec2<i32>(id.xy), i32(id.z), 0);
     }
-    let radiance = shade(id.xy, id.z, frame.eyes[id.z], occlusion, vec3<f32>(0.0));
+    let p = vec2<i32>(id.xy);
+    let depth = textureLoad(depth_layers, p, i32(id.z), 0);
+    let n = textureLoad(normal_layers, p, i32(id.z), 0).xyz;
+    let radiance = shade(id.xy, id.z, frame.eyes[id.z], depth, n, occlusion, vec3<f32>(0.0));
     textureStore(hdr_out, vec2<i32>(id.xy), i32(id.z), vec4<f32>(finite_or_zero3(radiance), 1.0));
 }
 
@@ -79,13 +81,18 @@ fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
     let unoccluded = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    // The quad's depths and normals, for shading and the joint bilateral weights.
+    var depths: array<f32, 4>;
+    var normals: array<vec3<f32>, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        let pixel = vec2<i32>(quad_pixel(id.xy, k));
+        depths[k] = textureLoad(depth_layers, pixel, i32(layer), 0);
+        normals[k] = textureLoad(normal_layers, pixel, i32(layer), 0).xyz;
+    }
     if ((HALF_RES && ao.technique != 0u) || RSM) {
-        // The quad's positions and normals for the joint bilateral weights.
         var pixels: array<UpsamplePixel, 4>;
         for (var k = 0u; k < 4u; k++) {
-            let pixel = quad_pixel(id.xy, k);
-            let depth = textureLoad(depth_layers, vec2<i32>(pixel), i32(layer), 0);
-            pixels[k] = upsample_pixel(normal_layers, pixel, layer, eye, depth);
+            pixels[k] = upsample_pixel(quad_pixel(id.xy, k), eye, depths[k], normals[k]);
         }
         let b = vec2<i32>(id.xy);
         if (HALF_RES && ao.technique != 0u) {
@@ -109,7 +116,7 @@ fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var k = 0u; k < 4u; k++) {
         let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
         if (all(pixel < frame.size)) {
-            let radiance = shade(pixel, layer, eye, occlusion[k], bounce[k]);
+            let radiance = shade(pixel, layer, eye, depths[k], normals[k], occlusion[k], bounce[k]);
             textureStore(hdr_out, vec2<i32>(pixel), i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
         }
     }

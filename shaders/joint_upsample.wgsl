@@ -69,14 +69,14 @@ fn quad_pixel(b: vec2<u32>, k: u32) -> vec2<u32> {
     return min(b * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
 }
 
-// The running sum of full-res `pixel` of eye `eye`, whose stored depth is `depth`: its
-// view position and normal from the G-buffer. A sky pixel (depth 0) gets a far-away
-// position; its result is not used.
-fn upsample_pixel(normal_layers: texture_2d_array<f32>, pixel: vec2<u32>, layer: u32, eye: Eye, depth: f32) -> UpsamplePixel {
+// The running sum of full-res `pixel` of eye `eye`, whose stored depth and normal are
+// `depth` and `normal` (G-buffer): its view position and normal. A sky pixel (depth 0)
+// gets a far-away position; its result is not used.
+fn upsample_pixel(pixel: vec2<u32>, eye: Eye, depth: f32, normal: vec3<f32>) -> UpsamplePixel {
     let position = load_view_position(max(depth, 1e-30), pixel, eye, frame.size, frame.near);
     var px: UpsamplePixel;
     px.position = position;
-    px.n = safe_normal(textureLoad(normal_layers, vec2<i32>(pixel), i32(layer), 0).xyz, position);
+    px.n = safe_normal(normal, position);
     px.pixel = vec2<f32>(pixel);
     px.plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
     px.sum = vec4<f32>(0.0);

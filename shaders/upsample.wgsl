@@ -23,7 +23,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let pixel = quad_pixel(id.xy, k);
         let depth = textureLoad(depth_layers, vec2<i32>(pixel), layer, 0);
         sky |= select(0u, 1u << k, depth <= 0.0);
-        pixels[k] = upsample_pixel(normal_layers, pixel, id.z, eye, depth);
+        let normal = textureLoad(normal_layers, vec2<i32>(pixel), layer, 0).xyz;
+        pixels[k] = upsample_pixel(pixel, eye, depth, normal);
     }
     pixels = upsample_quad(geometry_low, occlusion_low, vec2<i32>(id.xy), id.z, eye.tangents, pixels);
     for (var k = 0u; k < 4u; k++) {

@@ -643,7 +643,8 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
         let mut table = String::new();
         for r in records.iter().filter(plain).filter(|r| r.technique != against && r.technique != "rsm") {
             let partner = records.iter().filter(plain).find(|b| {
-                b.technique == against && (b.samples, b.radius_m, &b.resolution) == (r.samples, r.radius_m, &r.resolution)
+                b.technique == against
+                    && (b.samples, b.radius_m, &b.resolution) == (r.samples, r.radius_m, &r.resolution)
             });
             if let Some(b) = partner {
                 let ratio = r.technique_ms_per_eye / b.technique_ms_per_eye;
