@@ -21,12 +21,11 @@ struct Frame {
     exposure: f32,
     white_point: f32,
     has_environment: u32,
-    // Irradiance SH9 (already scaled by the environment intensity), rgb in xyz.
     // The environment light as quadratic polynomials in a view-space direction,
     // [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz] with rgb in xyz, turned into each
     // eye's view space on the CPU: irradiance SH9 (scaled by the environment intensity)
-    // of eye 0 and eye 1, then the pre-filtered (Hann-windowed) radiance SH9 of eye 0
-    // and eye 1 (SSDO); irradiance.wgsl reads them.
+    // of eye 0 and eye 1, then the pre-filtered radiance (SH bands 0 and 1, so its
+    // second-order terms are 0) of eye 0 and eye 1 (SSDO); irradiance.wgsl reads them.
     environment_quadratics: array<array<vec4<f32>, 10>, 4>,
 };
 

@@ -1,10 +1,11 @@
 // SSDO (seed 002 eq. 1; seed 003 §4.1): N directions uniform over the normal's
 // hemisphere, each covering Δω = 2π/N, with sample points P + λ_i ω_i, λ_i ∈ [0, r_max].
 // A point below the visible surface (its projection moves towards the eye) blocks its
-// direction; unblocked directions gather the environment radiance, pre-filtered as a
-// Hann-windowed SH9 (seed 002 §7.2 asks for a smooth map). Nine SH terms are a quadratic
-// polynomial in ω, so Σ L(ω_i) cos θ_i needs only the samples' moments Σc, Σcω, Σcωωᵀ:
-// ten multiply-adds per sample, and the colour is evaluated once per pixel.
+// direction; unblocked directions gather the environment radiance, pre-filtered to its
+// first two SH bands (seed 002 §7.2 asks for a smooth map;
+// `Environment::radiance_sh_prefiltered`). That is linear in ω, so Σ L(ω_i) cos θ_i needs
+// only the samples' moments Σc and Σcω: four adds per sample, and the colour is
+// evaluated once per pixel.
 // With the bounce (seed 002 eq. 2; seed 003 §4.2), in the same loop, each blocking
 // sample's surface sends the direct light stored at its pixel towards P: as eq. 2's
 // patch of area π r_max²/N (BOUNCE_PATCH), or through the blocked direction's share of
