@@ -24,8 +24,6 @@ struct LowResSample {
     normal: vec3<f32>,
     // 1 on the target and off the sky, else 0 (its weight vanishes).
     valid: f32,
-    // The full-res pixel it was computed at.
-    pixel: vec2<f32>,
     value: vec4<f32>,
 };
 
@@ -42,7 +40,6 @@ fn low_res_sample(
     let fq = full_res_pixel(vec2<u32>(clamped), 2u, frame.size);
     var s: LowResSample;
     s.valid = select(0.0, 1.0, all(q == clamped) && geometry.w > 0.0);
-    s.pixel = vec2<f32>(fq);
     s.position = view_position_from_distance(pixel_uv(fq, frame.size), geometry.w, tangents);
     s.normal = geometry.xyz;
     s.value = textureLoad(value_low, clamped, i32(layer), 0);
@@ -53,7 +50,8 @@ fn low_res_sample(
 struct UpsamplePixel {
     position: vec3<f32>,
     n: vec3<f32>,
-    pixel: vec2<f32>,
+    // n·position × plane_scale: a sample's plane distance is then one dot and a subtract.
+    plane_offset: f32,
     plane_scale: f32,
     sum: vec4<f32>,
     total: f32,
@@ -77,8 +75,8 @@ fn upsample_pixel(pixel: vec2<u32>, eye: Eye, depth: f32, normal: vec3<f32>) -> 
     var px: UpsamplePixel;
     px.position = position;
     px.n = safe_normal(normal, position);
-    px.pixel = vec2<f32>(pixel);
     px.plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
+    px.plane_offset = dot(px.n, position) * px.plane_scale;
     px.sum = vec4<f32>(0.0);
     px.total = 0.0;
     px.agree = 1.0;
@@ -87,18 +85,26 @@ fn upsample_pixel(pixel: vec2<u32>, eye: Eye, depth: f32, normal: vec3<f32>) -> 
 }
 
 // Weighs sample `s` into pixel `px`: its distance to the pixel's tangent plane and its
-// normal agreement (the geometric part), over 1 + its squared full-res pixel distance.
-fn add_sample(pixel: UpsamplePixel, s: LowResSample) -> UpsamplePixel {
+// normal agreement (the geometric part), times `spatial`, 1 / (1 + the squared full-res
+// pixel distance between them) (`spatial_weight`).
+fn add_sample(pixel: UpsamplePixel, s: LowResSample, spatial: f32) -> UpsamplePixel {
     var px = pixel;
-    let plane = dot(s.position - px.position, px.n) * px.plane_scale;
+    let plane = dot(s.position, px.n) * px.plane_scale - px.plane_offset;
     let agreement = s.valid * exp(-plane * plane) * normal_agreement(px.n, s.normal);
-    let offset = s.pixel - px.pixel;
-    let w = agreement / (1.0 + dot(offset, offset));
+    let w = agreement * spatial;
     let ok = w == w;
     px.sum += s.value * select(0.0, w, ok);
     px.total += select(0.0, w, ok);
     px.agree = min(px.agree, select(0.0, agreement, ok));
     return px;
+}
+
+// 1 / (1 + d²) for the full-res distance d between pixel k of the quad of b and low-res
+// sample b + `offset`, computed at full-res pixel 2(b + offset): a constant of the
+// unrolled loops (a sample clamped at the border is invalid and gets weight 0 anyway).
+fn spatial_weight(offset: vec2<i32>, k: i32) -> f32 {
+    let d = vec2<f32>(2 * offset - vec2<i32>(k & 1, k >> 1u));
+    return 1.0 / (1.0 + dot(d, d));
 }
 
 // The pixel's upsampled value; the nearest sample's when every weight vanished.
@@ -128,7 +134,7 @@ fn upsample_quad(
             if (i == 0) {
                 pixels[k].nearest = s.value;
             }
-            pixels[k] = add_sample(pixels[k], s);
+            pixels[k] = add_sample(pixels[k], s, spatial_weight(vec2<i32>(i & 1, i >> 1u), k));
         }
     }
     let edge = min(min(pixels[0].agree, pixels[1].agree), min(pixels[2].agree, pixels[3].agree));
@@ -144,7 +150,7 @@ fn upsample_quad(
             let s = low_res_sample(geometry_low, value_low, b + offset, layer, tangents);
             for (var k = 0; k < 4; k++) {
                 if ((needs & (1u << u32(k))) != 0u) {
-                    pixels[k] = add_sample(pixels[k], s);
+                    pixels[k] = add_sample(pixels[k], s, spatial_weight(offset, k));
                 }
             }
         }
