@@ -504,12 +504,13 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
             }
         })
         .collect();
-    for half in 0..out.len() {
-        let partner = out.iter().find(|full| full.resolution == "full" && same_case(full, &out[half]));
-        if let Some(full) = partner.filter(|f| out[half].resolution == "half" && f.composite_ms_per_eye > 0.0) {
-            let increase = out[half].composite_ms_per_eye - full.composite_ms_per_eye;
-            out[half].frame_upsample_ms_per_eye = (out[half].composite_ms_per_eye > 0.0).then_some(increase);
+    for i in 0..out.len() {
+        let half = &out[i];
+        if half.resolution != "half" || half.composite_ms_per_eye <= 0.0 {
+            continue;
         }
+        let full = out.iter().find(|f| f.resolution == "full" && f.composite_ms_per_eye > 0.0 && same_case(f, half));
+        out[i].frame_upsample_ms_per_eye = full.map(|f| half.composite_ms_per_eye - f.composite_ms_per_eye);
     }
     mark_pareto(&mut out);
     out
