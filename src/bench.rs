@@ -509,17 +509,21 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
         if half.resolution != "half" || half.composite_ms_per_eye <= 0.0 {
             continue;
         }
-        let full = out.iter().find(|f| f.resolution == "full" && f.composite_ms_per_eye > 0.0 && same_case(f, half));
+        let full = full_resolution_partner(&out, half).filter(|f| f.composite_ms_per_eye > 0.0);
         out[i].frame_upsample_ms_per_eye = full.map(|f| half.composite_ms_per_eye - f.composite_ms_per_eye);
     }
     mark_pareto(&mut out);
     out
 }
 
-/// Whether two records measure the same technique and setting (at any resolution).
-fn same_case(a: &BenchRecord, b: &BenchRecord) -> bool {
-    (a.technique.as_str(), a.samples, a.radius_m, a.depth_peeling, a.temporal)
-        == (b.technique.as_str(), b.samples, b.radius_m, b.depth_peeling, b.temporal)
+/// The full-resolution record of the same technique and setting as `half`.
+fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -> Option<&'a BenchRecord> {
+    let h = half;
+    records.iter().find(|f| {
+        f.resolution == "full"
+            && (f.technique.as_str(), f.samples, f.radius_m, f.depth_peeling, f.temporal)
+                == (h.technique.as_str(), h.samples, h.radius_m, h.depth_peeling, h.temporal)
+    })
 }
 
 /// Marks each record on the Pareto front of AO RMSE against occlusion ms per eye. Each
@@ -617,7 +621,7 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
     let plain = |r: &&BenchRecord| !r.depth_peeling && !r.temporal;
     let mut half_full = String::new();
     for half in records.iter().filter(|r| r.resolution == "half") {
-        let Some(full) = records.iter().find(|f| f.resolution == "full" && same_case(f, half)) else {
+        let Some(full) = full_resolution_partner(records, half) else {
             continue;
         };
         let in_frame = half.frame_upsample_ms_per_eye.map_or(String::new(), |up| {

@@ -191,9 +191,8 @@ impl FrameBuffers {
             let [l, r, u, d] = eye.fov.tangents();
             let world_from_view = eye.pose.orientation.as_quat();
             if let Some(env) = &scene.environment {
-                let in_view = |q: [Vec3; 10]| {
-                    quadratic_in_view(&q, Mat3::from_quat(world_from_view)).map(|c| c.extend(0.0).to_array())
-                };
+                let rotation = Mat3::from_quat(world_from_view);
+                let in_view = |q: [Vec3; 10]| quadratic_in_view(&q, rotation).map(|c| c.extend(0.0).to_array());
                 environment_quadratics[index] = in_view(env.irradiance_quadratic());
                 environment_quadratics[2 + index] = in_view(env.radiance_quadratic());
             }

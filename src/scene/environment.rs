@@ -279,41 +279,49 @@ mod tests {
         (0..50).map(|i| direction((i as f32 * 0.618_034).fract(), (i as f32 + 0.5) / 50.0))
     }
 
-    #[test]
-    fn quadratic_form_equals_the_sh_expansion() {
+    /// A 32×16 map with a different pattern per channel: every SH band is non-zero.
+    fn patterned() -> Environment {
         let texels: Vec<[f32; 3]> =
             (0..32 * 16).map(|i| [(i % 7) as f32, (i % 5) as f32 * 0.3, (i % 11) as f32]).collect();
-        let env = Environment::from_texels(32, 16, texels, 1.5).unwrap();
+        Environment::from_texels(32, 16, texels, 1.5).unwrap()
+    }
+
+    /// An eye's orientation turned about all three axes.
+    fn turned_view() -> Mat3 {
+        Mat3::from_quat(glam::Quat::from_euler(glam::EulerRot::YXZ, 0.7, -0.4, 0.2))
+    }
+
+    /// A quadratic of `sh9_quadratic`'s layout evaluated at direction `d`.
+    fn eval_quadratic(q: &[Vec3; 10], d: Vec3) -> Vec3 {
+        let Vec3 { x, y, z } = d;
+        let monomials = [1.0, x, y, z, x * x, y * y, z * z, x * y, x * z, y * z];
+        q.iter().zip(monomials).map(|(c, m)| *c * m).sum()
+    }
+
+    #[test]
+    fn quadratic_form_equals_the_sh_expansion() {
+        let env = patterned();
         let (sh, q) = (env.radiance_sh_prefiltered(), env.radiance_quadratic());
         for dir in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize(), Vec3::new(-0.7, 0.1, 0.2).normalize()] {
             let from_sh: Vec3 = sh.iter().zip(sh9_basis(dir)).map(|(c, y)| *c * y).sum();
-            let Vec3 { x, y, z } = dir;
-            let monomials = [1.0, x, y, z, x * x, y * y, z * z, x * y, x * z, y * z];
-            let from_q: Vec3 = q.iter().zip(monomials).map(|(c, m)| *c * m).sum();
+            let from_q = eval_quadratic(&q, dir);
             assert!((from_sh - from_q).abs().max_element() < 1e-4 * (1.0 + from_sh.abs().max_element()), "{dir}");
         }
     }
 
     #[test]
     fn view_space_quadratic_is_the_world_one_turned() {
-        let texels: Vec<[f32; 3]> =
-            (0..32 * 16).map(|i| [(i % 7) as f32, (i % 5) as f32 * 0.3, (i % 11) as f32]).collect();
-        let env = Environment::from_texels(32, 16, texels, 1.5).unwrap();
-        let world_from_view = Mat3::from_quat(glam::Quat::from_euler(glam::EulerRot::YXZ, 0.7, -0.4, 0.2));
+        let env = patterned();
+        let world_from_view = turned_view();
         let (world, view) = (env.radiance_quadratic(), quadratic_in_view(&env.radiance_quadratic(), world_from_view));
-        let eval = |q: &[Vec3; 10], d: Vec3| {
-            let Vec3 { x, y, z } = d;
-            let monomials = [1.0, x, y, z, x * x, y * y, z * z, x * y, x * z, y * z];
-            q.iter().zip(monomials).map(|(c, m)| *c * m).sum::<Vec3>()
-        };
         let irradiance = quadratic_in_view(&env.irradiance_quadratic(), world_from_view);
         for v in [Vec3::X, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize(), Vec3::new(-0.7, 0.1, 0.2).normalize()] {
-            let (expected, got) = (eval(&world, world_from_view * v), eval(&view, v));
+            let (expected, got) = (eval_quadratic(&world, world_from_view * v), eval_quadratic(&view, v));
             assert!(
                 (expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()),
                 "{v}: {expected} vs {got}"
             );
-            let (expected, got) = (env.irradiance(world_from_view * v), eval(&irradiance, v).max(Vec3::ZERO));
+            let (expected, got) = (env.irradiance(world_from_view * v), eval_quadratic(&irradiance, v).max(Vec3::ZERO));
             assert!(
                 (expected - got).abs().max_element() < 1e-4 * (1.0 + expected.abs().max_element()),
                 "E {v}: {expected} vs {got}"
@@ -325,11 +333,8 @@ mod tests {
     fn prefiltered_radiance_is_linear_in_the_direction() {
         // SSDO (irradiance.wgsl `linear_sum`) reads only rows 0..4: the rest must vanish,
         // in the world and turned into a view.
-        let texels: Vec<[f32; 3]> =
-            (0..32 * 16).map(|i| [(i % 7) as f32, (i % 5) as f32 * 0.3, (i % 11) as f32]).collect();
-        let env = Environment::from_texels(32, 16, texels, 1.5).unwrap();
-        let world_from_view = Mat3::from_quat(glam::Quat::from_euler(glam::EulerRot::YXZ, 0.7, -0.4, 0.2));
-        for q in [env.radiance_quadratic(), quadratic_in_view(&env.radiance_quadratic(), world_from_view)] {
+        let env = patterned();
+        for q in [env.radiance_quadratic(), quadratic_in_view(&env.radiance_quadratic(), turned_view())] {
             assert!(q[4..].iter().all(|c| c.abs().max_element() < 1e-6), "{q:?}");
             assert!(q[1..4].iter().any(|c| c.abs().max_element() > 1e-3), "the map's gradient survives: {q:?}");
         }
