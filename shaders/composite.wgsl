@@ -78,46 +78,44 @@ fn main_quad(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let layer = id.z;
     let eye = frame.eyes[layer];
+    let b = id.xy;
+    // The quad's depths and normals, for the joint bilateral weights and the shading.
+    // Its arrays are indexed by constants only (joint_upsample.wgsl says why).
+    let quad = quad_pixels(depth_layers, normal_layers, b, layer, eye);
     let unoccluded = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    // The quad's depths and normals, for shading and the joint bilateral weights.
-    var depths: array<f32, 4>;
-    var normals: array<vec3<f32>, 4>;
-    for (var k = 0u; k < 4u; k++) {
-        let pixel = vec2<i32>(quad_pixel(id.xy, k));
-        depths[k] = textureLoad(depth_layers, pixel, i32(layer), 0);
-        normals[k] = textureLoad(normal_layers, pixel, i32(layer), 0).xyz;
-    }
-    if ((HALF_RES && ao.technique != 0u) || RSM) {
-        var pixels: array<UpsamplePixel, 4>;
-        for (var k = 0u; k < 4u; k++) {
-            pixels[k] = upsample_pixel(quad_pixel(id.xy, k), eye, depths[k], normals[k]);
-        }
-        let b = vec2<i32>(id.xy);
-        if (HALF_RES && ao.technique != 0u) {
-            let up = upsample_quad(geometry_low, occlusion_layers, b, layer, eye.tangents, pixels);
-            for (var k = 0u; k < 4u; k++) {
-                occlusion[k] = upsampled(up[k]);
-            }
-        }
-        if (RSM) {
-            let up = upsample_quad(rsm_geometry, rsm_indirect, b, layer, eye.tangents, pixels);
-            for (var k = 0u; k < 4u; k++) {
-                bounce[k] = max(upsampled(up[k]).rgb, vec3<f32>(0.0));
-            }
-        }
+    if (HALF_RES && ao.technique != 0u) {
+        occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents);
     }
     if (!HALF_RES && ao.technique != 0u) {
-        for (var k = 0u; k < 4u; k++) {
-            occlusion[k] = textureLoad(occlusion_layers, vec2<i32>(quad_pixel(id.xy, k)), i32(layer), 0);
-        }
+        occlusion = array<vec4<f32>, 4>(
+            full_res_occlusion(quad[0], layer),
+            full_res_occlusion(quad[1], layer),
+            full_res_occlusion(quad[2], layer),
+            full_res_occlusion(quad[3], layer),
+        );
     }
-    for (var k = 0u; k < 4u; k++) {
-        let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
-        if (all(pixel < frame.size)) {
-            let radiance = shade(pixel, layer, eye, depths[k], normals[k], occlusion[k], bounce[k]);
-            textureStore(hdr_out, vec2<i32>(pixel), i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
-        }
+    if (RSM) {
+        let up = upsample_quad(rsm_geometry, rsm_indirect, quad, vec2<i32>(b), layer, eye.tangents);
+        let none = vec3<f32>(0.0);
+        bounce = array<vec3<f32>, 4>(max(up[0].rgb, none), max(up[1].rgb, none), max(up[2].rgb, none), max(up[3].rgb, none));
+    }
+    shade_and_store(quad[0], layer, eye, occlusion[0], bounce[0]);
+    shade_and_store(quad[1], layer, eye, occlusion[1], bounce[1]);
+    shade_and_store(quad[2], layer, eye, occlusion[2], bounce[2]);
+    shade_and_store(quad[3], layer, eye, occlusion[3], bounce[3]);
+}
+
+// The full-resolution occlusion at a quad pixel (RSM without half resolution).
+fn full_res_occlusion(px: UpsamplePixel, layer: u32) -> vec4<f32> {
+    return textureLoad(occlusion_layers, vec2<i32>(min(px.pixel, frame.size - vec2<u32>(1u))), i32(layer), 0);
+}
+
+// Shades a quad pixel and stores it, unless it lies past an odd edge.
+fn shade_and_store(px: UpsamplePixel, layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) {
+    if (all(px.pixel < frame.size)) {
+        let radiance = shade(px.pixel, layer, eye, px.depth, px.stored_normal, occlusion, bounce);
+        textureStore(hdr_out, vec2<i32>(px.pixel), i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
     }
 }

@@ -5,7 +5,10 @@
 // pixels 2b + {0, 1}² of low-res sample b: all four have the same 2×2 (and 3×3)
 // low-res neighbourhood, so each sample is fetched once per quad instead of once per
 // pixel. On lavapipe the fetches, not the weights, are what upsampling costs: per pixel
-// it went from 18.2 to 11.5 ms at 540×600 (Sibenik). Each low-res neighbour is weighted
+// it went from 18.2 to 11.5 ms at 540×600 (Sibenik). The quad's four pixels live in
+// arrays indexed only by constants (calls written out four times, never a loop over
+// them): lavapipe keeps an array indexed by a loop counter in memory, which made the
+// per-quad composite a third slower than a per-pixel one. Each low-res neighbour is weighted
 // by its distance to the pixel and by how well its geometry (normal and distance in
 // AoGeometry, from the full-res pixel it was computed at) matches: tangent-plane
 // distance and normal. Odd sizes work because low-res pixel q
@@ -46,8 +49,14 @@ fn low_res_sample(
     return s;
 }
 
-// One full-res pixel's running joint bilateral sum.
+// One full-res pixel of a quad and its running joint bilateral sum.
 struct UpsamplePixel {
+    // Where it would be stored; past an odd edge it lies outside the target and its
+    // callers skip the store (its geometry is the clamped neighbour's).
+    pixel: vec2<u32>,
+    // Its stored depth (0 on the sky) and normal, as the G-buffer holds them.
+    depth: f32,
+    stored_normal: vec3<f32>,
     position: vec3<f32>,
     n: vec3<f32>,
     // n·position × plane_scale: a sample's plane distance is then one dot and a subtract.
@@ -57,103 +66,125 @@ struct UpsamplePixel {
     total: f32,
     // The least geometric agreement of the samples so far (edge test).
     agree: f32,
-    // The value of low-res sample b itself, the answer when every weight vanishes.
-    nearest: vec4<f32>,
 };
 
-// Pixel `k` (0..3) of the quad of low-res sample `b`. Pixels past an odd edge repeat the
-// last row or column; callers skip their store.
-fn quad_pixel(b: vec2<u32>, k: u32) -> vec2<u32> {
-    return min(b * 2u + vec2<u32>(k & 1u, k >> 1u), frame.size - vec2<u32>(1u));
-}
-
-// The running sum of full-res `pixel` of eye `eye`, whose stored depth and normal are
-// `depth` and `normal` (G-buffer): its view position and normal. A sky pixel (depth 0)
-// gets a far-away position; its result is not used.
-fn upsample_pixel(pixel: vec2<u32>, eye: Eye, depth: f32, normal: vec3<f32>) -> UpsamplePixel {
-    let position = load_view_position(max(depth, 1e-30), pixel, eye, frame.size, frame.near);
+// Pixel `k` (0..3) of the quad of low-res sample `b`, with its G-buffer depth and
+// normal, its view position and normal, and an empty sum. A sky pixel (depth 0) gets a
+// far-away position; its result is not used.
+fn upsample_pixel(
+    depth_layers: texture_depth_2d_array,
+    normal_layers: texture_2d_array<f32>,
+    b: vec2<u32>,
+    k: u32,
+    layer: u32,
+    eye: Eye,
+) -> UpsamplePixel {
     var px: UpsamplePixel;
-    px.position = position;
-    px.n = safe_normal(normal, position);
-    px.plane_scale = 1.0 / (PLANE_SIGMA * -position.z);
-    px.plane_offset = dot(px.n, position) * px.plane_scale;
+    px.pixel = b * 2u + vec2<u32>(k & 1u, k >> 1u);
+    let inside = min(px.pixel, frame.size - vec2<u32>(1u));
+    px.depth = textureLoad(depth_layers, vec2<i32>(inside), i32(layer), 0);
+    px.stored_normal = textureLoad(normal_layers, vec2<i32>(inside), i32(layer), 0).xyz;
+    px.position = load_view_position(max(px.depth, 1e-30), inside, eye, frame.size, frame.near);
+    px.n = safe_normal(px.stored_normal, px.position);
+    px.plane_scale = 1.0 / (PLANE_SIGMA * -px.position.z);
+    px.plane_offset = dot(px.n, px.position) * px.plane_scale;
     px.sum = vec4<f32>(0.0);
     px.total = 0.0;
     px.agree = 1.0;
-    px.nearest = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     return px;
 }
 
-// Weighs sample `s` into pixel `px`: its distance to the pixel's tangent plane and its
-// normal agreement (the geometric part), times `spatial`, 1 / (1 + the squared full-res
-// pixel distance between them) (`spatial_weight`).
-fn add_sample(pixel: UpsamplePixel, s: LowResSample, spatial: f32) -> UpsamplePixel {
+// The four pixels of the quad of low-res sample `b`.
+fn quad_pixels(
+    depth_layers: texture_depth_2d_array,
+    normal_layers: texture_2d_array<f32>,
+    b: vec2<u32>,
+    layer: u32,
+    eye: Eye,
+) -> array<UpsamplePixel, 4> {
+    return array<UpsamplePixel, 4>(
+        upsample_pixel(depth_layers, normal_layers, b, 0u, layer, eye),
+        upsample_pixel(depth_layers, normal_layers, b, 1u, layer, eye),
+        upsample_pixel(depth_layers, normal_layers, b, 2u, layer, eye),
+        upsample_pixel(depth_layers, normal_layers, b, 3u, layer, eye),
+    );
+}
+
+// Weighs sample `s` into pixel `px` if `take`: its distance to the pixel's tangent plane
+// and its normal agreement (the geometric part), times `spatial`, 1 / (1 + the squared
+// full-res pixel distance between them) (`spatial_weight`).
+fn add_sample(pixel: UpsamplePixel, s: LowResSample, spatial: f32, take: bool) -> UpsamplePixel {
     var px = pixel;
     let plane = dot(s.position, px.n) * px.plane_scale - px.plane_offset;
     let agreement = s.valid * exp(-plane * plane) * normal_agreement(px.n, s.normal);
     let w = agreement * spatial;
-    let ok = w == w;
+    let finite = w == w;
+    let ok = finite && take;
     px.sum += s.value * select(0.0, w, ok);
     px.total += select(0.0, w, ok);
-    px.agree = min(px.agree, select(0.0, agreement, ok));
+    px.agree = min(px.agree, select(0.0, agreement, finite));
     return px;
 }
 
 // 1 / (1 + d²) for the full-res distance d between pixel k of the quad of b and low-res
-// sample b + `offset`, computed at full-res pixel 2(b + offset): a constant of the
-// unrolled loops (a sample clamped at the border is invalid and gets weight 0 anyway).
+// sample b + `offset`, computed at full-res pixel 2(b + offset) (a sample clamped at the
+// border is invalid and gets weight 0 anyway).
 fn spatial_weight(offset: vec2<i32>, k: i32) -> f32 {
     let d = vec2<f32>(2 * offset - vec2<i32>(k & 1, k >> 1u));
     return 1.0 / (1.0 + dot(d, d));
 }
 
-// The pixel's upsampled value; the nearest sample's when every weight vanished.
-fn upsampled(px: UpsamplePixel) -> vec4<f32> {
-    var result = px.nearest;
+// Sample `s` at low-res offset `offset` from b, weighed into each pixel of the quad
+// that `take` selects.
+fn add_to_quad(quad: array<UpsamplePixel, 4>, s: LowResSample, offset: vec2<i32>, take: vec4<bool>) -> array<UpsamplePixel, 4> {
+    return array<UpsamplePixel, 4>(
+        add_sample(quad[0], s, spatial_weight(offset, 0), take.x),
+        add_sample(quad[1], s, spatial_weight(offset, 1), take.y),
+        add_sample(quad[2], s, spatial_weight(offset, 2), take.z),
+        add_sample(quad[3], s, spatial_weight(offset, 3), take.w),
+    );
+}
+
+// The pixel's upsampled value; `nearest` (low-res sample b's) when every weight vanished.
+fn upsampled(px: UpsamplePixel, nearest: vec4<f32>) -> vec4<f32> {
+    var result = nearest;
     if (px.total > 1e-20) {
         result = px.sum / px.total;
     }
     return vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
 }
 
-// Upsamples the four pixels of the quad of low-res sample `b` (their positions and
-// normals already in `pixels`): the 2×2 samples b + {0, 1}² first; where any pixel
-// disagrees with them (an edge), the rest of the 3×3 around b for the pixels that do.
+// The upsampled values of the four pixels of `quad`, the quad of low-res sample `b`:
+// the 2×2 samples b + {0, 1}² first; where any pixel disagrees with them (an edge), the
+// rest of the 3×3 around b for the pixels that do.
 fn upsample_quad(
     geometry_low: texture_2d_array<f32>,
     value_low: texture_2d_array<f32>,
+    quad: array<UpsamplePixel, 4>,
     b: vec2<i32>,
     layer: u32,
     tangents: vec4<f32>,
-    quad: array<UpsamplePixel, 4>,
-) -> array<UpsamplePixel, 4> {
-    var pixels = quad;
-    for (var i = 0; i < 4; i++) {
-        let s = low_res_sample(geometry_low, value_low, b + vec2<i32>(i & 1, i >> 1u), layer, tangents);
-        for (var k = 0; k < 4; k++) {
-            if (i == 0) {
-                pixels[k].nearest = s.value;
-            }
-            pixels[k] = add_sample(pixels[k], s, spatial_weight(vec2<i32>(i & 1, i >> 1u), k));
-        }
-    }
-    let edge = min(min(pixels[0].agree, pixels[1].agree), min(pixels[2].agree, pixels[3].agree));
-    if (edge < EDGE_AGREEMENT) {
-        // Which pixels take the 3×3, decided before any of it is added.
-        var needs = 0u;
-        for (var k = 0; k < 4; k++) {
-            needs |= select(0u, 1u << u32(k), pixels[k].agree < EDGE_AGREEMENT);
-        }
+) -> array<vec4<f32>, 4> {
+    let every = vec4<bool>(true);
+    let nearest = low_res_sample(geometry_low, value_low, b, layer, tangents);
+    var pixels = add_to_quad(quad, nearest, vec2<i32>(0, 0), every);
+    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 0), layer, tangents), vec2<i32>(1, 0), every);
+    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(0, 1), layer, tangents), vec2<i32>(0, 1), every);
+    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 1), layer, tangents), vec2<i32>(1, 1), every);
+    // Which pixels take the 3×3, decided before any of it is added.
+    let edge = vec4<f32>(pixels[0].agree, pixels[1].agree, pixels[2].agree, pixels[3].agree) < vec4<f32>(EDGE_AGREEMENT);
+    if (any(edge)) {
         for (var i = 0; i < 5; i++) {
             // (-1,-1) (0,-1) (1,-1) (-1,0) (-1,1): the rest of the 3×3.
             let offset = select(vec2<i32>(-1, i - 2), vec2<i32>(i - 1, -1), i < 3);
             let s = low_res_sample(geometry_low, value_low, b + offset, layer, tangents);
-            for (var k = 0; k < 4; k++) {
-                if ((needs & (1u << u32(k))) != 0u) {
-                    pixels[k] = add_sample(pixels[k], s, spatial_weight(offset, k));
-                }
-            }
+            pixels = add_to_quad(pixels, s, offset, edge);
         }
     }
-    return pixels;
+    return array<vec4<f32>, 4>(
+        upsampled(pixels[0], nearest.value),
+        upsampled(pixels[1], nearest.value),
+        upsampled(pixels[2], nearest.value),
+        upsampled(pixels[3], nearest.value),
+    );
 }

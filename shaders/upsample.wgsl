@@ -15,23 +15,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
-    let eye = frame.eyes[id.z];
-    let layer = i32(id.z);
-    var pixels: array<UpsamplePixel, 4>;
-    var sky = 0u;
-    for (var k = 0u; k < 4u; k++) {
-        let pixel = quad_pixel(id.xy, k);
-        let depth = textureLoad(depth_layers, vec2<i32>(pixel), layer, 0);
-        sky |= select(0u, 1u << k, depth <= 0.0);
-        let normal = textureLoad(normal_layers, vec2<i32>(pixel), layer, 0).xyz;
-        pixels[k] = upsample_pixel(pixel, eye, depth, normal);
-    }
-    pixels = upsample_quad(geometry_low, occlusion_low, vec2<i32>(id.xy), id.z, eye.tangents, pixels);
-    for (var k = 0u; k < 4u; k++) {
-        let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
-        if (all(pixel < frame.size)) {
-            let value = select(upsampled(pixels[k]), vec4<f32>(0.0, 0.0, 0.0, 1.0), (sky & (1u << k)) != 0u);
-            textureStore(occlusion_out, vec2<i32>(pixel), layer, value);
-        }
+    let quad = quad_pixels(depth_layers, normal_layers, id.xy, id.z, frame.eyes[id.z]);
+    let values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), id.z, frame.eyes[id.z].tangents);
+    store(quad[0], id.z, values[0]);
+    store(quad[1], id.z, values[1]);
+    store(quad[2], id.z, values[2]);
+    store(quad[3], id.z, values[3]);
+}
+
+// Stores a quad pixel's value (unoccluded on the sky), unless it lies past an odd edge.
+fn store(px: UpsamplePixel, layer: u32, value: vec4<f32>) {
+    if (all(px.pixel < frame.size)) {
+        let sky = px.depth <= 0.0;
+        textureStore(occlusion_out, vec2<i32>(px.pixel), i32(layer), select(value, vec4<f32>(0.0, 0.0, 0.0, 1.0), sky));
     }
 }
