@@ -42,21 +42,13 @@ impl CompositePass {
         let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
         let variant = |half_res: bool, rsm: bool| {
             let constants = [("HALF_RES", half_res as u8 as f64), ("RSM", rsm as u8 as f64)];
-            let entry = if upsamples(half_res, rsm) { "main_quad" } else { "main" };
-            Kernel::with_constants(gpu, "composite", &files, entry, &SLOTS, &constants)
+            Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &constants)
         };
         CompositePass {
             kernels: [[variant(false, false), variant(false, true)], [variant(true, false), variant(true, true)]],
             unused,
         }
     }
-}
-
-/// Whether the composite upsamples anything (half-resolution occlusion or the RSM
-/// bounce), and so runs per quad of 2×2 pixels; otherwise per pixel, which measured
-/// faster without upsampling (Sibenik 1080×1200 SSAO: 120 against 170 ms for both eyes).
-fn upsamples(half_res: bool, rsm: bool) -> bool {
-    half_res || rsm
 }
 
 impl Pass for CompositePass {
@@ -107,9 +99,8 @@ impl Pass for CompositePass {
             if rsm { ctx.view(Resource::RsmIndirect) } else { unused() },
             if rsm { ctx.view(Resource::RsmGeometry) } else { unused() },
         ];
-        // Upsampling runs one invocation per quad of 2×2 pixels (composite.wgsl `main_quad`).
-        let extent = if upsamples(half_res, rsm) { ctx.quad_extent() } else { ctx.extent() };
+        // One invocation per quad of 2×2 pixels (composite.wgsl).
         let kernel = &self.kernels[half_res as usize][rsm as usize];
-        kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.quad_extent());
     }
 }

@@ -151,7 +151,8 @@ impl LightFit {
                 }
             }
         }
-        if !(lo.x <= hi.x) {
+        // No finite vertex: the bounds are still (+∞, −∞).
+        if lo.x > hi.x {
             (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
         }
         let centre = (lo + hi) * 0.5;

@@ -37,7 +37,7 @@ pub struct TemporalPass {
 fn history(frame_index: u64) -> ([Resource; 2], [Resource; 2]) {
     let a = [Resource::HistoryValueA, Resource::HistoryPositionA];
     let b = [Resource::HistoryValueB, Resource::HistoryPositionB];
-    if frame_index % 2 == 0 {
+    if frame_index.is_multiple_of(2) {
         (a, b)
     } else {
         (b, a)
