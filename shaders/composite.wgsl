@@ -70,16 +70,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let unoccluded = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    if (HALF_RES && ao.technique != 0u) {
-        occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents);
-    }
-    if (!HALF_RES && ao.technique != 0u) {
-        occlusion = array<vec4<f32>, 4>(
-            full_res_occlusion(quad[0], layer),
-            full_res_occlusion(quad[1], layer),
-            full_res_occlusion(quad[2], layer),
-            full_res_occlusion(quad[3], layer),
-        );
+    if (ao.technique != 0u) {
+        if (HALF_RES) {
+            occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents);
+        } else {
+            occlusion = array<vec4<f32>, 4>(
+                full_res_occlusion(quad[0], layer),
+                full_res_occlusion(quad[1], layer),
+                full_res_occlusion(quad[2], layer),
+                full_res_occlusion(quad[3], layer),
+            );
+        }
     }
     if (RSM) {
         let up = upsample_quad(rsm_geometry, rsm_indirect, quad, vec2<i32>(b), layer, eye.tangents);
@@ -92,9 +93,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     shade_and_store(quad[3], layer, eye, occlusion[3], bounce[3]);
 }
 
-// The full-resolution occlusion at a quad pixel (RSM without half resolution).
+// The full-resolution occlusion at a quad pixel.
 fn full_res_occlusion(px: UpsamplePixel, layer: u32) -> vec4<f32> {
-    return textureLoad(occlusion_layers, vec2<i32>(min(px.pixel, frame.size - vec2<u32>(1u))), i32(layer), 0);
+    return textureLoad(occlusion_layers, vec2<i32>(px.texel), i32(layer), 0);
 }
 
 // Shades a quad pixel and stores it, unless it lies past an odd edge.

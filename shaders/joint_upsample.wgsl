@@ -8,11 +8,11 @@
 // it went from 18.2 to 11.5 ms at 540×600 (Sibenik). The quad's four pixels live in
 // arrays indexed only by constants (calls written out four times, never a loop over
 // them): lavapipe keeps an array indexed by a loop counter in memory, which made the
-// per-quad composite a third slower than a per-pixel one. Each low-res neighbour is weighted
-// by its distance to the pixel and by how well its geometry (normal and distance in
-// AoGeometry, from the full-res pixel it was computed at) matches: tangent-plane
-// distance and normal. Odd sizes work because low-res pixel q
-// stands for full-res pixel min(2q, size − 1). The low-res size is the texture's own, so
+// per-quad composite a third slower than a per-pixel one. Each low-res neighbour is
+// weighted by its distance to the pixel and by how well its geometry (normal and
+// distance in AoGeometry, from the full-res pixel it was computed at) matches:
+// tangent-plane distance and normal. Odd sizes work because low-res pixel q stands for
+// full-res pixel min(2q, size − 1). The low-res size is the texture's own, so
 // any half-resolution target (occlusion, the RSM bounce) upsamples with it.
 
 const PLANE_SIGMA: f32 = 0.02;
@@ -52,8 +52,10 @@ fn low_res_sample(
 // One full-res pixel of a quad and its running joint bilateral sum.
 struct UpsamplePixel {
     // Where it would be stored; past an odd edge it lies outside the target and its
-    // callers skip the store (its geometry is the clamped neighbour's).
+    // callers skip the store.
     pixel: vec2<u32>,
+    // Where its G-buffer values come from: `pixel` clamped into the target.
+    texel: vec2<u32>,
     // Its stored depth (0 on the sky) and normal, as the G-buffer holds them.
     depth: f32,
     stored_normal: vec3<f32>,
@@ -81,10 +83,10 @@ fn upsample_pixel(
 ) -> UpsamplePixel {
     var px: UpsamplePixel;
     px.pixel = b * 2u + vec2<u32>(k & 1u, k >> 1u);
-    let inside = min(px.pixel, frame.size - vec2<u32>(1u));
-    px.depth = textureLoad(depth_layers, vec2<i32>(inside), i32(layer), 0);
-    px.stored_normal = textureLoad(normal_layers, vec2<i32>(inside), i32(layer), 0).xyz;
-    px.position = load_view_position(max(px.depth, 1e-30), inside, eye, frame.size, frame.near);
+    px.texel = min(px.pixel, frame.size - vec2<u32>(1u));
+    px.depth = textureLoad(depth_layers, vec2<i32>(px.texel), i32(layer), 0);
+    px.stored_normal = textureLoad(normal_layers, vec2<i32>(px.texel), i32(layer), 0).xyz;
+    px.position = load_view_position(max(px.depth, 1e-30), px.texel, eye, frame.size, frame.near);
     px.n = safe_normal(px.stored_normal, px.position);
     px.plane_scale = 1.0 / (PLANE_SIGMA * -px.position.z);
     px.plane_offset = dot(px.n, px.position) * px.plane_scale;

@@ -15,8 +15,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
-    let quad = quad_pixels(depth_layers, normal_layers, id.xy, id.z, frame.eyes[id.z]);
-    let values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), id.z, frame.eyes[id.z].tangents);
+    let eye = frame.eyes[id.z];
+    let quad = quad_pixels(depth_layers, normal_layers, id.xy, id.z, eye);
+    let values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), id.z, eye.tangents);
     store(quad[0], id.z, values[0]);
     store(quad[1], id.z, values[1]);
     store(quad[2], id.z, values[2]);

@@ -69,7 +69,7 @@ impl<'a> FrameContext<'a> {
     }
 
     /// Width × height × layers of the quads of 2×2 full-res pixels (rounded up), for the
-    /// passes that upsample one quad per invocation.
+    /// passes that work one quad per invocation (upsample, composite).
     pub fn quad_extent(&self) -> (u32, u32, u32) {
         let (width, height, layers) = self.extent();
         (width.div_ceil(2), height.div_ceil(2), layers)
