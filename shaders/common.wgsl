@@ -10,6 +10,9 @@ struct Eye {
     world_from_view: mat4x4<f32>,
     // tan(left), tan(right), tan(up), tan(down) of the eye's asymmetric frustum.
     tangents: vec4<f32>,
+    // The other eye's view from this eye's view (identity for a mono view): occlusion
+    // samples that leave this eye's image are looked up in the other eye's layer.
+    other_from_view: mat4x4<f32>,
 };
 
 struct Frame {
@@ -100,9 +103,13 @@ struct AoParams {
     blur_plane_sigma: f32,
     // Sample-length scale this frame (temporal range jitter; 1 otherwise).
     range_scale: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // GTAO: the slab behind each depth sample, as a fraction of the radius.
+    thickness: f32,
+    // GTAO: sample i of n along a half-slice lies at ((i + jitter) / n)^step_power × r.
+    step_power: f32,
+    // GTAO: successive samples closer in distance than this fraction of the radius lie
+    // on one continuous surface (0: never).
+    connect: f32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

@@ -1,7 +1,9 @@
 // HBAO (seed 003 §3.3, after Bavoil, Sainz and Dimitrov 2008): D screen directions,
 // rotated per pixel, each ray-marched S steps through the depth buffer. A sample above
-// the current horizon raises it and adds its occlusion, attenuated by
-// W = max(0, 1 − r/R). Horizon angles are measured from the tangent plane (the normal
+// the current horizon raises it and adds its occlusion; samples beyond R do not count
+// (the hard cut-off of every technique's target; seed 003's falloff W = 1 − r/R made
+// HBAO lighter than that target everywhere). Samples off the image are looked up in
+// the other eye's layer. Horizon angles are measured from the tangent plane (the normal
 // is known), and increments use sin²h instead of sin h: the cosine-weighted form of
 // eq. 3.2, so HBAO estimates the same cosine-weighted visibility as the reference.
 
@@ -18,8 +20,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let radius_px = ao.radius / max(metres_per_pixel, 1e-30);
     let steps = max(ao.steps, 1u);
     let directions = max(ao.directions, 1u);
-    // Never step less than a pixel; never further than the screen.
-    let step_px = clamp(radius_px * ao.range_scale / f32(steps + 1u), 1.0, f32(max(frame.size.x, frame.size.y)));
+    // Never further than the image's diagonal.
+    let march_px = min(radius_px * ao.range_scale, f32(frame.size.x + frame.size.y));
     let rotation = kernel_rotation(r.pixel, ao.noise) + ao.frame_angle;
     let jitter = fract(rotation * 0.1591549 * 7.0);
     // Angle bias: horizons below this elevation do not count (tessellation, noise).
@@ -29,26 +31,29 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let angle = rotation + 2.0 * PI * f32(d) / f32(directions);
         let dir = vec2<f32>(cos(angle), sin(angle));
         var max_sin = sin_bias;
+        var previous_distance = -r.position.z;
         for (var s = 0u; s < steps; s++) {
-            let offset = dir * (f32(s) + jitter + 1.0) * step_px;
+            // Steps crowd towards the pixel (quadratically, the first within a few
+            // pixels), so the horizon rises right at contact lines instead of a band
+            // one step away.
+            let t = (f32(s) + jitter) / f32(steps);
+            let offset = dir * max(t * t * march_px, f32(s) + 1.0);
             let q = vec2<f32>(r.pixel) + vec2<f32>(0.5) + offset;
-            if (any(q < vec2<f32>(0.0)) || any(q >= vec2<f32>(frame.size))) {
-                break;
-            }
-            let qp = vec2<u32>(q);
-            let qd = textureLoad(depth_layers, vec2<i32>(qp), i32(r.layer), 0);
-            if (qd <= 0.0) {
+            let surface = surface_at(q, r.layer, r.eye, previous_distance);
+            if (surface.w == 0.0) {
                 continue;
             }
-            let h = load_view_position(qd, qp, r.eye, frame.size, frame.near) - r.position;
+            previous_distance = -surface.z;
+            let h = surface.xyz - r.position;
             let dist = length(h);
             if (dist < 1e-20 || dist > ao.radius) {
                 continue;
             }
+            // Everything below the horizon within r blocks, with no falloff: HBAO
+            // estimates the hard cut-off visibility like every technique.
             let sin_h = dot(h, r.normal) / dist;
             if (sin_h > max_sin) {
-                let attenuation = max(0.0, 1.0 - dist / ao.radius);
-                occlusion += (sin_h * sin_h - max_sin * max_sin) * attenuation;
+                occlusion += sin_h * sin_h - max_sin * max_sin;
                 max_sin = sin_h;
             }
         }

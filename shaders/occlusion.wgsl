@@ -39,43 +39,107 @@ fn begin_receiver(id: vec3<u32>) -> Receiver {
         return r;
     }
     r.position = load_view_position(depth, r.pixel, r.eye, frame.size, frame.near);
-    r.normal = safe_normal(textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz, r.position);
+    let stored = textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz;
+    r.normal = repaired_normal(safe_normal(stored, r.position), r.pixel, r.layer, r.eye, r.position);
     textureStore(geometry_out, vec2<i32>(id.xy), i32(id.z), vec4<f32>(r.normal, -r.position.z));
     r.valid = true;
     return r;
+}
+
+// The normal the techniques use. Where the stored (interpolated) normal is grazing, as on
+// silhouettes, it is compared with the normal of the depth buffer itself, and replaced by
+// it when they disagree by more than 60° (a normal bent into the body made AO 0 there).
+// The result always leans at least a little towards the eye: the direction to the eye is
+// open (the pixel is seen), so no technique can find the whole hemisphere blocked.
+fn repaired_normal(stored: vec3<f32>, pixel: vec2<u32>, layer: u32, eye: Eye, position: vec3<f32>) -> vec3<f32> {
+    let view = normalize(-position);
+    var n = stored;
+    if (dot(n, view) < 0.3) {
+        let derived = depth_normal(pixel, layer, eye, position);
+        if (dot(n, derived) < 0.5) {
+            n = derived;
+        }
+    }
+    let facing = dot(n, view);
+    if (facing < 0.05) {
+        n = normalize(n + view * (0.05 - facing));
+    }
+    return n;
+}
+
+// The normal of the depth buffer at `pixel`, facing the eye: per axis, the neighbour
+// whose distance is closer to the pixel's (the same surface, not across an edge).
+fn depth_normal(pixel: vec2<u32>, layer: u32, eye: Eye, position: vec3<f32>) -> vec3<f32> {
+    let dx = neighbour_step(pixel, vec2<i32>(1, 0), layer, eye, position);
+    let dy = neighbour_step(pixel, vec2<i32>(0, 1), layer, eye, position);
+    let n = cross(dx, dy);
+    let len2 = dot(n, n);
+    if (!(len2 > 1e-30)) {
+        return normalize(-position);
+    }
+    return n * inverseSqrt(len2) * select(-1.0, 1.0, dot(n, -position) >= 0.0);
+}
+
+// From `position` to the neighbour along +axis or −axis (whichever lies closer in
+// distance), oriented along +axis; 0 when neither is on a surface.
+fn neighbour_step(pixel: vec2<u32>, axis: vec2<i32>, layer: u32, eye: Eye, position: vec3<f32>) -> vec3<f32> {
+    var best = vec3<f32>(0.0);
+    var best_gap = 3.0e38;
+    for (var k = -1; k <= 1; k += 2) {
+        let q = vec2<i32>(pixel) + axis * k;
+        if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(frame.size))) {
+            continue;
+        }
+        let d = textureLoad(depth_layers, q, i32(layer), 0);
+        if (!(d > 0.0)) {
+            continue;
+        }
+        let step = (load_view_position(d, vec2<u32>(q), eye, frame.size, frame.near) - position) * f32(k);
+        let gap = abs(step.z);
+        if (gap < best_gap) {
+            best_gap = gap;
+            best = step;
+        }
+    }
+    return best;
 }
 
 fn store_occlusion(id: vec3<u32>, value: vec4<f32>) {
     textureStore(ao_out, vec2<i32>(id.xy), i32(id.z), value);
 }
 
-// Whether the surface found by `probe` occludes a sample at view-space `s` for a receiver
-// at `position` with normal `n`: the surface lies in front of the sample (by more than
-// `bias`) AND rises above the receiver's tangent plane. The second test removes the
-// self-occlusion a flat surface gives itself at grazing angles, where one pixel's depth
-// spans far more than the bias.
-fn occludes(probe: DepthProbe, s: vec3<f32>, position: vec3<f32>, n: vec3<f32>, eye: Eye, bias: f32) -> bool {
-    if (!probe.valid || !(probe.distance < -s.z - bias)) {
+// Whether the surface found by `probe` occludes a sample for a receiver at `position`
+// with normal `n`: the surface lies in front of the sample (by more than `bias`) AND rises
+// above the receiver's tangent plane. The second test removes the self-occlusion a flat
+// surface gives itself at grazing angles, where one pixel's depth spans far more than the
+// bias.
+fn occludes(probe: DepthProbe, position: vec3<f32>, n: vec3<f32>, bias: f32) -> bool {
+    if (!probe.valid || !(probe.distance < probe.sample_distance - bias)) {
         return false;
     }
-    let surface = view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
-    return dot(surface - position, n) > bias + 1e-5 * -position.z;
+    return dot(probe.surface - position, n) > bias + 1e-5 * -position.z;
 }
 
-// What the depth buffer holds where view-space point `s` projects: `valid` is false
-// off-screen, behind the eye or on the sky; `distance` is the stored surface's
-// distance along −z and `pixel` the full-res pixel read.
+// What the depth buffer holds where a view-space sample point projects: `valid` is false
+// off both eyes' images, behind the eye or on the sky. `distance` is the stored surface's
+// distance and `sample_distance` the sample's, both along the −z of the eye that saw it
+// (`layer`), `pixel` the full-res pixel read there and `surface` the stored surface in
+// the receiver's view space.
 struct DepthProbe {
     valid: bool,
+    layer: u32,
     pixel: vec2<u32>,
     distance: f32,
+    sample_distance: f32,
+    surface: vec3<f32>,
 };
 
 // The full-res pixel where view-space point `s` projects, if on screen and in front of
-// the eye (`valid`; `distance` is left for the caller's fetch).
+// the eye (`valid`; `distance` and `surface` are left for the caller's fetch).
 fn probe_target(s: vec3<f32>, eye: Eye) -> DepthProbe {
     var probe: DepthProbe;
     probe.valid = false;
+    probe.sample_distance = -s.z;
     if (!(-s.z > frame.near * 0.5)) {
         return probe;
     }
@@ -88,13 +152,71 @@ fn probe_target(s: vec3<f32>, eye: Eye) -> DepthProbe {
     return probe;
 }
 
+// Probes `s` in the receiver's eye; a point off its image is probed in the other eye's
+// layer of the same depth buffer (each eye's inner border lies inside the other's view).
 fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, eye: Eye) -> DepthProbe {
     var probe = probe_target(s, eye);
+    probe.layer = layer;
+    if (probe.valid) {
+        let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+        probe.valid = d > 0.0;
+        probe.distance = frame.near / max(d, 1e-30);
+        probe.surface = s * (probe.distance / max(probe.sample_distance, 1e-30));
+        return probe;
+    }
+    if (frame.layers < 2u) {
+        return probe;
+    }
+    let other_layer = 1u - layer;
+    let other = frame.eyes[other_layer];
+    let in_other = (eye.other_from_view * vec4<f32>(s, 1.0)).xyz;
+    probe = probe_target(in_other, other);
+    probe.layer = other_layer;
     if (!probe.valid) {
         return probe;
     }
-    let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(layer), 0);
+    let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(other_layer), 0);
     probe.valid = d > 0.0;
     probe.distance = frame.near / max(d, 1e-30);
+    let surface_in_other = in_other * (probe.distance / max(probe.sample_distance, 1e-30));
+    probe.surface = (other.other_from_view * vec4<f32>(surface_in_other, 1.0)).xyz;
     return probe;
+}
+
+// The surface at screen position `q` (full-res pixel coordinates, may lie off the image)
+// of layer `layer`, in this eye's view space; w = 0 when none is known. Off the image the
+// other eye's layer is asked: the point on this eye's ray through `q` at distance `guess`
+// (along −z) is projected into the other eye, and the surface found there is returned
+// (screen-space marches: HBAO, GTAO).
+fn surface_at(q: vec2<f32>, layer: u32, eye: Eye, guess: f32) -> vec4<f32> {
+    let size = vec2<f32>(frame.size);
+    if (all(q >= vec2<f32>(0.0)) && all(q < size)) {
+        let p = vec2<u32>(q);
+        let d = textureLoad(depth_layers, vec2<i32>(p), i32(layer), 0);
+        if (!(d > 0.0)) {
+            return vec4<f32>(0.0);
+        }
+        return vec4<f32>(load_view_position(d, p, eye, frame.size, frame.near), 1.0);
+    }
+    if (frame.layers < 2u) {
+        return vec4<f32>(0.0);
+    }
+    let other_layer = 1u - layer;
+    let other = frame.eyes[other_layer];
+    let on_ray = view_position_from_distance(q / size, guess, eye.tangents);
+    let in_other = (eye.other_from_view * vec4<f32>(on_ray, 1.0)).xyz;
+    if (!(-in_other.z > frame.near)) {
+        return vec4<f32>(0.0);
+    }
+    let uv = view_to_uv(in_other, other.tangents);
+    if (!(all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
+        return vec4<f32>(0.0);
+    }
+    let p = min(vec2<u32>(uv * size), frame.size - vec2<u32>(1u));
+    let d = textureLoad(depth_layers, vec2<i32>(p), i32(other_layer), 0);
+    if (!(d > 0.0)) {
+        return vec4<f32>(0.0);
+    }
+    let surface = load_view_position(d, p, other, frame.size, frame.near);
+    return vec4<f32>((other.other_from_view * vec4<f32>(surface, 1.0)).xyz, 1.0);
 }

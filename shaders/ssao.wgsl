@@ -18,7 +18,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let k = kernel[i];
         let s = origin + frame_rot * k.xyz * (k.w * ao.range_scale * ao.radius);
         let probe = probe_depth(depth_layers, r.layer, s, r.eye);
-        if (occludes(probe, s, r.position, r.normal, r.eye, bias)) {
+        if (occludes(probe, r.position, r.normal, bias)) {
             var weight = 1.0;
             if (ao.range_check != 0u) {
                 // Depth constraint: occluders far in front of the pixel (a foreground

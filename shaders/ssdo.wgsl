@@ -27,12 +27,18 @@ struct SenderProbe {
 fn probe_sender(layer: u32, s: vec3<f32>, eye: Eye) -> SenderProbe {
     var sp: SenderProbe;
     sp.probe = probe_target(s, eye);
+    sp.probe.layer = layer;
     if (!sp.probe.valid) {
+        // Off this eye's image the other eye's depth still tells whether the direction
+        // is blocked; its sender's light is left out (texel 0 sends nothing).
+        sp.probe = probe_depth(depth_layers, layer, s, eye);
+        sp.texel = vec4<u32>(0u);
         return sp;
     }
     sp.texel = textureLoad(direct_layers, vec2<i32>(sp.probe.pixel), i32(layer), 0);
     sp.probe.distance = direct_distance(sp.texel);
     sp.probe.valid = sp.probe.distance > 0.0;
+    sp.probe.surface = s * (sp.probe.distance / max(sp.probe.sample_distance, 1e-30));
     return sp;
 }
 
@@ -67,9 +73,9 @@ override BOUNCE_PATCH: bool = false;
 override PEEL: bool = false;
 @group(0) @binding(8) var second_layers: texture_depth_2d_array;
 
-fn in_front_of_second_layer(probe: DepthProbe, layer: u32, s: vec3<f32>) -> bool {
-    let second = textureLoad(second_layers, vec2<i32>(probe.pixel), i32(layer), 0);
-    return -s.z * second < frame.near;
+fn in_front_of_second_layer(probe: DepthProbe) -> bool {
+    let second = textureLoad(second_layers, vec2<i32>(probe.pixel), i32(probe.layer), 0);
+    return probe.sample_distance * second < frame.near;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -108,9 +114,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             fetched.probe = probe_depth(depth_layers, r.layer, s, r.eye);
         }
         let probe = fetched.probe;
-        var blocked = occludes(probe, s, r.position, r.normal, r.eye, bias);
+        var blocked = occludes(probe, r.position, r.normal, bias);
         if (PEEL) {
-            blocked = blocked && in_front_of_second_layer(probe, r.layer, s);
+            blocked = blocked && in_front_of_second_layer(probe);
         } else if (blocked && ao.range_check != 0u && abs(-r.position.z - probe.distance) > ao.radius) {
             // A surface far in front is not a neighbour: the direction stays open.
             blocked = false;
@@ -120,7 +126,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             weight_visible += cos_theta;
         } else if (BOUNCE) {
             // The sender lies on the sample's view ray, at the stored distance.
-            let sender = s * (probe.distance / -s.z);
+            let sender = probe.surface;
             let to_receiver = r.position - sender;
             let d2 = dot(to_receiver, to_receiver);
             let dir = to_receiver * inverseSqrt(max(d2, 1e-30));
@@ -129,7 +135,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             if (BOUNCE_PATCH) {
                 // The packed texel has no room for the normal: the patch form alone
                 // pays a second fetch for it, from the G-buffer.
-                let sender_normal = textureLoad(normal_layers, vec2<i32>(probe.pixel), i32(r.layer), 0).xyz;
+                let sender_normal = textureLoad(normal_layers, vec2<i32>(probe.pixel), i32(probe.layer), 0).xyz;
                 let cos_sender = max(dot(safe_normal(sender_normal, sender), dir), 0.0);
                 weight = cos_sender * cos_receiver * disc_solid_angle(d2, disc_radius2);
             }

@@ -351,7 +351,7 @@ fn parse_on_off(s: &str) -> std::result::Result<bool, String> {
 struct AoArgs {
     #[command(flatten)]
     lights: LightArgs,
-    /// Occlusion technique: none, ssao, hbao, ssdo or ssdo-bounce (fetch-only: the
+    /// Occlusion technique: none, ssao, hbao, gtao, ssdo or ssdo-bounce (fetch-only: the
     /// benchmark baseline with SSAO's depth taps and no occlusion arithmetic).
     #[arg(long, default_value = "ssao")]
     technique: Technique,
@@ -394,6 +394,18 @@ struct AoArgs {
     /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
     #[arg(long, default_value = "halton")]
     noise: Noise,
+    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
+    /// radius (thin objects stop occluding behind themselves).
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
+    thickness: f32,
+    /// GTAO: exponent of the samples' spread along a half-slice (1 even, 2 crowded near
+    /// the pixel).
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
+    step_power: f32,
+    /// GTAO: successive samples closer in distance than this fraction of the radius
+    /// join into one surface (0: never).
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
+    connect: f32,
     /// Turn SSAO's range check (depth constraint) off.
     #[arg(long)]
     no_range_check: bool,
@@ -452,6 +464,9 @@ impl AoArgs {
                 motion_px: self.temporal_motion_px,
                 ..Default::default()
             },
+            thickness: self.thickness,
+            step_power: self.step_power,
+            connect: self.connect,
         }
     }
 }

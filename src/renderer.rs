@@ -111,6 +111,7 @@ impl Renderer {
             Box::new(RsmPass::new(&gpu, light_space.clone())),
             Box::new(OcclusionPass::ssao(&gpu)),
             Box::new(OcclusionPass::hbao(&gpu)),
+            Box::new(OcclusionPass::gtao(&gpu)),
             Box::new(DepthPeelPass::new(&gpu, &frame)),
             Box::new(SsdoPass::new(&gpu)),
             Box::new(OcclusionPass::fetch_only(&gpu)),

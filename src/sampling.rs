@@ -68,6 +68,18 @@ pub fn hbao_directions_steps(samples: u32) -> (u32, u32) {
     (directions, (samples / directions).max(1))
 }
 
+/// GTAO's slices and steps per half-slice for a budget of `samples` depth taps
+/// (slices × 2 × steps ≈ samples): 12 → 2×3, 24 → 3×4, 36 → 3×6, 64 → 4×8.
+pub fn gtao_slices_steps(samples: u32) -> (u32, u32) {
+    let slices = match samples {
+        0..=15 => 2,
+        16..=47 => 3,
+        48..=99 => 4,
+        _ => 6,
+    };
+    (slices, (samples / (2 * slices)).max(1))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,6 +123,13 @@ mod tests {
         let mean = |d| hemisphere_kernel(256, d).iter().map(|s| s[2] as f64).sum::<f64>() / 256.0;
         assert!((mean(HemisphereDensity::Cosine) - 2.0 / 3.0).abs() < 0.01);
         assert!((mean(HemisphereDensity::Uniform) - 0.5).abs() < 0.01);
+    }
+
+    #[test]
+    fn gtao_presets_spend_ssao_tap_counts() {
+        for (samples, split) in [(12, (2, 3)), (24, (3, 4)), (36, (3, 6)), (64, (4, 8)), (1, (2, 1)), (256, (6, 21))] {
+            assert_eq!(gtao_slices_steps(samples), split);
+        }
     }
 
     #[test]

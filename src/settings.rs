@@ -76,6 +76,9 @@ pub enum Technique {
     SsdoBounce,
     /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
     FetchOnly,
+    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
+    /// (Jimenez et al. 2016, Therrien et al. 2023).
+    Gtao,
 }
 
 impl Technique {
@@ -87,12 +90,14 @@ impl Technique {
             Technique::Ssdo => "ssdo",
             Technique::SsdoBounce => "ssdo-bounce",
             Technique::FetchOnly => "fetch-only",
+            Technique::Gtao => "gtao",
         }
     }
-    pub const ALL: [Technique; 6] = [
+    pub const ALL: [Technique; 7] = [
         Technique::None,
         Technique::Ssao,
         Technique::Hbao,
+        Technique::Gtao,
         Technique::Ssdo,
         Technique::SsdoBounce,
         Technique::FetchOnly,
@@ -103,7 +108,7 @@ impl std::str::FromStr for Technique {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
-            format!("unknown technique '{s}' (expected none, ssao, hbao, ssdo, ssdo-bounce or fetch-only)")
+            format!("unknown technique '{s}' (expected none, ssao, hbao, gtao, ssdo, ssdo-bounce or fetch-only)")
         })
     }
 }
@@ -242,6 +247,15 @@ pub struct AoSettings {
     pub blur_plane_sigma: f32,
     /// Temporal accumulation by reverse reprojection (seed 001 §3.1).
     pub temporal: Temporal,
+    /// GTAO: how far behind each depth sample the surface counts as solid, as a fraction
+    /// of the radius (thin objects stop occluding behind themselves).
+    pub thickness: f32,
+    /// GTAO: exponent of the samples' spread along a half-slice (1 even, 2 crowded near
+    /// the pixel).
+    pub step_power: f32,
+    /// GTAO: successive samples whose distances differ by less than this fraction of the
+    /// radius lie on one continuous surface, which also blocks the angles between them.
+    pub connect: f32,
 }
 
 /// How the temporal pass blends the new frame into the history.
@@ -301,6 +315,11 @@ impl Default for Temporal {
     }
 }
 
+/// GTAO's defaults (tuned against the reference: `vrao tune`, README).
+pub const DEFAULT_THICKNESS: f32 = 0.5;
+pub const DEFAULT_STEP_POWER: f32 = 2.0;
+pub const DEFAULT_CONNECT: f32 = 0.25;
+
 impl Default for AoSettings {
     fn default() -> Self {
         AoSettings {
@@ -318,6 +337,9 @@ impl Default for AoSettings {
             blur_radius: 5,
             blur_plane_sigma: 0.02,
             temporal: Temporal::default(),
+            thickness: DEFAULT_THICKNESS,
+            step_power: DEFAULT_STEP_POWER,
+            connect: DEFAULT_CONNECT,
         }
     }
 }
@@ -354,6 +376,15 @@ impl AoSettings {
         }
         if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
             return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
+        }
+        if !(self.thickness.is_finite() && (0.0..=100.0).contains(&self.thickness)) {
+            return Err(Error::input(format!("thickness {} is not within 0..=100 (a fraction of the radius)", self.thickness)));
+        }
+        if !(self.step_power.is_finite() && (0.25..=4.0).contains(&self.step_power)) {
+            return Err(Error::input(format!("step power {} is not within 0.25..=4", self.step_power)));
+        }
+        if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
+            return Err(Error::input(format!("connect {} is not within 0..=100 (a fraction of the radius)", self.connect)));
         }
         if self.blur_radius > 16 {
             return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));

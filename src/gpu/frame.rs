@@ -2,7 +2,7 @@
 //! shaders/common.wgsl), built in f64 and rounded once.
 
 use super::scene::GpuScene;
-use crate::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
+use crate::sampling::{gtao_slices_steps, hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
 use crate::scene::environment::quadratic_in_view;
 use crate::scene::{Light, Scene};
 use crate::settings::{Noise, Settings, Technique};
@@ -17,6 +17,8 @@ pub struct EyeUniform {
     pub view_from_anchored: [[f32; 4]; 4],
     pub world_from_view: [[f32; 4]; 4],
     pub tangents: [f32; 4],
+    /// The other eye's view from this eye's view (identity for a mono view).
+    pub other_from_view: [[f32; 4]; 4],
 }
 
 #[repr(C)]
@@ -67,7 +69,12 @@ pub struct AoParamsUniform {
     pub blur_plane_sigma: f32,
     /// Scale of the sample lengths this frame (HBAO's temporal range jitter; 1 otherwise).
     pub range_scale: f32,
-    pub _pad: [u32; 3],
+    /// GTAO: thickness of the slab behind each depth sample, as a fraction of the radius.
+    pub thickness: f32,
+    /// GTAO: exponent of the samples' spread along a half-slice.
+    pub step_power: f32,
+    /// GTAO: distance gap (fraction of the radius) under which successive samples join.
+    pub connect: f32,
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).
@@ -132,7 +139,10 @@ impl FrameBuffers {
     pub fn update_ao(&self, queue: &wgpu::Queue, settings: &Settings, frame_index: u64) {
         let ao = &settings.ao;
         let (width, height) = ao_extent(settings.profile.width, settings.profile.height, ao.half_res);
-        let (directions, steps) = hbao_directions_steps(ao.samples);
+        let (directions, steps) = match ao.technique {
+            Technique::Gtao => gtao_slices_steps(ao.samples),
+            _ => hbao_directions_steps(ao.samples),
+        };
         let density = match ao.technique {
             Technique::Ssdo | Technique::SsdoBounce => HemisphereDensity::Uniform,
             _ => HemisphereDensity::Cosine,
@@ -145,7 +155,7 @@ impl FrameBuffers {
         // stratification between parts. So the hemisphere techniques change their pattern
         // by parts and only HBAO, whose directions are not a Halton kernel, turns.
         let part = if ao.temporal.enabled { (frame_index % ao.temporal.max_frames as u64) as u32 } else { 0 };
-        let turns = ao.temporal.enabled && ao.technique == Technique::Hbao;
+        let turns = ao.temporal.enabled && matches!(ao.technique, Technique::Hbao | Technique::Gtao);
         let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
         let params = AoParamsUniform {
             ao_size: [width, height],
@@ -155,7 +165,7 @@ impl FrameBuffers {
             steps,
             technique: match ao.technique {
                 Technique::None => 0,
-                Technique::Ssao | Technique::Hbao | Technique::FetchOnly => 1,
+                Technique::Ssao | Technique::Hbao | Technique::Gtao | Technique::FetchOnly => 1,
                 Technique::Ssdo | Technique::SsdoBounce => 2,
             },
             noise: match ao.noise {
@@ -173,7 +183,9 @@ impl FrameBuffers {
             blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
             blur_plane_sigma: ao.blur_plane_sigma,
             range_scale: if turns { temporal_range_scale(frame_index) } else { 1.0 },
-            _pad: [0; 3],
+            thickness: ao.thickness,
+            step_power: ao.step_power,
+            connect: ao.connect,
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
         queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
@@ -201,6 +213,7 @@ impl FrameBuffers {
                 view_from_anchored: to_cols(view_from_anchored.as_mat4()),
                 world_from_view: to_cols(Mat4::from_quat(world_from_view)),
                 tangents: [l as f32, r as f32, u as f32, d as f32],
+                other_from_view: to_cols(other_from_view(views, index)),
             };
             for light in &scene.lights {
                 lights.push(match *light {
@@ -237,6 +250,17 @@ impl FrameBuffers {
         if !lights.is_empty() {
             queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(&lights));
         }
+    }
+}
+
+/// The other view's view-from-this-view of `views[index]`, in f64 (identity without a
+/// second view).
+fn other_from_view(views: &[Eye], index: usize) -> Mat4 {
+    match views.get(1 - index.min(1)) {
+        Some(other) if views.len() == 2 => {
+            (other.view_from_world() * views[index].view_from_world().inverse()).as_mat4()
+        }
+        _ => Mat4::IDENTITY,
     }
 }
 

@@ -13,6 +13,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("occlusion.wgsl", include_str!("../../shaders/occlusion.wgsl")),
     ("ssao.wgsl", include_str!("../../shaders/ssao.wgsl")),
     ("hbao.wgsl", include_str!("../../shaders/hbao.wgsl")),
+    ("gtao.wgsl", include_str!("../../shaders/gtao.wgsl")),
     ("ssdo.wgsl", include_str!("../../shaders/ssdo.wgsl")),
     ("fetch.wgsl", include_str!("../../shaders/fetch.wgsl")),
     ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),

@@ -1,6 +1,6 @@
 //! The screen-space occlusion techniques that share one binding layout
-//! (shaders/occlusion.wgsl): SSAO (seed 003 §3.2, seed 000 ch. 3), HBAO (seed 003 §3.3)
-//! and the fetch-only benchmark baseline. Each technique itself is its WGSL file; SSDO,
+//! (shaders/occlusion.wgsl): SSAO (seed 003 §3.2, seed 000 ch. 3), HBAO (seed 003 §3.3),
+//! GTAO with a visibility bitmask and the fetch-only benchmark baseline. Each technique itself is its WGSL file; SSDO,
 //! which also reads the direct light, is `ssdo.rs`.
 
 use super::{FrameContext, FrameSetup, Pass};
@@ -69,6 +69,10 @@ impl OcclusionPass {
 
     pub fn hbao(gpu: &Gpu) -> Self {
         Self::new(gpu, Technique::Hbao, "hbao.wgsl")
+    }
+
+    pub fn gtao(gpu: &Gpu) -> Self {
+        Self::new(gpu, Technique::Gtao, "gtao.wgsl")
     }
 
     /// SSAO's depth taps without the occlusion arithmetic (benchmark baseline).

@@ -1,0 +1,233 @@
+// GTAO with a visibility bitmask: the cosine-weighted visibility within the radius r
+// (the hard cut-off target), estimated over screen-space slices (Jimenez et al. 2016,
+// "Practical Real-Time Strategies for Accurate Indirect Occlusion"; Intel's XeGTAO), each
+// slice's occluded directions kept as a 32-sector bitmask with a finite thickness behind
+// every depth sample (Therrien, Levesque and Gilet 2023, "Screen Space Indirect Lighting
+// with Visibility Bitmask").
+//
+// A slice is the plane through the eye, the pixel's surface point P and a screen
+// direction; its directions are the angles θ from the view vector V (towards the eye),
+// the hemisphere about the normal spanning θ ∈ [γ − π/2, γ + π/2] where γ is the angle
+// of the normal projected into the slice. The slice's share of the cosine-weighted
+// integral has density |sin θ| cos(θ − γ) (GTAO's slice form), so the sectors are laid
+// out uniformly in its cumulative weight u(θ) ∈ [0, 1]: every bit weighs the same, and
+// the visible fraction of a slice is the share of clear bits. A flat open surface sets no
+// bit and reads exactly 1 (the slices are summed as a ratio of visible to total weight).
+//
+// Along each half of a slice, `steps` depth samples within r (screen distances spread by
+// `step_power`, jittered per pixel) each block the angles of a slab from the visible
+// surface back to `thickness` × r behind it (clipped at r). Two successive samples on
+// one continuous surface (their distances closer than `connect` × r) also block the
+// angles between them: a ray that is in front of a continuous surface at one sample
+// and behind it at the next crosses it in between.
+//
+// Samples that leave the eye's image are looked up in the other eye's layer
+// (occlusion.wgsl `surface_at`, guessing the last sample's distance).
+
+// Bindings and `begin_receiver`: occlusion.wgsl.
+
+const SECTORS: f32 = 32.0;
+
+// The slice's frame and its hemisphere's cumulative weight.
+struct Slice {
+    // Unit vector in the slice plane, perpendicular to V, towards positive θ.
+    t: vec3<f32>,
+    // The receiver's normal, and 1 / the length of its projection into the slice.
+    normal: vec3<f32>,
+    inv_projected_len: f32,
+    // The horizon directions of the tangent plane in the slice, at θ_max and θ_min.
+    horizon_plus: vec3<f32>,
+    horizon_minus: vec3<f32>,
+    cos_gamma: f32,
+    sin_gamma: f32,
+    theta_min: f32,
+    theta_max: f32,
+    // G(θ_min), and 1 / total weight of the hemisphere in this slice.
+    g_min: f32,
+    inv_total: f32,
+};
+
+// acos on [−1, 1] to about 7e-5 rad (Abramowitz and Stegun 4.4.45): a square root and a
+// cubic instead of the library's longer polynomial.
+fn fast_acos(x: f32) -> f32 {
+    let a = abs(x);
+    let r = sqrt(max(1.0 - a, 0.0)) * (1.5707288 + a * (-0.2121144 + a * (0.0742610 - 0.0187293 * a)));
+    return select(r, PI - r, x < 0.0);
+}
+
+fn fast_asin(x: f32) -> f32 {
+    return 0.5 * PI - fast_acos(x);
+}
+
+// Which half of the slice the direction `d` from P lies in: +1 towards `t`, else −1.
+fn slice_side(slice: Slice, d: vec3<f32>) -> f32 {
+    return select(-1.0, 1.0, dot(d, slice.t) >= 0.0);
+}
+
+// u(θ) of the direction from P along `d` (any length > 0) on half `side` of the slice:
+// the cumulative cosine weight from θ_min, normalised. The angle comes from the
+// direction's elevation e above the tangent plane (sin e = d̂·n / |n projected|, the
+// sign of cos e from the half's horizon), θ = θ_max − e or θ_min + e: exact for a point
+// in the slice plane, and a point of the tangent plane that the pixel grid puts a little
+// off the slice still lies exactly on the horizon (its in-slice angle would not).
+fn sector_coordinate(slice: Slice, d: vec3<f32>, side: f32) -> f32 {
+    let inv_len = inverseSqrt(max(dot(d, d), 1e-30));
+    let sin_e = dot(d, slice.normal) * inv_len * slice.inv_projected_len;
+    if (!(sin_e > 0.0)) {
+        // At or below the horizon.
+        return select(0.0, 1.0, side > 0.0);
+    }
+    let x = min(sin_e, 1.0);
+    let horizon = select(slice.horizon_minus, slice.horizon_plus, side > 0.0);
+    let cos_e = select(-1.0, 1.0, dot(d, horizon) >= 0.0) * sqrt(max(1.0 - x * x, 0.0));
+    let e = select(PI - fast_asin(x), fast_asin(x), cos_e >= 0.0);
+    let theta = select(slice.theta_min + e, slice.theta_max - e, side > 0.0);
+    // cos(2θ − γ) = −cos(γ ± 2e), with cos 2e and sin 2e from sin e and cos e.
+    let cos_2e = 1.0 - 2.0 * x * x;
+    let sin_2e = 2.0 * x * cos_e;
+    let cos_2t_minus_g = -(slice.cos_gamma * cos_2e + side * slice.sin_gamma * sin_2e);
+    // G(θ) = ¼ (−cos(2θ − γ) + cos γ + 2θ sin γ): the weight between 0 and θ.
+    let g = 0.25 * (slice.cos_gamma - cos_2t_minus_g + 2.0 * theta * slice.sin_gamma);
+    let u = (slice.g_min + side * g) * slice.inv_total;
+    // A direction never crosses V (θ = 0) to the other half.
+    let u_view = slice.g_min * slice.inv_total;
+    return clamp(select(min(u, u_view), max(u, u_view), side > 0.0), 0.0, 1.0);
+}
+
+// The bits whose sector centres lie in [lo, hi] (u coordinates).
+fn sector_bits(lo: f32, hi: f32) -> u32 {
+    let start = u32(clamp(round(lo * SECTORS), 0.0, SECTORS));
+    let end = u32(clamp(round(hi * SECTORS), 0.0, SECTORS));
+    if (end <= start) {
+        return 0u;
+    }
+    let count = end - start;
+    let ones = select((1u << count) - 1u, 0xffffffffu, count >= 32u);
+    return ones << start;
+}
+
+// 4×4 interleaved noise: a Bayer order (every 2×2 and 4×4 block holds evenly spread
+// values), so the 4×4 denoise window sees each of the 16 patterns once.
+fn bayer4(p: vec2<u32>) -> f32 {
+    let x = p.x & 3u;
+    let y = p.y & 3u;
+    let v = x ^ y;
+    let index = ((v & 1u) << 3u) | ((y & 1u) << 2u) | (v & 2u) | ((y & 2u) >> 1u);
+    return (f32(index) + 0.5) / 16.0;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let r = begin_receiver(id);
+    if (!r.valid) {
+        return;
+    }
+    let p = r.position;
+    let view = normalize(-p);
+    let distance = -p.z;
+    // Tangent span of one full-res pixel along x and y (y grows downwards on screen).
+    let pixel_tangent = vec2<f32>(r.eye.tangents.y - r.eye.tangents.x, r.eye.tangents.w - r.eye.tangents.z)
+        / vec2<f32>(frame.size);
+    let radius = ao.radius;
+    let radius_px = radius / max(abs(pixel_tangent.x) * distance, 1e-30);
+    if (!(radius_px >= 1.0)) {
+        // The whole radius lies inside this pixel: nothing to find.
+        store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    // Never march further than the image's diagonal.
+    let march_px = min(radius_px, f32(frame.size.x + frame.size.y));
+    let thickness = ao.thickness * radius;
+    let connect = ao.connect * radius;
+    let radius2 = radius * radius;
+    let slices = max(ao.directions, 1u);
+    let steps = max(ao.steps, 1u);
+    let rotation_noise = bayer4(r.pixel);
+    // A second, decorrelated value of the same tile for the step jitter.
+    let jitter = fract(rotation_noise * 7.0 + 0.3125);
+    let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
+    var visible = 0.0;
+    var total = 0.0;
+    for (var s = 0u; s < slices; s++) {
+        let phi = (f32(s) + rotation_noise) * PI / f32(slices) + ao.frame_angle;
+        let omega = vec2<f32>(cos(phi), sin(phi));
+        let direction = normalize(vec3<f32>(omega * pixel_tangent, 0.0));
+        var slice: Slice;
+        slice.t = normalize(direction - dot(direction, view) * view);
+        let axis = cross(slice.t, view);
+        let projected = r.normal - axis * dot(r.normal, axis);
+        let projected_len = length(projected);
+        if (!(projected_len > 1e-6)) {
+            continue;
+        }
+        slice.cos_gamma = clamp(dot(projected, view) / projected_len, -1.0, 1.0);
+        slice.sin_gamma = dot(projected, slice.t) / projected_len;
+        let gamma = atan2(slice.sin_gamma, slice.cos_gamma);
+        slice.theta_min = gamma - 0.5 * PI;
+        slice.theta_max = gamma + 0.5 * PI;
+        slice.g_min = 0.5 * (slice.cos_gamma + slice.theta_min * slice.sin_gamma);
+        let slice_total = slice.cos_gamma + gamma * slice.sin_gamma;
+        if (!(slice_total > 1e-6)) {
+            continue;
+        }
+        slice.inv_total = 1.0 / slice_total;
+        slice.normal = r.normal;
+        slice.inv_projected_len = 1.0 / projected_len;
+        slice.horizon_plus = slice.cos_gamma * slice.t - slice.sin_gamma * view;
+        slice.horizon_minus = -slice.horizon_plus;
+        var occluded = 0u;
+        for (var half = 0u; half < 2u; half++) {
+            let sign = select(-1.0, 1.0, half == 0u);
+            var previous_u = -1.0;
+            var previous_distance = distance;
+            for (var i = 0u; i < steps; i++) {
+                let t = (f32(i) + jitter) / f32(steps);
+                let offset_px = max(pow(t, ao.step_power) * march_px, f32(i) + 1.0);
+                let q = centre_px + sign * omega * offset_px;
+                let surface = surface_at(q, r.layer, r.eye, previous_distance);
+                if (surface.w == 0.0) {
+                    previous_u = -1.0;
+                    continue;
+                }
+                let front = surface.xyz - p;
+                let front2 = dot(front, front);
+                let sample_distance = -surface.z;
+                if (!(front2 < radius2)) {
+                    previous_u = -1.0;
+                    previous_distance = sample_distance;
+                    continue;
+                }
+                // The slab's back along the sample's view ray, clipped where it leaves
+                // the sphere of radius r about P.
+                let ray = normalize(surface.xyz);
+                let along = dot(front, ray);
+                let to_sphere = -along + sqrt(max(along * along - front2 + radius2, 0.0));
+                let back = front + ray * min(thickness, to_sphere);
+                let side = slice_side(slice, front);
+                let u_front = sector_coordinate(slice, front, side);
+                // The slab sweeps from its front away from V (its line passes through
+                // the eye, never through V); a back below the tangent plane reads as
+                // the horizon of the front's half.
+                let u_back = sector_coordinate(slice, back, side);
+                var lo = min(u_front, u_back);
+                var hi = max(u_front, u_back);
+                if (previous_u >= 0.0 && abs(sample_distance - previous_distance) < connect) {
+                    lo = min(lo, previous_u);
+                    hi = max(hi, previous_u);
+                }
+                occluded |= sector_bits(lo, hi);
+                previous_u = u_front;
+                previous_distance = sample_distance;
+            }
+        }
+        let weight = projected_len * slice_total;
+        visible += weight * (1.0 - f32(countOneBits(occluded)) / SECTORS);
+        total += weight;
+    }
+    var visibility = 1.0;
+    if (total > 1e-12) {
+        visibility = visible / total;
+    }
+    let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
+    store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, result));
+}
