@@ -148,9 +148,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
     var visible = 0.0;
     var total = 0.0;
+    // Slice directions: the pixel's first, then turned by π / slices each (one sin/cos
+    // pair per pixel and one per frame instead of one per slice).
+    let phi0 = rotation_noise * PI / f32(slices) + ao.frame_angle;
+    var omega = vec2<f32>(cos(phi0), sin(phi0));
+    let turn = vec2<f32>(cos(PI / f32(slices)), sin(PI / f32(slices)));
     for (var s = 0u; s < slices; s++) {
-        let phi = (f32(s) + rotation_noise) * PI / f32(slices) + ao.frame_angle;
-        let omega = vec2<f32>(cos(phi), sin(phi));
+        if (s > 0u) {
+            omega = vec2<f32>(omega.x * turn.x - omega.y * turn.y, omega.x * turn.y + omega.y * turn.x);
+        }
         let direction = normalize(vec3<f32>(omega * pixel_tangent, 0.0));
         var slice: Slice;
         slice.t = normalize(direction - dot(direction, view) * view);
@@ -162,7 +168,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         slice.cos_gamma = clamp(dot(projected, view) / projected_len, -1.0, 1.0);
         slice.sin_gamma = dot(projected, slice.t) / projected_len;
-        let gamma = atan2(slice.sin_gamma, slice.cos_gamma);
+        // The normal faces the eye (occlusion.wgsl `repaired_normal`): cos γ > 0, |γ| < π/2.
+        let gamma = select(-1.0, 1.0, slice.sin_gamma >= 0.0) * fast_acos(slice.cos_gamma);
         slice.theta_min = gamma - 0.5 * PI;
         slice.theta_max = gamma + 0.5 * PI;
         slice.g_min = 0.5 * (slice.cos_gamma + slice.theta_min * slice.sin_gamma);
@@ -182,7 +189,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             var previous_distance = distance;
             for (var i = 0u; i < steps; i++) {
                 let t = (f32(i) + jitter) / f32(steps);
-                let offset_px = max(pow(t, ao.step_power) * march_px, f32(i) + 1.0);
+                let spread = select(pow(t, ao.step_power), t * t, ao.step_power == 2.0);
+                let offset_px = max(spread * march_px, f32(i) + 1.0);
                 let q = centre_px + sign * omega * offset_px;
                 let surface = surface_at(q, r.layer, r.eye, previous_distance);
                 if (surface.w == 0.0) {

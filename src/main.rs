@@ -385,7 +385,11 @@ struct AoArgs {
     /// thin objects in front of a background. Assumes closed geometry.
     #[arg(long)]
     depth_peeling: bool,
-    /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns the blur off.
+    /// Spatial denoise: tile (edge-aware 4×4 matched to the 4×4 noise tile, one pass) or
+    /// bilateral (separable, --blur px either side).
+    #[arg(long, default_value = "tile")]
+    denoise: vrao::settings::Denoise,
+    /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns any denoise off.
     #[arg(long, default_value_t = 5)]
     blur: u32,
     /// Blur depth-edge width as a fraction of the pixel's distance (smaller keeps sharper edges).
@@ -454,6 +458,7 @@ impl AoArgs {
             noise: self.noise,
             half_res: self.half_res,
             depth_peeling: self.depth_peeling,
+            denoise: self.denoise,
             blur_radius: self.blur,
             blur_plane_sigma: self.blur_sigma,
             temporal: vrao::settings::Temporal {

@@ -212,6 +212,36 @@ impl std::str::FromStr for BounceForm {
     }
 }
 
+/// The spatial denoise of the occlusion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Denoise {
+    /// Edge-aware 4×4 box matched to the 4×4 noise tile, one pass (shaders/denoise.wgsl).
+    #[default]
+    Tile,
+    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; seed 000).
+    Bilateral,
+}
+
+impl Denoise {
+    pub const ALL: [Denoise; 2] = [Denoise::Tile, Denoise::Bilateral];
+    pub fn name(self) -> &'static str {
+        match self {
+            Denoise::Tile => "tile",
+            Denoise::Bilateral => "bilateral",
+        }
+    }
+}
+
+impl std::str::FromStr for Denoise {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Denoise::ALL
+            .into_iter()
+            .find(|d| d.name() == s)
+            .ok_or_else(|| format!("unknown denoise '{s}' (expected tile or bilateral)"))
+    }
+}
+
 /// Occlusion parameters shared by every technique.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AoSettings {
@@ -237,9 +267,10 @@ pub struct AoSettings {
     /// Depth peeling for SSDO (seed 002 §4): a second depth layer, and a sample occludes
     /// only between the first and second layer (inside an object). Off by default.
     pub depth_peeling: bool,
-    /// Separable geometry-aware bilateral blur radius in full-resolution pixels
-    /// (5 = 11×11; at half resolution 3 taps either side cover the same footprint);
-    /// 0 turns it off.
+    /// Which spatial denoise runs.
+    pub denoise: Denoise,
+    /// The bilateral blur's radius in full-resolution pixels (5 = 11×11; at half
+    /// resolution 3 taps either side cover the same footprint); 0 turns any denoise off.
     pub blur_radius: u32,
     /// The blur's depth edge: a neighbour this far off the centre's tangent plane, as a
     /// fraction of the centre's distance, loses most of its weight. Near 0 every
@@ -334,6 +365,7 @@ impl Default for AoSettings {
             noise: Noise::Halton,
             half_res: false,
             depth_peeling: false,
+            denoise: Denoise::Tile,
             blur_radius: 5,
             blur_plane_sigma: 0.02,
             temporal: Temporal::default(),

@@ -17,6 +17,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("ssdo.wgsl", include_str!("../../shaders/ssdo.wgsl")),
     ("fetch.wgsl", include_str!("../../shaders/fetch.wgsl")),
     ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),
+    ("denoise.wgsl", include_str!("../../shaders/denoise.wgsl")),
     ("joint_upsample.wgsl", include_str!("../../shaders/joint_upsample.wgsl")),
     ("upsample.wgsl", include_str!("../../shaders/upsample.wgsl")),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
