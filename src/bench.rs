@@ -9,10 +9,12 @@ use crate::gpu::Gpu;
 use crate::metrics;
 use crate::passes::final_occlusion;
 use crate::plot::{ScatterPlot, Series};
+use crate::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::reference::ReferenceImage;
 use crate::renderer::{Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::{Settings, Technique};
+use crate::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -56,6 +58,9 @@ pub struct BenchRow {
     /// Error of the one-bounce irradiance against the reference's `bounce` (ssdo-bounce
     /// and rsm rows, with a reference).
     pub bounce: Option<BounceFigures>,
+    /// How far the eyes' final AO disagree on the points both see (occlusion rows; no
+    /// reference needed).
+    pub stereo: Option<StereoConsistency>,
 }
 
 impl BenchRow {
@@ -95,7 +100,11 @@ pub fn measure(
     for _ in 0..how.frames {
         run.timed_frame()?;
     }
-    run.finish(reference)
+    let limit = match reference {
+        Some(reference) => Some(run.screen_limit(reference)?),
+        None => None,
+    };
+    run.finish(reference, limit.as_ref())
 }
 
 /// One case being measured: its renderer, and the per-pass times of its frames so far.
@@ -152,12 +161,43 @@ impl CaseRun {
         Ok(())
     }
 
-    /// The row: medians of the measured frames, and the last frame's error.
-    fn finish(mut self, reference: Option<&ReferenceImage>) -> Result<BenchRow> {
+    /// The screen-space limit of the last frame for the radius and grid of `reference`
+    /// (the march over its depth buffer and normals, [`screen_space_limit`]).
+    fn screen_limit(&self, reference: &ReferenceImage) -> Result<ScreenLimit> {
+        let depth = self.renderer.read_f32(crate::graph::Resource::Depth)?;
+        let normals = self.renderer.read_f32(crate::graph::Resource::Normals)?;
+        let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
+            .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: self.eyes.eyes[k].fov })
+            .collect();
+        let settings = LimitSettings::for_reference(reference, self.case.radius as f64, self.eyes.near);
+        screen_space_limit(&buffers, (reference.width, reference.height), &settings)
+    }
+
+    /// Pixels per degree of this case's eyes (the mean of both).
+    fn pixels_per_degree(&self) -> f64 {
+        let width = self.settings.profile.width;
+        self.eyes.eyes.iter().map(|e| pixels_per_degree(&e.fov, width)).sum::<f64>() / self.eyes.eyes.len() as f64
+    }
+
+    /// The row: medians of the measured frames, the last frame's stereo consistency, and
+    /// with a reference its error (against the screen-space `limit` too when given).
+    fn finish(mut self, reference: Option<&ReferenceImage>, limit: Option<&ScreenLimit>) -> Result<BenchRow> {
         let (settings, output) = (&self.settings, self.output);
-        let error = match reference {
-            Some(reference) => Some(error_figures(self.case.technique, &self.renderer.read_f32(output)?, reference)),
-            None => None,
+        let occlusion = self.renderer.read_f32(output)?;
+        let error = reference
+            .map(|reference| score(self.case.technique, &occlusion, reference, limit, self.pixels_per_degree()));
+        let stereo = {
+            let depth = self.renderer.read_f32(crate::graph::Resource::Depth)?;
+            let ao: Vec<Vec<f32>> = occlusion.iter().map(|l| l.iter().skip(3).step_by(4).copied().collect()).collect();
+            let size = (settings.profile.width, settings.profile.height);
+            (depth.len() == 2 && ao.len() == 2).then(|| {
+                stereo_consistency(
+                    &self.eyes.eyes,
+                    [EyeImages { depth: &depth[0], ao: &ao[0] }, EyeImages { depth: &depth[1], ao: &ao[1] }],
+                    size,
+                    self.eyes.near,
+                )
+            })
         };
         // SSDO's bounce alone: the same frame without the bounce (same pattern, and the
         // blur is linear with geometry-only weights), subtracted.
@@ -183,6 +223,7 @@ impl CaseRun {
             pass: settings.ao.pass_name(),
             error,
             bounce,
+            stereo,
             case: self.case,
         })
     }
@@ -241,7 +282,7 @@ pub fn measure_rsm(
         depth_peeling: false,
         temporal: false,
     };
-    Ok(BenchRow { case, spans: summarize(&timings), views: 2, pass: RSM_PASS, error: None, bounce })
+    Ok(BenchRow { case, spans: summarize(&timings), views: 2, pass: RSM_PASS, error: None, bounce, stereo: None })
 }
 
 /// A one-bounce irradiance estimate against the reference's `bounce`, by luminance over
@@ -291,8 +332,37 @@ pub fn bounce_figures(
     })
 }
 
+/// A rough estimate, in seconds, of what measuring `cases` will take: the first case's
+/// set-up (renderer, pipelines, first frame) and one more frame are timed, and every case
+/// is assumed to cost that set-up plus its warm-up and measured frames at that frame
+/// time. Other techniques, sample counts and resolutions cost more or less; the
+/// reference and the screen-space limit are not included. Returns (estimate, seconds a
+/// frame of the first case).
+pub fn estimate_seconds(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    base: &Settings,
+    cases: &[BenchCase],
+    how: Measurement,
+) -> Result<(f64, f64)> {
+    let Some(first) = cases.first() else {
+        return Ok((0.0, 0.0));
+    };
+    let start = std::time::Instant::now();
+    let mut run = CaseRun::new(gpu, scene, base, first, how)?;
+    run.frame()?;
+    let setup = start.elapsed().as_secs_f64();
+    let start = std::time::Instant::now();
+    run.frame()?;
+    let frame = start.elapsed().as_secs_f64();
+    let frames = (how.warmup + how.frames) as f64;
+    Ok((cases.len() as f64 * (setup + frames.max(1.0) * frame), frame))
+}
+
 /// Runs every case, calling `progress(done, total, row)` after each. `references` holds
-/// a reference image per radius (cases whose radius has none get no error figures).
+/// a reference image per radius (cases whose radius has none get no error figures); the
+/// screen-space limit of each such radius is marched once, from the frame of its first
+/// case, and scores every row of that radius.
 /// `interleave` cases at a time are measured round-robin, one frame each per round, so
 /// that a slow drift of the machine (other load, clocks, heat) falls on all of them alike
 /// and their ratios stay fair; 1 measures each case on its own, in a row.
@@ -307,6 +377,7 @@ pub fn sweep(
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
+    let mut limits: Vec<(f32, ScreenLimit)> = Vec::new();
     for group in cases.chunks(interleave.max(1)) {
         let mut runs = Vec::with_capacity(group.len());
         for case in group {
@@ -323,7 +394,15 @@ pub fn sweep(
         }
         for run in runs {
             let reference = references.iter().find(|(r, _)| *r == run.case.radius).map(|(_, image)| image);
-            let row = run.finish(reference)?;
+            // The limit depends only on the frame's depth and normals (the same G-buffer
+            // for every case) and the radius: marched once per radius, for its first row.
+            if let Some(reference) = reference {
+                if !limits.iter().any(|(r, _)| *r == run.case.radius) {
+                    limits.push((run.case.radius, run.screen_limit(reference)?));
+                }
+            }
+            let limit = limits.iter().find(|(r, _)| *r == run.case.radius).map(|(_, l)| l);
+            let row = run.finish(reference, limit)?;
             progress(rows.len() + 1, cases.len(), &row);
             rows.push(row);
         }
@@ -332,12 +411,21 @@ pub fn sweep(
 }
 
 /// How far one row's occlusion is from the reference tracer's, on the pixels the
-/// reference traced (both eyes; sky excluded).
+/// reference traced (both eyes; sky excluded). Every technique is scored against the same
+/// target: the reference's `ao`, cosine-weighted visibility within r with a hard cut-off.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ErrorFigures {
-    /// RMSE of the AO (`.a`) against the reference the technique approximates (HBAO: with
-    /// its linear falloff), with the reference's own noise taken out in quadrature.
+    /// RMSE of the AO (`.a`) against the reference's hard cut-off AO, with the reference's
+    /// own noise taken out in quadrature.
     pub ao_rmse: f64,
+    /// Mean of (estimate − reference): > 0 is too light, < 0 too dark.
+    pub ao_bias: f64,
+    /// The same over the pixels where the reference is below [`DARK_REFERENCE`]: how well
+    /// the occluded places (creases, contacts) come out. `None` when there are none.
+    pub ao_bias_dark: Option<f64>,
+    /// RMSE against the reference's linear-falloff AO (each occluded direction weighted by
+    /// 1 − d/r), noise taken out as for `ao_rmse`: a second figure, for every technique.
+    pub ao_rmse_falloff: f64,
     /// Mean SSIM of the AO images against the reference (1 = identical), per eye averaged.
     pub ao_ssim: f64,
     /// RMSE of the ambient light's luminance (what the composite multiplies by albedo/π)
@@ -345,30 +433,73 @@ pub struct ErrorFigures {
     /// plus one bounce of direct light from surfaces within r. Comparable across
     /// techniques; `None` when the reference has no ambient light at all.
     pub ambient_rel_rmse: Option<f64>,
+    /// Mean ꟻLIP of the AO against the reference AO ([`metrics::flip_mean`]) on the
+    /// reference's grid, at the headset's pixels per degree over the grid's spacing.
+    pub flip_mean: Option<f64>,
+    /// RMSE against the screen-space limit (the march over this frame's depth buffer):
+    /// the estimator's own error, with the limit's noise taken out.
+    pub ao_rmse_vs_limit: Option<f64>,
+    /// The screen-space limit's RMSE against the reference (both noises taken out): the
+    /// error no depth-buffer method can remove. The same for every row of a radius.
+    pub limit_rmse: Option<f64>,
+    /// The screen-space limit's mean bias against the reference.
+    pub limit_bias: Option<f64>,
+}
+
+/// Reference AO below which a pixel counts as occluded for [`ErrorFigures::ao_bias_dark`].
+pub const DARK_REFERENCE: f32 = 0.8;
+
+/// Pixels per degree of an eye `width` pixels across its horizontal field of view (the
+/// mean over the field: a Vive-class 1080-pixel eye over ~97.5° has ~11.1).
+pub fn pixels_per_degree(fov: &crate::stereo::Fov, width: u32) -> f64 {
+    width as f64 / (fov.right as f64 - fov.left as f64).to_degrees()
 }
 
 /// Compares the occlusion a frame produced (per layer, RGBA at the full image size) with
-/// the reference on its grid of traced pixels.
+/// the reference on its grid of traced pixels; FLIP at the pixels per degree of the
+/// project's Vive-class headset profile at the reference's size (what [`score`] takes
+/// from the frame's eyes), no screen-space limit.
 pub fn error_figures(technique: Technique, occlusion: &[Vec<f32>], reference: &ReferenceImage) -> ErrorFigures {
+    let profile = crate::stereo::HeadsetProfile::with_size("vive", reference.width, reference.height);
+    score(technique, occlusion, reference, None, pixels_per_degree(&profile.fov_left, reference.width))
+}
+
+/// [`error_figures`] with the screen-space limit of the same frame and radius (the limit
+/// columns are `None` without it) and FLIP at `pixels_per_degree` of the full image.
+pub fn score(
+    technique: Technique,
+    occlusion: &[Vec<f32>],
+    reference: &ReferenceImage,
+    limit: Option<&ScreenLimit>,
+    pixels_per_degree: f64,
+) -> ErrorFigures {
     let (w, h) = (reference.width as usize, reference.height as usize);
-    let stride = reference.stride.max(1) as usize;
-    let (gw, gh) = (w.div_ceil(stride), h.div_ceil(stride));
-    let (mut gpu_ao, mut ref_ao, mut noise2, mut mask) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (gw, gh) = reference.grid_size();
+    let (gw, gh) = (gw as usize, gh as usize);
+    let limit = limit.filter(|l| l.grid_size() == reference.grid_size() && l.layers.len() >= reference.layers.len());
+    let (mut gpu_ao, mut ref_ao, mut falloff, mut noise2, mut mask) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut limit_ao, mut limit_noise2, mut limit_mask) = (Vec::new(), Vec::new(), Vec::new());
     let (mut gpu_ambient, mut ref_ambient) = (Vec::new(), Vec::new());
-    let mut ssim_sum = 0.0;
+    let (mut ssim_sum, mut flip_sum, mut flip_pixels) = (0.0, 0.0, 0usize);
     for (layer, pixels) in reference.layers.iter().enumerate() {
         let image = &occlusion[layer];
         let first = gpu_ao.len();
         for gy in 0..gh {
             for gx in 0..gw {
                 let r = &pixels[gy * gw + gx];
-                let (x, y) = ((gx * stride + stride / 2).min(w - 1), (gy * stride + stride / 2).min(h - 1));
+                let (x, y) = reference.pixel_of(gx as u32, gy as u32);
+                let (x, y) = ((x as usize).min(w - 1), (y as usize).min(h - 1));
                 let texel = &image[(y * w + x) * 4..(y * w + x) * 4 + 4];
-                let target = if technique == Technique::Hbao { r.ao_falloff } else { r.ao };
                 gpu_ao.push(texel[3]);
-                ref_ao.push(target);
+                ref_ao.push(r.ao);
+                falloff.push(r.ao_falloff);
                 mask.push(r.hit);
                 noise2.push(if r.hit { (r.ao_std_error as f64).powi(2) } else { 0.0 });
+                let l = limit.map(|l| *l.get(layer, gx as u32, gy as u32));
+                limit_ao.push(l.map_or(1.0, |l| l.ao));
+                limit_mask.push(r.hit && l.is_some_and(|l| l.hit));
+                limit_noise2.push(l.map_or(0.0, |l| (l.std_error as f64).powi(2)));
                 let ambient = match technique {
                     Technique::Ssdo | Technique::SsdoBounce => [texel[0], texel[1], texel[2]],
                     _ => r.unoccluded.map(|c| c * texel[3]),
@@ -379,18 +510,67 @@ pub fn error_figures(technique: Technique, occlusion: &[Vec<f32>], reference: &R
             }
         }
         let range = first..gpu_ao.len();
-        ssim_sum += metrics::ssim(&gpu_ao[range.clone()], &ref_ao[range.clone()], gw, gh, Some(&mask[range]), 1.0)
-            .unwrap_or(0.0);
+        ssim_sum +=
+            metrics::ssim(&gpu_ao[range.clone()], &ref_ao[range.clone()], gw, gh, Some(&mask[range.clone()]), 1.0)
+                .unwrap_or(0.0);
+        // FLIP on this eye's grid, the sky 1 in both; pooled over both eyes' hit pixels.
+        let sky_is_one = |values: &[f32]| -> Vec<f32> {
+            values.iter().zip(&mask[range.clone()]).map(|(&v, &hit)| if hit { v } else { 1.0 }).collect()
+        };
+        let grid_ppd = pixels_per_degree / reference.stride.max(1) as f64;
+        let (test, truth) = (sky_is_one(&gpu_ao[range.clone()]), sky_is_one(&ref_ao[range.clone()]));
+        let hits = mask[range.clone()].iter().filter(|&&m| m).count();
+        if let Some(mean) = metrics::flip_mean(&test, &truth, gw, gh, Some(&mask[range]), grid_ppd) {
+            flip_sum += mean * hits as f64;
+            flip_pixels += hits;
+        }
     }
-    let hits = mask.iter().filter(|&&m| m).count().max(1) as f64;
+    let hit_count = mask.iter().filter(|&&m| m).count();
+    let hits = hit_count.max(1) as f64;
     let noise = (noise2.iter().sum::<f64>() / hits).sqrt();
-    let ao_rmse =
-        metrics::noise_corrected_rmse(metrics::rmse(&gpu_ao, &ref_ao, Some(&mask)).unwrap_or(f64::NAN), noise);
+    let corrected = |a: &[f32], b: &[f32], mask: &[bool], noise: f64| {
+        metrics::noise_corrected_rmse(metrics::rmse(a, b, Some(mask)).unwrap_or(f64::NAN), noise)
+    };
+    let mean_difference = |a: &[f32], b: &[f32], keep: &dyn Fn(usize) -> bool| {
+        let (mut n, mut sum) = (0usize, 0f64);
+        for i in (0..a.len()).filter(|&i| keep(i)) {
+            n += 1;
+            sum += a[i] as f64 - b[i] as f64;
+        }
+        (n > 0).then(|| sum / n as f64)
+    };
+    let ao_bias = mean_difference(&gpu_ao, &ref_ao, &|i| mask[i]).unwrap_or(f64::NAN);
+    let ao_bias_dark = mean_difference(&gpu_ao, &ref_ao, &|i| mask[i] && ref_ao[i] < DARK_REFERENCE);
     let mean_ambient = ref_ambient.iter().zip(&mask).filter(|(_, &m)| m).map(|(&a, _)| a as f64).sum::<f64>() / hits;
     let ambient_rel_rmse = (mean_ambient > 1e-12)
         .then(|| metrics::rmse(&gpu_ambient, &ref_ambient, Some(&mask)).map(|e| e / mean_ambient))
         .flatten();
-    ErrorFigures { ao_rmse, ao_ssim: ssim_sum / reference.layers.len().max(1) as f64, ambient_rel_rmse }
+    let (ao_rmse_vs_limit, limit_rmse, limit_bias) = match limit {
+        Some(_) if limit_mask.iter().any(|&m| m) => {
+            let n = limit_mask.iter().filter(|&&m| m).count() as f64;
+            let limit_noise2 =
+                limit_noise2.iter().zip(&limit_mask).filter(|(_, &m)| m).map(|(v, _)| v).sum::<f64>() / n;
+            let ref_noise2 = noise2.iter().zip(&limit_mask).filter(|(_, &m)| m).map(|(v, _)| v).sum::<f64>() / n;
+            (
+                Some(corrected(&gpu_ao, &limit_ao, &limit_mask, limit_noise2.sqrt())),
+                Some(corrected(&limit_ao, &ref_ao, &limit_mask, (limit_noise2 + ref_noise2).sqrt())),
+                mean_difference(&limit_ao, &ref_ao, &|i| limit_mask[i]),
+            )
+        }
+        _ => (None, None, None),
+    };
+    ErrorFigures {
+        ao_rmse: corrected(&gpu_ao, &ref_ao, &mask, noise),
+        ao_bias,
+        ao_bias_dark,
+        ao_rmse_falloff: corrected(&gpu_ao, &falloff, &mask, noise),
+        ao_ssim: ssim_sum / reference.layers.len().max(1) as f64,
+        ambient_rel_rmse,
+        flip_mean: (flip_pixels > 0).then(|| flip_sum / flip_pixels as f64),
+        ao_rmse_vs_limit,
+        limit_rmse,
+        limit_bias,
+    }
 }
 
 /// One row as written to CSV, JSON and Markdown.
@@ -407,7 +587,38 @@ pub struct BenchRecord {
     pub occlusion_ms_per_eye: f64,
     /// p75 / p25 of the technique pass: the run-to-run spread.
     pub p75_over_p25: f64,
+    /// RMSE against the reference's hard cut-off AO ([`ErrorFigures::ao_rmse`]).
     pub ao_rmse: Option<f64>,
+    /// Mean estimate − reference over hit pixels, both eyes.
+    #[serde(default)]
+    pub ao_bias: Option<f64>,
+    /// The bias over pixels whose reference AO is below 0.8.
+    #[serde(default)]
+    pub ao_bias_dark: Option<f64>,
+    /// RMSE against the reference's linear-falloff AO.
+    #[serde(default)]
+    pub ao_rmse_falloff: Option<f64>,
+    /// RMSE against the screen-space limit (estimator error).
+    #[serde(default)]
+    pub ao_rmse_vs_limit: Option<f64>,
+    /// The screen-space limit's RMSE and bias against the reference (screen-space error;
+    /// the same for every row of a radius).
+    #[serde(default)]
+    pub limit_rmse: Option<f64>,
+    #[serde(default)]
+    pub limit_bias: Option<f64>,
+    /// Mean ꟻLIP of the AO against the reference AO at the headset's pixels per degree.
+    #[serde(default)]
+    pub flip_mean: Option<f64>,
+    /// Share (0..1) of the points both eyes see whose AO differs by more than 0.02:
+    /// overall, within 40 px of the inner (nasal) border, and farther than 40 px from
+    /// every border.
+    #[serde(default)]
+    pub stereo_inconsistent: Option<f64>,
+    #[serde(default)]
+    pub stereo_inconsistent_inner_border: Option<f64>,
+    #[serde(default)]
+    pub stereo_inconsistent_interior: Option<f64>,
     pub ao_ssim: Option<f64>,
     pub ambient_rel_rmse: Option<f64>,
     /// On the Pareto front of AO RMSE against occlusion ms per eye.
@@ -458,7 +669,40 @@ pub struct BenchFile {
     pub frames: u32,
     /// The reference tracer's settings and noise, when errors were measured.
     pub reference: Option<ReferenceInfo>,
+    /// How the screen-space limit was marched, when errors were measured.
+    #[serde(default)]
+    pub limit: Option<LimitInfo>,
+    /// Pixels per degree of the eyes (FLIP uses this over the reference's stride).
+    #[serde(default)]
+    pub pixels_per_degree: Option<f64>,
+    /// vrao's version (and git commit when it could be read) that measured this.
+    #[serde(default)]
+    pub version: String,
+    /// The command line that measured this.
+    #[serde(default)]
+    pub command: String,
     pub records: Vec<BenchRecord>,
+}
+
+/// The screen-space limit's march ([`LimitSettings`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LimitInfo {
+    pub rays_per_pixel: u32,
+    pub steps: u32,
+    /// Thickness as a fraction of the radius.
+    pub thickness_of_radius: f64,
+}
+
+impl LimitInfo {
+    /// The defaults every bench uses.
+    pub fn defaults() -> LimitInfo {
+        use crate::reference::screen_limit::{DEFAULT_RAYS, DEFAULT_STEPS, DEFAULT_THICKNESS_OF_RADIUS};
+        LimitInfo {
+            rays_per_pixel: DEFAULT_RAYS,
+            steps: DEFAULT_STEPS,
+            thickness_of_radius: DEFAULT_THICKNESS_OF_RADIUS,
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -491,6 +735,16 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 occlusion_ms_per_eye: row.occlusion_ms_per_eye(),
                 p75_over_p25: spread,
                 ao_rmse: row.error.as_ref().map(|e| e.ao_rmse),
+                ao_bias: row.error.as_ref().map(|e| e.ao_bias),
+                ao_bias_dark: row.error.as_ref().and_then(|e| e.ao_bias_dark),
+                ao_rmse_falloff: row.error.as_ref().map(|e| e.ao_rmse_falloff),
+                ao_rmse_vs_limit: row.error.as_ref().and_then(|e| e.ao_rmse_vs_limit),
+                limit_rmse: row.error.as_ref().and_then(|e| e.limit_rmse),
+                limit_bias: row.error.as_ref().and_then(|e| e.limit_bias),
+                flip_mean: row.error.as_ref().and_then(|e| e.flip_mean),
+                stereo_inconsistent: row.stereo.and_then(|c| c.inconsistent),
+                stereo_inconsistent_inner_border: row.stereo.and_then(|c| c.inner_border),
+                stereo_inconsistent_interior: row.stereo.and_then(|c| c.interior),
                 ao_ssim: row.error.as_ref().map(|e| e.ao_ssim),
                 ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
                 pareto: false,
@@ -544,69 +798,338 @@ pub fn mark_pareto(out: &mut [BenchRecord]) {
     }
 }
 
-const COLUMNS: [&str; 20] = [
-    "technique",
-    "samples",
-    "radius_m",
-    "resolution",
-    "technique_ms_per_eye",
-    "blur_ms_per_eye",
-    "upsample_ms_per_eye",
-    "occlusion_ms_per_eye",
-    "p75_over_p25",
-    "ao_rmse",
-    "ao_ssim",
-    "ambient_rel_rmse",
-    "pareto",
-    "depth_peeling",
-    "peel_ms_per_eye",
-    "bounce_rel_rmse",
-    "bounce_rel_bias",
-    "temporal",
-    "composite_ms_per_eye",
-    "frame_upsample_ms_per_eye",
+/// One column of the CSV and of the Markdown table: its CSV name, its Markdown
+/// header, the CSV value (full precision) and the Markdown value (rounded to what it means).
+struct Column {
+    name: &'static str,
+    header: &'static str,
+    csv: fn(&BenchRecord) -> String,
+    markdown: fn(&BenchRecord) -> String,
+    /// Shown in the Markdown table only when some row has something there.
+    optional: bool,
+}
+
+fn fixed(v: Option<f64>, decimals: usize) -> String {
+    v.map_or(String::new(), |v| format!("{v:.decimals$}"))
+}
+
+fn percent(v: Option<f64>) -> String {
+    v.map_or(String::new(), |v| format!("{:.1} %", v * 100.0))
+}
+
+fn yes(b: bool) -> String {
+    if b { "yes" } else { "" }.to_string()
+}
+
+/// Every column, the ones a reader compares first first.
+const COLUMNS: &[Column] = &[
+    Column {
+        name: "technique",
+        header: "technique",
+        csv: |r| r.technique.clone(),
+        markdown: |r| r.technique.clone(),
+        optional: false,
+    },
+    Column {
+        name: "samples",
+        header: "N",
+        csv: |r| r.samples.to_string(),
+        markdown: |r| r.samples.to_string(),
+        optional: false,
+    },
+    Column {
+        name: "radius_m",
+        header: "r (m)",
+        csv: |r| format!("{}", r.radius_m),
+        markdown: |r| format!("{}", r.radius_m),
+        optional: false,
+    },
+    Column {
+        name: "resolution",
+        header: "res",
+        csv: |r| r.resolution.clone(),
+        markdown: |r| r.resolution.clone(),
+        optional: false,
+    },
+    Column {
+        name: "occlusion_ms_per_eye",
+        header: "ms/eye",
+        csv: |r| format!("{:.3}", r.occlusion_ms_per_eye),
+        markdown: |r| format!("{:.1}", r.occlusion_ms_per_eye),
+        optional: false,
+    },
+    Column {
+        name: "ao_rmse",
+        header: "RMSE",
+        csv: |r| fixed(r.ao_rmse, 4),
+        markdown: |r| fixed(r.ao_rmse, 3),
+        optional: false,
+    },
+    Column {
+        name: "ao_bias",
+        header: "bias",
+        csv: |r| fixed(r.ao_bias, 4),
+        markdown: |r| fixed(r.ao_bias, 3),
+        optional: false,
+    },
+    Column {
+        name: "ao_bias_dark",
+        header: "bias (ref < 0.8)",
+        csv: |r| fixed(r.ao_bias_dark, 4),
+        markdown: |r| fixed(r.ao_bias_dark, 3),
+        optional: false,
+    },
+    Column {
+        name: "ao_rmse_vs_limit",
+        header: "RMSE vs limit",
+        csv: |r| fixed(r.ao_rmse_vs_limit, 4),
+        markdown: |r| fixed(r.ao_rmse_vs_limit, 3),
+        optional: false,
+    },
+    Column {
+        name: "limit_rmse",
+        header: "limit RMSE",
+        csv: |r| fixed(r.limit_rmse, 4),
+        markdown: |r| fixed(r.limit_rmse, 3),
+        optional: false,
+    },
+    Column {
+        name: "limit_bias",
+        header: "limit bias",
+        csv: |r| fixed(r.limit_bias, 4),
+        markdown: |r| fixed(r.limit_bias, 3),
+        optional: false,
+    },
+    Column {
+        name: "flip_mean",
+        header: "FLIP",
+        csv: |r| fixed(r.flip_mean, 4),
+        markdown: |r| fixed(r.flip_mean, 3),
+        optional: false,
+    },
+    Column {
+        name: "stereo_inconsistent",
+        header: "stereo ≠",
+        csv: |r| fixed(r.stereo_inconsistent, 4),
+        markdown: |r| percent(r.stereo_inconsistent),
+        optional: false,
+    },
+    Column {
+        name: "stereo_inconsistent_inner_border",
+        header: "≠ inner border",
+        csv: |r| fixed(r.stereo_inconsistent_inner_border, 4),
+        markdown: |r| percent(r.stereo_inconsistent_inner_border),
+        optional: false,
+    },
+    Column {
+        name: "stereo_inconsistent_interior",
+        header: "≠ interior",
+        csv: |r| fixed(r.stereo_inconsistent_interior, 4),
+        markdown: |r| percent(r.stereo_inconsistent_interior),
+        optional: false,
+    },
+    Column {
+        name: "ao_rmse_falloff",
+        header: "RMSE falloff",
+        csv: |r| fixed(r.ao_rmse_falloff, 4),
+        markdown: |r| fixed(r.ao_rmse_falloff, 3),
+        optional: false,
+    },
+    Column {
+        name: "ao_ssim",
+        header: "SSIM",
+        csv: |r| fixed(r.ao_ssim, 4),
+        markdown: |r| fixed(r.ao_ssim, 3),
+        optional: false,
+    },
+    Column {
+        name: "ambient_rel_rmse",
+        header: "ambient rel. RMSE",
+        csv: |r| fixed(r.ambient_rel_rmse, 4),
+        markdown: |r| fixed(r.ambient_rel_rmse, 3),
+        optional: true,
+    },
+    Column {
+        name: "technique_ms_per_eye",
+        header: "technique ms",
+        csv: |r| format!("{:.3}", r.technique_ms_per_eye),
+        markdown: |r| format!("{:.1}", r.technique_ms_per_eye),
+        optional: false,
+    },
+    Column {
+        name: "blur_ms_per_eye",
+        header: "blur ms",
+        csv: |r| format!("{:.3}", r.blur_ms_per_eye),
+        markdown: |r| format!("{:.1}", r.blur_ms_per_eye),
+        optional: false,
+    },
+    Column {
+        name: "upsample_ms_per_eye",
+        header: "upsample ms",
+        csv: |r| format!("{:.3}", r.upsample_ms_per_eye),
+        markdown: |r| if r.resolution == "half" { format!("{:.1}", r.upsample_ms_per_eye) } else { String::new() },
+        optional: true,
+    },
+    Column {
+        name: "p75_over_p25",
+        header: "p75/p25",
+        csv: |r| format!("{:.3}", r.p75_over_p25),
+        markdown: |r| format!("{:.2}", r.p75_over_p25),
+        optional: false,
+    },
+    Column { name: "pareto", header: "Pareto", csv: |r| yes(r.pareto), markdown: |r| yes(r.pareto), optional: true },
+    Column {
+        name: "depth_peeling",
+        header: "peeled",
+        csv: |r| yes(r.depth_peeling),
+        markdown: |r| yes(r.depth_peeling),
+        optional: true,
+    },
+    Column {
+        name: "peel_ms_per_eye",
+        header: "peel ms",
+        csv: |r| format!("{:.3}", r.peel_ms_per_eye),
+        markdown: |r| if r.depth_peeling { format!("{:.1}", r.peel_ms_per_eye) } else { String::new() },
+        optional: true,
+    },
+    Column {
+        name: "bounce_rel_rmse",
+        header: "bounce rel. RMSE",
+        csv: |r| fixed(r.bounce_rel_rmse, 4),
+        markdown: |r| fixed(r.bounce_rel_rmse, 3),
+        optional: true,
+    },
+    Column {
+        name: "bounce_rel_bias",
+        header: "bounce rel. bias",
+        csv: |r| fixed(r.bounce_rel_bias, 4),
+        markdown: |r| fixed(r.bounce_rel_bias, 3),
+        optional: true,
+    },
+    Column {
+        name: "temporal",
+        header: "temporal",
+        csv: |r| yes(r.temporal),
+        markdown: |r| yes(r.temporal),
+        optional: true,
+    },
+    Column {
+        name: "composite_ms_per_eye",
+        header: "composite ms",
+        csv: |r| format!("{:.3}", r.composite_ms_per_eye),
+        markdown: |r| {
+            if r.composite_ms_per_eye > 0.0 {
+                format!("{:.1}", r.composite_ms_per_eye)
+            } else {
+                String::new()
+            }
+        },
+        optional: true,
+    },
+    Column {
+        name: "frame_upsample_ms_per_eye",
+        header: "frame upsample ms",
+        csv: |r| fixed(r.frame_upsample_ms_per_eye, 3),
+        markdown: |r| fixed(r.frame_upsample_ms_per_eye, 1),
+        optional: true,
+    },
 ];
 
-fn record_values(r: &BenchRecord) -> [String; 20] {
-    let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.4}"));
-    [
-        r.technique.clone(),
-        r.samples.to_string(),
-        format!("{}", r.radius_m),
-        r.resolution.clone(),
-        format!("{:.3}", r.technique_ms_per_eye),
-        format!("{:.3}", r.blur_ms_per_eye),
-        format!("{:.3}", r.upsample_ms_per_eye),
-        format!("{:.3}", r.occlusion_ms_per_eye),
-        format!("{:.3}", r.p75_over_p25),
-        optional(r.ao_rmse),
-        optional(r.ao_ssim),
-        optional(r.ambient_rel_rmse),
-        if r.pareto { "yes" } else { "" }.to_string(),
-        if r.depth_peeling { "yes" } else { "" }.to_string(),
-        format!("{:.3}", r.peel_ms_per_eye),
-        optional(r.bounce_rel_rmse),
-        optional(r.bounce_rel_bias),
-        if r.temporal { "yes" } else { "" }.to_string(),
-        format!("{:.3}", r.composite_ms_per_eye),
-        r.frame_upsample_ms_per_eye.map_or(String::new(), |v| format!("{v:.3}")),
-    ]
-}
-
+/// The CSV: every column of every record, full precision (shares as fractions 0..1).
 pub fn to_csv(records: &[BenchRecord]) -> String {
-    let mut s = COLUMNS.join(",") + "\n";
+    let mut s = COLUMNS.iter().map(|c| c.name).collect::<Vec<_>>().join(",") + "\n";
     for r in records {
-        s += &(record_values(r).join(",") + "\n");
+        s += &(COLUMNS.iter().map(|c| (c.csv)(r)).collect::<Vec<_>>().join(",") + "\n");
     }
     s
 }
 
+/// The table of records as Markdown, rounded for reading (RMSE and bias to 3 decimals, ms
+/// to 1, shares in percent to 1); optional columns only where some row has a value.
 pub fn to_markdown(records: &[BenchRecord]) -> String {
-    let mut s = format!("| {} |\n|{}\n", COLUMNS.join(" | "), "---|".repeat(COLUMNS.len()));
+    let shown: Vec<&Column> =
+        COLUMNS.iter().filter(|c| !c.optional || records.iter().any(|r| !(c.markdown)(r).is_empty())).collect();
+    let mut s = format!(
+        "| {} |\n|{}\n",
+        shown.iter().map(|c| c.header).collect::<Vec<_>>().join(" | "),
+        "---|".repeat(shown.len())
+    );
     for r in records {
-        let _ = writeln!(s, "| {} |", record_values(r).join(" | "));
+        let _ = writeln!(s, "| {} |", shown.iter().map(|c| (c.markdown)(r)).collect::<Vec<_>>().join(" | "));
     }
     s
+}
+
+/// What the columns mean, for the foot of bench.md.
+pub const COLUMN_NOTES: &str = "\
+- **RMSE**, **bias**: the AO against the ray-traced reference's hard cut-off AO (cosine-weighted \
+visibility within r), the target every technique is scored against; bias is mean(estimate − \
+reference), > 0 too light; **bias (ref < 0.8)** over the pixels the reference finds occluded. \
+**RMSE falloff**: against the reference with HBAO's linear falloff 1 − d/r instead, for comparison.
+- **limit RMSE**, **limit bias**: the *screen-space limit* (a brute-force march over this frame's \
+own depth buffer: many rays of length r, a thickness, off-image open) against the reference: the \
+error of seeing one depth layer per eye, which no screen-space technique can remove. The same \
+for every row of a radius.
+- **RMSE vs limit**: the technique against that limit: its *estimator* error (too few samples, \
+falloffs, one sample point per direction, noise). A technique with RMSE ≈ limit RMSE and a small \
+RMSE vs limit is as good as screen space gets; a large RMSE vs limit is the estimator's own fault.
+- **FLIP**: mean ꟻLIP of the AO image against the reference AO (both as grey images, sky 1) at \
+the headset's pixels per degree over the reference's stride: how visible the difference is; \
+noise and blotches count more than a smooth offset of the same RMSE.
+- **stereo ≠**: share of the surface points both eyes see whose final AO differs between the \
+eyes by more than 0.02 (both directions pooled), overall, within 40 px of each eye's inner \
+(nasal) border, and farther than 40 px from every border.
+- **ms/eye**: occlusion cost per eye (technique + blur + upsampling), median over the measured frames.
+";
+
+/// The header of bench.md: scene, adapter, version, command line and how it was measured.
+pub fn markdown_header(file: &BenchFile) -> String {
+    let mut s = format!("# vrao bench: {}\n\n", file.scene);
+    let driver = if file.driver.is_empty() { String::new() } else { format!(", driver {}", file.driver) };
+    let _ = writeln!(s, "- adapter: {} ({}{driver})", file.adapter, file.backend);
+    if !file.version.is_empty() {
+        let _ = writeln!(s, "- vrao {}", file.version);
+    }
+    if !file.command.is_empty() {
+        let _ = writeln!(s, "- command: `{}`", file.command);
+    }
+    let _ = writeln!(
+        s,
+        "- {}×{} per eye, {} timing, {} warm-up + {} measured frames per case",
+        file.width, file.height, file.timing, file.warmup, file.frames
+    );
+    if let Some(r) = &file.reference {
+        let _ = writeln!(
+            s,
+            "- reference: {} rays per pixel at every {} pixels (its AO noise, RMS standard error: {:.4})",
+            r.rays_per_pixel, r.stride, r.ao_noise_rms
+        );
+        if let Some(l) = &file.limit {
+            let _ = writeln!(
+                s,
+                "- screen-space limit: {} rays × {} steps per pixel on the same pixels, thickness {} r",
+                l.rays_per_pixel, l.steps, l.thickness_of_radius
+            );
+        }
+        if let Some(ppd) = file.pixels_per_degree {
+            let _ = writeln!(
+                s,
+                "- FLIP at {ppd:.1} pixels per degree, {:.1} on the reference's grid",
+                ppd / r.stride.max(1) as f64
+            );
+        }
+    }
+    s + "\n"
+}
+
+/// bench.md: the header, the table, what the columns mean, and the ratios.
+pub fn markdown_report(file: &BenchFile) -> String {
+    let mut s = markdown_header(file) + &to_markdown(&file.records);
+    if file.reference.is_some() {
+        s += "\n";
+        s += COLUMN_NOTES;
+    }
+    s + &ratios_markdown(&file.records)
 }
 
 /// The ratios a sweep is judged by, as Markdown (empty when no row has a partner):
@@ -754,8 +1277,25 @@ mod tests {
             spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
             views: 2,
             pass: technique.name(),
-            error: Some(ErrorFigures { ao_rmse, ao_ssim: 0.9, ambient_rel_rmse: None }),
+            error: Some(ErrorFigures {
+                ao_rmse,
+                ao_bias: -0.05,
+                ao_bias_dark: Some(-0.1),
+                ao_rmse_falloff: 0.3,
+                ao_ssim: 0.9,
+                ambient_rel_rmse: None,
+                flip_mean: Some(0.125),
+                ao_rmse_vs_limit: Some(0.06),
+                limit_rmse: Some(0.04),
+                limit_bias: Some(0.01),
+            }),
             bounce: None,
+            stereo: Some(StereoConsistency {
+                inconsistent: Some(0.25),
+                inner_border: Some(0.5),
+                interior: Some(0.125),
+                compared: 1000,
+            }),
         }
     }
 
@@ -771,6 +1311,10 @@ mod tests {
             warmup: 1,
             frames: 30,
             reference: None,
+            limit: None,
+            pixels_per_degree: None,
+            version: String::new(),
+            command: String::new(),
             records,
         }
     }
@@ -795,12 +1339,27 @@ mod tests {
         let recs = records(&rows);
         let csv = to_csv(&recs);
         assert_eq!(csv.lines().count(), 3);
-        assert!(csv
-            .lines()
-            .nth(2)
-            .unwrap()
-            .starts_with("hbao,12,0.5,full,6.000,1.000,0.000,7.000,1.000,0.2000,0.9000,,"));
-        assert_eq!(to_markdown(&recs).lines().count(), 4);
+        // technique, N, r, resolution, ms/eye, RMSE, bias, bias (ref < 0.8), vs limit,
+        // limit RMSE, limit bias, FLIP, stereo shares, falloff RMSE, SSIM, ambient, …
+        assert!(
+            csv.lines().nth(2).unwrap().starts_with(
+                "hbao,12,0.5,full,7.000,0.2000,-0.0500,-0.1000,0.0600,0.0400,0.0100,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
+            ),
+            "{csv}"
+        );
+        let header = csv.lines().next().unwrap();
+        for want in ["bias", "limit", "flip", "consisten"] {
+            assert!(header.split(',').any(|c| c.contains(want) && !c.contains("bounce")), "{want}: {header}");
+        }
+        // Markdown: rounded for reading; optional columns (peeling, bounce, …) left out.
+        let markdown = to_markdown(&recs);
+        assert_eq!(markdown.lines().count(), 4);
+        let hbao = markdown.lines().nth(3).unwrap();
+        assert!(
+            hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.125 | 25.0 % | 50.0 % | 12.5 % |"),
+            "{hbao}"
+        );
+        assert!(!markdown.contains("peel") && !markdown.contains("bounce"), "{markdown}");
         let json = to_json(&file(recs.clone()));
         let back: BenchFile = serde_json::from_str(&json).unwrap();
         assert_eq!(back.records, recs);

@@ -22,6 +22,7 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod stereo;
+pub mod stereo_consistency;
 pub mod temporal_bench;
 
 pub use error::{Error, Result};

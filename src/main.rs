@@ -727,19 +727,42 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         args.height,
         args.frames
     );
+    let how = Measurement { timing, warmup: args.warmup, frames: args.frames, whole_frame: args.frame };
+    let (estimate, frame_seconds) = vrao::bench::estimate_seconds(&gpu, &scene, &settings, &cases, how)?;
+    eprintln!(
+        "bench: estimated {} ({} cases × ({} + {} frames) at ~{:.0} ms a frame of the first case, plus set-up; other cases may differ)",
+        format_duration(estimate),
+        cases.len(),
+        args.warmup,
+        args.frames,
+        frame_seconds * 1000.0
+    );
     let started = std::time::Instant::now();
     let mut rows = sweep(
         &gpu,
         &scene,
         &settings,
         &cases,
-        Measurement { timing, warmup: args.warmup, frames: args.frames, whole_frame: args.frame },
+        how,
         args.interleave as usize,
         &references,
         |done, total, row| {
             let elapsed = started.elapsed().as_secs_f64();
             let eta = elapsed / done as f64 * (total - done) as f64;
-            let error = row.error.as_ref().map_or(String::new(), |e| format!("  AO RMSE {:.4}", e.ao_rmse));
+            let mut error = row.error.as_ref().map_or(String::new(), |e| {
+                let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+                format!(
+                    "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}) FLIP {}",
+                    e.ao_rmse,
+                    e.ao_bias,
+                    opt(e.ao_rmse_vs_limit),
+                    opt(e.limit_rmse),
+                    opt(e.flip_mean)
+                )
+            });
+            if let Some(share) = row.stereo.and_then(|s| s.inconsistent) {
+                error += &format!("  stereo ≠ {:.1} %", share * 100.0);
+            }
             eprintln!(
                 "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
                 format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
@@ -770,7 +793,13 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         timing: format!("{timing:?}").to_lowercase(),
         warmup: args.warmup,
         frames: args.frames,
+        limit: reference_info.as_ref().map(|_| vrao::bench::LimitInfo::defaults()),
+        pixels_per_degree: Some(
+            eyes.eyes.iter().map(|e| vrao::bench::pixels_per_degree(&e.fov, args.width)).sum::<f64>() / 2.0,
+        ),
         reference: reference_info,
+        version: version(),
+        command: command_line(),
         records: records(&rows),
     };
     let adapter = format!("{} ({:?}, {})", info.name, info.backend, info.driver_info);
@@ -779,14 +808,14 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
 
 /// Writes a bench's table, CSV, JSON, Markdown and plots into `args.out` and prints them.
 fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], adapter: &str) -> Result<()> {
-    use vrao::bench::{plot, ratios_markdown, to_csv, to_json, to_markdown};
+    use vrao::bench::{markdown_report, plot, to_csv, to_json};
     std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
     let write = |name: &str, text: String| {
         let path = args.out.join(name);
         std::fs::write(&path, text).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })
     };
     write("bench.csv", to_csv(&file.records))?;
-    let markdown = to_markdown(&file.records) + &ratios_markdown(&file.records);
+    let markdown = markdown_report(file);
     write("bench.md", markdown.clone())?;
     write("bench.json", to_json(file))?;
     let mut written = "bench.csv, bench.json, bench.md".to_string();
@@ -823,6 +852,53 @@ fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], a
     }
     println!("adapter: {adapter}; wrote {written} in {}", args.out.display());
     Ok(())
+}
+
+/// vrao's version, with the git commit it was built from when git can tell (read at run
+/// time from the source tree the binary was built in; "+changes" when it has uncommitted
+/// changes).
+fn version() -> String {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .arg("-C")
+            .arg(env!("CARGO_MANIFEST_DIR"))
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let mut v = env!("CARGO_PKG_VERSION").to_string();
+    if let Some(hash) = git(&["rev-parse", "--short", "HEAD"]).filter(|h| !h.is_empty()) {
+        let dirty = git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+        v += &format!(" (git {hash}{})", if dirty { "+changes" } else { "" });
+    }
+    v
+}
+
+/// The command line as typed (arguments with spaces or quotes quoted).
+fn command_line() -> String {
+    std::env::args()
+        .map(|a| {
+            if !a.is_empty() && a.chars().all(|c| c.is_ascii_alphanumeric() || "-_./:=,+@%".contains(c)) {
+                a
+            } else {
+                format!("'{}'", a.replace('\'', r"'\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// "42 s", "3.5 min" or "1.2 h".
+fn format_duration(seconds: f64) -> String {
+    if seconds < 90.0 {
+        format!("{seconds:.0} s")
+    } else if seconds < 5400.0 {
+        format!("{:.1} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
 }
 
 /// Where reference images are cached between runs.

@@ -52,6 +52,7 @@
 mod cache;
 mod geometry;
 mod progress;
+pub mod screen_limit;
 mod shading;
 #[cfg(test)]
 mod tests;
