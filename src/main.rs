@@ -205,6 +205,21 @@ struct BenchArgs {
     /// How ssdo-bounce rows weigh their senders: direction or patch (seed 002 eq. 2).
     #[arg(long, default_value = "direction")]
     bounce_form: vrao::settings::BounceForm,
+    /// GTAO rows: thickness behind each depth sample, as a fraction of the radius.
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
+    thickness: f32,
+    /// GTAO rows: exponent of the samples' spread along a half-slice.
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
+    step_power: f32,
+    /// GTAO rows: distance gap (fraction of the radius) under which successive samples join.
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
+    connect: f32,
+    /// Spatial denoise of every row: tile (4×4, one pass) or bilateral (separable, --blur).
+    #[arg(long, default_value = "tile")]
+    denoise: vrao::settings::Denoise,
+    /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
+    #[arg(long, default_value_t = 5)]
+    blur: u32,
     /// Measure this many cases at a time, round-robin one frame each, so that the
     /// machine's drift during a long sweep falls on all of them alike (fair ratios
     /// between techniques); each needs its own targets in memory at once.
@@ -645,6 +660,8 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     let mut settings =
         Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
     settings.ao.bounce_form = args.bounce_form;
+    (settings.ao.thickness, settings.ao.step_power, settings.ao.connect) = (args.thickness, args.step_power, args.connect);
+    (settings.ao.denoise, settings.ao.blur_radius) = (args.denoise, args.blur);
     let mut cases = Vec::new();
     for &technique in &args.techniques {
         for &samples in &args.samples {
