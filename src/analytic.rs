@@ -421,20 +421,19 @@ pub struct HbaoParams {
 /// The expected HBAO value at full-resolution `pixel` of `eye` (image `size`), averaged
 /// over a uniform per-pixel rotation, by running the estimator on the CPU against the
 /// surfaces `hit` returns for each pixel's centre ray: `directions` screen directions
-/// turned by the rotation α; along each, `steps` taps at (s + j + 1) · R_px / (steps + 1)
-/// pixels, where R_px is the radius in pixels at the receiver's depth and the jitter
-/// j = fract(7α / 2π) comes with the rotation, as on the GPU; a tap snaps to the pixel it
-/// falls in; a tap within r whose elevation above the tangent plane, sin h, exceeds the
-/// running horizon (which starts at the angle bias) adds (sin²h − sin²h_prev)(1 − d/r).
+/// turned by the rotation α; along each, `steps` taps at max(((s + j) / steps)² R_px,
+/// s + 1) pixels, where R_px is the radius in pixels at the receiver's depth and the
+/// jitter j = fract(7α / 2π) comes with the rotation, as on the GPU; a tap snaps to the
+/// pixel it falls in; a tap within r whose elevation above the tangent plane, sin h,
+/// exceeds the running horizon (which starts at the angle bias) adds sin²h − sin²h_prev.
 /// AO = 1 − (occlusion summed over directions) / directions.
 ///
 /// In the continuum (infinitely many steps, no angle bias, vertical slices with uniform
-/// azimuths) this is [`crease_visibility_falloff`] on the crease, because a slice at
-/// horizontal distance D from the wall adds ∫ (1 − d/r) d(sin²h) = (1 − D/r)². HBAO's
-/// expected value differs from that by its discretisation (the horizon rises at a few
-/// taps, each weighted by the attenuation at its own, farther, distance), the angle bias,
-/// and the perspective: uniform screen directions are not uniform azimuths on a surface
-/// seen obliquely, and a screen line is not a vertical slice.
+/// azimuths) this is the hard cut-off visibility [`crease_visibility`] when the wall is
+/// thick, as the crease's is. HBAO's expected value differs from that by its
+/// discretisation (the horizon rises only at taps), the angle bias, and the perspective:
+/// uniform screen directions are not uniform azimuths on a surface seen obliquely, and a
+/// screen line is not a vertical slice.
 pub fn hbao_expectation(
     params: &HbaoParams,
     eye: &Eye,
@@ -455,7 +454,7 @@ pub fn hbao_expectation(
     let radius_px = params.radius / metres_per_pixel.max(1e-30);
     let steps = params.steps.max(1);
     let directions = params.directions.max(1);
-    let step_px = (radius_px / (steps + 1) as f64).clamp(1.0, size.0.max(size.1) as f64);
+    let march_px = radius_px.min((size.0 + size.1) as f64);
     let sin_bias = (5.0 * params.bias).min(0.9);
     let rotations = params.rotations.max(1);
     let mut total = 0.0;
@@ -468,11 +467,11 @@ pub fn hbao_expectation(
             let dir = (angle.cos(), angle.sin());
             let mut max_sin = sin_bias;
             for s in 0..steps {
-                let reach = (s as f64 + jitter + 1.0) * step_px;
+                let t = (s as f64 + jitter) / steps as f64;
+                let reach = (t * t * march_px).max(s as f64 + 1.0);
                 let q = (pixel.0 as f64 + 0.5 + dir.0 * reach, pixel.1 as f64 + 0.5 + dir.1 * reach);
-                if q.0 < 0.0 || q.1 < 0.0 || q.0 >= size.0 as f64 || q.1 >= size.1 as f64 {
-                    break;
-                }
+                // Off the image the GPU asks the other eye, which sees about the same
+                // surface: here the scene itself answers.
                 let Some(tap) = surface(q.0.floor() + 0.5, q.1.floor() + 0.5) else { continue };
                 let h = tap - p;
                 let dist = h.length();
@@ -481,7 +480,7 @@ pub fn hbao_expectation(
                 }
                 let sin_h = h.dot(normal) / dist;
                 if sin_h > max_sin {
-                    occlusion += (sin_h * sin_h - max_sin * max_sin) * (1.0 - dist / params.radius).max(0.0);
+                    occlusion += sin_h * sin_h - max_sin * max_sin;
                     max_sin = sin_h;
                 }
             }

@@ -543,7 +543,7 @@ fn panel_ui(
         ui.heading("vrao");
         let ao = &mut panel.settings.ao;
         egui::ComboBox::from_label("technique").selected_text(ao.technique.name()).show_ui(ui, |ui| {
-            for t in [Technique::None, Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce] {
+            for t in [Technique::None, Technique::Ssao, Technique::Hbao, Technique::Gtao, Technique::Ssdo, Technique::SsdoBounce] {
                 ui.selectable_value(&mut ao.technique, t, t.name());
             }
         });

@@ -366,9 +366,10 @@ fn parse_on_off(s: &str) -> std::result::Result<bool, String> {
 struct AoArgs {
     #[command(flatten)]
     lights: LightArgs,
-    /// Occlusion technique: none, ssao, hbao, gtao, ssdo or ssdo-bounce (fetch-only: the
-    /// benchmark baseline with SSAO's depth taps and no occlusion arithmetic).
-    #[arg(long, default_value = "ssao")]
+    /// Occlusion technique: none, ssao, hbao, gtao (the default: the most accurate per
+    /// millisecond), ssdo or ssdo-bounce (fetch-only: the benchmark baseline with SSAO's
+    /// depth taps and no occlusion arithmetic).
+    #[arg(long, default_value = "gtao")]
     technique: Technique,
     /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
     #[arg(long, default_value = "medium")]

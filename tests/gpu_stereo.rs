@@ -206,6 +206,7 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
             "rsm",
             "ssao",
             "hbao",
+            "gtao",
             "depth-peel",
             "ssdo",
             "fetch-only",
