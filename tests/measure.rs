@@ -133,10 +133,24 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     for line in csv.lines().skip(1) {
         assert_eq!(line.split(',').count(), header.len(), "{line}");
     }
-    // The table of rows (header, rule, one line a row), then the ratios: half / full
-    // for each case, and HBAO and SSDO against SSAO at each setting and resolution.
+    for want in ["bias", "limit", "flip", "consisten"] {
+        assert!(header.iter().any(|c| c.contains(want) && !c.contains("bounce")), "no '{want}' column: {header:?}");
+    }
+    // bench.md: what ran where (scene, adapter, version, the command line), the table of
+    // rows (header, rule, one line a row), what the columns mean, then the ratios: half /
+    // full for each case, and HBAO and SSDO against SSAO at each setting and resolution.
     let markdown = std::fs::read_to_string(out_dir.join("bench.md")).unwrap();
-    assert_eq!(markdown.lines().take_while(|l| !l.is_empty()).count(), rows + 2, "{markdown}");
+    assert!(markdown.starts_with("# vrao bench: crease\n"), "{markdown}");
+    for line in ["- adapter: ", "- vrao 0.1", "- command: `", "--techniques ssao,hbao,ssdo"] {
+        assert!(markdown.contains(line), "no '{line}' in {markdown}");
+    }
+    let table: Vec<&str> =
+        markdown.lines().skip_while(|l| !l.starts_with("| technique")).take_while(|l| l.starts_with('|')).collect();
+    assert_eq!(table.len(), rows + 2, "{markdown}");
+    for name in ["RMSE", "bias", "RMSE vs limit", "limit RMSE", "FLIP", "stereo ≠", "ms/eye"] {
+        assert!(table[0].split('|').any(|c| c.trim() == name), "no column '{name}': {}", table[0]);
+    }
+    assert!(table[2].contains(" %"), "shares in percent: {}", table[2]);
     let ratio_rows = |title: &str| {
         let section = markdown.split(title).nth(1).unwrap_or_else(|| panic!("no '{title}' in {markdown}"));
         section.lines().skip(4).take_while(|l| l.starts_with("| ")).count()
@@ -152,7 +166,26 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
         let ssim = r["ao_ssim"].as_f64().unwrap();
         assert!((0.0..0.5).contains(&rmse) && (-1.0..=1.0).contains(&ssim), "{r}");
         assert!(r["occlusion_ms_per_eye"].as_f64().unwrap() > 0.0, "{r}");
+        // Bias is within ±RMSE (|mean| ≤ RMS; the RMSE has the reference's noise taken
+        // out, so allow for that); the crease is darker than 0.8 near its line.
+        let bias = r["ao_bias"].as_f64().unwrap();
+        assert!(bias.abs() <= rmse + 0.05, "{r}");
+        assert!(r["ao_bias_dark"].as_f64().is_some_and(|b| (-1.0..=1.0).contains(&b)), "{r}");
+        assert!(r["ao_rmse_falloff"].as_f64().is_some_and(|e| (0.0..0.5).contains(&e)), "{r}");
+        // The screen-space limit sees the whole crease (both planes face the eyes): it is
+        // close to the reference, and the technique's distance from it is an RMSE.
+        let limit = r["limit_rmse"].as_f64().unwrap();
+        assert!((0.0..0.06).contains(&limit) && r["limit_bias"].as_f64().unwrap().abs() < 0.03, "{r}");
+        assert!(r["ao_rmse_vs_limit"].as_f64().is_some_and(|e| (0.0..0.5).contains(&e)), "{r}");
+        assert!(r["flip_mean"].as_f64().is_some_and(|f| f > 0.0 && f < 1.0), "{r}");
+        for share in ["stereo_inconsistent", "stereo_inconsistent_inner_border"] {
+            assert!(r[share].as_f64().is_some_and(|s| (0.0..=1.0).contains(&s)), "{share}: {r}");
+        }
+        // No pixel of a 48×40 image is farther than 40 px from every border.
+        assert!(r["stereo_inconsistent_interior"].is_null(), "{r}");
     }
+    // The limit is the same for every row of the radius (one frame's depth buffer).
+    assert!(records.iter().all(|r| r["limit_rmse"] == records[0]["limit_rmse"]), "{records:?}");
     assert!(records.iter().any(|r| r["pareto"] == true));
     assert!(json["reference"]["ao_noise_rms"].as_f64().unwrap() > 0.0);
     let png = image::open(out_dir.join("bench.png")).expect("bench.png is an image");
@@ -178,7 +211,17 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     let again = again["records"].as_array().unwrap();
     assert_eq!(again.len(), rows);
     for (a, b) in records.iter().zip(again) {
-        for key in ["technique", "samples", "resolution", "ao_rmse", "ao_ssim"] {
+        for key in [
+            "technique",
+            "samples",
+            "resolution",
+            "ao_rmse",
+            "ao_ssim",
+            "ao_bias",
+            "ao_rmse_vs_limit",
+            "flip_mean",
+            "stereo_inconsistent",
+        ] {
             assert_eq!(a[key], b[key], "{key}: {a} vs {b}");
         }
         assert_eq!(a["composite_ms_per_eye"].as_f64(), Some(0.0), "no composite without --frame: {a}");

@@ -75,12 +75,14 @@ fn every_technique_stays_within_its_stated_error_of_the_reference_on_the_crease(
     }
 }
 
-/// Stated bounds on the AO RMSE against the reference (both eyes, sky excluded, 128×112
-/// per eye, r = 0.5 m). What a correct estimator leaves on the crease: SSAO's and SSDO's
-/// systematic bias against the reference (their samples crowd towards the centre and
-/// see less of the wall than rays of length r: `analytic.rs`), ≈ 0.05 measured on
-/// lavapipe, and HBAO's slice bias, ≈ 0.03; plus up to 0.03 of per-pixel noise and
-/// edge error after the blur. A broken estimator (self-occlusion of the floor, a wrong
-/// radius scale, a flipped normal) lands above 0.1.
+/// Stated bounds on the AO RMSE against the reference's hard cut-off AO, the one target
+/// every technique is scored against (both eyes, sky excluded, 128×112 per eye, r =
+/// 0.5 m). What a correct estimator leaves on the crease: SSAO's and SSDO's systematic
+/// bias against the reference (their samples crowd towards the centre and see less of
+/// the wall than rays of length r: `analytic.rs`), ≈ 0.05 measured on lavapipe, and
+/// HBAO's linear falloff plus its slice bias, ≈ 0.055–0.06 (≈ 0.03 against the falloff
+/// reference); plus up to 0.03 of per-pixel noise and edge error after the blur. A broken
+/// estimator (self-occlusion of the floor, a wrong radius scale, a flipped normal) lands
+/// above 0.1.
 const BOUNDS: [(Technique, f64); 4] =
-    [(Technique::Ssao, 0.08), (Technique::Hbao, 0.06), (Technique::Ssdo, 0.08), (Technique::SsdoBounce, 0.08)];
+    [(Technique::Ssao, 0.08), (Technique::Hbao, 0.08), (Technique::Ssdo, 0.08), (Technique::SsdoBounce, 0.08)];
