@@ -161,7 +161,7 @@ fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, e
         let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(layer), 0);
         probe.valid = d > 0.0;
         probe.distance = frame.near / max(d, 1e-30);
-        probe.surface = s * (probe.distance / max(probe.sample_distance, 1e-30));
+        probe.surface = probed_surface(probe, eye);
         return probe;
     }
     if (frame.layers < 2u) {
@@ -178,9 +178,16 @@ fn probe_depth(depth_layers: texture_depth_2d_array, layer: u32, s: vec3<f32>, e
     let d = textureLoad(depth_layers, vec2<i32>(probe.pixel), i32(other_layer), 0);
     probe.valid = d > 0.0;
     probe.distance = frame.near / max(d, 1e-30);
-    let surface_in_other = in_other * (probe.distance / max(probe.sample_distance, 1e-30));
-    probe.surface = (other.other_from_view * vec4<f32>(surface_in_other, 1.0)).xyz;
+    probe.surface = (other.other_from_view * vec4<f32>(probed_surface(probe, other), 1.0)).xyz;
     return probe;
+}
+
+// The stored surface at the probed pixel's centre, in the view space of the eye that
+// was probed. The pixel centre, not the sample's own ray: the depth belongs to the
+// centre, and on a surface seen at a grazing angle the sub-pixel difference would lift
+// the point above the receiver's tangent plane and make a flat floor occlude itself.
+fn probed_surface(probe: DepthProbe, eye: Eye) -> vec3<f32> {
+    return view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
 }
 
 // The surface at screen position `q` (full-res pixel coordinates, may lie off the image)

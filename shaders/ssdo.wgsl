@@ -38,7 +38,7 @@ fn probe_sender(layer: u32, s: vec3<f32>, eye: Eye) -> SenderProbe {
     sp.texel = textureLoad(direct_layers, vec2<i32>(sp.probe.pixel), i32(layer), 0);
     sp.probe.distance = direct_distance(sp.texel);
     sp.probe.valid = sp.probe.distance > 0.0;
-    sp.probe.surface = s * (sp.probe.distance / max(sp.probe.sample_distance, 1e-30));
+    sp.probe.surface = probed_surface(sp.probe, eye);
     return sp;
 }
 
@@ -125,7 +125,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             visible_m1 += m1;
             weight_visible += cos_theta;
         } else if (BOUNCE) {
-            // The sender lies on the sample's view ray, at the stored distance.
+            // The sender: the stored surface at the probed pixel.
             let sender = probe.surface;
             let to_receiver = r.position - sender;
             let d2 = dot(to_receiver, to_receiver);

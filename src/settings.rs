@@ -347,8 +347,8 @@ impl Default for Temporal {
 }
 
 /// GTAO's defaults (tuned against the reference: `vrao tune`, README).
-pub const DEFAULT_THICKNESS: f32 = 0.5;
-pub const DEFAULT_STEP_POWER: f32 = 2.0;
+pub const DEFAULT_THICKNESS: f32 = 1.0;
+pub const DEFAULT_STEP_POWER: f32 = 1.5;
 pub const DEFAULT_CONNECT: f32 = 0.25;
 
 impl Default for AoSettings {
