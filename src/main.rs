@@ -268,7 +268,8 @@ struct BenchArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box).
+    /// A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box,
+    /// furnished, columns, flipped-normals).
     #[arg(long, default_value = "builtin:room")]
     scene: String,
     /// Output directory.

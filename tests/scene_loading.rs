@@ -238,6 +238,29 @@ fn unknown_builtin_lists_the_available_ones() {
 }
 
 #[test]
+fn furnished_scene_file_is_the_builtin_room() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/furnished.toml");
+    let file = load(&path).unwrap();
+    let builtin = Scene::load("builtin:furnished").unwrap();
+    assert_eq!(file.name, builtin.name);
+    assert_eq!(file.triangle_count(), builtin.triangle_count());
+    assert_eq!(
+        file.meshes.iter().map(|m| &m.name).collect::<Vec<_>>(),
+        builtin.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()
+    );
+    assert_eq!(file.bounds(), builtin.bounds());
+    assert_eq!(file.materials.len(), builtin.materials.len());
+    assert_eq!(file.lights, builtin.lights, "the file restates the builtin's light");
+    let intensity = |s: &Scene| s.environment.as_ref().map(|e| e.intensity);
+    assert_eq!(intensity(&file), intensity(&builtin));
+    let (a, b) = (file.head.keys[0].1, builtin.head.keys[0].1);
+    assert!(
+        a.position.abs_diff_eq(b.position, 1e-12) && a.orientation.abs_diff_eq(b.orientation, 1e-12),
+        "{a:?} {b:?}"
+    );
+}
+
+#[test]
 fn scene_file_places_an_obj() {
     let dir = TempDir::new("placed");
     dir.write("square.obj", &format!("{SQUARE}f 1 2 3 4\n"));

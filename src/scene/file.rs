@@ -7,6 +7,8 @@
 //!
 //! [[mesh]]                         # any number; each is an OBJ or a built-in scene's meshes
 //! obj = "models/box.obj"           # or: builtin = "plane" | "crease" | "room" | "sphere" | "box"
+//!                                  #   | "furnished" | "columns" | "flipped-normals" (meshes and
+//!                                  #   materials only: lights and head come from this file)
 //! translate = [0.0, 0.0, 0.0]      # metres (optional)
 //! rotate_deg = [0.0, 90.0, 0.0]    # about the world X, then Y, then Z axis (optional)
 //! scale = 1.0                      # or [sx, sy, sz]; finite and nonzero (optional)

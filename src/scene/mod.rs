@@ -5,8 +5,10 @@
 //! returns [`crate::Error::Input`] naming the file and line for anything malformed.
 
 pub mod builtin;
+pub mod edge_cases;
 pub mod environment;
 pub mod file;
+pub mod furnished;
 pub mod fuzz;
 pub mod normals;
 pub mod obj;
