@@ -662,7 +662,8 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     let mut settings =
         Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
     settings.ao.bounce_form = args.bounce_form;
-    (settings.ao.thickness, settings.ao.step_power, settings.ao.connect) = (args.thickness, args.step_power, args.connect);
+    (settings.ao.thickness, settings.ao.step_power, settings.ao.connect) =
+        (args.thickness, args.step_power, args.connect);
     (settings.ao.denoise, settings.ao.blur_radius) = (args.denoise, args.blur);
     let mut cases = Vec::new();
     for &technique in &args.techniques {

@@ -410,13 +410,19 @@ impl AoSettings {
             return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
         }
         if !(self.thickness.is_finite() && (0.0..=100.0).contains(&self.thickness)) {
-            return Err(Error::input(format!("thickness {} is not within 0..=100 (a fraction of the radius)", self.thickness)));
+            return Err(Error::input(format!(
+                "thickness {} is not within 0..=100 (a fraction of the radius)",
+                self.thickness
+            )));
         }
         if !(self.step_power.is_finite() && (0.25..=4.0).contains(&self.step_power)) {
             return Err(Error::input(format!("step power {} is not within 0.25..=4", self.step_power)));
         }
         if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
-            return Err(Error::input(format!("connect {} is not within 0..=100 (a fraction of the radius)", self.connect)));
+            return Err(Error::input(format!(
+                "connect {} is not within 0..=100 (a fraction of the radius)",
+                self.connect
+            )));
         }
         if self.blur_radius > 16 {
             return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));

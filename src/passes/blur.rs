@@ -48,10 +48,9 @@ impl Pass for BlurPass {
             self.tile.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (w.div_ceil(2), h.div_ceil(2), layers));
             return;
         }
-        for (kernel, input, output) in [
-            (&self.horizontal, source, Resource::AoBlurH),
-            (&self.vertical, Resource::AoBlurH, Resource::AoBlurred),
-        ] {
+        for (kernel, input, output) in
+            [(&self.horizontal, source, Resource::AoBlurH), (&self.vertical, Resource::AoBlurH, Resource::AoBlurred)]
+        {
             let resources = resources(ctx, input, output);
             kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
         }
