@@ -773,10 +773,11 @@ mod tests {
             if x > R {
                 assert_eq!(v, 1.0, "open floor at x = {x}");
             } else if x > 0.1 {
-                // Discretisation, angle bias and perspective keep HBAO within 0.1 of the
-                // continuum; it never darkens more than the reference.
-                let f = crease_visibility_falloff(x, R);
-                assert!((v - f).abs() < 0.1 && v >= f - 0.02, "x = {x}: hbao {v}, falloff reference {f}");
+                // Discretisation, angle bias and perspective keep HBAO light of the hard
+                // cut-off reference by at most 0.17 (as in tests/occlusion.rs on the same
+                // crease); it never darkens more than the reference.
+                let f = crease_visibility(x, R);
+                assert!(v - f < 0.17 && v >= f - 0.02, "x = {x}: hbao {v}, reference {f}");
                 seen += 1;
             }
             assert!(v >= last - 0.01, "not monotone at x = {x}");
