@@ -205,15 +205,8 @@ struct BenchArgs {
     /// How ssdo-bounce rows weigh their senders: direction or patch (seed 002 eq. 2).
     #[arg(long, default_value = "direction")]
     bounce_form: vrao::settings::BounceForm,
-    /// GTAO rows: thickness behind each depth sample, as a fraction of the radius.
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
-    thickness: f32,
-    /// GTAO rows: exponent of the samples' spread along a half-slice.
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
-    step_power: f32,
-    /// GTAO rows: distance gap (fraction of the radius) under which successive samples join.
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
-    connect: f32,
+    #[command(flatten)]
+    gtao: GtaoArgs,
     /// Spatial denoise of every row: tile (4×4, one pass) or bilateral (separable, --blur).
     #[arg(long, default_value = "tile")]
     denoise: vrao::settings::Denoise,
@@ -362,6 +355,29 @@ fn parse_on_off(s: &str) -> std::result::Result<bool, String> {
     }
 }
 
+/// GTAO's free parameters (the render commands and the bench).
+#[derive(Args, Clone)]
+struct GtaoArgs {
+    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
+    /// radius (thin objects stop occluding behind themselves).
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
+    thickness: f32,
+    /// GTAO: exponent of the samples' spread along a half-slice (1 even, 2 crowded near
+    /// the pixel).
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
+    step_power: f32,
+    /// GTAO: successive samples closer in distance than this fraction of the radius
+    /// join into one surface (0: never).
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
+    connect: f32,
+}
+
+impl GtaoArgs {
+    fn apply(&self, ao: &mut AoSettings) {
+        (ao.thickness, ao.step_power, ao.connect) = (self.thickness, self.step_power, self.connect);
+    }
+}
+
 /// Occlusion options (shared by every command that renders).
 #[derive(Args, Clone)]
 struct AoArgs {
@@ -415,18 +431,8 @@ struct AoArgs {
     /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
     #[arg(long, default_value = "halton")]
     noise: Noise,
-    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
-    /// radius (thin objects stop occluding behind themselves).
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
-    thickness: f32,
-    /// GTAO: exponent of the samples' spread along a half-slice (1 even, 2 crowded near
-    /// the pixel).
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
-    step_power: f32,
-    /// GTAO: successive samples closer in distance than this fraction of the radius
-    /// join into one surface (0: never).
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
-    connect: f32,
+    #[command(flatten)]
+    gtao: GtaoArgs,
     /// Turn SSAO's range check (depth constraint) off.
     #[arg(long)]
     no_range_check: bool,
@@ -486,9 +492,9 @@ impl AoArgs {
                 motion_px: self.temporal_motion_px,
                 ..Default::default()
             },
-            thickness: self.thickness,
-            step_power: self.step_power,
-            connect: self.connect,
+            thickness: self.gtao.thickness,
+            step_power: self.gtao.step_power,
+            connect: self.gtao.connect,
         }
     }
 }
@@ -662,8 +668,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     let mut settings =
         Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
     settings.ao.bounce_form = args.bounce_form;
-    (settings.ao.thickness, settings.ao.step_power, settings.ao.connect) =
-        (args.thickness, args.step_power, args.connect);
+    args.gtao.apply(&mut settings.ao);
     (settings.ao.denoise, settings.ao.blur_radius) = (args.denoise, args.blur);
     let mut cases = Vec::new();
     for &technique in &args.techniques {
