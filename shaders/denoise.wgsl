@@ -1,13 +1,16 @@
-// The default denoise: an edge-aware 4×4 box at occlusion resolution, matched to GTAO's
-// 4×4 interleaved noise tile (each window holds every one of its 16 patterns once), in
-// one pass. One invocation filters a 2×2 quad of pixels: their four windows (offsets −2
-// to +1 about each pixel) together cover 5×5 texels, so each texel is fetched once per
-// quad, 6.25 fetches per pixel instead of the 11×11 separable blur's 22.
+// The default denoise: an edge-aware box over GTAO's 4×4 interleaved noise tile, split
+// into a horizontal and a vertical pass of 5 taps each, weighted ½, 1, 1, 1, ½. Offsets
+// −2 and +2 hold the same noise pattern (4 apart), so each pass gives each of the
+// tile's 4 columns (rows) the same total weight, and the window is centred: no
+// half-pixel shift. Each invocation filters a run of 4 pixels along the axis, so
+// a pixel costs 2 fetched taps per pass (4 in all, its own included) and 10 plane tests of two
+// multiply-adds, against the 11×11 bilateral blur's 22 fetched taps with an exp and a
+// normal test each.
 //
-// A tap counts for a pixel by how far it lies off the pixel's tangent plane, relative
-// to the pixel's distance (a tent, no exp): depth edges stay sharp. Where a pixel's
-// neighbours are almost all rejected (a lone pixel, a thin feature), the plain mean of
-// its window is blended in, so no isolated extreme value survives untouched.
+// A tap counts by how far it lies off the pixel's tangent plane, relative to the
+// pixel's distance (a tent, no exp): depth edges stay sharp. Where a pixel's neighbours
+// are almost all rejected (a lone pixel, a thin feature), the plain mean of its window
+// is blended in, so no isolated extreme value survives untouched.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -15,109 +18,79 @@
 @group(0) @binding(3) var occlusion_in: texture_2d_array<f32>;
 @group(0) @binding(4) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
 
-// One output pixel of the quad: its plane and its running sums.
-struct Filtered {
-    valid: bool,
-    pixel: vec2<i32>,
-    // Off-plane distance of a tap at distance d and offset k: (d (e + k·f) − d₀ e) × scale.
-    e: f32,
-    f: vec2<f32>,
-    centre_offset: f32,
-    scale: f32,
-    sum: vec4<f32>,
-    total: f32,
-    plain_sum: vec4<f32>,
-    plain_count: f32,
-};
+// Pixels filtered by one invocation, consecutive along the pass's axis: their windows
+// overlap, so 4 + 4 taps serve 4 pixels (2 taps per pixel instead of 5).
+const RUN: i32 = 4;
 
-fn filtered_pixel(p: vec2<i32>, layer: i32, eye: Eye) -> Filtered {
-    var out: Filtered;
-    out.pixel = p;
-    out.valid = all(p < vec2<i32>(ao.ao_size));
-    if (!out.valid) {
-        return out;
-    }
-    let centre = textureLoad(geometry_layers, p, layer, 0);
-    out.valid = centre.w > 0.0;
-    // The view ray through the pixel and its step per occlusion pixel (low-res q stands
-    // for full-res scale·q), as in bilateral.wgsl.
-    let uv = pixel_uv(full_res_pixel(vec2<u32>(p), ao.scale, frame.size), frame.size);
-    let ray = vec3<f32>(mix(eye.tangents.x, eye.tangents.y, uv.x), mix(eye.tangents.z, eye.tangents.w, uv.y), -1.0);
-    let tangent_step = vec2<f32>(eye.tangents.y - eye.tangents.x, eye.tangents.w - eye.tangents.z)
-        * f32(ao.scale) / vec2<f32>(frame.size);
-    out.e = dot(ray, centre.xyz);
-    out.f = tangent_step * centre.xy;
-    out.centre_offset = centre.w * out.e;
-    out.scale = 1.0 / max(ao.blur_plane_sigma * centre.w, 1e-30);
-    return out;
-}
-
-// Adds tap `value` at distance `distance`, `offset` texels from the pixel, if the tap
-// lies in the pixel's window (offsets −2..1 on each axis).
-fn add_tap(px: ptr<function, Filtered>, offset: vec2<i32>, distance: f32, value: vec4<f32>) {
-    if (any(offset < vec2<i32>(-2)) || any(offset > vec2<i32>(1))) {
-        return;
-    }
-    (*px).plain_sum += value;
-    (*px).plain_count += 1.0;
-    let k = vec2<f32>(offset);
-    let plane = (distance * ((*px).e + dot(k, (*px).f)) - (*px).centre_offset) * (*px).scale;
-    let w = max(1.0 - abs(plane), 0.0);
-    if (w > 0.0) {
-        (*px).sum += value * w;
-        (*px).total += w;
-    }
-}
-
-fn finish(px: Filtered, layer: i32) {
-    if (!all(px.pixel < vec2<i32>(ao.ao_size))) {
-        return;
-    }
-    if (!px.valid) {
-        // Sky: passed through.
-        textureStore(occlusion_out, px.pixel, layer, textureLoad(occlusion_in, px.pixel, layer, 0));
-        return;
-    }
-    // The centre alone weighs 1; below 2 the window's plain mean makes up the rest.
-    let prior = max(2.0 - px.total, 0.0);
-    let plain = px.plain_sum / max(px.plain_count, 1.0);
-    let result = (px.sum + plain * prior) / max(px.total + prior, 1e-20);
-    textureStore(occlusion_out, px.pixel, layer, vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a)));
-}
-
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let origin = vec2<i32>(id.xy) * 2;
-    if (any(origin >= vec2<i32>(ao.ao_size)) || id.z >= frame.layers) {
+fn denoise(id: vec3<u32>, axis: vec2<i32>) {
+    let first = vec2<i32>(id.xy) * (vec2<i32>(1) + axis * (RUN - 1));
+    if (any(first >= vec2<i32>(ao.ao_size)) || id.z >= frame.layers) {
         return;
     }
     let layer = i32(id.z);
     let eye = frame.eyes[id.z];
-    // The quad's pixels, written out (lavapipe keeps loop-indexed arrays in memory).
-    var p00 = filtered_pixel(origin, layer, eye);
-    var p10 = filtered_pixel(origin + vec2<i32>(1, 0), layer, eye);
-    var p01 = filtered_pixel(origin + vec2<i32>(0, 1), layer, eye);
-    var p11 = filtered_pixel(origin + vec2<i32>(1, 1), layer, eye);
-    for (var dy = -2; dy <= 2; dy++) {
-        for (var dx = -2; dx <= 2; dx++) {
-            let q = origin + vec2<i32>(dx, dy);
-            if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(ao.ao_size))) {
-                continue;
-            }
-            let distance = textureLoad(geometry_layers, q, layer, 0).w;
-            if (!(distance > 0.0)) {
-                continue;
-            }
-            let value = textureLoad(occlusion_in, q, layer, 0);
-            let d = vec2<i32>(dx, dy);
-            add_tap(&p00, d, distance, value);
-            add_tap(&p10, d - vec2<i32>(1, 0), distance, value);
-            add_tap(&p01, d - vec2<i32>(0, 1), distance, value);
-            add_tap(&p11, d - vec2<i32>(1, 1), distance, value);
-        }
+    let limit = vec2<i32>(ao.ao_size) - vec2<i32>(1);
+    // The run's taps, offsets −2 … RUN + 1 from its first pixel; clamped at the border
+    // (the edge texel stands in for the missing ones).
+    var geometry: array<vec4<f32>, 8>;
+    var values: array<vec4<f32>, 8>;
+    for (var j = 0; j < RUN + 4; j++) {
+        let q = clamp(first + axis * (j - 2), vec2<i32>(0), limit);
+        geometry[j] = textureLoad(geometry_layers, q, layer, 0);
+        values[j] = textureLoad(occlusion_in, q, layer, 0);
     }
-    finish(p00, layer);
-    finish(p10, layer);
-    finish(p01, layer);
-    finish(p11, layer);
+    let tangent_step = vec2<f32>(eye.tangents.y - eye.tangents.x, eye.tangents.w - eye.tangents.z)
+        * f32(ao.scale) / vec2<f32>(frame.size);
+    for (var o = 0; o < RUN; o++) {
+        let p = first + axis * o;
+        if (any(p > limit)) {
+            break;
+        }
+        let centre = geometry[o + 2];
+        if (!(centre.w > 0.0)) {
+            // Sky: passed through.
+            textureStore(occlusion_out, p, layer, values[o + 2]);
+            continue;
+        }
+        // A tap at distance d, k occlusion pixels along `axis`, lies (d (e + k f) − d₀ e)
+        // off the centre's tangent plane (as in bilateral.wgsl): the view ray through
+        // the pixel is (tx, ty, −1), each tangent linear in its pixel coordinate.
+        let uv = pixel_uv(full_res_pixel(vec2<u32>(p), ao.scale, frame.size), frame.size);
+        let ray = vec3<f32>(mix(eye.tangents.x, eye.tangents.y, uv.x), mix(eye.tangents.z, eye.tangents.w, uv.y), -1.0);
+        let e = dot(ray, centre.xyz);
+        let f = dot(vec2<f32>(axis) * tangent_step, centre.xy);
+        let centre_offset = centre.w * e;
+        let plane_scale = 1.0 / max(ao.blur_plane_sigma * centre.w, 1e-30);
+        var sum = vec4<f32>(0.0);
+        var total = 0.0;
+        var plain_sum = vec4<f32>(0.0);
+        var plain_total = 0.0;
+        for (var k = -2; k <= 2; k++) {
+            let distance = geometry[o + k + 2].w;
+            let value = values[o + k + 2];
+            let box = select(1.0, 0.5, abs(k) == 2);
+            let on_surface = select(0.0, box, distance > 0.0);
+            let plane = (distance * (e + f32(k) * f) - centre_offset) * plane_scale;
+            let w = on_surface * max(1.0 - abs(plane), 0.0);
+            sum += value * w;
+            total += w;
+            plain_sum += value * on_surface;
+            plain_total += on_surface;
+        }
+        // The centre alone weighs 1; below 2 the window's plain mean makes up the rest.
+        let prior = max(2.0 - total, 0.0);
+        let plain = plain_sum / max(plain_total, 1e-20);
+        let result = (sum + plain * prior) / max(total + prior, 1e-20);
+        textureStore(occlusion_out, p, layer, vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a)));
+    }
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn denoise_horizontal(@builtin(global_invocation_id) id: vec3<u32>) {
+    denoise(id, vec2<i32>(1, 0));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn denoise_vertical(@builtin(global_invocation_id) id: vec3<u32>) {
+    denoise(id, vec2<i32>(0, 1));
 }

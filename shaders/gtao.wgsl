@@ -116,6 +116,66 @@ fn bayer4(p: vec2<u32>) -> f32 {
     return (f32(index) + 0.5) / 16.0;
 }
 
+// One half-slice's march so far: the slice's occluded sectors, and the previous
+// sample (its sector coordinate, −1 when none, and its distance) for `connect`.
+struct March {
+    occluded: u32,
+    previous_u: f32,
+    previous_distance: f32,
+};
+
+struct SampleLimits {
+    radius2: f32,
+    thickness: f32,
+    connect: f32,
+};
+
+// Screen distance of step i of `steps` along a half-slice: spread by `step_power`
+// (crowded near the pixel), jittered per pixel, and at least one pixel per step.
+fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
+    let t = (f32(i) + jitter) / f32(steps);
+    return max(pow(t, ao.step_power) * march_px, f32(i) + 1.0);
+}
+
+// Marks the sectors that the depth sample `surface` (view space, w = 0 when none) blocks
+// for the receiver at `p`: the slab from the visible surface back to `thickness` behind
+// it, joined to the previous sample when both lie on one continuous surface.
+fn add_sample(march: ptr<function, March>, slice: Slice, p: vec3<f32>, surface: vec4<f32>, limits: SampleLimits) {
+    if (surface.w == 0.0) {
+        (*march).previous_u = -1.0;
+        return;
+    }
+    let front = surface.xyz - p;
+    let front2 = dot(front, front);
+    let sample_distance = -surface.z;
+    if (!(front2 < limits.radius2)) {
+        (*march).previous_u = -1.0;
+        (*march).previous_distance = sample_distance;
+        return;
+    }
+    // The slab's back along the sample's view ray, clipped where it leaves the sphere
+    // of radius r about P.
+    let ray = normalize(surface.xyz);
+    let along = dot(front, ray);
+    let to_sphere = -along + sqrt(max(along * along - front2 + limits.radius2, 0.0));
+    let back = front + ray * min(limits.thickness, to_sphere);
+    let side = slice_side(slice, front);
+    let u_front = sector_coordinate(slice, front, side);
+    // The slab sweeps from its front away from V (its line passes through the eye,
+    // never through V); a back below the tangent plane reads as the horizon of the
+    // front's half.
+    let u_back = sector_coordinate(slice, back, side);
+    var lo = min(u_front, u_back);
+    var hi = max(u_front, u_back);
+    if ((*march).previous_u >= 0.0 && abs(sample_distance - (*march).previous_distance) < limits.connect) {
+        lo = min(lo, (*march).previous_u);
+        hi = max(hi, (*march).previous_u);
+    }
+    (*march).occluded |= sector_bits(lo, hi);
+    (*march).previous_u = u_front;
+    (*march).previous_distance = sample_distance;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let r = begin_receiver(id);
@@ -137,15 +197,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     // Never march further than the image's diagonal.
     let march_px = min(radius_px, f32(frame.size.x + frame.size.y));
-    let thickness = ao.thickness * radius;
-    let connect = ao.connect * radius;
-    let radius2 = radius * radius;
+    var limits: SampleLimits;
+    limits.radius2 = radius * radius;
+    limits.thickness = ao.thickness * radius;
+    limits.connect = ao.connect * radius;
+    let size = vec2<f32>(frame.size);
+    let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
+    let near_border = any(centre_px - march_px < vec2<f32>(0.0)) || any(centre_px + march_px >= size);
     let slices = max(ao.directions, 1u);
     let steps = max(ao.steps, 1u);
     let rotation_noise = bayer4(r.pixel);
     // A second, decorrelated value of the same tile for the step jitter.
     let jitter = fract(rotation_noise * 7.0 + 0.3125);
-    let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
     var visible = 0.0;
     var total = 0.0;
     // Slice directions: the pixel's first, then turned by π / slices each (one sin/cos
@@ -182,52 +245,32 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         slice.inv_projected_len = 1.0 / projected_len;
         slice.horizon_plus = slice.cos_gamma * slice.t - slice.sin_gamma * view;
         slice.horizon_minus = -slice.horizon_plus;
-        var occluded = 0u;
+        var march: March;
+        march.occluded = 0u;
         for (var half = 0u; half < 2u; half++) {
             let sign = select(-1.0, 1.0, half == 0u);
-            var previous_u = -1.0;
-            var previous_distance = distance;
-            for (var i = 0u; i < steps; i++) {
-                let t = (f32(i) + jitter) / f32(steps);
-                let spread = select(pow(t, ao.step_power), t * t, ao.step_power == 2.0);
-                let offset_px = max(spread * march_px, f32(i) + 1.0);
-                let q = centre_px + sign * omega * offset_px;
-                let surface = surface_at(q, r.layer, r.eye, previous_distance);
-                if (surface.w == 0.0) {
-                    previous_u = -1.0;
-                    continue;
+            march.previous_u = -1.0;
+            march.previous_distance = distance;
+            // A straight march from inside the image never comes back once it leaves:
+            // the steps on the image read this eye's depth directly, and only those
+            // past its border (few pixels, near the borders) ask the other eye.
+            var i = 0u;
+            for (; i < steps; i++) {
+                let q = centre_px + sign * omega * step_offset_px(i, steps, jitter, march_px);
+                if (any(q < vec2<f32>(0.0)) || any(q >= size)) {
+                    break;
                 }
-                let front = surface.xyz - p;
-                let front2 = dot(front, front);
-                let sample_distance = -surface.z;
-                if (!(front2 < radius2)) {
-                    previous_u = -1.0;
-                    previous_distance = sample_distance;
-                    continue;
-                }
-                // The slab's back along the sample's view ray, clipped where it leaves
-                // the sphere of radius r about P.
-                let ray = normalize(surface.xyz);
-                let along = dot(front, ray);
-                let to_sphere = -along + sqrt(max(along * along - front2 + radius2, 0.0));
-                let back = front + ray * min(thickness, to_sphere);
-                let side = slice_side(slice, front);
-                let u_front = sector_coordinate(slice, front, side);
-                // The slab sweeps from its front away from V (its line passes through
-                // the eye, never through V); a back below the tangent plane reads as
-                // the horizon of the front's half.
-                let u_back = sector_coordinate(slice, back, side);
-                var lo = min(u_front, u_back);
-                var hi = max(u_front, u_back);
-                if (previous_u >= 0.0 && abs(sample_distance - previous_distance) < connect) {
-                    lo = min(lo, previous_u);
-                    hi = max(hi, previous_u);
-                }
-                occluded |= sector_bits(lo, hi);
-                previous_u = u_front;
-                previous_distance = sample_distance;
+                let pixel = vec2<u32>(q);
+                let d = textureLoad(depth_layers, vec2<i32>(pixel), i32(r.layer), 0);
+                let surface = load_view_position(d, pixel, r.eye, frame.size, frame.near);
+                add_sample(&march, slice, p, select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0), limits);
+            }
+            for (; near_border && i < steps; i++) {
+                let q = centre_px + sign * omega * step_offset_px(i, steps, jitter, march_px);
+                add_sample(&march, slice, p, surface_at(q, r.layer, r.eye, march.previous_distance), limits);
             }
         }
+        let occluded = march.occluded;
         let weight = projected_len * slice_total;
         visible += weight * (1.0 - f32(countOneBits(occluded)) / SECTORS);
         total += weight;

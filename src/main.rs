@@ -207,7 +207,7 @@ struct BenchArgs {
     bounce_form: vrao::settings::BounceForm,
     #[command(flatten)]
     gtao: GtaoArgs,
-    /// Spatial denoise of every row: tile (4×4, one pass) or bilateral (separable, --blur).
+    /// Spatial denoise of every row: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or bilateral (11×11 at --blur 5).
     #[arg(long, default_value = "tile")]
     denoise: vrao::settings::Denoise,
     /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
@@ -418,7 +418,7 @@ struct AoArgs {
     /// thin objects in front of a background. Assumes closed geometry.
     #[arg(long)]
     depth_peeling: bool,
-    /// Spatial denoise: tile (edge-aware 4×4 matched to the 4×4 noise tile, one pass) or
+    /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
     /// bilateral (separable, --blur px either side).
     #[arg(long, default_value = "tile")]
     denoise: vrao::settings::Denoise,

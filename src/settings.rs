@@ -215,7 +215,8 @@ impl std::str::FromStr for BounceForm {
 /// The spatial denoise of the occlusion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Denoise {
-    /// Edge-aware 4×4 box matched to the 4×4 noise tile, one pass (shaders/denoise.wgsl).
+    /// Edge-aware box over the 4×4 noise tile, 5 taps per axis in two passes
+    /// (shaders/denoise.wgsl).
     #[default]
     Tile,
     /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; seed 000).

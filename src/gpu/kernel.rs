@@ -40,6 +40,9 @@ const SHADERS: &[(&str, &str)] = &[
 /// A shader module made of the named files, concatenated in order (common first), so
 /// passes share `common.wgsl` without string formatting.
 pub fn shader_module(device: &wgpu::Device, label: &str, files: &[&str]) -> wgpu::ShaderModule {
+    // Shader development: `VRAO_SHADER_DIR=shaders` reads the files from disk, so an
+    // edited shader runs without rebuilding the binary.
+    let shader_dir = std::env::var_os("VRAO_SHADER_DIR").map(std::path::PathBuf::from);
     let mut source = String::new();
     for file in files {
         let text = SHADERS
@@ -47,7 +50,16 @@ pub fn shader_module(device: &wgpu::Device, label: &str, files: &[&str]) -> wgpu
             .find(|(name, _)| name == file)
             .map(|(_, text)| *text)
             .unwrap_or_else(|| panic!("shader {file} is not registered in SHADERS"));
-        source.push_str(text);
+        match &shader_dir {
+            Some(dir) => match std::fs::read_to_string(dir.join(file)) {
+                Ok(text) => source.push_str(&text),
+                Err(error) => {
+                    eprintln!("error: VRAO_SHADER_DIR: cannot read {}: {error}", dir.join(file).display());
+                    std::process::exit(2);
+                }
+            },
+            None => source.push_str(text),
+        }
         source.push('\n');
     }
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
