@@ -3,7 +3,10 @@
 //! visibility, a red wall bleeds red).
 //!
 //! Every triangle is counter-clockwise seen from the side its normal points to; the
-//! normals are exact (flat for planes, radial for the sphere). Units are metres, +Y up.
+//! normals are exact (flat for planes, radial for the sphere), except in
+//! `flipped-normals`, whose normals are wrong on purpose. Units are metres, +Y up.
+//! `furnished` (`furnished.rs`), `columns` and `flipped-normals` (`edge_cases.rs`) show
+//! screen-space AO's failure modes.
 
 use super::{Environment, HeadPath, Light, Material, Mesh, Scene};
 use crate::error::{Error, Result};
@@ -12,8 +15,6 @@ use glam::{DVec3, Vec3};
 use std::f64::consts::{PI, TAU};
 
 /// The built-in scene names, as `builtin:NAME` or `builtin = "NAME"` in a scene file.
-/// `furnished`, `columns` and `flipped-normals` show screen-space AO's failure modes
-/// (`furnished.rs`, `edge_cases.rs`).
 pub const NAMES: [&str; 8] = ["plane", "crease", "room", "sphere", "box", "furnished", "columns", "flipped-normals"];
 
 /// Half the side of the square floor of "plane", "sphere" and "box" (x, z in ±20 m).
