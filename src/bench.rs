@@ -42,6 +42,8 @@ pub struct Measurement {
     /// Render whole frames (direct light and composite too), not only the occlusion:
     /// rows then time the composite, which upsamples half-resolution occlusion inline.
     pub whole_frame: bool,
+    /// Cases measured at a time, round-robin one frame each (1: each case on its own).
+    pub interleave: usize,
 }
 
 /// One measured row: the case and per-pass medians over the measured frames.
@@ -363,7 +365,7 @@ pub fn estimate_seconds(
 /// a reference image per radius (cases whose radius has none get no error figures); the
 /// screen-space limit of each such radius is marched once, from the frame of its first
 /// case, and scores every row of that radius.
-/// `interleave` cases at a time are measured round-robin, one frame each per round, so
+/// `how.interleave` cases at a time are measured round-robin, one frame each per round, so
 /// that a slow drift of the machine (other load, clocks, heat) falls on all of them alike
 /// and their ratios stay fair; 1 measures each case on its own, in a row.
 pub fn sweep(
@@ -372,13 +374,12 @@ pub fn sweep(
     base: &Settings,
     cases: &[BenchCase],
     how: Measurement,
-    interleave: usize,
     references: &[(f32, ReferenceImage)],
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
     let mut limits: Vec<(f32, ScreenLimit)> = Vec::new();
-    for group in cases.chunks(interleave.max(1)) {
+    for group in cases.chunks(how.interleave.max(1)) {
         let mut runs = Vec::with_capacity(group.len());
         for case in group {
             let mut run = CaseRun::new(gpu, scene, base, case, how)?;

@@ -752,7 +752,13 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         args.height,
         args.frames
     );
-    let how = Measurement { timing, warmup: args.warmup, frames: args.frames, whole_frame: args.frame };
+    let how = Measurement {
+        timing,
+        warmup: args.warmup,
+        frames: args.frames,
+        whole_frame: args.frame,
+        interleave: args.interleave as usize,
+    };
     let (estimate, frame_seconds) = vrao::bench::estimate_seconds(&gpu, &scene, &settings, &cases, how)?;
     eprintln!(
         "bench: estimated {} ({} cases × ({} + {} frames) at ~{:.0} ms a frame of the first case, plus set-up; other cases may differ)",
@@ -763,32 +769,24 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         frame_seconds * 1000.0
     );
     let started = std::time::Instant::now();
-    let mut rows = sweep(
-        &gpu,
-        &scene,
-        &settings,
-        &cases,
-        how,
-        args.interleave as usize,
-        &references,
-        |done, total, row| {
-            let elapsed = started.elapsed().as_secs_f64();
-            let eta = elapsed / done as f64 * (total - done) as f64;
-            let mut error = row.error.as_ref().map_or(String::new(), |e| {
-                let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-                format!(
-                    "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}) FLIP {}",
-                    e.ao_rmse,
-                    e.ao_bias,
-                    opt(e.ao_rmse_vs_limit),
-                    opt(e.limit_rmse),
-                    opt(e.flip_mean)
-                )
-            });
-            if let Some(share) = row.stereo.and_then(|s| s.inconsistent) {
-                error += &format!("  stereo ≠ {:.1} %", share * 100.0);
-            }
-            eprintln!(
+    let mut rows = sweep(&gpu, &scene, &settings, &cases, how, &references, |done, total, row| {
+        let elapsed = started.elapsed().as_secs_f64();
+        let eta = elapsed / done as f64 * (total - done) as f64;
+        let mut error = row.error.as_ref().map_or(String::new(), |e| {
+            let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+            format!(
+                "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}) FLIP {}",
+                e.ao_rmse,
+                e.ao_bias,
+                opt(e.ao_rmse_vs_limit),
+                opt(e.limit_rmse),
+                opt(e.flip_mean)
+            )
+        });
+        if let Some(share) = row.stereo.and_then(|s| s.inconsistent) {
+            error += &format!("  stereo ≠ {:.1} %", share * 100.0);
+        }
+        eprintln!(
                 "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
                 format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
                 row.case.samples,
@@ -796,12 +794,10 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
                 if row.case.half_res { "half" } else { "full" },
                 row.occlusion_ms_per_eye()
             );
-        },
-    )?;
+    })?;
     for &samples in &args.rsm_samples {
         for &radius in &radii {
             let reference = references.iter().find(|(r, _)| *r == radius).map(|(_, image)| image);
-            let how = Measurement { timing, warmup: args.warmup, frames: args.frames, whole_frame: args.frame };
             let row = vrao::bench::measure_rsm(&gpu, &scene, &settings, samples, radius, how, reference)?;
             let error = row.bounce.map_or(String::new(), |b| format!("  bounce rel RMSE {:.4}", b.rel_rmse));
             eprintln!("[rsm] N={samples:<3} r={radius:<7} half {:>9.3} ms/eye{error}", row.occlusion_ms_per_eye());

@@ -139,7 +139,7 @@ fn direction(eyes: &[Eye; 2], images: &[EyeImages; 2], a: usize, size: (u32, u32
 /// it whose surface is `v`'s; `None` off the image or where B sees another surface.
 fn lookup(image: &EyeImages, v: DVec3, [l, r, u, d]: [f64; 4], size: (u32, u32), near: f64) -> Option<f32> {
     let distance = -v.z;
-    if !(distance >= near) {
+    if distance.is_nan() || distance < near {
         return None;
     }
     let (s, t) = ((v.x / distance - l) / (r - l), (v.y / distance - u) / (d - u));
