@@ -203,9 +203,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     limits.connect = ao.connect * radius;
     let size = vec2<f32>(frame.size);
     let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
-    let near_border = any(centre_px - march_px < vec2<f32>(0.0)) || any(centre_px + march_px >= size);
     let slices = max(ao.directions, 1u);
     let steps = max(ao.steps, 1u);
+    // Whether any step can leave the image (steps are at least a pixel apart, so the
+    // march reaches at most max(march_px, steps) pixels out).
+    let reach_px = max(march_px, f32(steps));
+    let near_border = any(centre_px - reach_px < vec2<f32>(0.0)) || any(centre_px + reach_px >= size);
     let rotation_noise = bayer4(r.pixel);
     // A second, decorrelated value of the same tile for the step jitter.
     let jitter = fract(rotation_noise * 7.0 + 0.3125);
