@@ -110,6 +110,8 @@ struct AoParams {
     // GTAO: successive samples closer in distance than this fraction of the radius lie
     // on one continuous surface (0: never).
     connect: f32,
+    // GTAO: columns along each eye's inner border marched with the other-eye lookups.
+    inner_band: u32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

@@ -21,12 +21,36 @@
 // angles between them: a ray that is in front of a continuous surface at one sample
 // and behind it at the next crosses it in between.
 //
-// Samples that leave the eye's image are looked up in the other eye's layer
-// (occlusion.wgsl `surface_at`, guessing the last sample's distance).
+// Samples that leave the eye's image through its inner border are looked up in the other
+// eye's layer (occlusion.wgsl `surface_at`, guessing the last sample's distance). The
+// pass runs as two dispatches of this file: the band of `ao.inner_band` columns along
+// each eye's inner border with those lookups compiled in (INNER_BAND = true), and the
+// rest of the image without them, where a march that leaves the image stops (open). The
+// lookups' code, even never taken, made every pixel's march about half as slow again.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 
 const SECTORS: f32 = 32.0;
+
+// Whether this dispatch covers the inner-border band (with the other-eye lookups) or
+// the rest of the image.
+override INNER_BAND: bool = false;
+
+// The occlusion pixel of invocation `id` in this dispatch's part of the image, or none
+// (x = ao_size.x) past its part's width.
+fn dispatch_pixel(id: vec3<u32>) -> vec3<u32> {
+    let band = min(ao.inner_band, ao.ao_size.x);
+    let band_on_left = id.z < frame.layers && other_eye_side(frame.eyes[min(id.z, 1u)]) < 0.0;
+    var x = ao.ao_size.x;
+    if (INNER_BAND) {
+        if (id.x < band) {
+            x = select(ao.ao_size.x - band + id.x, id.x, band_on_left);
+        }
+    } else if (id.x < ao.ao_size.x - band) {
+        x = select(id.x, id.x + band, band_on_left);
+    }
+    return vec3<u32>(x, id.y, id.z);
+}
 
 // The slice's frame and its hemisphere's cumulative weight.
 struct Slice {
@@ -177,7 +201,8 @@ fn add_sample(march: ptr<function, March>, slice: Slice, p: vec3<f32>, surface: 
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
+    let id = dispatch_pixel(invocation);
     let r = begin_receiver(id);
     if (!r.valid) {
         return;
@@ -205,10 +230,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
     let slices = max(ao.directions, 1u);
     let steps = max(ao.steps, 1u);
-    // Whether any step can leave the image (steps are at least a pixel apart, so the
-    // march reaches at most max(march_px, steps) pixels out).
+    // Whether any step can leave the image through the inner border, the only one the
+    // other eye sees past (steps are at least a pixel apart, so the march reaches at most
+    // max(march_px, steps) pixels out).
     let reach_px = max(march_px, f32(steps));
-    let near_border = any(centre_px - reach_px < vec2<f32>(0.0)) || any(centre_px + reach_px >= size);
+    let inner = other_eye_side(r.eye);
+    let near_inner_border = INNER_BAND
+        && ((inner > 0.0 && centre_px.x + reach_px >= size.x) || (inner < 0.0 && centre_px.x - reach_px < 0.0));
     let rotation_noise = bayer4(r.pixel);
     // A second, decorrelated value of the same tile for the step jitter.
     let jitter = fract(rotation_noise * 7.0 + 0.3125);
@@ -256,7 +284,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             march.previous_distance = distance;
             // A straight march from inside the image never comes back once it leaves:
             // the steps on the image read this eye's depth directly, and only those
-            // past its border (few pixels, near the borders) ask the other eye.
+            // past the inner border (few pixels, near it) ask the other eye. Past the
+            // outer, top and bottom borders the other eye sees no further: open.
             var i = 0u;
             for (; i < steps; i++) {
                 let q = centre_px + sign * omega * step_offset_px(i, steps, jitter, march_px);
@@ -268,8 +297,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 let surface = load_view_position(d, pixel, r.eye, frame.size, frame.near);
                 add_sample(&march, slice, p, select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0), limits);
             }
-            for (; near_border && i < steps; i++) {
+            let towards_inner = near_inner_border && sign * omega.x * inner > 0.0;
+            for (; towards_inner && i < steps; i++) {
                 let q = centre_px + sign * omega * step_offset_px(i, steps, jitter, march_px);
+                if (q.y < 0.0 || q.y >= size.y) {
+                    break;
+                }
                 add_sample(&march, slice, p, surface_at(q, r.layer, r.eye, march.previous_distance), limits);
             }
         }

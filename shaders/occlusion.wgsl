@@ -190,6 +190,16 @@ fn probed_surface(probe: DepthProbe, eye: Eye) -> vec3<f32> {
     return view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
 }
 
+// The side of this eye's image past which the other eye sees on: +1 right, −1 left, 0
+// for a mono view. It is the side the other eye's centre lies on (its x in this view).
+fn other_eye_side(eye: Eye) -> f32 {
+    let m = eye.other_from_view;
+    // The other eye's origin in this view: −Rᵀt for other_from_view = [R | t].
+    let t = m[3].xyz;
+    let x = -dot(m[0].xyz, t);
+    return select(select(0.0, -1.0, x < -1e-6), 1.0, x > 1e-6);
+}
+
 // The surface at screen position `q` (full-res pixel coordinates, may lie off the image)
 // of layer `layer`, in this eye's view space; w = 0 when none is known. Off the image the
 // other eye's layer is asked: the point on this eye's ray through `q` at distance `guess`

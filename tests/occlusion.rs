@@ -1066,6 +1066,74 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
     }
 }
 
+/// Every pixel of both eyes is computed once, whatever the split of a technique's
+/// dispatch (GTAO runs the inner-border band and the rest as two dispatches): each
+/// pixel with a surface has its geometry written, at odd sizes too.
+#[test]
+fn every_pixel_is_computed_in_both_eyes() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let head = scene.head.pose_at(0.0);
+    for technique in AO_TECHNIQUES {
+        let s = settings(97, 109, ao(technique, 12, 0.5));
+        let f = render(&gpu, &scene, &s, &head, &[Resource::AoGeometry, Resource::AoRaw]);
+        let missing: Vec<_> = f
+            .pixels()
+            .filter(|&(l, x, y)| f.world(l, x, y).is_some() && !(f.ao(Resource::AoGeometry, l, x, y) > 0.0))
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "{}: {} pixels never computed, first {:?}",
+            technique.name(),
+            missing.len(),
+            missing.first()
+        );
+    }
+}
+
+/// A march that leaves an eye's image through its inner (nasal) border goes on in the
+/// other eye's layer, which sees past that border. On surface points near the inner
+/// border that the other eye sees well inside its image, the two eyes' raw AO agree;
+/// with those marches stopped at the border instead (checked by hand: gtao.wgsl's band
+/// dispatch without lookups) the eye at its border reads lighter by 0.047.
+#[test]
+fn marches_past_the_inner_border_continue_in_the_other_eye() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let head = scene.head.pose_at(0.0);
+    let s = settings(128, 144, ao(Technique::Gtao, 64, 1.0));
+    let f = render(&gpu, &scene, &s, &head, &[Resource::AoRaw]);
+    let band = 12;
+    let (mut signed, mut occlusion) = (Vec::new(), Vec::new());
+    // Left eye: inner border on the right; right eye: on the left.
+    for (layer, other, columns) in [(0usize, 1usize, (f.width - band)..f.width), (1, 0, 0..band)] {
+        for x in columns {
+            for y in band..f.height - band {
+                let Some(p) = f.world(layer, x, y) else { continue };
+                let Some((ox, oy)) = f.pixel_of(other, p) else { continue };
+                if ox < band || ox >= f.width - band || oy < band || oy >= f.height - band {
+                    continue;
+                }
+                let Some(q) = f.world(other, ox, oy) else { continue };
+                if (q - p).length() > 0.01 * (p - f.eyes.eyes[layer].pose.position).length() {
+                    continue;
+                }
+                let (here, there) = (f.ao(Resource::AoRaw, layer, x, y), f.ao(Resource::AoRaw, other, ox, oy));
+                signed.push(here - there);
+                occlusion.push(1.0 - there);
+            }
+        }
+    }
+    let (bias, occluded) = (mean(signed.iter().copied()), mean(occlusion.iter().copied()));
+    eprintln!(
+        "inner border: {} matched px, mean (border eye − other eye) {bias:+.4}, mean occlusion seen by the other eye {occluded:.3}",
+        signed.len()
+    );
+    assert!(signed.len() > 500, "too few matched pixels at the inner borders ({})", signed.len());
+    assert!(occluded > 0.05, "nothing occluded at the inner borders: the case cannot tell");
+    assert!(bias.abs() < 0.015, "the eye at its inner border disagrees with the other eye by {bias:+.4}");
+}
+
 // ---------------------------------------------------------------------------------------
 // Numerics
 

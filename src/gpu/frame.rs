@@ -75,6 +75,19 @@ pub struct AoParamsUniform {
     pub step_power: f32,
     /// GTAO: distance gap (fraction of the radius) under which successive samples join.
     pub connect: f32,
+    /// GTAO: width in occlusion pixels of the band along each eye's inner border that
+    /// runs with the other-eye lookups ([`gtao_inner_band`]).
+    pub inner_band: u32,
+    /// The WGSL struct's size is a multiple of its 8-byte alignment (`ao_size`).
+    pub padding: u32,
+}
+
+/// GTAO's inner-border band for occlusion targets `width` pixels wide: a quarter of the
+/// width (whole 8-pixel workgroups). Only marches from this band look past the inner
+/// border into the other eye; one from further in that would cross it (its radius spans
+/// more than a quarter of the image: a surface very near the eye) stops there instead.
+pub fn gtao_inner_band(width: u32) -> u32 {
+    (width / 4).next_multiple_of(8).min(width)
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).
@@ -186,6 +199,8 @@ impl FrameBuffers {
             thickness: ao.thickness,
             step_power: ao.step_power,
             connect: ao.connect,
+            inner_band: gtao_inner_band(width),
+            padding: 0,
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
         queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));

@@ -4,6 +4,7 @@
 //! which also reads the direct light, is `ssdo.rs`.
 
 use super::{FrameContext, FrameSetup, Pass};
+use crate::gpu::frame::gtao_inner_band;
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
@@ -55,12 +56,15 @@ pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup
 pub struct OcclusionPass {
     technique: Technique,
     kernel: Kernel,
+    /// GTAO's second dispatch: the columns along each eye's inner border, compiled with
+    /// the other-eye lookups (gtao.wgsl `INNER_BAND`); `kernel` runs the rest.
+    inner_band: Option<Kernel>,
 }
 
 impl OcclusionPass {
     fn new(gpu: &Gpu, technique: Technique, shader: &str) -> Self {
         let kernel = Kernel::new(gpu, technique.name(), &["common.wgsl", "occlusion.wgsl", shader], "main", &SLOTS);
-        OcclusionPass { technique, kernel }
+        OcclusionPass { technique, kernel, inner_band: None }
     }
 
     pub fn ssao(gpu: &Gpu) -> Self {
@@ -72,7 +76,14 @@ impl OcclusionPass {
     }
 
     pub fn gtao(gpu: &Gpu) -> Self {
-        Self::new(gpu, Technique::Gtao, "gtao.wgsl")
+        let files = ["common.wgsl", "occlusion.wgsl", "gtao.wgsl"];
+        let label = Technique::Gtao.name();
+        let constants = |band: bool| [("INNER_BAND", if band { 1.0 } else { 0.0 })];
+        OcclusionPass {
+            technique: Technique::Gtao,
+            kernel: Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &constants(false)),
+            inner_band: Some(Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &constants(true))),
+        }
     }
 
     /// SSAO's depth taps without the occlusion arithmetic (benchmark baseline).
@@ -88,7 +99,14 @@ impl Pass for OcclusionPass {
 
     fn record(&self, ctx: &mut FrameContext) {
         let resources = bindings(ctx);
-        let extent = ctx.ao_extent();
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        let (width, height, layers) = ctx.ao_extent();
+        match &self.inner_band {
+            None => self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (width, height, layers)),
+            Some(band_kernel) => {
+                let band = gtao_inner_band(width);
+                self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (width - band, height, layers));
+                band_kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (band, height, layers));
+            }
+        }
     }
 }
