@@ -66,6 +66,10 @@ struct UpsamplePixel {
     plane_scale: f32,
     sum: vec4<f32>,
     total: f32,
+    // The same sum over the samples on any surface, by distance only: the fallback when
+    // the geometry rejects them all (a pixel whose normal points into the body).
+    surface_sum: vec4<f32>,
+    surface_total: f32,
     // The least geometric agreement of the samples so far (edge test).
     agree: f32,
 };
@@ -92,6 +96,8 @@ fn upsample_pixel(
     px.plane_offset = dot(px.n, px.position) * px.plane_scale;
     px.sum = vec4<f32>(0.0);
     px.total = 0.0;
+    px.surface_sum = vec4<f32>(0.0);
+    px.surface_total = 0.0;
     px.agree = 1.0;
     return px;
 }
@@ -124,6 +130,9 @@ fn add_sample(pixel: UpsamplePixel, s: LowResSample, spatial: f32, take: bool) -
     let ok = finite && take;
     px.sum += s.value * select(0.0, w, ok);
     px.total += select(0.0, w, ok);
+    let on_surface = select(0.0, s.valid * spatial, take);
+    px.surface_sum += s.value * on_surface;
+    px.surface_total += on_surface;
     px.agree = min(px.agree, select(0.0, agreement, finite));
     return px;
 }
@@ -147,11 +156,16 @@ fn add_to_quad(quad: array<UpsamplePixel, 4>, s: LowResSample, offset: vec2<i32>
     );
 }
 
-// The pixel's upsampled value; `nearest` (low-res sample b's) when every weight vanished.
+// The pixel's upsampled value. When the geometry rejected every sample, the samples on
+// any surface by distance alone (never one value that happens to be nearest: on a
+// silhouette that is often the sky's, rgb 0, which made SSDO's ambient black); with
+// none on a surface either, `nearest` (low-res sample b's).
 fn upsampled(px: UpsamplePixel, nearest: vec4<f32>) -> vec4<f32> {
     var result = nearest;
     if (px.total > 1e-20) {
         result = px.sum / px.total;
+    } else if (px.surface_total > 1e-20) {
+        result = px.surface_sum / px.surface_total;
     }
     return vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
 }

@@ -1066,6 +1066,45 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
     }
 }
 
+/// `builtin:flipped-normals`: a ball whose silhouette pixels carry normals turned into
+/// the body. No technique, at full or half resolution, may read AO exactly 0 there, and
+/// no shaded pixel may be pure black (before the fix, SSDO's half-resolution upsample
+/// rejected every neighbour on such a pixel and fell back to a sky texel's irradiance 0).
+#[test]
+fn flipped_normals_give_no_zero_ao_and_no_black_pixel() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:flipped-normals").unwrap();
+    let head = scene.head.pose_at(0.0);
+    for technique in AO_TECHNIQUES {
+        for half_res in [false, true] {
+            let mut a = ao(technique, 12, scene.suggested_ao_radius());
+            a.half_res = half_res;
+            let s = settings(270, 300, a);
+            // The final full-resolution AO.
+            let final_ao = if half_res { Resource::AoFull } else { Resource::AoBlurred };
+            let f = render(&gpu, &scene, &s, &head, &[final_ao, Resource::Hdr]);
+            let (mut surface, mut zero_ao, mut black) = (0, Vec::new(), Vec::new());
+            for (l, x, y) in f.pixels() {
+                if f.world(l, x, y).is_none() {
+                    continue;
+                }
+                surface += 1;
+                if f.ao(final_ao, l, x, y) <= 0.0 {
+                    zero_ao.push((l, x, y));
+                }
+                if f.rgb(Resource::Hdr, l, x, y).iter().all(|&c| c <= 0.0) {
+                    black.push((l, x, y));
+                }
+            }
+            let case = format!("{} {}", technique.name(), if half_res { "half" } else { "full" });
+            eprintln!("flipped normals {case}: {surface} surface px, {} AO 0, {} black", zero_ao.len(), black.len());
+            assert!(surface > 270 * 300 / 2, "{case}: the scene fills too little of the view");
+            assert!(zero_ao.is_empty(), "{case}: AO exactly 0 at {:?}", &zero_ao[..zero_ao.len().min(5)]);
+            assert!(black.is_empty(), "{case}: pure black at {:?}", &black[..black.len().min(5)]);
+        }
+    }
+}
+
 /// Every pixel of both eyes is computed once, whatever the split of a technique's
 /// dispatch (GTAO runs the inner-border band and the rest as two dispatches): each
 /// pixel with a surface has its geometry written, at odd sizes too.
