@@ -24,26 +24,10 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         textureStore(occlusion_out, p, i32(layer), centre_value);
         return;
     }
-    // The view ray through occlusion pixel q is (tx(q.x), ty(q.y), −1), each tangent
-    // linear in its coordinate (low-res q stands for full-res 2q, never clamped inside
-    // the target); a tap at distance d along it lies (d (e + k f) − d₀ e) off the
-    // centre's tangent plane, with e = n·ray(p) and f = n's axis component × the
-    // tangent's step per occlusion pixel. Two multiply-adds per tap instead of
-    // reconstructing its position (the blur is arithmetic-bound on lavapipe).
-    let uv = pixel_uv(full_res_pixel(id.xy, ao.scale, frame.size), frame.size);
-    let ray = vec3<f32>(mix(eye.tangents.x, eye.tangents.y, uv.x), mix(eye.tangents.z, eye.tangents.w, uv.y), -1.0);
     let n = centre.xyz;
-    let tangent_step = vec2<f32>(eye.tangents.y - eye.tangents.x, eye.tangents.w - eye.tangents.z)
-        * f32(ao.scale) / vec2<f32>(frame.size);
-    let e = dot(ray, n);
-    let f = dot(vec2<f32>(axis) * tangent_step, n.xy);
+    let plane = tap_plane(eye, id.xy, centre, axis, ao.scale, frame.size, ao.blur_plane_sigma);
     let radius = i32(ao.blur_radius);
     let sigma = max(f32(radius) * 0.5, 0.5);
-    // Off-plane distance in units of the depth-edge width (`ao.blur_plane_sigma` of the
-    // centre's distance). A sigma near 0 makes this huge: neighbours off the plane get
-    // weight 0 (or NaN, skipped below) and the centre value stays.
-    let plane_scale = 1.0 / max(ao.blur_plane_sigma * centre.w, 1e-30);
-    let centre_offset = centre.w * e;
     let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
     var sum = vec4<f32>(0.0);
     var total = 0.0;
@@ -57,9 +41,10 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
             continue;
         }
         let kf = f32(k);
-        let plane = (geometry.w * (e + kf * f) - centre_offset) * plane_scale;
-        // One exp for the spatial and depth terms; the normal term is (n·q)^16.
-        let w = exp(-kf * kf * inv_two_sigma2 - plane * plane) * normal_agreement(n, geometry.xyz);
+        let offset = plane_offset_of(plane, geometry.w, kf);
+        // One exp for the spatial and depth terms; the normal term is (n·q)^16. Off-plane
+        // offsets are NaN only for a degenerate centre: such a tap is skipped below.
+        let w = exp(-kf * kf * inv_two_sigma2 - offset * offset) * normal_agreement(n, geometry.xyz);
         if (w == w) {
             sum += textureLoad(occlusion_in, q, i32(layer), 0) * w;
             total += w;

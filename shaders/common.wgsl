@@ -202,6 +202,39 @@ fn normal_agreement(n: vec3<f32>, q: vec3<f32>) -> f32 {
     return c8 * c8;
 }
 
+// The tangent plane of occlusion pixel `p` (AoGeometry `centre`: normal, distance) for
+// taps along `axis`: a tap at distance d, k occlusion pixels along the axis, lies
+// `plane_offset_of(plane, d, k)` off it, in units of `sigma` × the centre's distance.
+// The view ray through an occlusion pixel is (tx, ty, −1), each tangent linear in its
+// pixel coordinate, so the offset is (d (e + k f) − d₀ e) with e = n·ray(p) and f = the
+// normal's axis component × the tangent's step per pixel: two multiply-adds per tap
+// instead of reconstructing its position (the denoise filters are arithmetic-bound on
+// lavapipe).
+struct TapPlane {
+    e: f32,
+    f: f32,
+    centre_offset: f32,
+    scale: f32,
+};
+
+fn tap_plane(eye: Eye, p: vec2<u32>, centre: vec4<f32>, axis: vec2<i32>, scale: u32, full_size: vec2<u32>, sigma: f32) -> TapPlane {
+    let tangent_step = vec2<f32>(eye.tangents.y - eye.tangents.x, eye.tangents.w - eye.tangents.z)
+        * f32(scale) / vec2<f32>(full_size);
+    let uv = pixel_uv(full_res_pixel(p, scale, full_size), full_size);
+    let ray = vec3<f32>(mix(eye.tangents.x, eye.tangents.y, uv.x), mix(eye.tangents.z, eye.tangents.w, uv.y), -1.0);
+    var plane: TapPlane;
+    plane.e = dot(ray, centre.xyz);
+    plane.f = dot(vec2<f32>(axis) * tangent_step, centre.xy);
+    plane.centre_offset = centre.w * plane.e;
+    // A sigma near 0 makes offsets huge: taps off the plane get weight 0.
+    plane.scale = 1.0 / max(sigma * centre.w, 1e-30);
+    return plane;
+}
+
+fn plane_offset_of(plane: TapPlane, distance: f32, k: f32) -> f32 {
+    return (distance * (plane.e + k * plane.f) - plane.centre_offset) * plane.scale;
+}
+
 // One texel of the `Direct` resource (rg32uint, 8 bytes) holds what SSDO's bounce needs
 // of a sender pixel: x = its view distance (f32 bits, 0 on the sky; the same value
 // occlusion probes compute from depth), y = its outgoing radiance in the shared-exponent

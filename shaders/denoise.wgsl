@@ -39,8 +39,6 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         geometry[j] = textureLoad(geometry_layers, q, layer, 0);
         values[j] = textureLoad(occlusion_in, q, layer, 0);
     }
-    let tangent_step = vec2<f32>(eye.tangents.y - eye.tangents.x, eye.tangents.w - eye.tangents.z)
-        * f32(ao.scale) / vec2<f32>(frame.size);
     for (var o = 0; o < RUN; o++) {
         let p = first + axis * o;
         if (any(p > limit)) {
@@ -52,15 +50,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
             textureStore(occlusion_out, p, layer, values[o + 2]);
             continue;
         }
-        // A tap at distance d, k occlusion pixels along `axis`, lies (d (e + k f) − d₀ e)
-        // off the centre's tangent plane (as in bilateral.wgsl): the view ray through
-        // the pixel is (tx, ty, −1), each tangent linear in its pixel coordinate.
-        let uv = pixel_uv(full_res_pixel(vec2<u32>(p), ao.scale, frame.size), frame.size);
-        let ray = vec3<f32>(mix(eye.tangents.x, eye.tangents.y, uv.x), mix(eye.tangents.z, eye.tangents.w, uv.y), -1.0);
-        let e = dot(ray, centre.xyz);
-        let f = dot(vec2<f32>(axis) * tangent_step, centre.xy);
-        let centre_offset = centre.w * e;
-        let plane_scale = 1.0 / max(ao.blur_plane_sigma * centre.w, 1e-30);
+        let plane = tap_plane(eye, vec2<u32>(p), centre, axis, ao.scale, frame.size, ao.blur_plane_sigma);
         var sum = vec4<f32>(0.0);
         var total = 0.0;
         var plain_sum = vec4<f32>(0.0);
@@ -70,8 +60,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
             let value = values[o + k + 2];
             let box = select(1.0, 0.5, abs(k) == 2);
             let on_surface = select(0.0, box, distance > 0.0);
-            let plane = (distance * (e + f32(k) * f) - centre_offset) * plane_scale;
-            let w = on_surface * max(1.0 - abs(plane), 0.0);
+            let w = on_surface * max(1.0 - abs(plane_offset_of(plane, distance, f32(k))), 0.0);
             sum += value * w;
             total += w;
             plain_sum += value * on_surface;
