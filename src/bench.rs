@@ -10,11 +10,11 @@ use crate::metrics;
 use crate::passes::final_occlusion;
 use crate::plot::{ScatterPlot, Series};
 use crate::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
-use crate::reference::ReferenceImage;
+use crate::reference::{ReferenceImage, ReferencePixel};
 use crate::renderer::{Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::{Settings, Technique};
-use crate::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency};
+use crate::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency, BORDER_PX};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -447,6 +447,35 @@ pub struct ErrorFigures {
     pub limit_rmse: Option<f64>,
     /// The screen-space limit's mean bias against the reference.
     pub limit_bias: Option<f64>,
+    /// RMSE (noise not taken out) over the pixels within [`BORDER_PX`] of an eye's outer,
+    /// top or bottom border, where samples that leave the image count as open: with
+    /// `ao_rmse`, what a guard band could win. `None` when no such pixel is covered.
+    pub ao_rmse_outer_border: Option<f64>,
+    /// Halos: the share (0..1) of the pixels beside a depth edge ([`near_depth_edge`])
+    /// that are too dark by more than [`HALO_DARKER`]. `None` when there is no edge.
+    pub halo_share: Option<f64>,
+}
+
+/// How much darker than the reference a pixel beside a depth edge must be to count as
+/// part of a halo.
+pub const HALO_DARKER: f32 = 0.1;
+
+/// Whether grid cell (i, j) of an eye's reference lies beside a depth edge: a neighbour
+/// within one cell sees the sky, or the depth along a row or column is not locally
+/// linear (second difference above 10 % of the depth; a sloped floor is linear in the
+/// pixel coordinate only to first order, far below that).
+fn near_depth_edge(pixels: &[ReferencePixel], (gw, gh): (usize, usize), i: usize, j: usize) -> bool {
+    let depth = |x: usize, y: usize| pixels[y * gw + x].hit.then_some(pixels[y * gw + x].depth as f64);
+    let Some(d) = depth(i, j) else { return false };
+    let bent = |a: Option<f64>, b: Option<f64>| match (a, b) {
+        (Some(a), Some(b)) => (a + b - 2.0 * d).abs() > 0.1 * d,
+        _ => true,
+    };
+    let (left, right) = (i.checked_sub(1), (i + 1 < gw).then_some(i + 1));
+    let (up, down) = (j.checked_sub(1), (j + 1 < gh).then_some(j + 1));
+    let horizontal = left.is_some() && right.is_some() && bent(depth(left.unwrap(), j), depth(right.unwrap(), j));
+    let vertical = up.is_some() && down.is_some() && bent(depth(i, up.unwrap()), depth(i, down.unwrap()));
+    horizontal || vertical
 }
 
 /// Reference AO below which a pixel counts as occluded for [`ErrorFigures::ao_bias_dark`].
@@ -485,6 +514,7 @@ pub fn score(
     let (mut limit_ao, mut limit_mask) = (Vec::new(), Vec::new());
     let (mut gpu_ambient, mut ref_ambient) = (Vec::new(), Vec::new());
     let (mut ssim_sum, mut flip_sum, mut flip_pixels) = (0.0, 0.0, 0usize);
+    let (mut outer_border, mut beside_edge) = (Vec::new(), Vec::new());
     for (layer, pixels) in reference.layers.iter().enumerate() {
         let image = &occlusion[layer];
         let first = gpu_ao.len();
@@ -494,6 +524,10 @@ pub fn score(
                 let (x, y) = reference.pixel_of(gx as u32, gy as u32);
                 let (x, y) = ((x as usize).min(w - 1), (y as usize).min(h - 1));
                 let texel = &image[(y * w + x) * 4..(y * w + x) * 4 + 4];
+                // Layer 0 is the left eye: its outer border is on the left.
+                let outer = if layer == 0 { x } else { w - 1 - x };
+                outer_border.push(r.hit && outer.min(y).min(h - 1 - y) < BORDER_PX as usize);
+                beside_edge.push(r.hit && near_depth_edge(pixels, (gw, gh), gx, gy));
                 gpu_ao.push(texel[3]);
                 ref_ao.push(r.ao);
                 falloff.push(r.ao_falloff);
@@ -564,7 +598,15 @@ pub fn score(
         }
         _ => (None, None, None),
     };
+    let edge_pixels = beside_edge.iter().filter(|&&e| e).count();
+    let halos = (0..gpu_ao.len()).filter(|&i| beside_edge[i] && gpu_ao[i] < ref_ao[i] - HALO_DARKER).count();
     ErrorFigures {
+        ao_rmse_outer_border: outer_border
+            .iter()
+            .any(|&b| b)
+            .then(|| metrics::rmse(&gpu_ao, &ref_ao, Some(&outer_border)))
+            .flatten(),
+        halo_share: (edge_pixels > 0).then(|| halos as f64 / edge_pixels as f64),
         ao_rmse: corrected(&gpu_ao, &ref_ao, &mask, noise),
         ao_bias,
         ao_bias_dark,
@@ -612,6 +654,12 @@ pub struct BenchRecord {
     pub limit_rmse: Option<f64>,
     #[serde(default)]
     pub limit_bias: Option<f64>,
+    /// RMSE within 40 px of the outer, top and bottom borders ([`ErrorFigures::ao_rmse_outer_border`]).
+    #[serde(default)]
+    pub ao_rmse_outer_border: Option<f64>,
+    /// Share of the pixels beside depth edges too dark by more than 0.1 ([`ErrorFigures::halo_share`]).
+    #[serde(default)]
+    pub halo_share: Option<f64>,
     /// Mean ꟻLIP of the AO against the reference AO at the headset's pixels per degree.
     #[serde(default)]
     pub flip_mean: Option<f64>,
@@ -746,6 +794,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 ao_rmse_vs_limit: row.error.as_ref().and_then(|e| e.ao_rmse_vs_limit),
                 limit_rmse: row.error.as_ref().and_then(|e| e.limit_rmse),
                 limit_bias: row.error.as_ref().and_then(|e| e.limit_bias),
+                ao_rmse_outer_border: row.error.as_ref().and_then(|e| e.ao_rmse_outer_border),
+                halo_share: row.error.as_ref().and_then(|e| e.halo_share),
                 flip_mean: row.error.as_ref().and_then(|e| e.flip_mean),
                 stereo_inconsistent: row.stereo.and_then(|c| c.inconsistent),
                 stereo_inconsistent_inner_border: row.stereo.and_then(|c| c.inner_border),
@@ -903,6 +953,20 @@ const COLUMNS: &[Column] = &[
         header: "limit bias",
         csv: |r| fixed(r.limit_bias, 4),
         markdown: |r| fixed(r.limit_bias, 3),
+        optional: false,
+    },
+    Column {
+        name: "ao_rmse_outer_border",
+        header: "RMSE outer border",
+        csv: |r| fixed(r.ao_rmse_outer_border, 4),
+        markdown: |r| fixed(r.ao_rmse_outer_border, 3),
+        optional: false,
+    },
+    Column {
+        name: "halo_share",
+        header: "halo",
+        csv: |r| fixed(r.halo_share, 4),
+        markdown: |r| percent(r.halo_share),
         optional: false,
     },
     Column {
@@ -1078,6 +1142,11 @@ for every row of a radius.
 - **RMSE vs limit**: the technique against that limit: its *estimator* error (too few samples, \
 falloffs, one sample point per direction, noise). A technique with RMSE ≈ limit RMSE and a small \
 RMSE vs limit is as good as screen space gets; a large RMSE vs limit is the estimator's own fault.
+- **RMSE outer border**: RMSE over the pixels within 40 px of an eye's outer, top or bottom \
+border, where samples that leave the image count as open (the other eye sees no further there): \
+compared with RMSE, what rendering a guard band around the image could win.
+- **halo**: share of the pixels beside a depth edge (within one reference cell) that are too \
+dark by more than 0.1: occlusion spilling from a near object onto the far surface behind it.
 - **FLIP**: mean ꟻLIP of the AO image against the reference AO (both as grey images, sky 1) at \
 the headset's pixels per degree over the reference's stride: how visible the difference is; \
 noise and blotches count more than a smooth offset of the same RMSE.
@@ -1293,6 +1362,8 @@ mod tests {
                 ao_rmse_vs_limit: Some(0.06),
                 limit_rmse: Some(0.04),
                 limit_bias: Some(0.01),
+                ao_rmse_outer_border: Some(0.07),
+                halo_share: Some(0.0625),
             }),
             bounce: None,
             stereo: Some(StereoConsistency {
@@ -1325,6 +1396,23 @@ mod tests {
     }
 
     #[test]
+    fn a_depth_edge_is_a_step_or_the_sky_not_a_slope() {
+        let cell = |depth: f32| ReferencePixel { hit: depth > 0.0, depth, ..ReferencePixel::SKY };
+        // A floor receding linearly along the row (1, 2, …, 5 m): no edge anywhere inside.
+        let slope: Vec<_> = (1..=5).map(|d| cell(d as f32)).collect();
+        assert!((1..4).all(|i| !near_depth_edge(&slope, (5, 1), i, 0)));
+        // A near object (1 m) in front of a wall (4 m): both sides of the step are edges,
+        // cells two away are not.
+        let step: Vec<_> = [1.0, 1.0, 1.0, 4.0, 4.0, 4.0].into_iter().map(cell).collect();
+        let edges: Vec<_> = (0..6).map(|i| near_depth_edge(&step, (6, 1), i, 0)).collect();
+        assert_eq!(edges, [false, false, true, true, false, false]);
+        // Beside the sky.
+        let sky: Vec<_> = [2.0, 2.0, 0.0].into_iter().map(cell).collect();
+        assert!(near_depth_edge(&sky, (3, 1), 1, 0));
+        assert!(!near_depth_edge(&sky, (3, 1), 2, 0), "the sky itself is no edge pixel");
+    }
+
+    #[test]
     fn per_eye_cost_halves_both_eye_dispatches_and_ignores_other_passes() {
         assert_eq!(row(Technique::Ssao, 10.0, 0.1).occlusion_ms_per_eye(), 6.0);
     }
@@ -1345,10 +1433,11 @@ mod tests {
         let csv = to_csv(&recs);
         assert_eq!(csv.lines().count(), 3);
         // technique, N, r, resolution, ms/eye, RMSE, bias, bias (ref < 0.8), vs limit,
-        // limit RMSE, limit bias, FLIP, stereo shares, falloff RMSE, SSIM, ambient, …
+        // limit RMSE, limit bias, outer border RMSE, halo, FLIP, stereo shares, falloff
+        // RMSE, SSIM, ambient, …
         assert!(
             csv.lines().nth(2).unwrap().starts_with(
-                "hbao,12,0.5,full,7.000,0.2000,-0.0500,-0.1000,0.0600,0.0400,0.0100,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
+                "hbao,12,0.5,full,7.000,0.2000,-0.0500,-0.1000,0.0600,0.0400,0.0100,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
             ),
             "{csv}"
         );
@@ -1361,7 +1450,7 @@ mod tests {
         assert_eq!(markdown.lines().count(), 4);
         let hbao = markdown.lines().nth(3).unwrap();
         assert!(
-            hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.125 | 25.0 % | 50.0 % | 12.5 % |"),
+            hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.070 | 6.2 % | 0.125 | 25.0 % | 50.0 % | 12.5 % |"),
             "{hbao}"
         );
         assert!(!markdown.contains("peel") && !markdown.contains("bounce"), "{markdown}");
