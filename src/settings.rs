@@ -347,8 +347,11 @@ impl Default for Temporal {
     }
 }
 
-/// GTAO's defaults (tuned against the reference: `vrao tune`, README).
-pub const DEFAULT_THICKNESS: f32 = 1.0;
+/// GTAO's defaults, tuned against the reference (scripts/tune-gtao.py and
+/// docs/gtao-tuning.md). Thickness 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps
+/// it costs no RMSE and leaves fewer halos (pixels beside depth edges too dark by > 0.1
+/// on the furnished room: 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
+pub const DEFAULT_THICKNESS: f32 = 0.75;
 pub const DEFAULT_STEP_POWER: f32 = 1.5;
 pub const DEFAULT_CONNECT: f32 = 0.25;
 
