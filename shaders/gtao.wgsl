@@ -83,13 +83,9 @@ fn fast_asin(x: f32) -> f32 {
     return 0.5 * PI - fast_acos(x);
 }
 
-// Which half of the slice the direction `d` from P lies in: +1 towards `t`, else −1.
-fn slice_side(slice: Slice, d: vec3<f32>) -> f32 {
-    return select(-1.0, 1.0, dot(d, slice.t) >= 0.0);
-}
-
 // u(θ) of the direction from P along `d` (any length > 0) on half `side` of the slice:
-// the cumulative cosine weight from θ_min, normalised. The angle comes from the
+// the cumulative cosine weight from θ_min, normalised; −1 when θ lies past V (θ = 0), on
+// the other half. The angle comes from the
 // direction's elevation e above the tangent plane (sin e = d̂·n / |n projected|, the
 // sign of cos e from the half's horizon), θ = θ_max − e or θ_min + e: exact for a point
 // in the slice plane, and a point of the tangent plane that the pixel grid puts a little
@@ -106,16 +102,16 @@ fn sector_coordinate(slice: Slice, d: vec3<f32>, side: f32) -> f32 {
     let cos_e = select(-1.0, 1.0, dot(d, horizon) >= 0.0) * sqrt(max(1.0 - x * x, 0.0));
     let e = select(PI - fast_asin(x), fast_asin(x), cos_e >= 0.0);
     let theta = select(slice.theta_min + e, slice.theta_max - e, side > 0.0);
+    if (theta * side < 0.0) {
+        return -1.0;
+    }
     // cos(2θ − γ) = −cos(γ ± 2e), with cos 2e and sin 2e from sin e and cos e.
     let cos_2e = 1.0 - 2.0 * x * x;
     let sin_2e = 2.0 * x * cos_e;
     let cos_2t_minus_g = -(slice.cos_gamma * cos_2e + side * slice.sin_gamma * sin_2e);
     // G(θ) = ¼ (−cos(2θ − γ) + cos γ + 2θ sin γ): the weight between 0 and θ.
     let g = 0.25 * (slice.cos_gamma - cos_2t_minus_g + 2.0 * theta * slice.sin_gamma);
-    let u = (slice.g_min + side * g) * slice.inv_total;
-    // A direction never crosses V (θ = 0) to the other half.
-    let u_view = slice.g_min * slice.inv_total;
-    return clamp(select(min(u, u_view), max(u, u_view), side > 0.0), 0.0, 1.0);
+    return clamp((slice.g_min + side * g) * slice.inv_total, 0.0, 1.0);
 }
 
 // The bits whose sector centres lie in [lo, hi] (u coordinates).
@@ -181,9 +177,10 @@ fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
 }
 
 // Marks the sectors that the depth sample `surface` (view space, w = 0 when none) blocks
-// for the receiver at `p`: the slab from the visible surface back to `thickness` behind
-// it, joined to the previous sample when both lie on one continuous surface.
-fn add_sample(march: ptr<function, March>, slice: Slice, p: vec3<f32>, surface: vec4<f32>, limits: SampleLimits) {
+// for the receiver at `p` on half `side` (+1 towards `t`, −1 away) of the slice: the
+// slab from the visible surface back to `thickness` behind it, joined to the previous
+// sample when both lie on one continuous surface.
+fn add_sample(march: ptr<function, March>, slice: Slice, side: f32, p: vec3<f32>, surface: vec4<f32>, limits: SampleLimits) {
     if (surface.w == 0.0) {
         (*march).previous_u = -1.0;
         return;
@@ -196,18 +193,27 @@ fn add_sample(march: ptr<function, March>, slice: Slice, p: vec3<f32>, surface: 
         (*march).previous_distance = sample_distance;
         return;
     }
+    // A front past V belongs to the other half: the pixel grid put the sample off the
+    // slice, across the view plane (a short step from an off-centre pixel), typically
+    // in the tangent plane. It occludes nothing here; mapped onto this half, with its
+    // back at this half's horizon, it blocked the whole half (isolated dark pixels on an
+    // open plane).
+    let u_front = sector_coordinate(slice, front, side);
+    if (u_front < 0.0) {
+        (*march).previous_u = -1.0;
+        (*march).previous_distance = sample_distance;
+        return;
+    }
     // The slab's back along the sample's view ray, clipped where it leaves the sphere
-    // of radius r about P.
+    // of radius r about P. The slab sweeps from its front away from V (its line passes
+    // through the eye, never through V): a back below the tangent plane reads as this
+    // half's horizon, one past V (by rounding) stops at V.
     let ray = normalize(surface.xyz);
     let along = dot(front, ray);
     let to_sphere = -along + sqrt(max(along * along - front2 + limits.radius2, 0.0));
     let back = front + ray * min(limits.thickness, to_sphere);
-    let side = slice_side(slice, front);
-    let u_front = sector_coordinate(slice, front, side);
-    // The slab sweeps from its front away from V (its line passes through the eye,
-    // never through V); a back below the tangent plane reads as the horizon of the
-    // front's half.
-    let u_back = sector_coordinate(slice, back, side);
+    let u_back_raw = sector_coordinate(slice, back, side);
+    let u_back = select(u_back_raw, slice.g_min * slice.inv_total, u_back_raw < 0.0);
     var lo = min(u_front, u_back);
     var hi = max(u_front, u_back);
     if ((*march).previous_u >= 0.0 && abs(sample_distance - (*march).previous_distance) < limits.connect) {
@@ -314,7 +320,7 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
                 let pixel = vec2<u32>(q);
                 let d = textureLoad(depth_layers, vec2<i32>(pixel), i32(r.layer), 0);
                 let surface = load_view_position(d, pixel, r.eye, frame.size, frame.near);
-                add_sample(&march, slice, p, select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0), limits);
+                add_sample(&march, slice, sign, p, select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0), limits);
             }
             let towards_inner = near_inner_border && sign * omega.x * inner > 0.0;
             for (; towards_inner && i < steps; i++) {
@@ -322,7 +328,7 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
                 if (q.y < 0.0 || q.y >= size.y) {
                     break;
                 }
-                add_sample(&march, slice, p, surface_at(q, r.layer, r.eye, march.previous_distance), limits);
+                add_sample(&march, slice, sign, p, surface_at(q, r.layer, r.eye, march.previous_distance), limits);
             }
         }
         let occluded = march.occluded;
