@@ -136,25 +136,6 @@ fn bayer4(p: vec2<u32>) -> f32 {
     return (f32(index) + 0.5) / 16.0;
 }
 
-// The occlusion pixel whose noise value a pixel takes. The tile is laid over occlusion
-// pixels (at half resolution the full-res pixel has even coordinates only, which would
-// leave 4 of the 16 patterns), and over the left eye's: the right eye takes the value of
-// the left-eye pixel that sees its surface point, so both eyes march the same slices
-// and steps there and agree, not just in expectation (the eyes' independent noise was
-// the main source of stereo-inconsistent pixels). Disparity is smooth, so the right eye
-// still sees every pattern in each 4×4 window away from depth edges.
-fn noise_pixel(own: vec2<u32>, layer: u32, eye: Eye, position: vec3<f32>) -> vec2<u32> {
-    if (layer == 0u || frame.layers < 2u) {
-        return own;
-    }
-    let in_left = (eye.other_from_view * vec4<f32>(position, 1.0)).xyz;
-    let uv = view_to_uv(in_left, frame.eyes[0].tangents);
-    if (!(-in_left.z > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
-        return own;
-    }
-    return vec2<u32>(uv * vec2<f32>(ao.ao_size));
-}
-
 // One half-slice's march so far: the slice's occluded sectors, and the previous
 // sample (its sector coordinate, −1 when none, and its distance) for `connect`.
 struct March {
@@ -262,7 +243,9 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let inner = other_eye_side(r.eye);
     let near_inner_border = INNER_BAND
         && ((inner > 0.0 && centre_px.x + reach_px >= size.x) || (inner < 0.0 && centre_px.x - reach_px < 0.0));
-    let rotation_noise = bayer4(noise_pixel(id.xy, r.layer, r.eye, p));
+    // The tile is laid over occlusion pixels (at half resolution the full-res pixel has
+    // even coordinates only, which would leave 4 of the 16 patterns).
+    let rotation_noise = bayer4(stereo_noise_pixel(id.xy, ao.ao_size, r.layer, r.eye, p));
     // A second, decorrelated value of the same tile for the step jitter.
     let jitter = fract(rotation_noise * 7.0 + 0.3125);
     var visible = 0.0;

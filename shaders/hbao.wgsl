@@ -22,7 +22,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let directions = max(ao.directions, 1u);
     // Never further than the image's diagonal.
     let march_px = min(radius_px * ao.range_scale, f32(frame.size.x + frame.size.y));
-    let rotation = kernel_rotation(r.pixel, ao.noise) + ao.frame_angle;
+    let rotation = kernel_rotation(stereo_noise_pixel(r.pixel, frame.size, r.layer, r.eye, r.position), ao.noise) + ao.frame_angle;
     let jitter = fract(rotation * 0.1591549 * 7.0);
     // Angle bias: horizons below this elevation do not count (tessellation, noise).
     let sin_bias = min(5.0 * ao.bias, 0.9);

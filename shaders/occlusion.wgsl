@@ -190,6 +190,24 @@ fn probed_surface(probe: DepthProbe, eye: Eye) -> vec3<f32> {
     return view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
 }
 
+// The pixel of a `grid`-sized image whose noise value (kernel rotation, slice turn) a
+// pixel takes: its own (`own`) in the left eye; in the right eye, that of the left-eye
+// pixel that sees its surface point, so both eyes sample the same point alike and
+// agree, not just in expectation (the eyes' independent noise made AO differ between
+// them). Disparity is smooth, so the right eye still sees every value of a noise tile in
+// each tile-sized window away from depth edges.
+fn stereo_noise_pixel(own: vec2<u32>, grid: vec2<u32>, layer: u32, eye: Eye, position: vec3<f32>) -> vec2<u32> {
+    if (layer == 0u || frame.layers < 2u) {
+        return own;
+    }
+    let in_left = (eye.other_from_view * vec4<f32>(position, 1.0)).xyz;
+    let uv = view_to_uv(in_left, frame.eyes[0].tangents);
+    if (!(-in_left.z > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
+        return own;
+    }
+    return vec2<u32>(uv * vec2<f32>(grid));
+}
+
 // The side of this eye's image past which the other eye sees on: +1 right, −1 left, 0
 // for a mono view. It is the side the other eye's centre lies on (its x in this view).
 fn other_eye_side(eye: Eye) -> f32 {

@@ -84,7 +84,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.valid) {
         return;
     }
-    let frame_rot = tangent_frame(r.normal, kernel_rotation(r.pixel, ao.noise) + ao.frame_angle);
+    let frame_rot = tangent_frame(r.normal, kernel_rotation(stereo_noise_pixel(r.pixel, frame.size, r.layer, r.eye, r.position), ao.noise) + ao.frame_angle);
     let bias = ao.bias * ao.radius;
     let origin = r.position + r.normal * bias;
     let samples = max(ao.samples, 1u);
