@@ -877,6 +877,32 @@ fn yes(b: bool) -> String {
 }
 
 /// Every column, the ones a reader compares first first.
+/// A column of an error figure (`Option<f64>` field): 4 decimals in CSV, 3 in Markdown.
+macro_rules! figure_column {
+    ($field:ident, $header:literal, $optional:literal) => {
+        Column {
+            name: stringify!($field),
+            header: $header,
+            csv: |r| fixed(r.$field, 4),
+            markdown: |r| fixed(r.$field, 3),
+            optional: $optional,
+        }
+    };
+}
+
+/// A column of a share (`Option<f64>` in 0..1): 4 decimals in CSV, a percentage in Markdown.
+macro_rules! share_column {
+    ($field:ident, $header:literal) => {
+        Column {
+            name: stringify!($field),
+            header: $header,
+            csv: |r| fixed(r.$field, 4),
+            markdown: |r| percent(r.$field),
+            optional: false,
+        }
+    };
+}
+
 const COLUMNS: &[Column] = &[
     Column {
         name: "technique",
@@ -913,111 +939,21 @@ const COLUMNS: &[Column] = &[
         markdown: |r| format!("{:.1}", r.occlusion_ms_per_eye),
         optional: false,
     },
-    Column {
-        name: "ao_rmse",
-        header: "RMSE",
-        csv: |r| fixed(r.ao_rmse, 4),
-        markdown: |r| fixed(r.ao_rmse, 3),
-        optional: false,
-    },
-    Column {
-        name: "ao_bias",
-        header: "bias",
-        csv: |r| fixed(r.ao_bias, 4),
-        markdown: |r| fixed(r.ao_bias, 3),
-        optional: false,
-    },
-    Column {
-        name: "ao_bias_dark",
-        header: "bias (ref < 0.8)",
-        csv: |r| fixed(r.ao_bias_dark, 4),
-        markdown: |r| fixed(r.ao_bias_dark, 3),
-        optional: false,
-    },
-    Column {
-        name: "ao_rmse_vs_limit",
-        header: "RMSE vs limit",
-        csv: |r| fixed(r.ao_rmse_vs_limit, 4),
-        markdown: |r| fixed(r.ao_rmse_vs_limit, 3),
-        optional: false,
-    },
-    Column {
-        name: "limit_rmse",
-        header: "limit RMSE",
-        csv: |r| fixed(r.limit_rmse, 4),
-        markdown: |r| fixed(r.limit_rmse, 3),
-        optional: false,
-    },
-    Column {
-        name: "limit_bias",
-        header: "limit bias",
-        csv: |r| fixed(r.limit_bias, 4),
-        markdown: |r| fixed(r.limit_bias, 3),
-        optional: false,
-    },
-    Column {
-        name: "ao_rmse_outer_border",
-        header: "RMSE outer border",
-        csv: |r| fixed(r.ao_rmse_outer_border, 4),
-        markdown: |r| fixed(r.ao_rmse_outer_border, 3),
-        optional: false,
-    },
-    Column {
-        name: "halo_share",
-        header: "halo",
-        csv: |r| fixed(r.halo_share, 4),
-        markdown: |r| percent(r.halo_share),
-        optional: false,
-    },
-    Column {
-        name: "flip_mean",
-        header: "FLIP",
-        csv: |r| fixed(r.flip_mean, 4),
-        markdown: |r| fixed(r.flip_mean, 3),
-        optional: false,
-    },
-    Column {
-        name: "stereo_inconsistent",
-        header: "stereo ≠",
-        csv: |r| fixed(r.stereo_inconsistent, 4),
-        markdown: |r| percent(r.stereo_inconsistent),
-        optional: false,
-    },
-    Column {
-        name: "stereo_inconsistent_inner_border",
-        header: "≠ inner border",
-        csv: |r| fixed(r.stereo_inconsistent_inner_border, 4),
-        markdown: |r| percent(r.stereo_inconsistent_inner_border),
-        optional: false,
-    },
-    Column {
-        name: "stereo_inconsistent_interior",
-        header: "≠ interior",
-        csv: |r| fixed(r.stereo_inconsistent_interior, 4),
-        markdown: |r| percent(r.stereo_inconsistent_interior),
-        optional: false,
-    },
-    Column {
-        name: "ao_rmse_falloff",
-        header: "RMSE falloff",
-        csv: |r| fixed(r.ao_rmse_falloff, 4),
-        markdown: |r| fixed(r.ao_rmse_falloff, 3),
-        optional: false,
-    },
-    Column {
-        name: "ao_ssim",
-        header: "SSIM",
-        csv: |r| fixed(r.ao_ssim, 4),
-        markdown: |r| fixed(r.ao_ssim, 3),
-        optional: false,
-    },
-    Column {
-        name: "ambient_rel_rmse",
-        header: "ambient rel. RMSE",
-        csv: |r| fixed(r.ambient_rel_rmse, 4),
-        markdown: |r| fixed(r.ambient_rel_rmse, 3),
-        optional: true,
-    },
+    figure_column!(ao_rmse, "RMSE", false),
+    figure_column!(ao_bias, "bias", false),
+    figure_column!(ao_bias_dark, "bias (ref < 0.8)", false),
+    figure_column!(ao_rmse_vs_limit, "RMSE vs limit", false),
+    figure_column!(limit_rmse, "limit RMSE", false),
+    figure_column!(limit_bias, "limit bias", false),
+    figure_column!(ao_rmse_outer_border, "RMSE outer border", false),
+    share_column!(halo_share, "halo"),
+    figure_column!(flip_mean, "FLIP", false),
+    share_column!(stereo_inconsistent, "stereo ≠"),
+    share_column!(stereo_inconsistent_inner_border, "≠ inner border"),
+    share_column!(stereo_inconsistent_interior, "≠ interior"),
+    figure_column!(ao_rmse_falloff, "RMSE falloff", false),
+    figure_column!(ao_ssim, "SSIM", false),
+    figure_column!(ambient_rel_rmse, "ambient rel. RMSE", true),
     Column {
         name: "technique_ms_per_eye",
         header: "technique ms",
@@ -1061,20 +997,8 @@ const COLUMNS: &[Column] = &[
         markdown: |r| if r.depth_peeling { format!("{:.1}", r.peel_ms_per_eye) } else { String::new() },
         optional: true,
     },
-    Column {
-        name: "bounce_rel_rmse",
-        header: "bounce rel. RMSE",
-        csv: |r| fixed(r.bounce_rel_rmse, 4),
-        markdown: |r| fixed(r.bounce_rel_rmse, 3),
-        optional: true,
-    },
-    Column {
-        name: "bounce_rel_bias",
-        header: "bounce rel. bias",
-        csv: |r| fixed(r.bounce_rel_bias, 4),
-        markdown: |r| fixed(r.bounce_rel_bias, 3),
-        optional: true,
-    },
+    figure_column!(bounce_rel_rmse, "bounce rel. RMSE", true),
+    figure_column!(bounce_rel_bias, "bounce rel. bias", true),
     Column {
         name: "temporal",
         header: "temporal",
