@@ -105,7 +105,8 @@ struct AoParams {
     range_scale: f32,
     // GTAO: the slab behind each depth sample, as a fraction of the radius.
     thickness: f32,
-    // GTAO: sample i of n along a half-slice lies at ((i + jitter) / n)^step_power × r.
+    // GTAO: sample i of n along a half-slice lies at r · t ((2 − P) + (P − 1) t), with
+    // t = (i + jitter) / n and P = step_power in 1..=2.
     step_power: f32,
     // GTAO: successive samples closer in distance than this fraction of the radius lie
     // on one continuous surface (0: never).

@@ -362,8 +362,8 @@ struct GtaoArgs {
     /// radius (thin objects stop occluding behind themselves).
     #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
     thickness: f32,
-    /// GTAO: exponent of the samples' spread along a half-slice (1 even, 2 crowded near
-    /// the pixel).
+    /// GTAO: the samples' spread along a half-slice, 1..=2 (1 even, 2 quadratic: crowded
+    /// near the pixel).
     #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
     step_power: f32,
     /// GTAO: successive samples closer in distance than this fraction of the radius

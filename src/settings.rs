@@ -282,8 +282,8 @@ pub struct AoSettings {
     /// GTAO: how far behind each depth sample the surface counts as solid, as a fraction
     /// of the radius (thin objects stop occluding behind themselves).
     pub thickness: f32,
-    /// GTAO: exponent of the samples' spread along a half-slice (1 even, 2 crowded near
-    /// the pixel).
+    /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
+    /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
     pub step_power: f32,
     /// GTAO: successive samples whose distances differ by less than this fraction of the
     /// radius lie on one continuous surface, which also blocks the angles between them.
@@ -419,8 +419,8 @@ impl AoSettings {
                 self.thickness
             )));
         }
-        if !(self.step_power.is_finite() && (0.25..=4.0).contains(&self.step_power)) {
-            return Err(Error::input(format!("step power {} is not within 0.25..=4", self.step_power)));
+        if !(self.step_power.is_finite() && (1.0..=2.0).contains(&self.step_power)) {
+            return Err(Error::input(format!("step power {} is not within 1..=2", self.step_power)));
         }
         if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
             return Err(Error::input(format!(

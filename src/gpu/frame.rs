@@ -71,7 +71,7 @@ pub struct AoParamsUniform {
     pub range_scale: f32,
     /// GTAO: thickness of the slab behind each depth sample, as a fraction of the radius.
     pub thickness: f32,
-    /// GTAO: exponent of the samples' spread along a half-slice.
+    /// GTAO: the samples' spread along a half-slice (1 even, 2 quadratic).
     pub step_power: f32,
     /// GTAO: distance gap (fraction of the radius) under which successive samples join.
     pub connect: f32,
