@@ -85,11 +85,11 @@ fn fast_asin(x: f32) -> f32 {
 
 // u(θ) of the direction from P along `d` (any length > 0) on half `side` of the slice:
 // the cumulative cosine weight from θ_min, normalised; −1 when θ lies past V (θ = 0), on
-// the other half. The angle comes from the
-// direction's elevation e above the tangent plane (sin e = d̂·n / |n projected|, the
-// sign of cos e from the half's horizon), θ = θ_max − e or θ_min + e: exact for a point
-// in the slice plane, and a point of the tangent plane that the pixel grid puts a little
-// off the slice still lies exactly on the horizon (its in-slice angle would not).
+// the other half. The angle comes from the direction's elevation e above the tangent
+// plane (sin e = d̂·n / |n projected|, the sign of cos e from the half's horizon),
+// θ = θ_max − e or θ_min + e: exact for a point in the slice plane, and a point of the
+// tangent plane that the pixel grid puts a little off the slice still lies exactly on
+// the horizon (its in-slice angle would not).
 fn sector_coordinate(slice: Slice, d: vec3<f32>, side: f32) -> f32 {
     let inv_len = inverseSqrt(max(dot(d, d), 1e-30));
     let sin_e = dot(d, slice.normal) * inv_len * slice.inv_projected_len;
