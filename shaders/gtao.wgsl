@@ -48,11 +48,11 @@ override RIGHT_EYE: bool = false;
 
 // The left eye's raw occlusion at the surface point of right-eye receiver `r`, or −1
 // where the left eye does not see that point: off its image, or another surface there
-// (its depth at the point's pixel more than 1 % away, or the surface of the occlusion
-// pixel standing for it more than 5 % away: a depth edge within the pixel's block).
-// Interpolated at the point: the nearest occlusion pixel shifted the right eye's AO by
-// up to a pixel against the left's (stereo-inconsistent pixels at half resolution,
-// furnished 3.3 %, bilinear 2.1 %).
+// (its depth at the point's pixel more than 1 % away). Interpolated at the point among
+// the four occlusion pixels around it that lie on the same surface (within 5 % in
+// distance): the nearest occlusion pixel shifted the right eye's AO by up to a pixel
+// against the left's (stereo-inconsistent pixels at half resolution, furnished 3.3 %;
+// bilinear 2.1 %), and a neighbour across a depth edge would bring another surface's AO.
 fn left_eye_occlusion(r: Receiver) -> f32 {
     let in_left = (r.eye.other_from_view * vec4<f32>(r.position, 1.0)).xyz;
     let distance = -in_left.z;
@@ -62,29 +62,33 @@ fn left_eye_occlusion(r: Receiver) -> f32 {
         return -1.0;
     }
     let full = min(vec2<u32>(uv * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
-    let low = min(vec2<u32>(uv * vec2<f32>(ao.ao_size)), ao.ao_size - vec2<u32>(1u));
-    let standing = full_res_pixel(low, ao.scale, frame.size);
     let d_here = textureLoad(depth_layers, vec2<i32>(full), 0, 0);
-    let d_standing = textureLoad(depth_layers, vec2<i32>(standing), 0, 0);
-    if (!(d_here > 0.0 && d_standing > 0.0)) {
+    let here = -load_view_position(max(d_here, 1e-30), full, left, frame.size, frame.near).z;
+    if (!(d_here > 0.0 && abs(here - distance) < 0.01 * distance)) {
         return -1.0;
     }
-    let here = -load_view_position(d_here, full, left, frame.size, frame.near).z;
-    let stand = -load_view_position(d_standing, standing, left, frame.size, frame.near).z;
-    if (!(abs(here - distance) < 0.01 * distance && abs(stand - distance) < 0.05 * distance)) {
-        return -1.0;
-    }
-    // Bilinear among the four occlusion pixels around the point (each stands for the
-    // centre of its top-left full-res pixel's block).
+    // Occlusion pixel k stands for the centre of its top-left full-res pixel.
     let f = uv * vec2<f32>(ao.ao_size) - 0.5 / f32(ao.scale);
     let base = vec2<i32>(floor(f));
     let t = f - floor(f);
     let last = vec2<i32>(ao.ao_size) - 1;
-    let a = textureLoad(left_occlusion, clamp(base, vec2<i32>(0), last), 0, 0).a;
-    let b = textureLoad(left_occlusion, clamp(base + vec2<i32>(1, 0), vec2<i32>(0), last), 0, 0).a;
-    let c = textureLoad(left_occlusion, clamp(base + vec2<i32>(0, 1), vec2<i32>(0), last), 0, 0).a;
-    let d = textureLoad(left_occlusion, clamp(base + vec2<i32>(1, 1), vec2<i32>(0), last), 0, 0).a;
-    return mix(mix(a, b, t.x), mix(c, d, t.x), t.y);
+    var sum = 0.0;
+    var total = 0.0;
+    for (var k = 0; k < 4; k++) {
+        let corner = vec2<i32>(k & 1, k >> 1u);
+        let q = clamp(base + corner, vec2<i32>(0), last);
+        let standing = full_res_pixel(vec2<u32>(q), ao.scale, frame.size);
+        let d = textureLoad(depth_layers, vec2<i32>(standing), 0, 0);
+        let there = -load_view_position(max(d, 1e-30), standing, left, frame.size, frame.near).z;
+        let bilinear = mix(1.0 - t.x, t.x, f32(corner.x)) * mix(1.0 - t.y, t.y, f32(corner.y));
+        let w = select(0.0, bilinear, d > 0.0 && abs(there - distance) < 0.05 * distance);
+        sum += w * textureLoad(left_occlusion, q, 0, 0).a;
+        total += w;
+    }
+    if (!(total > 1e-6)) {
+        return -1.0;
+    }
+    return sum / total;
 }
 
 // The occlusion pixel of invocation `id` in this dispatch's part of the image, or none
