@@ -9,6 +9,15 @@
 @group(0) @binding(5) var ao_out: texture_storage_2d_array<rgba16float, write>;
 @group(0) @binding(6) var geometry_out: texture_storage_2d_array<rgba32float, write>;
 
+// Whether the outputs are bound as one-layer views of the receiver's layer (GTAO's
+// right-eye dispatch, which reads the left eye's layer of the same targets meanwhile).
+override SINGLE_LAYER_OUTPUT: bool = false;
+
+// The layer of the bound outputs that occlusion pixel `id` writes.
+fn output_layer(id: vec3<u32>) -> i32 {
+    return select(i32(id.z), 0, SINGLE_LAYER_OUTPUT);
+}
+
 // The surface an occlusion pixel stands for.
 struct Receiver {
     // False outside the target or on the sky (the pixel is then already written).
@@ -35,13 +44,13 @@ fn begin_receiver(id: vec3<u32>) -> Receiver {
     let depth = textureLoad(depth_layers, vec2<i32>(r.pixel), i32(r.layer), 0);
     if (depth <= 0.0) {
         store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
-        textureStore(geometry_out, vec2<i32>(id.xy), i32(id.z), vec4<f32>(0.0));
+        textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(0.0));
         return r;
     }
     r.position = load_view_position(depth, r.pixel, r.eye, frame.size, frame.near);
     let stored = textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz;
     r.normal = repaired_normal(safe_normal(stored, r.position), r.pixel, r.layer, r.eye, r.position);
-    textureStore(geometry_out, vec2<i32>(id.xy), i32(id.z), vec4<f32>(r.normal, -r.position.z));
+    textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, -r.position.z));
     r.valid = true;
     return r;
 }
@@ -105,7 +114,7 @@ fn neighbour_step(pixel: vec2<u32>, axis: vec2<i32>, layer: u32, eye: Eye, posit
 }
 
 fn store_occlusion(id: vec3<u32>, value: vec4<f32>) {
-    textureStore(ao_out, vec2<i32>(id.xy), i32(id.z), value);
+    textureStore(ao_out, vec2<i32>(id.xy), output_layer(id), value);
 }
 
 // Whether the surface found by `probe` occludes a sample for a receiver at `position`

@@ -370,11 +370,16 @@ struct GtaoArgs {
     /// join into one surface (0: never).
     #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
     connect: f32,
+    /// GTAO: march both eyes on their own; by default the right eye takes the left eye's
+    /// value wherever the left eye sees the same surface point.
+    #[arg(long)]
+    independent_eyes: bool,
 }
 
 impl GtaoArgs {
     fn apply(&self, ao: &mut AoSettings) {
         (ao.thickness, ao.step_power, ao.connect) = (self.thickness, self.step_power, self.connect);
+        ao.stereo_reuse = !self.independent_eyes;
     }
 }
 
@@ -495,6 +500,7 @@ impl AoArgs {
             thickness: self.gtao.thickness,
             step_power: self.gtao.step_power,
             connect: self.gtao.connect,
+            stereo_reuse: !self.gtao.independent_eyes,
         }
     }
 }

@@ -288,6 +288,10 @@ pub struct AoSettings {
     /// GTAO: successive samples whose distances differ by less than this fraction of the
     /// radius lie on one continuous surface, which also blocks the angles between them.
     pub connect: f32,
+    /// GTAO with two views: the right eye takes the left eye's value wherever the left
+    /// eye sees the same surface point, and marches only the rest (both eyes agree by
+    /// construction and the right eye costs a fraction). Off: each eye marches alone.
+    pub stereo_reuse: bool,
 }
 
 /// How the temporal pass blends the new frame into the history.
@@ -376,6 +380,7 @@ impl Default for AoSettings {
             thickness: DEFAULT_THICKNESS,
             step_power: DEFAULT_STEP_POWER,
             connect: DEFAULT_CONNECT,
+            stereo_reuse: true,
         }
     }
 }

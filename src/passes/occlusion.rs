@@ -52,19 +52,31 @@ pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup
         .disabled_if(!runs_for.contains(&chosen), reason)
 }
 
+/// GTAO's bindings: the shared ones and, at 7, AoRaw's left-eye layer for the right
+/// eye's dispatch (gtao.wgsl `left_occlusion`).
+const GTAO_SLOTS: [Slot; 8] = [SLOTS[0], SLOTS[1], SLOTS[2], SLOTS[3], SLOTS[4], SLOTS[5], SLOTS[6], Slot::Layers];
+
+/// GTAO's three pipelines of one shader (gtao.wgsl): the rest of the image, the band
+/// along the inner border with the other-eye lookups, and the right eye reusing the
+/// left eye's values.
+struct GtaoKernels {
+    interior: Kernel,
+    inner_band: Kernel,
+    right_eye: Kernel,
+}
+
 /// One technique of the shared layout.
 pub struct OcclusionPass {
     technique: Technique,
-    kernel: Kernel,
-    /// GTAO's second dispatch: the columns along each eye's inner border, compiled with
-    /// the other-eye lookups (gtao.wgsl `INNER_BAND`); `kernel` runs the rest.
-    inner_band: Option<Kernel>,
+    /// Every technique but GTAO.
+    kernel: Option<Kernel>,
+    gtao: Option<GtaoKernels>,
 }
 
 impl OcclusionPass {
     fn new(gpu: &Gpu, technique: Technique, shader: &str) -> Self {
         let kernel = Kernel::new(gpu, technique.name(), &["common.wgsl", "occlusion.wgsl", shader], "main", &SLOTS);
-        OcclusionPass { technique, kernel, inner_band: None }
+        OcclusionPass { technique, kernel: Some(kernel), gtao: None }
     }
 
     pub fn ssao(gpu: &Gpu) -> Self {
@@ -78,11 +90,20 @@ impl OcclusionPass {
     pub fn gtao(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "gtao.wgsl"];
         let label = Technique::Gtao.name();
-        let constants = |band: bool| [("INNER_BAND", if band { 1.0 } else { 0.0 })];
+        let flag = |on: bool| if on { 1.0 } else { 0.0 };
+        let kernel = |band: bool, right: bool| {
+            let constants =
+                [("INNER_BAND", flag(band)), ("RIGHT_EYE", flag(right)), ("SINGLE_LAYER_OUTPUT", flag(right))];
+            Kernel::with_constants(gpu, label, &files, "main", &GTAO_SLOTS, &constants)
+        };
         OcclusionPass {
             technique: Technique::Gtao,
-            kernel: Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &constants(false)),
-            inner_band: Some(Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &constants(true))),
+            kernel: None,
+            gtao: Some(GtaoKernels {
+                interior: kernel(false, false),
+                inner_band: kernel(true, false),
+                right_eye: kernel(false, true),
+            }),
         }
     }
 
@@ -92,21 +113,49 @@ impl OcclusionPass {
     }
 }
 
+/// A one-layer array view of `layer` of a resource's target.
+fn layer_view(ctx: &FrameContext, r: Resource, layer: u32) -> wgpu::TextureView {
+    ctx.target(r).texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(r.name()),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
 impl Pass for OcclusionPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         technique_decl(PassDecl::new(self.technique.name()), &[self.technique], setup)
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let resources = bindings(ctx);
         let (width, height, layers) = ctx.ao_extent();
-        match &self.inner_band {
-            None => self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (width, height, layers)),
-            Some(band_kernel) => {
-                let band = gtao_inner_band(width);
-                self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (width - band, height, layers));
-                band_kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (band, height, layers));
-            }
+        let device = &ctx.gpu.device;
+        let Some(gtao) = &self.gtao else {
+            let resources = bindings(ctx);
+            self.kernel.as_ref().expect("a kernel").dispatch(device, ctx.encoder, &resources, (width, height, layers));
+            return;
+        };
+        // The left eye (or the only view) marches every pixel, in two parts; with two
+        // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
+        // Slot 7 is unused before the right eye's dispatch: the normals stand in.
+        let mut resources = bindings(ctx);
+        resources.push(ctx.view(Resource::Normals));
+        let reuse = ctx.setup.settings.ao.stereo_reuse && layers == 2;
+        let marched_layers = if reuse { 1 } else { layers };
+        let band = gtao_inner_band(width);
+        gtao.interior.dispatch(device, ctx.encoder, &resources, (width - band, height, marched_layers));
+        gtao.inner_band.dispatch(device, ctx.encoder, &resources, (band, height, marched_layers));
+        if !reuse {
+            return;
         }
+        let (ao_right, geometry_right) =
+            (layer_view(ctx, Resource::AoRaw, 1), layer_view(ctx, Resource::AoGeometry, 1));
+        let ao_left = layer_view(ctx, Resource::AoRaw, 0);
+        resources[5] = wgpu::BindingResource::TextureView(&ao_right);
+        resources[6] = wgpu::BindingResource::TextureView(&geometry_right);
+        resources[7] = wgpu::BindingResource::TextureView(&ao_left);
+        gtao.right_eye.dispatch(device, ctx.encoder, &resources, (width, height, 1));
     }
 }
