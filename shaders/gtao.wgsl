@@ -172,10 +172,13 @@ fn sector_coordinate(slice: Slice, d: vec3<f32>, side: f32) -> f32 {
     return clamp((slice.g_min + side * g) * slice.inv_total, 0.0, 1.0);
 }
 
-// The bits whose sector centres lie in [lo, hi] (u coordinates).
-fn sector_bits(lo: f32, hi: f32) -> u32 {
-    let start = u32(clamp(round(lo * SECTORS), 0.0, SECTORS));
-    let end = u32(clamp(round(hi * SECTORS), 0.0, SECTORS));
+// The bits of the sectors [lo, hi] covers (u coordinates), its ends rounded with a
+// per-pixel `offset` in [0, 1) rather than to the nearest: a slab narrower than a sector
+// then sets its bit as often as its width says, over the noise tile, instead of never
+// (nearest rounding dropped thin far occluders: a light bias).
+fn sector_bits(lo: f32, hi: f32, offset: f32) -> u32 {
+    let start = u32(clamp(floor(lo * SECTORS + offset), 0.0, SECTORS));
+    let end = u32(clamp(floor(hi * SECTORS + offset), 0.0, SECTORS));
     if (end <= start) {
         return 0u;
     }
@@ -203,6 +206,8 @@ struct March {
 };
 
 struct SampleLimits {
+    // Where sector boundaries round (`sector_bits`), per pixel.
+    sector_offset: f32,
     radius2: f32,
     thickness: f32,
     connect: f32,
@@ -262,7 +267,7 @@ fn add_sample(march: ptr<function, March>, slice: Slice, side: f32, p: vec3<f32>
         lo = min(lo, (*march).previous_u);
         hi = max(hi, (*march).previous_u);
     }
-    (*march).occluded |= sector_bits(lo, hi);
+    (*march).occluded |= sector_bits(lo, hi, limits.sector_offset);
     (*march).previous_u = u_front;
     (*march).previous_distance = sample_distance;
 }
@@ -316,6 +321,8 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let rotation_noise = bayer4(stereo_noise_pixel(id.xy, ao.ao_size, r.layer, r.eye, p));
     // A second, decorrelated value of the same tile for the step jitter.
     let jitter = fract(rotation_noise * 7.0 + 0.3125);
+    // A third value of the same tile (11 is prime to 16: all 16 values occur).
+    limits.sector_offset = fract(rotation_noise * 11.0 + 0.71875);
     var visible = 0.0;
     var total = 0.0;
     // Slice directions: the pixel's first, then turned by π / slices each (one sin/cos
