@@ -23,10 +23,11 @@
 //
 // Samples that leave the eye's image through its inner border are looked up in the other
 // eye's layer (occlusion.wgsl `surface_at`, guessing the last sample's distance). The
-// pass runs as two dispatches of this file: the band of `ao.inner_band` columns along
-// each eye's inner border with those lookups compiled in (INNER_BAND = true), and the
+// marching eye runs as two dispatches of this file: the band of `ao.inner_band` columns
+// along its inner border with those lookups compiled in (INNER_BAND = true), and the
 // rest of the image without them, where a march that leaves the image stops (open). The
 // lookups' code, even never taken, made every pixel's march about half as slow again.
+// With two views and `stereo_reuse`, the right eye then runs as a third (RIGHT_EYE).
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 
@@ -54,13 +55,13 @@ override RIGHT_EYE: bool = false;
 // against the left's (stereo-inconsistent pixels at half resolution, furnished 3.3 %;
 // bilinear 2.1 %), and a neighbour across a depth edge would bring another surface's AO.
 fn left_eye_occlusion(r: Receiver) -> f32 {
-    let in_left = (r.eye.other_from_view * vec4<f32>(r.position, 1.0)).xyz;
-    let distance = -in_left.z;
     let left = frame.eyes[0];
-    let uv = view_to_uv(in_left, left.tangents);
-    if (!(distance > frame.near && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
+    let in_left = in_other_eye(r.position, r.eye, left);
+    if (in_left.w == 0.0) {
         return -1.0;
     }
+    let uv = in_left.xy;
+    let distance = in_left.z;
     let full = min(vec2<u32>(uv * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
     let d_here = textureLoad(depth_layers, vec2<i32>(full), 0, 0);
     let here = -load_view_position(max(d_here, 1e-30), full, left, frame.size, frame.near).z;

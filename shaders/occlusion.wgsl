@@ -199,6 +199,16 @@ fn probed_surface(probe: DepthProbe, eye: Eye) -> vec3<f32> {
     return view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
 }
 
+// Where view-space point `v` of `eye` lands in the other eye `other`: (uv, distance along
+// the other eye's −z, 1), or w = 0 where it lies off that eye's image or not beyond its
+// near plane.
+fn in_other_eye(v: vec3<f32>, eye: Eye, other: Eye) -> vec4<f32> {
+    let w = (eye.other_from_view * vec4<f32>(v, 1.0)).xyz;
+    let uv = view_to_uv(w, other.tangents);
+    let seen = -w.z > frame.near && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0));
+    return vec4<f32>(uv, -w.z, select(0.0, 1.0, seen));
+}
+
 // The pixel of a `grid`-sized image whose noise value (kernel rotation, slice turn) a
 // pixel takes: its own (`own`) in the left eye; in the right eye, that of the left-eye
 // pixel that sees its surface point, so both eyes sample the same point alike and
@@ -209,12 +219,11 @@ fn stereo_noise_pixel(own: vec2<u32>, grid: vec2<u32>, layer: u32, eye: Eye, pos
     if (layer == 0u || frame.layers < 2u) {
         return own;
     }
-    let in_left = (eye.other_from_view * vec4<f32>(position, 1.0)).xyz;
-    let uv = view_to_uv(in_left, frame.eyes[0].tangents);
-    if (!(-in_left.z > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
+    let in_left = in_other_eye(position, eye, frame.eyes[0]);
+    if (in_left.w == 0.0) {
         return own;
     }
-    return vec2<u32>(uv * vec2<f32>(grid));
+    return vec2<u32>(in_left.xy * vec2<f32>(grid));
 }
 
 // The side of this eye's image past which the other eye sees on: +1 right, −1 left, 0
@@ -248,15 +257,11 @@ fn surface_at(q: vec2<f32>, layer: u32, eye: Eye, guess: f32) -> vec4<f32> {
     let other_layer = 1u - layer;
     let other = frame.eyes[other_layer];
     let on_ray = view_position_from_distance(q / size, guess, eye.tangents);
-    let in_other = (eye.other_from_view * vec4<f32>(on_ray, 1.0)).xyz;
-    if (!(-in_other.z > frame.near)) {
+    let in_other = in_other_eye(on_ray, eye, other);
+    if (in_other.w == 0.0) {
         return vec4<f32>(0.0);
     }
-    let uv = view_to_uv(in_other, other.tangents);
-    if (!(all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0)))) {
-        return vec4<f32>(0.0);
-    }
-    let p = min(vec2<u32>(uv * size), frame.size - vec2<u32>(1u));
+    let p = min(vec2<u32>(in_other.xy * size), frame.size - vec2<u32>(1u));
     let d = textureLoad(depth_layers, vec2<i32>(p), i32(other_layer), 0);
     if (!(d > 0.0)) {
         return vec4<f32>(0.0);

@@ -65,18 +65,22 @@ struct GtaoKernels {
     right_eye: Kernel,
 }
 
+/// A technique's pipelines: one, or GTAO's three.
+enum Kernels {
+    One(Kernel),
+    Gtao(GtaoKernels),
+}
+
 /// One technique of the shared layout.
 pub struct OcclusionPass {
     technique: Technique,
-    /// Every technique but GTAO.
-    kernel: Option<Kernel>,
-    gtao: Option<GtaoKernels>,
+    kernels: Kernels,
 }
 
 impl OcclusionPass {
     fn new(gpu: &Gpu, technique: Technique, shader: &str) -> Self {
         let kernel = Kernel::new(gpu, technique.name(), &["common.wgsl", "occlusion.wgsl", shader], "main", &SLOTS);
-        OcclusionPass { technique, kernel: Some(kernel), gtao: None }
+        OcclusionPass { technique, kernels: Kernels::One(kernel) }
     }
 
     pub fn ssao(gpu: &Gpu) -> Self {
@@ -98,8 +102,7 @@ impl OcclusionPass {
         };
         OcclusionPass {
             technique: Technique::Gtao,
-            kernel: None,
-            gtao: Some(GtaoKernels {
+            kernels: Kernels::Gtao(GtaoKernels {
                 interior: kernel(false, false),
                 inner_band: kernel(true, false),
                 right_eye: kernel(false, true),
@@ -132,10 +135,12 @@ impl Pass for OcclusionPass {
     fn record(&self, ctx: &mut FrameContext) {
         let (width, height, layers) = ctx.ao_extent();
         let device = &ctx.gpu.device;
-        let Some(gtao) = &self.gtao else {
-            let resources = bindings(ctx);
-            self.kernel.as_ref().expect("a kernel").dispatch(device, ctx.encoder, &resources, (width, height, layers));
-            return;
+        let gtao = match &self.kernels {
+            Kernels::One(kernel) => {
+                kernel.dispatch(device, ctx.encoder, &bindings(ctx), (width, height, layers));
+                return;
+            }
+            Kernels::Gtao(gtao) => gtao,
         };
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
