@@ -2,8 +2,9 @@
 // on normal and depth; seed 003 §4.3.2). Geometry comes from AoGeometry (normal and
 // distance at each occlusion pixel, written by the technique): one fetch per tap. A neighbour counts by its pixel distance
 // (Gaussian), by how far it lies off the centre's tangent plane relative to the centre's
-// distance (depth edge) and by normal agreement. Each layer is blurred on its own, so
-// the eyes never mix. When every weight vanishes the centre value is kept.
+// distance (depth edge) and by normal agreement. Each layer is blurred on its own; the
+// right eye's vertical pass may instead take the left eye's result (denoise_stereo.wgsl).
+// When every weight vanishes the centre value is kept.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -15,14 +16,22 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
     if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
         return;
     }
-    let layer = id.z;
+    let layers = denoise_layers(id);
+    let layer = layers.x;
     let eye = frame.eyes[layer];
     let p = vec2<i32>(id.xy);
-    let centre_value = textureLoad(occlusion_in, p, i32(layer), 0);
-    let centre = textureLoad(geometry_layers, p, i32(layer), 0);
+    let centre_value = textureLoad(occlusion_in, p, layer, 0);
+    let centre = textureLoad(geometry_layers, p, layer, 0);
     if (!(centre.w > 0.0) || ao.blur_radius == 0u) {
-        textureStore(occlusion_out, p, i32(layer), centre_value);
+        textureStore(occlusion_out, p, layers.y, centre_value);
         return;
+    }
+    if (RIGHT_EYE) {
+        let left = reused_from_left_eye(p, centre);
+        if (left.found) {
+            textureStore(occlusion_out, p, layers.y, left.value);
+            return;
+        }
     }
     let n = centre.xyz;
     let plane = tap_plane(eye, id.xy, centre, axis, ao.scale, frame.size, ao.blur_plane_sigma);
@@ -36,7 +45,7 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         if (any(q < vec2<i32>(0)) || any(q >= vec2<i32>(ao.ao_size))) {
             continue;
         }
-        let geometry = textureLoad(geometry_layers, q, i32(layer), 0);
+        let geometry = textureLoad(geometry_layers, q, layer, 0);
         if (!(geometry.w > 0.0)) {
             continue;
         }
@@ -46,7 +55,7 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         // offsets are NaN only for a degenerate centre: such a tap is skipped below.
         let w = exp(-kf * kf * inv_two_sigma2 - offset * offset) * normal_agreement(n, geometry.xyz);
         if (w == w) {
-            sum += textureLoad(occlusion_in, q, i32(layer), 0) * w;
+            sum += textureLoad(occlusion_in, q, layer, 0) * w;
             total += w;
         }
     }
@@ -55,7 +64,7 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         result = sum / total;
     }
     result = vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
-    textureStore(occlusion_out, p, i32(layer), result);
+    textureStore(occlusion_out, p, layers.y, result);
 }
 
 @compute @workgroup_size(8, 8, 1)

@@ -146,6 +146,81 @@ fn view_to_uv(v: vec3<f32>, tangents: vec4<f32>) -> vec2<f32> {
     return vec2<f32>((tan_x - tangents.x) / (tangents.y - tangents.x), (tan_y - tangents.z) / (tangents.w - tangents.z));
 }
 
+// Where view-space point `v` of `eye` lands in the other eye `other`: (uv, distance along
+// the other eye's −z, 1), or w = 0 where it lies off that eye's image or not beyond its
+// near plane.
+fn in_other_eye(v: vec3<f32>, eye: Eye, other: Eye, near: f32) -> vec4<f32> {
+    let w = (eye.other_from_view * vec4<f32>(v, 1.0)).xyz;
+    let uv = view_to_uv(w, other.tangents);
+    let seen = -w.z > near && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0));
+    return vec4<f32>(uv, -w.z, select(0.0, 1.0, seen));
+}
+
+// The stereo reuse (GTAO's right-eye march, every technique's denoise): a right-eye
+// surface point the left eye also sees takes the left eye's value there. AO within r
+// belongs to the surface point, not to the eye, so the eyes then agree by construction.
+struct LeftEyeValue {
+    value: vec4<f32>,
+    // False where the left eye does not see the point: the right eye computes it.
+    found: bool,
+};
+
+// The left eye's value (`left_values`, at occlusion resolution, layer 0; `left_geometry`
+// its AoGeometry) at right-eye view-space point `position`. Not found off the left
+// image, or where the left eye sees another surface there (its depth at the point's
+// full-res pixel more than 1 % away). Interpolated at the point among the four occlusion
+// pixels around it on the same surface (within 5 % in distance): the nearest pixel
+// shifted the eyes' AO by up to a pixel against each other, and a neighbour across a
+// depth edge would bring another surface's value.
+fn left_eye_value(
+    position: vec3<f32>,
+    right: Eye,
+    left: Eye,
+    depth: texture_depth_2d_array,
+    left_values: texture_2d_array<f32>,
+    left_geometry: texture_2d_array<f32>,
+    scale: u32,
+    full_size: vec2<u32>,
+    near: f32,
+) -> LeftEyeValue {
+    var result: LeftEyeValue;
+    result.found = false;
+    let in_left = in_other_eye(position, right, left, near);
+    if (in_left.w == 0.0) {
+        return result;
+    }
+    let uv = in_left.xy;
+    let distance = in_left.z;
+    let full = min(vec2<u32>(uv * vec2<f32>(full_size)), full_size - vec2<u32>(1u));
+    let d_here = textureLoad(depth, vec2<i32>(full), 0, 0);
+    let here = -load_view_position(max(d_here, 1e-30), full, left, full_size, near).z;
+    if (!(d_here > 0.0 && abs(here - distance) < 0.01 * distance)) {
+        return result;
+    }
+    // Occlusion pixel k stands for the centre of its top-left full-res pixel.
+    let grid = textureDimensions(left_values);
+    let f = uv * vec2<f32>(grid) - 0.5 / f32(scale);
+    let base = vec2<i32>(floor(f));
+    let t = f - floor(f);
+    let last = vec2<i32>(grid) - 1;
+    var sum = vec4<f32>(0.0);
+    var total = 0.0;
+    for (var k = 0; k < 4; k++) {
+        let corner = vec2<i32>(k & 1, k >> 1u);
+        let q = clamp(base + corner, vec2<i32>(0), last);
+        let there = textureLoad(left_geometry, q, 0, 0).w;
+        let bilinear = mix(1.0 - t.x, t.x, f32(corner.x)) * mix(1.0 - t.y, t.y, f32(corner.y));
+        let w = select(0.0, bilinear, there > 0.0 && abs(there - distance) < 0.05 * distance);
+        sum += w * textureLoad(left_values, q, 0, 0);
+        total += w;
+    }
+    if (total > 1e-6) {
+        result.value = sum / total;
+        result.found = true;
+    }
+    return result;
+}
+
 // Clamps to [0, 1] and maps NaN to 1 (unoccluded): AO never leaves its range.
 fn saturate_ao(a: f32) -> f32 {
     return select(1.0, clamp(a, 0.0, 1.0), a == a);

@@ -10,7 +10,9 @@
 // A tap counts by how far it lies off the pixel's tangent plane, relative to the
 // pixel's distance (a tent, no exp): depth edges stay sharp. Where a pixel's neighbours
 // are almost all rejected (a lone pixel, a thin feature), the plain mean of its window
-// is blended in, so no isolated extreme value survives untouched.
+// is blended in, so no isolated extreme value survives untouched. With two views the
+// right eye's vertical pass takes the left eye's result where the left eye sees the same
+// point (denoise_stereo.wgsl).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -27,9 +29,33 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
     if (any(first >= vec2<i32>(ao.ao_size)) || id.z >= frame.layers) {
         return;
     }
-    let layer = i32(id.z);
-    let eye = frame.eyes[id.z];
+    let layers = denoise_layers(id);
+    let layer = layers.x;
+    let eye = frame.eyes[layer];
     let limit = vec2<i32>(ao.ao_size) - vec2<i32>(1);
+    // The right eye's pixels the left eye sees (bit o for pixel o of the run, also set
+    // past the edge): written here, skipped below; a run of only those loads no taps.
+    var reused = 0u;
+    if (RIGHT_EYE) {
+        for (var o = 0; o < RUN; o++) {
+            let p = first + axis * o;
+            if (any(p > limit)) {
+                reused |= 1u << u32(o);
+                continue;
+            }
+            let centre = textureLoad(geometry_layers, p, layer, 0);
+            if (centre.w > 0.0) {
+                let left = reused_from_left_eye(p, centre);
+                if (left.found) {
+                    textureStore(occlusion_out, p, layers.y, left.value);
+                    reused |= 1u << u32(o);
+                }
+            }
+        }
+        if (reused == (1u << u32(RUN)) - 1u) {
+            return;
+        }
+    }
     // The run's taps, offsets −2 … RUN + 1 from its first pixel; clamped at the border
     // (the edge texel stands in for the missing ones).
     var geometry: array<vec4<f32>, 8>;
@@ -44,10 +70,13 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         if (any(p > limit)) {
             break;
         }
+        if (((reused >> u32(o)) & 1u) != 0u) {
+            continue;
+        }
         let centre = geometry[o + 2];
         if (!(centre.w > 0.0)) {
             // Sky: passed through.
-            textureStore(occlusion_out, p, layer, values[o + 2]);
+            textureStore(occlusion_out, p, layers.y, values[o + 2]);
             continue;
         }
         let plane = tap_plane(eye, vec2<u32>(p), centre, axis, ao.scale, frame.size, ao.blur_plane_sigma);
@@ -70,7 +99,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         let prior = max(2.0 - total, 0.0);
         let plain = plain_sum / max(plain_total, 1e-20);
         let result = (sum + plain * prior) / max(total + prior, 1e-20);
-        textureStore(occlusion_out, p, layer, vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a)));
+        textureStore(occlusion_out, p, layers.y, vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a)));
     }
 }
 

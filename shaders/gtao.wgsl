@@ -44,53 +44,10 @@ override INNER_BAND: bool = false;
 // see (its outer side, disocclusions). Its outputs are bound as one-layer views
 // (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layer of AoRaw.
 override RIGHT_EYE: bool = false;
-// AoRaw's left-eye layer in the right eye's dispatch (any array texture otherwise).
+// AoRaw's and AoGeometry's left-eye layers in the right eye's dispatch (any array
+// textures otherwise).
 @group(0) @binding(7) var left_occlusion: texture_2d_array<f32>;
-
-// The left eye's raw occlusion at the surface point of right-eye receiver `r`, or −1
-// where the left eye does not see that point: off its image, or another surface there
-// (its depth at the point's pixel more than 1 % away). Interpolated at the point among
-// the four occlusion pixels around it that lie on the same surface (within 5 % in
-// distance): the nearest occlusion pixel shifted the right eye's AO by up to a pixel
-// against the left's (stereo-inconsistent pixels at half resolution, furnished 3.3 %;
-// bilinear 2.1 %), and a neighbour across a depth edge would bring another surface's AO.
-fn left_eye_occlusion(r: Receiver) -> f32 {
-    let left = frame.eyes[0];
-    let in_left = in_other_eye(r.position, r.eye, left);
-    if (in_left.w == 0.0) {
-        return -1.0;
-    }
-    let uv = in_left.xy;
-    let distance = in_left.z;
-    let full = min(vec2<u32>(uv * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
-    let d_here = textureLoad(depth_layers, vec2<i32>(full), 0, 0);
-    let here = -load_view_position(max(d_here, 1e-30), full, left, frame.size, frame.near).z;
-    if (!(d_here > 0.0 && abs(here - distance) < 0.01 * distance)) {
-        return -1.0;
-    }
-    // Occlusion pixel k stands for the centre of its top-left full-res pixel.
-    let f = uv * vec2<f32>(ao.ao_size) - 0.5 / f32(ao.scale);
-    let base = vec2<i32>(floor(f));
-    let t = f - floor(f);
-    let last = vec2<i32>(ao.ao_size) - 1;
-    var sum = 0.0;
-    var total = 0.0;
-    for (var k = 0; k < 4; k++) {
-        let corner = vec2<i32>(k & 1, k >> 1u);
-        let q = clamp(base + corner, vec2<i32>(0), last);
-        let standing = full_res_pixel(vec2<u32>(q), ao.scale, frame.size);
-        let d = textureLoad(depth_layers, vec2<i32>(standing), 0, 0);
-        let there = -load_view_position(max(d, 1e-30), standing, left, frame.size, frame.near).z;
-        let bilinear = mix(1.0 - t.x, t.x, f32(corner.x)) * mix(1.0 - t.y, t.y, f32(corner.y));
-        let w = select(0.0, bilinear, d > 0.0 && abs(there - distance) < 0.05 * distance);
-        sum += w * textureLoad(left_occlusion, q, 0, 0).a;
-        total += w;
-    }
-    if (!(total > 1e-6)) {
-        return -1.0;
-    }
-    return sum / total;
-}
+@group(0) @binding(8) var left_geometry: texture_2d_array<f32>;
 
 // The occlusion pixel of invocation `id` in this dispatch's part of the image, or none
 // (x = ao_size.x) past its part's width.
@@ -281,9 +238,11 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
         return;
     }
     if (RIGHT_EYE) {
-        let left = left_eye_occlusion(r);
-        if (left >= 0.0) {
-            store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, left));
+        let left = left_eye_value(
+            r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
+        );
+        if (left.found) {
+            store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, left.value.a));
             return;
         }
     }

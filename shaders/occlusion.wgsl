@@ -199,16 +199,6 @@ fn probed_surface(probe: DepthProbe, eye: Eye) -> vec3<f32> {
     return view_position_from_distance(pixel_uv(probe.pixel, frame.size), probe.distance, eye.tangents);
 }
 
-// Where view-space point `v` of `eye` lands in the other eye `other`: (uv, distance along
-// the other eye's −z, 1), or w = 0 where it lies off that eye's image or not beyond its
-// near plane.
-fn in_other_eye(v: vec3<f32>, eye: Eye, other: Eye) -> vec4<f32> {
-    let w = (eye.other_from_view * vec4<f32>(v, 1.0)).xyz;
-    let uv = view_to_uv(w, other.tangents);
-    let seen = -w.z > frame.near && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0));
-    return vec4<f32>(uv, -w.z, select(0.0, 1.0, seen));
-}
-
 // The pixel of a `grid`-sized image whose noise value (kernel rotation, slice turn) a
 // pixel takes: its own (`own`) in the left eye; in the right eye, that of the left-eye
 // pixel that sees its surface point, so both eyes sample the same point alike and
@@ -219,7 +209,7 @@ fn stereo_noise_pixel(own: vec2<u32>, grid: vec2<u32>, layer: u32, eye: Eye, pos
     if (layer == 0u || frame.layers < 2u) {
         return own;
     }
-    let in_left = in_other_eye(position, eye, frame.eyes[0]);
+    let in_left = in_other_eye(position, eye, frame.eyes[0], frame.near);
     if (in_left.w == 0.0) {
         return own;
     }
@@ -257,7 +247,7 @@ fn surface_at(q: vec2<f32>, layer: u32, eye: Eye, guess: f32) -> vec4<f32> {
     let other_layer = 1u - layer;
     let other = frame.eyes[other_layer];
     let on_ray = view_position_from_distance(q / size, guess, eye.tangents);
-    let in_other = in_other_eye(on_ray, eye, other);
+    let in_other = in_other_eye(on_ray, eye, other, frame.near);
     if (in_other.w == 0.0) {
         return vec4<f32>(0.0);
     }

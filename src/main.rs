@@ -370,8 +370,9 @@ struct GtaoArgs {
     /// join into one surface (0: never).
     #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
     connect: f32,
-    /// GTAO: march both eyes on their own; by default the right eye takes the left eye's
-    /// value wherever the left eye sees the same surface point.
+    /// Compute both eyes on their own; by default the right eye takes the left eye's value
+    /// wherever the left eye sees the same surface point (GTAO's march, every technique's
+    /// denoise).
     #[arg(long)]
     independent_eyes: bool,
 }

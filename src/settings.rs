@@ -288,9 +288,10 @@ pub struct AoSettings {
     /// GTAO: successive samples whose distances differ by less than this fraction of the
     /// radius lie on one continuous surface, which also blocks the angles between them.
     pub connect: f32,
-    /// GTAO with two views: the right eye takes the left eye's value wherever the left
-    /// eye sees the same surface point, and marches only the rest (both eyes agree by
-    /// construction and the right eye costs a fraction). Off: each eye marches alone.
+    /// With two views, the right eye takes the left eye's value wherever the left eye
+    /// sees the same surface point: GTAO's march (the right eye marches only the rest and
+    /// costs a fraction) and every technique's denoise (its vertical pass, so the eyes'
+    /// final AO agree at full resolution). Off: each eye computes everything alone.
     pub stereo_reuse: bool,
 }
 

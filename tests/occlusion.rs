@@ -1123,21 +1123,23 @@ fn every_pixel_is_computed_in_both_eyes() {
     }
 }
 
-/// GTAO's right eye takes the left eye's value wherever the left eye sees the same
-/// surface point. The share of stereo-inconsistent points (the bench's measure: AO
-/// differing by more than 0.02 between the eyes, `vrao::stereo_consistency`) falls
-/// below ¾ of what it is when each eye marches on its own, at full and half resolution
-/// (measured: full 1.8 → 0.9 %, half 3.3 → 2.1 %; what is left comes from the denoise's
-/// and upsample's windows, which differ by the disparity).
+/// The right eye takes the left eye's value wherever the left eye sees the same surface
+/// point: GTAO's march, and every technique's denoise (its last pass, whose output is
+/// the final AO at full resolution). The share of stereo-inconsistent points (the
+/// bench's measure: AO differing by more than 0.02 between the eyes,
+/// `vrao::stereo_consistency`) falls below ¼ of what it is with independent eyes at full
+/// resolution and below ½ at half resolution, where each eye upsamples from its own
+/// grid (measured on the furnished room: GTAO full 1.8 → 0.3 %, half 3.3 → 1.3 %; SSAO
+/// full 1.7 → 0.2 %).
 #[test]
 fn the_right_eye_reuses_the_left_eye_where_it_sees_the_same_point() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:furnished").unwrap();
     let head = scene.head.pose_at(0.0);
-    for half_res in [false, true] {
+    for (technique, half_res) in [(Technique::Gtao, false), (Technique::Gtao, true), (Technique::Ssao, false)] {
         let mut shares = [0.0; 2];
         for (i, reuse) in [false, true].into_iter().enumerate() {
-            let mut a = ao(Technique::Gtao, 24, 0.3);
+            let mut a = ao(technique, 24, 0.3);
             (a.stereo_reuse, a.half_res) = (reuse, half_res);
             let s = settings(540, 600, a);
             let final_ao = if half_res { Resource::AoFull } else { Resource::AoBlurred };
@@ -1146,14 +1148,15 @@ fn the_right_eye_reuses_the_left_eye_where_it_sees_the_same_point() {
             let ao: Vec<Vec<f32>> = f.outputs[&final_ao].iter().map(|l| l.chunks(4).map(|p| p[3]).collect()).collect();
             let images = [0, 1].map(|l| EyeImages { depth: &depth[l], ao: &ao[l] });
             let c = stereo_consistency(&f.eyes.eyes, images, (f.width, f.height), f.eyes.near);
-            eprintln!("stereo reuse {reuse}, half {half_res}: {c:?}");
+            eprintln!("{technique:?} stereo reuse {reuse}, half {half_res}: {c:?}");
             assert!(c.compared > 50_000, "too few points compared ({})", c.compared);
             shares[i] = c.inconsistent.unwrap();
         }
         let [independent, reused] = shares;
+        let most = if half_res { 0.5 } else { 0.25 };
         assert!(
-            reused < 0.75 * independent,
-            "half {half_res}: {:.1} % inconsistent with reuse, {:.1} % with independent eyes",
+            reused < most * independent,
+            "{technique:?}, half {half_res}: {:.1} % inconsistent with reuse, {:.1} % with independent eyes",
             100.0 * reused,
             100.0 * independent
         );

@@ -18,6 +18,7 @@ const SHADERS: &[(&str, &str)] = &[
     ("fetch.wgsl", include_str!("../../shaders/fetch.wgsl")),
     ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),
     ("denoise.wgsl", include_str!("../../shaders/denoise.wgsl")),
+    ("denoise_stereo.wgsl", include_str!("../../shaders/denoise_stereo.wgsl")),
     ("joint_upsample.wgsl", include_str!("../../shaders/joint_upsample.wgsl")),
     ("upsample.wgsl", include_str!("../../shaders/upsample.wgsl")),
     ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),

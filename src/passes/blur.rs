@@ -3,6 +3,7 @@
 //! matched to the 4×4 noise tile (shaders/denoise.wgsl), or the geometry-aware 11×11
 //! bilateral blur (shaders/bilateral.wgsl).
 
+use super::occlusion::layer_view;
 use super::{occlusion_before_upsample, occlusion_source, FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::Gpu;
@@ -12,24 +13,48 @@ use crate::settings::{Denoise, Technique};
 /// Pixels per invocation of the tile denoise (`RUN` in shaders/denoise.wgsl).
 const DENOISE_RUN: u32 = 4;
 
+/// One denoise kind's pipelines: horizontal, vertical, and the right eye's vertical
+/// dispatch that reuses the left eye (shaders/denoise_stereo.wgsl).
+struct DenoiseKernels {
+    horizontal: Kernel,
+    vertical: Kernel,
+    right_eye_vertical: Kernel,
+}
+
+impl DenoiseKernels {
+    fn new(gpu: &Gpu, label: &str, shader: &str, horizontal: &str, vertical: &str) -> Self {
+        let slots = [
+            Slot::Uniform,
+            Slot::Uniform,
+            Slot::Layers,
+            Slot::Layers,
+            Slot::Output(Resource::AoBlurred.format()),
+            Slot::Depth,
+            Slot::Layers,
+        ];
+        let files = ["common.wgsl", "denoise_stereo.wgsl", shader];
+        let kernel = |entry: &str, right_eye: bool| {
+            let constants = [("RIGHT_EYE", if right_eye { 1.0 } else { 0.0 })];
+            Kernel::with_constants(gpu, label, &files, entry, &slots, &constants)
+        };
+        DenoiseKernels {
+            horizontal: kernel(horizontal, false),
+            vertical: kernel(vertical, false),
+            right_eye_vertical: kernel(vertical, true),
+        }
+    }
+}
+
 pub struct BlurPass {
-    tile_horizontal: Kernel,
-    tile_vertical: Kernel,
-    bilateral_horizontal: Kernel,
-    bilateral_vertical: Kernel,
+    tile: DenoiseKernels,
+    bilateral: DenoiseKernels,
 }
 
 impl BlurPass {
     pub fn new(gpu: &Gpu) -> Self {
-        let slots =
-            [Slot::Uniform, Slot::Uniform, Slot::Layers, Slot::Layers, Slot::Output(Resource::AoBlurred.format())];
-        let tile = ["common.wgsl", "denoise.wgsl"];
-        let bilateral = ["common.wgsl", "bilateral.wgsl"];
         BlurPass {
-            tile_horizontal: Kernel::new(gpu, "denoise horizontal", &tile, "denoise_horizontal", &slots),
-            tile_vertical: Kernel::new(gpu, "denoise vertical", &tile, "denoise_vertical", &slots),
-            bilateral_horizontal: Kernel::new(gpu, "blur horizontal", &bilateral, "blur_horizontal", &slots),
-            bilateral_vertical: Kernel::new(gpu, "blur vertical", &bilateral, "blur_vertical", &slots),
+            tile: DenoiseKernels::new(gpu, "denoise", "denoise.wgsl", "denoise_horizontal", "denoise_vertical"),
+            bilateral: DenoiseKernels::new(gpu, "blur", "bilateral.wgsl", "blur_horizontal", "blur_vertical"),
         }
     }
 }
@@ -38,6 +63,7 @@ impl Pass for BlurPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
         PassDecl::new("blur")
+            .read(Resource::Depth)
             .read(Resource::AoGeometry)
             .read(occlusion_source(setup.settings))
             .write(Resource::AoBlurH)
@@ -48,35 +74,47 @@ impl Pass for BlurPass {
 
     fn record(&self, ctx: &mut FrameContext) {
         debug_assert_eq!(occlusion_before_upsample(ctx.setup.settings), Some(Resource::AoBlurred));
-        let extent = ctx.ao_extent();
         let source = occlusion_source(ctx.setup.settings);
-        let (horizontal, vertical) = match ctx.setup.settings.ao.denoise {
-            Denoise::Tile => (&self.tile_horizontal, &self.tile_vertical),
-            Denoise::Bilateral => (&self.bilateral_horizontal, &self.bilateral_vertical),
+        let ao = &ctx.setup.settings.ao;
+        let kernels = match ao.denoise {
+            Denoise::Tile => &self.tile,
+            Denoise::Bilateral => &self.bilateral,
         };
         // The tile denoise filters runs of `DENOISE_RUN` pixels along each pass's axis.
-        let (w, h, layers) = extent;
-        let (horizontal_grid, vertical_grid) = match ctx.setup.settings.ao.denoise {
-            Denoise::Tile => ((w.div_ceil(DENOISE_RUN), h, layers), (w, h.div_ceil(DENOISE_RUN), layers)),
-            Denoise::Bilateral => (extent, extent),
+        let (w, h, layers) = ctx.ao_extent();
+        let (horizontal_grid, vertical_grid) = match ao.denoise {
+            Denoise::Tile => ((w.div_ceil(DENOISE_RUN), h, layers), (w, h.div_ceil(DENOISE_RUN))),
+            Denoise::Bilateral => ((w, h, layers), (w, h)),
         };
-        for (kernel, input, output, grid) in [
-            (horizontal, source, Resource::AoBlurH, horizontal_grid),
-            (vertical, Resource::AoBlurH, Resource::AoBlurred, vertical_grid),
-        ] {
-            let resources = resources(ctx, input, output);
-            kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, grid);
+        let reuse = ao.stereo_reuse && layers == 2;
+        let device = &ctx.gpu.device;
+        let horizontal = resources(ctx, source, Resource::AoBlurH);
+        kernels.horizontal.dispatch(device, ctx.encoder, &horizontal, horizontal_grid);
+        // The vertical pass: both eyes alike, or the left eye and then the right eye
+        // reusing it.
+        let mut vertical = resources(ctx, Resource::AoBlurH, Resource::AoBlurred);
+        let filtered_layers = if reuse { 1 } else { layers };
+        kernels.vertical.dispatch(device, ctx.encoder, &vertical, (vertical_grid.0, vertical_grid.1, filtered_layers));
+        if reuse {
+            let (right, left) = (layer_view(ctx, Resource::AoBlurred, 1), layer_view(ctx, Resource::AoBlurred, 0));
+            vertical[4] = wgpu::BindingResource::TextureView(&right);
+            vertical[6] = wgpu::BindingResource::TextureView(&left);
+            kernels.right_eye_vertical.dispatch(device, ctx.encoder, &vertical, (vertical_grid.0, vertical_grid.1, 1));
         }
     }
 }
 
-/// Bindings of both denoise shaders: frame, AO parameters, geometry, input, output.
-fn resources<'a>(ctx: &FrameContext<'a>, input: Resource, output: Resource) -> [wgpu::BindingResource<'a>; 5] {
+/// Bindings of both denoise shaders: frame, AO parameters, geometry, input, output,
+/// depth and, at 6, the output's left-eye layer for the right eye's vertical dispatch
+/// (AoGeometry stands in before it).
+fn resources<'a>(ctx: &FrameContext<'a>, input: Resource, output: Resource) -> [wgpu::BindingResource<'a>; 7] {
     [
         ctx.frame.frame.as_entire_binding(),
         ctx.frame.ao.as_entire_binding(),
         ctx.view(Resource::AoGeometry),
         ctx.view(input),
         ctx.view(output),
+        ctx.view(Resource::Depth),
+        ctx.view(Resource::AoGeometry),
     ]
 }

@@ -52,9 +52,10 @@ pub fn technique_decl(decl: PassDecl, runs_for: &[Technique], setup: &FrameSetup
         .disabled_if(!runs_for.contains(&chosen), reason)
 }
 
-/// GTAO's bindings: the shared ones and, at 7, AoRaw's left-eye layer for the right
-/// eye's dispatch (gtao.wgsl `left_occlusion`).
-const GTAO_SLOTS: [Slot; 8] = [SLOTS[0], SLOTS[1], SLOTS[2], SLOTS[3], SLOTS[4], SLOTS[5], SLOTS[6], Slot::Layers];
+/// GTAO's bindings: the shared ones and, at 7 and 8, AoRaw's and AoGeometry's left-eye
+/// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`).
+const GTAO_SLOTS: [Slot; 9] =
+    [SLOTS[0], SLOTS[1], SLOTS[2], SLOTS[3], SLOTS[4], SLOTS[5], SLOTS[6], Slot::Layers, Slot::Layers];
 
 /// GTAO's three pipelines of one shader (gtao.wgsl): the rest of the image, the band
 /// along the inner border with the other-eye lookups, and the right eye reusing the
@@ -117,7 +118,7 @@ impl OcclusionPass {
 }
 
 /// A one-layer array view of `layer` of a resource's target.
-fn layer_view(ctx: &FrameContext, r: Resource, layer: u32) -> wgpu::TextureView {
+pub fn layer_view(ctx: &FrameContext, r: Resource, layer: u32) -> wgpu::TextureView {
     ctx.target(r).texture.create_view(&wgpu::TextureViewDescriptor {
         label: Some(r.name()),
         dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -144,8 +145,9 @@ impl Pass for OcclusionPass {
         };
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
-        // Slot 7 is unused before the right eye's dispatch: the normals stand in.
+        // Slots 7 and 8 are unused before the right eye's dispatch: the normals stand in.
         let mut resources = bindings(ctx);
+        resources.push(ctx.view(Resource::Normals));
         resources.push(ctx.view(Resource::Normals));
         let reuse = ctx.setup.settings.ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
@@ -157,10 +159,11 @@ impl Pass for OcclusionPass {
         }
         let (ao_right, geometry_right) =
             (layer_view(ctx, Resource::AoRaw, 1), layer_view(ctx, Resource::AoGeometry, 1));
-        let ao_left = layer_view(ctx, Resource::AoRaw, 0);
+        let (ao_left, geometry_left) = (layer_view(ctx, Resource::AoRaw, 0), layer_view(ctx, Resource::AoGeometry, 0));
         resources[5] = wgpu::BindingResource::TextureView(&ao_right);
         resources[6] = wgpu::BindingResource::TextureView(&geometry_right);
         resources[7] = wgpu::BindingResource::TextureView(&ao_left);
+        resources[8] = wgpu::BindingResource::TextureView(&geometry_left);
         gtao.right_eye.dispatch(device, ctx.encoder, &resources, (width, height, 1));
     }
 }
