@@ -371,8 +371,8 @@ struct GtaoArgs {
     #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
     connect: f32,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
-    /// wherever the left eye sees the same surface point (GTAO's march, every technique's
-    /// denoise).
+    /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
+    /// every technique's denoise).
     #[arg(long)]
     independent_eyes: bool,
 }

@@ -290,8 +290,9 @@ pub struct AoSettings {
     pub connect: f32,
     /// With two views, the right eye takes the left eye's value wherever the left eye
     /// sees the same surface point: GTAO's march (the right eye marches only the rest and
-    /// costs a fraction) and every technique's denoise (its vertical pass, so the eyes'
-    /// final AO agree at full resolution). Off: each eye computes everything alone.
+    /// costs a fraction) and, at half resolution, every technique's denoise (its vertical
+    /// pass, before each eye upsamples from its own grid). Off: each eye computes
+    /// everything alone.
     pub stereo_reuse: bool,
 }
 
