@@ -42,7 +42,8 @@ override INNER_BAND: bool = false;
 // visibility within r is a property of the surface point, not of the eye, so the eyes
 // then agree by construction, and the right eye marches only what the left eye cannot
 // see (its outer side, disocclusions). Its outputs are bound as one-layer views
-// (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layer of AoRaw.
+// (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layers of AoRaw and
+// AoGeometry (common.wgsl `left_eye_value`).
 override RIGHT_EYE: bool = false;
 // AoRaw's and AoGeometry's left-eye layers in the right eye's dispatch (any array
 // textures otherwise).
