@@ -5,7 +5,8 @@
 // half-pixel shift. Each invocation filters a run of 4 pixels along the axis, so
 // a pixel costs 2 fetched taps per pass (4 in all, its own included) and 10 plane tests of two
 // multiply-adds, against the 11×11 bilateral blur's 22 fetched taps with an exp and a
-// normal test each.
+// normal test each. Only SSDO's targets carry light in rgb (CARRIES_LIGHT); for the other
+// techniques the filter runs on alpha alone, a quarter of the arithmetic.
 //
 // A tap counts by how far it lies off the pixel's tangent plane, relative to the
 // pixel's distance (a tent, no exp): depth edges stay sharp. Where a pixel's neighbours
@@ -23,6 +24,10 @@
 // Pixels filtered by one invocation, consecutive along the pass's axis: their windows
 // overlap, so 4 + 4 taps serve 4 pixels (2 taps per pixel instead of 5).
 const RUN: i32 = 4;
+
+// Whether the occlusion carries gathered light in rgb (SSDO) to filter with the AO; the
+// other techniques write rgb 0, kept as is.
+override CARRIES_LIGHT: bool = true;
 
 fn denoise(id: vec3<u32>, axis: vec2<i32>) {
     let first = vec2<i32>(id.xy) * (vec2<i32>(1) + axis * (RUN - 1));
@@ -59,11 +64,14 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
     // The run's taps, offsets −2 … RUN + 1 from its first pixel; clamped at the border
     // (the edge texel stands in for the missing ones).
     var geometry: array<vec4<f32>, 8>;
-    var values: array<vec4<f32>, 8>;
+    var occlusion: array<f32, 8>;
+    var light: array<vec3<f32>, 8>;
     for (var j = 0; j < RUN + 4; j++) {
         let q = clamp(first + axis * (j - 2), vec2<i32>(0), limit);
         geometry[j] = textureLoad(geometry_layers, q, layer, 0);
-        values[j] = textureLoad(occlusion_in, q, layer, 0);
+        let value = textureLoad(occlusion_in, q, layer, 0);
+        occlusion[j] = value.a;
+        light[j] = select(vec3<f32>(0.0), value.rgb, CARRIES_LIGHT);
     }
     for (var o = 0; o < RUN; o++) {
         let p = first + axis * o;
@@ -76,30 +84,40 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         let centre = geometry[o + 2];
         if (!(centre.w > 0.0)) {
             // Sky: passed through.
-            textureStore(occlusion_out, p, layers.y, values[o + 2]);
+            textureStore(occlusion_out, p, layers.y, vec4<f32>(light[o + 2], occlusion[o + 2]));
             continue;
         }
         let plane = tap_plane(eye, vec2<u32>(p), centre, axis, ao.scale, frame.size, ao.blur_plane_sigma);
-        var sum = vec4<f32>(0.0);
+        var sum = 0.0;
+        var light_sum = vec3<f32>(0.0);
         var total = 0.0;
-        var plain_sum = vec4<f32>(0.0);
+        var plain_sum = 0.0;
+        var plain_light_sum = vec3<f32>(0.0);
         var plain_total = 0.0;
         for (var k = -2; k <= 2; k++) {
             let distance = geometry[o + k + 2].w;
-            let value = values[o + k + 2];
             let box = select(1.0, 0.5, abs(k) == 2);
             let on_surface = select(0.0, box, distance > 0.0);
             let w = on_surface * max(1.0 - abs(plane_offset_of(plane, distance, f32(k))), 0.0);
-            sum += value * w;
+            sum += occlusion[o + k + 2] * w;
             total += w;
-            plain_sum += value * on_surface;
+            plain_sum += occlusion[o + k + 2] * on_surface;
             plain_total += on_surface;
+            if (CARRIES_LIGHT) {
+                light_sum += light[o + k + 2] * w;
+                plain_light_sum += light[o + k + 2] * on_surface;
+            }
         }
         // The centre alone weighs 1; below 2 the window's plain mean makes up the rest.
         let prior = max(2.0 - total, 0.0);
-        let plain = plain_sum / max(plain_total, 1e-20);
-        let result = (sum + plain * prior) / max(total + prior, 1e-20);
-        textureStore(occlusion_out, p, layers.y, vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a)));
+        let plain_weight = prior / max(plain_total, 1e-20);
+        let normaliser = 1.0 / max(total + prior, 1e-20);
+        let result = (sum + plain_sum * plain_weight) * normaliser;
+        var light_result = vec3<f32>(0.0);
+        if (CARRIES_LIGHT) {
+            light_result = finite_or_zero3((light_sum + plain_light_sum * plain_weight) * normaliser);
+        }
+        textureStore(occlusion_out, p, layers.y, vec4<f32>(light_result, saturate_ao(result)));
     }
 }
 

@@ -536,9 +536,10 @@ pub fn score(
                 let l = limit.map(|l| *l.get(layer, gx as u32, gy as u32));
                 limit_ao.push(l.map_or(1.0, |l| l.ao));
                 limit_mask.push(r.hit && l.is_some_and(|l| l.hit));
-                let ambient = match technique {
-                    Technique::Ssdo | Technique::SsdoBounce => [texel[0], texel[1], texel[2]],
-                    _ => r.unoccluded.map(|c| c * texel[3]),
+                let ambient = if technique.carries_light() {
+                    [texel[0], texel[1], texel[2]]
+                } else {
+                    r.unoccluded.map(|c| c * texel[3])
                 };
                 let truth = [0, 1, 2].map(|c| r.environment_visible[c] + r.bounce[c]);
                 gpu_ambient.push(luminance(ambient) as f32);

@@ -93,6 +93,13 @@ impl Technique {
             Technique::Gtao => "gtao",
         }
     }
+    /// True for the techniques whose occlusion targets carry gathered light in rgb
+    /// (SSDO's directional occlusion of the environment, with or without its bounce); the
+    /// others write AO in alpha alone (rgb 0), so the denoise filters alpha alone for them.
+    pub fn carries_light(self) -> bool {
+        matches!(self, Technique::Ssdo | Technique::SsdoBounce)
+    }
+
     pub const ALL: [Technique; 7] = [
         Technique::None,
         Technique::Ssao,

@@ -22,7 +22,8 @@ struct DenoiseKernels {
 }
 
 impl DenoiseKernels {
-    fn new(gpu: &Gpu, shader: &str, horizontal: &str, vertical: &str) -> Self {
+    /// `constants`: the shader's pipeline constants besides `RIGHT_EYE`.
+    fn new(gpu: &Gpu, shader: &str, horizontal: &str, vertical: &str, constants: &[(&str, f64)]) -> Self {
         let slots = [
             Slot::Uniform,
             Slot::Uniform,
@@ -34,7 +35,8 @@ impl DenoiseKernels {
         ];
         let files = ["common.wgsl", "denoise_stereo.wgsl", shader];
         let kernel = |entry: &str, right_eye: bool| {
-            let constants = [("RIGHT_EYE", if right_eye { 1.0 } else { 0.0 })];
+            let mut constants = constants.to_vec();
+            constants.push(("RIGHT_EYE", if right_eye { 1.0 } else { 0.0 }));
             let label = if right_eye { format!("{entry} right eye") } else { entry.to_string() };
             Kernel::with_constants(gpu, &label, &files, entry, &slots, &constants)
         };
@@ -47,15 +49,19 @@ impl DenoiseKernels {
 }
 
 pub struct BlurPass {
-    tile: DenoiseKernels,
+    /// The tile denoise by whether the occlusion carries light in rgb (SSDO) or AO alone.
+    tile: [DenoiseKernels; 2],
     bilateral: DenoiseKernels,
 }
 
 impl BlurPass {
     pub fn new(gpu: &Gpu) -> Self {
         BlurPass {
-            tile: DenoiseKernels::new(gpu, "denoise.wgsl", "denoise_horizontal", "denoise_vertical"),
-            bilateral: DenoiseKernels::new(gpu, "bilateral.wgsl", "blur_horizontal", "blur_vertical"),
+            tile: [false, true].map(|carries_light| {
+                let constants = [("CARRIES_LIGHT", if carries_light { 1.0 } else { 0.0 })];
+                DenoiseKernels::new(gpu, "denoise.wgsl", "denoise_horizontal", "denoise_vertical", &constants)
+            }),
+            bilateral: DenoiseKernels::new(gpu, "bilateral.wgsl", "blur_horizontal", "blur_vertical", &[]),
         }
     }
 }
@@ -78,7 +84,7 @@ impl Pass for BlurPass {
         let source = occlusion_source(ctx.setup.settings);
         let ao = &ctx.setup.settings.ao;
         let kernels = match ao.denoise {
-            Denoise::Tile => &self.tile,
+            Denoise::Tile => &self.tile[usize::from(ao.technique.carries_light())],
             Denoise::Bilateral => &self.bilateral,
         };
         // The tile denoise filters runs of `DENOISE_RUN` pixels along each pass's axis.
