@@ -76,7 +76,7 @@ impl Reprojector {
     pub fn new(gpu: &Gpu) -> Reprojector {
         let files = ["common.wgsl", "reproject.wgsl"];
         let variant = |label, entry, positional: bool| {
-            Kernel::with_constants(gpu, label, &files, entry, &SLOTS, &[("POSITIONAL", positional as u8 as f64)])
+            Kernel::with_constants(gpu, label, &files, entry, &SLOTS, &[("POSITIONAL", f64::from(positional))])
         };
         Reprojector {
             splat: variant("reproject splat", "splat", true),

@@ -36,7 +36,7 @@ impl DenoiseKernels {
         let files = ["common.wgsl", "denoise_stereo.wgsl", shader];
         let kernel = |entry: &str, right_eye: bool| {
             let mut constants = constants.to_vec();
-            constants.push(("RIGHT_EYE", if right_eye { 1.0 } else { 0.0 }));
+            constants.push(("RIGHT_EYE", f64::from(right_eye)));
             let label = if right_eye { format!("{entry} right eye") } else { entry.to_string() };
             Kernel::with_constants(gpu, &label, &files, entry, &slots, &constants)
         };
@@ -58,7 +58,7 @@ impl BlurPass {
     pub fn new(gpu: &Gpu) -> Self {
         BlurPass {
             tile: [false, true].map(|carries_light| {
-                let constants = [("CARRIES_LIGHT", if carries_light { 1.0 } else { 0.0 })];
+                let constants = [("CARRIES_LIGHT", f64::from(carries_light))];
                 DenoiseKernels::new(gpu, "denoise.wgsl", "denoise_horizontal", "denoise_vertical", &constants)
             }),
             bilateral: DenoiseKernels::new(gpu, "bilateral.wgsl", "blur_horizontal", "blur_vertical", &[]),

@@ -41,7 +41,7 @@ impl CompositePass {
         let files = ["common.wgsl", "irradiance.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
         let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
         let variant = |half_res: bool, rsm: bool| {
-            let constants = [("HALF_RES", half_res as u8 as f64), ("RSM", rsm as u8 as f64)];
+            let constants = [("HALF_RES", f64::from(half_res)), ("RSM", f64::from(rsm))];
             Kernel::with_constants(gpu, "composite", &files, "main", &SLOTS, &constants)
         };
         CompositePass {

@@ -95,10 +95,12 @@ impl OcclusionPass {
     pub fn gtao(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "gtao.wgsl"];
         let label = Technique::Gtao.name();
-        let flag = |on: bool| if on { 1.0 } else { 0.0 };
         let kernel = |band: bool, right: bool| {
-            let constants =
-                [("INNER_BAND", flag(band)), ("RIGHT_EYE", flag(right)), ("SINGLE_LAYER_OUTPUT", flag(right))];
+            let constants = [
+                ("INNER_BAND", f64::from(band)),
+                ("RIGHT_EYE", f64::from(right)),
+                ("SINGLE_LAYER_OUTPUT", f64::from(right)),
+            ];
             Kernel::with_constants(gpu, label, &files, "main", &GTAO_SLOTS, &constants)
         };
         OcclusionPass {

@@ -47,8 +47,8 @@ impl SsdoPass {
             [0, 1, 2].map(|bounce| {
                 let constants = [
                     ("PEEL", peel as f64),
-                    ("BOUNCE", (bounce > 0) as u8 as f64),
-                    ("BOUNCE_PATCH", (bounce == 2) as u8 as f64),
+                    ("BOUNCE", f64::from(bounce > 0)),
+                    ("BOUNCE_PATCH", f64::from(bounce == 2)),
                 ];
                 Kernel::with_constants(gpu, labels[peel][bounce], &files, "main", &SLOTS, &constants)
             })
