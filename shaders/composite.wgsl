@@ -6,7 +6,11 @@
 // 15.5–16.7 against 15.5–16.3 ms per eye).
 // technique 0: unoccluded ambient (SH irradiance of the environment);
 // 1: ambient × AO (SSAO, HBAO); 2: SSDO's gathered irradiance (rgb) replaces it.
-// Sky pixels show the environment.
+// Sky pixels show the environment. The output's alpha holds the pixel's AO: with the
+// stereo reuse at half resolution (RIGHT_EYE, AO-only techniques) the right eye runs as
+// a dispatch of its own after the left and takes the left eye's AO from there
+// (joint_upsample.wgsl `right_eye_quad`), its output bound as a one-layer view beside a
+// sampled view of the left eye's layer.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -24,11 +28,14 @@
 // irradiance and its geometry at half resolution, upsampled like the occlusion (RSM only).
 @group(0) @binding(11) var rsm_indirect: texture_2d_array<f32>;
 @group(0) @binding(12) var rsm_geometry: texture_2d_array<f32>;
+// The output's left-eye layer in the right eye's dispatch (any array texture otherwise).
+@group(0) @binding(13) var left_hdr: texture_2d_array<f32>;
 
 override HALF_RES: bool = false;
 // A pipeline constant, not a uniform: lavapipe pays for the upsample code even when a
 // uniform skips it (composite 122 → 213 ms at 1080×1200 on Sibenik).
 override RSM: bool = false;
+override RIGHT_EYE: bool = false;
 
 // Outgoing radiance at `pixel`, whose stored depth and normal are `depth` and `n`: the
 // environment on the sky; else the direct light plus albedo/π × the ambient, which
@@ -61,7 +68,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
-    let layer = id.z;
+    // The layer read, and the layer of the bound output written.
+    let layer = select(id.z, 1u, RIGHT_EYE);
+    let out_layer = select(id.z, 0u, RIGHT_EYE);
     let eye = frame.eyes[layer];
     let b = id.xy;
     // The quad's depths and normals, for the joint bilateral weights and the shading.
@@ -71,7 +80,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     if (ao.technique != 0u) {
-        if (HALF_RES) {
+        if (HALF_RES && RIGHT_EYE) {
+            occlusion = right_eye_quad(depth_layers, left_hdr, geometry_low, occlusion_layers, quad, vec2<i32>(b), eye.tangents);
+        } else if (HALF_RES) {
             occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents);
         } else {
             occlusion = array<vec4<f32>, 4>(
@@ -87,10 +98,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let none = vec3<f32>(0.0);
         bounce = array<vec3<f32>, 4>(max(up[0].rgb, none), max(up[1].rgb, none), max(up[2].rgb, none), max(up[3].rgb, none));
     }
-    shade_and_store(quad[0], layer, eye, occlusion[0], bounce[0]);
-    shade_and_store(quad[1], layer, eye, occlusion[1], bounce[1]);
-    shade_and_store(quad[2], layer, eye, occlusion[2], bounce[2]);
-    shade_and_store(quad[3], layer, eye, occlusion[3], bounce[3]);
+    shade_and_store(quad[0], layer, out_layer, eye, occlusion[0], bounce[0]);
+    shade_and_store(quad[1], layer, out_layer, eye, occlusion[1], bounce[1]);
+    shade_and_store(quad[2], layer, out_layer, eye, occlusion[2], bounce[2]);
+    shade_and_store(quad[3], layer, out_layer, eye, occlusion[3], bounce[3]);
 }
 
 // The full-resolution occlusion at a quad pixel.
@@ -98,10 +109,12 @@ fn full_res_occlusion(px: UpsamplePixel, layer: u32) -> vec4<f32> {
     return textureLoad(occlusion_layers, vec2<i32>(px.texel), i32(layer), 0);
 }
 
-// Shades a quad pixel and stores it, unless it lies past an odd edge.
-fn shade_and_store(px: UpsamplePixel, layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) {
+// Shades a quad pixel of `layer` and stores it (with its AO) at `out_layer` of the
+// bound output, unless it lies past an odd edge.
+fn shade_and_store(px: UpsamplePixel, layer: u32, out_layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) {
     if (all(px.pixel < frame.size)) {
         let radiance = shade(px.pixel, layer, eye, px.depth, px.stored_normal, occlusion, bounce);
-        textureStore(hdr_out, vec2<i32>(px.pixel), i32(layer), vec4<f32>(finite_or_zero3(radiance), 1.0));
+        let stored = vec4<f32>(finite_or_zero3(radiance), saturate_ao(occlusion.a));
+        textureStore(hdr_out, vec2<i32>(px.pixel), i32(out_layer), stored);
     }
 }

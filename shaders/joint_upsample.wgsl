@@ -204,3 +204,70 @@ fn upsample_quad(
         upsampled(pixels[3], nearest.value),
     );
 }
+
+// The stereo reuse of the upsampled occlusion (half resolution, AO-only techniques): a
+// right-eye pixel whose surface point the left eye sees takes the left eye's upsampled AO
+// at the left pixel the point lands on (`left_final`, full resolution, its layer 0, AO
+// in .a), where that pixel holds the same surface (distance within 1 %). The occlusion
+// is then interpolated once, in the left eye, instead of once per eye from two low-res
+// grids that sample different surface points (that double interpolation left the eyes
+// disagreeing at half resolution although the denoise already reuses the left eye).
+// The nearest left pixel, not a bilinear blend: two loads per pixel, fewer than its own
+// upsample's, and the shift is under a full-res pixel of a field the denoise smoothed.
+struct LeftEyeFinal {
+    ao: f32,
+    found: bool,
+};
+
+fn left_eye_final(px: UpsamplePixel, depth_layers: texture_depth_2d_array, left_final: texture_2d_array<f32>) -> LeftEyeFinal {
+    var result: LeftEyeFinal;
+    // The sky: nothing to upsample (its callers show it unoccluded).
+    result.ao = 1.0;
+    result.found = !(px.depth > 0.0);
+    if (result.found) {
+        return result;
+    }
+    let left = frame.eyes[0];
+    let in_left = in_other_eye(px.position, frame.eyes[1], left, frame.near);
+    if (in_left.w == 0.0) {
+        return result;
+    }
+    let full = min(vec2<u32>(in_left.xy * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
+    let d_there = textureLoad(depth_layers, vec2<i32>(full), 0, 0);
+    let there = -load_view_position(max(d_there, 1e-30), full, left, frame.size, frame.near).z;
+    if (d_there > 0.0 && abs(there - in_left.z) < 0.01 * in_left.z) {
+        result.ao = textureLoad(left_final, vec2<i32>(full), 0, 0).a;
+        result.found = true;
+    }
+    return result;
+}
+
+// The quad's upsampled values, in the right eye's dispatch taking the left eye's final
+// AO (`left_eye_final`) at the pixels where the left eye sees the same point and
+// upsampling its own only where some pixel it does not.
+fn right_eye_quad(
+    depth_layers: texture_depth_2d_array,
+    left_final: texture_2d_array<f32>,
+    geometry_low: texture_2d_array<f32>,
+    value_low: texture_2d_array<f32>,
+    quad: array<UpsamplePixel, 4>,
+    b: vec2<i32>,
+    tangents: vec4<f32>,
+) -> array<vec4<f32>, 4> {
+    let l0 = left_eye_final(quad[0], depth_layers, left_final);
+    let l1 = left_eye_final(quad[1], depth_layers, left_final);
+    let l2 = left_eye_final(quad[2], depth_layers, left_final);
+    let l3 = left_eye_final(quad[3], depth_layers, left_final);
+    let none = vec3<f32>(0.0);
+    var values = array<vec4<f32>, 4>(vec4<f32>(none, l0.ao), vec4<f32>(none, l1.ao), vec4<f32>(none, l2.ao), vec4<f32>(none, l3.ao));
+    if (!(l0.found && l1.found && l2.found && l3.found)) {
+        let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents);
+        values = array<vec4<f32>, 4>(
+            select(own[0], values[0], l0.found),
+            select(own[1], values[1], l1.found),
+            select(own[2], values[2], l2.found),
+            select(own[3], values[3], l3.found),
+        );
+    }
+    return values;
+}

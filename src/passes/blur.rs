@@ -95,7 +95,9 @@ impl Pass for BlurPass {
         };
         // At half resolution only: there each eye upsamples from its own grid and the eyes
         // drifted apart (furnished, 540×600: 2.0 % of the points both see differ by more
-        // than 0.02; 1.3 % with the reuse, at a cost within the timing noise). At full
+        // than 0.02; 1.3 % with the reuse, at a cost within the timing noise; the right
+        // eye's upsample reuses the left eye's too for AO-only techniques, and SSDO's
+        // values feed the right eye's own upsample where the left eye does not see). At full
         // resolution they already agree (Sibenik 1080×1200: 0.5 %) and the reuse's lookups
         // cost a fifth of the denoise (80–101 against 64–84 ms per eye, lavapipe).
         let reuse = ao.stereo_reuse && ao.half_res && layers == 2;

@@ -107,6 +107,16 @@ pub fn final_occlusion(settings: &Settings) -> Option<Resource> {
     Some(if settings.ao.half_res { Resource::AoFull } else { ao })
 }
 
+/// Whether the right eye takes the left eye's upsampled AO instead of upsampling its own
+/// wherever the left eye sees the same point (shaders/joint_upsample.wgsl
+/// `right_eye_quad`): with the stereo reuse, two views and half-resolution occlusion of
+/// an AO-only technique (SSDO's rgb carries gathered light, which the composite's alpha,
+/// where the left eye's AO waits for the right eye, cannot hold).
+pub fn reuses_left_eye_upsample(settings: &Settings, layers: u32) -> bool {
+    let ao = &settings.ao;
+    ao.stereo_reuse && ao.half_res && layers == 2 && ao.technique != Technique::None && !ao.technique.carries_light()
+}
+
 pub trait Pass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl;
     fn record(&self, ctx: &mut FrameContext);

@@ -3,13 +3,16 @@
 //! instead, so the graph runs this pass only when AoFull itself is asked for (debug
 //! images, tests).
 
-use super::{occlusion_before_upsample, FrameContext, FrameSetup, Pass};
+use super::occlusion::layer_view;
+use super::{occlusion_before_upsample, reuses_left_eye_upsample, FrameContext, FrameSetup, Pass};
 use crate::gpu::kernel::{Kernel, Slot};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 
 pub struct UpsamplePass {
     kernel: Kernel,
+    /// The right eye's dispatch that reuses the left eye's result.
+    right_eye: Kernel,
 }
 
 impl UpsamplePass {
@@ -22,16 +25,13 @@ impl UpsamplePass {
             Slot::Layers,
             Slot::Layers,
             Slot::Output(Resource::AoFull.format()),
+            Slot::Layers,
         ];
-        UpsamplePass {
-            kernel: Kernel::new(
-                gpu,
-                "upsample",
-                &["common.wgsl", "joint_upsample.wgsl", "upsample.wgsl"],
-                "main",
-                &slots,
-            ),
-        }
+        let files = ["common.wgsl", "joint_upsample.wgsl", "upsample.wgsl"];
+        let kernel = |label: &str, right_eye: bool| {
+            Kernel::with_constants(gpu, label, &files, "main", &slots, &[("RIGHT_EYE", f64::from(right_eye))])
+        };
+        UpsamplePass { kernel: kernel("upsample", false), right_eye: kernel("upsample right eye", true) }
     }
 }
 
@@ -52,7 +52,7 @@ impl Pass for UpsamplePass {
 
     fn record(&self, ctx: &mut FrameContext) {
         let input = occlusion_before_upsample(ctx.setup.settings).expect("upsample runs only with a technique");
-        let resources = [
+        let mut resources = [
             ctx.frame.frame.as_entire_binding(),
             ctx.frame.ao.as_entire_binding(),
             ctx.view(Resource::Depth),
@@ -60,8 +60,20 @@ impl Pass for UpsamplePass {
             ctx.view(Resource::AoGeometry),
             ctx.view(input),
             ctx.view(Resource::AoFull),
+            // The left eye's layer for the right eye's dispatch; AoGeometry stands in.
+            ctx.view(Resource::AoGeometry),
         ];
-        // One invocation per quad of 2×2 full-res pixels (upsample.wgsl).
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.quad_extent());
+        // One invocation per quad of 2×2 full-res pixels (upsample.wgsl): both eyes
+        // alike, or the left eye and then the right eye reusing it.
+        let (w, h, layers) = ctx.quad_extent();
+        let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
+        let device = &ctx.gpu.device;
+        self.kernel.dispatch(device, ctx.encoder, &resources, (w, h, if reuse { 1 } else { layers }));
+        if reuse {
+            let (right, left) = (layer_view(ctx, Resource::AoFull, 1), layer_view(ctx, Resource::AoFull, 0));
+            resources[6] = wgpu::BindingResource::TextureView(&right);
+            resources[7] = wgpu::BindingResource::TextureView(&left);
+            self.right_eye.dispatch(device, ctx.encoder, &resources, (w, h, 1));
+        }
     }
 }
