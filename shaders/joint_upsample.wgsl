@@ -242,9 +242,27 @@ fn left_eye_final(px: UpsamplePixel, depth_layers: texture_depth_2d_array, left_
     return result;
 }
 
-// The quad's upsampled values, in the right eye's dispatch taking the left eye's final
-// AO (`left_eye_final`) at the pixels where the left eye sees the same point and
-// upsampling its own only where some pixel it does not.
+// The left eye's final AO at the four pixels of a right-eye quad, and which of them the
+// left eye sees.
+struct LeftEyeQuad {
+    values: array<vec4<f32>, 4>,
+    found: vec4<bool>,
+};
+
+fn left_eye_quad(depth_layers: texture_depth_2d_array, left_final: texture_2d_array<f32>, quad: array<UpsamplePixel, 4>) -> LeftEyeQuad {
+    let l0 = left_eye_final(quad[0], depth_layers, left_final);
+    let l1 = left_eye_final(quad[1], depth_layers, left_final);
+    let l2 = left_eye_final(quad[2], depth_layers, left_final);
+    let l3 = left_eye_final(quad[3], depth_layers, left_final);
+    let none = vec3<f32>(0.0);
+    var result: LeftEyeQuad;
+    result.values = array<vec4<f32>, 4>(vec4<f32>(none, l0.ao), vec4<f32>(none, l1.ao), vec4<f32>(none, l2.ao), vec4<f32>(none, l3.ao));
+    result.found = vec4<bool>(l0.found, l1.found, l2.found, l3.found);
+    return result;
+}
+
+// The upsampled values of a right-eye quad: the left eye's final AO at the pixels where
+// the left eye sees the same point, its own upsample elsewhere.
 fn right_eye_quad(
     depth_layers: texture_depth_2d_array,
     left_final: texture_2d_array<f32>,
@@ -254,20 +272,12 @@ fn right_eye_quad(
     b: vec2<i32>,
     tangents: vec4<f32>,
 ) -> array<vec4<f32>, 4> {
-    let l0 = left_eye_final(quad[0], depth_layers, left_final);
-    let l1 = left_eye_final(quad[1], depth_layers, left_final);
-    let l2 = left_eye_final(quad[2], depth_layers, left_final);
-    let l3 = left_eye_final(quad[3], depth_layers, left_final);
-    let none = vec3<f32>(0.0);
-    var values = array<vec4<f32>, 4>(vec4<f32>(none, l0.ao), vec4<f32>(none, l1.ao), vec4<f32>(none, l2.ao), vec4<f32>(none, l3.ao));
-    if (!(l0.found && l1.found && l2.found && l3.found)) {
-        let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents);
-        values = array<vec4<f32>, 4>(
-            select(own[0], values[0], l0.found),
-            select(own[1], values[1], l1.found),
-            select(own[2], values[2], l2.found),
-            select(own[3], values[3], l3.found),
-        );
-    }
-    return values;
+    let left = left_eye_quad(depth_layers, left_final, quad);
+    let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents);
+    return array<vec4<f32>, 4>(
+        select(own[0], left.values[0], left.found.x),
+        select(own[1], left.values[1], left.found.y),
+        select(own[2], left.values[2], left.found.z),
+        select(own[3], left.values[3], left.found.w),
+    );
 }

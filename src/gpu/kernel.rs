@@ -204,21 +204,44 @@ impl Kernel {
         resources: &[wgpu::BindingResource],
         (width, height, layers): (u32, u32, u32),
     ) {
+        let bind_group = self.bind_group(device, resources);
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);
+    }
+
+    /// Binds `resources` and dispatches the workgroup counts that an earlier dispatch
+    /// wrote into `args` at `offset` (three u32: x, y, z), for work only the GPU knows
+    /// the size of.
+    pub fn dispatch_indirect(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &[wgpu::BindingResource],
+        args: &wgpu::Buffer,
+        offset: u64,
+    ) {
+        let bind_group = self.bind_group(device, resources);
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups_indirect(args, offset);
+    }
+
+    fn bind_group(&self, device: &wgpu::Device, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
         assert_eq!(resources.len(), self.slots.len(), "kernel {}: one resource per slot", self.label);
         let entries: Vec<_> = resources
             .iter()
             .enumerate()
             .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
             .collect();
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(&self.label),
             layout: &self.layout,
             entries: &entries,
-        });
-        let mut pass = encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);
+        })
     }
 }
