@@ -372,7 +372,7 @@ struct GtaoArgs {
     connect: f32,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
     /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
-    /// every technique's denoise).
+    /// every technique's denoise, and the upsampled AO of all but SSDO).
     #[arg(long)]
     independent_eyes: bool,
 }

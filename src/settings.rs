@@ -298,8 +298,8 @@ pub struct AoSettings {
     /// With two views, the right eye takes the left eye's value wherever the left eye
     /// sees the same surface point: GTAO's march (the right eye marches only the rest and
     /// costs a fraction) and, at half resolution, every technique's denoise (its vertical
-    /// pass, before each eye upsamples from its own grid). Off: each eye computes
-    /// everything alone.
+    /// pass) and the AO-only techniques' upsample (`passes::reuses_left_eye_upsample`).
+    /// Off: each eye computes everything alone.
     pub stereo_reuse: bool,
 }
 
