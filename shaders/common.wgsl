@@ -165,13 +165,46 @@ struct LeftEyeValue {
     found: bool,
 };
 
+// Where right-eye view-space point `position` lands in the left eye: its uv, its
+// distance along the left eye's −z and the left eye's full-res pixel there. Seen where
+// that pixel holds the same surface (its depth within 1 % of the point's distance); not
+// off the left image, or where the left eye sees another surface there.
+struct LeftEyePoint {
+    uv: vec2<f32>,
+    distance: f32,
+    pixel: vec2<u32>,
+    seen: bool,
+};
+
+fn left_eye_point(
+    position: vec3<f32>,
+    right: Eye,
+    left: Eye,
+    depth: texture_depth_2d_array,
+    full_size: vec2<u32>,
+    near: f32,
+) -> LeftEyePoint {
+    var point: LeftEyePoint;
+    point.seen = false;
+    let in_left = in_other_eye(position, right, left, near);
+    if (in_left.w == 0.0) {
+        return point;
+    }
+    point.uv = in_left.xy;
+    point.distance = in_left.z;
+    point.pixel = min(vec2<u32>(point.uv * vec2<f32>(full_size)), full_size - vec2<u32>(1u));
+    let d_there = textureLoad(depth, vec2<i32>(point.pixel), 0, 0);
+    let there = -load_view_position(max(d_there, 1e-30), point.pixel, left, full_size, near).z;
+    point.seen = d_there > 0.0 && abs(there - point.distance) < 0.01 * point.distance;
+    return point;
+}
+
 // The left eye's value (`left_values`, at occlusion resolution, layer 0; `left_geometry`
-// its AoGeometry) at right-eye view-space point `position`. Not found off the left
-// image, or where the left eye sees another surface there (its depth at the point's
-// full-res pixel more than 1 % away). Interpolated at the point among the four occlusion
-// pixels around it on the same surface (within 5 % in distance): the nearest pixel
-// shifted the eyes' AO by up to a pixel against each other, and a neighbour across a
-// depth edge would bring another surface's value.
+// its AoGeometry) at right-eye view-space point `position`, where the left eye sees it
+// (`left_eye_point`). Interpolated at the point among the four occlusion pixels around
+// it on the same surface (within 5 % in distance): the nearest pixel shifted the eyes'
+// AO by up to a pixel against each other, and a neighbour across a depth edge would
+// bring another surface's value.
 fn left_eye_value(
     position: vec3<f32>,
     right: Eye,
@@ -185,18 +218,12 @@ fn left_eye_value(
 ) -> LeftEyeValue {
     var result: LeftEyeValue;
     result.found = false;
-    let in_left = in_other_eye(position, right, left, near);
-    if (in_left.w == 0.0) {
+    let point = left_eye_point(position, right, left, depth, full_size, near);
+    if (!point.seen) {
         return result;
     }
-    let uv = in_left.xy;
-    let distance = in_left.z;
-    let full = min(vec2<u32>(uv * vec2<f32>(full_size)), full_size - vec2<u32>(1u));
-    let d_here = textureLoad(depth, vec2<i32>(full), 0, 0);
-    let here = -load_view_position(max(d_here, 1e-30), full, left, full_size, near).z;
-    if (!(d_here > 0.0 && abs(here - distance) < 0.01 * distance)) {
-        return result;
-    }
+    let uv = point.uv;
+    let distance = point.distance;
     // Occlusion pixel k stands for the centre of its top-left full-res pixel.
     let grid = textureDimensions(left_values);
     let f = uv * vec2<f32>(grid) - 0.5 / f32(scale);

@@ -206,12 +206,12 @@ fn upsample_quad(
 }
 
 // The stereo reuse of the upsampled occlusion (half resolution, AO-only techniques): a
-// right-eye pixel whose surface point the left eye sees takes the left eye's upsampled AO
-// at the left pixel the point lands on (`left_final`, full resolution, its layer 0, AO
-// in .a), where that pixel holds the same surface (distance within 1 %). The occlusion
-// is then interpolated once, in the left eye, instead of once per eye from two low-res
-// grids that sample different surface points (that double interpolation left the eyes
-// disagreeing at half resolution although the denoise already reuses the left eye).
+// right-eye pixel whose surface point the left eye sees (common.wgsl `left_eye_point`)
+// takes the left eye's upsampled AO at the left pixel the point lands on (`left_final`,
+// full resolution, its layer 0, AO in .a). The occlusion is then interpolated once, in
+// the left eye, instead of once per eye from two low-res grids that sample different
+// surface points (that double interpolation left the eyes disagreeing at half
+// resolution although the denoise already reuses the left eye).
 // The nearest left pixel, not a bilinear blend: two loads per pixel, fewer than its own
 // upsample's, and the shift is under a full-res pixel of a field the denoise smoothed.
 struct LeftEyeFinal {
@@ -227,16 +227,9 @@ fn left_eye_final(px: UpsamplePixel, depth_layers: texture_depth_2d_array, left_
     if (result.found) {
         return result;
     }
-    let left = frame.eyes[0];
-    let in_left = in_other_eye(px.position, frame.eyes[1], left, frame.near);
-    if (in_left.w == 0.0) {
-        return result;
-    }
-    let full = min(vec2<u32>(in_left.xy * vec2<f32>(frame.size)), frame.size - vec2<u32>(1u));
-    let d_there = textureLoad(depth_layers, vec2<i32>(full), 0, 0);
-    let there = -load_view_position(max(d_there, 1e-30), full, left, frame.size, frame.near).z;
-    if (d_there > 0.0 && abs(there - in_left.z) < 0.01 * in_left.z) {
-        result.ao = textureLoad(left_final, vec2<i32>(full), 0, 0).a;
+    let point = left_eye_point(px.position, frame.eyes[1], frame.eyes[0], depth_layers, frame.size, frame.near);
+    if (point.seen) {
+        result.ao = textureLoad(left_final, vec2<i32>(point.pixel), 0, 0).a;
         result.found = true;
     }
     return result;
