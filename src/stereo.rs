@@ -190,12 +190,16 @@ impl EyePair {
 }
 
 /// A headset's display description: per-eye size, refresh rate and fields of view.
+/// Named real headsets are in [`crate::profiles`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeadsetProfile {
     pub name: &'static str,
     pub width: u32,
     pub height: u32,
+    /// The rate in use; `budget_ms` follows it.
     pub refresh_hz: f64,
+    /// The rates the headset can run at (`with_refresh` picks among them).
+    pub refresh_rates_hz: &'static [f64],
     pub ipd: f64,
     pub fov_left: Fov,
     pub fov_right: Fov,
@@ -204,6 +208,11 @@ pub struct HeadsetProfile {
 impl HeadsetProfile {
     /// An HTC Vive-class headset: 1080×1200 per eye at 90 Hz. The frustum is 52° up and
     /// down, 45° towards the nose, and outward as wide as square pixels require.
+    /// Size: the Vive's own config, `eye_target_width/height_in_pixels` 1080×1200
+    /// (https://gist.github.com/ChristophHaag/c6235817421f2ce5da839772eff48f40); 90 Hz: its
+    /// hmdq dump (https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html). The
+    /// frustum is an approximation kept as is because earlier measurements used it (the
+    /// dump measures 54.4° out, 46.8° nasal, 55.7° up, 55.9° down).
     pub fn vive() -> HeadsetProfile {
         HeadsetProfile::with_size("vive", 1080, 1200)
     }
@@ -224,9 +233,32 @@ impl HeadsetProfile {
             width,
             height,
             refresh_hz: 90.0,
+            refresh_rates_hz: &[90.0],
             ipd: DEFAULT_IPD,
             fov_left: left_eye,
             fov_right: left_eye.mirrored(),
+        }
+    }
+
+    /// The same headset rendered at another per-eye size, keeping its field of view (the
+    /// pixels stop being square when the aspect differs from the frustum's).
+    pub fn with_render_size(self, width: u32, height: u32) -> HeadsetProfile {
+        HeadsetProfile { width, height, ..self }
+    }
+
+    /// The same headset at another of its supported refresh rates.
+    pub fn with_refresh(self, hz: f64) -> Result<HeadsetProfile, String> {
+        // A tolerance so that a rate parsed from text (e.g. "72.0") still matches.
+        match self.refresh_rates_hz.iter().find(|&&r| (r - hz).abs() < 1e-6) {
+            Some(&rate) => Ok(HeadsetProfile { refresh_hz: rate, ..self }),
+            None => {
+                let rates: Vec<String> = self.refresh_rates_hz.iter().map(|r| r.to_string()).collect();
+                Err(format!(
+                    "refresh rate {hz} Hz is not supported by headset profile '{}' (supported: {} Hz)",
+                    self.name,
+                    rates.join(", ")
+                ))
+            }
         }
     }
 
