@@ -16,6 +16,7 @@ pub mod metrics;
 pub mod output;
 pub mod passes;
 pub mod plot;
+pub mod profiles;
 pub mod reference;
 pub mod renderer;
 pub mod sampling;
