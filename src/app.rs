@@ -8,11 +8,13 @@ use crate::graph::Resource;
 use crate::headset::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::headset::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::headset::{FrameRequest, Headset, SubmittedFrame};
-use crate::renderer::{FrameReport, Renderer};
+use crate::gpu::timing::FrameTiming;
+use crate::renderer::{FrameReport, Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stereo::HeadsetProfile;
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// Which headset `vrao run` drives.
@@ -76,23 +78,33 @@ pub fn open_headset(
     }
 }
 
-/// Per-pass GPU times of recent frames, for the profiler graph.
+/// Per-pass GPU times of recent frames (as they come back from the GPU, a few frames
+/// after they were submitted), for the profiler graph.
 #[derive(Clone, Debug, Default)]
 pub struct PassHistory {
-    pub frames: VecDeque<Vec<(String, f64)>>,
+    pub frames: VecDeque<FrameTiming>,
+    /// CPU time spent encoding each recent frame (ms), newest last.
+    pub cpu_encode_ms: VecDeque<f64>,
     pub capacity: usize,
 }
 
 impl PassHistory {
     pub fn new(capacity: usize) -> PassHistory {
-        PassHistory { frames: VecDeque::with_capacity(capacity), capacity }
+        PassHistory { frames: VecDeque::with_capacity(capacity), cpu_encode_ms: VecDeque::new(), capacity }
     }
 
-    pub fn push(&mut self, spans: Vec<(String, f64)>) {
+    pub fn push(&mut self, timing: FrameTiming) {
         if self.frames.len() == self.capacity {
             self.frames.pop_front();
         }
-        self.frames.push_back(spans);
+        self.frames.push_back(timing);
+    }
+
+    pub fn push_cpu_encode(&mut self, ms: f64) {
+        if self.cpu_encode_ms.len() == self.capacity {
+            self.cpu_encode_ms.pop_front();
+        }
+        self.cpu_encode_ms.push_back(ms);
     }
 }
 
@@ -102,14 +114,39 @@ pub struct Step {
     pub report: Option<FrameReport>,
 }
 
-/// The headset frame loop.
+/// The headset frame loop. Frames are submitted without waiting for the GPU; their GPU
+/// times come back later and feed the history, the over-budget count and the governor.
 pub struct FrameLoop {
     pub gpu: Arc<Gpu>,
     pub renderer: Renderer,
     pub headset: Box<dyn Headset>,
     pub history: PassHistory,
+    /// Frames rendered (handed to the headset with an image).
     pub frames: u64,
+    /// Stop after this many rendered frames.
+    pub frame_limit: Option<u64>,
+    /// The display period the frame must fit (ms).
+    pub budget_ms: f64,
+    /// Frames whose GPU time exceeded `budget_ms`, and all frames whose time came back.
+    pub over_budget_frames: u64,
+    pub timed_frames: u64,
+    /// Every frame's GPU time and CPU encode time (ms), for the run's medians.
+    pub gpu_frame_ms: Vec<f64>,
+    pub cpu_encode_ms: Vec<f64>,
+    /// Set (by Ctrl-C) to end the session cleanly after the current frame.
+    pub exit_requested: Arc<AtomicBool>,
+    exit_sent: bool,
+    /// On a CPU adapter, every [`SERIAL_EVERY`]-th frame is submitted pass by pass.
+    cpu_adapter: bool,
+    serial_frames: VecDeque<u64>,
 }
+
+/// On a CPU adapter (lavapipe), timestamps within one submission credit work to the
+/// wrong pass, and one submission per pass keeps frames from overlapping (each
+/// submission waits for the previous one there). So one frame in this many is
+/// submitted pass by pass for the profiler's true per-pass times; the others are
+/// submitted whole and stay in flight.
+pub const SERIAL_EVERY: u64 = 8;
 
 impl FrameLoop {
     /// A loop rendering `scene` with `settings` at the headset's recommended size.
@@ -117,53 +154,156 @@ impl FrameLoop {
         let mut settings = settings.clone();
         (settings.profile.width, settings.profile.height) = headset.recommended_size();
         let renderer = Renderer::new(gpu.clone(), scene, &settings)?;
-        Ok(FrameLoop { gpu, renderer, headset, history: PassHistory::new(120), frames: 0 })
+        let cpu_adapter = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+        Ok(FrameLoop {
+            cpu_adapter,
+            serial_frames: VecDeque::new(),
+            gpu,
+            renderer,
+            headset,
+            history: PassHistory::new(120),
+            frames: 0,
+            frame_limit: None,
+            budget_ms: settings.profile.budget_ms(),
+            over_budget_frames: 0,
+            timed_frames: 0,
+            gpu_frame_ms: Vec::new(),
+            cpu_encode_ms: Vec::new(),
+            exit_requested: Arc::new(AtomicBool::new(false)),
+            exit_sent: false,
+        })
     }
 
     /// Waits for the headset's next frame, renders it and submits it; `None` when the
-    /// session has ended.
+    /// session has ended (or the frame limit is reached, or exit was requested).
     pub fn step(&mut self) -> Result<Option<Step>> {
+        if self.frame_limit.is_some_and(|n| self.frames >= n) {
+            return Ok(None);
+        }
+        if self.exit_requested.load(Ordering::Relaxed) && !self.exit_sent {
+            self.exit_sent = true;
+            return Ok(None);
+        }
         let Some(request) = self.headset.wait_frame(&self.gpu)? else { return Ok(None) };
         if !request.should_render {
             self.headset.submit(&self.gpu, &request, None)?;
             return Ok(Some(Step { request, report: None }));
         }
-        let report = self.renderer.render(&request.eyes.eyes, &[Resource::Color, Resource::Depth])?;
+        let serial = self.cpu_adapter && self.renderer.frame_index().is_multiple_of(SERIAL_EVERY);
+        self.renderer.set_timing(if serial { Timing::Serial } else { Timing::Pipelined });
+        if serial {
+            self.serial_frames.push_back(self.renderer.frame_index());
+        }
+        let (headset, gpu) = (&mut self.headset, &self.gpu);
+        let report = self.renderer.render_with(&request.eyes.eyes, &[Resource::Color, Resource::Depth], |encoder, targets| {
+            if let (Some(color), Some(depth)) = (targets.get(&Resource::Color), targets.get(&Resource::Depth)) {
+                headset.record_frame(gpu, encoder, &request, color, depth);
+            }
+        })?;
         let color = self.renderer.target(Resource::Color).ok_or_else(|| Error::Gpu("no eye colour".into()))?;
         let depth = self.renderer.target(Resource::Depth).ok_or_else(|| Error::Gpu("no eye depth".into()))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
         self.headset.submit(&self.gpu, &request, Some(frame))?;
-        self.history.push(report.gpu_ms.clone());
         self.frames += 1;
+        self.cpu_encode_ms.push(report.cpu_encode_ms);
+        self.history.push_cpu_encode(report.cpu_encode_ms);
+        self.take_timings(report.finished.clone());
         Ok(Some(Step { request, report: Some(report) }))
     }
 
+    /// Books the GPU times of frames that came back.
+    fn take_timings(&mut self, finished: Vec<FrameTiming>) {
+        for mut timing in finished {
+            while self.serial_frames.front().is_some_and(|&f| f < timing.frame) {
+                self.serial_frames.pop_front();
+            }
+            timing.serial = self.serial_frames.front() == Some(&timing.frame);
+            self.timed_frames += 1;
+            if timing.total_ms > self.budget_ms {
+                self.over_budget_frames += 1;
+            }
+            self.gpu_frame_ms.push(timing.total_ms);
+            self.history.push(timing);
+        }
+    }
+
+    /// Ends the session: waits for the frames in flight (their times are booked too).
     pub fn end(&mut self) -> Result<()> {
+        let finished = self.renderer.finish()?;
+        self.take_timings(finished);
         self.headset.end(&self.gpu)
     }
 }
 
-/// What a run did: frames rendered, the headset's counters and per-pass medians.
+fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    crate::gpu::timing::quantile(&sorted, 0.5)
+}
+
+/// What a run did (`vrao run --report`): frames rendered and in flight, the frame budget
+/// and how often it was missed, the headset's counters and per-pass medians.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct RunSummary {
     pub headset: String,
-    pub frames: u64,
+    pub adapter: String,
+    /// Frames rendered and handed to the headset.
+    pub frames_rendered: u64,
+    /// The most frames the GPU worked on at once, and the limit.
+    pub frames_in_flight_max: usize,
+    pub frames_in_flight_limit: usize,
+    /// The display period (ms) and the frames whose GPU time exceeded it (of those timed).
+    pub budget_ms: f64,
+    pub over_budget_frames: u64,
+    pub timed_frames: u64,
+    /// Medians over the run: GPU time per frame (both eyes), CPU encode time per frame,
+    /// and their ratio.
+    pub gpu_frame_ms_median: f64,
+    pub cpu_encode_ms_median: f64,
+    pub cpu_encode_share_of_gpu: f64,
+    /// How the passes were timed: pipelined or serial (one submission per pass).
+    pub timing: String,
     pub counters: crate::headset::FrameCounters,
     /// (pass, median GPU ms for both eyes) over the recent frames.
     pub pass_medians_ms: Vec<(String, f64)>,
+    /// Whether Ctrl-C ended the run.
+    pub interrupted: bool,
 }
 
 impl RunSummary {
     pub fn of(frame_loop: &FrameLoop) -> RunSummary {
-        let frames: Vec<Vec<(String, f64)>> = frame_loop.history.frames.iter().cloned().collect();
+        let frames: Vec<Vec<(String, f64)>> = frame_loop.history.frames.iter().map(|f| f.spans.clone()).collect();
+        let gpu_frame_ms_median = median(&frame_loop.gpu_frame_ms);
+        let cpu_encode_ms_median = median(&frame_loop.cpu_encode_ms);
         RunSummary {
             headset: frame_loop.headset.describe(),
-            frames: frame_loop.frames,
+            adapter: frame_loop.gpu.adapter.get_info().name,
+            frames_rendered: frame_loop.frames,
+            frames_in_flight_max: frame_loop.renderer.frames_in_flight_max(),
+            frames_in_flight_limit: frame_loop.renderer.frames_in_flight_limit(),
+            budget_ms: frame_loop.budget_ms,
+            over_budget_frames: frame_loop.over_budget_frames,
+            timed_frames: frame_loop.timed_frames,
+            gpu_frame_ms_median,
+            cpu_encode_ms_median,
+            cpu_encode_share_of_gpu: if gpu_frame_ms_median > 0.0 {
+                cpu_encode_ms_median / gpu_frame_ms_median
+            } else {
+                0.0
+            },
+            timing: match frame_loop.renderer.timing() {
+                Timing::Pipelined => "pipelined".into(),
+                Timing::Serial => "serial".into(),
+            },
             counters: frame_loop.headset.counters(),
             pass_medians_ms: crate::gpu::timing::summarize(&frames)
                 .into_iter()
                 .map(|s| (s.label, s.median_ms))
                 .collect(),
+            interrupted: frame_loop.exit_requested.load(Ordering::Relaxed),
         }
     }
 
@@ -171,14 +311,22 @@ impl RunSummary {
         let c = &self.counters;
         let passes: Vec<String> = self.pass_medians_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect();
         format!(
-            "frames: {} rendered, {} submitted; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms\npass medians (ms, both eyes): {}",
-            self.frames,
+            "frames: {} rendered (up to {} in flight), {} submitted; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms\nGPU per frame: median {:.2} ms against a {:.2} ms budget, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}",
+            self.frames_rendered,
+            self.frames_in_flight_max,
             c.submitted,
             c.presented,
             c.reprojected,
             c.dropped,
             c.latency_median_ms,
             c.latency_p95_ms,
+            self.gpu_frame_ms_median,
+            self.budget_ms,
+            self.over_budget_frames,
+            self.timed_frames,
+            self.cpu_encode_ms_median,
+            100.0 * self.cpu_encode_share_of_gpu,
+            self.timing,
             passes.join(", ")
         )
     }

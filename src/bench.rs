@@ -152,7 +152,7 @@ impl CaseRun {
 
     /// One frame, not measured (warm-up).
     fn frame(&mut self) -> Result<crate::renderer::FrameReport> {
-        self.renderer.render(&self.eyes.eyes, &self.outputs)
+        self.renderer.render_and_wait(&self.eyes.eyes, &self.outputs)
     }
 
     /// One measured frame: serial timing keeps each pass's wall-clock time; pipelined,
@@ -264,7 +264,7 @@ pub fn measure_rsm(
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let mut timings = Vec::new();
     for frame in 0..warmup + frames {
-        let report = renderer.render(&eyes.eyes, &[crate::graph::Resource::RsmIndirect])?;
+        let report = renderer.render_and_wait(&eyes.eyes, &[crate::graph::Resource::RsmIndirect])?;
         if frame >= warmup {
             timings.push(if timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
         }

@@ -133,7 +133,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
     let mut pass_order: Vec<String> = Vec::new();
     for round in 0..how.warmup + how.frames {
         for (k, v) in views.iter().enumerate() {
-            let report = renderer.render(v, &[how.output])?;
+            let report = renderer.render_and_wait(v, &[how.output])?;
             if round < how.warmup {
                 continue;
             }

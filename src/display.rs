@@ -596,14 +596,14 @@ fn panel_ui(
 fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
     let mut passes: Vec<String> = Vec::new();
     for frame in &history.frames {
-        for (name, _) in frame {
+        for (name, _) in &frame.spans {
             if !passes.contains(name) && !name.ends_with(" left") && !name.ends_with(" right") {
                 passes.push(name.clone());
             }
         }
     }
     let total =
-        |frame: &Vec<(String, f64)>| frame.iter().filter(|(n, _)| passes.contains(n)).map(|(_, ms)| ms).sum::<f64>();
+        |frame: &crate::gpu::timing::FrameTiming| frame.spans.iter().filter(|(n, _)| passes.contains(n)).map(|(_, ms)| ms).sum::<f64>();
     let max_ms = history.frames.iter().map(total).fold(0.0, f64::max).max(1e-3);
     ui.label(format!("GPU ms per frame, both eyes (top {max_ms:.1} ms)"));
     let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width(), 120.0), egui::Sense::hover());
@@ -615,7 +615,7 @@ fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
         let x = rect.left() + i as f32 * bar_width;
         let mut y = rect.bottom();
         for (k, pass) in passes.iter().enumerate() {
-            let ms = frame.iter().find(|(name, _)| name == pass).map_or(0.0, |(_, ms)| *ms);
+            let ms = frame.spans.iter().find(|(name, _)| name == pass).map_or(0.0, |(_, ms)| *ms);
             let h = (ms / max_ms) as f32 * rect.height();
             let bar = egui::Rect::from_min_max(egui::pos2(x, y - h), egui::pos2(x + bar_width.max(1.0), y));
             painter.rect_filled(bar, 0.0, pass_colour(k));
@@ -624,7 +624,7 @@ fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
     }
     let latest = history.frames.back();
     for (k, pass) in passes.iter().enumerate() {
-        let ms = latest.and_then(|f| f.iter().find(|(n, _)| n == pass)).map_or(0.0, |(_, ms)| *ms);
+        let ms = latest.and_then(|f| f.spans.iter().find(|(n, _)| n == pass)).map_or(0.0, |(_, ms)| *ms);
         ui.horizontal(|ui| {
             let (swatch, painter) = ui.allocate_painter(egui::vec2(10.0, 10.0), egui::Sense::hover());
             painter.rect_filled(swatch.rect, 0.0, pass_colour(k));

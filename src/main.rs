@@ -588,7 +588,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     let mut timings = Vec::new();
     let mut report = None;
     for frame in 0..warmup + args.frames {
-        let r = renderer.render(&eyes.eyes, &outputs)?;
+        let r = renderer.render_and_wait(&eyes.eyes, &outputs)?;
         if frame >= warmup {
             let mut spans = r.gpu_ms.clone();
             spans.extend(r.wall_ms.iter().map(|(pass, ms)| (format!("{pass} (wall)"), *ms)));

@@ -1,6 +1,12 @@
 //! The renderer: owns the passes and their targets. Each frame it asks the passes what
 //! they read and write, lets the graph keep only what the requested outputs need, and
 //! records the kept passes with a GPU timestamp span around each.
+//!
+//! Frames in flight: [`Renderer::render`] submits and returns without waiting for the
+//! GPU; up to [`Renderer::set_frames_in_flight`] frames run at once (the oldest is
+//! waited for before another is encoded) and each frame's GPU times come back a few
+//! frames later in [`FrameReport::finished`]. Only pixel readbacks and
+//! [`Renderer::render_and_wait`] (measurements) wait.
 
 use crate::error::{Error, Result};
 use crate::gpu::frame::ao_extent;
@@ -8,7 +14,7 @@ use crate::gpu::frame::FrameBuffers;
 use crate::gpu::readback;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::LayeredTarget;
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::timing::{FrameTiming, PassTimer};
 use crate::gpu::Gpu;
 use crate::graph::{self, Plan, Resource};
 use crate::passes::blur::BlurPass;
@@ -27,21 +33,34 @@ use crate::passes::{FrameContext, FrameSetup, Pass};
 use crate::scene::Scene;
 use crate::settings::{Settings, StereoMode};
 use crate::stereo::Eye;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
+
+/// Frames the renderer lets the GPU work on at once unless told otherwise.
+pub const DEFAULT_FRAMES_IN_FLIGHT: usize = 2;
 
 /// What one frame did: the plan (passes run and left out) and how long each took.
 #[derive(Clone, Debug)]
 pub struct FrameReport {
+    /// This frame's number (counts every frame the renderer submitted).
+    pub frame: u64,
     pub plan: Plan,
-    /// (span, GPU milliseconds) per pass, plus per-eye spans where a pass runs per eye.
-    /// Empty when the adapter has no timestamp queries.
+    /// (span, GPU milliseconds) per pass of this frame, plus per-eye spans where a pass
+    /// runs per eye: filled by [`Renderer::render_and_wait`]; after [`Renderer::render`]
+    /// the frame is still on the GPU and its times arrive later in `finished`. Empty when
+    /// the adapter has no timestamp queries.
     pub gpu_ms: Vec<(String, f64)>,
     /// CPU time spent encoding the frame's commands.
     pub cpu_encode_ms: f64,
-    /// With [`Timing::Serial`]: (pass, wall-clock ms from submit to completion) per pass.
+    /// With [`Timing::Serial`] and [`Renderer::render_and_wait`]: (pass, wall-clock ms
+    /// from submit to completion) per pass.
     pub wall_ms: Vec<(String, f64)>,
+    /// Frames the GPU had not finished when this one was submitted, this one included.
+    pub frames_in_flight: usize,
+    /// Earlier frames whose GPU times came back while this one was recorded.
+    pub finished: Vec<FrameTiming>,
 }
 
 /// How a frame's passes are submitted and timed.
@@ -50,9 +69,11 @@ pub enum Timing {
     /// One submission per frame, a timestamp pair around every pass (how frames run).
     #[default]
     Pipelined,
-    /// One submission per pass, each waited for: timestamps plus the wall-clock time of
-    /// each pass. Slower, but immune to drivers that misplace timestamps between passes
-    /// (lavapipe 22.x credits one compute pass's work to its neighbour).
+    /// One submission per pass. Lavapipe 22.x credits one pass's work to its neighbour
+    /// within a submission, but finishes each submission before the next one's
+    /// timestamps, so its per-pass times are true this way (and match the wall clock).
+    /// The CPU still does not wait; [`Renderer::render_and_wait`] also waits for each
+    /// pass and reports its wall-clock time.
     Serial,
 }
 
@@ -71,11 +92,34 @@ pub struct Renderer {
     frame: FrameBuffers,
     passes: Vec<Box<dyn Pass>>,
     targets: BTreeMap<Resource, LayeredTarget>,
-    timer: GpuTimer,
+    timer: PassTimer,
     timing: Timing,
     /// Frames rendered so far, and the views of the last one (temporal reuse).
     frame_index: u64,
     previous_views: Vec<Eye>,
+    /// The last plan and what it was made for: kept while nothing it depends on changes.
+    plan_cache: Option<(PlanKey, Plan)>,
+    /// Submitted frames the GPU has not been seen to finish, oldest first.
+    in_flight: VecDeque<InFlight>,
+    frames_in_flight: usize,
+    frames_in_flight_max: usize,
+}
+
+/// What a frame's plan depends on besides the passes themselves.
+#[derive(Clone, PartialEq)]
+struct PlanKey {
+    settings: Settings,
+    layers: u32,
+    outputs: Vec<Resource>,
+    /// The temporal pass swaps its history targets every frame and reads them only with
+    /// a previous frame of as many views.
+    odd_frame: bool,
+    has_history: bool,
+}
+
+struct InFlight {
+    submission: wgpu::SubmissionIndex,
+    done: Arc<AtomicBool>,
 }
 
 impl Renderer {
@@ -121,7 +165,7 @@ impl Renderer {
             Box::new(CompositePass::new(&gpu)),
             Box::new(TonemapPass::new(&gpu)),
         ];
-        let timer = GpuTimer::new(&gpu, 32);
+        let timer = PassTimer::new(&gpu)?;
         gpu.take_error()?;
         Ok(Renderer {
             gpu,
@@ -136,7 +180,36 @@ impl Renderer {
             timing: Timing::Pipelined,
             frame_index: 0,
             previous_views: Vec::new(),
+            plan_cache: None,
+            in_flight: VecDeque::new(),
+            frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
+            frames_in_flight_max: 0,
         })
+    }
+
+    /// How many frames may be on the GPU at once (at least 1: each frame waits for the
+    /// previous one).
+    pub fn set_frames_in_flight(&mut self, frames: usize) {
+        self.frames_in_flight = frames.max(1);
+    }
+
+    /// How many frames may be on the GPU at once.
+    pub fn frames_in_flight_limit(&self) -> usize {
+        self.frames_in_flight
+    }
+
+    pub fn timing(&self) -> Timing {
+        self.timing
+    }
+
+    /// The most frames that were on the GPU at once so far.
+    pub fn frames_in_flight_max(&self) -> usize {
+        self.frames_in_flight_max
+    }
+
+    /// Frames rendered so far.
+    pub fn frame_index(&self) -> u64 {
+        self.frame_index
     }
 
     pub fn gpu(&self) -> &Arc<Gpu> {
@@ -190,18 +263,98 @@ impl Renderer {
         graph::plan(&decls, outputs).map_err(Error::Gpu)
     }
 
-    /// Renders one frame for `views` (two eyes, or one mono view) producing `outputs`,
-    /// and waits for it. Only the passes the outputs need are recorded.
+    /// This frame's plan: the last one while its key holds, a new one otherwise.
+    fn frame_plan(&mut self, layers: u32, outputs: &[Resource]) -> Result<Plan> {
+        let key = PlanKey {
+            settings: self.settings.clone(),
+            layers,
+            outputs: outputs.to_vec(),
+            odd_frame: self.frame_index % 2 == 1,
+            has_history: self.previous_views.len() == layers as usize,
+        };
+        if let Some((cached, plan)) = &self.plan_cache {
+            if *cached == key {
+                return Ok(plan.clone());
+            }
+        }
+        let plan = self.plan(layers, outputs)?;
+        self.plan_cache = Some((key, plan.clone()));
+        Ok(plan)
+    }
+
+    /// Renders one frame for `views` (two eyes, or one mono view) producing `outputs`
+    /// and submits it without waiting for the GPU (see the module's notes on frames in
+    /// flight). Only the passes the outputs need are recorded.
     pub fn render(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<FrameReport> {
+        self.record_and_submit(views, outputs, false, |_, _| {})
+    }
+
+    /// [`Renderer::render`], with `append` recording more commands (a headset's copy of
+    /// the eyes, say) into the frame's last encoder, so that they go to the GPU in the
+    /// frame's submission: a second submission would wait for the first on lavapipe.
+    pub fn render_with(
+        &mut self,
+        views: &[Eye],
+        outputs: &[Resource],
+        append: impl FnOnce(&mut wgpu::CommandEncoder, &BTreeMap<Resource, LayeredTarget>),
+    ) -> Result<FrameReport> {
+        self.record_and_submit(views, outputs, false, append)
+    }
+
+    /// Renders one frame and waits for it: its GPU times are in [`FrameReport::gpu_ms`]
+    /// (and with [`Timing::Serial`] each pass's wall-clock time in `wall_ms`). For
+    /// measurements; frame loops use [`Renderer::render`].
+    pub fn render_and_wait(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<FrameReport> {
+        let mut report = self.record_and_submit(views, outputs, true, |_, _| {})?;
+        self.gpu.wait_idle()?;
+        self.in_flight.clear();
+        report.finished.extend(self.timer.finished());
+        if let Some(own) = report.finished.iter().find(|t| t.frame == report.frame) {
+            report.gpu_ms = own.spans.clone();
+        }
+        Ok(report)
+    }
+
+    /// Waits until the GPU has finished every submitted frame and returns the GPU times
+    /// that had not come back yet.
+    pub fn finish(&mut self) -> Result<Vec<FrameTiming>> {
+        self.gpu.wait_idle()?;
+        self.in_flight.clear();
+        Ok(self.timer.finished())
+    }
+
+    /// Forgets frames the GPU has finished, then waits for the oldest ones until fewer
+    /// than the allowed number are in flight.
+    fn throttle(&mut self) -> Result<()> {
+        // A non-blocking poll runs the completion callbacks of finished submissions.
+        self.gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        self.in_flight.retain(|f| !f.done.load(Ordering::Acquire));
+        while self.in_flight.len() >= self.frames_in_flight {
+            let oldest = self.in_flight.pop_front().expect("non-empty");
+            self.gpu
+                .device
+                .poll(wgpu::PollType::Wait { submission_index: Some(oldest.submission), timeout: None })
+                .map_err(|e| Error::Gpu(format!("waiting for frame: {e}")))?;
+        }
+        Ok(())
+    }
+
+    fn record_and_submit(
+        &mut self,
+        views: &[Eye],
+        outputs: &[Resource],
+        wait_each_pass: bool,
+        append: impl FnOnce(&mut wgpu::CommandEncoder, &BTreeMap<Resource, LayeredTarget>),
+    ) -> Result<FrameReport> {
         if views.is_empty() || views.len() > 2 {
             return Err(Error::input(format!("a frame has 1 or 2 views, not {}", views.len())));
         }
+        self.throttle()?;
         let layers = views.len() as u32;
-        let plan = self.plan(layers, outputs)?;
+        let plan = self.frame_plan(layers, outputs)?;
         self.allocate_targets(&plan, layers);
         self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
         self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
-        self.timer.reset();
         let setup = FrameSetup {
             scene: &self.scene,
             settings: &self.settings,
@@ -223,31 +376,57 @@ impl Renderer {
                 targets: &self.targets,
                 frame: &self.frame,
                 scene: &self.gpu_scene,
-                timer: &mut self.timer,
+                timer: &self.timer,
                 setup: &setup,
             };
             let span = ctx.timer.begin(ctx.encoder, name);
             self.passes[index].record(&mut ctx);
             ctx.timer.end(ctx.encoder, span);
-            if step + 1 == plan.run.len() {
+            let last = step + 1 == plan.run.len();
+            if last {
                 self.timer.resolve(&mut encoder);
             }
             cpu_encode_ms += encode_start.elapsed().as_secs_f64() * 1e3;
-            if self.timing == Timing::Serial {
+            if self.timing == Timing::Serial && !last {
                 let finished =
                     std::mem::replace(&mut encoder, self.gpu.device.create_command_encoder(&Default::default()));
                 let submitted = Instant::now();
                 self.gpu.queue.submit([finished.finish()]);
-                self.gpu.wait_idle()?;
-                wall_ms.push((name.to_string(), submitted.elapsed().as_secs_f64() * 1e3));
+                if wait_each_pass {
+                    self.gpu.wait_idle()?;
+                    wall_ms.push((name.to_string(), submitted.elapsed().as_secs_f64() * 1e3));
+                }
             }
         }
-        self.gpu.queue.submit([encoder.finish()]);
-        let gpu_ms = self.timer.read(&self.gpu)?;
-        self.gpu.wait_idle()?;
+        append(&mut encoder, &self.targets);
+        // In flight: the frames the GPU has not finished as this one is handed over
+        // (counted before the submit call, which on lavapipe returns only once the
+        // previous submission has finished: wgpu chains submissions with semaphores
+        // that Mesa 22.3 waits for on the CPU).
+        self.gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        self.in_flight.retain(|f| !f.done.load(Ordering::Acquire));
+        let frames_in_flight = self.in_flight.len() + 1;
+        let submitted = Instant::now();
+        let submission = self.gpu.queue.submit([encoder.finish()]);
+        if self.timing == Timing::Serial && wait_each_pass {
+            self.gpu.wait_idle()?;
+            let last = plan.names.last().map(|n| n.to_string()).unwrap_or_default();
+            wall_ms.push((last, submitted.elapsed().as_secs_f64() * 1e3));
+        }
+        let done = Arc::new(AtomicBool::new(false));
+        let signal = done.clone();
+        self.gpu.queue.on_submitted_work_done(move || signal.store(true, Ordering::Release));
+        self.in_flight.push_back(InFlight { submission, done });
+        self.timer.end_frame(self.frame_index)?;
+        self.frames_in_flight_max = self.frames_in_flight_max.max(frames_in_flight);
+        // Collect the times of earlier frames that finished meanwhile (never waits).
+        self.gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        let finished = self.timer.finished();
+        self.gpu.take_error()?;
+        let frame = self.frame_index;
         self.frame_index += 1;
         self.previous_views = views.to_vec();
-        Ok(FrameReport { plan, gpu_ms, cpu_encode_ms, wall_ms })
+        Ok(FrameReport { frame, plan, gpu_ms: Vec::new(), cpu_encode_ms, wall_ms, frames_in_flight, finished })
     }
 
     /// (Re)creates the targets this plan touches at their size for this frame; targets

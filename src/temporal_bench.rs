@@ -60,7 +60,7 @@ pub fn convergence(
         for frame in 1..=*CHECKPOINTS.last().unwrap() {
             let head = motion.pose_at(&scene.head, frame as f64 * dt);
             let eyes = settings.profile.eyes(&head, settings.near);
-            let report = renderer.render(&eyes.eyes, &[output])?;
+            let report = renderer.render_and_wait(&eyes.eyes, &[output])?;
             let ms: f64 = report
                 .wall_ms
                 .iter()

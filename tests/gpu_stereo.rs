@@ -195,7 +195,7 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
     let s = settings(64, 72, StereoMode::Auto);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
-    let report = renderer.render(&eyes.eyes, &[Resource::Normals]).unwrap();
+    let report = renderer.render_and_wait(&eyes.eyes, &[Resource::Normals]).unwrap();
     assert_eq!(report.plan.names, vec!["gbuffer"]);
     let left_out: Vec<_> = report.plan.left_out.iter().map(|(n, _)| *n).collect();
     assert_eq!(

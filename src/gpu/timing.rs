@@ -1,124 +1,106 @@
-//! GPU timestamps around passes. One query pair per recorded span; resolved after the
-//! frame's submission and read back as milliseconds.
+//! GPU timestamps around passes, read back frames later without a stall: the scopes go
+//! through `wgpu-profiler`, which keeps a ring of query sets and readback buffers and
+//! hands back a frame's times once its buffers have mapped.
 
 use super::Gpu;
 use crate::error::{Error, Result};
+use std::collections::VecDeque;
 
-/// Collects (label, start, end) timestamp pairs for one frame.
-pub struct GpuTimer {
-    query_set: Option<wgpu::QuerySet>,
-    resolve: Option<wgpu::Buffer>,
-    readback: Option<wgpu::Buffer>,
-    capacity: u32,
-    labels: Vec<String>,
-    period_ns: f64,
+/// One finished frame's spans: (label, GPU milliseconds), nested spans after their parent.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameTiming {
+    pub frame: u64,
+    pub spans: Vec<(String, f64)>,
+    /// GPU time of the whole frame: the sum of its passes (the top-level spans).
+    pub total_ms: f64,
+    /// Whether the frame's passes went to the GPU one submission each (true per-pass
+    /// times on lavapipe; see [`crate::renderer::Timing::Serial`]).
+    pub serial: bool,
 }
 
-impl GpuTimer {
-    /// `max_spans` bounds the spans per frame; without timestamp support every call is a no-op.
-    pub fn new(gpu: &Gpu, max_spans: u32) -> GpuTimer {
-        let capacity = max_spans * 2;
-        let mut timer = GpuTimer {
-            query_set: None,
-            resolve: None,
-            readback: None,
-            capacity,
-            labels: Vec::new(),
-            period_ns: gpu.queue.get_timestamp_period() as f64,
+/// An open span; hand it back to [`PassTimer::end`] on the same encoder.
+pub struct Span(wgpu_profiler::GpuProfilerQuery);
+
+/// Timestamp spans of every frame in flight.
+pub struct PassTimer {
+    profiler: wgpu_profiler::GpuProfiler,
+    /// Frames whose spans were submitted and are not yet read back, oldest first (the
+    /// profiler returns frames in this order).
+    pending: VecDeque<u64>,
+    timestamp_period: f32,
+}
+
+/// The profiler never drops a frame as long as fewer than this many are pending; the
+/// renderer keeps far fewer in flight.
+const MAX_PENDING_FRAMES: usize = 16;
+
+impl PassTimer {
+    /// Timestamps where the adapter has them (inside encoders); a no-op otherwise.
+    pub fn new(gpu: &Gpu) -> Result<PassTimer> {
+        let settings = wgpu_profiler::GpuProfilerSettings {
+            enable_timer_queries: gpu.caps.timestamps,
+            enable_debug_groups: false,
+            max_num_pending_frames: MAX_PENDING_FRAMES,
         };
-        if gpu.caps.timestamps {
-            let bytes = capacity as u64 * 8;
-            timer.query_set = Some(gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("pass timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count: capacity,
-            }));
-            timer.resolve = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamp resolve"),
-                size: bytes,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }));
-            timer.readback = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamp readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            }));
-        }
-        timer
+        let profiler = wgpu_profiler::GpuProfiler::new(&gpu.device, settings)
+            .map_err(|e| Error::Gpu(format!("GPU profiler: {e}")))?;
+        Ok(PassTimer { profiler, pending: VecDeque::new(), timestamp_period: gpu.queue.get_timestamp_period() })
     }
 
     pub fn enabled(&self) -> bool {
-        self.query_set.is_some()
+        self.profiler.settings().enable_timer_queries
     }
 
-    /// Starts a new frame: forgets the previous frame's spans.
-    pub fn reset(&mut self) {
-        self.labels.clear();
+    /// Opens a span on `encoder`.
+    pub fn begin(&self, encoder: &mut wgpu::CommandEncoder, label: &str) -> Span {
+        Span(self.profiler.begin_query(label, encoder))
     }
 
-    /// Records the start of a span; returns its index for [`GpuTimer::end`].
-    pub fn begin(&mut self, encoder: &mut wgpu::CommandEncoder, label: &str) -> Option<u32> {
-        let qs = self.query_set.as_ref()?;
-        let index = self.labels.len() as u32;
-        if (index + 1) * 2 > self.capacity {
-            log::warn!("timer full; span '{label}' is not timed");
-            return None;
+    pub fn end(&self, encoder: &mut wgpu::CommandEncoder, span: Span) {
+        self.profiler.end_query(encoder, span.0);
+    }
+
+    /// Copies the frame's queries towards their readback buffers; record it in the
+    /// frame's last encoder.
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.profiler.resolve_queries(encoder);
+    }
+
+    /// Closes `frame` after its last submission and starts mapping its results.
+    pub fn end_frame(&mut self, frame: u64) -> Result<()> {
+        self.profiler.end_frame().map_err(|e| Error::Gpu(format!("GPU profiler: {e}")))?;
+        if self.enabled() {
+            self.pending.push_back(frame);
         }
-        self.labels.push(label.to_string());
-        encoder.write_timestamp(qs, index * 2);
-        Some(index)
+        Ok(())
     }
 
-    pub fn end(&mut self, encoder: &mut wgpu::CommandEncoder, span: Option<u32>) {
-        if let (Some(qs), Some(index)) = (self.query_set.as_ref(), span) {
-            encoder.write_timestamp(qs, index * 2 + 1);
+    /// Frames whose spans have been read back since the last call (poll the device for
+    /// them to arrive); never waits.
+    pub fn finished(&mut self) -> Vec<FrameTiming> {
+        let mut done = Vec::new();
+        while let Some(results) = self.profiler.process_finished_frame(self.timestamp_period) {
+            let Some(frame) = self.pending.pop_front() else { break };
+            let mut spans = Vec::new();
+            flatten(&results, &mut spans);
+            let total_ms = results.iter().filter_map(|r| r.time.as_ref()).map(|t| (t.end - t.start).max(0.0) * 1e3).sum();
+            done.push(FrameTiming { frame, spans, total_ms, serial: false });
         }
+        done
     }
 
-    /// Copies this frame's queries into the readback buffer; call before `finish`.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let (Some(qs), Some(resolve), Some(readback)) = (&self.query_set, &self.resolve, &self.readback) {
-            let n = self.labels.len() as u32 * 2;
-            if n == 0 {
-                return;
-            }
-            encoder.resolve_query_set(qs, 0..n, resolve, 0);
-            encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, n as u64 * 8);
-        }
+    /// Frames submitted whose spans have not come back yet.
+    pub fn pending(&self) -> usize {
+        self.pending.len()
     }
+}
 
-    /// Reads the spans of the submitted frame as (label, milliseconds). Waits for the GPU.
-    pub fn read(&self, gpu: &Gpu) -> Result<Vec<(String, f64)>> {
-        let Some(readback) = &self.readback else { return Ok(Vec::new()) };
-        let n = self.labels.len() as u64 * 2;
-        if n == 0 {
-            return Ok(Vec::new());
+fn flatten(results: &[wgpu_profiler::GpuTimerQueryResult], out: &mut Vec<(String, f64)>) {
+    for r in results {
+        if let Some(time) = &r.time {
+            out.push((r.label.clone(), (time.end - time.start).max(0.0) * 1e3));
         }
-        let slice = readback.slice(..n * 8);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        gpu.wait_idle()?;
-        rx.recv()
-            .map_err(|_| Error::Gpu("timestamp callback never ran".into()))?
-            .map_err(|e| Error::Gpu(format!("timestamp readback: {e}")))?;
-        let ticks: Vec<u64> = {
-            let data = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?;
-            data.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap())).collect()
-        };
-        readback.unmap();
-        Ok(self
-            .labels
-            .iter()
-            .enumerate()
-            .map(|(i, label)| {
-                let ticks = ticks[2 * i + 1].saturating_sub(ticks[2 * i]);
-                (label.clone(), ticks as f64 * self.period_ns * 1e-6)
-            })
-            .collect())
+        flatten(&r.nested_queries, out);
     }
 }
 

@@ -66,6 +66,18 @@ pub trait Headset {
     /// Blocks until the application should start the next frame and returns it, or `None`
     /// when the session has ended (the user quit, or the runtime is exiting).
     fn wait_frame(&mut self, gpu: &Gpu) -> Result<Option<FrameRequest>>;
+    /// Records what the headset does with a frame's eyes (a copy, say) into the
+    /// frame's own encoder, before the frame is submitted; `submit` then need not
+    /// submit that work on its own. Headsets that copy in `submit` leave this empty.
+    fn record_frame(
+        &mut self,
+        _gpu: &Gpu,
+        _encoder: &mut wgpu::CommandEncoder,
+        _request: &FrameRequest,
+        _color: &LayeredTarget,
+        _depth: &LayeredTarget,
+    ) {
+    }
     /// Hands over the rendered frame (or `None` when `should_render` was false).
     fn submit(&mut self, gpu: &Gpu, request: &FrameRequest, frame: Option<SubmittedFrame>) -> Result<()>;
     /// What the headset's display shows now (the compositor's output), if it can be read:

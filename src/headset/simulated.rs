@@ -18,6 +18,8 @@ use crate::gpu::Gpu;
 use crate::graph::Resource;
 use crate::scene::HeadPath;
 use crate::stereo::{EyePair, HeadsetProfile};
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
 
 /// How time passes on the simulated headset.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,8 +53,23 @@ struct HeldFrame {
     depth: LayeredTarget,
 }
 
+/// How often, in real time, the headset looks whether a rendering frame has finished.
+const COMPLETION_POLL_S: f64 = 0.005;
+
+/// A frame handed over in real time whose GPU work has not been seen to finish: the
+/// compositor gets it, with the time it finished, once it has.
+struct Rendering {
+    frame: u64,
+    target_vsync: u64,
+    pose_time: f64,
+    finished_at: Arc<Mutex<Option<f64>>>,
+}
+
 pub struct SimulatedHeadset {
     options: SimulatedOptions,
+    rendering: VecDeque<Rendering>,
+    /// The frame whose hold copy went into its own submission ([`Headset::record_frame`]).
+    recorded: Option<u64>,
     clock: Clock,
     compositor: Compositor,
     next_frame: u64,
@@ -80,6 +97,8 @@ impl SimulatedHeadset {
             TimeMode::Virtual { .. } => Clock::Virtual { now: 0.0 },
         };
         Ok(SimulatedHeadset {
+            rendering: VecDeque::new(),
+            recorded: None,
             compositor: Compositor::new(options.profile.refresh_hz),
             options,
             clock,
@@ -98,8 +117,47 @@ impl SimulatedHeadset {
         self.options.profile.eyes(&self.options.motion.pose_at(&self.options.path, t), self.options.near)
     }
 
+    /// Hands the compositor the frames whose GPU work has finished, with when it did.
+    fn collect_finished(&mut self, gpu: &Gpu) -> Result<()> {
+        if self.rendering.is_empty() {
+            return Ok(());
+        }
+        gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        while let Some(front) = self.rendering.front() {
+            let Some(finished) = *front.finished_at.lock().expect("finish time") else { break };
+            self.compositor.submit(front.frame, front.target_vsync, finished, front.pose_time);
+            self.rendering.pop_front();
+        }
+        Ok(())
+    }
+
+    /// Waits until time `t` on the headset's clock. In real time it waits on the GPU
+    /// while frames are rendering, so that each one's finishing time is seen when it
+    /// happens, not at the next vsync.
+    fn wait_until(&mut self, gpu: &Gpu, t: f64) -> Result<()> {
+        loop {
+            self.collect_finished(gpu)?;
+            let now = self.clock.now();
+            if now >= t || !matches!(self.clock, Clock::Real { .. }) {
+                break;
+            }
+            if self.rendering.is_empty() {
+                self.clock.wait_until(t);
+            } else {
+                // Naps between non-blocking polls. Lavapipe makes polls and timed waits
+                // costly: polling every 0.5 ms (or a blocking wait with a timeout)
+                // tripled its frame time (192x216, 33 -> 91 ms); a finish is seen at
+                // most this late.
+                self.clock.wait_until(t.min(now + COMPLETION_POLL_S));
+            }
+        }
+        self.clock.wait_until(t);
+        Ok(())
+    }
+
     /// Processes the vsyncs up to now and, when composing, computes the newest one's image.
     fn advance(&mut self, gpu: &Gpu) -> Result<()> {
+        self.collect_finished(gpu)?;
         let outcomes = self.compositor.advance_to(self.clock.now());
         for (_, outcome) in &outcomes {
             if let VsyncOutcome::Presented { frame } | VsyncOutcome::Reprojected { frame } = outcome {
@@ -164,9 +222,26 @@ impl SimulatedHeadset {
         self.clock.now()
     }
 
-    /// Copies the submitted frame into a held slot that is not the one on display.
+    /// Copies the submitted frame into a held slot that is not the one on display, in
+    /// its own submission.
     fn hold(&mut self, gpu: &Gpu, index: u64, frame: &SubmittedFrame) {
-        let extent = frame.color.extent();
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hold frame") });
+        self.record_hold(gpu, &mut encoder, index, frame.eyes, frame.color, frame.depth);
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Records the copy of a frame's eyes into a held slot that is not the one on display.
+    fn record_hold(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        index: u64,
+        eyes: &EyePair,
+        color: &LayeredTarget,
+        depth: &LayeredTarget,
+    ) {
+        let extent = color.extent();
         let shown = self.shown;
         let reusable = self.held.iter().position(|h| Some(h.frame) != shown && h.color.extent() == extent);
         let slot = match reusable {
@@ -176,7 +251,7 @@ impl SimulatedHeadset {
                 let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
                 self.held.push(HeldFrame {
                     frame: index,
-                    eyes: *frame.eyes,
+                    eyes: *eyes,
                     color: LayeredTarget::new(&gpu.device, "held colour", Resource::Color.format(), extent, usage),
                     depth: LayeredTarget::new(&gpu.device, "held depth", Resource::Depth.format(), extent, usage),
                 });
@@ -185,17 +260,15 @@ impl SimulatedHeadset {
         };
         let held = &mut self.held[slot];
         held.frame = index;
-        held.eyes = *frame.eyes;
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hold frame") });
-        for (from, to) in [(frame.color, &held.color), (frame.depth, &held.depth)] {
+        held.eyes = *eyes;
+        for (from, to) in [(color, &held.color), (depth, &held.depth)] {
             encoder.copy_texture_to_texture(
                 from.texture.as_image_copy(),
                 to.texture.as_image_copy(),
                 from.texture.size(),
             );
         }
-        gpu.queue.submit([encoder.finish()]);
+        self.recorded = Some(index);
     }
 }
 
@@ -229,7 +302,7 @@ impl Headset for SimulatedHeadset {
         }
         // Like xrWaitFrame: return at the next vsync, with poses predicted one period on.
         let start_vsync = self.compositor.vsync_after(self.clock.now() - 1e-9).max(1);
-        self.clock.wait_until(self.compositor.vsync_time(start_vsync));
+        self.wait_until(gpu, self.compositor.vsync_time(start_vsync))?;
         self.advance(gpu)?;
         let display_time = self.compositor.vsync_time(start_vsync + 1);
         self.started = Some((start_vsync, self.clock.now()));
@@ -252,10 +325,43 @@ impl Headset for SimulatedHeadset {
             self.clock.advance(ms / 1e3);
         }
         if let Some(frame) = frame {
-            self.hold(gpu, request.index, &frame);
-            self.compositor.submit(request.index, start_vsync + 1, self.clock.now(), pose_time);
+            if self.recorded.take() != Some(request.index) {
+                self.hold(gpu, request.index, &frame);
+            }
+            match &self.clock {
+                // In real time the frame is still on the GPU (frames in flight): the
+                // compositor learns when it finishes.
+                Clock::Real { start } => {
+                    let start = *start;
+                    let finished_at = Arc::new(Mutex::new(None));
+                    let slot = finished_at.clone();
+                    gpu.queue.on_submitted_work_done(move || {
+                        *slot.lock().expect("finish time") = Some(start.elapsed().as_secs_f64());
+                    });
+                    self.rendering.push_back(Rendering {
+                        frame: request.index,
+                        target_vsync: start_vsync + 1,
+                        pose_time,
+                        finished_at,
+                    });
+                }
+                Clock::Virtual { .. } => {
+                    self.compositor.submit(request.index, start_vsync + 1, self.clock.now(), pose_time)
+                }
+            }
         }
         self.advance(gpu)
+    }
+
+    fn record_frame(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        request: &FrameRequest,
+        color: &LayeredTarget,
+        depth: &LayeredTarget,
+    ) {
+        self.record_hold(gpu, encoder, request.index, &request.eyes, color, depth);
     }
 
     fn display_image(&self) -> Option<&LayeredTarget> {
@@ -266,8 +372,10 @@ impl Headset for SimulatedHeadset {
         self.compositor.counters()
     }
 
-    fn end(&mut self, _gpu: &Gpu) -> Result<()> {
+    fn end(&mut self, gpu: &Gpu) -> Result<()> {
         if !self.ended {
+            gpu.wait_idle()?;
+            self.collect_finished(gpu)?;
             // The display shows what was submitted last before the session closes.
             let last = self.compositor.vsync_after(self.clock.now()) + 1;
             self.clock.wait_until(self.compositor.vsync_time(last));

@@ -18,7 +18,7 @@ use crate::gpu::frame::ao_extent;
 use crate::gpu::frame::FrameBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::LayeredTarget;
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::scene::Scene;
@@ -48,7 +48,7 @@ pub struct FrameContext<'a> {
     pub targets: &'a BTreeMap<Resource, LayeredTarget>,
     pub frame: &'a FrameBuffers,
     pub scene: &'a GpuScene,
-    pub timer: &'a mut GpuTimer,
+    pub timer: &'a PassTimer,
     pub setup: &'a FrameSetup<'a>,
 }
 
