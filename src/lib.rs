@@ -9,6 +9,7 @@ pub mod bench;
 pub mod budget;
 pub mod display;
 pub mod error;
+pub mod governor;
 pub mod gpu;
 pub mod graph;
 pub mod headset;
