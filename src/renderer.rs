@@ -451,9 +451,12 @@ impl Renderer {
                 (p.width, p.height, layers)
             }
         };
+        let before = self.targets.len();
         self.targets.retain(|r, t| t.extent() == extent_of(*r));
+        let mut changed = self.targets.len() != before;
         for &r in &plan.resources {
             self.targets.entry(r).or_insert_with(|| {
+                changed = true;
                 let usage = if r.is_attachment() {
                     wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
                 } else {
@@ -464,6 +467,9 @@ impl Renderer {
                 };
                 LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent_of(r), usage)
             });
+        }
+        if changed {
+            crate::gpu::kernel::invalidate_bind_groups();
         }
     }
 

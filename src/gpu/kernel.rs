@@ -3,6 +3,23 @@
 //! names its slots and binds resources in the same order; binding `i` is slot `i`.
 
 use super::Gpu;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Bumped whenever targets are made or dropped: every kernel then forgets its bind
+/// groups, which would otherwise keep dropped textures alive.
+static BIND_GROUP_EPOCH: AtomicU64 = AtomicU64::new(0);
+
+/// Bind groups a kernel keeps before it starts over (a frame binds each kernel a few
+/// times; more means the resources change every frame).
+const MAX_CACHED_BIND_GROUPS: usize = 64;
+
+/// Forgets every kernel's cached bind groups (call when targets are recreated).
+pub fn invalidate_bind_groups() {
+    BIND_GROUP_EPOCH.fetch_add(1, Ordering::Relaxed);
+}
 
 /// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
 pub const TILE: u32 = 8;
@@ -158,6 +175,9 @@ pub struct Kernel {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     slots: Vec<Slot>,
+    /// Bind groups made so far, by the identity of what they bind, with the epoch they
+    /// were made in: a frame binds what the last one did, so none is made again.
+    bind_groups: Mutex<(u64, HashMap<u64, wgpu::BindGroup>)>,
 }
 
 impl Kernel {
@@ -192,7 +212,13 @@ impl Kernel {
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,
         });
-        Kernel { label: label.to_string(), pipeline, layout, slots: slots.to_vec() }
+        Kernel {
+            label: label.to_string(),
+            pipeline,
+            layout,
+            slots: slots.to_vec(),
+            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
+        }
     }
 
     /// Binds `resources` (one per slot, in slot order) and dispatches over
@@ -231,8 +257,29 @@ impl Kernel {
         pass.dispatch_workgroups_indirect(args, offset);
     }
 
+    /// The bind group of `resources`: the kept one when these resources were bound
+    /// before, a new one otherwise.
     fn bind_group(&self, device: &wgpu::Device, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
         assert_eq!(resources.len(), self.slots.len(), "kernel {}: one resource per slot", self.label);
+        let key = identity(resources);
+        let epoch = BIND_GROUP_EPOCH.load(Ordering::Relaxed);
+        let mut cache = self.bind_groups.lock().expect("bind group cache");
+        if cache.0 != epoch || cache.1.len() >= MAX_CACHED_BIND_GROUPS {
+            *cache = (epoch, HashMap::new());
+        }
+        if let Some(key) = key {
+            if let Some(group) = cache.1.get(&key) {
+                return group.clone();
+            }
+        }
+        let group = self.make_bind_group(device, resources);
+        if let Some(key) = key {
+            cache.1.insert(key, group.clone());
+        }
+        group
+    }
+
+    fn make_bind_group(&self, device: &wgpu::Device, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
         let entries: Vec<_> = resources
             .iter()
             .enumerate()
@@ -244,4 +291,22 @@ impl Kernel {
             entries: &entries,
         })
     }
+}
+
+/// A hash of which buffers (and ranges), views and samplers are bound where; `None` for
+/// kinds of binding it does not know (those are never cached).
+fn identity(resources: &[wgpu::BindingResource]) -> Option<u64> {
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for (slot, resource) in resources.iter().enumerate() {
+        slot.hash(&mut hasher);
+        match resource {
+            wgpu::BindingResource::Buffer(b) => {
+                (0u8, b.buffer, b.offset, b.size).hash(&mut hasher);
+            }
+            wgpu::BindingResource::TextureView(view) => (1u8, *view).hash(&mut hasher),
+            wgpu::BindingResource::Sampler(sampler) => (2u8, *sampler).hash(&mut hasher),
+            _ => return None,
+        }
+    }
+    Some(hasher.finish())
 }
