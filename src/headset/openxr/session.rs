@@ -620,8 +620,9 @@ fn end_frame(xr: &mut Xr, display_time: xr::Time, layer: Option<&Layer>) -> std:
                 // Reversed-Z with an infinite far plane: window depth 0 is infinitely
                 // far and 1 is the near plane. The extension's nearZ and farZ are the
                 // distances of minDepth and maxDepth ("a nearZ greater than farZ means
-                // reversed depth", "nearZ can be infinite"), so minDepth 0 ↔ nearZ = +∞
-                // and maxDepth 1 ↔ farZ = the near plane.
+                // reversed depth"), so minDepth 0 ↔ nearZ = far and maxDepth 1 ↔ farZ =
+                // the near plane. nearZ is f32::MAX, not +∞: a runtime linearising depth
+                // with ∞ gets NaN (∞/∞, ∞·0), and no depth value tells the two apart.
                 *depth_info = Some(sys::CompositionLayerDepthInfoKHR {
                     ty: sys::CompositionLayerDepthInfoKHR::TYPE,
                     next: std::ptr::null(),
@@ -632,7 +633,7 @@ fn end_frame(xr: &mut Xr, display_time: xr::Time, layer: Option<&Layer>) -> std:
                     },
                     min_depth: 0.0,
                     max_depth: 1.0,
-                    near_z: f32::INFINITY,
+                    near_z: f32::MAX,
                     far_z: layer.near as f32,
                 });
             }
