@@ -1,7 +1,8 @@
 //! The OpenXR headset: the fall back without a runtime (CI: the real loader, no runtime),
-//! the swapchain blit's colour encoding and depth copy, and — when `XR_RUNTIME_JSON`
-//! names a runtime (Monado with `XRT_COMPOSITOR_NULL=1` runs headless on lavapipe) — a
-//! real session of a few hundred frames, and a lost session's fall back.
+//! the swapchain blit's colour encoding and depth copy, and — ignored unless run with
+//! `--ignored` against a runtime (`XR_RUNTIME_JSON`, e.g. Monado with
+//! `XRT_COMPOSITOR_NULL=1`, which runs headless on lavapipe) — a real session of a few
+//! hundred frames, `--frames`, and a lost session's fall back.
 //!
 //! A process may hold one OpenXR instance at a time, and these tests change
 //! `XR_RUNTIME_JSON`: every test holds the one GPU lock for its whole run.
@@ -48,14 +49,22 @@ impl Drop for NoRuntime {
     }
 }
 
-/// The runtime manifest to test against, or `None` (the session tests are skipped).
-fn runtime_manifest() -> Option<PathBuf> {
+/// The runtime the ignored session tests run against (`XR_RUNTIME_JSON` when set,
+/// otherwise the loader's active runtime): its name. Fails the test when none answers.
+fn require_runtime() -> String {
     // As the CLI does: Mesa's WSI probe complains on headless machines without it.
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
-    let path = PathBuf::from(std::env::var_os(RUNTIME_VAR)?);
-    path.is_file().then_some(path)
+    if let Some(path) = std::env::var_os(RUNTIME_VAR).map(PathBuf::from) {
+        assert!(path.is_file(), "{RUNTIME_VAR}={} is not a runtime manifest", path.display());
+    }
+    probe_runtime().unwrap_or_else(|e| {
+        panic!(
+            "this test needs an OpenXR runtime: {e} (set {RUNTIME_VAR} to a runtime's manifest, e.g. Monado's with \
+             XRT_COMPOSITOR_NULL=1)"
+        )
+    })
 }
 
 fn small_simulated(frames: Option<u64>) -> SimulatedOptions {
@@ -332,16 +341,24 @@ fn in_order(seen: &[SessionPhase], want: &[SessionPhase]) -> bool {
 }
 
 #[test]
+fn the_simulated_headset_ends_at_request_exit_and_has_no_openxr_report() {
+    let (gpu, _one_at_a_time) = common::gpu();
+    let mut headset = vrao::headset::simulated::SimulatedHeadset::new(small_simulated(Some(10))).unwrap();
+    assert_eq!(headset.openxr_report(), None);
+    let request = headset.wait_frame(&gpu).unwrap().expect("a first frame");
+    headset.submit(&gpu, &request, None).unwrap();
+    headset.request_exit();
+    assert_eq!(headset.wait_frame(&gpu).unwrap(), None, "no frame after request_exit");
+    headset.end(&gpu).unwrap();
+}
+
+#[test]
+#[ignore = "needs an OpenXR runtime (e.g. Monado); run with --ignored"]
 fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
     let _one_at_a_time = common::gpu_lock();
-    let Some(manifest) = runtime_manifest() else {
-        eprintln!(
-            "skipped: set {RUNTIME_VAR} to an OpenXR runtime's manifest (e.g. Monado's, with XRT_COMPOSITOR_NULL=1)"
-        );
-        return;
-    };
-    let (mut headset, gpu) = OpenXrHeadset::open(session_options(None))
-        .unwrap_or_else(|e| panic!("the runtime at {} did not open a session: {e}", manifest.display()));
+    let runtime = require_runtime();
+    let (mut headset, gpu) =
+        OpenXrHeadset::open(session_options(None)).unwrap_or_else(|e| panic!("{runtime} did not open a session: {e}"));
     eprintln!("{}", headset.describe());
     assert_eq!(headset.recommended_size(), (96, 80));
     let mut renderer = renderer_for(&headset, &gpu);
@@ -352,7 +369,7 @@ fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
     assert!(headset.phases().contains(&SessionPhase::Focused), "{:?}", headset.phases());
 
     // Ask to leave: the runtime walks STOPPING → (xrEndSession) → IDLE → EXITING.
-    headset.request_exit().unwrap();
+    headset.request_exit();
     let mut after_exit = 0;
     while let Some(request) = headset.wait_frame(&gpu).unwrap() {
         headset.submit(&gpu, &request, None).unwrap();
@@ -377,6 +394,15 @@ fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
     assert!(headset.submits_depth(), "Monado has XR_KHR_composition_layer_depth: {}", headset.swapchains());
     assert_eq!(stats.layers_with_depth, stats.layers, "every layer carries depth");
     assert_eq!(counters.reprojected, 0, "reprojection is the runtime's and not counted");
+    let report = headset.openxr_report().expect("the OpenXR headset reports");
+    eprintln!("report {}", serde_json::to_string(&report).unwrap());
+    assert_eq!(report.frames_rendered, rendered);
+    assert_eq!(report.layers_submitted, rendered);
+    assert_eq!(report.depth_layers_submitted, rendered);
+    assert_eq!(report.empty_frames, stats.empty_frames);
+    assert_eq!(report.states_seen, phases.iter().map(|p| p.name()).collect::<Vec<_>>());
+    assert_eq!((report.loss_reason, report.ending.as_deref(), report.fell_back), (None, Some("EXITING"), false));
+    assert_eq!(report.runtime, runtime);
     drop(renderer);
     drop(headset);
     // The instance is gone: another may be made.
@@ -384,12 +410,30 @@ fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
 }
 
 #[test]
+#[ignore = "needs an OpenXR runtime (e.g. Monado); run with --ignored"]
+fn frames_counts_rendered_frames_then_the_session_walks_to_exiting() {
+    let _one_at_a_time = common::gpu_lock();
+    require_runtime();
+    let options = OpenXrOptions { frames: Some(30), ..session_options(None) };
+    let (mut headset, gpu) = OpenXrHeadset::open(options).expect("session");
+    let mut renderer = renderer_for(&headset, &gpu);
+    // More than asked for: wait_frame returns None after the 30th rendered frame.
+    let rendered = run_frames(&mut headset, &gpu, &mut renderer, 1000);
+    assert_eq!(rendered, 30);
+    assert!(headset.wait_frame(&gpu).unwrap().is_none());
+    let report = headset.openxr_report().unwrap();
+    assert_eq!(report.frames_rendered, 30);
+    assert_eq!(report.layers_submitted, 30);
+    assert_eq!(report.ending.as_deref(), Some("EXITING"), "{report:?}");
+    assert!(report.states_seen.ends_with(&["STOPPING".into(), "IDLE".into(), "EXITING".into()]), "{report:?}");
+    headset.end(&gpu).unwrap();
+}
+
+#[test]
+#[ignore = "needs an OpenXR runtime (e.g. Monado); run with --ignored"]
 fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
     let _one_at_a_time = common::gpu_lock();
-    if runtime_manifest().is_none() {
-        eprintln!("skipped: set {RUNTIME_VAR} to an OpenXR runtime's manifest");
-        return;
-    }
+    require_runtime();
     let (mut headset, gpu) = OpenXrHeadset::open(session_options(Some(small_simulated(None)))).expect("session");
     let mut renderer = renderer_for(&headset, &gpu);
     let before = run_frames(&mut headset, &gpu, &mut renderer, 20);
@@ -403,16 +447,21 @@ fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
     let after = run_frames(&mut headset, &gpu, &mut renderer, 10);
     assert_eq!(after, 10);
     assert_eq!(headset.counters().submitted, before + after);
+    let report = headset.openxr_report().expect("still reported after the fall back");
+    assert_eq!(report.loss_reason.as_deref(), Some("test: LOSS_PENDING"));
+    assert!(report.fell_back);
+    assert_eq!(report.frames_rendered, before);
+    // The fall back takes the exit request.
+    headset.request_exit();
+    assert!(headset.wait_frame(&gpu).unwrap().is_none());
     headset.end(&gpu).unwrap();
 }
 
 #[test]
+#[ignore = "needs an OpenXR runtime (e.g. Monado); run with --ignored"]
 fn one_swapchain_per_eye_works_too() {
     let _one_at_a_time = common::gpu_lock();
-    if runtime_manifest().is_none() {
-        eprintln!("skipped: set {RUNTIME_VAR} to an OpenXR runtime's manifest");
-        return;
-    }
+    require_runtime();
     let options = OpenXrOptions { layout: Some(SwapchainLayout::PerEye), ..session_options(None) };
     let (mut headset, gpu) = OpenXrHeadset::open(options).expect("session");
     assert!(headset.swapchains().contains("one swapchain per eye"), "{}", headset.swapchains());

@@ -86,6 +86,15 @@ pub trait Headset {
         None
     }
     fn counters(&self) -> FrameCounters;
+    /// Asks the session to end (the user quit): the following `wait_frame` calls return
+    /// `None` once the headset has wound down (OpenXR: xrRequestExitSession, then
+    /// STOPPING → xrEndSession → EXITING; at once when the session is not running).
+    fn request_exit(&mut self);
+    /// What the OpenXR session did (`None` for headsets that are not OpenXR). An
+    /// OpenXR headset that fell back to the simulated one still reports, with the loss.
+    fn openxr_report(&self) -> Option<crate::headset::openxr::OpenXrReport> {
+        None
+    }
     /// Ends the session cleanly.
     fn end(&mut self, gpu: &Gpu) -> Result<()>;
 }

@@ -18,6 +18,7 @@ use glam::{DQuat, DVec3};
 
 #[cfg(feature = "xr")]
 mod session;
+pub mod state;
 #[cfg(feature = "xr")]
 mod swapchain;
 #[cfg(feature = "xr")]
@@ -97,6 +98,31 @@ impl std::fmt::Display for SessionPhase {
     }
 }
 
+/// What an OpenXR session did, for reports and tests (`Headset::openxr_report`).
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct OpenXrReport {
+    /// The runtime's name and version.
+    pub runtime: String,
+    /// Session states in the order seen (XrSessionState names), consecutive repeats
+    /// dropped.
+    pub states_seen: Vec<String>,
+    /// Frames the application rendered and submitted with an image (what `--frames`
+    /// counts).
+    pub frames_rendered: u64,
+    /// Frames ended with the projection layer.
+    pub layers_submitted: u64,
+    /// Of those, layers whose views carried depth (XR_KHR_composition_layer_depth).
+    pub depth_layers_submitted: u64,
+    /// Frames ended without a layer (not rendered, or run while leaving).
+    pub empty_frames: u64,
+    /// Why the session was lost or a runtime call failed, if so.
+    pub loss_reason: Option<String>,
+    /// How the session ended (`EXITING`, a timeout, a loss), once it has.
+    pub ending: Option<String>,
+    /// Whether the run went on on the simulated headset after a loss.
+    pub fell_back: bool,
+}
+
 /// How `vrao run` (or a test) wants the OpenXR headset driven.
 #[derive(Clone, Debug)]
 pub struct OpenXrOptions {
@@ -109,8 +135,9 @@ pub struct OpenXrOptions {
     /// Per-eye render and swapchain size; `None` takes the runtime's recommended size.
     /// Clamped to the runtime's maximum.
     pub size: Option<(u32, u32)>,
-    /// End the session after this many frames: xrRequestExitSession, then STOPPING →
-    /// xrEndSession → EXITING, and `wait_frame` returns `None`.
+    /// End the session after this many rendered frames (submitted with an image):
+    /// xrRequestExitSession, then STOPPING → xrEndSession → EXITING, and `wait_frame`
+    /// returns `None`.
     pub frames: Option<u64>,
     /// Print session state changes and a lost session's fall back to stderr.
     pub report: bool,

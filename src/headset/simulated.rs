@@ -80,6 +80,8 @@ pub struct SimulatedHeadset {
     reprojector: Option<Reprojector>,
     output: Option<LayeredTarget>,
     last_outcome: Option<(u64, VsyncOutcome)>,
+    /// `request_exit` was called: no more frames.
+    exit_requested: bool,
     ended: bool,
 }
 
@@ -109,6 +111,7 @@ impl SimulatedHeadset {
             reprojector: None,
             output: None,
             last_outcome: None,
+            exit_requested: false,
             ended: false,
         })
     }
@@ -297,7 +300,7 @@ impl Headset for SimulatedHeadset {
     }
 
     fn wait_frame(&mut self, gpu: &Gpu) -> Result<Option<FrameRequest>> {
-        if self.ended || self.options.frames.is_some_and(|n| self.next_frame >= n) {
+        if self.ended || self.exit_requested || self.options.frames.is_some_and(|n| self.next_frame >= n) {
             return Ok(None);
         }
         // Like xrWaitFrame: return at the next vsync, with poses predicted one period on.
@@ -370,6 +373,10 @@ impl Headset for SimulatedHeadset {
 
     fn counters(&self) -> FrameCounters {
         self.compositor.counters()
+    }
+
+    fn request_exit(&mut self) {
+        self.exit_requested = true;
     }
 
     fn end(&mut self, gpu: &Gpu) -> Result<()> {

@@ -7,29 +7,32 @@
 //! xrEndFrame with a projection layer (and each view's depth, with
 //! XR_KHR_composition_layer_depth), or with no layer when the runtime said not to render.
 //!
-//! States (XrSessionState): IDLE waits; READY → xrBeginSession; SYNCHRONIZED, VISIBLE
-//! and FOCUSED run frames (the runtime's shouldRender decides whether anything is drawn);
-//! STOPPING → xrEndSession; EXITING ends the run (`wait_frame` returns `None`);
-//! LOSS_PENDING, a pending instance loss or a failing runtime call tear the session down
-//! and, when the options give one, continue on the simulated headset. Reprojection,
-//! dropped and late frames are the runtime compositor's business: it does not report
-//! them through OpenXR, so vrao's counters only say what was submitted.
+//! States (XrSessionState) are decided by the pure [`SessionMachine`] (`state.rs`); this
+//! file makes the runtime calls it answers: READY → xrBeginSession; SYNCHRONIZED,
+//! VISIBLE and FOCUSED run frames (the runtime's shouldRender decides whether anything
+//! is drawn); STOPPING → xrEndSession, after which only events are polled; EXITING ends
+//! the run (`wait_frame` returns `None`); LOSS_PENDING, a pending instance loss or a
+//! failing runtime call tear the session down and, when the options give one, continue
+//! on the simulated headset. Reprojection, dropped and late frames are the runtime
+//! compositor's business: it does not report them through OpenXR, so vrao's counters
+//! only say what was submitted.
 
+use super::state::{Action, Event, FrameBudget, SessionMachine, Turn};
 use super::swapchain::{EyeSwapchains, FillError, SubImage};
-use super::{application_info, load_entry, vulkan, InstanceSlot, OpenXrOptions, SessionPhase, Unavailable};
+use super::{
+    application_info, load_entry, vulkan, InstanceSlot, OpenXrOptions, OpenXrReport, SessionPhase, Unavailable,
+};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::headset::simulated::SimulatedHeadset;
 use crate::headset::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use crate::stereo::{Eye, EyePair, EyeSide, Fov, HeadPose};
-use glam::{DQuat, DVec3};
+use glam::{DQuat, DVec3, Quat, Vec3};
 use openxr as xr;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 const VIEW_TYPE: xr::ViewConfigurationType = xr::ViewConfigurationType::PRIMARY_STEREO;
-/// How long a session may stay before its first READY before vrao gives up on it.
-const READY_TIMEOUT: Duration = Duration::from_secs(30);
 /// How often an idle session (not running) is polled for events.
 const IDLE_POLL: Duration = Duration::from_millis(5);
 /// Latency samples kept for the counters' median and 95th percentile.
@@ -63,9 +66,6 @@ struct Xr {
     blend_mode: xr::EnvironmentBlendMode,
     /// XR_KHR_convert_timespec_time: the runtime's clock can be read (for latency).
     clock: bool,
-    /// Between xrBeginSession and xrEndSession.
-    running: bool,
-    exit_requested: bool,
 }
 
 /// A frame between `wait_frame` and `submit`.
@@ -88,17 +88,17 @@ pub struct OpenXrHeadset {
     /// Whether layers carry depth (XR_KHR_composition_layer_depth and a depth format).
     depth: bool,
     swapchain_text: String,
-    phases: Vec<SessionPhase>,
+    machine: SessionMachine,
+    /// Rendered frames, for `--frames`.
+    budget: FrameBudget,
     stats: OpenXrStats,
     counters: FrameCounters,
     latencies_ms: Vec<f64>,
+    /// The next frame's `FrameRequest::index` (frames handed to the application).
     next_index: u64,
     pending: Option<Pending>,
-    last_views: Option<[xr::View; 2]>,
+    tracking: Tracking,
     opened: Instant,
-    ever_ready: bool,
-    exited: bool,
-    lost: Option<String>,
     fallback: Option<SimulatedHeadset>,
 }
 
@@ -187,9 +187,8 @@ impl OpenXrHeadset {
             _slot: slot,
             blend_mode,
             clock: extensions.khr_convert_timespec_time,
-            running: false,
-            exit_requested: false,
         };
+        let budget = FrameBudget::new(options.frames);
         let headset = OpenXrHeadset {
             gpu: gpu.clone(),
             options,
@@ -200,17 +199,15 @@ impl OpenXrHeadset {
             size,
             depth,
             swapchain_text,
-            phases: Vec::new(),
+            machine: SessionMachine::new(),
+            budget,
             stats: OpenXrStats::default(),
             counters: FrameCounters::default(),
             latencies_ms: Vec::new(),
             next_index: 0,
             pending: None,
-            last_views: None,
+            tracking: Tracking::default(),
             opened: Instant::now(),
-            ever_ready: false,
-            exited: false,
-            lost: None,
             fallback: None,
         };
         Ok((headset, gpu))
@@ -221,18 +218,19 @@ impl OpenXrHeadset {
         &self.runtime
     }
 
-    /// The session states seen so far, in order.
+    /// The session states seen so far, in order (consecutive repeats dropped).
     pub fn phases(&self) -> &[SessionPhase] {
-        &self.phases
+        self.machine.states()
     }
 
     pub fn stats(&self) -> OpenXrStats {
         self.stats
     }
 
-    /// Why the session was lost, if it was (the headset then runs the simulated one).
+    /// Why the session was lost, if it was (the headset then runs the simulated one,
+    /// unless the run was ending anyway).
     pub fn lost(&self) -> Option<&str> {
-        self.lost.as_deref()
+        self.machine.loss_reason()
     }
 
     /// Whether frames carry depth (the runtime has XR_KHR_composition_layer_depth and a
@@ -246,24 +244,19 @@ impl OpenXrHeadset {
         &self.swapchain_text
     }
 
-    /// Asks the runtime to end the session (xrRequestExitSession): the following
-    /// `wait_frame` calls walk STOPPING → xrEndSession → EXITING and return `None`.
-    /// Before READY, the request is made as soon as the session begins.
-    pub fn request_exit(&mut self) -> Result<()> {
-        self.ask_exit().map_err(Error::Gpu)
-    }
-
-    fn ask_exit(&mut self) -> std::result::Result<(), String> {
-        let Some(xr) = self.xr.as_mut() else { return Ok(()) };
-        if xr.exit_requested {
-            return Ok(());
+    /// What the session did so far.
+    pub fn report(&self) -> OpenXrReport {
+        OpenXrReport {
+            runtime: self.runtime.clone(),
+            states_seen: self.machine.states().iter().map(|p| p.name().to_string()).collect(),
+            frames_rendered: self.budget.rendered,
+            layers_submitted: self.stats.layers,
+            depth_layers_submitted: self.stats.layers_with_depth,
+            empty_frames: self.stats.empty_frames,
+            loss_reason: self.machine.loss_reason().map(str::to_string),
+            ending: self.machine.ending().map(str::to_string),
+            fell_back: self.fallback.is_some(),
         }
-        if xr.running {
-            xr.session.request_exit().map_err(|e| format!("xrRequestExitSession: {e}"))?;
-        }
-        xr.exit_requested = true;
-        self.note("exit requested");
-        Ok(())
     }
 
     /// Tears the session down the way a lost one is (LOSS_PENDING): the headset goes on
@@ -271,7 +264,8 @@ impl OpenXrHeadset {
     /// session on demand, so tests use this to exercise that path.
     pub fn simulate_loss(&mut self, why: &str) {
         if self.xr.is_some() && self.fallback.is_none() {
-            self.lose(why.to_string());
+            self.feed(Event::Failed(why.to_string()));
+            self.conclude();
         }
     }
 
@@ -282,89 +276,107 @@ impl OpenXrHeadset {
         }
     }
 
-    /// Handles the queued events: session state changes (beginning and ending the
-    /// session as the states ask) and a pending instance loss.
-    fn poll_events(&mut self) -> std::result::Result<(), String> {
-        let Some(xr) = self.xr.as_ref() else { return Ok(()) };
-        let mut states = Vec::new();
-        let mut loss = None;
-        let mut buffer = xr::EventDataBuffer::new();
-        while let Some(event) = xr.instance.poll_event(&mut buffer).map_err(|e| format!("xrPollEvent: {e}"))? {
-            match event {
-                xr::Event::SessionStateChanged(change) => states.push(change.state()),
-                xr::Event::InstanceLossPending(_) => loss = Some("the runtime is going away (instance loss pending)"),
-                xr::Event::EventsLost(lost) => log::warn!("OpenXR: {} events lost", lost.lost_event_count()),
-                _ => {}
+    /// Feeds the state machine and makes the runtime calls it answers. A failing call
+    /// is fed back, which settles the machine's verdict.
+    fn feed(&mut self, event: Event) {
+        let at = self.opened.elapsed();
+        for action in self.machine.feed(event, at) {
+            if let Err(why) = self.execute(action) {
+                self.machine.feed(Event::Failed(why), at);
+                return;
             }
-        }
-        for state in states {
-            self.on_state(state)?;
-        }
-        match loss {
-            Some(why) => Err(why.into()),
-            None => Ok(()),
         }
     }
 
-    fn on_state(&mut self, state: xr::SessionState) -> std::result::Result<(), String> {
-        let phase = match state {
-            xr::SessionState::IDLE => SessionPhase::Idle,
-            xr::SessionState::READY => SessionPhase::Ready,
-            xr::SessionState::SYNCHRONIZED => SessionPhase::Synchronized,
-            xr::SessionState::VISIBLE => SessionPhase::Visible,
-            xr::SessionState::FOCUSED => SessionPhase::Focused,
-            xr::SessionState::STOPPING => SessionPhase::Stopping,
-            xr::SessionState::LOSS_PENDING => SessionPhase::LossPending,
-            xr::SessionState::EXITING => SessionPhase::Exiting,
-            other => {
-                log::warn!("OpenXR: unknown session state {other:?}");
-                return Ok(());
+    fn execute(&mut self, action: Action) -> std::result::Result<(), String> {
+        let Some(xr) = self.xr.as_ref() else { return Ok(()) };
+        match action {
+            Action::BeginSession => xr.session.begin(VIEW_TYPE).map(drop).map_err(|e| format!("xrBeginSession: {e}")),
+            Action::EndSession => xr.session.end().map(drop).map_err(|e| format!("xrEndSession: {e}")),
+            Action::RequestExit => xr.session.request_exit().map_err(|e| format!("xrRequestExitSession: {e}")),
+        }
+    }
+
+    /// Once the machine has its verdict: tears the session down and, after a loss,
+    /// continues on the fall back. Returns whether the run was over.
+    fn conclude(&mut self) -> bool {
+        if !self.machine.is_over() || self.xr.is_none() {
+            return self.machine.is_over();
+        }
+        match self.machine.turn(self.opened.elapsed()) {
+            Turn::Lose(why) => self.lose(why),
+            _ => {
+                if let Some(why) = self.machine.loss_reason() {
+                    log::warn!("OpenXR: the session ended after a failure: {why}");
+                }
+                self.note(&format!("session over ({})", self.machine.ending().unwrap_or("left")));
+                self.teardown();
             }
-        };
-        self.phases.push(phase);
-        self.note(&format!("session {phase}"));
-        let xr = self.xr.as_mut().expect("events come from a live session");
-        match phase {
-            SessionPhase::Ready => {
-                xr.session.begin(VIEW_TYPE).map_err(|e| format!("xrBeginSession: {e}"))?;
-                xr.running = true;
-                self.ever_ready = true;
-                if xr.exit_requested {
-                    // Asked to end before the session began: ask the runtime now.
-                    xr.session.request_exit().map_err(|e| format!("xrRequestExitSession: {e}"))?;
+        }
+        true
+    }
+
+    /// Feeds the queued events to the machine: session state changes and a pending
+    /// instance loss.
+    fn poll_events(&mut self) {
+        let Some(xr) = self.xr.as_ref() else { return };
+        let mut events = Vec::new();
+        let mut buffer = xr::EventDataBuffer::new();
+        loop {
+            match xr.instance.poll_event(&mut buffer) {
+                Ok(Some(xr::Event::SessionStateChanged(change))) => match phase_of(change.state()) {
+                    Some(phase) => events.push(Event::State(phase)),
+                    None => log::warn!("OpenXR: unknown session state {:?}", change.state()),
+                },
+                Ok(Some(xr::Event::InstanceLossPending(_))) => events.push(Event::InstanceLossPending),
+                Ok(Some(xr::Event::EventsLost(lost))) => {
+                    log::warn!("OpenXR: {} events lost", lost.lost_event_count())
+                }
+                Ok(Some(_)) => {}
+                Ok(None) => break,
+                Err(e) => {
+                    events.push(Event::Failed(format!("xrPollEvent: {e}")));
+                    break;
                 }
             }
-            SessionPhase::Stopping => {
-                xr.session.end().map_err(|e| format!("xrEndSession: {e}"))?;
-                xr.running = false;
-            }
-            SessionPhase::Exiting => self.exited = true,
-            SessionPhase::LossPending => return Err("the session is being lost (LOSS_PENDING)".into()),
-            _ => {}
         }
-        Ok(())
+        for event in events {
+            if let Event::State(phase) = &event {
+                self.note(&format!("session {phase}"));
+            }
+            self.feed(event);
+        }
     }
 
-    /// One turn of the session: events, then a frame if the session runs. `Ok(None)`
-    /// when there is no frame for the application this turn.
-    fn turn(&mut self) -> std::result::Result<Option<FrameRequest>, String> {
-        self.poll_events()?;
-        if self.exited {
-            return Ok(None);
+    /// Ends an open frame with no layer (a failure goes to the machine).
+    fn end_empty(&mut self, display_time: xr::Time) {
+        let Some(xr) = self.xr.as_mut() else { return };
+        match end_frame(xr, display_time, None) {
+            Ok(()) => self.stats.empty_frames += 1,
+            Err(e) => self.feed(Event::Failed(format!("xrEndFrame: {e}"))),
         }
-        let xr = self.xr.as_mut().expect("turn needs a session");
-        if !xr.running {
-            if !self.ever_ready && self.opened.elapsed() > READY_TIMEOUT {
-                return Err(format!("the session did not become READY within {} s", READY_TIMEOUT.as_secs()));
+    }
+
+    /// One frame of the running session: xrWaitFrame and xrBeginFrame, then the
+    /// located views for the application (`render`), or at once an empty xrEndFrame.
+    /// A failing call goes to the machine and gives `None`.
+    fn frame(&mut self, render: bool) -> Option<FrameRequest> {
+        match self.try_frame(render) {
+            Ok(request) => request,
+            Err(why) => {
+                self.feed(Event::Failed(why));
+                None
             }
-            std::thread::sleep(IDLE_POLL);
-            return Ok(None);
         }
+    }
+
+    fn try_frame(&mut self, render: bool) -> std::result::Result<Option<FrameRequest>, String> {
+        let xr = self.xr.as_mut().expect("frames need a session");
         let state = xr.frame_waiter.wait().map_err(|e| format!("xrWaitFrame: {e}"))?;
         xr.frame_stream.begin().map_err(|e| format!("xrBeginFrame: {e}"))?;
-        if xr.exit_requested {
-            // Until the runtime says STOPPING, the session still runs frames; they show
-            // nothing new.
+        if !render {
+            // Leaving: until the runtime says STOPPING the session still runs frames;
+            // they show nothing new.
             end_frame(xr, state.predicted_display_time, None).map_err(|e| format!("xrEndFrame: {e}"))?;
             self.stats.empty_frames += 1;
             return Ok(None);
@@ -372,15 +384,13 @@ impl OpenXrHeadset {
         let located = xr.session.locate_views(VIEW_TYPE, state.predicted_display_time, &xr.space);
         let sampled_at = if xr.clock { xr.instance.now().ok() } else { None };
         let (flags, views) = located.map_err(|e| format!("xrLocateViews: {e}"))?;
-        let valid = flags.contains(xr::ViewStateFlags::ORIENTATION_VALID) && views.len() == 2;
-        let views = if valid {
-            let views = [views[0], views[1]];
-            self.last_views = Some(views);
-            views
-        } else {
-            // Tracking lost: keep the last known views (or look straight ahead).
-            self.last_views.unwrap_or([default_view(-1.0), default_view(1.0)])
-        };
+        let (views, warning) = self.tracking.merge(flags, &views);
+        if let Some(warning) = warning {
+            log::warn!("OpenXR: {warning}");
+            if self.options.report {
+                eprintln!("openxr: {warning}");
+            }
+        }
         if let Some(now) = sampled_at {
             let ms = (state.predicted_display_time.as_nanos() - now.as_nanos()) as f64 / 1e6;
             if self.latencies_ms.len() == LATENCY_SAMPLES {
@@ -421,10 +431,7 @@ impl OpenXrHeadset {
     /// Ends the session's frame with the projection layer for `frame`.
     fn present(&mut self, pending: &Pending, frame: &SubmittedFrame) -> std::result::Result<(), String> {
         let near = frame.near;
-        let xr = self.xr.as_mut().expect("present needs a session");
-        if !xr.running {
-            return Ok(());
-        }
+        let Some(xr) = self.xr.as_mut() else { return Ok(()) };
         let sub_images = match xr.swapchains.fill(&self.gpu, frame.color, frame.depth) {
             Ok(sub_images) => sub_images,
             Err(FillError::Gpu(e)) => {
@@ -445,10 +452,10 @@ impl OpenXrHeadset {
     }
 
     /// Tears the session down after a loss or failure and continues on the simulated
-    /// headset when the options give one.
+    /// headset when the options give one and frames remain.
     fn lose(&mut self, why: String) {
         self.teardown();
-        let remaining = self.options.frames.map(|n| n.saturating_sub(self.next_index));
+        let remaining = self.budget.remaining();
         let message = match self.options.fallback.clone() {
             Some(mut simulated) if remaining != Some(0) => {
                 let (width, height) = self.recommended_size();
@@ -466,7 +473,6 @@ impl OpenXrHeadset {
             }
             _ => format!("OpenXR session lost ({why}): the run ends"),
         };
-        self.lost = Some(why);
         // Always said, whatever `report` is: the user must know the headset went away.
         log::warn!("{message}");
         eprintln!("headset: {message}");
@@ -485,28 +491,107 @@ impl OpenXrHeadset {
         }
     }
 
-    /// Ends the session cleanly: closes an open frame, requests exit and runs empty
-    /// frames until EXITING (at most 5 s). A session that is not running has nothing to
-    /// walk and is only torn down.
-    fn finish(&mut self) -> std::result::Result<(), String> {
-        if let (Some(pending), Some(xr)) = (self.pending.take(), self.xr.as_mut()) {
-            end_frame(xr, pending.display_time, None).map_err(|e| format!("xrEndFrame: {e}"))?;
-            self.stats.empty_frames += 1;
+    /// Ends the session cleanly: closes an open frame, asks to exit and runs empty
+    /// frames until EXITING (the machine bounds the wait). A session that is not running
+    /// has nothing to walk and is only left.
+    fn finish(&mut self) {
+        if self.xr.is_none() {
+            return;
         }
-        let Some(xr) = self.xr.as_ref() else { return Ok(()) };
-        if self.exited || !(xr.running || xr.exit_requested && self.ever_ready) {
-            return Ok(());
+        if let Some(pending) = self.pending.take() {
+            self.end_empty(pending.display_time);
         }
-        self.ask_exit()?;
-        let deadline = Instant::now() + Duration::from_secs(5);
-        while !self.exited {
-            if Instant::now() > deadline {
-                return Err("the runtime did not end the session within 5 s".into());
+        self.feed(Event::ExitRequested);
+        loop {
+            self.poll_events();
+            match self.machine.turn(self.opened.elapsed()) {
+                Turn::Frame | Turn::EmptyFrame => {
+                    self.frame(false);
+                }
+                Turn::Poll => std::thread::sleep(IDLE_POLL),
+                Turn::Leave | Turn::Lose(_) => break,
             }
-            self.turn()?;
         }
-        Ok(())
+        if let Some(why) = self.machine.loss_reason() {
+            log::warn!("OpenXR: ending the session: {why}");
+        }
     }
+}
+
+/// The session state an XrSessionState names (`None`: one OpenXR 1.0 does not define).
+fn phase_of(state: xr::SessionState) -> Option<SessionPhase> {
+    Some(match state {
+        xr::SessionState::IDLE => SessionPhase::Idle,
+        xr::SessionState::READY => SessionPhase::Ready,
+        xr::SessionState::SYNCHRONIZED => SessionPhase::Synchronized,
+        xr::SessionState::VISIBLE => SessionPhase::Visible,
+        xr::SessionState::FOCUSED => SessionPhase::Focused,
+        xr::SessionState::STOPPING => SessionPhase::Stopping,
+        xr::SessionState::LOSS_PENDING => SessionPhase::LossPending,
+        xr::SessionState::EXITING => SessionPhase::Exiting,
+        _ => return None,
+    })
+}
+
+/// The views frames are rendered with, when tracking is partial or lost too.
+#[derive(Default)]
+struct Tracking {
+    /// The last views with a valid orientation: used whole when orientation is lost.
+    last: Option<[xr::View; 2]>,
+    /// The last views with a valid position as well: where the head is held while only
+    /// orientation is tracked.
+    anchor: Option<[xr::View; 2]>,
+    /// Within a position-loss episode (warned about at its start only).
+    position_lost: bool,
+}
+
+impl Tracking {
+    /// The views to render with, from what xrLocateViews answered; and a warning when a
+    /// position-loss episode begins (not every frame of it).
+    fn merge(&mut self, flags: xr::ViewStateFlags, located: &[xr::View]) -> ([xr::View; 2], Option<&'static str>) {
+        let orientation = flags.contains(xr::ViewStateFlags::ORIENTATION_VALID) && located.len() == 2;
+        // Without POSITION_VALID the located positions are undefined.
+        let position = orientation && flags.contains(xr::ViewStateFlags::POSITION_VALID);
+        let views = if position {
+            self.anchor = Some([located[0], located[1]]);
+            [located[0], located[1]]
+        } else if orientation {
+            orientation_only(&[located[0], located[1]], &self.anchor.unwrap_or(default_views()))
+        } else {
+            self.last.unwrap_or(default_views())
+        };
+        if orientation {
+            self.last = Some(views);
+        }
+        let warning = (!position && !self.position_lost).then_some(if orientation {
+            "position tracking lost: orientation only, the head held at its last position"
+        } else {
+            "tracking lost: the last pose is held"
+        });
+        self.position_lost = !position;
+        (views, warning)
+    }
+}
+
+/// Orientation-only tracking: each located view's orientation and field of view, with
+/// the head held where `anchor` (the last views with a valid position) had it. The eyes
+/// keep their offsets from the head's centre, turned with the head, so the stereo
+/// baseline follows the head.
+fn orientation_only(located: &[xr::View; 2], anchor: &[xr::View; 2]) -> [xr::View; 2] {
+    let vec = |v: xr::Vector3f| Vec3::new(v.x, v.y, v.z);
+    let quat = |q: xr::Quaternionf| Quat::from_xyzw(q.x, q.y, q.z, q.w).normalize();
+    let center = (vec(anchor[0].pose.position) + vec(anchor[1].pose.position)) * 0.5;
+    std::array::from_fn(|i| {
+        let offset = quat(anchor[i].pose.orientation).inverse() * (vec(anchor[i].pose.position) - center);
+        let p = center + quat(located[i].pose.orientation) * offset;
+        xr::View {
+            pose: xr::Posef {
+                orientation: located[i].pose.orientation,
+                position: xr::Vector3f { x: p.x, y: p.y, z: p.z },
+            },
+            fov: located[i].fov,
+        }
+    })
 }
 
 /// The projection layer of one frame.
@@ -535,8 +620,9 @@ fn end_frame(xr: &mut Xr, display_time: xr::Time, layer: Option<&Layer>) -> std:
                 // Reversed-Z with an infinite far plane: window depth 0 is infinitely
                 // far and 1 is the near plane. The extension's nearZ and farZ are the
                 // distances of minDepth and maxDepth ("a nearZ greater than farZ means
-                // reversed depth", "nearZ can be infinite"), so minDepth 0 ↔ nearZ = +∞
-                // and maxDepth 1 ↔ farZ = the near plane.
+                // reversed depth"), so minDepth 0 ↔ nearZ = far and maxDepth 1 ↔ farZ =
+                // the near plane. nearZ is f32::MAX, not +∞: a runtime linearising depth
+                // with ∞ gets NaN (∞/∞, ∞·0), and no depth value tells the two apart.
                 *depth_info = Some(sys::CompositionLayerDepthInfoKHR {
                     ty: sys::CompositionLayerDepthInfoKHR::TYPE,
                     next: std::ptr::null(),
@@ -547,7 +633,7 @@ fn end_frame(xr: &mut Xr, display_time: xr::Time, layer: Option<&Layer>) -> std:
                     },
                     min_depth: 0.0,
                     max_depth: 1.0,
-                    near_z: f32::INFINITY,
+                    near_z: f32::MAX,
                     far_z: layer.near as f32,
                 });
             }
@@ -610,6 +696,11 @@ fn fov_from_xr(fov: &xr::Fovf) -> Fov {
     Fov { left: fov.angle_left, right: fov.angle_right, up: fov.angle_up, down: fov.angle_down }
 }
 
+/// Both views before tracking.
+fn default_views() -> [xr::View; 2] {
+    [default_view(-1.0), default_view(1.0)]
+}
+
 /// A view before tracking: 32 mm to the side, 45° each way.
 fn default_view(side: f32) -> xr::View {
     let a = std::f32::consts::FRAC_PI_4;
@@ -637,7 +728,7 @@ impl Headset for OpenXrHeadset {
              counted by vrao)",
             self.system, self.runtime, self.swapchain_text, self.recommended.0, self.recommended.1
         );
-        match (&self.fallback, &self.lost) {
+        match (&self.fallback, self.machine.loss_reason()) {
             (Some(simulated), Some(why)) => {
                 format!("{} after the OpenXR session was lost ({why}); before that: {base}", simulated.describe())
             }
@@ -656,36 +747,36 @@ impl Headset for OpenXrHeadset {
         if let Some(simulated) = self.fallback.as_mut() {
             return simulated.wait_frame(gpu);
         }
-        if self.xr.is_none() || self.exited {
+        if self.xr.is_none() {
             return Ok(None);
         }
         if let Some(pending) = self.pending.take() {
             // The application skipped submit: close the frame it left open.
-            let xr = self.xr.as_mut().expect("checked above");
-            if let Err(e) = end_frame(xr, pending.display_time, None) {
-                self.lose(format!("xrEndFrame: {e}"));
-                return self.wait_frame(gpu);
-            }
-            self.stats.empty_frames += 1;
+            self.end_empty(pending.display_time);
         }
-        if self.options.frames.is_some_and(|n| self.next_index >= n) {
-            if let Err(why) = self.ask_exit() {
-                self.lose(why);
-                return self.wait_frame(gpu);
-            }
+        if self.budget.reached() && !self.machine.exit_wanted() && !self.machine.is_over() {
+            self.note(&format!("{} frames rendered: exit requested", self.budget.rendered));
+            self.feed(Event::FramesReached);
         }
         loop {
-            match self.turn() {
-                Ok(Some(request)) => return Ok(Some(request)),
-                Ok(None) if self.exited => {
-                    self.teardown();
-                    return Ok(None);
+            if self.conclude() {
+                // Left (the session is gone) or lost (the fall back, if any, goes on).
+                return self.wait_frame(gpu);
+            }
+            self.poll_events();
+            match self.machine.turn(self.opened.elapsed()) {
+                Turn::Frame => {
+                    if let Some(request) = self.frame(true) {
+                        return Ok(Some(request));
+                    }
                 }
-                Ok(None) => {}
-                Err(why) => {
-                    self.lose(why);
-                    return self.wait_frame(gpu);
+                Turn::EmptyFrame => {
+                    self.frame(false);
                 }
+                // Not running (before READY, or stopped): no xrWaitFrame, which would
+                // block or fail; the machine bounds how long this lasts.
+                Turn::Poll => std::thread::sleep(IDLE_POLL),
+                Turn::Leave | Turn::Lose(_) => {}
             }
         }
     }
@@ -707,17 +798,20 @@ impl Headset for OpenXrHeadset {
                 request.index, pending.index
             )));
         }
-        let outcome = match frame {
-            Some(frame) if request.should_render => self.present(&pending, &frame),
-            _ => {
-                let xr = self.xr.as_mut().expect("a pending frame has a session");
-                self.stats.empty_frames += 1;
-                end_frame(xr, pending.display_time, None).map_err(|e| format!("xrEndFrame: {e}"))
+        match frame {
+            Some(frame) if request.should_render => {
+                self.budget.submitted(true);
+                if let Err(why) = self.present(&pending, &frame) {
+                    self.feed(Event::Failed(why));
+                }
             }
-        };
-        if let Err(why) = outcome {
-            self.lose(why);
+            _ => {
+                self.budget.submitted(false);
+                self.end_empty(pending.display_time);
+            }
         }
+        // A failure: tear down (and fall back) now rather than at the next wait_frame.
+        self.conclude();
         Ok(())
     }
 
@@ -737,15 +831,30 @@ impl Headset for OpenXrHeadset {
         counters
     }
 
+    fn openxr_report(&self) -> Option<OpenXrReport> {
+        Some(self.report())
+    }
+
+    /// xrRequestExitSession when the session runs (the following `wait_frame` calls
+    /// walk STOPPING → xrEndSession → EXITING and return `None`); before READY or while
+    /// stopped the next `wait_frame` returns `None` at once. After a loss, the fall
+    /// back is asked instead.
+    fn request_exit(&mut self) {
+        if let Some(simulated) = self.fallback.as_mut() {
+            return simulated.request_exit();
+        }
+        if self.xr.is_some() && !self.machine.exit_wanted() && !self.machine.is_over() {
+            self.note("exit requested");
+            self.feed(Event::ExitRequested);
+        }
+    }
+
     fn end(&mut self, gpu: &Gpu) -> Result<()> {
         if let Some(simulated) = self.fallback.as_mut() {
             return simulated.end(gpu);
         }
-        let outcome = self.finish();
+        self.finish();
         self.teardown();
-        if let Err(why) = outcome {
-            log::warn!("OpenXR: ending the session: {why}");
-        }
         Ok(())
     }
 }
@@ -777,6 +886,89 @@ mod tests {
         assert_eq!(p.position, DVec3::new(1.0, 1.5, -2.0));
         // 180° about +Y: looking down +Z.
         assert!((p.orientation * -DVec3::Z - DVec3::Z).length() < 1e-12);
+    }
+
+    fn view(yaw: f32, position: [f32; 3]) -> xr::View {
+        let q = Quat::from_rotation_y(yaw);
+        xr::View {
+            pose: xr::Posef {
+                orientation: xr::Quaternionf { x: q.x, y: q.y, z: q.z, w: q.w },
+                position: xr::Vector3f { x: position[0], y: position[1], z: position[2] },
+            },
+            fov: default_view(1.0).fov,
+        }
+    }
+
+    fn position(v: &xr::View) -> Vec3 {
+        Vec3::new(v.pose.position.x, v.pose.position.y, v.pose.position.z)
+    }
+
+    #[test]
+    fn orientation_only_holds_the_head_and_turns_the_eyes_about_it() {
+        let anchor = [view(0.0, [0.968, 1.6, 2.0]), view(0.0, [1.032, 1.6, 2.0])];
+        // Turned 90° left; the runtime's positions are undefined without POSITION_VALID.
+        let turn = std::f32::consts::FRAC_PI_2;
+        let located = [view(turn, [f32::NAN; 3]), view(turn, [99.0, 99.0, 99.0])];
+        let merged = orientation_only(&located, &anchor);
+        // Facing -X now: the left eye is on +Z of the head's centre, the right on -Z.
+        assert!((position(&merged[0]) - Vec3::new(1.0, 1.6, 2.032)).length() < 1e-5, "{:?}", position(&merged[0]));
+        assert!((position(&merged[1]) - Vec3::new(1.0, 1.6, 1.968)).length() < 1e-5, "{:?}", position(&merged[1]));
+        for (m, l) in merged.iter().zip(&located) {
+            assert_eq!(m.pose.orientation, l.pose.orientation, "the located orientation is used");
+            assert_eq!(m.fov, l.fov);
+        }
+        // Not turned: exactly the anchor's eyes.
+        let merged = orientation_only(&[view(0.0, [5.0; 3]), view(0.0, [5.0; 3])], &anchor);
+        assert!((position(&merged[0]) - position(&anchor[0])).length() < 1e-6);
+        assert!((position(&merged[1]) - position(&anchor[1])).length() < 1e-6);
+    }
+
+    #[test]
+    fn tracking_keeps_the_last_valid_position_and_warns_once_per_loss() {
+        use xr::ViewStateFlags as F;
+        let full = F::ORIENTATION_VALID | F::POSITION_VALID | F::ORIENTATION_TRACKED | F::POSITION_TRACKED;
+        let orientation = F::ORIENTATION_VALID | F::ORIENTATION_TRACKED;
+        let mut tracking = Tracking::default();
+        let valid = [view(0.0, [-0.03, 1.7, 0.0]), view(0.0, [0.03, 1.7, 0.0])];
+        let (views, warning) = tracking.merge(full, &valid);
+        assert_eq!(warning, None);
+        assert_eq!(position(&views[0]), position(&valid[0]));
+
+        // Position lost: warned at the first frame of the episode only.
+        let drifted = [view(0.3, [4.0, 0.0, 0.0]), view(0.3, [4.0, 0.0, 0.0])];
+        let (views, warning) = tracking.merge(orientation, &drifted);
+        assert!(warning.is_some_and(|w| w.contains("orientation only")), "{warning:?}");
+        let center = (position(&views[0]) + position(&views[1])) * 0.5;
+        assert!((center - Vec3::new(0.0, 1.7, 0.0)).length() < 1e-6, "the head stays put: {center:?}");
+        assert_eq!(views[0].pose.orientation, drifted[0].pose.orientation);
+        for _ in 0..3 {
+            assert_eq!(tracking.merge(orientation, &drifted).1, None, "no warning every frame");
+        }
+        // Orientation lost too, within the same episode: the last views, no new warning.
+        let (held, warning) = tracking.merge(F::EMPTY, &[]);
+        assert_eq!(warning, None);
+        assert_eq!(held[0].pose.orientation, drifted[0].pose.orientation);
+        assert!((position(&held[0]) - position(&views[0])).length() < 1e-6);
+
+        // Back, then lost again: a new episode, a new warning.
+        let moved = [view(0.0, [1.0, 1.7, 0.0]), view(0.0, [1.06, 1.7, 0.0])];
+        assert_eq!(tracking.merge(full, &moved).1, None);
+        let (views, warning) = tracking.merge(orientation, &drifted);
+        assert!(warning.is_some());
+        let center = (position(&views[0]) + position(&views[1])) * 0.5;
+        assert!((center - Vec3::new(1.03, 1.7, 0.0)).length() < 1e-6, "held at the newest valid position");
+    }
+
+    #[test]
+    fn tracking_before_any_valid_pose_uses_the_default_views() {
+        let mut tracking = Tracking::default();
+        let (views, warning) = tracking.merge(xr::ViewStateFlags::EMPTY, &[]);
+        assert!(warning.is_some_and(|w| w.contains("tracking lost")));
+        assert_eq!(position(&views[0]), position(&default_view(-1.0)));
+        // Orientation only from the start: the default eyes, turned.
+        let (views, _) =
+            tracking.merge(xr::ViewStateFlags::ORIENTATION_VALID, &[view(0.0, [9.0; 3]), view(0.0, [9.0; 3])]);
+        assert!((position(&views[1]) - Vec3::new(0.032, 0.0, 0.0)).length() < 1e-6);
     }
 
     #[test]
