@@ -8,11 +8,11 @@ use crate::graph::Resource;
 use crate::headset::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::headset::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::headset::{FrameRequest, Headset, SubmittedFrame};
+use crate::governor::{Governor, GovernorChange};
 use crate::gpu::timing::FrameTiming;
 use crate::renderer::{FrameReport, Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::Settings;
-use crate::stereo::HeadsetProfile;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -45,12 +45,14 @@ impl std::str::FromStr for HeadsetChoice {
 /// and, on fall back, why. An OpenXR session brings its own GPU (the runtime creates the
 /// Vulkan device); the simulated headset renders on `Gpu::new(backend)`.
 ///
-/// The OpenXR headset renders at the runtime's recommended per-eye size unless the
-/// simulated profile asks for another size than the Vive-class default (`vrao run
-/// --width/--height`); it falls back to the simulated headset if its session is lost.
+/// The OpenXR headset renders at the runtime's recommended per-eye size (and with its
+/// views) unless `size` asks for another (`vrao run --width/--height`); the profile is
+/// the simulated headset's only. It falls back to the simulated headset if its session
+/// is lost.
 pub fn open_headset(
     choice: HeadsetChoice,
     simulated: SimulatedOptions,
+    size: Option<(u32, u32)>,
     backend: BackendChoice,
 ) -> Result<OpenedHeadset> {
     let simulated_headset = |why: String| -> Result<OpenedHeadset> {
@@ -63,9 +65,6 @@ pub fn open_headset(
         if backend == BackendChoice::Gl {
             return Err(Unavailable::Unsupported("OpenXR sessions need the Vulkan backend, not --backend gl".into()));
         }
-        let vive = HeadsetProfile::vive();
-        let size = (simulated.profile.width, simulated.profile.height);
-        let size = (size != (vive.width, vive.height)).then_some(size);
         openxr::open_headset(OpenXrOptions::from_simulated(&simulated, size))
     };
     match choice {
@@ -139,7 +138,14 @@ pub struct FrameLoop {
     /// On a CPU adapter, every [`SERIAL_EVERY`]-th frame is submitted pass by pass.
     cpu_adapter: bool,
     serial_frames: VecDeque<u64>,
+    /// Chooses the AO setting from the measured GPU times (`None`: settings fixed).
+    pub governor: Option<Governor>,
 }
+
+/// Spans of the passes the governor's AO setting changes (the rest of the frame does
+/// not depend on it).
+const AO_PASSES: [&str; 9] =
+    ["ssao", "hbao", "gtao", "ssdo", "fetch-only", "depth-peel", "temporal", "blur", "upsample"];
 
 /// On a CPU adapter (lavapipe), timestamps within one submission credit work to the
 /// wrong pass, and one submission per pass keeps frames from overlapping (each
@@ -158,6 +164,7 @@ impl FrameLoop {
         Ok(FrameLoop {
             cpu_adapter,
             serial_frames: VecDeque::new(),
+            governor: None,
             gpu,
             renderer,
             headset,
@@ -180,9 +187,11 @@ impl FrameLoop {
         if self.frame_limit.is_some_and(|n| self.frames >= n) {
             return Ok(None);
         }
+        // Ctrl-C: ask the headset to end the session; OpenXR then walks the session
+        // through STOPPING to EXITING over the next calls.
         if self.exit_requested.load(Ordering::Relaxed) && !self.exit_sent {
             self.exit_sent = true;
-            return Ok(None);
+            self.headset.request_exit();
         }
         let Some(request) = self.headset.wait_frame(&self.gpu)? else { return Ok(None) };
         if !request.should_render {
@@ -223,8 +232,29 @@ impl FrameLoop {
                 self.over_budget_frames += 1;
             }
             self.gpu_frame_ms.push(timing.total_ms);
+            if let Some(governor) = &mut self.governor {
+                let ao_ms: f64 =
+                    timing.spans.iter().filter(|(pass, _)| AO_PASSES.contains(&pass.as_str())).map(|(_, ms)| ms).sum();
+                if let Some(change) = governor.observe_with_ao(timing.frame, timing.total_ms, ao_ms) {
+                    log::info!("governor, frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason);
+                    let mut settings = self.renderer.settings().clone();
+                    settings.ao = governor.current().apply(&settings.ao);
+                    if let Err(e) = self.renderer.set_settings(&settings) {
+                        log::warn!("governor: {e}");
+                    }
+                }
+            }
             self.history.push(timing);
         }
+    }
+
+    /// Lets `governor` choose the AO setting from now on, starting at its current level.
+    pub fn set_governor(&mut self, governor: Governor) -> Result<()> {
+        let mut settings = self.renderer.settings().clone();
+        settings.ao = governor.current().apply(&settings.ao);
+        self.renderer.set_settings(&settings)?;
+        self.governor = Some(governor);
+        Ok(())
     }
 
     /// Ends the session: waits for the frames in flight (their times are booked too).
@@ -271,6 +301,13 @@ pub struct RunSummary {
     pub pass_medians_ms: Vec<(String, f64)>,
     /// Whether Ctrl-C ended the run.
     pub interrupted: bool,
+    /// The budget governor: on or off, every change it made, and the AO setting the run
+    /// ended with.
+    pub governor: String,
+    pub governor_changes: Vec<GovernorChange>,
+    pub final_ao_setting: String,
+    /// The OpenXR session's states, layers and loss reason (OpenXR headsets only).
+    pub openxr: Option<crate::headset::openxr::OpenXrReport>,
 }
 
 impl RunSummary {
@@ -304,6 +341,15 @@ impl RunSummary {
                 .map(|s| (s.label, s.median_ms))
                 .collect(),
             interrupted: frame_loop.exit_requested.load(Ordering::Relaxed),
+            governor: if frame_loop.governor.is_some() { "on" } else { "off" }.into(),
+            governor_changes: frame_loop.governor.as_ref().map(|g| g.changes().to_vec()).unwrap_or_default(),
+            final_ao_setting: {
+                let ao = &frame_loop.renderer.settings().ao;
+                let resolution = if ao.half_res { "half" } else { "full" };
+                let temporal = if ao.temporal.enabled { " temporal" } else { "" };
+                format!("{}{temporal} N={} r={} m {resolution}", ao.technique.name(), ao.samples, ao.radius)
+            },
+            openxr: frame_loop.headset.openxr_report(),
         }
     }
 
@@ -311,7 +357,10 @@ impl RunSummary {
         let c = &self.counters;
         let passes: Vec<String> = self.pass_medians_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect();
         format!(
-            "frames: {} rendered (up to {} in flight), {} submitted; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms\nGPU per frame: median {:.2} ms against a {:.2} ms budget, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}",
+            "governor {}: {} changes, AO setting at the end: {}\nframes: {} rendered (up to {} in flight), {} submitted; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms\nGPU per frame: median {:.2} ms against a {:.2} ms budget, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}",
+            self.governor,
+            self.governor_changes.len(),
+            self.final_ao_setting,
             self.frames_rendered,
             self.frames_in_flight_max,
             c.submitted,

@@ -68,12 +68,31 @@ struct RunArgs {
     /// in ms (cycled): deterministic counters.
     #[arg(long, value_delimiter = ',')]
     virtual_time: Vec<f64>,
-    /// Simulated per-eye width (default: Vive-class 1080).
-    #[arg(long, default_value_t = 1080)]
-    width: u32,
-    /// Simulated per-eye height (default: Vive-class 1200).
-    #[arg(long, default_value_t = 1200)]
-    height: u32,
+    /// Headset profile of the simulated headset: vive, vive-pro-2, index, quest-2,
+    /// quest-3 or pico-4 (per-eye size, field of view, refresh rate; the frame budget
+    /// follows the rate). An OpenXR runtime's recommended size and views win over it.
+    #[arg(long, default_value = "vive")]
+    profile: String,
+    /// Refresh rate in Hz, one the profile supports (default: the profile's).
+    #[arg(long)]
+    refresh: Option<f64>,
+    /// Per-eye width to render at (default: the profile's; with OpenXR, the runtime's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Per-eye height to render at (default: the profile's; with OpenXR, the runtime's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Budget governor: on (choose the AO setting by error per millisecond so that each
+    /// frame's GPU time stays under the display period) or off (keep the settings).
+    #[arg(long, default_value = "on")]
+    governor: OnOff,
+    /// The governor's frontier: a bench JSON made by `vrao bench` (default: the built-in
+    /// one, measured on the furnished room; see assets/governor/README.md).
+    #[arg(long)]
+    governor_frontier: Option<PathBuf>,
+    /// Frames the GPU may work on at once.
+    #[arg(long, default_value_t = vrao::renderer::DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
+    frames_in_flight: u64,
     /// Window size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
     window: String,
@@ -951,9 +970,25 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     use vrao::headset::simulated::{SimulatedOptions, TimeMode};
     use vrao::settings::DisplayMode;
     let scene = Scene::load(&args.scene)?;
-    let settings = args.ao.eye_settings(&scene, args.width, args.height);
+    let mut profile = vrao::profiles::by_name(&args.profile).map_err(|e| Error::input(format!("--profile: {e}")))?;
+    if let Some(hz) = args.refresh {
+        profile = profile.with_refresh(hz).map_err(|e| Error::input(format!("--refresh: {e}")))?;
+    }
+    let size = match (args.width, args.height) {
+        (None, None) => None,
+        (w, h) => Some((w.unwrap_or(profile.width), h.unwrap_or(profile.height))),
+    };
+    if let Some((w, h)) = size {
+        profile = profile.with_render_size(w, h);
+    }
+    let mut settings = args.ao.eye_settings(&scene, profile.width, profile.height);
+    settings.profile = profile;
     settings.validate()?;
     let window_size = parse_size(&args.window)?;
+    let governor = match args.governor {
+        OnOff::Off => None,
+        OnOff::On => Some(governor_for(&args, &settings)?),
+    };
     let frames = args.frames.or((args.display == DisplayMode::None).then_some(600));
     let simulated = SimulatedOptions {
         profile: settings.profile,
@@ -969,9 +1004,30 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         compose: args.display == DisplayMode::Mirror,
         frames,
     };
-    let (headset, gpu, message) = vrao::app::open_headset(args.headset, simulated, backend)?;
+    let (headset, gpu, message) = vrao::app::open_headset(args.headset, simulated, size, backend)?;
     println!("headset: {message}");
     let mut frame_loop = vrao::app::FrameLoop::new(gpu.clone(), &scene, &settings, headset)?;
+    frame_loop.frame_limit = frames;
+    frame_loop.renderer.set_frames_in_flight(args.frames_in_flight as usize);
+    if let Some(governor) = governor {
+        println!(
+            "governor: on, {} levels from {} to {}; starting at {}",
+            governor.frontier().len(),
+            governor.frontier().levels()[0].setting,
+            governor.frontier().levels()[governor.frontier().top()].setting,
+            governor.current().setting
+        );
+        frame_loop.set_governor(governor)?;
+    }
+    // Ctrl-C ends the session cleanly (OpenXR walks to EXITING) and the report is still
+    // written; a second Ctrl-C while it ends is the default: the process stops.
+    let exit = frame_loop.exit_requested.clone();
+    let _ = ctrlc::set_handler(move || {
+        if exit.swap(true, std::sync::atomic::Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        eprintln!("Ctrl-C: ending the session");
+    });
     let summary = if args.display == DisplayMode::None {
         while frame_loop.step()?.is_some() {}
         frame_loop.end()?;
@@ -989,6 +1045,34 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         std::fs::write(path, json).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
     }
     Ok(())
+}
+
+/// The governor of `vrao run`: its frontier (the bench file given, or the built-in one)
+/// at the frame budget of the profile, starting at the level nearest the asked setting.
+fn governor_for(args: &RunArgs, settings: &Settings) -> Result<vrao::governor::Governor> {
+    use vrao::governor::{Frontier, Governor, GovernorConfig};
+    let frontier = match &args.governor_frontier {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
+            Frontier::from_json(&text, &path.display().to_string(), settings.ao.radius).map_err(Error::input)?
+        }
+        None => Frontier::builtin(),
+    };
+    let ao = &settings.ao;
+    let start = frontier
+        .levels()
+        .iter()
+        .position(|l| l.technique == ao.technique && l.samples == ao.samples && l.half_res == ao.half_res && l.temporal == ao.temporal.enabled)
+        .unwrap_or(frontier.top());
+    let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
+    Governor::new(frontier, config, start).map_err(Error::input)
+}
+
+/// A switch: on or off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum OnOff {
+    On,
+    Off,
 }
 
 fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {

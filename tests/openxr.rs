@@ -100,7 +100,7 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
     }
 
     let (mut headset, gpu, message) =
-        vrao::app::open_headset(vrao::app::HeadsetChoice::Auto, small_simulated(Some(3)), BackendChoice::Auto)
+        vrao::app::open_headset(vrao::app::HeadsetChoice::Auto, small_simulated(Some(3)), None, BackendChoice::Auto)
             .expect("the fall back opens");
     assert!(message.contains("using the simulated headset"), "{message}");
     assert!(message.contains(if ci { "no OpenXR runtime" } else { "no OpenXR" }), "{message}");
@@ -114,7 +114,7 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
     assert_eq!(frames, 3);
     headset.end(&gpu).unwrap();
 
-    let err = vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), BackendChoice::Auto)
+    let err = vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), None, BackendChoice::Auto)
         .err()
         .expect("--headset openxr without a runtime is an error");
     assert_eq!(err.exit_code(), 2, "{err}");

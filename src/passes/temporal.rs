@@ -114,8 +114,10 @@ impl Pass for TemporalPass {
             TemporalBlend::Confidence => 1,
         };
         u.history_valid = setup.previous_views.is_some() as u32;
+        // The frame's own views (an OpenXR runtime's, every frame), not the profile's.
         let p = &setup.settings.profile;
-        let [l, r, _, _] = p.fov_left.tangents();
+        let fov = current.first().map_or(p.fov_left, |eye| eye.fov);
+        let [l, r, _, _] = fov.tangents();
         let scale = if setup.settings.ao.half_res { 2.0 } else { 1.0 };
         u.pixel_tangent = ((r - l) / p.width as f64 * scale) as f32;
         ctx.gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&u));
