@@ -76,6 +76,38 @@ struct PanelState {
     settings: Settings,
     quality: Option<Quality>,
     mode: DisplayMode,
+    /// Presented, reprojected and dropped frames per second, from the counters' change
+    /// over the last second.
+    rates: [f64; 3],
+    rate_base: Option<(std::time::Instant, crate::headset::FrameCounters)>,
+    /// Governor changes already taken into the panel's settings.
+    governor_changes_seen: usize,
+}
+
+impl PanelState {
+    fn update_rates(&mut self, counters: &crate::headset::FrameCounters) {
+        let now = std::time::Instant::now();
+        match self.rate_base {
+            Some((since, base)) if now.duration_since(since).as_secs_f64() >= 1.0 => {
+                let dt = now.duration_since(since).as_secs_f64();
+                self.rates = [
+                    counters.presented.saturating_sub(base.presented) as f64 / dt,
+                    counters.reprojected.saturating_sub(base.reprojected) as f64 / dt,
+                    counters.dropped.saturating_sub(base.dropped) as f64 / dt,
+                ];
+                self.rate_base = Some((now, *counters));
+            }
+            Some(_) => {}
+            None => self.rate_base = Some((now, *counters)),
+        }
+    }
+}
+
+/// What the panel shows besides the settings it edits.
+struct PanelInfo<'a> {
+    history: &'a crate::app::PassHistory,
+    budget_ms: f64,
+    governor: Option<&'a crate::governor::Governor>,
 }
 
 impl ApplicationHandler for WindowApp {
@@ -202,7 +234,14 @@ impl WindowState {
             egui_ctx,
             egui_winit,
             egui_renderer,
-            panel: PanelState { settings, quality, mode: options.mode },
+            panel: PanelState {
+                settings,
+                quality,
+                mode: options.mode,
+                rates: [0.0; 3],
+                rate_base: None,
+                governor_changes_seen: 0,
+            },
             mono: None,
             last_paint: None,
         })
@@ -264,11 +303,25 @@ impl WindowState {
         let gpu = frame_loop.gpu.clone();
         let raw_input = self.egui_winit.take_egui_input(&self.window);
         let counters = frame_loop.headset.counters();
+        self.panel.update_rates(&counters);
+        // The governor's changes become the panel's settings, so that the panel shows
+        // what runs and edits start from it.
+        if let Some(governor) = &frame_loop.governor {
+            if governor.changes().len() != self.panel.governor_changes_seen {
+                self.panel.governor_changes_seen = governor.changes().len();
+                self.panel.settings.ao = frame_loop.renderer.settings().ao.clone();
+                self.panel.quality = Quality::ALL.into_iter().find(|q| q.samples() == self.panel.settings.ao.samples);
+            }
+        }
         let mut changed = false;
         let panel = &mut self.panel;
-        let history = &frame_loop.history;
+        let info = PanelInfo {
+            history: &frame_loop.history,
+            budget_ms: frame_loop.budget_ms,
+            governor: frame_loop.governor.as_ref(),
+        };
         let full_output = self.egui_ctx.run_ui(raw_input, |ui| {
-            changed = panel_ui(ui, panel, history, &counters);
+            changed = panel_ui(ui, panel, &info, &counters);
         });
         self.egui_winit.handle_platform_output(&self.window, full_output.platform_output);
         if changed {
@@ -530,12 +583,13 @@ fn pass_colour(i: usize) -> egui::Color32 {
     egui::Color32::from_rgb(r, g, b)
 }
 
-/// The side panel: settings, display mode, the profiler graph and the frame counters.
-/// Returns whether a setting changed.
+/// The side panel: settings (those that do not apply to the chosen technique disabled),
+/// display mode, frame rates, the governor and the profiler graph. Returns whether a
+/// setting changed.
 fn panel_ui(
     ui: &mut egui::Ui,
     panel: &mut PanelState,
-    history: &crate::app::PassHistory,
+    info: &PanelInfo,
     counters: &crate::headset::FrameCounters,
 ) -> bool {
     let before = (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone());
@@ -547,27 +601,32 @@ fn panel_ui(
                 ui.selectable_value(&mut ao.technique, t, t.name());
             }
         });
-        let quality_text = panel.quality.map_or("custom", |q| q.name());
-        egui::ComboBox::from_label("quality").selected_text(quality_text).show_ui(ui, |ui| {
-            for q in Quality::ALL {
-                if ui.selectable_value(&mut panel.quality, Some(q), q.name()).clicked() {
-                    ao.samples = q.samples();
+        let any = ao.technique != Technique::None;
+        let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
+        let bounce = ao.technique == Technique::SsdoBounce;
+        ui.add_enabled_ui(any, |ui| {
+            let quality_text = panel.quality.map_or("custom", |q| q.name());
+            egui::ComboBox::from_label("quality").selected_text(quality_text).show_ui(ui, |ui| {
+                for q in Quality::ALL {
+                    if ui.selectable_value(&mut panel.quality, Some(q), q.name()).clicked() {
+                        ao.samples = q.samples();
+                    }
                 }
+            });
+            if ui.add(egui::Slider::new(&mut ao.samples, 1..=256).text("samples")).changed() {
+                panel.quality = Quality::ALL.into_iter().find(|q| q.samples() == ao.samples);
             }
+            ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
+            ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
+            ui.checkbox(&mut ao.half_res, "half resolution");
+            ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
         });
-        if ui.add(egui::Slider::new(&mut ao.samples, 1..=256).text("samples")).changed() {
-            panel.quality = Quality::ALL.into_iter().find(|q| q.samples() == ao.samples);
-        }
-        ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
-        ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
-        ui.add(egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
+        ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
         let mut patch = ao.bounce_form == BounceForm::Patch;
-        if ui.checkbox(&mut patch, "bounce as seed 002's patches").changed() {
+        if ui.add_enabled(bounce, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches")).changed() {
             ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
         }
-        ui.checkbox(&mut ao.half_res, "half resolution");
-        ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
-        ui.checkbox(&mut ao.depth_peeling, "depth peeling (SSDO)");
+        ui.add_enabled(ssdo, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (SSDO)"));
         ui.checkbox(&mut panel.settings.shadows.enabled, "shadows (directional lights)");
         ui.checkbox(&mut panel.settings.shadows.rsm, "reflective shadow maps (sun bounce)");
         ui.separator();
@@ -577,52 +636,88 @@ fn panel_ui(
             ui.radio_value(&mut panel.mode, DisplayMode::SinglePass, "single-pass");
         });
         ui.separator();
+        let [presented, reprojected, dropped] = panel.rates;
         ui.label(format!(
-            "vsyncs: {} presented, {} reprojected\nframes: {} submitted, {} dropped\nlatency: median {:.1} ms, p95 {:.1} ms",
-            counters.presented,
-            counters.reprojected,
-            counters.submitted,
-            counters.dropped,
-            counters.latency_median_ms,
-            counters.latency_p95_ms
+            "per second: {presented:.0} presented, {reprojected:.0} reprojected, {dropped:.1} dropped\nlatency: median {:.1} ms, p95 {:.1} ms",
+            counters.latency_median_ms, counters.latency_p95_ms
         ));
         ui.separator();
-        profiler_ui(ui, history);
+        match info.governor {
+            Some(governor) => {
+                ui.label(format!(
+                    "governor: level {} of {}: {}",
+                    governor.level(),
+                    governor.frontier().top(),
+                    governor.current().setting
+                ));
+                for change in governor.changes().iter().rev().take(4) {
+                    ui.small(format!("frame {}: {} → {} ({})", change.frame, change.from, change.to, change.reason));
+                }
+            }
+            None => {
+                ui.label("governor: off");
+            }
+        }
+        ui.separator();
+        profiler_ui(ui, info);
     });
     (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone()) != before
 }
 
-/// Seed 003's profiler: one stacked bar per recent frame, a colour per pass.
-fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
+/// The profiler: one stacked bar per recent frame, a colour per pass, against the frame
+/// budget (and 90 % of it, where the governor drops a level), with each frame's CPU
+/// encode time as a white tick. On a CPU adapter only the frames submitted pass by pass
+/// are drawn: timestamps within one submission credit work to the wrong pass there.
+fn profiler_ui(ui: &mut egui::Ui, info: &PanelInfo) {
+    let history = info.history;
+    let serial_only = history.frames.iter().any(|f| f.serial);
+    let frames: Vec<&crate::gpu::timing::FrameTiming> =
+        history.frames.iter().filter(|f| !serial_only || f.serial).collect();
     let mut passes: Vec<String> = Vec::new();
-    for frame in &history.frames {
+    for frame in &frames {
         for (name, _) in &frame.spans {
             if !passes.contains(name) && !name.ends_with(" left") && !name.ends_with(" right") {
                 passes.push(name.clone());
             }
         }
     }
-    let total =
-        |frame: &crate::gpu::timing::FrameTiming| frame.spans.iter().filter(|(n, _)| passes.contains(n)).map(|(_, ms)| ms).sum::<f64>();
-    let max_ms = history.frames.iter().map(total).fold(0.0, f64::max).max(1e-3);
-    ui.label(format!("GPU ms per frame, both eyes (top {max_ms:.1} ms)"));
+    let max_ms = frames.iter().map(|f| f.total_ms).fold(info.budget_ms, f64::max).max(1e-3);
+    let which = if serial_only { ", frames timed pass by pass" } else { "" };
+    ui.label(format!("GPU ms per frame, both eyes{which} (top {max_ms:.1} ms)"));
     let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width(), 120.0), egui::Sense::hover());
     let rect = response.rect;
     painter.rect_filled(rect, 0.0, egui::Color32::from_gray(20));
+    let y_of = |ms: f64| rect.bottom() - (ms / max_ms) as f32 * rect.height();
     let n = history.capacity.max(1) as f32;
     let bar_width = rect.width() / n;
-    for (i, frame) in history.frames.iter().enumerate() {
-        let x = rect.left() + i as f32 * bar_width;
+    let step = (n / frames.len().max(1) as f32).max(1.0);
+    for (i, frame) in frames.iter().enumerate() {
+        let x = rect.left() + i as f32 * bar_width * step;
         let mut y = rect.bottom();
         for (k, pass) in passes.iter().enumerate() {
             let ms = frame.spans.iter().find(|(name, _)| name == pass).map_or(0.0, |(_, ms)| *ms);
             let h = (ms / max_ms) as f32 * rect.height();
-            let bar = egui::Rect::from_min_max(egui::pos2(x, y - h), egui::pos2(x + bar_width.max(1.0), y));
+            let bar = egui::Rect::from_min_max(egui::pos2(x, y - h), egui::pos2(x + (bar_width * step).max(1.0), y));
             painter.rect_filled(bar, 0.0, pass_colour(k));
             y -= h;
         }
     }
-    let latest = history.frames.back();
+    for (i, ms) in history.cpu_encode_ms.iter().enumerate() {
+        let x = rect.left() + i as f32 * bar_width;
+        let y = y_of(*ms);
+        painter.line_segment([egui::pos2(x, y), egui::pos2(x + bar_width.max(1.0), y)], (1.0, egui::Color32::WHITE));
+    }
+    for (fraction, colour) in [(1.0, egui::Color32::RED), (0.9, egui::Color32::YELLOW)] {
+        let y = y_of(info.budget_ms * fraction);
+        painter.line_segment([egui::pos2(rect.left(), y), egui::pos2(rect.right(), y)], (1.0, colour));
+    }
+    ui.small(format!("red: the {:.2} ms budget; yellow: 90 % of it; white: CPU encode", info.budget_ms));
+    let cpu = history.cpu_encode_ms.iter().copied().fold(0.0, f64::max);
+    let latest = frames.last();
+    ui.label(format!(
+        "last frame: GPU {:.2} ms; CPU encode up to {cpu:.3} ms",
+        latest.map_or(0.0, |f| f.total_ms)
+    ));
     for (k, pass) in passes.iter().enumerate() {
         let ms = latest.and_then(|f| f.spans.iter().find(|(n, _)| n == pass)).map_or(0.0, |(_, ms)| *ms);
         ui.horizontal(|ui| {
@@ -632,6 +727,6 @@ fn profiler_ui(ui: &mut egui::Ui, history: &crate::app::PassHistory) {
         });
     }
     if passes.is_empty() {
-        ui.label("(no GPU timestamps on this adapter)");
+        ui.label("(no GPU timestamps yet, or none on this adapter)");
     }
 }
