@@ -3,13 +3,13 @@
 //! depth. The desktop window (`display.rs`) drives the same loop one step per redraw.
 
 use crate::error::{Error, Result};
+use crate::governor::{Governor, GovernorChange};
+use crate::gpu::timing::FrameTiming;
 use crate::gpu::{BackendChoice, Gpu};
 use crate::graph::Resource;
 use crate::headset::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::headset::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::headset::{FrameRequest, Headset, SubmittedFrame};
-use crate::governor::{Governor, GovernorChange};
-use crate::gpu::timing::FrameTiming;
 use crate::renderer::{FrameReport, Renderer, Timing};
 use crate::scene::Scene;
 use crate::settings::Settings;
@@ -204,11 +204,15 @@ impl FrameLoop {
             self.serial_frames.push_back(self.renderer.frame_index());
         }
         let (headset, gpu) = (&mut self.headset, &self.gpu);
-        let report = self.renderer.render_with(&request.eyes.eyes, &[Resource::Color, Resource::Depth], |encoder, targets| {
-            if let (Some(color), Some(depth)) = (targets.get(&Resource::Color), targets.get(&Resource::Depth)) {
-                headset.record_frame(gpu, encoder, &request, color, depth);
-            }
-        })?;
+        let report = self.renderer.render_with(
+            &request.eyes.eyes,
+            &[Resource::Color, Resource::Depth],
+            |encoder, targets| {
+                if let (Some(color), Some(depth)) = (targets.get(&Resource::Color), targets.get(&Resource::Depth)) {
+                    headset.record_frame(gpu, encoder, &request, color, depth);
+                }
+            },
+        )?;
         let color = self.renderer.target(Resource::Color).ok_or_else(|| Error::Gpu("no eye colour".into()))?;
         let depth = self.renderer.target(Resource::Depth).ok_or_else(|| Error::Gpu("no eye depth".into()))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
@@ -236,7 +240,13 @@ impl FrameLoop {
                 let ao_ms: f64 =
                     timing.spans.iter().filter(|(pass, _)| AO_PASSES.contains(&pass.as_str())).map(|(_, ms)| ms).sum();
                 if let Some(change) = governor.observe_with_ao(timing.frame, timing.total_ms, ao_ms) {
-                    log::info!("governor, frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason);
+                    log::info!(
+                        "governor, frame {}: {} -> {} ({})",
+                        change.frame,
+                        change.from,
+                        change.to,
+                        change.reason
+                    );
                     let mut settings = self.renderer.settings().clone();
                     settings.ao = governor.current().apply(&settings.ao);
                     if let Err(e) = self.renderer.set_settings(&settings) {

@@ -714,10 +714,7 @@ fn profiler_ui(ui: &mut egui::Ui, info: &PanelInfo) {
     ui.small(format!("red: the {:.2} ms budget; yellow: 90 % of it; white: CPU encode", info.budget_ms));
     let cpu = history.cpu_encode_ms.iter().copied().fold(0.0, f64::max);
     let latest = frames.last();
-    ui.label(format!(
-        "last frame: GPU {:.2} ms; CPU encode up to {cpu:.3} ms",
-        latest.map_or(0.0, |f| f.total_ms)
-    ));
+    ui.label(format!("last frame: GPU {:.2} ms; CPU encode up to {cpu:.3} ms", latest.map_or(0.0, |f| f.total_ms)));
     for (k, pass) in passes.iter().enumerate() {
         let ms = latest.and_then(|f| f.spans.iter().find(|(n, _)| n == pass)).map_or(0.0, |(_, ms)| *ms);
         ui.horizontal(|ui| {

@@ -1062,7 +1062,12 @@ fn governor_for(args: &RunArgs, settings: &Settings) -> Result<vrao::governor::G
     let start = frontier
         .levels()
         .iter()
-        .position(|l| l.technique == ao.technique && l.samples == ao.samples && l.half_res == ao.half_res && l.temporal == ao.temporal.enabled)
+        .position(|l| {
+            l.technique == ao.technique
+                && l.samples == ao.samples
+                && l.half_res == ao.half_res
+                && l.temporal == ao.temporal.enabled
+        })
         .unwrap_or(frontier.top());
     let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
     Governor::new(frontier, config, start).map_err(Error::input)

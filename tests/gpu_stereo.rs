@@ -243,3 +243,38 @@ fn lit_room_is_finite_and_not_flat() {
         assert!(mean > 30.0 && var.sqrt() > 10.0, "room image is dark or flat (mean {mean}, std {})", var.sqrt());
     }
 }
+
+#[test]
+fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let mut renderer = Renderer::new(gpu.clone(), &scene, &settings(96, 80, StereoMode::Auto)).unwrap();
+    let eyes = renderer.settings().profile.eyes(&scene.head.pose_at(0.0), renderer.settings().near);
+    let mut timings = Vec::new();
+    for frame in 0..6u64 {
+        let report = renderer.render(&eyes.eyes, &[Resource::Color]).unwrap();
+        assert_eq!(report.frame, frame);
+        assert!(report.gpu_ms.is_empty(), "render does not wait for its own times");
+        assert!((1..=2).contains(&report.frames_in_flight), "{}", report.frames_in_flight);
+        timings.extend(report.finished);
+    }
+    timings.extend(renderer.finish().unwrap());
+    if gpu.caps.timestamps {
+        let frames: Vec<u64> = timings.iter().map(|t| t.frame).collect();
+        assert_eq!(frames, (0..6).collect::<Vec<_>>(), "each frame's times come back once, in order");
+        for t in &timings {
+            let passes: f64 = t.spans.iter().filter(|(s, _)| !vrao::gpu::timing::is_per_eye(s)).map(|(_, ms)| ms).sum();
+            assert!((t.total_ms - passes).abs() < 1e-9 && t.total_ms > 0.0, "{t:?}");
+        }
+    }
+    // A frame of a CPU adapter takes milliseconds: the next one is encoded and handed
+    // over while it is still on the GPU.
+    if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+        assert_eq!(renderer.frames_in_flight_max(), 2);
+    }
+    // With one frame in flight, each frame waits for the one before.
+    renderer.set_frames_in_flight(1);
+    for _ in 0..3 {
+        assert_eq!(renderer.render(&eyes.eyes, &[Resource::Color]).unwrap().frames_in_flight, 1);
+    }
+}

@@ -119,3 +119,53 @@ fn depth_based_reprojection_beats_rotational_under_translation_and_both_beat_no_
         assert!(r.depth_rmse < 0.8 * r.rotational_rmse, "{r:?}");
     }
 }
+
+fn run_report(dir: &std::path::Path, name: &str, extra: &[&str]) -> serde_json::Value {
+    let report = dir.join(name);
+    let mut args = vec!["run", "--headset", "simulated", "--display", "none", "--frames", "12"];
+    args.extend(extra);
+    args.extend(["--report", report.to_str().unwrap()]);
+    args.extend(SMALL);
+    let out = vrao(&args);
+    assert!(out.status.success(), "{}", text(&out));
+    serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+}
+
+#[test]
+fn the_run_report_counts_rendered_frames_frames_in_flight_and_the_governors_changes() {
+    let dir = common::temp_dir("run-report");
+    let on = run_report(&dir, "on.json", &[]);
+    assert_eq!(on["frames_rendered"], 12, "{on}");
+    assert_eq!(on["frames_in_flight_limit"], 2, "{on}");
+    let in_flight = on["frames_in_flight_max"].as_u64().unwrap();
+    assert!((1..=2).contains(&in_flight), "{on}");
+    // Every frame's GPU time came back (the last ones when the session ended), and each
+    // over-budget frame is one of them.
+    assert_eq!(on["timed_frames"], 12, "{on}");
+    assert!(on["over_budget_frames"].as_u64().unwrap() <= 12, "{on}");
+    assert_eq!(on["governor"], "on");
+    for change in on["governor_changes"].as_array().unwrap() {
+        assert!(change["reason"].as_str().unwrap().contains("ms"), "{change}");
+        assert_ne!(change["from"], change["to"], "{change}");
+    }
+    let off = run_report(&dir, "off.json", &["--governor", "off", "--frames-in-flight", "1"]);
+    assert_eq!(off["governor"], "off");
+    assert_eq!(off["governor_changes"], serde_json::json!([]));
+    // One frame in flight: each frame waits for the one before it.
+    assert_eq!(off["frames_in_flight_max"], 1, "{off}");
+}
+
+#[test]
+fn profiles_set_the_budget_and_an_unknown_profile_or_rate_is_refused() {
+    let dir = common::temp_dir("profiles");
+    let index = run_report(&dir, "index.json", &["--profile", "index", "--refresh", "144", "--governor", "off"]);
+    assert!((index["budget_ms"].as_f64().unwrap() - 1000.0 / 144.0).abs() < 1e-9, "{index}");
+    assert!(index["headset"].as_str().unwrap().contains("index"), "{index}");
+    for bad in [&["--profile", "no-such-headset"][..], &["--profile", "pico-4", "--refresh", "120"][..]] {
+        let mut args = vec!["run", "--headset", "simulated", "--display", "none", "--frames", "2"];
+        args.extend(bad);
+        let out = vrao(&args);
+        assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+        assert_eq!(text(&out).trim().lines().count(), 1, "{}", text(&out));
+    }
+}

@@ -114,9 +114,10 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
     assert_eq!(frames, 3);
     headset.end(&gpu).unwrap();
 
-    let err = vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), None, BackendChoice::Auto)
-        .err()
-        .expect("--headset openxr without a runtime is an error");
+    let err =
+        vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), None, BackendChoice::Auto)
+            .err()
+            .expect("--headset openxr without a runtime is an error");
     assert_eq!(err.exit_code(), 2, "{err}");
     let text = err.to_string();
     assert!(text.contains("--headset openxr") && text.contains("no OpenXR"), "{text}");

@@ -83,7 +83,8 @@ impl PassTimer {
             let Some(frame) = self.pending.pop_front() else { break };
             let mut spans = Vec::new();
             flatten(&results, &mut spans);
-            let total_ms = results.iter().filter_map(|r| r.time.as_ref()).map(|t| (t.end - t.start).max(0.0) * 1e3).sum();
+            // A pass's per-eye spans lie inside its own span: only passes add up.
+            let total_ms = spans.iter().filter(|(label, _)| !is_per_eye(label)).map(|(_, ms)| ms).sum();
             done.push(FrameTiming { frame, spans, total_ms, serial: false });
         }
         done
@@ -93,6 +94,11 @@ impl PassTimer {
     pub fn pending(&self) -> usize {
         self.pending.len()
     }
+}
+
+/// Per-eye spans (a pass run once per eye) are labelled "<pass> left" / "<pass> right".
+pub fn is_per_eye(label: &str) -> bool {
+    label.ends_with(" left") || label.ends_with(" right")
 }
 
 fn flatten(results: &[wgpu_profiler::GpuTimerQueryResult], out: &mut Vec<(String, f64)>) {
