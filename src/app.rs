@@ -322,7 +322,15 @@ pub struct RunSummary {
 
 impl RunSummary {
     pub fn of(frame_loop: &FrameLoop) -> RunSummary {
-        let frames: Vec<Vec<(String, f64)>> = frame_loop.history.frames.iter().map(|f| f.spans.clone()).collect();
+        // On a CPU adapter the per-pass medians come from the frames timed pass by pass.
+        let serial_only = frame_loop.history.frames.iter().any(|f| f.serial);
+        let frames: Vec<Vec<(String, f64)>> = frame_loop
+            .history
+            .frames
+            .iter()
+            .filter(|f| !serial_only || f.serial)
+            .map(|f| f.spans.clone())
+            .collect();
         let gpu_frame_ms_median = median(&frame_loop.gpu_frame_ms);
         let cpu_encode_ms_median = median(&frame_loop.cpu_encode_ms);
         RunSummary {
@@ -341,9 +349,10 @@ impl RunSummary {
             } else {
                 0.0
             },
-            timing: match frame_loop.renderer.timing() {
-                Timing::Pipelined => "pipelined".into(),
-                Timing::Serial => "serial".into(),
+            timing: if frame_loop.cpu_adapter {
+                format!("pipelined; every {SERIAL_EVERY}th frame serial for the per-pass medians (CPU adapter)")
+            } else {
+                "pipelined".into()
             },
             counters: frame_loop.headset.counters(),
             pass_medians_ms: crate::gpu::timing::summarize(&frames)

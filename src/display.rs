@@ -651,7 +651,7 @@ fn panel_ui(
                     governor.current().setting
                 ));
                 for change in governor.changes().iter().rev().take(4) {
-                    ui.small(format!("frame {}: {} → {} ({})", change.frame, change.from, change.to, change.reason));
+                    ui.small(format!("frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason));
                 }
             }
             None => {
