@@ -304,7 +304,8 @@ pub struct RunSummary {
     pub gpu_frame_ms_median: f64,
     pub cpu_encode_ms_median: f64,
     pub cpu_encode_share_of_gpu: f64,
-    /// How the passes were timed: pipelined or serial (one submission per pass).
+    /// How the passes were timed: pipelined, and on a CPU adapter every
+    /// [`SERIAL_EVERY`]th frame serial (one submission per pass).
     pub timing: String,
     pub counters: crate::headset::FrameCounters,
     /// (pass, median GPU ms for both eyes) over the recent frames.
@@ -324,13 +325,8 @@ impl RunSummary {
     pub fn of(frame_loop: &FrameLoop) -> RunSummary {
         // On a CPU adapter the per-pass medians come from the frames timed pass by pass.
         let serial_only = frame_loop.history.frames.iter().any(|f| f.serial);
-        let frames: Vec<Vec<(String, f64)>> = frame_loop
-            .history
-            .frames
-            .iter()
-            .filter(|f| !serial_only || f.serial)
-            .map(|f| f.spans.clone())
-            .collect();
+        let frames: Vec<Vec<(String, f64)>> =
+            frame_loop.history.frames.iter().filter(|f| !serial_only || f.serial).map(|f| f.spans.clone()).collect();
         let gpu_frame_ms_median = median(&frame_loop.gpu_frame_ms);
         let cpu_encode_ms_median = median(&frame_loop.cpu_encode_ms);
         RunSummary {

@@ -198,10 +198,6 @@ impl Renderer {
         self.frames_in_flight
     }
 
-    pub fn timing(&self) -> Timing {
-        self.timing
-    }
-
     /// The most frames that were on the GPU at once so far.
     pub fn frames_in_flight_max(&self) -> usize {
         self.frames_in_flight_max
@@ -306,9 +302,7 @@ impl Renderer {
     /// measurements; frame loops use [`Renderer::render`].
     pub fn render_and_wait(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<FrameReport> {
         let mut report = self.record_and_submit(views, outputs, true, |_, _| {})?;
-        self.gpu.wait_idle()?;
-        self.in_flight.clear();
-        report.finished.extend(self.timer.finished());
+        report.finished.extend(self.finish()?);
         if let Some(own) = report.finished.iter().find(|t| t.frame == report.frame) {
             report.gpu_ms = own.spans.clone();
         }
@@ -323,12 +317,18 @@ impl Renderer {
         Ok(self.timer.finished())
     }
 
+    /// Forgets the frames the GPU has finished (a non-blocking poll runs their
+    /// completion callbacks).
+    fn forget_finished_frames(&mut self) -> Result<()> {
+        self.gpu.poll()?;
+        self.in_flight.retain(|f| !f.done.load(Ordering::Acquire));
+        Ok(())
+    }
+
     /// Forgets frames the GPU has finished, then waits for the oldest ones until fewer
     /// than the allowed number are in flight.
     fn throttle(&mut self) -> Result<()> {
-        // A non-blocking poll runs the completion callbacks of finished submissions.
-        self.gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
-        self.in_flight.retain(|f| !f.done.load(Ordering::Acquire));
+        self.forget_finished_frames()?;
         while self.in_flight.len() >= self.frames_in_flight {
             let oldest = self.in_flight.pop_front().expect("non-empty");
             self.gpu
@@ -403,8 +403,7 @@ impl Renderer {
         // (counted before the submit call, which on lavapipe returns only once the
         // previous submission has finished: wgpu chains submissions with semaphores
         // that Mesa 22.3 waits for on the CPU).
-        self.gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
-        self.in_flight.retain(|f| !f.done.load(Ordering::Acquire));
+        self.forget_finished_frames()?;
         let frames_in_flight = self.in_flight.len() + 1;
         let submitted = Instant::now();
         let submission = self.gpu.queue.submit([encoder.finish()]);
@@ -420,7 +419,7 @@ impl Renderer {
         self.timer.end_frame(self.frame_index)?;
         self.frames_in_flight_max = self.frames_in_flight_max.max(frames_in_flight);
         // Collect the times of earlier frames that finished meanwhile (never waits).
-        self.gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        self.gpu.poll()?;
         let finished = self.timer.finished();
         self.gpu.take_error()?;
         let frame = self.frame_index;

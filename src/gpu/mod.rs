@@ -162,6 +162,13 @@ impl Gpu {
     }
 
     /// Blocks until all submitted work has finished.
+    /// Runs the callbacks of submissions that have finished (completion callbacks,
+    /// buffer mappings) without waiting for any.
+    pub fn poll(&self) -> Result<()> {
+        self.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        Ok(())
+    }
+
     pub fn wait_idle(&self) -> Result<()> {
         self.device
             .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })

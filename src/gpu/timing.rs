@@ -6,12 +6,13 @@ use super::Gpu;
 use crate::error::{Error, Result};
 use std::collections::VecDeque;
 
-/// One finished frame's spans: (label, GPU milliseconds), nested spans after their parent.
+/// One finished frame's spans: (label, GPU milliseconds) in the order they were
+/// recorded; per-eye spans ([`is_per_eye`]) lie inside their pass's span.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameTiming {
     pub frame: u64,
     pub spans: Vec<(String, f64)>,
-    /// GPU time of the whole frame: the sum of its passes (the top-level spans).
+    /// GPU time of the whole frame: the sum of its passes' spans (not the per-eye ones).
     pub total_ms: f64,
     /// Whether the frame's passes went to the GPU one submission each (true per-pass
     /// times on lavapipe; see [`crate::renderer::Timing::Serial`]).

@@ -125,7 +125,7 @@ impl SimulatedHeadset {
         if self.rendering.is_empty() {
             return Ok(());
         }
-        gpu.device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(format!("polling the device: {e}")))?;
+        gpu.poll()?;
         while let Some(front) = self.rendering.front() {
             let Some(finished) = *front.finished_at.lock().expect("finish time") else { break };
             self.compositor.submit(front.frame, front.target_vsync, finished, front.pose_time);
@@ -134,9 +134,9 @@ impl SimulatedHeadset {
         Ok(())
     }
 
-    /// Waits until time `t` on the headset's clock. In real time it waits on the GPU
-    /// while frames are rendering, so that each one's finishing time is seen when it
-    /// happens, not at the next vsync.
+    /// Waits until time `t` on the headset's clock. In real time, while frames are
+    /// rendering, it looks every [`COMPLETION_POLL_S`] whether they have finished, so
+    /// that each one's finishing time is seen then, not at the next vsync.
     fn wait_until(&mut self, gpu: &Gpu, t: f64) -> Result<()> {
         loop {
             self.collect_finished(gpu)?;
