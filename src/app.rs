@@ -41,6 +41,61 @@ impl std::str::FromStr for HeadsetChoice {
     }
 }
 
+/// What the desktop window shows of each eye (`vrao run --show`, the panel's "show"):
+/// the eye images, or one of the buffers behind them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BufferView {
+    /// The eye images (or, in the mirror, what the headset's compositor shows).
+    #[default]
+    Eyes,
+    /// The occlusion the composite applies (blurred, upsampled or accumulated), as grey.
+    FinalAo,
+    /// The occlusion as the technique computed it, before any filter, as grey.
+    RawAo,
+    /// Reversed-Z depth as log-distance: near white, far dark, sky black.
+    Depth,
+    /// View-space normals, xyz mapped from [-1, 1] to colour.
+    Normals,
+}
+
+impl BufferView {
+    pub const ALL: [BufferView; 5] =
+        [BufferView::Eyes, BufferView::FinalAo, BufferView::RawAo, BufferView::Depth, BufferView::Normals];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            BufferView::Eyes => "eyes",
+            BufferView::FinalAo => "ao",
+            BufferView::RawAo => "raw-ao",
+            BufferView::Depth => "depth",
+            BufferView::Normals => "normals",
+        }
+    }
+
+    /// The renderer's resource that holds this view under `settings`; `None` for the eye
+    /// images and for AO when no technique runs.
+    pub fn resource(self, settings: &Settings) -> Option<Resource> {
+        let any_ao = settings.ao.technique != crate::settings::Technique::None;
+        match self {
+            BufferView::Eyes => None,
+            BufferView::FinalAo => crate::passes::final_occlusion(settings),
+            BufferView::RawAo => any_ao.then_some(Resource::AoRaw),
+            BufferView::Depth => Some(Resource::Depth),
+            BufferView::Normals => Some(Resource::Normals),
+        }
+    }
+}
+
+impl std::str::FromStr for BufferView {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        BufferView::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| format!("unknown buffer '{s}' (expected eyes, ao, raw-ao, depth or normals)"))
+    }
+}
+
 /// Opens the chosen headset and the GPU to render for it; the message says which one
 /// and, on fall back, why. An OpenXR session brings its own GPU (the runtime creates the
 /// Vulkan device); the simulated headset renders on `Gpu::new(backend)`.
@@ -140,6 +195,9 @@ pub struct FrameLoop {
     serial_frames: VecDeque<u64>,
     /// Chooses the AO setting from the measured GPU times (`None`: settings fixed).
     pub governor: Option<Governor>,
+    /// The buffer the window shows; every frame also produces it (an AO buffer the
+    /// composite would otherwise fuse away, such as the upsampled AO, adds its pass).
+    pub buffer_view: BufferView,
 }
 
 /// Spans of the passes the governor's AO setting changes (the rest of the frame does
@@ -165,6 +223,7 @@ impl FrameLoop {
             cpu_adapter,
             serial_frames: VecDeque::new(),
             governor: None,
+            buffer_view: BufferView::Eyes,
             gpu,
             renderer,
             headset,
@@ -203,16 +262,14 @@ impl FrameLoop {
         if serial {
             self.serial_frames.push_back(self.renderer.frame_index());
         }
+        let mut outputs = vec![Resource::Color, Resource::Depth];
+        outputs.extend(self.buffer_view.resource(self.renderer.settings()));
         let (headset, gpu) = (&mut self.headset, &self.gpu);
-        let report = self.renderer.render_with(
-            &request.eyes.eyes,
-            &[Resource::Color, Resource::Depth],
-            |encoder, targets| {
-                if let (Some(color), Some(depth)) = (targets.get(&Resource::Color), targets.get(&Resource::Depth)) {
-                    headset.record_frame(gpu, encoder, &request, color, depth);
-                }
-            },
-        )?;
+        let report = self.renderer.render_with(&request.eyes.eyes, &outputs, |encoder, targets| {
+            if let (Some(color), Some(depth)) = (targets.get(&Resource::Color), targets.get(&Resource::Depth)) {
+                headset.record_frame(gpu, encoder, &request, color, depth);
+            }
+        })?;
         let color = self.renderer.target(Resource::Color).ok_or_else(|| Error::Gpu("no eye colour".into()))?;
         let depth = self.renderer.target(Resource::Depth).ok_or_else(|| Error::Gpu("no eye depth".into()))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };

@@ -7,7 +7,7 @@
 //! A minimised (0×0) window keeps the headset running and skips presenting; a lost or
 //! outdated surface is reconfigured.
 
-use crate::app::{FrameLoop, RunSummary};
+use crate::app::{BufferView, FrameLoop, RunSummary};
 use crate::error::{Error, Result};
 use crate::gpu::kernel::shader_module;
 use crate::gpu::Gpu;
@@ -29,10 +29,13 @@ pub struct WindowOptions {
     pub size: (u32, u32),
     /// Save the window's last picture (panel included) to this PNG.
     pub screenshot: Option<PathBuf>,
+    /// What the picture shows of each eye at first (the panel can change it).
+    pub show: BufferView,
 }
 
 /// Opens the window and runs the session until the headset ends it or the window closes.
-pub fn run_window(frame_loop: FrameLoop, scene: &Scene, options: WindowOptions) -> Result<RunSummary> {
+pub fn run_window(mut frame_loop: FrameLoop, scene: &Scene, options: WindowOptions) -> Result<RunSummary> {
+    frame_loop.buffer_view = options.show;
     let event_loop = EventLoop::new().map_err(|e| Error::Device(format!("cannot open a desktop window: {e}")))?;
     let mut app = WindowApp { frame_loop, scene: scene.clone(), options, window: None, error: None, finished: false };
     event_loop.run_app(&mut app).map_err(|e| Error::Device(format!("the window's event loop failed: {e}")))?;
@@ -76,6 +79,8 @@ struct PanelState {
     settings: Settings,
     quality: Option<Quality>,
     mode: DisplayMode,
+    /// The buffer the picture shows of each eye.
+    show: BufferView,
     /// Presented, reprojected and dropped frames per second, from the counters' change
     /// over the last second.
     rates: [f64; 3],
@@ -238,6 +243,7 @@ impl WindowState {
                 settings,
                 quality,
                 mode: options.mode,
+                show: frame_loop.buffer_view,
                 rates: [0.0; 3],
                 rate_base: None,
                 governor_changes_seen: 0,
@@ -324,6 +330,8 @@ impl WindowState {
             changed = panel_ui(ui, panel, &info, &counters);
         });
         self.egui_winit.handle_platform_output(&self.window, full_output.platform_output);
+        // The next frame also produces the buffer shown (shown from then on).
+        frame_loop.buffer_view = self.panel.show;
         if changed {
             match frame_loop.renderer.set_settings(&self.panel.settings) {
                 Ok(()) => {}
@@ -374,9 +382,18 @@ impl WindowState {
 }
 
 impl WindowState {
-    /// The images the picture shows: the two eyes (mirror) or the mono view.
-    fn picture_images<'a>(&'a self, frame_loop: &'a FrameLoop) -> Vec<&'a wgpu::TextureView> {
-        match self.panel.mode {
+    /// The images the picture shows and how to draw them: the two eyes (mirror), the
+    /// mono view, or each eye's buffer that the panel's "show" picks.
+    fn picture_images<'a>(&'a self, frame_loop: &'a FrameLoop) -> (PictureKind, Vec<&'a wgpu::TextureView>) {
+        if self.panel.show != BufferView::Eyes {
+            let target =
+                self.panel.show.resource(frame_loop.renderer.settings()).and_then(|r| frame_loop.renderer.target(r));
+            return (
+                PictureKind::of(self.panel.show),
+                target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default(),
+            );
+        }
+        let images = match self.panel.mode {
             DisplayMode::SinglePass => match self.mono.as_ref().and_then(|m| m.target(Resource::Color)) {
                 Some(target) => vec![&target.layer_views[0]],
                 None => vec![],
@@ -386,7 +403,8 @@ impl WindowState {
                 let target = frame_loop.headset.display_image().or_else(|| frame_loop.renderer.target(Resource::Color));
                 target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default()
             }
-        }
+        };
+        (PictureKind::Eye, images)
     }
 
     /// Records and submits the picture (eye images fitted into the area right of the
@@ -401,13 +419,13 @@ impl WindowState {
         let gpu = &frame_loop.gpu;
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window") });
         let buffers = self.egui_renderer.update_buffers(&gpu.device, &gpu.queue, &mut encoder, paint_jobs, screen);
-        let images = self.picture_images(frame_loop);
+        let (kind, images) = self.picture_images(frame_loop);
         let eye_aspect = {
             let p = &frame_loop.renderer.settings().profile;
             p.width as f32 / p.height as f32
         };
         let (ax, ay, aw, ah) = self.picture_area(PANEL_WIDTH * screen.pixels_per_point);
-        let bind_groups: Vec<wgpu::BindGroup> = images.iter().map(|v| self.blit.bind_group(gpu, v)).collect();
+        let bind_groups: Vec<wgpu::BindGroup> = images.iter().map(|v| self.blit.bind_group(gpu, kind, v)).collect();
         {
             let mut pass = encoder
                 .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -430,14 +448,15 @@ impl WindowState {
             let count = bind_groups.len().max(1) as f32;
             for (i, group) in bind_groups.iter().enumerate() {
                 // Each image gets an equal slot; within it, the largest rectangle of its aspect.
-                let aspect = if self.panel.mode == DisplayMode::SinglePass { aw / ah } else { eye_aspect };
+                let mono = self.panel.mode == DisplayMode::SinglePass && kind == PictureKind::Eye;
+                let aspect = if mono { aw / ah } else { eye_aspect };
                 let (slot_w, slot_h) = (aw / count, ah);
                 let (w, h) =
                     if slot_w / slot_h > aspect { (slot_h * aspect, slot_h) } else { (slot_w, slot_w / aspect) };
                 let x = ax + slot_w * i as f32 + (slot_w - w) * 0.5;
                 let y = ay + (slot_h - h) * 0.5;
                 pass.set_viewport(x, y, w.max(1.0), h.max(1.0), 0.0, 1.0);
-                pass.set_pipeline(&self.blit.pipeline);
+                pass.set_pipeline(self.blit.pipeline(kind));
                 pass.set_bind_group(0, group, &[]);
                 pass.draw(0..3, 0..1);
             }
@@ -488,82 +507,147 @@ impl WindowState {
     }
 }
 
-/// The eye-image blit: a full-screen triangle sampling one 2D view.
+/// How a picture image is drawn: the eye image filtered, or a buffer texel for texel
+/// (shaders/mirror.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PictureKind {
+    Eye,
+    Occlusion,
+    Normals,
+    Depth,
+}
+
+impl PictureKind {
+    fn of(view: BufferView) -> PictureKind {
+        match view {
+            BufferView::Eyes => PictureKind::Eye,
+            BufferView::FinalAo | BufferView::RawAo => PictureKind::Occlusion,
+            BufferView::Normals => PictureKind::Normals,
+            BufferView::Depth => PictureKind::Depth,
+        }
+    }
+}
+
+/// The picture's pipelines: a full-screen triangle drawing one 2D view into a viewport,
+/// one pipeline per [`PictureKind`].
 struct Blit {
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    eye: wgpu::RenderPipeline,
+    occlusion: wgpu::RenderPipeline,
+    normals: wgpu::RenderPipeline,
+    depth: wgpu::RenderPipeline,
+    eye_layout: wgpu::BindGroupLayout,
+    float_layout: wgpu::BindGroupLayout,
+    depth_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+}
+
+/// A bind group layout of one fragment-stage texture or sampler per entry.
+fn fragment_layout(gpu: &Gpu, label: &str, entries: &[(u32, wgpu::BindingType)]) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = entries
+        .iter()
+        .map(|&(binding, ty)| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty,
+            count: None,
+        })
+        .collect();
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+}
+
+fn texture_binding(sample_type: wgpu::TextureSampleType) -> wgpu::BindingType {
+    wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false }
 }
 
 impl Blit {
     fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> Blit {
         let device = &gpu.device;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("mirror"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+        let eye_layout = fragment_layout(
+            gpu,
+            "mirror",
+            &[
+                (0, texture_binding(wgpu::TextureSampleType::Float { filterable: true })),
+                (1, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("mirror"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        );
+        let float_layout = fragment_layout(
+            gpu,
+            "buffer view",
+            &[(2, texture_binding(wgpu::TextureSampleType::Float { filterable: false }))],
+        );
+        let depth_layout = fragment_layout(gpu, "depth view", &[(3, texture_binding(wgpu::TextureSampleType::Depth))]);
         let module = shader_module(device, "mirror", &["mirror.wgsl"]);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("mirror"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                buffers: &[],
-                compilation_options: Default::default(),
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                targets: &[Some(format.into())],
-                compilation_options: Default::default(),
-            }),
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry_point),
+                bind_group_layouts: &[Some(layout)],
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    buffers: &[],
+                    compilation_options: Default::default(),
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry_point),
+                    targets: &[Some(format.into())],
+                    compilation_options: Default::default(),
+                }),
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("mirror"),
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        Blit { pipeline, layout, sampler }
+        Blit {
+            eye: pipeline(&eye_layout, "fs_main"),
+            occlusion: pipeline(&float_layout, "fs_occlusion"),
+            normals: pipeline(&float_layout, "fs_normals"),
+            depth: pipeline(&depth_layout, "fs_depth"),
+            eye_layout,
+            float_layout,
+            depth_layout,
+            sampler,
+        }
     }
 
-    fn bind_group(&self, gpu: &Gpu, view: &wgpu::TextureView) -> wgpu::BindGroup {
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mirror"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-            ],
-        })
+    fn pipeline(&self, kind: PictureKind) -> &wgpu::RenderPipeline {
+        match kind {
+            PictureKind::Eye => &self.eye,
+            PictureKind::Occlusion => &self.occlusion,
+            PictureKind::Normals => &self.normals,
+            PictureKind::Depth => &self.depth,
+        }
+    }
+
+    fn bind_group(&self, gpu: &Gpu, kind: PictureKind, view: &wgpu::TextureView) -> wgpu::BindGroup {
+        let texture = wgpu::BindingResource::TextureView(view);
+        let (layout, entries) = match kind {
+            PictureKind::Eye => (
+                &self.eye_layout,
+                vec![
+                    wgpu::BindGroupEntry { binding: 0, resource: texture },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                ],
+            ),
+            PictureKind::Occlusion | PictureKind::Normals => {
+                (&self.float_layout, vec![wgpu::BindGroupEntry { binding: 2, resource: texture }])
+            }
+            PictureKind::Depth => (&self.depth_layout, vec![wgpu::BindGroupEntry { binding: 3, resource: texture }]),
+        };
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mirror"), layout, entries: &entries })
     }
 }
 
@@ -635,6 +719,14 @@ fn panel_ui(
             ui.radio_value(&mut panel.mode, DisplayMode::Mirror, "mirror");
             ui.radio_value(&mut panel.mode, DisplayMode::SinglePass, "single-pass");
         });
+        egui::ComboBox::from_label("show (each eye)").selected_text(buffer_label(panel.show)).show_ui(ui, |ui| {
+            for view in BufferView::ALL {
+                ui.selectable_value(&mut panel.show, view, buffer_label(view));
+            }
+        });
+        if panel.show != BufferView::Eyes && panel.show.resource(&panel.settings).is_none() {
+            ui.small("no AO buffer: the technique is none");
+        }
         ui.separator();
         let [presented, reprojected, dropped] = panel.rates;
         ui.label(format!(
@@ -662,6 +754,17 @@ fn panel_ui(
         profiler_ui(ui, info);
     });
     (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone()) != before
+}
+
+/// The panel's name of a buffer view.
+fn buffer_label(view: BufferView) -> &'static str {
+    match view {
+        BufferView::Eyes => "eye images",
+        BufferView::FinalAo => "final AO",
+        BufferView::RawAo => "raw AO",
+        BufferView::Depth => "depth",
+        BufferView::Normals => "normals",
+    }
 }
 
 /// The profiler: one stacked bar per recent frame, a colour per pass, against the frame

@@ -99,6 +99,10 @@ struct RunArgs {
     /// Save a screenshot of the window to this PNG after the last frame.
     #[arg(long)]
     screenshot: Option<PathBuf>,
+    /// What the window shows of each eye: eyes, ao (the final AO), raw-ao (before any
+    /// filter), depth or normals; the panel can change it.
+    #[arg(long, default_value = "eyes")]
+    show: vrao::app::BufferView,
     /// Write the frame counters and per-pass medians to this JSON file.
     #[arg(long)]
     report: Option<PathBuf>,
@@ -985,6 +989,12 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     settings.profile = profile;
     settings.validate()?;
     let window_size = parse_size(&args.window)?;
+    if args.display == DisplayMode::None && args.show != vrao::app::BufferView::Eyes {
+        return Err(Error::input(format!(
+            "--show {} needs a window (--display mirror or single-pass)",
+            args.show.name()
+        )));
+    }
     let governor = match args.governor {
         OnOff::Off => None,
         OnOff::On => Some(governor_for(&args, &settings)?),
@@ -1036,7 +1046,12 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         vrao::display::run_window(
             frame_loop,
             &scene,
-            vrao::display::WindowOptions { mode: args.display, size: window_size, screenshot: args.screenshot.clone() },
+            vrao::display::WindowOptions {
+                mode: args.display,
+                size: window_size,
+                screenshot: args.screenshot.clone(),
+                show: args.show,
+            },
         )?
     };
     println!("{}", summary.to_text());
