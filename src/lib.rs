@@ -2,35 +2,21 @@
 //!
 //! The library is usable without the CLI: load a [`Scene`], open a [`Gpu`], make a
 //! [`Renderer`] with [`Settings`], and render an [`EyePair`] into layered targets.
+//!
+//! Four folders with a dependency rule (checked by `tests/layout.rs`): [`render`]
+//! imports none of the others; [`xr`] (headsets) imports only `render`; [`app`] (the
+//! frame loop, governor and window) and [`measure`] (reference, metrics, bench, studies)
+//! import `render` and `xr` but not each other. The CLI (`src/cli/`) is the binary's.
 
-pub mod analytic;
 pub mod app;
-pub mod bench;
-pub mod budget;
-pub mod display;
-pub mod error;
-pub mod governor;
-pub mod gpu;
-pub mod graph;
-pub mod headset;
-pub mod metrics;
-pub mod output;
-pub mod passes;
-pub mod plot;
-pub mod profiles;
-pub mod reference;
-pub mod renderer;
-pub mod sampling;
-pub mod scene;
-pub mod settings;
-pub mod stereo;
-pub mod stereo_consistency;
-pub mod temporal_bench;
+pub mod measure;
+pub mod render;
+pub mod xr;
 
-pub use error::{Error, Result};
-pub use gpu::{BackendChoice, Gpu};
-pub use graph::Resource;
-pub use renderer::{FrameReport, Renderer};
-pub use scene::Scene;
-pub use settings::{Settings, StereoMode};
-pub use stereo::{Eye, EyePair, Fov, HeadPose, HeadsetProfile};
+pub use render::error::{Error, Result};
+pub use render::gpu::{BackendChoice, Gpu};
+pub use render::graph::Resource;
+pub use render::renderer::{FrameReport, Renderer};
+pub use render::scene::Scene;
+pub use render::settings::{Settings, StereoMode};
+pub use render::stereo::{Eye, EyePair, Fov, HeadPose, HeadsetProfile};

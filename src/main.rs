@@ -5,10 +5,10 @@ use glam::DVec3;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
-use vrao::error::{Error, Result};
-use vrao::renderer::Timing;
-use vrao::settings::{AoSettings, Noise, Quality, Technique};
-use vrao::stereo::HeadsetProfile;
+use vrao::render::error::{Error, Result};
+use vrao::render::renderer::Timing;
+use vrao::render::settings::{AoSettings, Noise, Quality, Technique};
+use vrao::render::stereo::HeadsetProfile;
 use vrao::{BackendChoice, Gpu, HeadPose, Renderer, Resource, Scene, Settings, StereoMode};
 
 #[derive(Parser)]
@@ -54,16 +54,16 @@ struct RunArgs {
     headset: vrao::app::HeadsetChoice,
     /// Desktop window: none, mirror (both eyes side by side) or single-pass (mono view).
     #[arg(long, default_value = "mirror")]
-    display: vrao::settings::DisplayMode,
+    display: vrao::render::settings::DisplayMode,
     /// Stop after this many frames (default: until the window is closed; 600 without one).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     frames: Option<u64>,
     /// Simulated head motion: static, yaw-sweep, figure-eight or head-roll.
     #[arg(long, default_value = "static")]
-    motion: vrao::headset::motion::HeadMotion,
+    motion: vrao::xr::simulated::motion::HeadMotion,
     /// Simulated compositor reprojection: rotational or depth.
     #[arg(long, default_value = "depth")]
-    reprojection: vrao::headset::reproject::ReprojectionMode,
+    reprojection: vrao::xr::simulated::reproject::ReprojectionMode,
     /// Run the simulated headset in virtual time, each frame taking these render times
     /// in ms (cycled): deterministic counters.
     #[arg(long, value_delimiter = ',')]
@@ -91,7 +91,7 @@ struct RunArgs {
     #[arg(long)]
     governor_frontier: Option<PathBuf>,
     /// Frames the GPU may work on at once.
-    #[arg(long, default_value_t = vrao::renderer::DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
+    #[arg(long, default_value_t = vrao::render::renderer::DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
     frames_in_flight: u64,
     /// Window size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
@@ -227,12 +227,12 @@ struct BenchArgs {
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (seed 002 eq. 2).
     #[arg(long, default_value = "direction")]
-    bounce_form: vrao::settings::BounceForm,
+    bounce_form: vrao::render::settings::BounceForm,
     #[command(flatten)]
     gtao: GtaoArgs,
     /// Spatial denoise of every row: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or bilateral (11×11 at --blur 5).
     #[arg(long, default_value = "tile")]
-    denoise: vrao::settings::Denoise,
+    denoise: vrao::render::settings::Denoise,
     /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
     #[arg(long, default_value_t = 5)]
     blur: u32,
@@ -313,7 +313,7 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1200)]
     height: u32,
     /// Interpupillary distance in metres.
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::stereo::DEFAULT_IPD)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::render::stereo::DEFAULT_IPD)]
     ipd: f64,
     /// Linear exposure before tone mapping.
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
@@ -359,13 +359,13 @@ struct LightArgs {
 }
 
 impl LightArgs {
-    fn settings(&self, scene: &Scene) -> vrao::settings::ShadowSettings {
-        vrao::settings::ShadowSettings {
+    fn settings(&self, scene: &Scene) -> vrao::render::settings::ShadowSettings {
+        vrao::render::settings::ShadowSettings {
             enabled: self.shadows,
             size: self.shadow_size,
             rsm: self.rsm,
             rsm_samples: self.rsm_samples,
-            rsm_radius: self.rsm_radius.unwrap_or_else(|| vrao::passes::shadow::suggested_rsm_radius(scene)),
+            rsm_radius: self.rsm_radius.unwrap_or_else(|| vrao::render::passes::shadow::suggested_rsm_radius(scene)),
         }
     }
 }
@@ -383,15 +383,15 @@ fn parse_on_off(s: &str) -> std::result::Result<bool, String> {
 struct GtaoArgs {
     /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
     /// radius (thin objects stop occluding behind themselves).
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_THICKNESS)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::render::settings::DEFAULT_THICKNESS)]
     thickness: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2 (1 even, 2 quadratic: crowded
     /// near the pixel).
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_STEP_POWER)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::render::settings::DEFAULT_STEP_POWER)]
     step_power: f32,
     /// GTAO: successive samples closer in distance than this fraction of the radius
     /// join into one surface (0: never).
-    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::settings::DEFAULT_CONNECT)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = vrao::render::settings::DEFAULT_CONNECT)]
     connect: f32,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
     /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
@@ -438,7 +438,7 @@ struct AoArgs {
     /// How the bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
     /// the receiver cosine) or patch (seed 002 eq. 2: area π r²/N, both cosines, 1/d²).
     #[arg(long, default_value = "direction")]
-    bounce_form: vrao::settings::BounceForm,
+    bounce_form: vrao::render::settings::BounceForm,
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
@@ -450,7 +450,7 @@ struct AoArgs {
     /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
     /// bilateral (separable, --blur px either side).
     #[arg(long, default_value = "tile")]
-    denoise: vrao::settings::Denoise,
+    denoise: vrao::render::settings::Denoise,
     /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns any denoise off.
     #[arg(long, default_value_t = 5)]
     blur: u32,
@@ -475,7 +475,7 @@ struct AoArgs {
     temporal_epsilon: f32,
     /// Temporal blend: average (running mean) or confidence (seed 001 eqs. 4–5).
     #[arg(long, default_value = "average")]
-    temporal_blend: vrao::settings::TemporalBlend,
+    temporal_blend: vrao::render::settings::TemporalBlend,
     /// Frames after which a pixel counts as converged.
     #[arg(long, default_value_t = 16)]
     temporal_frames: u32,
@@ -513,7 +513,7 @@ impl AoArgs {
             denoise: self.denoise,
             blur_radius: self.blur,
             blur_plane_sigma: self.blur_sigma,
-            temporal: vrao::settings::Temporal {
+            temporal: vrao::render::settings::Temporal {
                 enabled: self.temporal,
                 epsilon_m: self.temporal_epsilon,
                 blend: self.temporal_blend,
@@ -583,7 +583,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     if let (Some(eye), Some(target)) = (args.eye, args.look_at) {
         let pose = HeadPose::look_at(eye, target)
             .ok_or_else(|| Error::input(format!("--eye and --look-at are the same point {eye}")))?;
-        scene.head = vrao::scene::HeadPath::fixed(pose);
+        scene.head = vrao::render::scene::HeadPath::fixed(pose);
     }
     let mut profile = HeadsetProfile::with_size("vive", args.width, args.height);
     profile.ipd = args.ipd;
@@ -604,7 +604,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     let mut outputs = vec![Resource::Color];
     if args.debug {
         outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
-        outputs.extend(vrao::output::occlusion_outputs(&settings));
+        outputs.extend(vrao::render::output::occlusion_outputs(&settings));
     }
     // Warm-up frames (pipeline compilation, first-touch allocation) are not measured.
     let warmup = if args.frames > 1 { (args.frames / 10).clamp(1, 10) } else { 0 };
@@ -621,7 +621,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         report = Some(r);
     }
     let report = report.expect("at least one frame");
-    let written = vrao::output::write_images(&renderer, &args.out, 2, args.debug)?;
+    let written = vrao::render::output::write_images(&renderer, &args.out, 2, args.debug)?;
     println!(
         "rendered '{}' ({} triangles) on {}: {}x{} per eye, {} G-buffer, {} N={} r={} m{}",
         scene.name,
@@ -643,7 +643,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
             args.frames, adapter.name, adapter.backend
         );
         println!("  {:<22} {:>10} {:>10} {:>10}", "span", "median ms", "p25 ms", "p75 ms");
-        for s in vrao::gpu::timing::summarize(&timings) {
+        for s in vrao::render::gpu::timing::summarize(&timings) {
             println!("  {:<22} {:>10.3} {:>10.3} {:>10.3}", s.label, s.median_ms, s.p25_ms, s.p75_ms);
         }
         if report.gpu_ms.is_empty() {
@@ -657,10 +657,10 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
 }
 
 fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
-    use vrao::bench::{records, sweep, BenchCase, BenchFile, Measurement};
+    use vrao::measure::bench::{records, sweep, BenchCase, BenchFile, Measurement};
     if let Some(path) = &args.replot {
-        let mut file = vrao::bench::read_json(path)?;
-        vrao::bench::mark_pareto(&mut file.records);
+        let mut file = vrao::measure::bench::read_json(path)?;
+        vrao::measure::bench::mark_pareto(&mut file.records);
         let mut radii: Vec<f32> = file.records.iter().map(|r| r.radius_m).collect();
         radii.sort_by(f32::total_cmp);
         radii.dedup();
@@ -726,7 +726,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             return Err(Error::input("--techniques: none has no occlusion to measure"));
         }
     }
-    if !args.rsm_samples.is_empty() && vrao::passes::shadow::shadow_casters(&scene).is_empty() {
+    if !args.rsm_samples.is_empty() && vrao::render::passes::shadow::shadow_casters(&scene).is_empty() {
         return Err(Error::input(format!("--rsm-samples: '{}' has no directional light to bounce", scene.name)));
     }
     if let Some(n) = args.rsm_samples.iter().find(|n| !(1..=1024).contains(*n)) {
@@ -742,15 +742,15 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         let cache = args.cache.clone().unwrap_or_else(default_cache_dir);
         let (mut noise, mut rays, mut seconds) = (0.0f64, 0u64, 0.0f64);
         for &radius in &radii {
-            let reference_settings = vrao::reference::ReferenceSettings {
+            let reference_settings = vrao::measure::reference::ReferenceSettings {
                 radius: radius as f64,
                 rays_per_pixel: args.rays,
                 stride: args.stride,
                 near: settings.near,
             };
             eprintln!("reference: r = {radius} m, {} rays per pixel, every {} pixels", args.rays, args.stride);
-            let mut bar = vrao::reference::ProgressBar::new("reference");
-            let image = vrao::reference::trace_cached(
+            let mut bar = vrao::measure::reference::ProgressBar::new("reference");
+            let image = vrao::measure::reference::trace_cached(
                 &cache,
                 &scene,
                 &eyes.eyes,
@@ -766,7 +766,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             }
             references.push((radius, image));
         }
-        reference_info = Some(vrao::bench::ReferenceInfo {
+        reference_info = Some(vrao::measure::bench::ReferenceInfo {
             rays_per_pixel: args.rays,
             stride: args.stride,
             ao_noise_rms: noise,
@@ -789,7 +789,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         whole_frame: args.frame,
         interleave: args.interleave as usize,
     };
-    let (estimate, frame_seconds) = vrao::bench::estimate_seconds(&gpu, &scene, &settings, &cases, how)?;
+    let (estimate, frame_seconds) = vrao::measure::bench::estimate_seconds(&gpu, &scene, &settings, &cases, how)?;
     eprintln!(
         "bench: estimated {} ({} cases × ({} + {} frames) at ~{:.0} ms a frame of the first case, plus set-up; other cases may differ)",
         format_duration(estimate),
@@ -828,7 +828,7 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     for &samples in &args.rsm_samples {
         for &radius in &radii {
             let reference = references.iter().find(|(r, _)| *r == radius).map(|(_, image)| image);
-            let row = vrao::bench::measure_rsm(&gpu, &scene, &settings, samples, radius, how, reference)?;
+            let row = vrao::measure::bench::measure_rsm(&gpu, &scene, &settings, samples, radius, how, reference)?;
             let error = row.bounce.map_or(String::new(), |b| format!("  bounce rel RMSE {:.4}", b.rel_rmse));
             eprintln!("[rsm] N={samples:<3} r={radius:<7} half {:>9.3} ms/eye{error}", row.occlusion_ms_per_eye());
             rows.push(row);
@@ -844,9 +844,9 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
         timing: format!("{timing:?}").to_lowercase(),
         warmup: args.warmup,
         frames: args.frames,
-        limit: reference_info.as_ref().map(|_| vrao::bench::LimitInfo::defaults()),
+        limit: reference_info.as_ref().map(|_| vrao::measure::bench::LimitInfo::defaults()),
         pixels_per_degree: Some(
-            eyes.eyes.iter().map(|e| vrao::bench::pixels_per_degree(&e.fov, args.width)).sum::<f64>() / 2.0,
+            eyes.eyes.iter().map(|e| vrao::measure::bench::pixels_per_degree(&e.fov, args.width)).sum::<f64>() / 2.0,
         ),
         reference: reference_info,
         version: version(),
@@ -858,8 +858,8 @@ fn bench(backend: BackendChoice, args: BenchArgs) -> Result<()> {
 }
 
 /// Writes a bench's table, CSV, JSON, Markdown and plots into `args.out` and prints them.
-fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], adapter: &str) -> Result<()> {
-    use vrao::bench::{markdown_report, plot, to_csv, to_json};
+fn write_bench(args: &BenchArgs, file: &vrao::measure::bench::BenchFile, radii: &[f32], adapter: &str) -> Result<()> {
+    use vrao::measure::bench::{markdown_report, plot, to_csv, to_json};
     std::fs::create_dir_all(&args.out).map_err(|e| Error::Output { path: args.out.clone(), message: e.to_string() })?;
     let write = |name: &str, text: String| {
         let path = args.out.join(name);
@@ -889,7 +889,7 @@ fn write_bench(args: &BenchArgs, file: &vrao::bench::BenchFile, radii: &[f32], a
             r.rays_per_second.map_or(String::new(), |s| format!("; traced at {:.2} Mrays/s", s / 1e6))
         );
         for &radius in radii {
-            let mut front: Vec<&vrao::bench::BenchRecord> =
+            let mut front: Vec<&vrao::measure::bench::BenchRecord> =
                 file.records.iter().filter(|r| r.pareto && r.radius_m == radius).collect();
             front.sort_by(|a, b| a.occlusion_ms_per_eye.total_cmp(&b.occlusion_ms_per_eye));
             let front: Vec<String> = front
@@ -971,10 +971,11 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 }
 
 fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
-    use vrao::headset::simulated::{SimulatedOptions, TimeMode};
-    use vrao::settings::DisplayMode;
+    use vrao::render::settings::DisplayMode;
+    use vrao::xr::simulated::{SimulatedOptions, TimeMode};
     let scene = Scene::load(&args.scene)?;
-    let mut profile = vrao::profiles::by_name(&args.profile).map_err(|e| Error::input(format!("--profile: {e}")))?;
+    let mut profile =
+        vrao::xr::profiles::by_name(&args.profile).map_err(|e| Error::input(format!("--profile: {e}")))?;
     if let Some(hz) = args.refresh {
         profile = profile.with_refresh(hz).map_err(|e| Error::input(format!("--refresh: {e}")))?;
     }
@@ -1043,10 +1044,10 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         frame_loop.end()?;
         vrao::app::RunSummary::of(&frame_loop)
     } else {
-        vrao::display::run_window(
+        vrao::app::window::run_window(
             frame_loop,
             &scene,
-            vrao::display::WindowOptions {
+            vrao::app::window::WindowOptions {
                 mode: args.display,
                 size: window_size,
                 screenshot: args.screenshot.clone(),
@@ -1064,8 +1065,8 @@ fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
 
 /// The governor of `vrao run`: its frontier (the bench file given, or the built-in one)
 /// at the frame budget of the profile, starting at the level nearest the asked setting.
-fn governor_for(args: &RunArgs, settings: &Settings) -> Result<vrao::governor::Governor> {
-    use vrao::governor::{Frontier, Governor, GovernorConfig};
+fn governor_for(args: &RunArgs, settings: &Settings) -> Result<vrao::app::governor::Governor> {
+    use vrao::app::governor::{Frontier, Governor, GovernorConfig};
     let frontier = match &args.governor_frontier {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
@@ -1096,7 +1097,7 @@ enum OnOff {
 }
 
 fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
-    use vrao::headset::reprojection_bench::{default_movements, measure, to_markdown};
+    use vrao::measure::reprojection::{default_movements, measure, to_markdown};
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
     settings.validate()?;
@@ -1119,8 +1120,8 @@ fn reprojection(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
 }
 
 fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
-    use vrao::headset::motion::HeadMotion;
-    use vrao::settings::TemporalBlend;
+    use vrao::render::settings::TemporalBlend;
+    use vrao::xr::simulated::motion::HeadMotion;
     let scene = Scene::load(&args.scene)?;
     let base = args.ao.eye_settings(&scene, args.width, args.height);
     base.validate()?;
@@ -1148,7 +1149,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
         s.validate()?;
     }
     let gpu = Arc::new(Gpu::new(backend)?);
-    let reference = vrao::reference::ReferenceSettings {
+    let reference = vrao::measure::reference::ReferenceSettings {
         radius: base.ao.radius as f64,
         rays_per_pixel: args.rays,
         stride: 2,
@@ -1157,7 +1158,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
     let mut points = Vec::new();
     for motion in [HeadMotion::Static, HeadMotion::YawSweep] {
         eprintln!("temporal: {} ({} configurations × 16 frames)", motion.name(), configurations.len());
-        points.extend(vrao::temporal_bench::convergence(
+        points.extend(vrao::measure::temporal::convergence(
             &gpu,
             &scene,
             &configurations,
@@ -1176,7 +1177,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
         base.ao.radius,
         gpu.adapter.get_info().name
     );
-    print!("{}", vrao::temporal_bench::to_markdown(&points));
+    print!("{}", vrao::measure::temporal::to_markdown(&points));
     if let Some(path) = &args.out {
         let json = serde_json::to_string_pretty(&points).expect("points serialise");
         std::fs::write(path, json).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
@@ -1185,7 +1186,7 @@ fn temporal(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
 }
 
 fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
-    use vrao::budget::{run, BudgetRun};
+    use vrao::measure::budget::{run, BudgetRun};
     let scene = Scene::load(&args.scene)?;
     let mut settings = args.ao.eye_settings(&scene, args.width, args.height);
     let budget_ms = args.budget_ms.unwrap_or(settings.profile.budget_ms());
@@ -1199,15 +1200,15 @@ fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
     };
     settings.validate()?;
     let fit_file = match &args.fit {
-        Some(path) => Some(vrao::bench::read_json(path)?),
+        Some(path) => Some(vrao::measure::bench::read_json(path)?),
         None => None,
     };
     let gpu = Arc::new(Gpu::new(backend)?);
     let timing = args.timing.resolve(&gpu);
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
-    let measure = |settings: &Settings, frames: u32| -> Result<vrao::budget::BudgetReport> {
+    let measure = |settings: &Settings, frames: u32| -> Result<vrao::measure::budget::BudgetReport> {
         let output = if occlusion_only {
-            vrao::passes::final_occlusion(settings)
+            vrao::render::passes::final_occlusion(settings)
                 .ok_or_else(|| Error::input("--measure occlusion needs an occlusion technique"))?
         } else {
             Resource::Color
@@ -1238,13 +1239,13 @@ fn budget(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
 /// budget leaves per eye after the passes every frame pays (measured here with no
 /// occlusion), returned as the settings to measure.
 fn fit_setting(
-    file: &vrao::bench::BenchFile,
+    file: &vrao::measure::bench::BenchFile,
     path: &std::path::Path,
     gpu: &Gpu,
     settings: &Settings,
     budget_ms: f64,
     occlusion_only: bool,
-    measure: impl Fn(&Settings, u32) -> Result<vrao::budget::BudgetReport>,
+    measure: impl Fn(&Settings, u32) -> Result<vrao::measure::budget::BudgetReport>,
 ) -> Result<AoSettings> {
     let adapter = gpu.adapter.get_info().name;
     if file.adapter != adapter {

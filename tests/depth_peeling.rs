@@ -7,10 +7,10 @@
 mod common;
 
 use glam::{DVec3, Vec3};
-use vrao::bench::error_figures;
-use vrao::passes::final_occlusion;
-use vrao::reference::{trace, ReferenceImage, ReferenceSettings};
-use vrao::settings::{AoSettings, Technique};
+use vrao::measure::bench::error_figures;
+use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
+use vrao::render::passes::final_occlusion;
+use vrao::render::settings::{AoSettings, Technique};
 use vrao::{HeadsetProfile, Renderer, Resource, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 144);
@@ -88,8 +88,8 @@ fn mean_over(
 /// Wall cells within `reach` grid cells of a board cell: where a halo would show.
 fn halo_band(reference: &ReferenceImage, reach: i64) -> impl Fn(usize, u32, u32) -> bool + '_ {
     let (gw, gh) = reference.grid_size();
-    let on_wall = |p: &vrao::reference::ReferencePixel| p.hit && p.depth > (-WALL_Z as f32) - 0.05;
-    let on_board = |p: &vrao::reference::ReferencePixel| p.hit && p.depth < (-WALL_Z as f32) - 0.05;
+    let on_wall = |p: &vrao::measure::reference::ReferencePixel| p.hit && p.depth > (-WALL_Z as f32) - 0.05;
+    let on_board = |p: &vrao::measure::reference::ReferencePixel| p.hit && p.depth < (-WALL_Z as f32) - 0.05;
     move |layer, i, j| {
         if !on_wall(reference.get(layer, i, j)) {
             return false;
@@ -153,7 +153,7 @@ fn a_closed_box_still_occludes_the_floor_beside_it_with_peeling() {
         let eyes = &eyes;
         let reference = &reference;
         move |layer: usize, i: u32, j: u32| {
-            vrao::reference::world_position(reference, &eyes.eyes[layer], layer, i, j).is_some_and(|p| {
+            vrao::measure::reference::world_position(reference, &eyes.eyes[layer], layer, i, j).is_some_and(|p| {
                 let out = p.x.abs().max(p.z.abs());
                 p.y.abs() < 0.01 && out > near && out < far
             })
@@ -187,7 +187,8 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
         let s = settings(AoSettings { technique, depth_peeling, ..AoSettings::default() });
         Renderer::new(gpu.clone(), &scene, &s).unwrap().plan(2, outputs).unwrap()
     };
-    let reason = |p: &vrao::graph::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
+    let reason =
+        |p: &vrao::render::graph::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
     for technique in [Technique::Ssdo, Technique::SsdoBounce] {
         let on = plan(technique, true, &[Resource::Color]);
         assert!(on.runs("depth-peel"), "{on}");

@@ -7,7 +7,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
-use vrao::scene::fuzz::{load_bytes, Mutator, Target, VALID_MTL, VALID_OBJ, VALID_SCENE};
+use vrao::render::scene::fuzz::{load_bytes, Mutator, Target, VALID_MTL, VALID_OBJ, VALID_SCENE};
 
 /// Time per target; `VRAO_FUZZ_SECONDS` overrides it for longer runs.
 fn budget() -> Duration {
@@ -27,7 +27,8 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
         Target::Mtl => VALID_MTL.as_bytes().to_vec(),
         Target::SceneFile => VALID_SCENE.as_bytes().to_vec(),
     }];
-    let cornell = |ext: &str| vrao::scene::shared_scene_for_test(&format!("cornell_box/CornellBox-Original.{ext}"));
+    let cornell =
+        |ext: &str| vrao::render::scene::shared_scene_for_test(&format!("cornell_box/CornellBox-Original.{ext}"));
     match target {
         Target::Obj => seeds.extend(cornell("obj").and_then(|p| std::fs::read(p).ok())),
         Target::Mtl => seeds.extend(cornell("mtl").and_then(|p| std::fs::read(p).ok())),

@@ -3,7 +3,7 @@
 mod common;
 
 use glam::DVec3;
-use vrao::stereo::{view_position_from_depth, HeadsetProfile};
+use vrao::render::stereo::{view_position_from_depth, HeadsetProfile};
 use vrao::{HeadPose, Renderer, Resource, Scene, Settings, StereoMode};
 
 fn settings(width: u32, height: u32, stereo: StereoMode) -> Settings {
@@ -124,7 +124,7 @@ fn differing_bytes(a: &[Vec<Vec<u8>>], b: &[Vec<Vec<u8>>]) -> Vec<(&'static str,
 /// by a sun and a point light: no triangle needs clipping.
 fn unclipped_scene() -> Scene {
     let mut scene = common::bare_scene(Vec::new());
-    scene.materials.push(vrao::scene::Material::plain("red", glam::Vec3::new(0.8, 0.1, 0.1)));
+    scene.materials.push(vrao::render::scene::Material::plain("red", glam::Vec3::new(0.8, 0.1, 0.1)));
     for (i, (x, y, z)) in
         [(-0.5, 0.3, -2.0), (0.4, -0.2, -3.0), (0.0, 0.0, -5.0), (-0.3, -0.5, -1.5)].iter().enumerate()
     {
@@ -139,12 +139,16 @@ fn unclipped_scene() -> Scene {
         scene.meshes.push(square);
     }
     scene.lights = vec![
-        vrao::scene::Light::Directional {
+        vrao::render::scene::Light::Directional {
             direction: glam::Vec3::new(0.3, -1.0, -0.5).normalize(),
             color: glam::Vec3::ONE,
             intensity: 2.0,
         },
-        vrao::scene::Light::Point { position: DVec3::new(0.5, 1.0, -1.0), color: glam::Vec3::ONE, intensity: 3.0 },
+        vrao::render::scene::Light::Point {
+            position: DVec3::new(0.5, 1.0, -1.0),
+            color: glam::Vec3::ONE,
+            intensity: 3.0,
+        },
     ];
     scene
 }
@@ -263,7 +267,8 @@ fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
         let frames: Vec<u64> = timings.iter().map(|t| t.frame).collect();
         assert_eq!(frames, (0..6).collect::<Vec<_>>(), "each frame's times come back once, in order");
         for t in &timings {
-            let passes: f64 = t.spans.iter().filter(|(s, _)| !vrao::gpu::timing::is_per_eye(s)).map(|(_, ms)| ms).sum();
+            let passes: f64 =
+                t.spans.iter().filter(|(s, _)| !vrao::render::gpu::timing::is_per_eye(s)).map(|(_, ms)| ms).sum();
             assert!((t.total_ms - passes).abs() < 1e-9 && t.total_ms > 0.0, "{t:?}");
         }
     }

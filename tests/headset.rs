@@ -4,7 +4,7 @@
 mod common;
 
 use std::process::{Command, Output};
-use vrao::headset::reprojection_bench::{measure, HeadMove};
+use vrao::measure::reprojection::{measure, HeadMove};
 
 fn vrao(args: &[&str]) -> Output {
     let _one_at_a_time = common::gpu_lock();

@@ -8,12 +8,12 @@ mod common;
 
 use glam::{DQuat, DVec3, Vec3};
 use std::sync::Arc;
-use vrao::gpu::targets::LayeredTarget;
-use vrao::graph::Resource;
-use vrao::headset::reproject::{output_target, ReprojectionMode, Reprojector};
-use vrao::scene::{Light, Material, Scene};
-use vrao::settings::{AoSettings, Denoise, Technique};
-use vrao::stereo::{Fov, HeadPose};
+use vrao::render::gpu::targets::LayeredTarget;
+use vrao::render::graph::Resource;
+use vrao::render::scene::{Light, Material, Scene};
+use vrao::render::settings::{AoSettings, Denoise, Technique};
+use vrao::render::stereo::{Fov, HeadPose};
+use vrao::xr::simulated::reproject::{output_target, ReprojectionMode, Reprojector};
 use vrao::{Gpu, HeadsetProfile, Renderer, Settings};
 
 const TECHNIQUES: [Technique; 4] = [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce];
@@ -38,7 +38,7 @@ fn render_checked(gpu: &Arc<Gpu>, label: &str, scene: &Scene, s: &Settings, head
     if s.ao.blur_radius > 0 {
         intermediate.push(Resource::AoBlurred);
     }
-    let final_ao = vrao::passes::final_occlusion(s).unwrap();
+    let final_ao = vrao::render::passes::final_occlusion(s).unwrap();
     // The occlusion chain (with the standalone upsample at half resolution) ...
     let mut wanted = intermediate.clone();
     wanted.push(final_ao);
@@ -388,7 +388,7 @@ fn a_reprojection_history_without_usable_depth_falls_back_to_the_rotational_warp
         reprojector.record(&gpu, &mut encoder, mode, color, depth, &source.eyes, &target.eyes, s.near, &output);
         gpu.queue.submit([encoder.finish()]);
         gpu.take_error().unwrap();
-        vrao::gpu::readback::read_layers(&gpu, &output).unwrap()
+        vrao::render::gpu::readback::read_layers(&gpu, &output).unwrap()
     };
     // NaN cannot reach a Depth32Float history (copies into it are forbidden and
     // rasterisation clamps depth to [0, 1]); the shader still treats anything outside
@@ -405,7 +405,7 @@ fn a_reprojection_history_without_usable_depth_falls_back_to_the_rotational_warp
 
 #[test]
 fn error_against_the_reference_does_not_grow_when_the_scene_moves_1e5_m_out() {
-    use vrao::reference::{trace, ReferenceSettings};
+    use vrao::measure::reference::{trace, ReferenceSettings};
     let (gpu, _lock) = common::gpu();
     let size = (96, 80);
     let crease = Scene::load("builtin:crease").unwrap();
@@ -428,10 +428,10 @@ fn error_against_the_reference_does_not_grow_when_the_scene_moves_1e5_m_out() {
         .unwrap();
         for technique in TECHNIQUES {
             let s = settings(size, AoSettings { technique, radius: 0.5, ..AoSettings::default() });
-            let output = vrao::passes::final_occlusion(&s).unwrap();
+            let output = vrao::render::passes::final_occlusion(&s).unwrap();
             let mut renderer = Renderer::new(gpu.clone(), scene, &s).unwrap();
             renderer.render(&eyes.eyes, &[output]).unwrap();
-            let e = vrao::bench::error_figures(technique, &renderer.read_f32(output).unwrap(), &reference);
+            let e = vrao::measure::bench::error_figures(technique, &renderer.read_f32(output).unwrap(), &reference);
             errors.push((technique, e.ao_rmse));
         }
     }

@@ -1,5 +1,5 @@
 //! The occlusion family (SSAO, HBAO, SSDO, SSDO + bounce, bilateral blur, half-resolution
-//! upsampling) on the GPU, against expectations from analysis (`vrao::analytic`):
+//! upsampling) on the GPU, against expectations from analysis (`vrao::measure::analytic`):
 //! an open plane is unoccluded, a 90° crease darkens towards its edge as the estimators'
 //! expected values and the reference visibility say, SSDO shadows what faces away from a
 //! single light, a red wall bleeds red only with the bounce, the blur keeps depth edges,
@@ -13,13 +13,13 @@ mod common;
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
-use vrao::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
-use vrao::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
-use vrao::scene::builtin::{CREASE_WALL_Z, ROOM_MAX, ROOM_MIN};
-use vrao::scene::{environment, Environment, Scene};
-use vrao::settings::{AoSettings, BounceForm, Denoise, Noise, Technique};
-use vrao::stereo::HeadsetProfile;
-use vrao::stereo_consistency::{stereo_consistency, EyeImages};
+use vrao::measure::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
+use vrao::measure::stereo_consistency::{stereo_consistency, EyeImages};
+use vrao::render::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
+use vrao::render::scene::builtin::{CREASE_WALL_Z, ROOM_MAX, ROOM_MIN};
+use vrao::render::scene::{environment, Environment, Scene};
+use vrao::render::settings::{AoSettings, BounceForm, Denoise, Noise, Technique};
+use vrao::render::stereo::HeadsetProfile;
 use vrao::{EyePair, FrameReport, Gpu, HeadPose, Renderer, Resource, Settings};
 
 /// The techniques that compute occlusion.
@@ -492,7 +492,7 @@ fn assert_bins(
 
 /// Tolerance of a bin mean against the estimator's own expectation (SSAO, HBAO, SSDO).
 ///
-/// The expectation runs the estimator's test on the CPU (`vrao::analytic`) at each
+/// The expectation runs the estimator's test on the CPU (`vrao::measure::analytic`) at each
 /// pixel's reconstructed position with the real eye, averaged over kernel rotations, so
 /// what remains is: (a) the finite rotation pattern: one pixel's SSAO with 64 taps varies
 /// by ±0.02 (one standard deviation) over rotations near the crease, and a bin averages
@@ -1127,7 +1127,7 @@ fn every_pixel_is_computed_in_both_eyes() {
 /// point: GTAO's march, and at half resolution every technique's denoise (its vertical
 /// pass) and the AO-only techniques' upsample. The share of stereo-inconsistent points
 /// (the bench's measure: AO differing by more than 0.02 between the eyes,
-/// `vrao::stereo_consistency`) falls below ½ of what it is with independent eyes
+/// `vrao::measure::stereo_consistency`) falls below ½ of what it is with independent eyes
 /// (measured on the furnished room: GTAO full 1.8 → 0.9 %, half 3.3 → 0.5 %; SSAO half,
 /// where the march does not reuse, 3.1 → 0.3 %).
 #[test]

@@ -13,17 +13,17 @@ mod common;
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use vrao::gpu::readback::{read_layers, read_layers_f32};
-use vrao::gpu::targets::LayeredTarget;
-use vrao::graph::Resource;
-use vrao::headset::openxr::{
+use vrao::render::gpu::readback::{read_layers, read_layers_f32};
+use vrao::render::gpu::targets::LayeredTarget;
+use vrao::render::graph::Resource;
+use vrao::render::scene::Scene;
+use vrao::render::settings::Settings;
+use vrao::render::stereo::HeadsetProfile;
+use vrao::xr::openxr::{
     probe_runtime, EyeBlit, OpenXrHeadset, OpenXrOptions, SessionPhase, SwapchainLayout, Unavailable,
 };
-use vrao::headset::simulated::{SimulatedOptions, TimeMode};
-use vrao::headset::{Headset, SubmittedFrame};
-use vrao::scene::Scene;
-use vrao::settings::Settings;
-use vrao::stereo::HeadsetProfile;
+use vrao::xr::simulated::{SimulatedOptions, TimeMode};
+use vrao::xr::{Headset, SubmittedFrame};
 use vrao::{BackendChoice, Gpu};
 
 const RUNTIME_VAR: &str = "XR_RUNTIME_JSON";
@@ -301,7 +301,12 @@ fn the_swapchain_blit_keeps_srgb_bytes_and_depth_exact_and_decodes_for_linear_sw
 }
 
 /// Renders and submits `frames` frames; returns how many were rendered.
-fn run_frames(headset: &mut dyn Headset, gpu: &Arc<Gpu>, renderer: &mut vrao::renderer::Renderer, frames: u64) -> u64 {
+fn run_frames(
+    headset: &mut dyn Headset,
+    gpu: &Arc<Gpu>,
+    renderer: &mut vrao::render::renderer::Renderer,
+    frames: u64,
+) -> u64 {
     let mut rendered = 0;
     for _ in 0..frames {
         let Some(request) = headset.wait_frame(gpu).expect("wait_frame") else { break };
@@ -328,11 +333,11 @@ fn session_options(fallback: Option<SimulatedOptions>) -> OpenXrOptions {
     OpenXrOptions { size: Some((96, 80)), report: false, fallback, ..OpenXrOptions::from_simulated(&simulated, None) }
 }
 
-fn renderer_for(headset: &OpenXrHeadset, gpu: &Arc<Gpu>) -> vrao::renderer::Renderer {
+fn renderer_for(headset: &OpenXrHeadset, gpu: &Arc<Gpu>) -> vrao::render::renderer::Renderer {
     let scene = Scene::load("builtin:room").unwrap();
     let (width, height) = headset.recommended_size();
     let settings = Settings { profile: HeadsetProfile::with_size("openxr", width, height), ..Settings::default() };
-    vrao::renderer::Renderer::new(gpu.clone(), &scene, &settings).unwrap()
+    vrao::render::renderer::Renderer::new(gpu.clone(), &scene, &settings).unwrap()
 }
 
 /// `want` appears in `seen` in order (other states may come between).
@@ -344,7 +349,7 @@ fn in_order(seen: &[SessionPhase], want: &[SessionPhase]) -> bool {
 #[test]
 fn the_simulated_headset_ends_at_request_exit_and_has_no_openxr_report() {
     let (gpu, _one_at_a_time) = common::gpu();
-    let mut headset = vrao::headset::simulated::SimulatedHeadset::new(small_simulated(Some(10))).unwrap();
+    let mut headset = vrao::xr::simulated::SimulatedHeadset::new(small_simulated(Some(10))).unwrap();
     assert_eq!(headset.openxr_report(), None);
     let request = headset.wait_frame(&gpu).unwrap().expect("a first frame");
     headset.submit(&gpu, &request, None).unwrap();

@@ -3,10 +3,10 @@
 
 mod common;
 
-use vrao::bench::{error_figures, ErrorFigures};
-use vrao::passes::final_occlusion;
-use vrao::reference::{trace, ReferenceSettings};
-use vrao::settings::{BounceForm, Technique};
+use vrao::measure::bench::{error_figures, ErrorFigures};
+use vrao::measure::reference::{trace, ReferenceSettings};
+use vrao::render::passes::final_occlusion;
+use vrao::render::settings::{BounceForm, Technique};
 use vrao::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 112);
@@ -16,7 +16,7 @@ fn errors(
     technique: Technique,
     samples: u32,
     form: BounceForm,
-    reference: &vrao::reference::ReferenceImage,
+    reference: &vrao::measure::reference::ReferenceImage,
 ) -> ErrorFigures {
     let (gpu, _one_at_a_time) = common::gpu();
     let scene = Scene::load("builtin:crease").unwrap();

@@ -3,7 +3,7 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use std::path::{Path, PathBuf};
-use vrao::scene::{builtin, shared_scene_for_test, Light, Scene};
+use vrao::render::scene::{builtin, shared_scene_for_test, Light, Scene};
 
 /// A scratch directory under the system temp dir, removed when dropped.
 struct TempDir(PathBuf);

@@ -12,11 +12,11 @@ mod common;
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
-use vrao::analytic::luminance;
-use vrao::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
-use vrao::scene::{Light, Material, Scene};
-use vrao::settings::Technique;
-use vrao::stereo::HeadsetProfile;
+use vrao::measure::analytic::luminance;
+use vrao::render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
+use vrao::render::scene::{Light, Material, Scene};
+use vrao::render::settings::Technique;
+use vrao::render::stereo::HeadsetProfile;
 use vrao::{Gpu, HeadPose, Renderer, Resource, Settings};
 
 fn settings(width: u32, height: u32) -> Settings {
@@ -218,7 +218,7 @@ fn only_directional_lights_get_a_shadow_pass_and_explain_says_why() {
         Renderer::new(gpu.clone(), scene, s).unwrap().plan(2, outputs).unwrap()
     };
     let reason =
-        |p: &vrao::graph::Plan, pass: &str| p.left_out.iter().find(|(n, _)| *n == pass).map(|(_, r)| r.clone());
+        |p: &vrao::render::graph::Plan, pass: &str| p.left_out.iter().find(|(n, _)| *n == pass).map(|(_, r)| r.clone());
     // The room has one point light: no shadow pass, and --explain says why.
     let room = Scene::load("builtin:room").unwrap();
     assert!(room.lights.iter().all(|l| matches!(l, Light::Point { .. })));
@@ -315,7 +315,7 @@ fn a_sunlit_red_wall_bleeds_red_onto_the_floor_near_it_through_the_rsm_bounce() 
 
 #[test]
 fn the_rsm_bounce_matches_the_reference_bounce_on_average() {
-    use vrao::reference::{trace, ReferenceSettings};
+    use vrao::measure::reference::{trace, ReferenceSettings};
     let (gpu, _guard) = common::gpu();
     // The reference's bounce: one ray bounce within r off the shadow-ray-lit wall; the
     // RSM gathers within R = r in the light's image plane, about the same neighbourhood.
@@ -331,7 +331,7 @@ fn the_rsm_bounce_matches_the_reference_bounce_on_average() {
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     renderer.render(&eyes.eyes, &[Resource::RsmIndirect]).unwrap();
     let irradiance = renderer.read_f32(Resource::RsmIndirect).unwrap();
-    let b = vrao::bench::bounce_figures(&irradiance, size.0.div_ceil(2), 2, &reference).unwrap();
+    let b = vrao::measure::bench::bounce_figures(&irradiance, size.0.div_ceil(2), 2, &reference).unwrap();
     eprintln!("red wall, r = R = {radius} m, 256 VPLs: RSM bounce vs reference: {b:?}");
     // Unbiased up to the different neighbourhoods and the RSM's missing visibility: mean
     // within 15 %; per pixel one frame's 256 VPLs are noisy: RMSE below 60 % of the mean.
@@ -412,7 +412,8 @@ fn no_shadow_or_rsm_output_is_ever_nan_or_inf() {
     let mut far = boxed.clone();
     far.meshes.iter_mut().for_each(|m| m.origin += DVec3::new(1e5, 0.0, -1e5));
     let head = boxed.head.pose_at(0.0);
-    far.head = vrao::scene::HeadPath::fixed(HeadPose { position: head.position + DVec3::new(1e5, 0.0, -1e5), ..head });
+    far.head =
+        vrao::render::scene::HeadPath::fixed(HeadPose { position: head.position + DVec3::new(1e5, 0.0, -1e5), ..head });
     cases.push(("1e5 m out".into(), far, base.clone()));
     for (label, samples, radius, size) in
         [("1 VPL, 1 µm", 1, 1e-6, 16), ("1024 VPLs, 1e6 m", 1024, 1e6, 64), ("16² map", 64, 1.0, 16)]

@@ -5,10 +5,10 @@
 mod common;
 
 use vrao::app::FrameLoop;
-use vrao::headset::motion::HeadMotion;
-use vrao::headset::reproject::ReprojectionMode;
-use vrao::headset::simulated::{SimulatedHeadset, SimulatedOptions, TimeMode};
-use vrao::settings::AoSettings;
+use vrao::render::settings::AoSettings;
+use vrao::xr::simulated::motion::HeadMotion;
+use vrao::xr::simulated::reproject::ReprojectionMode;
+use vrao::xr::simulated::{SimulatedHeadset, SimulatedOptions, TimeMode};
 use vrao::{HeadsetProfile, Scene, Settings};
 
 /// Resident set size of this process in KiB (Linux /proc).

@@ -6,9 +6,9 @@
 mod common;
 
 use glam::{DQuat, DVec3};
-use vrao::graph::Resource;
-use vrao::settings::{AoSettings, Technique};
-use vrao::stereo::HeadPose;
+use vrao::render::graph::Resource;
+use vrao::render::settings::{AoSettings, Technique};
+use vrao::render::stereo::HeadPose;
 use vrao::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (96, 80);
@@ -24,7 +24,7 @@ fn ao_of(layers: &[Vec<f32>]) -> Vec<f32> {
 }
 
 fn rmse(a: &[f32], b: &[f32]) -> f64 {
-    vrao::metrics::rmse(a, b, None).unwrap()
+    vrao::measure::metrics::rmse(a, b, None).unwrap()
 }
 
 #[test]

@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
-use vrao::scene::{HeadPath, Material, Mesh, Scene};
+use vrao::render::scene::{HeadPath, Material, Mesh, Scene};
 use vrao::{BackendChoice, Gpu};
 
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
@@ -120,7 +120,7 @@ pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize
 /// `width` × `height`), or None on the sky: what the GPU tests compare pixels by.
 pub fn world_positions(
     depth: &[Vec<f32>],
-    eyes: &[vrao::stereo::Eye],
+    eyes: &[vrao::render::stereo::Eye],
     width: u32,
     height: u32,
     near: f64,
@@ -136,7 +136,8 @@ pub fn world_positions(
                     (d > 0.0).then(|| {
                         let uv =
                             [((i % width) as f64 + 0.5) / width as f64, ((i / width) as f64 + 0.5) / height as f64];
-                        world_from_view.transform_point3(vrao::stereo::view_position_from_depth(uv, d, &eye.fov, near))
+                        world_from_view
+                            .transform_point3(vrao::render::stereo::view_position_from_depth(uv, d, &eye.fov, near))
                     })
                 })
                 .collect()

@@ -1,0 +1,194 @@
+//! The headless per-eye budget test: renders frames of one setting and compares every
+//! pass's median time, per eye, with the headset's frame budget (11.1 ms per stereo frame
+//! at 90 Hz unless overridden).
+//!
+//! A pass that covers both eyes in one dispatch has no per-eye time of its own, so each
+//! measured round renders the stereo frame and then each eye alone (a one-layer frame of
+//! the same passes): the stereo figures say what a frame costs, the single-eye figures say
+//! what each eye costs. Both are reported. An eye passes when the sum of its passes fits
+//! half the budget; the stereo frame passes when the sum of its passes fits the budget.
+
+use crate::render::error::Result;
+use crate::render::gpu::timing::{summarize, SpanSummary};
+use crate::render::graph::Resource;
+use crate::render::renderer::{FrameReport, Renderer, Timing};
+use crate::render::stereo::EyePair;
+use serde::{Deserialize, Serialize};
+
+/// Per-pass times of one budget run.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PassTimes {
+    pub pass: String,
+    /// Both eyes in one frame (one dispatch covering both layers, or both per-eye passes).
+    pub stereo: Option<SpanSummary>,
+    pub left: Option<SpanSummary>,
+    pub right: Option<SpanSummary>,
+}
+
+/// The verdict for one eye or for the whole stereo frame.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Verdict {
+    pub what: String,
+    /// Sum of the per-pass medians.
+    pub ms: f64,
+    pub budget_ms: f64,
+    pub pass: bool,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BudgetReport {
+    pub adapter: String,
+    pub backend: String,
+    pub width: u32,
+    pub height: u32,
+    pub timing: String,
+    pub warmup: u32,
+    pub frames: u32,
+    /// What the frames produced: the eye colour (a whole frame) or the occlusion alone.
+    pub output: String,
+    pub budget_ms: f64,
+    pub passes: Vec<PassTimes>,
+    /// CPU time spent encoding the stereo frame, the left and the right eye frame.
+    pub cpu_encode: Vec<SpanSummary>,
+    pub verdicts: Vec<Verdict>,
+}
+
+impl BudgetReport {
+    pub fn within_budget(&self) -> bool {
+        self.verdicts.iter().all(|v| v.pass)
+    }
+
+    /// The table `vrao budget` prints.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "budget: {} on {} ({}), {}x{} per eye, {} timing, median of {} frames after {} warm-up (p25–p75)",
+            self.output, self.adapter, self.backend, self.width, self.height, self.timing, self.frames, self.warmup
+        );
+        let cell = |span: &Option<SpanSummary>| match span {
+            Some(s) => format!("{:.3} ({:.3}–{:.3})", s.median_ms, s.p25_ms, s.p75_ms),
+            None => "-".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "  {:<14} {:>30} {:>30} {:>30}",
+            "pass ms", "stereo frame", "left eye alone", "right eye alone"
+        );
+        for p in &self.passes {
+            let _ =
+                writeln!(s, "  {:<14} {:>30} {:>30} {:>30}", p.pass, cell(&p.stereo), cell(&p.left), cell(&p.right));
+        }
+        let encode: Vec<Option<SpanSummary>> = self.cpu_encode.iter().cloned().map(Some).collect();
+        if encode.len() == 3 {
+            let _ = writeln!(
+                s,
+                "  {:<14} {:>30} {:>30} {:>30}",
+                "cpu encode",
+                cell(&encode[0]),
+                cell(&encode[1]),
+                cell(&encode[2])
+            );
+        }
+        for v in &self.verdicts {
+            let _ = writeln!(
+                s,
+                "{:<13} {:>10.3} ms of {:>8.3} ms  {}",
+                v.what,
+                v.ms,
+                v.budget_ms,
+                if v.pass { "PASS".to_string() } else { format!("FAIL ({:.1}× over)", v.ms / v.budget_ms) }
+            );
+        }
+        s
+    }
+}
+
+/// How the budget run measures.
+#[derive(Clone, Copy, Debug)]
+pub struct BudgetRun {
+    pub timing: Timing,
+    pub warmup: u32,
+    pub frames: u32,
+    /// The stereo frame budget in milliseconds.
+    pub budget_ms: f64,
+    pub output: Resource,
+}
+
+/// A frame's pass times: wall clock per pass with serial timing, timestamps otherwise.
+fn pass_times(report: &FrameReport, timing: Timing) -> Vec<(String, f64)> {
+    let source = if timing == Timing::Serial { &report.wall_ms } else { &report.gpu_ms };
+    // Per-eye sub-spans inside a pass ("gbuffer left") are not passes of their own.
+    source.iter().filter(|(name, _)| !name.ends_with(" left") && !name.ends_with(" right")).cloned().collect()
+}
+
+/// Renders `warmup + frames` rounds of (stereo frame, left eye alone, right eye alone)
+/// and compares the medians with the budget.
+pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<BudgetReport> {
+    renderer.set_timing(how.timing);
+    let views: [&[crate::render::stereo::Eye]; 3] = [&eyes.eyes, &eyes.eyes[..1], &eyes.eyes[1..]];
+    let mut times: [Vec<Vec<(String, f64)>>; 3] = Default::default();
+    let mut encode: [Vec<Vec<(String, f64)>>; 3] = Default::default();
+    let mut pass_order: Vec<String> = Vec::new();
+    for round in 0..how.warmup + how.frames {
+        for (k, v) in views.iter().enumerate() {
+            let report = renderer.render_and_wait(v, &[how.output])?;
+            if round < how.warmup {
+                continue;
+            }
+            let t = pass_times(&report, how.timing);
+            for (name, _) in &t {
+                if !pass_order.contains(name) {
+                    pass_order.push(name.clone());
+                }
+            }
+            times[k].push(t);
+            encode[k].push(vec![("cpu encode".to_string(), report.cpu_encode_ms)]);
+        }
+    }
+    let summaries: Vec<Vec<SpanSummary>> = times.iter().map(|t| summarize(t)).collect();
+    let find = |k: usize, pass: &str| summaries[k].iter().find(|s| s.label == pass).cloned();
+    let passes: Vec<PassTimes> = pass_order
+        .iter()
+        .map(|p| PassTimes { pass: p.clone(), stereo: find(0, p), left: find(1, p), right: find(2, p) })
+        .collect();
+    let total = |k: usize| summaries[k].iter().map(|s| s.median_ms).sum::<f64>();
+    let per_eye_budget = how.budget_ms / 2.0;
+    let verdict =
+        |what: &str, ms: f64, budget_ms: f64| Verdict { what: what.into(), ms, budget_ms, pass: ms <= budget_ms };
+    let verdicts = vec![
+        verdict("left eye", total(1), per_eye_budget),
+        verdict("right eye", total(2), per_eye_budget),
+        verdict("stereo frame", total(0), how.budget_ms),
+    ];
+    let cpu_encode = ["stereo frame", "left eye", "right eye"]
+        .iter()
+        .zip(&encode)
+        .map(|(label, e)| {
+            let mut s = summarize(e).pop().expect("at least one measured frame");
+            s.label = label.to_string();
+            s
+        })
+        .collect();
+    let info = renderer.gpu().adapter.get_info();
+    let p = &renderer.settings().profile;
+    Ok(BudgetReport {
+        adapter: info.name.clone(),
+        backend: format!("{:?}", info.backend),
+        width: p.width,
+        height: p.height,
+        timing: format!("{:?}", how.timing).to_lowercase(),
+        warmup: how.warmup,
+        frames: how.frames,
+        output: if how.output == Resource::Color {
+            "whole frame".into()
+        } else {
+            format!("{} only", how.output.name())
+        },
+        budget_ms: how.budget_ms,
+        passes,
+        cpu_encode,
+        verdicts,
+    })
+}

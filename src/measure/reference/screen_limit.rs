@@ -1,0 +1,475 @@
+//! The *screen-space limit*: the AO that a brute-force march over a frame's own depth
+//! buffer gives, for the pixels of a [`ReferenceImage`](super::ReferenceImage)'s grid.
+//!
+//! Screen space sees one depth layer per eye. What no depth-buffer method can know (the
+//! back of anything, what lies behind a surface, what is off the image) is as unknown
+//! here as it is to SSAO or HBAO; everything else is sampled far more finely than any
+//! real-time estimator does. The gap between the ray-traced reference and this limit is
+//! *screen-space error* (no estimator can remove it); the gap between a technique and
+//! this limit is *estimator error* (sampling, falloffs, bias).
+//!
+//! At a grid pixel with depth d > 0 the receiver P is the view-space position the GPU
+//! reconstructs (`stereo::view_position_from_depth` at the pixel centre, as
+//! `shaders/common.wgsl` does) and n the G-buffer's view-space normal, flipped to face the
+//! eye. M cosine-weighted directions about n (a jittered ⌊√M⌋² grid mapped by the
+//! concentric map, as the reference tracer draws them, from a PCG32 stream seeded by the
+//! eye layer and pixel: deterministic and independent of threads) are each marched to
+//! length r in S evenly spaced steps t_k = r (k + ξ) / S, k = 0..S, with one jitter ξ per
+//! ray. A step Q is *blocked* when, at the pixel Q projects to, the depth buffer's visible
+//! surface lies in front of Q by less than the thickness (0 < dist(Q) − dist(surface) <
+//! thickness, distances along −z), and that surface point S (reconstructed at its pixel
+//! centre) is above the receiver's tangent plane: (S − P)·n > 1 % of r. That last test is
+//! the guard against self-intersection: the depth buffer is piecewise constant per pixel,
+//! so on a sloped or grazing surface a step just above the surface often lands "behind"
+//! a neighbouring pixel of the same surface; a surface point in (or below) the receiver's
+//! own tangent plane cannot occlude the upper hemisphere, whatever the discretisation
+//! says. The 1 % of r costs occluders lower than that, which only the near-horizontal
+//! directions can reach (cosine weight ≲ 1e-4 of the hemisphere). A ray is blocked at its
+//! first blocked step; steps off the image, in front of the near plane or on the sky are
+//! open (the ray stops when it leaves the image: the image of a segment is a segment, and
+//! the image is convex). AO = unblocked rays / M, as the reference's 1 − (1/π)∫[hit]cos θ dω.
+//!
+//! Thickness: the depth buffer cannot say how deep anything is. A step counts only within
+//! a finite thickness behind the visible surface, so an object in front of a far wall does
+//! not shadow the wall (the halo of infinite thickness) and a thin slab stops occluding a
+//! little behind itself. It must exceed one step's depth change (r / S along the view axis
+//! at most), or a ray could step over a surface it crosses without a step landing behind
+//! it; the default is r / 4 (six steps at S = 24), scaled with r rather than fixed in
+//! metres so that it stays above that floor for any radius and stays small next to the
+//! region the occlusion integrates over.
+
+use super::shading::{concentric_disk, orthonormal_basis, pixel_seed, stratified_points, Rng};
+use super::{grid_size, pixel_of, ReferenceImage};
+use crate::render::error::{Error, Result};
+use crate::render::stereo::{view_position_from_depth, Fov};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Default rays per pixel of the march.
+pub const DEFAULT_RAYS: u32 = 64;
+/// Default steps along each ray.
+pub const DEFAULT_STEPS: u32 = 24;
+/// Default thickness as a fraction of the radius (see the module docs).
+pub const DEFAULT_THICKNESS_OF_RADIUS: f64 = 0.25;
+/// Surface points closer to the receiver's tangent plane than this fraction of r do not
+/// occlude it (the self-intersection guard).
+pub const TANGENT_PLANE_TOLERANCE_OF_RADIUS: f64 = 0.01;
+
+/// Salt of the per-pixel seed, so the march's directions are not the reference's.
+const SEED_SALT: u64 = 0x6c69_6d69_745f_6d61;
+
+/// How the limit is marched.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LimitSettings {
+    /// Ray length r in metres (the AO radius).
+    pub radius: f64,
+    /// Cosine-weighted rays per pixel (a square number stratifies best).
+    pub rays_per_pixel: u32,
+    /// Evenly spaced steps per ray.
+    pub steps: u32,
+    /// Metres behind the visible surface in which a step counts as inside it.
+    pub thickness: f64,
+    /// March every `stride`-th pixel (the reference's grid).
+    pub stride: u32,
+    /// Near plane in metres (what the depth encodes as near / distance).
+    pub near: f64,
+}
+
+impl LimitSettings {
+    /// The defaults (64 rays, 24 steps, thickness r / 4) for `radius` on a grid of `stride`.
+    pub fn new(radius: f64, stride: u32, near: f64) -> LimitSettings {
+        LimitSettings {
+            radius,
+            rays_per_pixel: DEFAULT_RAYS,
+            steps: DEFAULT_STEPS,
+            thickness: radius * DEFAULT_THICKNESS_OF_RADIUS,
+            stride,
+            near,
+        }
+    }
+
+    /// The defaults on the grid of `reference`.
+    pub fn for_reference(reference: &ReferenceImage, radius: f64, near: f64) -> LimitSettings {
+        LimitSettings::new(radius, reference.stride, near)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.radius) || !positive(self.thickness) || !positive(self.near) {
+            return Err(Error::input(format!(
+                "screen-space limit: radius {}, thickness {} and near {} must be finite and > 0",
+                self.radius, self.thickness, self.near
+            )));
+        }
+        if self.rays_per_pixel == 0 || self.steps == 0 || self.stride == 0 {
+            return Err(Error::input("screen-space limit: rays, steps and stride must be ≥ 1"));
+        }
+        Ok(())
+    }
+}
+
+/// One eye's G-buffer as read back: reversed-Z depth (one value a pixel, 0 on the sky)
+/// and view-space normals (RGBA, w unused), `width × height` row-major.
+#[derive(Clone, Copy, Debug)]
+pub struct EyeBuffers<'a> {
+    pub depth: &'a [f32],
+    pub normals: &'a [f32],
+    pub fov: Fov,
+}
+
+/// The limit at one grid pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LimitPixel {
+    /// The depth buffer has a surface here (false on the sky, where `ao` is 1).
+    pub hit: bool,
+    pub ao: f32,
+    /// Standard error of `ao` from its own rays (√(p(1 − p)/(M − 1)); conservative, as
+    /// the reference's: stratification makes the real error smaller).
+    pub std_error: f32,
+}
+
+/// The limit for every eye on a grid of `stride`, laid out as a reference image's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScreenLimit {
+    pub width: u32,
+    pub height: u32,
+    pub stride: u32,
+    pub settings: LimitSettings,
+    /// Per eye, row-major over [`grid_size`](Self::grid_size).
+    pub layers: Vec<Vec<LimitPixel>>,
+}
+
+impl ScreenLimit {
+    pub fn grid_size(&self) -> (u32, u32) {
+        grid_size((self.width, self.height), self.stride)
+    }
+
+    pub fn get(&self, layer: usize, i: u32, j: u32) -> &LimitPixel {
+        &self.layers[layer][(j * self.grid_size().0 + i) as usize]
+    }
+}
+
+/// Marches the limit for each eye's buffers at `size` pixels per eye (see the module docs).
+pub fn screen_space_limit(eyes: &[EyeBuffers], size: (u32, u32), settings: &LimitSettings) -> Result<ScreenLimit> {
+    settings.validate()?;
+    let pixels = size.0 as usize * size.1 as usize;
+    for (layer, eye) in eyes.iter().enumerate() {
+        if eye.depth.len() != pixels || eye.normals.len() != pixels * 4 {
+            return Err(Error::input(format!(
+                "screen-space limit: eye {layer} has {} depth and {} normal values for {}×{} pixels",
+                eye.depth.len(),
+                eye.normals.len(),
+                size.0,
+                size.1
+            )));
+        }
+        eye.fov.validate().map_err(Error::input)?;
+    }
+    let (gw, gh) = grid_size(size, settings.stride);
+    let rows: Vec<Vec<LimitPixel>> = (0..eyes.len() * gh as usize)
+        .into_par_iter()
+        .map(|row| {
+            let (layer, j) = (row / gh as usize, (row % gh as usize) as u32);
+            let marcher = Marcher::new(&eyes[layer], size, settings);
+            let mut points = Vec::with_capacity(settings.rays_per_pixel as usize);
+            (0..gw)
+                .map(|i| {
+                    let (x, y) = pixel_of(size, settings.stride, i, j);
+                    marcher.pixel(layer as u32, x, y, &mut points)
+                })
+                .collect()
+        })
+        .collect();
+    let mut layers = vec![Vec::with_capacity((gw * gh) as usize); eyes.len()];
+    for (row, pixels) in rows.into_iter().enumerate() {
+        layers[row / gh as usize].extend(pixels);
+    }
+    Ok(ScreenLimit { width: size.0, height: size.1, stride: settings.stride, settings: *settings, layers })
+}
+
+/// One eye's depth buffer as the march reads it.
+struct Marcher<'a> {
+    eye: &'a EyeBuffers<'a>,
+    size: (u32, u32),
+    settings: &'a LimitSettings,
+    /// Frustum tangents (left, right, up, down).
+    tangents: [f64; 4],
+}
+
+impl<'a> Marcher<'a> {
+    fn new(eye: &'a EyeBuffers<'a>, size: (u32, u32), settings: &'a LimitSettings) -> Marcher<'a> {
+        Marcher { eye, size, settings, tangents: eye.fov.tangents() }
+    }
+
+    /// Reversed-Z depth at a pixel, `None` on the sky (or a value that is no depth).
+    fn depth(&self, x: u32, y: u32) -> Option<f64> {
+        let d = self.eye.depth[y as usize * self.size.0 as usize + x as usize] as f64;
+        (d.is_finite() && d > 0.0).then_some(d)
+    }
+
+    /// The view-space surface point at the centre of pixel (x, y) with depth `d`.
+    fn position(&self, x: u32, y: u32, d: f64) -> DVec3 {
+        let uv = [(x as f64 + 0.5) / self.size.0 as f64, (y as f64 + 0.5) / self.size.1 as f64];
+        view_position_from_depth(uv, d, &self.eye.fov, self.settings.near)
+    }
+
+    /// The pixel a view-space point projects to, `None` off the image or not in front.
+    fn project(&self, q: DVec3) -> Option<(u32, u32)> {
+        let distance = -q.z;
+        if distance < self.settings.near {
+            return None;
+        }
+        let [l, r, u, d] = self.tangents;
+        let (tan_x, tan_y) = (q.x / distance, q.y / distance);
+        let (s, t) = ((tan_x - l) / (r - l), (tan_y - u) / (d - u));
+        if !(0.0..1.0).contains(&s) || !(0.0..1.0).contains(&t) {
+            return None;
+        }
+        let x = ((s * self.size.0 as f64) as u32).min(self.size.0 - 1);
+        let y = ((t * self.size.1 as f64) as u32).min(self.size.1 - 1);
+        Some((x, y))
+    }
+
+    fn pixel(&self, layer: u32, x: u32, y: u32, points: &mut Vec<(f64, f64)>) -> LimitPixel {
+        let Some(d) = self.depth(x, y) else {
+            return LimitPixel { hit: false, ao: 1.0, std_error: 0.0 };
+        };
+        let s = self.settings;
+        let p = self.position(x, y, d);
+        let towards_eye = (-p).normalize();
+        let k = (y as usize * self.size.0 as usize + x as usize) * 4;
+        let raw =
+            DVec3::new(self.eye.normals[k] as f64, self.eye.normals[k + 1] as f64, self.eye.normals[k + 2] as f64);
+        // A normal that is no direction (zero, NaN) falls back to the view direction;
+        // one that faces away is flipped, as the reference flips its shading normal.
+        let mut n = raw.try_normalize().unwrap_or(towards_eye);
+        if n.dot(towards_eye) < 0.0 {
+            n = -n;
+        }
+        let (t, b) = orthonormal_basis(n);
+        let mut rng = Rng::new(pixel_seed(layer, x, y) ^ SEED_SALT);
+        stratified_points(s.rays_per_pixel, &mut rng, points);
+        let tolerance = s.radius * TANGENT_PLANE_TOLERANCE_OF_RADIUS;
+        let mut blocked = 0u32;
+        for &(u, v) in points.iter() {
+            let (dx, dy) = concentric_disk(u, v);
+            let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+            let dir = (t * dx + b * dy + n * dz).normalize();
+            let jitter = rng.next_f64();
+            for step in 0..s.steps {
+                let q = p + dir * (s.radius * (step as f64 + jitter) / s.steps as f64);
+                let Some((qx, qy)) = self.project(q) else {
+                    break; // off the image (or in front of the near plane): open
+                };
+                let Some(surface_depth) = self.depth(qx, qy) else {
+                    continue; // the sky: nothing in front of Q
+                };
+                let behind = -q.z - s.near / surface_depth;
+                if behind <= 0.0 || behind >= s.thickness {
+                    continue;
+                }
+                let surface = self.position(qx, qy, surface_depth);
+                if (surface - p).dot(n) <= tolerance {
+                    continue; // the receiver's own plane (or below it)
+                }
+                blocked += 1;
+                break;
+            }
+        }
+        let m = s.rays_per_pixel as f64;
+        let occluded = blocked as f64 / m;
+        let std_error =
+            if s.rays_per_pixel > 1 { (occluded * (1.0 - occluded) / (m - 1.0)).max(0.0).sqrt() } else { 0.5 };
+        LimitPixel { hit: true, ao: (1.0 - occluded) as f32, std_error: std_error as f32 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::analytic::{crease_visibility, first_hit, visibility_by_ray_casting, Rect};
+
+    const NEAR: f64 = 0.05;
+
+    fn fov() -> Fov {
+        let a = 40f32.to_radians();
+        Fov { left: -a, right: a, up: a, down: -a }
+    }
+
+    /// Depth and view-space normals of `rects` (given in view space: the eye at the
+    /// origin looking down −z) through each pixel centre, as the G-buffer would write them.
+    fn rasterise(rects: &[Rect], size: (u32, u32)) -> (Vec<f32>, Vec<f32>) {
+        let [l, r, u, d] = fov().tangents();
+        let (mut depth, mut normals) = (Vec::new(), Vec::new());
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let (s, t) = ((x as f64 + 0.5) / size.0 as f64, (y as f64 + 0.5) / size.1 as f64);
+                let dir = DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0);
+                let hit = rects
+                    .iter()
+                    .filter_map(|rect| rect.hit(DVec3::ZERO, dir).map(|t| (t, rect)))
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                match hit {
+                    Some((t, rect)) => {
+                        // dir.z = −1, so t is the view distance.
+                        depth.push((NEAR / t) as f32);
+                        let mut n = rect.u.cross(rect.v).normalize();
+                        if n.dot(dir) > 0.0 {
+                            n = -n;
+                        }
+                        normals.extend([n.x as f32, n.y as f32, n.z as f32, 0.0]);
+                    }
+                    None => {
+                        depth.push(0.0);
+                        normals.extend([0.0; 4]);
+                    }
+                }
+            }
+        }
+        (depth, normals)
+    }
+
+    fn limit(rects: &[Rect], size: (u32, u32), settings: LimitSettings) -> (ScreenLimit, Vec<f32>) {
+        let (depth, normals) = rasterise(rects, size);
+        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov() };
+        (screen_space_limit(&[eye], size, &settings).unwrap(), depth)
+    }
+
+    /// A view-space position of grid cell (i, j), from the depth the test wrote.
+    fn position(depth: &[f32], size: (u32, u32), stride: u32, i: u32, j: u32) -> DVec3 {
+        let (x, y) = pixel_of(size, stride, i, j);
+        let uv = [(x as f64 + 0.5) / size.0 as f64, (y as f64 + 0.5) / size.1 as f64];
+        view_position_from_depth(uv, depth[(y * size.0 + x) as usize] as f64, &fov(), NEAR)
+    }
+
+    #[test]
+    fn an_open_plane_is_unoccluded_at_every_pixel_even_seen_at_a_grazing_angle() {
+        // A floor 1.6 m below the eye, seen from 0° to 40° below the horizon, and a
+        // plane tilted about two axes.
+        let floor = Rect {
+            corner: DVec3::new(-50.0, -1.6, 0.0),
+            u: DVec3::new(100.0, 0.0, 0.0),
+            v: DVec3::new(0.0, 0.0, -100.0),
+        };
+        let tilted = Rect {
+            corner: DVec3::new(-20.0, -8.0, -3.0),
+            u: DVec3::new(40.0, 4.0, -6.0),
+            v: DVec3::new(3.0, 30.0, -12.0),
+        };
+        for (plane, radius) in [(floor, 0.5), (floor, 3.0), (tilted, 0.4)] {
+            let size = (48, 40);
+            let (limit, _) = limit(&[plane], size, LimitSettings::new(radius, 2, NEAR));
+            let hits: Vec<&LimitPixel> = limit.layers[0].iter().filter(|p| p.hit).collect();
+            assert!(hits.len() > 200, "{}", hits.len());
+            for p in hits {
+                assert_eq!(p.ao, 1.0, "r = {radius}: {p:?}");
+            }
+        }
+    }
+
+    /// `rects` given in world space, moved into the view space of an eye at `pose`.
+    fn into_view(rects: &[Rect], pose: &crate::render::stereo::HeadPose) -> Vec<Rect> {
+        let view = pose.world_from_local().inverse();
+        rects
+            .iter()
+            .map(|r| Rect {
+                corner: view.transform_point3(r.corner),
+                u: view.transform_vector3(r.u),
+                v: view.transform_vector3(r.v),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_90_degree_crease_gives_the_analytic_visibility() {
+        // The floor y = 0 (z ≥ 0) and a wall z = 0 (y ≥ 0), seen from the open side at 45°
+        // down; floor pixels within the middle of the image across (rays of receivers
+        // near the side borders leave the image: open, as they must be for a screen-space
+        // method, but not analytic).
+        let floor =
+            Rect { corner: DVec3::new(-20.0, 0.0, 0.0), u: DVec3::new(40.0, 0.0, 0.0), v: DVec3::new(0.0, 0.0, 20.0) };
+        let wall =
+            Rect { corner: DVec3::new(-20.0, 0.0, 0.0), u: DVec3::new(40.0, 0.0, 0.0), v: DVec3::new(0.0, 20.0, 0.0) };
+        let pose = crate::render::stereo::HeadPose::look_at(DVec3::new(0.0, 1.0, 1.0), DVec3::ZERO).unwrap();
+        let (size, stride, radius) = ((96, 96), 2, 0.6);
+        let settings = LimitSettings { rays_per_pixel: 256, steps: 48, ..LimitSettings::new(radius, stride, NEAR) };
+        let (limit, depth) = limit(&into_view(&[floor, wall], &pose), size, settings);
+        let (gw, gh) = limit.grid_size();
+        let (mut n, mut sum, mut sum_sq, mut darkest) = (0, 0.0, 0.0, 1.0f64);
+        for j in 0..gh {
+            for i in 0..gw {
+                let p = pose.world_from_local().transform_point3(position(&depth, size, stride, i, j));
+                if p.y.abs() > 1e-4 || p.x.abs() > 0.3 || p.z < 1e-3 || p.z > 0.9 {
+                    continue;
+                }
+                let expected = crease_visibility(p.z, radius);
+                let got = limit.get(0, i, j).ao as f64;
+                darkest = darkest.min(got);
+                n += 1;
+                sum += got - expected;
+                sum_sq += (got - expected).powi(2);
+            }
+        }
+        assert!(n > 50, "{n} floor pixels");
+        let (bias, rmse) = (sum / n as f64, (sum_sq / n as f64).sqrt());
+        assert!(bias.abs() < 0.02 && rmse < 0.05, "bias {bias}, RMSE {rmse} over {n} pixels");
+        assert!(darkest < 0.65, "the crease darkens: {darkest}");
+    }
+
+    #[test]
+    fn a_thin_slab_stops_occluding_behind_itself_within_the_thickness() {
+        // The eye looks straight down at a floor 3 m away; a thin horizontal plate 0.5 m
+        // above the floor covers x > 0. Receivers on the floor just beside the plate see it
+        // overhead on one side. Ray traced, only the rays that cross the plate are blocked;
+        // with a thickness above the plate's height the depth buffer makes it a solid block
+        // down to the floor, which also blocks the rays passing under it.
+        let floor = Rect {
+            corner: DVec3::new(-20.0, -20.0, -3.0),
+            u: DVec3::new(40.0, 0.0, 0.0),
+            v: DVec3::new(0.0, 40.0, 0.0),
+        };
+        let plate =
+            Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(20.0, 0.0, 0.0), v: DVec3::new(0.0, 40.0, 0.0) };
+        let (size, stride, radius) = ((96, 96), 2, 1.0);
+        let base = LimitSettings { rays_per_pixel: 256, steps: 48, ..LimitSettings::new(radius, stride, NEAR) };
+        let (thin, depth) = limit(&[floor, plate], size, LimitSettings { thickness: 0.05, ..base });
+        let (solid, _) = limit(&[floor, plate], size, LimitSettings { thickness: 10.0, ..base });
+        let (gw, gh) = thin.grid_size();
+        let (mut n, mut thin_error, mut solid_gap) = (0, 0.0, 0.0);
+        for j in 0..gh {
+            for i in 0..gw {
+                let p = position(&depth, size, stride, i, j);
+                // Floor receivers within 0.3 m of the plate's edge, near the image centre row.
+                if (p.z + 3.0).abs() > 1e-4 || !(-0.3..-0.02).contains(&p.x) || p.y.abs() > 0.5 {
+                    continue;
+                }
+                let truth =
+                    visibility_by_ray_casting(p, DVec3::Z, radius, false, 200, |o, d| first_hit(&[floor, plate], o, d));
+                n += 1;
+                thin_error += (thin.get(0, i, j).ao as f64 - truth).abs();
+                solid_gap += truth - solid.get(0, i, j).ao as f64;
+            }
+        }
+        assert!(n > 10, "{n} receivers");
+        let (thin_error, solid_gap) = (thin_error / n as f64, solid_gap / n as f64);
+        assert!(thin_error < 0.03, "thin thickness: mean |limit − truth| {thin_error}");
+        assert!(solid_gap > 0.1, "a thickness above the plate's height darkens by only {solid_gap}");
+    }
+
+    #[test]
+    fn the_sky_is_open_and_mismatched_buffers_are_refused() {
+        let size = (8, 6);
+        let (depth, normals) = (vec![0.0; 48], vec![0.0; 192]);
+        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov() };
+        let limit = screen_space_limit(&[eye, eye], size, &LimitSettings::new(1.0, 1, NEAR)).unwrap();
+        assert!(limit.layers.iter().flatten().all(|p| !p.hit && p.ao == 1.0));
+        let short = EyeBuffers { depth: &depth[..40], ..eye };
+        assert!(screen_space_limit(&[short], size, &LimitSettings::new(1.0, 1, NEAR)).is_err());
+        assert!(screen_space_limit(
+            &[eye],
+            size,
+            &LimitSettings { thickness: 0.0, ..LimitSettings::new(1.0, 1, NEAR) }
+        )
+        .is_err());
+    }
+}

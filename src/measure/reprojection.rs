@@ -1,0 +1,158 @@
+//! How good the compositor's warp is: a frame rendered at one head pose is reprojected to
+//! a moved pose and compared with a frame rendered fresh at that pose, for each mode.
+
+use crate::render::error::Result;
+use crate::render::gpu::readback::read_layers;
+use crate::render::graph::Resource;
+use crate::render::renderer::Renderer;
+use crate::render::stereo::HeadPose;
+use crate::xr::simulated::reproject::{output_target, ReprojectionMode, Reprojector};
+use glam::{DQuat, DVec3};
+use serde::Serialize;
+
+/// A head movement between rendering and display.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum HeadMove {
+    /// Yaw about the vertical by this many degrees.
+    RotateDegrees(f64),
+    /// Sideways (the head's +X) by this many centimetres.
+    TranslateCm(f64),
+}
+
+impl HeadMove {
+    pub fn apply(self, pose: &HeadPose) -> HeadPose {
+        match self {
+            HeadMove::RotateDegrees(deg) => HeadPose {
+                position: pose.position,
+                orientation: (DQuat::from_rotation_y(deg.to_radians()) * pose.orientation).normalize(),
+            },
+            HeadMove::TranslateCm(cm) => HeadPose {
+                position: pose.position + pose.orientation * DVec3::X * (cm / 100.0),
+                orientation: pose.orientation,
+            },
+        }
+    }
+
+    pub fn describe(self) -> String {
+        match self {
+            HeadMove::RotateDegrees(d) => format!("rotate {d}°"),
+            HeadMove::TranslateCm(c) => format!("translate {c} cm"),
+        }
+    }
+}
+
+/// RMSE (colour values 0..1, both eyes, every pixel) of a warped frame against a fresh one.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReprojectionError {
+    pub movement: HeadMove,
+    /// Not warping at all: the old frame shown as it is.
+    pub stale_rmse: f64,
+    pub rotational_rmse: f64,
+    pub depth_rmse: f64,
+}
+
+fn rmse(a: &[Vec<u8>], b: &[Vec<u8>]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (la, lb) in a.iter().zip(b) {
+        for (pa, pb) in la.chunks_exact(4).zip(lb.chunks_exact(4)) {
+            for c in 0..3 {
+                let d = (pa[c] as f64 - pb[c] as f64) / 255.0;
+                sum += d * d;
+            }
+            n += 3;
+        }
+    }
+    (sum / n.max(1) as f64).sqrt()
+}
+
+/// Renders at `head`, then for each movement warps that frame in both modes and compares
+/// with a fresh render at the moved pose.
+pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove]) -> Result<Vec<ReprojectionError>> {
+    let gpu = renderer.gpu().clone();
+    let settings = renderer.settings().clone();
+    let outputs = [Resource::Color, Resource::Depth];
+    let source_eyes = settings.profile.eyes(head, settings.near);
+    renderer.render(&source_eyes.eyes, &outputs)?;
+    let stale = read_layers(&gpu, renderer.target(Resource::Color).expect("rendered"))?;
+    // Keep the source frame: the fresh renders below reuse the renderer's targets.
+    let extent = renderer.target(Resource::Color).expect("rendered").extent();
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+    let color = crate::render::gpu::targets::LayeredTarget::new(
+        &gpu.device,
+        "source colour",
+        Resource::Color.format(),
+        extent,
+        usage,
+    );
+    let depth = crate::render::gpu::targets::LayeredTarget::new(
+        &gpu.device,
+        "source depth",
+        Resource::Depth.format(),
+        extent,
+        usage,
+    );
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    for (resource, copy) in [(Resource::Color, &color), (Resource::Depth, &depth)] {
+        let from = renderer.target(resource).expect("rendered");
+        encoder.copy_texture_to_texture(
+            from.texture.as_image_copy(),
+            copy.texture.as_image_copy(),
+            from.texture.size(),
+        );
+    }
+    gpu.queue.submit([encoder.finish()]);
+    let output = output_target(&gpu, extent);
+    let mut reprojector = Reprojector::new(&gpu);
+    let mut rows = Vec::new();
+    for &movement in movements {
+        let target_eyes = settings.profile.eyes(&movement.apply(head), settings.near);
+        renderer.render(&target_eyes.eyes, &outputs)?;
+        let fresh = read_layers(&gpu, renderer.target(Resource::Color).expect("rendered"))?;
+        let mut warped = |mode| -> Result<Vec<Vec<u8>>> {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            reprojector.record(
+                &gpu,
+                &mut encoder,
+                mode,
+                &color,
+                &depth,
+                &source_eyes.eyes,
+                &target_eyes.eyes,
+                settings.near,
+                &output,
+            );
+            gpu.queue.submit([encoder.finish()]);
+            gpu.take_error()?;
+            read_layers(&gpu, &output)
+        };
+        let rotational = warped(ReprojectionMode::Rotational)?;
+        let depth_based = warped(ReprojectionMode::Depth)?;
+        rows.push(ReprojectionError {
+            movement,
+            stale_rmse: rmse(&stale, &fresh),
+            rotational_rmse: rmse(&rotational, &fresh),
+            depth_rmse: rmse(&depth_based, &fresh),
+        });
+    }
+    Ok(rows)
+}
+
+/// The benchmark's movements: rotations of 1–10° and translations of 1–10 cm.
+pub fn default_movements() -> Vec<HeadMove> {
+    let steps = [1.0, 2.0, 5.0, 10.0];
+    steps.iter().map(|&d| HeadMove::RotateDegrees(d)).chain(steps.iter().map(|&c| HeadMove::TranslateCm(c))).collect()
+}
+
+pub fn to_markdown(rows: &[ReprojectionError]) -> String {
+    let mut s = String::from("| movement | no warp RMSE | rotational RMSE | depth-based RMSE |\n|---|---|---|---|\n");
+    for r in rows {
+        s += &format!(
+            "| {} | {:.4} | {:.4} | {:.4} |\n",
+            r.movement.describe(),
+            r.stale_rmse,
+            r.rotational_rmse,
+            r.depth_rmse
+        );
+    }
+    s
+}

@@ -1,0 +1,128 @@
+//! How temporal accumulation converges: AO error against the reference after 1, 2, 4, 8
+//! and 16 frames, with a static head and with the head moving, next to the same
+//! per-frame settings without temporal reuse.
+
+use crate::measure::bench::error_figures;
+use crate::measure::reference::{trace_cached, ReferenceImage, ReferenceSettings};
+use crate::render::error::Result;
+use crate::render::gpu::Gpu;
+use crate::render::passes::final_occlusion;
+use crate::render::renderer::Renderer;
+use crate::render::scene::Scene;
+use crate::render::settings::Settings;
+use crate::xr::simulated::motion::HeadMotion;
+use serde::Serialize;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The error after `frame` frames of one configuration.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConvergencePoint {
+    pub configuration: String,
+    pub motion: String,
+    pub frame: u32,
+    pub ao_rmse: f64,
+    /// RMSE against the same technique's converged value at this pose (256 samples, no
+    /// blur, no reuse): the noise left, without the estimator's bias.
+    pub noise_rmse: f64,
+    /// Median ms per eye of the occlusion passes (technique, temporal, blur) per frame.
+    pub occlusion_ms_per_eye: f64,
+}
+
+/// Frames at which the error is recorded.
+pub const CHECKPOINTS: [u32; 5] = [1, 2, 4, 8, 16];
+
+/// Renders `16` frames of each configuration along `motion` (90 Hz frame times) and
+/// records the AO RMSE against the reference at each checkpoint. With motion, the
+/// reference is traced for every checkpoint's pose.
+pub fn convergence(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    configurations: &[(String, Settings)],
+    motion: HeadMotion,
+    reference: &ReferenceSettings,
+    cache: &Path,
+) -> Result<Vec<ConvergencePoint>> {
+    let mut points = Vec::new();
+    let dt = 1.0 / 90.0;
+    let mut references: Vec<(u32, ReferenceImage)> = Vec::new();
+    for (name, settings) in configurations {
+        let mut converged_settings = settings.clone();
+        converged_settings.ao.samples = 256;
+        converged_settings.ao.blur_radius = 0;
+        converged_settings.ao.temporal.enabled = false;
+        let converged_output = final_occlusion(&converged_settings).expect("an occlusion technique");
+        let mut converged = Renderer::new(gpu.clone(), scene, &converged_settings)?;
+        let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
+        renderer.set_timing(crate::render::renderer::Timing::Serial);
+        let output = final_occlusion(settings).expect("an occlusion technique");
+        let mut times = Vec::new();
+        for frame in 1..=*CHECKPOINTS.last().unwrap() {
+            let head = motion.pose_at(&scene.head, frame as f64 * dt);
+            let eyes = settings.profile.eyes(&head, settings.near);
+            let report = renderer.render_and_wait(&eyes.eyes, &[output])?;
+            let ms: f64 = report
+                .wall_ms
+                .iter()
+                .filter(|(pass, _)| !matches!(pass.as_str(), "gbuffer" | "direct" | "depth-peel"))
+                .map(|(_, ms)| ms)
+                .sum();
+            times.push(ms / eyes.eyes.len() as f64);
+            if !CHECKPOINTS.contains(&frame) {
+                continue;
+            }
+            let key = if motion == HeadMotion::Static { 1 } else { frame };
+            if !references.iter().any(|(k, _)| *k == key) {
+                let size = (settings.profile.width, settings.profile.height);
+                references.push((key, trace_cached(cache, scene, &eyes.eyes, size, reference, &mut |_| {})?));
+            }
+            let reference = &references.iter().find(|(k, _)| *k == key).expect("traced above").1;
+            let image = renderer.read_f32(output)?;
+            let e = error_figures(settings.ao.technique, &image, reference);
+            converged.render(&eyes.eyes, &[converged_output])?;
+            let target = converged.read_f32(converged_output)?;
+            let ao = |layers: &[Vec<f32>]| {
+                layers.iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>()
+            };
+            let noise_rmse = crate::measure::metrics::rmse(&ao(&image), &ao(&target), None).unwrap_or(f64::NAN);
+            let mut sorted = times.clone();
+            sorted.sort_by(f64::total_cmp);
+            points.push(ConvergencePoint {
+                configuration: name.clone(),
+                motion: motion.name().to_string(),
+                frame,
+                ao_rmse: e.ao_rmse,
+                noise_rmse,
+                occlusion_ms_per_eye: crate::render::gpu::timing::quantile(&sorted, 0.5),
+            });
+        }
+    }
+    Ok(points)
+}
+
+/// A Markdown table: one row per configuration, one column per checkpoint, each cell
+/// "error against the reference / noise against the converged estimator".
+pub fn to_markdown(points: &[ConvergencePoint]) -> String {
+    let mut s = String::from("| configuration | motion | ms/eye |");
+    for c in CHECKPOINTS {
+        s += &format!(" {c} frame{} |", if c == 1 { "" } else { "s" });
+    }
+    s += &format!("\n|---|---|---|{}\n", "---|".repeat(CHECKPOINTS.len()));
+    let mut seen: Vec<(String, String)> = Vec::new();
+    for p in points {
+        let key = (p.configuration.clone(), p.motion.clone());
+        if seen.contains(&key) {
+            continue;
+        }
+        seen.push(key.clone());
+        let rows: Vec<&ConvergencePoint> =
+            points.iter().filter(|q| q.configuration == key.0 && q.motion == key.1).collect();
+        let ms = rows.last().map_or(0.0, |r| r.occlusion_ms_per_eye);
+        s += &format!("| {} | {} | {ms:.1} |", key.0, key.1);
+        for r in rows {
+            s += &format!(" {:.4} / {:.4} |", r.ao_rmse, r.noise_rmse);
+        }
+        s += "\n";
+    }
+    s
+}

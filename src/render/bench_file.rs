@@ -1,0 +1,141 @@
+//! The bench's file format (`vrao bench --out`, JSON): plain data that `measure` writes
+//! and the governor in `app` reads its frontier from, so it lives below both.
+
+use serde::{Deserialize, Serialize};
+
+/// One row as written to CSV, JSON and Markdown.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchRecord {
+    pub technique: String,
+    pub samples: u32,
+    pub radius_m: f32,
+    pub resolution: String,
+    pub technique_ms_per_eye: f64,
+    pub blur_ms_per_eye: f64,
+    pub upsample_ms_per_eye: f64,
+    /// Technique + blur + upsample per eye: the occlusion's cost.
+    pub occlusion_ms_per_eye: f64,
+    /// p75 / p25 of the technique pass: the run-to-run spread.
+    pub p75_over_p25: f64,
+    /// RMSE against the reference's hard cut-off AO (`measure::bench::ErrorFigures::ao_rmse`).
+    pub ao_rmse: Option<f64>,
+    /// Mean estimate − reference over hit pixels, both eyes.
+    #[serde(default)]
+    pub ao_bias: Option<f64>,
+    /// The bias over pixels whose reference AO is below 0.8.
+    #[serde(default)]
+    pub ao_bias_dark: Option<f64>,
+    /// RMSE against the reference's linear-falloff AO.
+    #[serde(default)]
+    pub ao_rmse_falloff: Option<f64>,
+    /// RMSE against the screen-space limit (estimator error).
+    #[serde(default)]
+    pub ao_rmse_vs_limit: Option<f64>,
+    /// The screen-space limit's RMSE and bias against the reference (screen-space error;
+    /// the same for every row of a radius).
+    #[serde(default)]
+    pub limit_rmse: Option<f64>,
+    #[serde(default)]
+    pub limit_bias: Option<f64>,
+    /// RMSE within 40 px of the outer, top and bottom borders (`measure::bench::ErrorFigures::ao_rmse_outer_border`).
+    #[serde(default)]
+    pub ao_rmse_outer_border: Option<f64>,
+    /// Share of the pixels beside depth edges too dark by more than 0.1 (`measure::bench::ErrorFigures::halo_share`).
+    #[serde(default)]
+    pub halo_share: Option<f64>,
+    /// Mean ꟻLIP of the AO against the reference AO at the headset's pixels per degree.
+    #[serde(default)]
+    pub flip_mean: Option<f64>,
+    /// Share (0..1) of the points both eyes see whose AO differs by more than 0.02:
+    /// overall, within 40 px of the inner (nasal) border, and farther than 40 px from
+    /// every border.
+    #[serde(default)]
+    pub stereo_inconsistent: Option<f64>,
+    #[serde(default)]
+    pub stereo_inconsistent_inner_border: Option<f64>,
+    #[serde(default)]
+    pub stereo_inconsistent_interior: Option<f64>,
+    pub ao_ssim: Option<f64>,
+    pub ambient_rel_rmse: Option<f64>,
+    /// On the Pareto front of AO RMSE against occlusion ms per eye.
+    pub pareto: bool,
+    /// SSDO with depth peeling; its second-layer pass is in `occlusion_ms_per_eye`.
+    #[serde(default)]
+    pub depth_peeling: bool,
+    #[serde(default)]
+    pub peel_ms_per_eye: f64,
+    /// One-bounce irradiance against the reference's bounce (ssdo-bounce, rsm rows).
+    #[serde(default)]
+    pub bounce_rel_rmse: Option<f64>,
+    #[serde(default)]
+    pub bounce_rel_bias: Option<f64>,
+    /// Temporal accumulation on; its pass is in `occlusion_ms_per_eye`.
+    #[serde(default)]
+    pub temporal: bool,
+    /// The composite (bench `--frame`; 0 without). At half resolution it upsamples the
+    /// occlusion inline, as every frame does.
+    #[serde(default)]
+    pub composite_ms_per_eye: f64,
+    /// Half-resolution rows with `--frame`: what upsampling costs a frame, this row's
+    /// composite minus the composite of the same case at full resolution (measured in
+    /// the same sweep). Frames do not run the stand-alone upsample pass.
+    #[serde(default)]
+    pub frame_upsample_ms_per_eye: Option<f64>,
+}
+
+impl BenchRecord {
+    pub fn setting(&self) -> String {
+        let peel = if self.depth_peeling { " peeled" } else { "" };
+        let temporal = if self.temporal { " temporal" } else { "" };
+        format!("{}{peel}{temporal} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
+    }
+}
+
+/// A whole sweep: where it ran, how, and every row.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BenchFile {
+    pub scene: String,
+    pub adapter: String,
+    pub backend: String,
+    pub driver: String,
+    pub width: u32,
+    pub height: u32,
+    pub timing: String,
+    pub warmup: u32,
+    pub frames: u32,
+    /// The reference tracer's settings and noise, when errors were measured.
+    pub reference: Option<ReferenceInfo>,
+    /// How the screen-space limit was marched, when errors were measured.
+    #[serde(default)]
+    pub limit: Option<LimitInfo>,
+    /// Pixels per degree of the eyes (FLIP uses this over the reference's stride).
+    #[serde(default)]
+    pub pixels_per_degree: Option<f64>,
+    /// vrao's version (and git commit when it could be read) that measured this.
+    #[serde(default)]
+    pub version: String,
+    /// The command line that measured this.
+    #[serde(default)]
+    pub command: String,
+    pub records: Vec<BenchRecord>,
+}
+
+/// The screen-space limit's march (the reference tracer's `LimitSettings`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LimitInfo {
+    pub rays_per_pixel: u32,
+    pub steps: u32,
+    /// Thickness as a fraction of the radius.
+    pub thickness_of_radius: f64,
+}
+
+/// The reference tracer's settings and noise, when errors were measured.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    pub rays_per_pixel: u32,
+    pub stride: u32,
+    /// RMS over hit pixels of the reference AO's standard error (worst radius).
+    pub ao_noise_rms: f64,
+    /// Tracer throughput on this machine (rays per second, all cores), when it traced.
+    pub rays_per_second: Option<f64>,
+}

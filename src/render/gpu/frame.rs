@@ -1,0 +1,295 @@
+//! Per-frame uniforms shared by every pass (mirrors `Frame`, `Eye` and `Light` in
+//! shaders/common.wgsl), built in f64 and rounded once.
+
+use super::scene::GpuScene;
+use crate::render::sampling::{gtao_slices_steps, hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
+use crate::render::scene::environment::quadratic_in_view;
+use crate::render::scene::{Light, Scene};
+use crate::render::settings::{Noise, Settings, Technique};
+use crate::render::stereo::Eye;
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, Mat3, Mat4, Vec3};
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct EyeUniform {
+    pub clip_from_anchored: [[f32; 4]; 4],
+    pub view_from_anchored: [[f32; 4]; 4],
+    pub world_from_view: [[f32; 4]; 4],
+    pub tangents: [f32; 4],
+    /// The other eye's view from this eye's view (identity for a mono view).
+    pub other_from_view: [[f32; 4]; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct FrameUniform {
+    pub eyes: [EyeUniform; 2],
+    pub size: [u32; 2],
+    pub layers: u32,
+    pub light_count: u32,
+    pub near: f32,
+    pub exposure: f32,
+    pub white_point: f32,
+    pub has_environment: u32,
+    /// The environment light as quadratics in each eye's view-space direction
+    /// (`quadratic_in_view`; zero without an environment): [irradiance of eye 0, of
+    /// eye 1 (`Environment::irradiance_quadratic`), pre-filtered radiance of eye 0, of
+    /// eye 1 (`Environment::radiance_quadratic`, SSDO)].
+    pub environment_quadratics: [[[f32; 4]; 10]; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct LightUniform {
+    pub pos_or_dir: [f32; 4],
+    pub radiance: [f32; 4],
+    pub kind: [u32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct AoParamsUniform {
+    pub ao_size: [u32; 2],
+    pub scale: u32,
+    pub samples: u32,
+    pub directions: u32,
+    pub steps: u32,
+    pub technique: u32,
+    pub noise: u32,
+    pub radius: f32,
+    pub strength: f32,
+    pub bias: f32,
+    pub range_check: u32,
+    pub bounce: f32,
+    /// Extra rotation of every pixel's pattern this frame (HBAO with temporal
+    /// accumulation turns its directions by the golden angle per frame; 0 otherwise).
+    pub frame_angle: f32,
+    pub blur_radius: u32,
+    pub blur_plane_sigma: f32,
+    /// Scale of the sample lengths this frame (HBAO's temporal range jitter; 1 otherwise).
+    pub range_scale: f32,
+    /// GTAO: thickness of the slab behind each depth sample, as a fraction of the radius.
+    pub thickness: f32,
+    /// GTAO: the samples' spread along a half-slice (1 even, 2 quadratic).
+    pub step_power: f32,
+    /// GTAO: distance gap (fraction of the radius) under which successive samples join.
+    pub connect: f32,
+    /// GTAO: width in occlusion pixels of the band along each eye's inner border that
+    /// runs with the other-eye lookups ([`gtao_inner_band`]).
+    pub inner_band: u32,
+    /// The WGSL struct's size is a multiple of its 8-byte alignment (`ao_size`).
+    pub padding: u32,
+}
+
+/// GTAO's inner-border band for occlusion targets `width` pixels wide: a quarter of the
+/// width (whole 8-pixel workgroups). Only marches from this band look past the inner
+/// border into the other eye; one from further in that would cross it (its radius spans
+/// more than a quarter of the image: a surface very near the eye) stops there instead.
+pub fn gtao_inner_band(width: u32) -> u32 {
+    (width / 4).next_multiple_of(8).min(width)
+}
+
+/// Most samples a kernel may hold (the settings' limit on N).
+pub const MAX_KERNEL_SAMPLES: usize = 256;
+
+/// The uniform and light buffers of one frame.
+pub struct FrameBuffers {
+    pub frame: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    /// `AoParams` of common.wgsl.
+    pub ao: wgpu::Buffer,
+    /// The hemisphere kernel: one [x, y, z, length] per sample.
+    pub kernel: wgpu::Buffer,
+    light_capacity: usize,
+}
+
+/// Occlusion targets' size: half per axis (rounded up, so odd sizes keep their last
+/// row and column) with half resolution.
+pub fn ao_extent(width: u32, height: u32, half_res: bool) -> (u32, u32) {
+    if half_res {
+        (width.div_ceil(2), height.div_ceil(2))
+    } else {
+        (width, height)
+    }
+}
+
+impl FrameBuffers {
+    pub fn new(device: &wgpu::Device, light_count: usize) -> FrameBuffers {
+        // Both eyes' copies; at least one element since wgpu rejects empty bindings.
+        let light_capacity = (light_count * 2).max(1);
+        FrameBuffers {
+            frame: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame uniforms"),
+                size: std::mem::size_of::<FrameUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            lights: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lights"),
+                size: (light_capacity * std::mem::size_of::<LightUniform>()) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            ao: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ao params"),
+                size: std::mem::size_of::<AoParamsUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            kernel: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ao kernel"),
+                size: (MAX_KERNEL_SAMPLES * 16) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            light_capacity,
+        }
+    }
+
+    /// Writes the occlusion parameters and the kernel that suits the technique.
+    /// `frame_index` changes the sampling pattern when temporal accumulation is on.
+    pub fn update_ao(&self, queue: &wgpu::Queue, settings: &Settings, frame_index: u64) {
+        let ao = &settings.ao;
+        let (width, height) = ao_extent(settings.profile.width, settings.profile.height, ao.half_res);
+        let (directions, steps) = match ao.technique {
+            Technique::Gtao => gtao_slices_steps(ao.samples),
+            _ => hbao_directions_steps(ao.samples),
+        };
+        let density = match ao.technique {
+            Technique::Ssdo | Technique::SsdoBounce => HemisphereDensity::Uniform,
+            _ => HemisphereDensity::Cosine,
+        };
+        // With temporal accumulation each frame of the window takes its own part of a
+        // longer Halton kernel, so the accumulated samples are as stratified as one
+        // kernel of window × N. Measured (room, SSAO N = 8, 270×300, noise against the
+        // converged estimator after 8 frames): golden-angle turns of one kernel 0.0122,
+        // parts plus turns 0.0125, parts alone 0.0078 — turning a part breaks the
+        // stratification between parts. So the hemisphere techniques change their pattern
+        // by parts and only HBAO, whose directions are not a Halton kernel, turns.
+        let part = if ao.temporal.enabled { (frame_index % ao.temporal.max_frames as u64) as u32 } else { 0 };
+        let turns = ao.temporal.enabled && matches!(ao.technique, Technique::Hbao | Technique::Gtao);
+        let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
+        let params = AoParamsUniform {
+            ao_size: [width, height],
+            scale: if ao.half_res { 2 } else { 1 },
+            samples: ao.samples,
+            directions,
+            steps,
+            technique: match ao.technique {
+                Technique::None => 0,
+                Technique::Ssao | Technique::Hbao | Technique::Gtao | Technique::FetchOnly => 1,
+                Technique::Ssdo | Technique::SsdoBounce => 2,
+            },
+            noise: match ao.noise {
+                Noise::Tiled5x5 => 0,
+                Noise::Halton => 1,
+            },
+            radius: ao.radius,
+            strength: ao.strength,
+            bias: ao.bias,
+            range_check: ao.range_check as u32,
+            bounce: if ao.bounce_active() { ao.bounce } else { 0.0 },
+            frame_angle: if turns { temporal_angle(frame_index) } else { 0.0 },
+            // The blur radius is in full-resolution pixels: at half resolution the same
+            // screen footprint takes half as many taps.
+            blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
+            blur_plane_sigma: ao.blur_plane_sigma,
+            range_scale: if turns { temporal_range_scale(frame_index) } else { 1.0 },
+            thickness: ao.thickness,
+            step_power: ao.step_power,
+            connect: ao.connect,
+            inner_band: gtao_inner_band(width),
+            padding: 0,
+        };
+        queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
+        queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
+    }
+
+    /// Writes this frame's views (1 or 2), lights in each view's space, and settings.
+    pub fn update(&self, queue: &wgpu::Queue, scene: &Scene, gpu_scene: &GpuScene, views: &[Eye], settings: &Settings) {
+        let to_cols = |m: Mat4| m.to_cols_array_2d();
+        let mut eyes = [EyeUniform::zeroed(); 2];
+        let mut environment_quadratics = [[[0.0; 4]; 10]; 4];
+        let mut lights = Vec::with_capacity(self.light_capacity);
+        for (index, (slot, eye)) in eyes.iter_mut().zip(views).enumerate() {
+            let view_from_world = eye.view_from_world();
+            let view_from_anchored = view_from_world * DMat4::from_translation(gpu_scene.anchor);
+            let [l, r, u, d] = eye.fov.tangents();
+            let world_from_view = eye.pose.orientation.as_quat();
+            if let Some(env) = &scene.environment {
+                let rotation = Mat3::from_quat(world_from_view);
+                let in_view = |q: [Vec3; 10]| quadratic_in_view(&q, rotation).map(|c| c.extend(0.0).to_array());
+                environment_quadratics[index] = in_view(env.irradiance_quadratic());
+                environment_quadratics[2 + index] = in_view(env.radiance_quadratic());
+            }
+            *slot = EyeUniform {
+                clip_from_anchored: to_cols(eye.clip_from_anchored(gpu_scene.anchor, settings.near)),
+                view_from_anchored: to_cols(view_from_anchored.as_mat4()),
+                world_from_view: to_cols(Mat4::from_quat(world_from_view)),
+                tangents: [l as f32, r as f32, u as f32, d as f32],
+                other_from_view: to_cols(other_from_view(views, index)),
+            };
+            for light in &scene.lights {
+                lights.push(match *light {
+                    Light::Directional { direction, color, intensity } => LightUniform {
+                        pos_or_dir: view_from_world
+                            .transform_vector3(direction.as_dvec3())
+                            .normalize_or_zero()
+                            .as_vec3()
+                            .extend(0.0)
+                            .to_array(),
+                        radiance: (color * intensity).extend(0.0).to_array(),
+                        kind: [0; 4],
+                    },
+                    Light::Point { position, color, intensity } => LightUniform {
+                        pos_or_dir: view_from_world.transform_point3(position).as_vec3().extend(1.0).to_array(),
+                        radiance: (color * intensity).extend(0.0).to_array(),
+                        kind: [1, 0, 0, 0],
+                    },
+                });
+            }
+        }
+        let uniform = FrameUniform {
+            eyes,
+            size: [settings.profile.width, settings.profile.height],
+            layers: views.len() as u32,
+            light_count: scene.lights.len() as u32,
+            near: settings.near as f32,
+            exposure: settings.exposure,
+            white_point: settings.white_point,
+            has_environment: scene.environment.is_some() as u32,
+            environment_quadratics,
+        };
+        queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));
+        if !lights.is_empty() {
+            queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(&lights));
+        }
+    }
+}
+
+/// The other view's view-from-this-view of `views[index]`, in f64 (identity without a
+/// second view).
+fn other_from_view(views: &[Eye], index: usize) -> Mat4 {
+    match views.get(1 - index.min(1)) {
+        Some(other) if views.len() == 2 => {
+            (other.view_from_world() * views[index].view_from_world().inverse()).as_mat4()
+        }
+        _ => Mat4::IDENTITY,
+    }
+}
+
+/// HBAO's turn of its directions this frame (radians): the golden angle (137.5°) per frame.
+/// Seed 001 turns it 10° per frame; measured on the room (SSAO N = 8, 135×150 per eye),
+/// 10° steps leave successive patterns so alike that 8 frames cut the noise only from
+/// 0.037 to 0.029, while golden-angle steps reach 0.012 (the 1/√8 of independent ones).
+pub fn temporal_angle(frame_index: u64) -> f32 {
+    ((frame_index as f64 * 137.507_764f64).rem_euclid(360.0)).to_radians() as f32
+}
+
+/// Seed 001's range jitter (HBAO): the sample lengths scale by a factor in [0.9, 1] that follows
+/// the golden-ratio sequence, so successive frames reach different depths.
+pub fn temporal_range_scale(frame_index: u64) -> f32 {
+    let golden = 0.618_033_988_749_895_f64;
+    (1.0 - 0.1 * (frame_index as f64 * golden).fract()) as f32
+}

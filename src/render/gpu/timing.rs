@@ -1,0 +1,180 @@
+//! GPU timestamps around passes, read back frames later without a stall: the scopes go
+//! through `wgpu-profiler`, which keeps a ring of query sets and readback buffers and
+//! hands back a frame's times once its buffers have mapped.
+
+use super::Gpu;
+use crate::render::error::{Error, Result};
+use std::collections::VecDeque;
+
+/// One finished frame's spans: (label, GPU milliseconds) in the order they were
+/// recorded; per-eye spans ([`is_per_eye`]) lie inside their pass's span.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameTiming {
+    pub frame: u64,
+    pub spans: Vec<(String, f64)>,
+    /// GPU time of the whole frame: the sum of its passes' spans (not the per-eye ones).
+    pub total_ms: f64,
+    /// Whether the frame's passes went to the GPU one submission each (true per-pass
+    /// times on lavapipe; see [`crate::render::renderer::Timing::Serial`]).
+    pub serial: bool,
+}
+
+/// An open span; hand it back to [`PassTimer::end`] on the same encoder.
+pub struct Span(wgpu_profiler::GpuProfilerQuery);
+
+/// Timestamp spans of every frame in flight.
+pub struct PassTimer {
+    profiler: wgpu_profiler::GpuProfiler,
+    /// Frames whose spans were submitted and are not yet read back, oldest first (the
+    /// profiler returns frames in this order).
+    pending: VecDeque<u64>,
+    timestamp_period: f32,
+}
+
+/// The profiler never drops a frame as long as fewer than this many are pending; the
+/// renderer keeps far fewer in flight.
+const MAX_PENDING_FRAMES: usize = 16;
+
+impl PassTimer {
+    /// Timestamps where the adapter has them (inside encoders); a no-op otherwise.
+    pub fn new(gpu: &Gpu) -> Result<PassTimer> {
+        let settings = wgpu_profiler::GpuProfilerSettings {
+            enable_timer_queries: gpu.caps.timestamps,
+            enable_debug_groups: false,
+            max_num_pending_frames: MAX_PENDING_FRAMES,
+        };
+        let profiler = wgpu_profiler::GpuProfiler::new(&gpu.device, settings)
+            .map_err(|e| Error::Gpu(format!("GPU profiler: {e}")))?;
+        Ok(PassTimer { profiler, pending: VecDeque::new(), timestamp_period: gpu.queue.get_timestamp_period() })
+    }
+
+    pub fn enabled(&self) -> bool {
+        self.profiler.settings().enable_timer_queries
+    }
+
+    /// Opens a span on `encoder`.
+    pub fn begin(&self, encoder: &mut wgpu::CommandEncoder, label: &str) -> Span {
+        Span(self.profiler.begin_query(label, encoder))
+    }
+
+    pub fn end(&self, encoder: &mut wgpu::CommandEncoder, span: Span) {
+        self.profiler.end_query(encoder, span.0);
+    }
+
+    /// Copies the frame's queries towards their readback buffers; record it in the
+    /// frame's last encoder.
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.profiler.resolve_queries(encoder);
+    }
+
+    /// Closes `frame` after its last submission and starts mapping its results.
+    pub fn end_frame(&mut self, frame: u64) -> Result<()> {
+        self.profiler.end_frame().map_err(|e| Error::Gpu(format!("GPU profiler: {e}")))?;
+        if self.enabled() {
+            self.pending.push_back(frame);
+        }
+        Ok(())
+    }
+
+    /// Frames whose spans have been read back since the last call (poll the device for
+    /// them to arrive); never waits.
+    pub fn finished(&mut self) -> Vec<FrameTiming> {
+        let mut done = Vec::new();
+        while let Some(results) = self.profiler.process_finished_frame(self.timestamp_period) {
+            let Some(frame) = self.pending.pop_front() else { break };
+            let mut spans = Vec::new();
+            flatten(&results, &mut spans);
+            // A pass's per-eye spans lie inside its own span: only passes add up.
+            let total_ms = spans.iter().filter(|(label, _)| !is_per_eye(label)).map(|(_, ms)| ms).sum();
+            done.push(FrameTiming { frame, spans, total_ms, serial: false });
+        }
+        done
+    }
+
+    /// Frames submitted whose spans have not come back yet.
+    pub fn pending(&self) -> usize {
+        self.pending.len()
+    }
+}
+
+/// Per-eye spans (a pass run once per eye) are labelled "<pass> left" / "<pass> right".
+pub fn is_per_eye(label: &str) -> bool {
+    label.ends_with(" left") || label.ends_with(" right")
+}
+
+fn flatten(results: &[wgpu_profiler::GpuTimerQueryResult], out: &mut Vec<(String, f64)>) {
+    for r in results {
+        if let Some(time) = &r.time {
+            out.push((r.label.clone(), (time.end - time.start).max(0.0) * 1e3));
+        }
+        flatten(&r.nested_queries, out);
+    }
+}
+
+/// One span's times over many frames.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SpanSummary {
+    pub label: String,
+    pub frames: usize,
+    pub median_ms: f64,
+    /// Interquartile range: the spread that one slow frame does not distort.
+    pub p25_ms: f64,
+    pub p75_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+}
+
+/// Median and spread of every span over frames, in the order spans first appear.
+pub fn summarize(frames: &[Vec<(String, f64)>]) -> Vec<SpanSummary> {
+    let mut labels: Vec<&str> = Vec::new();
+    for frame in frames {
+        for (label, _) in frame {
+            if !labels.contains(&label.as_str()) {
+                labels.push(label);
+            }
+        }
+    }
+    labels
+        .into_iter()
+        .map(|label| {
+            let mut times: Vec<f64> =
+                frames.iter().flat_map(|f| f.iter().filter(|(l, _)| l == label).map(|(_, ms)| *ms)).collect();
+            times.sort_by(f64::total_cmp);
+            SpanSummary {
+                label: label.to_string(),
+                frames: times.len(),
+                median_ms: quantile(&times, 0.5),
+                p25_ms: quantile(&times, 0.25),
+                p75_ms: quantile(&times, 0.75),
+                min_ms: times[0],
+                max_ms: times[times.len() - 1],
+            }
+        })
+        .collect()
+}
+
+/// Linear-interpolated quantile of sorted, non-empty values.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let pos = q.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
+    let (i, frac) = (pos.floor() as usize, pos.fract());
+    let next = sorted[(i + 1).min(sorted.len() - 1)];
+    sorted[i] + (next - sorted[i]) * frac
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_and_quartiles_of_spans() {
+        let frames: Vec<Vec<(String, f64)>> = [1.0, 5.0, 2.0, 4.0, 3.0]
+            .iter()
+            .map(|&ms| vec![("a".to_string(), ms), ("b".to_string(), 10.0 * ms)])
+            .collect();
+        let s = summarize(&frames);
+        assert_eq!(s.len(), 2);
+        assert_eq!((s[0].median_ms, s[0].p25_ms, s[0].p75_ms, s[0].min_ms, s[0].max_ms), (3.0, 2.0, 4.0, 1.0, 5.0));
+        assert_eq!(s[1].median_ms, 30.0);
+        assert_eq!(quantile(&[1.0, 2.0], 0.5), 1.5);
+    }
+}

@@ -1,0 +1,15 @@
+//! The renderer: the GPU device and its helpers, the frame graph and its passes, stereo
+//! views, scenes and settings. It imports nothing else of vrao: `xr`, `app` and
+//! `measure` build on it (checked by `tests/layout.rs`).
+
+pub mod bench_file;
+pub mod error;
+pub mod gpu;
+pub mod graph;
+pub mod output;
+pub mod passes;
+pub mod renderer;
+pub mod sampling;
+pub mod scene;
+pub mod settings;
+pub mod stereo;

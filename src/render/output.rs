@@ -1,0 +1,107 @@
+//! Writes eye images and debug views as PNG files.
+
+use crate::render::error::{Error, Result};
+use crate::render::graph::Resource;
+use crate::render::renderer::Renderer;
+use crate::render::settings::{Settings, Technique};
+use std::path::{Path, PathBuf};
+
+pub const EYE_NAMES: [&str; 2] = ["left", "right"];
+
+fn save_rgba(path: &Path, width: u32, height: u32, rgba: Vec<u8>) -> Result<()> {
+    let image = image::RgbaImage::from_raw(width, height, rgba)
+        .ok_or_else(|| Error::Output { path: path.into(), message: "image size mismatch".into() })?;
+    image.save(path).map_err(|e| Error::Output { path: path.into(), message: e.to_string() })
+}
+
+/// Depth shown as log-distance, near = white, far = dark, sky = black; the range is the
+/// image's own nearest and farthest surface so any scale is visible.
+pub fn depth_to_rgba(depth: &[f32], near: f64) -> Vec<u8> {
+    let distances: Vec<f64> = depth.iter().map(|&d| if d > 0.0 { (near / d as f64).ln() } else { f64::NAN }).collect();
+    let (lo, hi) = distances
+        .iter()
+        .filter(|d| d.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &d| (lo.min(d), hi.max(d)));
+    let span = (hi - lo).max(1e-9);
+    distances
+        .iter()
+        .flat_map(|&d| {
+            let v = if d.is_finite() { (255.0 * (1.0 - 0.85 * (d - lo) / span)) as u8 } else { 0 };
+            [v, v, v, 255]
+        })
+        .collect()
+}
+
+/// View-space normals mapped from [-1, 1] to [0, 255].
+pub fn normals_to_rgba(normals: &[f32]) -> Vec<u8> {
+    normals
+        .chunks_exact(4)
+        .flat_map(|n| {
+            let c = |v: f32| ((v.clamp(-1.0, 1.0) * 0.5 + 0.5) * 255.0).round() as u8;
+            [c(n[0]), c(n[1]), c(n[2]), 255]
+        })
+        .collect()
+}
+
+/// The occlusion resources `--debug` writes: raw, and final (blurred and/or upsampled).
+pub fn occlusion_outputs(settings: &Settings) -> Vec<Resource> {
+    match crate::render::passes::final_occlusion(settings) {
+        Some(last) if last != Resource::AoRaw => vec![Resource::AoRaw, last],
+        Some(_) => vec![Resource::AoRaw],
+        None => Vec::new(),
+    }
+}
+
+/// The AO channel (alpha) of an occlusion target as grey.
+pub fn occlusion_to_rgba(occlusion: &[f32]) -> Vec<u8> {
+    occlusion
+        .chunks_exact(4)
+        .flat_map(|p| {
+            let v = (p[3].clamp(0.0, 1.0) * 255.0).round() as u8;
+            [v, v, v, 255]
+        })
+        .collect()
+}
+
+/// Writes `left.png` and `right.png` (or `mono.png` for one view), and with `debug`
+/// the depth, normals and albedo of each view. Returns the files written.
+pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(out).map_err(|e| Error::Output { path: out.into(), message: e.to_string() })?;
+    let profile = &renderer.settings().profile;
+    let (w, h) = (profile.width, profile.height);
+    let names: &[&str] = if views == 2 { &EYE_NAMES } else { &["mono"] };
+    let mut written = Vec::new();
+    let mut save_sized = |name: String, (w, h): (u32, u32), rgba: Vec<u8>| -> Result<()> {
+        let path = out.join(name);
+        save_rgba(&path, w, h, rgba)?;
+        written.push(path);
+        Ok(())
+    };
+    let mut save = |name: String, rgba: Vec<u8>| save_sized(name, (w, h), rgba);
+    for (name, rgba) in names.iter().zip(renderer.read_bytes(Resource::Color)?) {
+        save(format!("{name}.png"), rgba)?;
+    }
+    if debug {
+        let near = renderer.settings().near;
+        for (name, depth) in names.iter().zip(renderer.read_f32(Resource::Depth)?) {
+            save(format!("depth_{name}.png"), depth_to_rgba(&depth, near))?;
+        }
+        for (name, normals) in names.iter().zip(renderer.read_f32(Resource::Normals)?) {
+            save(format!("normals_{name}.png"), normals_to_rgba(&normals))?;
+        }
+        for (name, albedo) in names.iter().zip(renderer.read_bytes(Resource::Albedo)?) {
+            save(format!("albedo_{name}.png"), albedo)?;
+        }
+        if renderer.settings().ao.technique != Technique::None {
+            for r in occlusion_outputs(renderer.settings()) {
+                let target = renderer.target(r).expect("occlusion was rendered");
+                let size = (target.width, target.height);
+                let label = if r == Resource::AoRaw { "ao_raw" } else { "ao" };
+                for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
+                    save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
+                }
+            }
+        }
+    }
+    Ok(written)
+}

@@ -1,0 +1,195 @@
+//! Composite: direct light plus the ambient term, attenuated by the occlusion the graph
+//! produced (or unoccluded when the technique is none), and the sky, one invocation per
+//! quad of 2×2 pixels. Half-resolution occlusion is upsampled here (3×3 joint bilateral,
+//! shared with the upsample pass), so a frame writes and reads no full-resolution
+//! occlusion target. With reflective shadow maps, their half-resolution one-bounce
+//! irradiance is upsampled the same way and added to the ambient. With the stereo reuse
+//! of half-resolution AO (`reuses_left_eye_upsample`) the left eye is composited first
+//! and the right eye, in a dispatch of its own, takes the left eye's AO from the output's
+//! alpha wherever the left eye sees the same point; the quads it does not fully see are
+//! listed on the GPU and composited by an indirect dispatch over just them.
+
+use super::occlusion::layer_view;
+use super::shadow::rsm_active;
+use super::{occlusion_before_upsample, reuses_left_eye_upsample, FrameContext, FrameSetup, Pass};
+use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::targets::LayeredTarget;
+use crate::render::gpu::Gpu;
+use crate::render::graph::{PassDecl, Resource};
+use std::sync::Mutex;
+use wgpu::util::DeviceExt;
+
+pub struct CompositePass {
+    /// Variants by (half resolution, RSM bounce): pipeline constants, so a frame without
+    /// them runs none of their code.
+    kernels: [[Kernel; 2]; 2],
+    /// The right eye's half-resolution dispatches, by RSM bounce: reusing the left eye's
+    /// AO (listing the quads it cannot), and over the listed quads.
+    right_eye: [Kernel; 2],
+    right_eye_fallback: [Kernel; 2],
+    /// The list of right-eye quads the left eye does not fully see, with the indirect
+    /// dispatch's arguments in front (composite.wgsl `FallbackQuads`), grown to the
+    /// frame's quads when needed; and the header it starts each frame from.
+    fallback: Mutex<Option<wgpu::Buffer>>,
+    fallback_header: wgpu::Buffer,
+    /// The indirect arguments copied out of the list (a buffer may not be both the
+    /// dispatch's read-write binding and its arguments).
+    fallback_args: wgpu::Buffer,
+    /// Bound in place of occlusion or its geometry where the shader does not read them.
+    unused: LayeredTarget,
+}
+
+/// Bytes of `FallbackQuads` before its list: the indirect arguments (x, y, z) and the count.
+const FALLBACK_HEADER_BYTES: u64 = 16;
+
+const SLOTS: [Slot; 15] = [
+    Slot::Uniform,
+    Slot::Uniform,
+    Slot::Depth,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::UintLayers,
+    Slot::Layers,
+    Slot::Texture2d,
+    Slot::Sampler,
+    Slot::Output(wgpu::TextureFormat::Rgba16Float),
+    Slot::Layers,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::Layers,
+    Slot::ReadWriteBuffer,
+];
+
+impl CompositePass {
+    pub fn new(gpu: &Gpu) -> Self {
+        let files = ["common.wgsl", "irradiance.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
+        let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
+        let variant = |half_res: bool, rsm: bool, right_eye: bool, fallback: bool| {
+            let constants = [
+                ("HALF_RES", f64::from(half_res)),
+                ("RSM", f64::from(rsm)),
+                ("RIGHT_EYE", f64::from(right_eye)),
+                ("FALLBACK", f64::from(fallback)),
+            ];
+            let label = match (right_eye, fallback) {
+                (false, _) => "composite",
+                (true, false) => "composite right eye",
+                (true, true) => "composite right eye fallback",
+            };
+            Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &constants)
+        };
+        let fallback_header = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("composite fallback header"),
+            // No workgroups yet (x = 0), y = z = 1, no quads listed; room for a list of
+            // one, so that it also binds where no list is used.
+            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0, 0, 0, 0]),
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::STORAGE,
+        });
+        let fallback_args = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("composite fallback dispatch"),
+            size: FALLBACK_HEADER_BYTES,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        CompositePass {
+            fallback_args,
+            kernels: [false, true].map(|half_res| [false, true].map(|rsm| variant(half_res, rsm, false, false))),
+            right_eye: [false, true].map(|rsm| variant(true, rsm, true, false)),
+            right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true)),
+            fallback: Mutex::new(None),
+            fallback_header,
+            unused,
+        }
+    }
+}
+
+impl Pass for CompositePass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let decl = PassDecl::new("composite")
+            .read(Resource::Depth)
+            .read(Resource::Normals)
+            .read(Resource::Albedo)
+            .read(Resource::Direct)
+            .write(Resource::Hdr);
+        let decl = match occlusion_before_upsample(setup.settings) {
+            None => decl,
+            Some(occlusion) if setup.settings.ao.half_res => decl
+                .read(occlusion)
+                .read(Resource::AoGeometry)
+                .note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)"),
+            Some(occlusion) => decl.read(occlusion),
+        };
+        if rsm_active(setup.scene, setup.settings) {
+            decl.read(Resource::RsmIndirect).read(Resource::RsmGeometry)
+        } else {
+            decl
+        }
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let unused = || wgpu::BindingResource::TextureView(&self.unused.array_view);
+        let half_res = ctx.setup.settings.ao.half_res;
+        let rsm = rsm_active(ctx.setup.scene, ctx.setup.settings);
+        let (occlusion, geometry) = match occlusion_before_upsample(ctx.setup.settings) {
+            Some(occlusion) if half_res => (ctx.view(occlusion), ctx.view(Resource::AoGeometry)),
+            Some(occlusion) => (ctx.view(occlusion), unused()),
+            None => (unused(), unused()),
+        };
+        let mut resources = [
+            ctx.frame.frame.as_entire_binding(),
+            ctx.frame.ao.as_entire_binding(),
+            ctx.view(Resource::Depth),
+            ctx.view(Resource::Normals),
+            ctx.view(Resource::Albedo),
+            ctx.view(Resource::Direct),
+            occlusion,
+            wgpu::BindingResource::TextureView(&ctx.scene.environment),
+            wgpu::BindingResource::Sampler(&ctx.scene.sampler),
+            ctx.view(Resource::Hdr),
+            geometry,
+            // One bounce from reflective shadow maps (passes/rsm.rs), when on.
+            if rsm { ctx.view(Resource::RsmIndirect) } else { unused() },
+            if rsm { ctx.view(Resource::RsmGeometry) } else { unused() },
+            // The output's left-eye layer and the fallback list, for the right eye's dispatches.
+            unused(),
+            self.fallback_header.as_entire_binding(),
+        ];
+        // One invocation per quad of 2×2 pixels (composite.wgsl): both eyes alike, or the
+        // left eye, then the right eye reusing its AO, then the quads it listed.
+        let (w, h, layers) = ctx.quad_extent();
+        let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
+        let device = &ctx.gpu.device;
+        let kernel = &self.kernels[half_res as usize][rsm as usize];
+        kernel.dispatch(device, ctx.encoder, &resources, (w, h, if reuse { 1 } else { layers }));
+        if reuse {
+            let fallback = self.fallback_list(device, u64::from(w) * u64::from(h));
+            ctx.encoder.copy_buffer_to_buffer(&self.fallback_header, 0, &fallback, 0, FALLBACK_HEADER_BYTES);
+            let (right, left) = (layer_view(ctx, Resource::Hdr, 1), layer_view(ctx, Resource::Hdr, 0));
+            resources[9] = wgpu::BindingResource::TextureView(&right);
+            resources[13] = wgpu::BindingResource::TextureView(&left);
+            resources[14] = fallback.as_entire_binding();
+            self.right_eye[rsm as usize].dispatch(device, ctx.encoder, &resources, (w, h, 1));
+            ctx.encoder.copy_buffer_to_buffer(&fallback, 0, &self.fallback_args, 0, 12);
+            let args = &self.fallback_args;
+            self.right_eye_fallback[rsm as usize].dispatch_indirect(device, ctx.encoder, &resources, args, 0);
+        }
+    }
+}
+
+impl CompositePass {
+    /// The fallback list, room for `quads` (a clone of the one buffer: wgpu buffers are
+    /// shared handles).
+    fn fallback_list(&self, device: &wgpu::Device, quads: u64) -> wgpu::Buffer {
+        let size = FALLBACK_HEADER_BYTES + 4 * quads;
+        let mut list = self.fallback.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if list.as_ref().is_none_or(|b| b.size() < size) {
+            *list = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("composite fallback quads"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        list.as_ref().expect("allocated above").clone()
+    }
+}

@@ -1,0 +1,190 @@
+//! The layered G-buffer: reversed-Z depth, view-space normals, albedo and emission for
+//! every eye layer. Multiview draws both eyes in one pass; otherwise one pass per eye.
+//! Both paths share the fragment shader and vertex transform, so they give equal pixels.
+
+use super::{FrameContext, FrameSetup, Pass};
+use crate::render::gpu::frame::FrameBuffers;
+use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::scene::{GpuScene, Vertex};
+use crate::render::gpu::Gpu;
+use crate::render::graph::{PassDecl, Resource};
+use std::num::NonZeroU32;
+use wgpu::util::DeviceExt;
+
+const COLOR_TARGETS: [Resource; 3] = [Resource::Normals, Resource::Albedo, Resource::Emission];
+
+pub struct GBufferPass {
+    frame_group: wgpu::BindGroup,
+    /// One pass for both layers; `None` when the adapter lacks multiview.
+    multiview: Option<wgpu::RenderPipeline>,
+    multipass: wgpu::RenderPipeline,
+    /// Bind groups selecting eye 0 and eye 1 for the per-eye path.
+    eye_select: [wgpu::BindGroup; 2],
+}
+
+impl GBufferPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
+        let device = &gpu.device;
+        let uniform_entry = |binding, visibility| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let vs_fs = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gbuffer frame"),
+            entries: &[uniform_entry(0, vs_fs)],
+        });
+        let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gbuffer eye select"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+        });
+        let eye_select = [0u32, 1].map(|eye| {
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("eye select"),
+                contents: bytemuck::cast_slice(&[eye, 0, 0, 0]),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("eye select"),
+                layout: &eye_layout,
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+            })
+        });
+        let multiview = gpu.caps.multiview.then(|| {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gbuffer multiview"),
+                bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout)],
+                immediate_size: 0,
+            });
+            let module =
+                shader_module(device, "gbuffer multiview", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multiview.wgsl"]);
+            pipeline(device, &layout, &module, NonZeroU32::new(0b11))
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer multipass"),
+            bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
+            immediate_size: 0,
+        });
+        let module =
+            shader_module(device, "gbuffer multipass", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multipass.wgsl"]);
+        let multipass = pipeline(device, &layout, &module, None);
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer frame"),
+            layout: &frame_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.frame.as_entire_binding() }],
+        });
+        GBufferPass { frame_group, multiview, multipass, eye_select }
+    }
+}
+
+fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    multiview_mask: Option<NonZeroU32>,
+) -> wgpu::RenderPipeline {
+    let targets = COLOR_TARGETS.map(|r| Some(wgpu::ColorTargetState::from(r.format())));
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("gbuffer"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<Vertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+            })],
+        },
+        // No culling: OBJ windings are not trusted; the fragment shader faces normals
+        // towards the eye instead.
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: Resource::Depth.format(),
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater), // reversed Z
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask,
+        cache: None,
+    })
+}
+
+impl Pass for GBufferPass {
+    fn declare(&self, _: &FrameSetup) -> PassDecl {
+        PassDecl::new("gbuffer")
+            .write(Resource::Depth)
+            .write(Resource::Normals)
+            .write(Resource::Albedo)
+            .write(Resource::Emission)
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let multiview = ctx.setup.multiview && ctx.setup.views == 2;
+        if multiview {
+            let pipeline = self.multiview.as_ref().expect("multiview requested without adapter support");
+            let views = |r: Resource| &ctx.targets[&r].array_view;
+            let mut pass = begin(ctx.encoder, views, NonZeroU32::new(0b11));
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &self.frame_group, &[]);
+            ctx.scene.draw(&mut pass, Some(1));
+        } else {
+            for layer in 0..ctx.setup.views as usize {
+                let label = if layer == 0 { "gbuffer left" } else { "gbuffer right" };
+                let span = ctx.timer.begin(ctx.encoder, label);
+                {
+                    let views = |r: Resource| &ctx.targets[&r].layer_views[layer];
+                    let mut pass = begin(ctx.encoder, views, None);
+                    pass.set_pipeline(&self.multipass);
+                    pass.set_bind_group(0, &self.frame_group, &[]);
+                    pass.set_bind_group(2, &self.eye_select[layer], &[]);
+                    ctx.scene.draw(&mut pass, Some(1));
+                }
+                ctx.timer.end(ctx.encoder, span);
+            }
+        }
+    }
+}
+
+/// A render pass clearing every G-buffer target (depth to 0 = infinitely far).
+fn begin<'e, 't>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    views: impl Fn(Resource) -> &'t wgpu::TextureView,
+    multiview_mask: Option<NonZeroU32>,
+) -> wgpu::RenderPass<'e> {
+    let color = COLOR_TARGETS.map(|r| {
+        Some(wgpu::RenderPassColorAttachment {
+            view: views(r),
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+        })
+    });
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("gbuffer"),
+        color_attachments: &color,
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: views(Resource::Depth),
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask,
+    })
+}

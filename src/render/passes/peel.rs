@@ -1,0 +1,168 @@
+//! Depth peeling for SSDO (seed 002 §4): a second depth layer per eye, the nearest
+//! surface behind the G-buffer's depth (shaders/peel.wgsl). With it SSDO counts a sample
+//! as an occluder only between the first and second layer, inside an object, so thin
+//! objects in front of a background no longer cast a halo onto it. An optional quality
+//! mode (`ao.depth_peeling`): the pass exists only while SSDO runs with peeling on.
+//!
+//! One depth-only render pass per eye layer, whatever the G-buffer uses: multiview is
+//! unreliable on lavapipe, and each pass reads its own layer of the first depth.
+
+use super::{FrameContext, FrameSetup, Pass};
+use crate::render::gpu::frame::FrameBuffers;
+use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::scene::Vertex;
+use crate::render::gpu::Gpu;
+use crate::render::graph::{PassDecl, Resource};
+use crate::render::settings::Technique;
+use wgpu::util::DeviceExt;
+
+pub struct DepthPeelPass {
+    pipeline: wgpu::RenderPipeline,
+    frame_group: wgpu::BindGroup,
+    eye_layout: wgpu::BindGroupLayout,
+    /// The eye index (0 left, 1 right) each per-eye pass binds.
+    eye_index: [wgpu::Buffer; 2],
+}
+
+impl DepthPeelPass {
+    pub fn new(gpu: &Gpu, frame: &FrameBuffers) -> Self {
+        let device = &gpu.device;
+        let uniform = |binding, visibility| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth peel frame"),
+            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
+        });
+        let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth peel eye"),
+            entries: &[
+                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth peel"),
+            bind_group_layouts: &[Some(&frame_layout), Some(&eye_layout)],
+            immediate_size: 0,
+        });
+        let module = shader_module(device, "depth peel", &["common.wgsl", "peel.wgsl"]);
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("depth peel"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_peel"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+                })],
+            },
+            // No culling, as in the G-buffer: the back faces are what this pass is for.
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: Resource::DepthLayer2.format(),
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater), // reversed Z
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_peel"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("depth peel frame"),
+            layout: &frame_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.frame.as_entire_binding() }],
+        });
+        let eye_index = [0u32, 1].map(|eye| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("depth peel eye"),
+                contents: bytemuck::cast_slice(&[eye, 0, 0, 0]),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        });
+        DepthPeelPass { pipeline, frame_group, eye_layout, eye_index }
+    }
+}
+
+impl Pass for DepthPeelPass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let ao = &setup.settings.ao;
+        let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
+        PassDecl::new("depth-peel")
+            .read(Resource::Depth)
+            .write(Resource::DepthLayer2)
+            .disabled_if(!ao.depth_peeling, "depth peeling is off (--depth-peeling turns it on for SSDO)")
+            .disabled_if(
+                !ssdo,
+                format!("technique is {}: only SSDO tests occluders against a second depth layer", ao.technique.name()),
+            )
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let first = ctx.view(Resource::Depth);
+        let second = ctx.target(Resource::DepthLayer2);
+        for layer in 0..ctx.setup.views as usize {
+            let eye_group = ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("depth peel eye"),
+                layout: &self.eye_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.eye_index[layer].as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: first.clone() },
+                ],
+            });
+            let label = if layer == 0 { "depth-peel left" } else { "depth-peel right" };
+            let span = ctx.timer.begin(ctx.encoder, label);
+            {
+                let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("depth peel"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &second.layer_views[layer],
+                        // Cleared to 0 = infinitely far: where nothing lies behind the first
+                        // layer, every sample behind it counts as inside.
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(0.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.frame_group, &[]);
+                pass.set_bind_group(1, &eye_group, &[]);
+                ctx.scene.draw(&mut pass, None);
+            }
+            ctx.timer.end(ctx.encoder, span);
+        }
+    }
+}

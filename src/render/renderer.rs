@@ -1,0 +1,495 @@
+//! The renderer: owns the passes and their targets. Each frame it asks the passes what
+//! they read and write, lets the graph keep only what the requested outputs need, and
+//! records the kept passes with a GPU timestamp span around each.
+//!
+//! Frames in flight: [`Renderer::render`] submits and returns without waiting for the
+//! GPU; up to [`Renderer::set_frames_in_flight`] frames run at once (the oldest is
+//! waited for before another is encoded) and each frame's GPU times come back a few
+//! frames later in [`FrameReport::finished`]. Only pixel readbacks and
+//! [`Renderer::render_and_wait`] (measurements) wait.
+
+use crate::render::error::{Error, Result};
+use crate::render::gpu::frame::ao_extent;
+use crate::render::gpu::frame::FrameBuffers;
+use crate::render::gpu::readback;
+use crate::render::gpu::scene::GpuScene;
+use crate::render::gpu::targets::LayeredTarget;
+use crate::render::gpu::timing::{FrameTiming, PassTimer};
+use crate::render::gpu::Gpu;
+use crate::render::graph::{self, Plan, Resource};
+use crate::render::passes::blur::BlurPass;
+use crate::render::passes::composite::CompositePass;
+use crate::render::passes::direct::DirectLightPass;
+use crate::render::passes::gbuffer::GBufferPass;
+use crate::render::passes::occlusion::OcclusionPass;
+use crate::render::passes::peel::DepthPeelPass;
+use crate::render::passes::rsm::RsmPass;
+use crate::render::passes::shadow::{LightSpace, ShadowPass};
+use crate::render::passes::ssdo::SsdoPass;
+use crate::render::passes::temporal::TemporalPass;
+use crate::render::passes::tonemap::TonemapPass;
+use crate::render::passes::upsample::UpsamplePass;
+use crate::render::passes::{FrameContext, FrameSetup, Pass};
+use crate::render::scene::Scene;
+use crate::render::settings::{Settings, StereoMode};
+use crate::render::stereo::Eye;
+use std::collections::{BTreeMap, VecDeque};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Frames the renderer lets the GPU work on at once unless told otherwise.
+pub const DEFAULT_FRAMES_IN_FLIGHT: usize = 2;
+
+/// What one frame did: the plan (passes run and left out) and how long each took.
+#[derive(Clone, Debug)]
+pub struct FrameReport {
+    /// This frame's number (counts every frame the renderer submitted).
+    pub frame: u64,
+    pub plan: Plan,
+    /// (span, GPU milliseconds) per pass of this frame, plus per-eye spans where a pass
+    /// runs per eye: filled by [`Renderer::render_and_wait`]; after [`Renderer::render`]
+    /// the frame is still on the GPU and its times arrive later in `finished`. Empty when
+    /// the adapter has no timestamp queries.
+    pub gpu_ms: Vec<(String, f64)>,
+    /// CPU time spent encoding the frame's commands.
+    pub cpu_encode_ms: f64,
+    /// With [`Timing::Serial`] and [`Renderer::render_and_wait`]: (pass, wall-clock ms
+    /// from submit to completion) per pass.
+    pub wall_ms: Vec<(String, f64)>,
+    /// Frames the GPU had not finished when this one was submitted, this one included.
+    pub frames_in_flight: usize,
+    /// Earlier frames whose GPU times came back while this one was recorded.
+    pub finished: Vec<FrameTiming>,
+}
+
+/// How a frame's passes are submitted and timed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Timing {
+    /// One submission per frame, a timestamp pair around every pass (how frames run).
+    #[default]
+    Pipelined,
+    /// One submission per pass. Lavapipe 22.x credits one pass's work to its neighbour
+    /// within a submission, but finishes each submission before the next one's
+    /// timestamps, so its per-pass times are true this way (and match the wall clock).
+    /// The CPU still does not wait; [`Renderer::render_and_wait`] also waits for each
+    /// pass and reports its wall-clock time.
+    Serial,
+}
+
+impl FrameReport {
+    pub fn gpu_ms_of(&self, span: &str) -> Option<f64> {
+        self.gpu_ms.iter().find(|(s, _)| s == span).map(|(_, ms)| *ms)
+    }
+}
+
+pub struct Renderer {
+    gpu: Arc<Gpu>,
+    scene: Scene,
+    settings: Settings,
+    multiview: bool,
+    gpu_scene: GpuScene,
+    frame: FrameBuffers,
+    passes: Vec<Box<dyn Pass>>,
+    targets: BTreeMap<Resource, LayeredTarget>,
+    timer: PassTimer,
+    timing: Timing,
+    /// Frames rendered so far, and the views of the last one (temporal reuse).
+    frame_index: u64,
+    previous_views: Vec<Eye>,
+    /// The last plan and what it was made for: kept while nothing it depends on changes.
+    plan_cache: Option<(PlanKey, Plan)>,
+    /// Submitted frames the GPU has not been seen to finish, oldest first.
+    in_flight: VecDeque<InFlight>,
+    frames_in_flight: usize,
+    frames_in_flight_max: usize,
+}
+
+/// What a frame's plan depends on besides the passes themselves.
+#[derive(Clone, PartialEq)]
+struct PlanKey {
+    settings: Settings,
+    layers: u32,
+    outputs: Vec<Resource>,
+    /// The temporal pass swaps its history targets every frame and reads them only with
+    /// a previous frame of as many views.
+    odd_frame: bool,
+    has_history: bool,
+}
+
+struct InFlight {
+    submission: wgpu::SubmissionIndex,
+    done: Arc<AtomicBool>,
+}
+
+impl Renderer {
+    pub fn new(gpu: Arc<Gpu>, scene: &Scene, settings: &Settings) -> Result<Renderer> {
+        settings.validate()?;
+        let multiview = match settings.stereo {
+            StereoMode::Auto => gpu.caps.multiview_reliable,
+            StereoMode::Multipass => false,
+            StereoMode::Multiview if gpu.caps.multiview => {
+                if !gpu.caps.multiview_reliable {
+                    log::warn!(
+                        "multiview on this adapter failed the start-up probe: clipped triangles may miss the right eye"
+                    );
+                }
+                true
+            }
+            StereoMode::Multiview => {
+                return Err(Error::input(format!(
+                    "--stereo multiview: adapter '{}' has no multiview; use --stereo multipass",
+                    gpu.adapter.get_info().name
+                )))
+            }
+        };
+        let gpu_scene = GpuScene::upload(&gpu, scene);
+        let frame = FrameBuffers::new(&gpu.device, scene.lights.len());
+        // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
+        let light_space = Arc::new(LightSpace::new(&gpu, scene, gpu_scene.anchor));
+        // Declaration order is execution order.
+        let passes: Vec<Box<dyn Pass>> = vec![
+            Box::new(GBufferPass::new(&gpu, &gpu_scene, &frame)),
+            Box::new(ShadowPass::new(&gpu, &gpu_scene, light_space.clone())),
+            Box::new(DirectLightPass::new(&gpu, light_space.clone())),
+            Box::new(RsmPass::new(&gpu, light_space.clone())),
+            Box::new(OcclusionPass::ssao(&gpu)),
+            Box::new(OcclusionPass::hbao(&gpu)),
+            Box::new(OcclusionPass::gtao(&gpu)),
+            Box::new(DepthPeelPass::new(&gpu, &frame)),
+            Box::new(SsdoPass::new(&gpu)),
+            Box::new(OcclusionPass::fetch_only(&gpu)),
+            Box::new(TemporalPass::new(&gpu)),
+            Box::new(BlurPass::new(&gpu)),
+            Box::new(UpsamplePass::new(&gpu)),
+            Box::new(CompositePass::new(&gpu)),
+            Box::new(TonemapPass::new(&gpu)),
+        ];
+        let timer = PassTimer::new(&gpu)?;
+        gpu.take_error()?;
+        Ok(Renderer {
+            gpu,
+            scene: scene.clone(),
+            settings: settings.clone(),
+            multiview,
+            gpu_scene,
+            frame,
+            passes,
+            targets: BTreeMap::new(),
+            timer,
+            timing: Timing::Pipelined,
+            frame_index: 0,
+            previous_views: Vec::new(),
+            plan_cache: None,
+            in_flight: VecDeque::new(),
+            frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
+            frames_in_flight_max: 0,
+        })
+    }
+
+    /// How many frames may be on the GPU at once (at least 1: each frame waits for the
+    /// previous one).
+    pub fn set_frames_in_flight(&mut self, frames: usize) {
+        self.frames_in_flight = frames.max(1);
+    }
+
+    /// How many frames may be on the GPU at once.
+    pub fn frames_in_flight_limit(&self) -> usize {
+        self.frames_in_flight
+    }
+
+    /// The most frames that were on the GPU at once so far.
+    pub fn frames_in_flight_max(&self) -> usize {
+        self.frames_in_flight_max
+    }
+
+    /// Frames rendered so far.
+    pub fn frame_index(&self) -> u64 {
+        self.frame_index
+    }
+
+    pub fn gpu(&self) -> &Arc<Gpu> {
+        &self.gpu
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Switches to new settings (technique, quality, radius, …) for the next frame. The
+    /// passes hold every variant, so nothing is rebuilt; targets follow the next plan.
+    pub fn set_settings(&mut self, settings: &Settings) -> Result<()> {
+        settings.validate()?;
+        if settings.stereo != self.settings.stereo {
+            return Err(Error::input("the stereo mode cannot change on a running renderer"));
+        }
+        if settings.ao != self.settings.ao {
+            // Accumulated occlusion of other settings is not this one's history.
+            self.previous_views.clear();
+        }
+        self.settings = settings.clone();
+        Ok(())
+    }
+
+    pub fn set_timing(&mut self, timing: Timing) {
+        self.timing = timing;
+    }
+
+    /// Whether the G-buffer draws both eyes in one multiview pass.
+    pub fn uses_multiview(&self) -> bool {
+        self.multiview
+    }
+
+    fn setup(&self, views: u32) -> FrameSetup<'_> {
+        FrameSetup {
+            scene: &self.scene,
+            settings: &self.settings,
+            views,
+            multiview: self.multiview,
+            frame_index: self.frame_index,
+            current_views: &[],
+            previous_views: (self.previous_views.len() == views as usize).then_some(&self.previous_views[..]),
+        }
+    }
+
+    /// The plan for a frame of `views` layers that must produce `outputs`.
+    pub fn plan(&self, views: u32, outputs: &[Resource]) -> Result<Plan> {
+        let setup = self.setup(views);
+        let decls: Vec<_> = self.passes.iter().map(|p| p.declare(&setup)).collect();
+        graph::plan(&decls, outputs).map_err(Error::Gpu)
+    }
+
+    /// This frame's plan: the last one while its key holds, a new one otherwise.
+    fn frame_plan(&mut self, layers: u32, outputs: &[Resource]) -> Result<Plan> {
+        let key = PlanKey {
+            settings: self.settings.clone(),
+            layers,
+            outputs: outputs.to_vec(),
+            odd_frame: self.frame_index % 2 == 1,
+            has_history: self.previous_views.len() == layers as usize,
+        };
+        if let Some((cached, plan)) = &self.plan_cache {
+            if *cached == key {
+                return Ok(plan.clone());
+            }
+        }
+        let plan = self.plan(layers, outputs)?;
+        self.plan_cache = Some((key, plan.clone()));
+        Ok(plan)
+    }
+
+    /// Renders one frame for `views` (two eyes, or one mono view) producing `outputs`
+    /// and submits it without waiting for the GPU (see the module's notes on frames in
+    /// flight). Only the passes the outputs need are recorded.
+    pub fn render(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<FrameReport> {
+        self.record_and_submit(views, outputs, false, |_, _| {})
+    }
+
+    /// [`Renderer::render`], with `append` recording more commands (a headset's copy of
+    /// the eyes, say) into the frame's last encoder, so that they go to the GPU in the
+    /// frame's submission: a second submission would wait for the first on lavapipe.
+    pub fn render_with(
+        &mut self,
+        views: &[Eye],
+        outputs: &[Resource],
+        append: impl FnOnce(&mut wgpu::CommandEncoder, &BTreeMap<Resource, LayeredTarget>),
+    ) -> Result<FrameReport> {
+        self.record_and_submit(views, outputs, false, append)
+    }
+
+    /// Renders one frame and waits for it: its GPU times are in [`FrameReport::gpu_ms`]
+    /// (and with [`Timing::Serial`] each pass's wall-clock time in `wall_ms`). For
+    /// measurements; frame loops use [`Renderer::render`].
+    pub fn render_and_wait(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<FrameReport> {
+        let mut report = self.record_and_submit(views, outputs, true, |_, _| {})?;
+        report.finished.extend(self.finish()?);
+        if let Some(own) = report.finished.iter().find(|t| t.frame == report.frame) {
+            report.gpu_ms = own.spans.clone();
+        }
+        Ok(report)
+    }
+
+    /// Waits until the GPU has finished every submitted frame and returns the GPU times
+    /// that had not come back yet.
+    pub fn finish(&mut self) -> Result<Vec<FrameTiming>> {
+        self.gpu.wait_idle()?;
+        self.in_flight.clear();
+        Ok(self.timer.finished())
+    }
+
+    /// Forgets the frames the GPU has finished (a non-blocking poll runs their
+    /// completion callbacks).
+    fn forget_finished_frames(&mut self) -> Result<()> {
+        self.gpu.poll()?;
+        self.in_flight.retain(|f| !f.done.load(Ordering::Acquire));
+        Ok(())
+    }
+
+    /// Forgets frames the GPU has finished, then waits for the oldest ones until fewer
+    /// than the allowed number are in flight.
+    fn throttle(&mut self) -> Result<()> {
+        self.forget_finished_frames()?;
+        while self.in_flight.len() >= self.frames_in_flight {
+            let oldest = self.in_flight.pop_front().expect("non-empty");
+            self.gpu
+                .device
+                .poll(wgpu::PollType::Wait { submission_index: Some(oldest.submission), timeout: None })
+                .map_err(|e| Error::Gpu(format!("waiting for frame: {e}")))?;
+        }
+        Ok(())
+    }
+
+    fn record_and_submit(
+        &mut self,
+        views: &[Eye],
+        outputs: &[Resource],
+        wait_each_pass: bool,
+        append: impl FnOnce(&mut wgpu::CommandEncoder, &BTreeMap<Resource, LayeredTarget>),
+    ) -> Result<FrameReport> {
+        if views.is_empty() || views.len() > 2 {
+            return Err(Error::input(format!("a frame has 1 or 2 views, not {}", views.len())));
+        }
+        self.throttle()?;
+        let layers = views.len() as u32;
+        let plan = self.frame_plan(layers, outputs)?;
+        self.allocate_targets(&plan, layers);
+        self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
+        self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
+        let setup = FrameSetup {
+            scene: &self.scene,
+            settings: &self.settings,
+            views: layers,
+            multiview: self.multiview,
+            frame_index: self.frame_index,
+            current_views: views,
+            previous_views: (self.previous_views.len() == views.len()).then_some(&self.previous_views[..]),
+        };
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut wall_ms = Vec::new();
+        let mut cpu_encode_ms = 0.0;
+        for (step, (&index, name)) in plan.run.iter().zip(&plan.names).enumerate() {
+            let encode_start = Instant::now();
+            let mut ctx = FrameContext {
+                gpu: &self.gpu,
+                encoder: &mut encoder,
+                targets: &self.targets,
+                frame: &self.frame,
+                scene: &self.gpu_scene,
+                timer: &self.timer,
+                setup: &setup,
+            };
+            let span = ctx.timer.begin(ctx.encoder, name);
+            self.passes[index].record(&mut ctx);
+            ctx.timer.end(ctx.encoder, span);
+            let last = step + 1 == plan.run.len();
+            if last {
+                self.timer.resolve(&mut encoder);
+            }
+            cpu_encode_ms += encode_start.elapsed().as_secs_f64() * 1e3;
+            if self.timing == Timing::Serial && !last {
+                let finished =
+                    std::mem::replace(&mut encoder, self.gpu.device.create_command_encoder(&Default::default()));
+                let submitted = Instant::now();
+                self.gpu.queue.submit([finished.finish()]);
+                if wait_each_pass {
+                    self.gpu.wait_idle()?;
+                    wall_ms.push((name.to_string(), submitted.elapsed().as_secs_f64() * 1e3));
+                }
+            }
+        }
+        append(&mut encoder, &self.targets);
+        // In flight: the frames the GPU has not finished as this one is handed over
+        // (counted before the submit call, which on lavapipe returns only once the
+        // previous submission has finished: wgpu chains submissions with semaphores
+        // that Mesa 22.3 waits for on the CPU).
+        self.forget_finished_frames()?;
+        let frames_in_flight = self.in_flight.len() + 1;
+        let submitted = Instant::now();
+        let submission = self.gpu.queue.submit([encoder.finish()]);
+        if self.timing == Timing::Serial && wait_each_pass {
+            self.gpu.wait_idle()?;
+            let last = plan.names.last().map(|n| n.to_string()).unwrap_or_default();
+            wall_ms.push((last, submitted.elapsed().as_secs_f64() * 1e3));
+        }
+        let done = Arc::new(AtomicBool::new(false));
+        let signal = done.clone();
+        self.gpu.queue.on_submitted_work_done(move || signal.store(true, Ordering::Release));
+        self.in_flight.push_back(InFlight { submission, done });
+        self.timer.end_frame(self.frame_index)?;
+        self.frames_in_flight_max = self.frames_in_flight_max.max(frames_in_flight);
+        // Collect the times of earlier frames that finished meanwhile (never waits).
+        self.gpu.poll()?;
+        let finished = self.timer.finished();
+        self.gpu.take_error()?;
+        let frame = self.frame_index;
+        self.frame_index += 1;
+        self.previous_views = views.to_vec();
+        Ok(FrameReport { frame, plan, gpu_ms: Vec::new(), cpu_encode_ms, wall_ms, frames_in_flight, finished })
+    }
+
+    /// (Re)creates the targets this plan touches at their size for this frame; targets
+    /// of another size are dropped, so a resource no pass needs costs no memory.
+    fn allocate_targets(&mut self, plan: &Plan, layers: u32) {
+        let p = &self.settings.profile;
+        let (ao_w, ao_h) = ao_extent(p.width, p.height, self.settings.ao.half_res);
+        let (half_w, half_h) = ao_extent(p.width, p.height, true);
+        let light = crate::render::passes::shadow::light_extent(
+            &self.scene,
+            &self.settings,
+            self.gpu.device.limits().max_texture_dimension_2d,
+        );
+        let extent_of = |r: Resource| {
+            if r.in_light_space() {
+                light
+            } else if r.at_half_resolution() {
+                (half_w, half_h, layers)
+            } else if r.at_ao_resolution() {
+                (ao_w, ao_h, layers)
+            } else {
+                (p.width, p.height, layers)
+            }
+        };
+        let before = self.targets.len();
+        self.targets.retain(|r, t| t.extent() == extent_of(*r));
+        let mut changed = self.targets.len() != before;
+        for &r in &plan.resources {
+            self.targets.entry(r).or_insert_with(|| {
+                changed = true;
+                let usage = if r.is_attachment() {
+                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
+                } else {
+                    // COPY_DST: tests poison histories and targets by writing them.
+                    wgpu::TextureUsages::STORAGE_BINDING
+                        | wgpu::TextureUsages::TEXTURE_BINDING
+                        | wgpu::TextureUsages::COPY_DST
+                };
+                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent_of(r), usage)
+            });
+        }
+        if changed {
+            crate::render::gpu::kernel::invalidate_bind_groups();
+        }
+    }
+
+    /// The target a previous frame wrote, if that frame needed it.
+    pub fn target(&self, r: Resource) -> Option<&LayeredTarget> {
+        self.targets.get(&r)
+    }
+
+    /// Raw bytes per layer of a resource the last frame produced.
+    pub fn read_bytes(&self, r: Resource) -> Result<Vec<Vec<u8>>> {
+        let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        readback::read_layers(&self.gpu, target)
+    }
+
+    /// Values per layer (channels interleaved) of a float or depth resource; `Direct`
+    /// decodes to rgba radiance (a = 0).
+    pub fn read_f32(&self, r: Resource) -> Result<Vec<Vec<f32>>> {
+        let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        if r == Resource::Direct {
+            return Ok(readback::decode_direct(readback::read_layers(&self.gpu, target)?));
+        }
+        readback::read_layers_f32(&self.gpu, target)
+    }
+}

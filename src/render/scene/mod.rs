@@ -1,0 +1,248 @@
+//! Scenes: meshes with materials, lights, an optional environment and the head pose.
+//!
+//! Loaded from OBJ+MTL (`obj.rs`), from a TOML scene file (`file.rs`), or built in
+//! (`builtin.rs`, addressed as `builtin:NAME`). Every loader validates what it reads and
+//! returns [`crate::render::error::Error::Input`] naming the file and line for anything malformed.
+
+pub mod builtin;
+pub mod edge_cases;
+pub mod environment;
+pub mod file;
+pub mod furnished;
+pub mod fuzz;
+pub mod normals;
+pub mod obj;
+
+use crate::render::error::{Error, Result};
+use crate::render::stereo::HeadPose;
+use glam::{DVec3, Vec2, Vec3};
+use std::path::{Path, PathBuf};
+
+pub use environment::Environment;
+
+/// A triangle mesh. Positions are stored relative to `origin` (f64) so that a scene
+/// placed far from the world origin keeps full f32 precision near the camera.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub name: String,
+    pub origin: DVec3,
+    pub positions: Vec<Vec3>,
+    /// Unit normals, one per position.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position (zero when the source has none). v = 0 is the
+    /// top row of the texture (OBJ's bottom-up v is flipped at load).
+    pub uvs: Vec<Vec2>,
+    /// Triangle list into the vertex arrays.
+    pub indices: Vec<u32>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+impl Mesh {
+    /// Splits world positions into an origin (the bounding-box centre, f64) and f32 offsets
+    /// from it, so that geometry far from the world origin keeps its precision.
+    pub fn recentre(world: &[DVec3]) -> (DVec3, Vec<Vec3>) {
+        let mut bounds = Aabb::EMPTY;
+        world.iter().for_each(|&p| bounds.extend(p));
+        let origin = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
+        (origin, world.iter().map(|&p| (p - origin).as_vec3()).collect())
+    }
+}
+
+/// An RGBA8 texture in sRGB encoding, row-major from the top-left texel.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    /// Linear diffuse reflectance (MTL `Kd`), each channel in [0, 1].
+    pub diffuse: Vec3,
+    /// Emitted radiance (MTL `Ke`), linear, unbounded.
+    pub emissive: Vec3,
+    /// Diffuse texture (MTL `map_Kd`), multiplied with `diffuse`.
+    pub diffuse_texture: Option<Texture>,
+}
+
+impl Material {
+    pub fn plain(name: &str, diffuse: Vec3) -> Self {
+        Material { name: name.into(), diffuse, emissive: Vec3::ZERO, diffuse_texture: None }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    /// Light arriving along `direction` (unit, pointing from the light into the scene);
+    /// `intensity` is the irradiance on a surface facing it.
+    Directional { direction: Vec3, color: Vec3, intensity: f32 },
+    /// An isotropic point light; `intensity` is radiant intensity (irradiance at 1 m).
+    Point { position: DVec3, color: Vec3, intensity: f32 },
+}
+
+impl Light {
+    /// The sun used when a scene names no light: white, irradiance 3, arriving from above,
+    /// in front (+Z) and to the left (−X) so that floors and front faces are both lit.
+    pub fn default_sun() -> Light {
+        Light::Directional { direction: Vec3::new(1.0, -2.0, -1.0).normalize(), color: Vec3::ONE, intensity: 3.0 }
+    }
+}
+
+/// Axis-aligned bounds in world space (f64).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+    pub fn extend(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+    pub fn center(&self) -> DVec3 {
+        (self.min + self.max) * 0.5
+    }
+    pub fn size(&self) -> DVec3 {
+        self.max - self.min
+    }
+
+    /// A head pose that frames these bounds for a ~90° field of view: in front (+Z),
+    /// slightly above the centre and looking at it, far enough back that the bounding
+    /// sphere fits (half diagonal / tan 40°) plus half the depth, so the eye is outside
+    /// the box. An open-fronted model such as the Cornell box is seen from its open side.
+    /// Empty bounds give a standing head at the origin looking along −Z.
+    pub fn framing_pose(&self) -> HeadPose {
+        let size = self.size();
+        let diagonal = size.length();
+        if self.is_empty() || !diagonal.is_finite() {
+            return HeadPose::look_at(DVec3::new(0.0, 1.6, 0.0), DVec3::new(0.0, 1.6, -1.0))
+                .unwrap_or(HeadPose::IDENTITY);
+        }
+        let extent = if diagonal > 1e-9 { diagonal } else { 1.0 };
+        let distance = 0.5 * extent / 40f64.to_radians().tan() + 0.5 * size.z;
+        let centre = self.center();
+        let eye = centre + DVec3::new(0.0, 0.1 * extent, distance);
+        HeadPose::look_at(eye, centre).unwrap_or(HeadPose { position: eye, orientation: glam::DQuat::IDENTITY })
+    }
+}
+
+/// The head pose over time: one key for a static head, several for a scripted path.
+/// Between keys, position is interpolated linearly and orientation by slerp.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadPath {
+    /// (time in seconds, pose), sorted by time, at least one key.
+    pub keys: Vec<(f64, HeadPose)>,
+}
+
+impl HeadPath {
+    pub fn fixed(pose: HeadPose) -> Self {
+        HeadPath { keys: vec![(0.0, pose)] }
+    }
+    /// The pose at time `t` (seconds); clamps to the first and last key.
+    pub fn pose_at(&self, t: f64) -> HeadPose {
+        let keys = &self.keys;
+        if t <= keys[0].0 || keys.len() == 1 {
+            return keys[0].1;
+        }
+        for pair in keys.windows(2) {
+            let ((t0, a), (t1, b)) = (pair[0], pair[1]);
+            if t <= t1 {
+                let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+                return HeadPose {
+                    position: a.position.lerp(b.position, s),
+                    orientation: a.orientation.slerp(b.orientation, s),
+                };
+            }
+        }
+        keys[keys.len() - 1].1
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub environment: Option<Environment>,
+    pub head: HeadPath,
+}
+
+impl Scene {
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for m in &self.meshes {
+            for p in &m.positions {
+                b.extend(m.origin + p.as_dvec3());
+            }
+        }
+        b
+    }
+
+    /// A default occlusion radius for this scene: 8 % of its bounding-box diagonal,
+    /// kept within 1 cm and 1 m (room-scale detail; a cathedral still gets 1 m).
+    pub fn suggested_ao_radius(&self) -> f32 {
+        let b = self.bounds();
+        let diagonal = if b.is_empty() { 0.0 } else { b.size().length() };
+        ((0.08 * diagonal) as f32).clamp(0.01, 1.0)
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.indices.len() / 3).sum()
+    }
+
+    /// True when some material emits light.
+    pub fn has_emissive(&self) -> bool {
+        self.materials.iter().any(|m| m.emissive.max_element() > 0.0)
+    }
+
+    /// Loads `builtin:NAME`, a `.toml` scene file, or a bare `.obj`.
+    pub fn load(spec: &str) -> Result<Scene> {
+        if let Some(name) = spec.strip_prefix("builtin:") {
+            return builtin::load(name);
+        }
+        let path = Path::new(spec);
+        if !path.exists() {
+            return Err(Error::in_file(path, "no such file"));
+        }
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+            Some(ext) if ext == "toml" => file::load(path),
+            Some(ext) if ext == "obj" => obj::load_bare(path),
+            _ => Err(Error::in_file(path, "unknown scene type: expected builtin:NAME, a .toml scene file or an .obj")),
+        }
+    }
+}
+
+/// The shared scene directory (`../shared/scenes` beside the repository, or `$VRAO_SCENES`),
+/// when it exists.
+pub fn shared_scenes_dir() -> Option<PathBuf> {
+    let dir = match std::env::var_os("VRAO_SCENES") {
+        Some(dir) => PathBuf::from(dir),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes"),
+    };
+    dir.is_dir().then_some(dir)
+}
+
+/// For tests: the shared scene file `relative`, or `None` after printing why the test is
+/// skipped. Panics when the file is missing and `CI` is set, because CI must run every test.
+#[doc(hidden)]
+pub fn shared_scene_for_test(relative: &str) -> Option<PathBuf> {
+    let path = shared_scenes_dir().map(|dir| dir.join(relative)).filter(|p| p.is_file());
+    if path.is_none() {
+        let message = format!("shared scene file {relative} not found (set VRAO_SCENES)");
+        assert!(std::env::var_os("CI").is_none(), "{message}");
+        eprintln!("skipped: {message}");
+    }
+    path
+}

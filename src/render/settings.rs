@@ -1,0 +1,559 @@
+//! Render settings, validated once so passes can trust them.
+
+use crate::render::error::{Error, Result};
+use crate::render::stereo::{HeadsetProfile, DEFAULT_NEAR};
+
+/// How the G-buffer reaches both eye layers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StereoMode {
+    /// Multiview when the adapter has it, one pass per eye otherwise.
+    #[default]
+    Auto,
+    /// One render pass writes both layers (`view_index` selects the eye).
+    Multiview,
+    /// One render pass per eye layer.
+    Multipass,
+}
+
+impl std::str::FromStr for StereoMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(StereoMode::Auto),
+            "multiview" => Ok(StereoMode::Multiview),
+            "multipass" => Ok(StereoMode::Multipass),
+            other => Err(format!("unknown stereo mode '{other}' (expected auto, multiview or multipass)")),
+        }
+    }
+}
+
+/// What the desktop window shows (seed 003 §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DisplayMode {
+    /// No window: the headset alone.
+    #[default]
+    None,
+    /// Both eye images side by side, as the headset shows them.
+    Mirror,
+    /// The scene rendered once more in mono from the head's viewpoint at the window's size.
+    SinglePass,
+}
+
+impl DisplayMode {
+    pub const ALL: [DisplayMode; 3] = [DisplayMode::None, DisplayMode::Mirror, DisplayMode::SinglePass];
+    pub fn name(self) -> &'static str {
+        match self {
+            DisplayMode::None => "none",
+            DisplayMode::Mirror => "mirror",
+            DisplayMode::SinglePass => "single-pass",
+        }
+    }
+}
+
+impl std::str::FromStr for DisplayMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        DisplayMode::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown display mode '{s}' (expected none, mirror or single-pass)"))
+    }
+}
+
+/// The occlusion technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Technique {
+    /// No occlusion pass: the ambient term is unoccluded.
+    None,
+    /// Normal-oriented hemisphere SSAO (seed 003 §3.2, seed 000 ch. 3).
+    #[default]
+    Ssao,
+    /// Horizon-based AO, directions × steps ray-marched in depth (seed 003 §3.3).
+    Hbao,
+    /// Screen-space directional occlusion of the environment (seed 002 eq. 1).
+    Ssdo,
+    /// SSDO plus one indirect bounce in the same loop (seed 002 eq. 2).
+    SsdoBounce,
+    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
+    FetchOnly,
+    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
+    /// (Jimenez et al. 2016, Therrien et al. 2023).
+    Gtao,
+}
+
+impl Technique {
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::None => "none",
+            Technique::Ssao => "ssao",
+            Technique::Hbao => "hbao",
+            Technique::Ssdo => "ssdo",
+            Technique::SsdoBounce => "ssdo-bounce",
+            Technique::FetchOnly => "fetch-only",
+            Technique::Gtao => "gtao",
+        }
+    }
+    /// True for the techniques whose occlusion targets carry gathered light in rgb
+    /// (SSDO's directional occlusion of the environment, with or without its bounce); the
+    /// others write AO in alpha alone (rgb 0), so the denoise filters alpha alone for them.
+    pub fn carries_light(self) -> bool {
+        matches!(self, Technique::Ssdo | Technique::SsdoBounce)
+    }
+
+    pub const ALL: [Technique; 7] = [
+        Technique::None,
+        Technique::Ssao,
+        Technique::Hbao,
+        Technique::Gtao,
+        Technique::Ssdo,
+        Technique::SsdoBounce,
+        Technique::FetchOnly,
+    ];
+}
+
+impl std::str::FromStr for Technique {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
+            format!("unknown technique '{s}' (expected none, ssao, hbao, gtao, ssdo, ssdo-bounce or fetch-only)")
+        })
+    }
+}
+
+/// Sampling quality presets: seed 003's kernel sizes N = 12, 24, 36, 64.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Quality {
+    Low,
+    #[default]
+    Medium,
+    High,
+    Ultra,
+}
+
+impl Quality {
+    pub const ALL: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Low => "low",
+            Quality::Medium => "medium",
+            Quality::High => "high",
+            Quality::Ultra => "ultra",
+        }
+    }
+    /// Depth taps per pixel (SSAO/SSDO samples; HBAO directions × steps).
+    pub fn samples(self) -> u32 {
+        match self {
+            Quality::Low => 12,
+            Quality::Medium => 24,
+            Quality::High => 36,
+            Quality::Ultra => 64,
+        }
+    }
+}
+
+impl std::str::FromStr for Quality {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Quality::ALL
+            .into_iter()
+            .find(|q| q.name() == s)
+            .ok_or_else(|| format!("unknown quality '{s}' (expected low, medium, high or ultra)"))
+    }
+}
+
+/// Where each pixel's kernel rotation comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Noise {
+    /// A 5×5 tile of rotations repeated over the screen (seed 003).
+    Tiled5x5,
+    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (seed 000).
+    #[default]
+    Halton,
+}
+
+impl std::str::FromStr for Noise {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "tiled" | "tiled5x5" => Ok(Noise::Tiled5x5),
+            "halton" => Ok(Noise::Halton),
+            other => Err(format!("unknown noise '{other}' (expected tiled or halton)")),
+        }
+    }
+}
+
+/// How SSDO's bounce weighs a blocking sample's sender.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BounceForm {
+    /// Seed 002 eq. 2: a patch of area π r²/N × strength at the sender pixel, weighted by
+    /// the sender and receiver cosines over d² (as a disc's solid angle, so a sender
+    /// touching the receiver stays bounded).
+    Patch,
+    /// The sender's radiance through the blocked direction's share of the hemisphere,
+    /// 2π/N, × the receiver's cosine towards the sender, as eq. 1 treats unblocked
+    /// directions: for diffuse senders the radiance arriving along a direction does not
+    /// depend on the sender's orientation or distance. Against the reference's bounce it
+    /// roughly halves eq. 2's low bias and error (red wall, crease, Cornell box), and it
+    /// needs no sender normal.
+    #[default]
+    Direction,
+}
+
+impl BounceForm {
+    pub const ALL: [BounceForm; 2] = [BounceForm::Direction, BounceForm::Patch];
+    pub fn name(self) -> &'static str {
+        match self {
+            BounceForm::Patch => "patch",
+            BounceForm::Direction => "direction",
+        }
+    }
+}
+
+impl std::str::FromStr for BounceForm {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        BounceForm::ALL
+            .into_iter()
+            .find(|f| f.name() == s)
+            .ok_or_else(|| format!("unknown bounce form '{s}' (expected direction or patch)"))
+    }
+}
+
+/// The spatial denoise of the occlusion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Denoise {
+    /// Edge-aware box over the 4×4 noise tile, 5 taps per axis in two passes
+    /// (shaders/denoise.wgsl).
+    #[default]
+    Tile,
+    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; seed 000).
+    Bilateral,
+}
+
+impl Denoise {
+    pub const ALL: [Denoise; 2] = [Denoise::Tile, Denoise::Bilateral];
+    pub fn name(self) -> &'static str {
+        match self {
+            Denoise::Tile => "tile",
+            Denoise::Bilateral => "bilateral",
+        }
+    }
+}
+
+impl std::str::FromStr for Denoise {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Denoise::ALL
+            .into_iter()
+            .find(|d| d.name() == s)
+            .ok_or_else(|| format!("unknown denoise '{s}' (expected tile or bilateral)"))
+    }
+}
+
+/// Occlusion parameters shared by every technique.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AoSettings {
+    pub technique: Technique,
+    /// Depth taps per pixel, 1..=256 (a quality preset sets it).
+    pub samples: u32,
+    /// World-space radius r (SSAO/SSDO r_max, HBAO R), metres.
+    pub radius: f32,
+    /// Occlusion weight: 0 leaves the ambient untouched, 1 applies the full occlusion.
+    pub strength: f32,
+    /// Depth bias against self-occlusion, as a fraction of the radius.
+    pub bias: f32,
+    /// Range check: an occluder farther than the radius from the pixel counts less
+    /// (SSAO's depth constraint) instead of darkening distant backgrounds.
+    pub range_check: bool,
+    /// SSDO bounce strength (scales each sender's weight); 0 turns the bounce off.
+    pub bounce: f32,
+    /// How the bounce weighs its senders.
+    pub bounce_form: BounceForm,
+    pub noise: Noise,
+    /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
+    pub half_res: bool,
+    /// Depth peeling for SSDO (seed 002 §4): a second depth layer, and a sample occludes
+    /// only between the first and second layer (inside an object). Off by default.
+    pub depth_peeling: bool,
+    /// Which spatial denoise runs.
+    pub denoise: Denoise,
+    /// The bilateral blur's radius in full-resolution pixels (5 = 11×11; at half
+    /// resolution 3 taps either side cover the same footprint); 0 turns any denoise off.
+    pub blur_radius: u32,
+    /// The blur's depth edge: a neighbour this far off the centre's tangent plane, as a
+    /// fraction of the centre's distance, loses most of its weight. Near 0 every
+    /// neighbour's weight vanishes and the centre value is kept.
+    pub blur_plane_sigma: f32,
+    /// Temporal accumulation by reverse reprojection (seed 001 §3.1).
+    pub temporal: Temporal,
+    /// GTAO: how far behind each depth sample the surface counts as solid, as a fraction
+    /// of the radius (thin objects stop occluding behind themselves).
+    pub thickness: f32,
+    /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
+    /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
+    pub step_power: f32,
+    /// GTAO: successive samples whose distances differ by less than this fraction of the
+    /// radius lie on one continuous surface, which also blocks the angles between them.
+    pub connect: f32,
+    /// With two views, the right eye takes the left eye's value wherever the left eye
+    /// sees the same surface point: GTAO's march (the right eye marches only the rest and
+    /// costs a fraction) and, at half resolution, every technique's denoise (its vertical
+    /// pass) and the AO-only techniques' upsample (`passes::reuses_left_eye_upsample`).
+    /// Off: each eye computes everything alone.
+    pub stereo_reuse: bool,
+}
+
+/// How the temporal pass blends the new frame into the history.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TemporalBlend {
+    /// The running mean of the last `max_frames` frames: each frame's rotated pattern
+    /// counts equally, so N frames of n samples approach one frame of N·n.
+    #[default]
+    Average,
+    /// Seed 001 eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
+    /// V = c·V_{t−1} + (1 − c)·V_t.
+    Confidence,
+}
+
+impl std::str::FromStr for TemporalBlend {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "average" => Ok(TemporalBlend::Average),
+            "confidence" => Ok(TemporalBlend::Confidence),
+            other => Err(format!("unknown temporal blend '{other}' (expected average or confidence)")),
+        }
+    }
+}
+
+/// Temporal accumulation settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Temporal {
+    pub enabled: bool,
+    /// Disocclusion threshold ε in metres on the world-position distance (seed 001 eq. 3).
+    /// The pass also allows two pixel footprints at the pixel's distance (an extension:
+    /// a fixed ε would reject every distant pixel, whose neighbour is centimetres away).
+    pub epsilon_m: f32,
+    pub blend: TemporalBlend,
+    /// Frames after which a pixel counts as converged: the mean stops growing and
+    /// becomes a moving average over this many frames.
+    pub max_frames: u32,
+    /// Seed 001's confidence bias (only for the confidence blend).
+    pub confidence_bias: f32,
+    /// Motion-adaptive window of the running mean: a pixel that moved m occlusion
+    /// pixels since the last frame keeps at most max_frames / (1 + m / motion_px)
+    /// frames (at least 4). Screen-space occlusion changes with the view, so a long
+    /// mean lags a turning head (ghosting); a still head keeps the whole window. 0 = off.
+    pub motion_px: f32,
+}
+
+impl Default for Temporal {
+    fn default() -> Self {
+        Temporal {
+            enabled: false,
+            epsilon_m: 0.02,
+            blend: TemporalBlend::Average,
+            max_frames: 16,
+            confidence_bias: 0.1,
+            motion_px: 0.5,
+        }
+    }
+}
+
+/// GTAO's defaults, tuned against the reference (scripts/tune-gtao.py and
+/// docs/gtao-tuning.md). Thickness 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps
+/// it costs no RMSE and leaves fewer halos (pixels beside depth edges too dark by > 0.1
+/// on the furnished room: 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
+pub const DEFAULT_THICKNESS: f32 = 0.75;
+pub const DEFAULT_STEP_POWER: f32 = 1.5;
+pub const DEFAULT_CONNECT: f32 = 0.25;
+
+impl Default for AoSettings {
+    fn default() -> Self {
+        AoSettings {
+            technique: Technique::Ssao,
+            samples: Quality::Medium.samples(),
+            radius: 0.5,
+            strength: 1.0,
+            bias: 0.02,
+            range_check: true,
+            bounce: 1.0,
+            bounce_form: BounceForm::Direction,
+            noise: Noise::Halton,
+            half_res: false,
+            depth_peeling: false,
+            denoise: Denoise::Tile,
+            blur_radius: 5,
+            blur_plane_sigma: 0.02,
+            temporal: Temporal::default(),
+            thickness: DEFAULT_THICKNESS,
+            step_power: DEFAULT_STEP_POWER,
+            connect: DEFAULT_CONNECT,
+            stereo_reuse: true,
+        }
+    }
+}
+
+impl AoSettings {
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=256).contains(&self.samples) {
+            return Err(Error::input(format!("samples {} is not within 1..=256", self.samples)));
+        }
+        if !(self.radius.is_finite() && self.radius > 0.0 && self.radius <= 1e6) {
+            return Err(Error::input(format!("radius {} m must be a finite number in (0, 1e6]", self.radius)));
+        }
+        if !(self.strength.is_finite() && (0.0..=4.0).contains(&self.strength)) {
+            return Err(Error::input(format!("strength {} is not within 0..=4", self.strength)));
+        }
+        if !(self.bias.is_finite() && (0.0..1.0).contains(&self.bias)) {
+            return Err(Error::input(format!("bias {} is not within 0..1 (a fraction of the radius)", self.bias)));
+        }
+        if !(self.bounce.is_finite() && (0.0..=100.0).contains(&self.bounce)) {
+            return Err(Error::input(format!("bounce {} is not within 0..=100", self.bounce)));
+        }
+        let t = &self.temporal;
+        if !(t.epsilon_m.is_finite() && t.epsilon_m >= 0.0) {
+            return Err(Error::input(format!("temporal epsilon {} m must be finite and ≥ 0", t.epsilon_m)));
+        }
+        if !(1..=1024).contains(&t.max_frames) {
+            return Err(Error::input(format!("temporal frame cap {} is not within 1..=1024", t.max_frames)));
+        }
+        if !(t.motion_px.is_finite() && t.motion_px >= 0.0) {
+            return Err(Error::input(format!("temporal motion scale {} px must be finite and ≥ 0", t.motion_px)));
+        }
+        if !(t.confidence_bias.is_finite() && t.confidence_bias >= 0.0) {
+            return Err(Error::input(format!("temporal confidence bias {} must be finite and ≥ 0", t.confidence_bias)));
+        }
+        if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
+            return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
+        }
+        if !(self.thickness.is_finite() && (0.0..=100.0).contains(&self.thickness)) {
+            return Err(Error::input(format!(
+                "thickness {} is not within 0..=100 (a fraction of the radius)",
+                self.thickness
+            )));
+        }
+        if !(self.step_power.is_finite() && (1.0..=2.0).contains(&self.step_power)) {
+            return Err(Error::input(format!("step power {} is not within 1..=2", self.step_power)));
+        }
+        if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
+            return Err(Error::input(format!(
+                "connect {} is not within 0..=100 (a fraction of the radius)",
+                self.connect
+            )));
+        }
+        if self.blur_radius > 16 {
+            return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));
+        }
+        Ok(())
+    }
+
+    /// The graph pass that runs the technique: SSDO is `ssdo-bounce` only while the
+    /// bounce strength is above 0.
+    pub fn pass_name(&self) -> &'static str {
+        match self.technique {
+            Technique::SsdoBounce if !self.bounce_active() => Technique::Ssdo.name(),
+            technique => technique.name(),
+        }
+    }
+
+    /// True when the SSDO pass also gathers the bounce.
+    pub fn bounce_active(&self) -> bool {
+        self.technique == Technique::SsdoBounce && self.bounce > 0.0
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// The headset's per-eye size, refresh rate, IPD and fields of view.
+    pub profile: HeadsetProfile,
+    pub stereo: StereoMode,
+    /// Near plane in metres (the far plane is at infinity).
+    pub near: f64,
+    /// Linear exposure applied before tone mapping.
+    pub exposure: f32,
+    /// Reinhard's L_white: the smallest (exposed) luminance mapped to white.
+    pub white_point: f32,
+    pub ao: AoSettings,
+    /// Shadow maps and reflective shadow maps of directional lights.
+    pub shadows: ShadowSettings,
+}
+
+/// Shadow maps with PCF (seed 000) and reflective shadow maps (seed 001) for the
+/// scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
+/// directional light has neither, whatever these say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Shadow the directional lights' direct light (`--shadows on|off`).
+    pub enabled: bool,
+    /// Texels along each side of the square light-space maps (`--shadow-size`).
+    pub size: u32,
+    /// Add one bounce of the directional lights from reflective shadow maps (`--rsm on|off`).
+    pub rsm: bool,
+    /// Virtual point lights gathered per pixel and light (`--rsm-samples`).
+    pub rsm_samples: u32,
+    /// Gather radius around each pixel in the light's image plane, metres (`--rsm-radius`).
+    pub rsm_radius: f32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: 1.0 }
+    }
+}
+
+impl ShadowSettings {
+    pub fn validate(&self) -> Result<()> {
+        if !(16..=8192).contains(&self.size) {
+            return Err(Error::input(format!("shadow map size {} is not within 16..=8192", self.size)));
+        }
+        if !(1..=1024).contains(&self.rsm_samples) {
+            return Err(Error::input(format!("RSM samples {} is not within 1..=1024", self.rsm_samples)));
+        }
+        if !(self.rsm_radius.is_finite() && self.rsm_radius > 0.0 && self.rsm_radius <= 1e6) {
+            return Err(Error::input(format!("RSM radius {} m must be a finite number in (0, 1e6]", self.rsm_radius)));
+        }
+        Ok(())
+    }
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            profile: HeadsetProfile::vive(),
+            stereo: StereoMode::Auto,
+            near: DEFAULT_NEAR,
+            exposure: 1.0,
+            white_point: 4.0,
+            ao: AoSettings::default(),
+            shadows: ShadowSettings::default(),
+        }
+    }
+}
+
+impl Settings {
+    /// Checks every value; the error names the setting and the value.
+    pub fn validate(&self) -> Result<()> {
+        let p = &self.profile;
+        if p.width == 0 || p.height == 0 || p.width > 8192 || p.height > 8192 {
+            return Err(Error::input(format!("eye size {}x{} is not within 1..=8192", p.width, p.height)));
+        }
+        if !(p.ipd.is_finite() && (0.0..=1.0).contains(&p.ipd)) {
+            return Err(Error::input(format!("ipd {} m is not within 0..=1 m", p.ipd)));
+        }
+        for fov in [p.fov_left, p.fov_right] {
+            fov.validate().map_err(Error::input)?;
+        }
+        if !(self.near.is_finite() && self.near > 0.0) {
+            return Err(Error::input(format!("near plane {} m must be a positive finite number", self.near)));
+        }
+        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+            return Err(Error::input(format!("exposure {} must be a positive finite number", self.exposure)));
+        }
+        if !(self.white_point.is_finite() && self.white_point > 0.0) {
+            return Err(Error::input(format!("white point {} must be a positive finite number", self.white_point)));
+        }
+        self.ao.validate()?;
+        self.shadows.validate()
+    }
+}

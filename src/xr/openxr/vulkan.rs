@@ -1,0 +1,197 @@
+//! The GPU of an OpenXR session, through XR_KHR_vulkan_enable2: the runtime creates the
+//! VkInstance and VkDevice (`xrCreateVulkanInstanceKHR`, `xrCreateVulkanDeviceKHR`) from
+//! create infos that already name what wgpu-hal needs, adding its own extensions; wgpu
+//! then wraps them (`wgpu::hal::vulkan::Instance::from_raw`, `Adapter::device_from_raw`).
+//! XR_KHR_vulkan_enable (the first version) is not used: it hands the application a list
+//! of device extensions that lavapipe does not have, where enable2 lets the runtime pick.
+//!
+//! wgpu-hal owns the instance and device it wraps (no drop callback) and destroys them
+//! when the last wgpu handle goes, after the OpenXR session: enable2 makes the
+//! application the owner of both.
+
+use crate::render::gpu::Gpu;
+use ash::vk;
+use ash::vk::Handle as _;
+use std::ffi::{c_char, CStr};
+use wgpu::hal::api::Vulkan as HalVulkan;
+
+/// What `xrCreateSession` needs to bind the session to the device.
+pub(super) struct Binding {
+    pub instance: vk::Instance,
+    pub physical_device: vk::PhysicalDevice,
+    pub device: vk::Device,
+    pub queue_family_index: u32,
+}
+
+impl Binding {
+    pub fn session_create_info(&self) -> openxr::vulkan::SessionCreateInfo {
+        openxr::vulkan::SessionCreateInfo {
+            instance: self.instance.as_raw() as usize as _,
+            physical_device: self.physical_device.as_raw() as usize as _,
+            device: self.device.as_raw() as usize as _,
+            queue_family_index: self.queue_family_index,
+            queue_index: 0,
+        }
+    }
+}
+
+/// The Vulkan version to create the instance with: what the loader offers, capped at
+/// 1.3 (wgpu-hal's ceiling) and at the runtime's maximum.
+fn api_version(entry: &ash::Entry, requirements: &openxr::vulkan::Requirements) -> Result<u32, String> {
+    // SAFETY: a plain query of the loader.
+    let loader = unsafe { entry.try_enumerate_instance_version() }
+        .map_err(|e| format!("vkEnumerateInstanceVersion: {e}"))?
+        .unwrap_or(vk::API_VERSION_1_0);
+    let max = requirements.max_api_version_supported;
+    let runtime_max = vk::make_api_version(0, max.major() as u32, max.minor() as u32, 0);
+    let version = loader.min(vk::API_VERSION_1_3).min(runtime_max.max(vk::API_VERSION_1_0));
+    let min = requirements.min_api_version_supported;
+    let runtime_min = vk::make_api_version(0, min.major() as u32, min.minor() as u32, 0);
+    if version < runtime_min {
+        return Err(format!(
+            "the runtime needs Vulkan {}.{}, the loader offers {}.{}",
+            min.major(),
+            min.minor(),
+            vk::api_version_major(loader),
+            vk::api_version_minor(loader)
+        ));
+    }
+    Ok(version)
+}
+
+fn names(list: &[&'static CStr]) -> Vec<*const c_char> {
+    list.iter().map(|name| name.as_ptr()).collect()
+}
+
+/// Creates the Vulkan instance and device through the runtime and wraps them as vrao's
+/// `Gpu` (same features, limits and multiview probe as `Gpu::new`).
+pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Result<(Gpu, Binding), String> {
+    // xrGetVulkanGraphicsRequirements2KHR must come before the instance is created.
+    let requirements = xr
+        .graphics_requirements::<openxr::Vulkan>(system)
+        .map_err(|e| format!("xrGetVulkanGraphicsRequirements2KHR: {e}"))?;
+    // SAFETY: loads the system's Vulkan loader (libvulkan.so.1), as wgpu itself does.
+    let entry = unsafe { ash::Entry::load() }.map_err(|e| format!("no Vulkan loader: {e}"))?;
+    let version = api_version(&entry, &requirements)?;
+    let flags = wgpu::InstanceFlags::from_build_config().with_env();
+    let instance_extensions = wgpu::hal::vulkan::Instance::desired_extensions(&entry, version, flags)
+        .map_err(|e| format!("Vulkan instance extensions: {e}"))?;
+    let instance_extension_names = names(&instance_extensions);
+    let app_info = vk::ApplicationInfo::default()
+        .application_name(c"vrao")
+        .application_version(1)
+        .engine_name(c"vrao")
+        .engine_version(1)
+        .api_version(version);
+    let instance_info = vk::InstanceCreateInfo::default()
+        .application_info(&app_info)
+        .enabled_extension_names(&instance_extension_names);
+    // SAFETY: the two function-pointer types have the same ABI (instance handle and name
+    // in, optional function pointer out); openxr-sys spells the handle as a pointer.
+    let get_instance_proc_addr: openxr::sys::platform::VkGetInstanceProcAddr =
+        unsafe { std::mem::transmute(entry.static_fn().get_instance_proc_addr) };
+
+    // SAFETY: the create info and everything it points to live until the call returns;
+    // the graphics requirements were queried above, as enable2 requires.
+    let raw_instance =
+        unsafe { xr.create_vulkan_instance(system, get_instance_proc_addr, &instance_info as *const _ as *const _) }
+            .map_err(|e| format!("xrCreateVulkanInstanceKHR: {e}"))?
+            .map_err(|e| {
+                format!("xrCreateVulkanInstanceKHR: vkCreateInstance returned {:?}", vk::Result::from_raw(e))
+            })?;
+    let vk_instance = vk::Instance::from_raw(raw_instance as usize as u64);
+    // SAFETY: the instance was just created through this entry's vkGetInstanceProcAddr.
+    let ash_instance = unsafe { ash::Instance::load(entry.static_fn(), vk_instance) };
+    // SAFETY: created from `entry` with `version` and a superset of desired_extensions();
+    // no drop callback: wgpu-hal owns the instance from here on.
+    let hal_instance = unsafe {
+        wgpu::hal::vulkan::Instance::from_raw(
+            entry.clone(),
+            ash_instance.clone(),
+            version,
+            0,
+            None,
+            instance_extensions,
+            flags,
+            wgpu::MemoryBudgetThresholds::default(),
+            false,
+            None,
+        )
+    }
+    .map_err(|e| format!("wrapping the runtime's Vulkan instance: {e}"))?;
+
+    // SAFETY: the instance came from xrCreateVulkanInstanceKHR for this system.
+    let raw_physical = unsafe { xr.vulkan_graphics_device(system, raw_instance) }
+        .map_err(|e| format!("xrGetVulkanGraphicsDevice2KHR: {e}"))?;
+    let physical_device = vk::PhysicalDevice::from_raw(raw_physical as usize as u64);
+    let exposed = hal_instance
+        .expose_adapter(physical_device)
+        .ok_or_else(|| "wgpu cannot use the runtime's Vulkan device (too old or missing features)".to_string())?;
+    let adapter_name = exposed.info.name.clone();
+    // SAFETY: the hal instance is a Vulkan instance.
+    let instance = unsafe { wgpu::Instance::from_hal::<HalVulkan>(hal_instance) };
+    // SAFETY: the adapter was exposed by the instance just wrapped.
+    let adapter = unsafe { instance.create_adapter_from_hal(exposed) };
+    let desc = Gpu::device_descriptor(&adapter);
+
+    // One queue, from the first family that does graphics and compute (wgpu's own device
+    // uses one such queue too).
+    // SAFETY: a query of a valid physical device.
+    let families = unsafe { ash_instance.get_physical_device_queue_family_properties(physical_device) };
+    let queue_family_index = families
+        .iter()
+        .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
+        .ok_or_else(|| format!("{adapter_name} has no graphics and compute queue"))?
+        as u32;
+
+    let open = {
+        // SAFETY: the adapter is a Vulkan adapter.
+        let hal_adapter = unsafe { adapter.as_hal::<HalVulkan>() }
+            .ok_or_else(|| "the OpenXR adapter is not a Vulkan adapter".to_string())?;
+        let device_extensions = hal_adapter.required_device_extensions(desc.required_features);
+        let mut device_features = hal_adapter.physical_device_features(&device_extensions, desc.required_features);
+        let device_extension_names = names(&device_extensions);
+        let priorities = [1.0f32];
+        let queues =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family_index).queue_priorities(&priorities)];
+        let device_info = device_features.add_to_device_create(
+            vk::DeviceCreateInfo::default()
+                .queue_create_infos(&queues)
+                .enabled_extension_names(&device_extension_names),
+        );
+        // SAFETY: the create info and its feature chain live until the call returns; the
+        // physical device is the one the runtime chose.
+        let raw_device = unsafe {
+            xr.create_vulkan_device(system, get_instance_proc_addr, raw_physical, &device_info as *const _ as *const _)
+        }
+        .map_err(|e| format!("xrCreateVulkanDeviceKHR: {e}"))?
+        .map_err(|e| format!("xrCreateVulkanDeviceKHR: vkCreateDevice returned {:?}", vk::Result::from_raw(e)))?;
+        let vk_device = vk::Device::from_raw(raw_device as usize as u64);
+        // SAFETY: the device was created on this instance.
+        let ash_device = unsafe { ash::Device::load(ash_instance.fp_v1_0(), vk_device) };
+        // SAFETY: created from this adapter with queue family `queue_family_index`, the
+        // required extensions (the runtime may add more) and physical_device_features();
+        // no drop callback: wgpu-hal owns the device.
+        let open = unsafe {
+            hal_adapter.device_from_raw(
+                ash_device,
+                None,
+                &device_extensions,
+                desc.required_features,
+                &desc.required_limits,
+                &desc.memory_hints,
+                queue_family_index,
+                0,
+            )
+        }
+        .map_err(|e| format!("wrapping the runtime's Vulkan device: {e}"))?;
+        (open, vk_device)
+    };
+    let (open, vk_device) = open;
+    // SAFETY: the hal device was opened from this adapter with `desc`'s features/limits.
+    let (device, queue) = unsafe { adapter.create_device_from_hal(open, &desc) }
+        .map_err(|e| format!("{adapter_name} refused a device: {e}"))?;
+    let gpu = Gpu::from_device(instance, adapter, device, queue);
+    let binding = Binding { instance: vk_instance, physical_device, device: vk_device, queue_family_index };
+    Ok((gpu, binding))
+}

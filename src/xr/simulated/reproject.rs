@@ -1,0 +1,171 @@
+//! The compositor's late warp (shaders/reproject.wgsl): a finished stereo frame is
+//! re-presented at a newer head pose, rotationally (orientation only, a homography per
+//! eye) or positionally (the submitted depth forward-splatted into the new view).
+
+use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::targets::LayeredTarget;
+use crate::render::gpu::Gpu;
+use crate::render::graph::Resource;
+use crate::render::stereo::Eye;
+use bytemuck::{Pod, Zeroable};
+use glam::DMat4;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ReprojectionMode {
+    /// Orientation only: every pixel is treated as infinitely far.
+    Rotational,
+    /// Orientation and position, using the frame's depth; disocclusions take the
+    /// background beside them.
+    #[default]
+    Depth,
+}
+
+impl ReprojectionMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            ReprojectionMode::Rotational => "rotational",
+            ReprojectionMode::Depth => "depth",
+        }
+    }
+}
+
+impl std::str::FromStr for ReprojectionMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rotational" => Ok(ReprojectionMode::Rotational),
+            "depth" | "positional" => Ok(ReprojectionMode::Depth),
+            other => Err(format!("unknown reprojection '{other}' (expected rotational or depth)")),
+        }
+    }
+}
+
+/// Mirrors `Reproject` in shaders/reproject.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ReprojectUniform {
+    source_from_target: [[[f32; 4]; 4]; 2],
+    target_from_source: [[[f32; 4]; 4]; 2],
+    source_tangents: [[f32; 4]; 2],
+    target_tangents: [[f32; 4]; 2],
+    size: [u32; 2],
+    layers: u32,
+    near: f32,
+}
+
+pub struct Reprojector {
+    splat: Kernel,
+    positional: Kernel,
+    rotational: Kernel,
+    uniform: wgpu::Buffer,
+    sampler: wgpu::Sampler,
+    /// Splatted target depths, one u32 per pixel and layer (grown on demand).
+    splatted: Option<wgpu::Buffer>,
+}
+
+const SLOTS: [Slot; 6] = [
+    Slot::Uniform,
+    Slot::Depth,
+    Slot::FilterableLayers,
+    Slot::Sampler,
+    Slot::ReadWriteBuffer,
+    Slot::Output(wgpu::TextureFormat::Rgba8Unorm),
+];
+
+impl Reprojector {
+    pub fn new(gpu: &Gpu) -> Reprojector {
+        let files = ["common.wgsl", "reproject.wgsl"];
+        let variant = |label, entry, positional: bool| {
+            Kernel::with_constants(gpu, label, &files, entry, &SLOTS, &[("POSITIONAL", f64::from(positional))])
+        };
+        Reprojector {
+            splat: variant("reproject splat", "splat", true),
+            positional: variant("reproject depth", "resolve", true),
+            rotational: variant("reproject rotational", "resolve", false),
+            uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("reproject"),
+                size: std::mem::size_of::<ReprojectUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            sampler: gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("reproject"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                ..Default::default()
+            }),
+            splatted: None,
+        }
+    }
+
+    /// Records the warp of `color` + `depth` (rendered for `source` eyes) to the `target`
+    /// eyes into `output` (Rgba8Unorm, same size and layers).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        mode: ReprojectionMode,
+        color: &LayeredTarget,
+        depth: &LayeredTarget,
+        source: &[Eye],
+        target: &[Eye],
+        near: f64,
+        output: &LayeredTarget,
+    ) {
+        let layers = source.len().min(target.len()).min(2) as u32;
+        let (width, height) = (color.width, color.height);
+        let mut u = ReprojectUniform::zeroed();
+        for layer in 0..layers as usize {
+            let world_from_source = source[layer].view_from_world().inverse();
+            let target_from_world: DMat4 = target[layer].view_from_world();
+            let target_from_source = target_from_world * world_from_source;
+            u.target_from_source[layer] = target_from_source.as_mat4().to_cols_array_2d();
+            u.source_from_target[layer] = target_from_source.inverse().as_mat4().to_cols_array_2d();
+            u.source_tangents[layer] = source[layer].fov.tangents().map(|t| t as f32);
+            u.target_tangents[layer] = target[layer].fov.tangents().map(|t| t as f32);
+        }
+        u.size = [width, height];
+        u.layers = layers;
+        u.near = near as f32;
+        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&u));
+        let bytes = (width as u64 * height as u64 * layers as u64 * 4).max(4);
+        if self.splatted.as_ref().is_none_or(|b| b.size() < bytes) {
+            self.splatted = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("reproject splatted depth"),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        let splatted = self.splatted.as_ref().expect("allocated above");
+        let resources = [
+            self.uniform.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&depth.array_view),
+            wgpu::BindingResource::TextureView(&color.array_view),
+            wgpu::BindingResource::Sampler(&self.sampler),
+            splatted.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&output.array_view),
+        ];
+        let extent = (width, height, layers);
+        match mode {
+            ReprojectionMode::Rotational => self.rotational.dispatch(&gpu.device, encoder, &resources, extent),
+            ReprojectionMode::Depth => {
+                encoder.clear_buffer(splatted, 0, Some(bytes));
+                self.splat.dispatch(&gpu.device, encoder, &resources, extent);
+                self.positional.dispatch(&gpu.device, encoder, &resources, extent);
+            }
+        }
+    }
+}
+
+/// A target the warp can write and the mirror can read: the colour format of eye frames.
+pub fn output_target(gpu: &Gpu, (width, height, layers): (u32, u32, u32)) -> LayeredTarget {
+    LayeredTarget::new(
+        &gpu.device,
+        "compositor output",
+        Resource::Color.format(),
+        (width, height, layers),
+        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    )
+}

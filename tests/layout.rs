@@ -1,0 +1,77 @@
+//! The dependency rule between the library's folders (see `src/lib.rs`): `render`
+//! imports none of the others, `xr` only `render`, `app` and `measure` use `render` and
+//! `xr` but not each other, and nothing in the library reaches the CLI.
+
+use std::path::{Path, PathBuf};
+
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let path = entry.expect("directory entry").path();
+        if path.is_dir() {
+            files.extend(rust_files(&path));
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            files.push(path);
+        }
+    }
+    files
+}
+
+/// The top-level folders of `src/` a file refers to by `crate::<folder>` (in code, doc
+/// links included; plain comments are skipped).
+fn references(text: &str) -> Vec<(usize, String)> {
+    let mut found = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let code = line.trim_start();
+        if code.starts_with("//") && !code.starts_with("///") && !code.starts_with("//!") {
+            continue;
+        }
+        let mut rest = line;
+        while let Some(at) = rest.find("crate::") {
+            let name: String = rest[at + 7..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            found.push((n + 1, name));
+            rest = &rest[at + 7..];
+        }
+    }
+    found
+}
+
+#[test]
+fn each_folder_imports_only_what_the_rule_allows() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let allowed: [(&str, &[&str]); 4] = [
+        ("render", &["render"]),
+        ("xr", &["render", "xr"]),
+        ("app", &["render", "xr", "app"]),
+        ("measure", &["render", "xr", "measure"]),
+    ];
+    let mut violations = Vec::new();
+    let mut files_checked = 0;
+    for (folder, may_use) in allowed {
+        for file in rust_files(&src.join(folder)) {
+            files_checked += 1;
+            let text = std::fs::read_to_string(&file).expect("readable source");
+            for (line, name) in references(&text) {
+                if !may_use.contains(&name.as_str()) {
+                    violations.push(format!("{}:{line}: {folder} uses crate::{name}", file.display()));
+                }
+            }
+        }
+    }
+    assert!(files_checked > 50, "only {files_checked} files under src/render, xr, app and measure");
+    assert!(violations.is_empty(), "the dependency rule is broken:\n{}", violations.join("\n"));
+}
+
+#[test]
+fn the_library_never_reaches_the_cli() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let lib = std::fs::read_to_string(src.join("lib.rs")).expect("src/lib.rs");
+    assert!(!lib.contains("mod cli"), "src/lib.rs declares the CLI: it belongs to the binary");
+}
+
+#[test]
+fn the_reference_scanner_sees_imports_and_skips_comments() {
+    let text = "use crate::render::gpu::Gpu;\n// crate::app in a comment\n/// [`crate::xr::Headset`]\nlet x = crate::measure::metrics::rmse(a, b);";
+    let names: Vec<String> = references(text).into_iter().map(|(_, n)| n).collect();
+    assert_eq!(names, ["render", "xr", "measure"]);
+}
