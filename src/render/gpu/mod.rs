@@ -5,6 +5,7 @@ pub mod frame;
 pub mod half;
 pub mod kernel;
 pub mod multiview_probe;
+pub mod raster;
 pub mod readback;
 pub mod scene;
 pub mod targets;

@@ -39,17 +39,7 @@ impl LayeredTarget {
             array_layer_count: Some(layers),
             ..Default::default()
         });
-        let layer_views = (0..layers)
-            .map(|layer| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    label: Some(label),
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
+        let layer_views = super::raster::layer_views(&texture, label, layers);
         LayeredTarget { texture, array_view, layer_views, format, width, height, layers }
     }
 

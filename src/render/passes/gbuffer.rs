@@ -5,7 +5,8 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::shader_module;
-use crate::render::gpu::scene::{GpuScene, Vertex};
+use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
+use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 use std::num::NonZeroU32;
@@ -25,16 +26,6 @@ pub struct GBufferPass {
 impl GBufferPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
         let device = &gpu.device;
-        let uniform_entry = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let vs_fs = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer frame"),
@@ -97,11 +88,7 @@ fn pipeline(
             module,
             entry_point: Some("vs_main"),
             compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: std::mem::size_of::<Vertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
-            })],
+            buffers: &[Some(mesh_vertex_buffer(&MESH_ATTRIBUTES))],
         },
         // No culling: OBJ windings are not trusted; the fragment shader faces normals
         // towards the eye instead.

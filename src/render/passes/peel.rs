@@ -10,7 +10,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::shader_module;
-use crate::render::gpu::scene::Vertex;
+use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 use crate::render::settings::Technique;
@@ -27,24 +27,14 @@ pub struct DepthPeelPass {
 impl DepthPeelPass {
     pub fn new(gpu: &Gpu, frame: &FrameBuffers) -> Self {
         let device = &gpu.device;
-        let uniform = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth peel frame"),
-            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
         });
         let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth peel eye"),
             entries: &[
-                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -70,11 +60,7 @@ impl DepthPeelPass {
                 module: &module,
                 entry_point: Some("vs_peel"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Vertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-                })],
+                buffers: &[Some(mesh_vertex_buffer(&MESH_ATTRIBUTES[..1]))],
             },
             // No culling, as in the G-buffer: the back faces are what this pass is for.
             primitive: wgpu::PrimitiveState::default(),

@@ -19,7 +19,8 @@
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::shader_module;
-use crate::render::gpu::scene::{GpuScene, Vertex};
+use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
+use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
@@ -270,16 +271,6 @@ pub struct ShadowPass {
 impl ShadowPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, light_space: Arc<LightSpace>) -> ShadowPass {
         let device = &gpu.device;
-        let uniform_entry = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow light"),
             entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
@@ -332,11 +323,7 @@ fn pipeline(
             module,
             entry_point: Some("vs_main"),
             compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: std::mem::size_of::<Vertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
-            })],
+            buffers: &[Some(mesh_vertex_buffer(&MESH_ATTRIBUTES))],
         },
         // Two-sided, as the G-buffer: both faces of a surface cast.
         primitive: wgpu::PrimitiveState::default(),

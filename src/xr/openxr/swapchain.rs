@@ -113,19 +113,7 @@ impl Chain {
                 .collect();
             let views = textures
                 .iter()
-                .map(|texture| {
-                    (0..layers)
-                        .map(|layer| {
-                            texture.create_view(&wgpu::TextureViewDescriptor {
-                                label: Some(label),
-                                dimension: Some(wgpu::TextureViewDimension::D2),
-                                base_array_layer: layer,
-                                array_layer_count: Some(1),
-                                ..Default::default()
-                            })
-                        })
-                        .collect()
-                })
+                .map(|texture| crate::render::gpu::raster::layer_views(texture, label, layers))
                 .collect();
             chain.swapchains.push(swapchain);
             chain.textures.push(textures);
