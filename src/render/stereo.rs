@@ -209,8 +209,8 @@ impl HeadsetProfile {
     /// An HTC Vive-class headset: 1080×1200 per eye at 90 Hz. The frustum is 52° up and
     /// down, 45° towards the nose, and outward as wide as square pixels require.
     /// Size: the Vive's own config, `eye_target_width/height_in_pixels` 1080×1200
-    /// (https://gist.github.com/ChristophHaag/c6235817421f2ce5da839772eff48f40); 90 Hz: its
-    /// hmdq dump (https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html). The
+    /// (<https://gist.github.com/ChristophHaag/c6235817421f2ce5da839772eff48f40>); 90 Hz: its
+    /// hmdq dump (<https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html>). The
     /// frustum is an approximation kept as is because earlier measurements used it (the
     /// dump measures 54.4° out, 46.8° nasal, 55.7° up, 55.9° down).
     pub fn vive() -> HeadsetProfile {

@@ -66,7 +66,9 @@ struct GtaoKernels {
     right_eye: Kernel,
 }
 
-/// A technique's pipelines: one, or GTAO's three.
+/// A technique's pipelines: one, or GTAO's three. One value per pass, made once, so
+/// the size difference between the variants costs nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 enum Kernels {
     One(Kernel),
     Gtao(GtaoKernels),
