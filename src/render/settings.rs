@@ -27,7 +27,7 @@ impl std::str::FromStr for StereoMode {
     }
 }
 
-/// What the desktop window shows (seed 003 §5.2).
+/// What the desktop window shows (Belonogov 2018 §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DisplayMode {
     /// No window: the headset alone.
@@ -65,14 +65,14 @@ impl std::str::FromStr for DisplayMode {
 pub enum Technique {
     /// No occlusion pass: the ambient term is unoccluded.
     None,
-    /// Normal-oriented hemisphere SSAO (seed 003 §3.2, seed 000 ch. 3).
+    /// Normal-oriented hemisphere SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3).
     #[default]
     Ssao,
-    /// Horizon-based AO, directions × steps ray-marched in depth (seed 003 §3.3).
+    /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
     Hbao,
-    /// Screen-space directional occlusion of the environment (seed 002 eq. 1).
+    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
     Ssdo,
-    /// SSDO plus one indirect bounce in the same loop (seed 002 eq. 2).
+    /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
     SsdoBounce,
     /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
     FetchOnly,
@@ -120,7 +120,7 @@ impl std::str::FromStr for Technique {
     }
 }
 
-/// Sampling quality presets: seed 003's kernel sizes N = 12, 24, 36, 64.
+/// Sampling quality presets: Belonogov 2018's kernel sizes N = 12, 24, 36, 64.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Quality {
     Low,
@@ -164,9 +164,9 @@ impl std::str::FromStr for Quality {
 /// Where each pixel's kernel rotation comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Noise {
-    /// A 5×5 tile of rotations repeated over the screen (seed 003).
+    /// A 5×5 tile of rotations repeated over the screen (Belonogov 2018).
     Tiled5x5,
-    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (seed 000).
+    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (the Czech SSDO thesis).
     #[default]
     Halton,
 }
@@ -185,9 +185,9 @@ impl std::str::FromStr for Noise {
 /// How SSDO's bounce weighs a blocking sample's sender.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BounceForm {
-    /// Seed 002 eq. 2: a patch of area π r²/N × strength at the sender pixel, weighted by
-    /// the sender and receiver cosines over d² (as a disc's solid angle, so a sender
-    /// touching the receiver stays bounded).
+    /// Ritschel et al. 2009 eq. 2: a patch of area π r²/N × strength at the sender pixel,
+    /// weighted by the sender and receiver cosines over d² (as a disc's solid angle, so a
+    /// sender touching the receiver stays bounded).
     Patch,
     /// The sender's radiance through the blocked direction's share of the hemisphere,
     /// 2π/N, × the receiver's cosine towards the sender, as eq. 1 treats unblocked
@@ -226,7 +226,8 @@ pub enum Denoise {
     /// (shaders/denoise.wgsl).
     #[default]
     Tile,
-    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; seed 000).
+    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; the Czech SSDO
+    /// thesis).
     Bilateral,
 }
 
@@ -272,8 +273,8 @@ pub struct AoSettings {
     pub noise: Noise,
     /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
     pub half_res: bool,
-    /// Depth peeling for SSDO (seed 002 §4): a second depth layer, and a sample occludes
-    /// only between the first and second layer (inside an object). Off by default.
+    /// Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer, and a sample
+    /// occludes only between the first and second layer (inside an object). Off by default.
     pub depth_peeling: bool,
     /// Which spatial denoise runs.
     pub denoise: Denoise,
@@ -284,7 +285,7 @@ pub struct AoSettings {
     /// fraction of the centre's distance, loses most of its weight. Near 0 every
     /// neighbour's weight vanishes and the centre value is kept.
     pub blur_plane_sigma: f32,
-    /// Temporal accumulation by reverse reprojection (seed 001 §3.1).
+    /// Temporal accumulation by reverse reprojection (Lin's NCTU thesis §3.1).
     pub temporal: Temporal,
     /// GTAO: how far behind each depth sample the surface counts as solid, as a fraction
     /// of the radius (thin objects stop occluding behind themselves).
@@ -310,7 +311,7 @@ pub enum TemporalBlend {
     /// counts equally, so N frames of n samples approach one frame of N·n.
     #[default]
     Average,
-    /// Seed 001 eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
+    /// Lin's NCTU thesis eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
     /// V = c·V_{t−1} + (1 − c)·V_t.
     Confidence,
 }
@@ -330,15 +331,15 @@ impl std::str::FromStr for TemporalBlend {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Temporal {
     pub enabled: bool,
-    /// Disocclusion threshold ε in metres on the world-position distance (seed 001 eq. 3).
-    /// The pass also allows two pixel footprints at the pixel's distance (an extension:
+    /// Disocclusion threshold ε in metres on the world-position distance (Lin's NCTU thesis eq.
+    /// 3). The pass also allows two pixel footprints at the pixel's distance (an extension:
     /// a fixed ε would reject every distant pixel, whose neighbour is centimetres away).
     pub epsilon_m: f32,
     pub blend: TemporalBlend,
     /// Frames after which a pixel counts as converged: the mean stops growing and
     /// becomes a moving average over this many frames.
     pub max_frames: u32,
-    /// Seed 001's confidence bias (only for the confidence blend).
+    /// The confidence bias of Lin's NCTU thesis (only for the confidence blend).
     pub confidence_bias: f32,
     /// Motion-adaptive window of the running mean: a pixel that moved m occlusion
     /// pixels since the last frame keeps at most max_frames / (1 + m / motion_px)
@@ -479,8 +480,8 @@ pub struct Settings {
     pub shadows: ShadowSettings,
 }
 
-/// Shadow maps with PCF (seed 000) and reflective shadow maps (seed 001) for the
-/// scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
+/// Shadow maps with PCF (the Czech SSDO thesis) and reflective shadow maps (Lin's NCTU thesis)
+/// for the scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
 /// directional light has neither, whatever these say.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadowSettings {

@@ -1,7 +1,8 @@
 //! The screen-space occlusion techniques that share one binding layout
-//! (shaders/occlusion.wgsl): SSAO (seed 003 §3.2, seed 000 ch. 3), HBAO (seed 003 §3.3),
-//! GTAO with a visibility bitmask and the fetch-only benchmark baseline. Each technique itself is its WGSL file; SSDO,
-//! which also reads the direct light, is `ssdo.rs`.
+//! (shaders/occlusion.wgsl): SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3), HBAO
+//! (Belonogov 2018 §3.3), GTAO with a visibility bitmask and the fetch-only benchmark baseline.
+//! Each technique itself is its WGSL file; SSDO, which also reads the direct light, is
+//! `ssdo.rs`.
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::gtao_inner_band;

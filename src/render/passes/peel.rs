@@ -1,4 +1,4 @@
-//! Depth peeling for SSDO (seed 002 §4): a second depth layer per eye, the nearest
+//! Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
 //! surface behind the G-buffer's depth (shaders/peel.wgsl). With it SSDO counts a sample
 //! as an occluder only between the first and second layer, inside an object, so thin
 //! objects in front of a background no longer cast a halo onto it. An optional quality

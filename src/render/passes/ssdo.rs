@@ -1,5 +1,5 @@
-//! SSDO, with the optional bounce gathered in the same loop (seed 002 eqs. 1–2,
-//! seed 003 §4.1–4.2). The technique itself is shaders/ssdo.wgsl; a bounce strength of
+//! SSDO, with the optional bounce gathered in the same loop (Ritschel et al. 2009 eqs. 1–2,
+//! Belonogov 2018 §4.1–4.2). The technique itself is shaders/ssdo.wgsl; a bounce strength of
 //! 0 selects the pipeline compiled without bounce work, which also does not read the
 //! direct light, so the graph need not produce it for an occlusion-only frame.
 

@@ -1,4 +1,4 @@
-//! Temporal accumulation (seed 001 §3.1; shaders/temporal.wgsl): the occlusion of this
+//! Temporal accumulation (Lin's NCTU thesis §3.1; shaders/temporal.wgsl): the occlusion of this
 //! frame blended with the history reprojected from the previous frame. The history is
 //! two pairs of targets (value, world position + frame count) that swap roles every
 //! frame; they persist between frames because the renderer keeps targets whose size

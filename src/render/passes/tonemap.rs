@@ -1,4 +1,4 @@
-//! Reinhard tone mapping with a white point (seed 000, eq. 2.4) and sRGB encoding.
+//! Reinhard tone mapping with a white point (the Czech SSDO thesis, eq. 2.4) and sRGB encoding.
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{Kernel, Slot};

@@ -1,4 +1,4 @@
-//! 3×3 joint bilateral upsampling of half-resolution occlusion (seed 000) into a
+//! 3×3 joint bilateral upsampling of half-resolution occlusion (the Czech SSDO thesis) into a
 //! full-resolution target (shaders/upsample.wgsl). Frames upsample inside the composite
 //! instead, so the graph runs this pass only when AoFull itself is asked for (debug
 //! images, tests).
