@@ -123,10 +123,14 @@ impl std::str::FromStr for Technique {
 /// Sampling quality presets: Belonogov 2018's kernel sizes N = 12, 24, 36, 64.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Quality {
+    /// N = 12.
     Low,
+    /// N = 24 (the default).
     #[default]
     Medium,
+    /// N = 36.
     High,
+    /// N = 64.
     Ultra,
 }
 
@@ -254,6 +258,7 @@ impl std::str::FromStr for Denoise {
 /// Occlusion parameters shared by every technique.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AoSettings {
+    /// Which technique estimates the occlusion.
     pub technique: Technique,
     /// Depth taps per pixel, 1..=256 (a quality preset sets it).
     pub samples: u32,
@@ -270,6 +275,7 @@ pub struct AoSettings {
     pub bounce: f32,
     /// How the bounce weighs its senders.
     pub bounce_form: BounceForm,
+    /// Where each pixel's kernel rotation comes from.
     pub noise: Noise,
     /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
     pub half_res: bool,
@@ -330,11 +336,14 @@ impl std::str::FromStr for TemporalBlend {
 /// Temporal accumulation settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Temporal {
+    /// Accumulate occlusion over frames (off by default).
     pub enabled: bool,
-    /// Disocclusion threshold ε in metres on the world-position distance (Lin's NCTU thesis eq.
-    /// 3). The pass also allows two pixel footprints at the pixel's distance (an extension:
-    /// a fixed ε would reject every distant pixel, whose neighbour is centimetres away).
+    /// Disocclusion threshold ε in metres on the world-position distance (Lin's NCTU
+    /// thesis eq. 3). The pass also allows two pixel footprints at the pixel's distance (an
+    /// extension: a fixed ε would reject every distant pixel, whose neighbour is
+    /// centimetres away).
     pub epsilon_m: f32,
+    /// How a pixel's history and this frame's value are blended.
     pub blend: TemporalBlend,
     /// Frames after which a pixel counts as converged: the mean stops growing and
     /// becomes a moving average over this many frames.
@@ -366,7 +375,9 @@ impl Default for Temporal {
 /// it costs no RMSE and leaves fewer halos (pixels beside depth edges too dark by > 0.1
 /// on the furnished room: 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
 pub const DEFAULT_THICKNESS: f32 = 0.75;
+/// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
 pub const DEFAULT_STEP_POWER: f32 = 1.5;
+/// GTAO's default: successive samples closer than this fraction of the radius are joined.
 pub const DEFAULT_CONNECT: f32 = 0.25;
 
 impl Default for AoSettings {
@@ -396,6 +407,7 @@ impl Default for AoSettings {
 }
 
 impl AoSettings {
+    /// Checks every value's range; the error names the value and its range.
     pub fn validate(&self) -> Result<()> {
         if !(1..=256).contains(&self.samples) {
             return Err(Error::input(format!("samples {} is not within 1..=256", self.samples)));
@@ -464,10 +476,15 @@ impl AoSettings {
     }
 }
 
+/// Everything a frame is rendered with: the headset, the stereo path, tone mapping,
+/// occlusion and shadows. Start from [`Settings::default`] and change what you need;
+/// [`Settings::validate`] (also run by [`Renderer::new`](crate::Renderer::new)) rejects
+/// values out of range with a one-line error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// The headset's per-eye size, refresh rate, IPD and fields of view.
     pub profile: HeadsetProfile,
+    /// How the G-buffer reaches both eye layers.
     pub stereo: StereoMode,
     /// Near plane in metres (the far plane is at infinity).
     pub near: f64,
@@ -475,6 +492,7 @@ pub struct Settings {
     pub exposure: f32,
     /// Reinhard's L_white: the smallest (exposed) luminance mapped to white.
     pub white_point: f32,
+    /// Ambient occlusion: technique, samples, radius, denoise, resolution, temporal.
     pub ao: AoSettings,
     /// Shadow maps and reflective shadow maps of directional lights.
     pub shadows: ShadowSettings,
@@ -504,6 +522,7 @@ impl Default for ShadowSettings {
 }
 
 impl ShadowSettings {
+    /// Checks the map size, the RSM samples and the RSM radius.
     pub fn validate(&self) -> Result<()> {
         if !(16..=8192).contains(&self.size) {
             return Err(Error::input(format!("shadow map size {} is not within 16..=8192", self.size)));

@@ -87,14 +87,17 @@ impl OcclusionPass {
         OcclusionPass { technique, kernels: Kernels::One(kernel) }
     }
 
+    /// The occlusion pass of SSAO (shaders/ssao.wgsl).
     pub fn ssao(gpu: &Gpu) -> Self {
         Self::new(gpu, Technique::Ssao, "ssao.wgsl")
     }
 
+    /// The occlusion pass of HBAO (shaders/hbao.wgsl).
     pub fn hbao(gpu: &Gpu) -> Self {
         Self::new(gpu, Technique::Hbao, "hbao.wgsl")
     }
 
+    /// The occlusion pass of GTAO (shaders/gtao.wgsl), its three pipelines.
     pub fn gtao(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "gtao.wgsl"];
         let label = Technique::Gtao.name();

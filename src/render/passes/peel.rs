@@ -16,6 +16,7 @@ use crate::render::graph::{PassDecl, Resource};
 use crate::render::settings::Technique;
 use wgpu::util::DeviceExt;
 
+/// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
     pipeline: wgpu::RenderPipeline,
     frame_group: wgpu::BindGroup,
@@ -25,6 +26,7 @@ pub struct DepthPeelPass {
 }
 
 impl DepthPeelPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, frame: &FrameBuffers) -> Self {
         let device = &gpu.device;
         let uniform = |binding, visibility| wgpu::BindGroupLayoutEntry {

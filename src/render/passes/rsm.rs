@@ -25,6 +25,7 @@ struct RsmParamsUniform {
     _pad: [f32; 3],
 }
 
+/// One bounce of directional light from reflective shadow maps (module docs).
 pub struct RsmPass {
     kernel: Kernel,
     light_space: Arc<LightSpace>,
@@ -34,6 +35,7 @@ pub struct RsmPass {
 }
 
 impl RsmPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> RsmPass {
         let slots = [
             Slot::Uniform,

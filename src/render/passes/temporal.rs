@@ -28,6 +28,7 @@ struct TemporalUniform {
     _pad: u32,
 }
 
+/// Temporal accumulation of the occlusion by reverse reprojection (module docs).
 pub struct TemporalPass {
     kernel: Kernel,
     uniform: wgpu::Buffer,
@@ -45,6 +46,7 @@ fn history(frame_index: u64) -> ([Resource; 2], [Resource; 2]) {
 }
 
 impl TemporalPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> TemporalPass {
         let slots = [
             Slot::Uniform,

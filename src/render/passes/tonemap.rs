@@ -5,11 +5,13 @@ use crate::render::gpu::kernel::{Kernel, Slot};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 
+/// Tone mapping of the HDR radiance into the eye colour (module docs).
 pub struct TonemapPass {
     kernel: Kernel,
 }
 
 impl TonemapPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         let slots = [Slot::Uniform, Slot::Layers, Slot::Output(Resource::Color.format())];
         TonemapPass { kernel: Kernel::new(gpu, "tonemap", &["common.wgsl", "tonemap.wgsl"], "main", &slots) }

@@ -9,6 +9,7 @@ use crate::render::gpu::kernel::{Kernel, Slot};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 
+/// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
 pub struct UpsamplePass {
     kernel: Kernel,
     /// The right eye's dispatch that reuses the left eye's result.
@@ -16,6 +17,7 @@ pub struct UpsamplePass {
 }
 
 impl UpsamplePass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         let slots = [
             Slot::Uniform,
