@@ -478,8 +478,9 @@ impl AoSettings {
 
 /// Everything a frame is rendered with: the headset, the stereo path, tone mapping,
 /// occlusion and shadows. Start from [`Settings::default`] and change what you need;
-/// [`Settings::validate`] (also run by [`Renderer::new`](crate::render::renderer::Renderer::new)) rejects
-/// values out of range with a one-line error.
+/// [`Settings::validate`] (also run by
+/// [`Renderer::new`](crate::render::renderer::Renderer::new)) rejects values out of range
+/// with a one-line error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// The headset's per-eye size, refresh rate, IPD and fields of view.
