@@ -16,7 +16,17 @@ use vrao::render::passes::final_occlusion;
 use vrao::render::settings::{AoSettings, Technique};
 use vrao::{BackendChoice, Gpu, HeadsetProfile, Renderer, Resource, Scene, Settings};
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
     // Mesa's Vulkan drivers probe for a Wayland display and print "error: XDG_RUNTIME_DIR
     // is invalid" on headless machines although nothing is wrong; give the probe a
     // directory to look in (the vrao binary does the same).
