@@ -1,10 +1,10 @@
-// Separable geometry-aware bilateral blur of the occlusion (seed 000: 11×11, edge stops
-// on normal and depth; seed 003 §4.3.2). Geometry comes from AoGeometry (normal and
-// distance at each occlusion pixel, written by the technique): one fetch per tap. A neighbour counts by its pixel distance
-// (Gaussian), by how far it lies off the centre's tangent plane relative to the centre's
-// distance (depth edge) and by normal agreement. Each layer is blurred on its own; the
-// right eye's vertical pass may instead take the left eye's result (denoise_stereo.wgsl).
-// When every weight vanishes the centre value is kept.
+// Separable geometry-aware bilateral blur of the occlusion (the Czech SSDO thesis: 11×11, edge
+// stops on normal and depth; Belonogov 2018 §4.3.2). Geometry comes from AoGeometry (normal and
+// distance at each occlusion pixel, written by the technique): one fetch per tap. A neighbour
+// counts by its pixel distance (Gaussian), by how far it lies off the centre's tangent plane
+// relative to the centre's distance (depth edge) and by normal agreement. Each layer is blurred
+// on its own; the right eye's vertical pass may instead take the left eye's result
+// (denoise_stereo.wgsl). When every weight vanishes the centre value is kept.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;

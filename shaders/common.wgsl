@@ -265,7 +265,7 @@ fn environment_radiance(env: texture_2d<f32>, env_sampler: sampler, dir: vec3<f3
 // ---- Occlusion helpers shared by SSAO, HBAO and SSDO ----
 
 // Per-pixel kernel rotation (radians). noise 0: a 5×5 tile repeated over the screen
-// (seed 003), its 25 angles visited in a stride-7 permutation so neighbours differ;
+// (Belonogov 2018), its 25 angles visited in a stride-7 permutation so neighbours differ;
 // noise 1: a per-pixel low-discrepancy rotation (the R2 sequence), no visible tile.
 fn kernel_rotation(p: vec2<u32>, noise: u32) -> f32 {
     if (noise == 0u) {

@@ -1,6 +1,6 @@
 // Direct light: the scene's point and directional lights on diffuse surfaces, plus
 // emission, as outgoing radiance. The composite adds the ambient term on top, and
-// SSDO's bounce uses this as the sender radiance L_pixel (seed 002 eq. 2); the view
+// SSDO's bounce uses this as the sender radiance L_pixel (Ritschel et al. 2009 eq. 2); the view
 // distance rides along (`pack_direct`) so that the bounce's occluder probe reads
 // distance and sender radiance in one fetch.
 

@@ -1,7 +1,7 @@
-// HBAO (seed 003 §3.3, after Bavoil, Sainz and Dimitrov 2008): D screen directions,
+// HBAO (Belonogov 2018 §3.3, after Bavoil, Sainz and Dimitrov 2008): D screen directions,
 // rotated per pixel, each ray-marched S steps through the depth buffer. A sample above
 // the current horizon raises it and adds its occlusion; samples beyond R do not count
-// (the hard cut-off of every technique's target; seed 003's falloff W = 1 − r/R made
+// (the hard cut-off of every technique's target; Belonogov 2018's falloff W = 1 − r/R made
 // HBAO lighter than that target everywhere). Samples off the image are looked up in
 // the other eye's layer. Horizon angles are measured from the tangent plane (the normal
 // is known), and increments use sin²h instead of sin h: the cosine-weighted form of

@@ -1,4 +1,4 @@
-// Joint bilateral upsampling (Kopf et al. 2007; seed 000: 3×3, not separated) of
+// Joint bilateral upsampling (Kopf et al. 2007; the Czech SSDO thesis: 3×3, not separated) of
 // half-resolution occlusion, shared by the upsample pass (which writes AoFull for debug
 // images and tests) and the composite (which upsamples inline, so a frame needs no
 // full-resolution occlusion target). One invocation upsamples the quad of 2×2 full-res

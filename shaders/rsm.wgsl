@@ -1,13 +1,13 @@
 // One bounce of directional light from reflective shadow maps (Dachsbacher & Stamminger
-// 2005; seed 001 §3.3), at half resolution per axis. Each map texel is a virtual point
+// 2005; Lin's NCTU thesis §3.3), at half resolution per axis. Each map texel is a virtual point
 // light (VPL) q with flux Φ_q; a receiver p gathers
 //     E_p = Σ_q Φ_q / π · max(0, N_p·D) · max(0, N_q·(−D)) / ‖q − p‖²,  D = (q − p)/‖q − p‖
-// (seed 001 eqs. 9–10 with the 1/π a Lambertian VPL's intensity Φ cos θ / π carries).
+// (Lin's NCTU thesis eqs. 9–10 with the 1/π a Lambertian VPL's intensity Φ cos θ / π carries).
 // The sum runs over VPLs sampled in a disk of radius R around p's projection into the
 // map: sample k lies in the k-th of N equal-width rings (so samples crowd towards the
 // centre, as in the original RSM) at an angle stepping by the golden angle, and stands
 // for the area of its ring, 2π r R / N: each ring's estimate is unbiased. The whole
-// pattern turns per pixel (interleaved) and per frame (seed 001: "we always have to
+// pattern turns per pixel (interleaved) and per frame (Lin's NCTU thesis: "we always have to
 // rotate the sampling pattern"; the frame index comes from the pass's own counter), and
 // the rings shift by a per-pixel jitter. VPL visibility is not tested (as in the
 // original RSM). A VPL within its own area of p counts as a disk, Φ/(π d² + A) instead

@@ -1,6 +1,6 @@
-// Shadow maps (seed 000 §2.1, §5.1) and reflective shadow maps (seed 001 §3.3) of the
-// scene's directional lights: one orthographic light-space layer per shadowed light,
-// fitted to the scene (passes/shadow.rs). Shared by the light-space pass, the direct
+// Shadow maps (the Czech SSDO thesis §2.1, §5.1) and reflective shadow maps (Lin's NCTU thesis
+// §3.3) of the scene's directional lights: one orthographic light-space layer per shadowed
+// light, fitted to the scene (passes/shadow.rs). Shared by the light-space pass, the direct
 // pass (PCF lookups) and the RSM gather. Nothing here binds a resource.
 
 // One shadowed directional light (mirrors `ShadowLightUniform` in passes/shadow.rs).
@@ -51,11 +51,11 @@ fn anchored_from_view_vector(eye: Eye, v: vec3<f32>) -> vec3<f32> {
 
 // Fraction of `light` (map layer `layer`, `size` texels a side) reaching the surface at
 // anchored position `pa` with unit normal `na` (facing the light): 3×3 PCF, taps one
-// texel apart, each a bilinear 2×2 hardware comparison (seed 000: "3x3 … simply averaged
-// … bilinear filtering for shadow maps").
+// texel apart, each a bilinear 2×2 hardware comparison (the Czech SSDO thesis: "3x3 … simply
+// averaged … bilinear filtering for shadow maps").
 //
-// Bias (seed 000, b = p/2 · tan α): a comparison stands for the patch of texels it reads.
-// Each tap compares against the receiver's tangent plane extrapolated to the tap (so the
+// Bias (the Czech SSDO thesis, b = p/2 · tan α): a comparison stands for the patch of texels it
+// reads. Each tap compares against the receiver's tangent plane extrapolated to the tap (so the
 // 3×3 spread adds no acne), and its bilinear 2×2 reads texel centres up to one texel away
 // along each axis, a patch of diagonal p' = 2√2 p; b = p'/2 · tan α = √2 p tan α keeps a
 // lit plane at any orientation from shadowing itself.

@@ -1,6 +1,6 @@
 // The light-space pass: the scene seen from one directional light through its
 // orthographic fit (passes/shadow.rs). Depth always (the shadow map); with reflective
-// shadow maps also each texel's normal and flux (seed 001 §3.3: every texel a virtual
+// shadow maps also each texel's normal and flux (Lin's NCTU thesis §3.3: every texel a virtual
 // point light). Positions come back from the depth and the texel, so none is stored.
 
 @group(0) @binding(0) var<uniform> light: ShadowLight;

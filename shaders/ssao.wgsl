@@ -1,6 +1,7 @@
-// SSAO (seed 003 §3.2, seed 000 ch. 3): N points in a normal-oriented hemisphere around
-// each pixel's view-space position, most of them close to it; a point is occluded when
-// the depth buffer holds a surface in front of it. Applied to the ambient term only.
+// SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3): N points in a normal-oriented
+// hemisphere around each pixel's view-space position, most of them close to it; a point is
+// occluded when the depth buffer holds a surface in front of it. Applied to the ambient term
+// only.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 

@@ -1,13 +1,13 @@
-// SSDO (seed 002 eq. 1; seed 003 §4.1): N directions uniform over the normal's
-// hemisphere, each covering Δω = 2π/N, with sample points P + λ_i ω_i, λ_i ∈ [0, r_max].
-// A point below the visible surface (its projection moves towards the eye) blocks its
+// SSDO (Ritschel et al. 2009 eq. 1; Belonogov 2018 §4.1): N directions uniform over the
+// normal's hemisphere, each covering Δω = 2π/N, with sample points P + λ_i ω_i, λ_i ∈ [0,
+// r_max]. A point below the visible surface (its projection moves towards the eye) blocks its
 // direction; unblocked directions gather the environment radiance, pre-filtered to its
-// first two SH bands (seed 002 §7.2 asks for a smooth map;
+// first two SH bands (Ritschel et al. 2009 §7.2 asks for a smooth map;
 // `Environment::radiance_sh_prefiltered`). That is linear in ω, so Σ L(ω_i) cos θ_i needs
 // only the samples' moments Σc and Σcω: four adds per sample, and the colour is
 // evaluated once per pixel.
-// With the bounce (seed 002 eq. 2; seed 003 §4.2), in the same loop, each blocking
-// sample's surface sends the direct light stored at its pixel towards P: as eq. 2's
+// With the bounce (Ritschel et al. 2009 eq. 2; Belonogov 2018 §4.2), in the same loop, each
+// blocking sample's surface sends the direct light stored at its pixel towards P: as eq. 2's
 // patch of area π r_max²/N (BOUNCE_PATCH), or through the blocked direction's share of
 // the hemisphere, 2π/N, with the receiver's cosine towards the sender (the default;
 // settings.rs `BounceForm`). Both scale by the bounce strength.
@@ -52,8 +52,9 @@ fn gathered_radiance(layer: u32, m0: f32, m1: vec3<f32>) -> vec3<f32> {
 // Solid angle of a disc of radius² `a` seen on its axis from distance² `d2`:
 // 2π (1 − d / √(d² + a)), written without the cancellation at large d. It is the
 // patch's A/d² far away and at most 2π (a hemisphere) when the sender touches the
-// receiver, where A/d² diverges: seed 002 clamps d_i there, and a clamp at the patch's
-// own size cut the bounce from the nearest senders, which carry most of it, by up to 6×.
+// receiver, where A/d² diverges: Ritschel et al. 2009 clamps d_i there, and a clamp at the
+// patch's own size cut the bounce from the nearest senders, which carry most of it, by up to
+// 6×.
 fn disc_solid_angle(d2: f32, a: f32) -> f32 {
     let s = sqrt(d2 + a);
     return 2.0 * PI * a / (s * (s + sqrt(d2)));
@@ -61,12 +62,12 @@ fn disc_solid_angle(d2: f32, a: f32) -> f32 {
 
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the variant without).
 override BOUNCE: bool = false;
-// Seed 002 eq. 2's patch form of the bounce instead of the direction form.
+// The bounce in the patch form of Ritschel et al. 2009 eq. 2 instead of the direction form.
 override BOUNCE_PATCH: bool = false;
 
-// Depth peeling (seed 002 §4, passes/peel.rs): the second depth layer, the nearest surface
-// behind the first. With PEEL a sample is an occluder only between the two layers, inside
-// the object the first layer sees, not merely behind it: no halo around thin objects in
+// Depth peeling (Ritschel et al. 2009 §4, passes/peel.rs): the second depth layer, the nearest
+// surface behind the first. With PEEL a sample is an occluder only between the two layers,
+// inside the object the first layer sees, not merely behind it: no halo around thin objects in
 // front of a background. That inside test also replaces the range check: a sample inside
 // an object is within r of the receiver, so the object is a neighbour however far its
 // front face is. Nothing behind the first layer (depth 0) counts as infinitely thick.
@@ -89,8 +90,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = r.position + r.normal * bias;
     let samples = max(ao.samples, 1u);
     // Direction form: each direction covers 2π/N of the hemisphere. Patch form: each
-    // sender is a patch of area π r_max² / N (seed 002), seen as a disc of that area
-    // facing the receiver, `disc_radius2` its radius².
+    // sender is a patch of area π r_max² / N (Ritschel et al. 2009), seen as a disc of that
+    // area facing the receiver, `disc_radius2` its radius².
     let direction_solid_angle = 2.0 * PI / f32(samples);
     let disc_radius2 = ao.radius * ao.radius / f32(samples);
     // Cosine-weighted moments of all and of unblocked directions (view space).

@@ -1,7 +1,7 @@
-// Temporal accumulation of the occlusion by reverse reprojection (seed 001 §3.1). Each
+// Temporal accumulation of the occlusion by reverse reprojection (Lin's NCTU thesis §3.1). Each
 // occlusion pixel is carried to where its surface point was in the previous frame
 // (C = P_{t−1} V_{t−1} W_t); the history there is reused when it holds the same point,
-// ‖W_t − W_{t−1}‖ ≤ ε (seed 001 eq. 3, plus two pixel footprints at the pixel's
+// ‖W_t − W_{t−1}‖ ≤ ε (Lin's NCTU thesis eq. 3, plus two pixel footprints at the pixel's
 // distance), and blended with this frame's value. The technique turns its sampling
 // pattern each frame, so the blend averages different patterns. Disoccluded,
 // off-screen or non-finite history is discarded: the pixel starts again from this frame.
@@ -14,7 +14,7 @@ struct Temporal {
     epsilon: f32,
     confidence_bias: f32,
     max_frames: f32,
-    // 0: running mean of up to max_frames frames; 1: seed 001's confidence blend.
+    // 0: running mean of up to max_frames frames; 1: the confidence blend of Lin's NCTU thesis.
     blend: u32,
     // 0 when there is no usable previous frame (first frame, settings changed).
     history_valid: u32,

@@ -1,4 +1,4 @@
-// Reinhard's global operator with a white point (seed 000, eq. 2.4) on luminance,
+// Reinhard's global operator with a white point (the Czech SSDO thesis, eq. 2.4) on luminance,
 // then sRGB encoding. Exposure is the same for both eyes so they never disagree.
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -1,4 +1,4 @@
-//! Depth peeling for SSDO (seed 002 §4): a second depth layer per eye, and a sample
+//! Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer per eye, and a sample
 //! occludes only between the first and second layer. Checked against the reference
 //! tracer: a thin board floating in front of a wall casts no halo onto the wall with
 //! peeling; a closed box still darkens the floor beside it; the pass runs only when

@@ -249,7 +249,8 @@ struct CreaseBin {
     /// depth tests against the crease; HBAO: its march), and blurred like the AO.
     expected_raw: f64,
     expected_blurred: f64,
-    /// SSAO and SSDO: the closed forms `analytic::ss{a,d}o_crease_expectation_with_depth_scale`.
+    /// SSAO and SSDO: the closed forms
+    /// `analytic::ss{a,d}o_crease_expectation_with_depth_scale`.
     closed_raw: f64,
     /// Reference visibility (hits within r) and with HBAO's linear falloff, per pixel and
     /// blurred like the AO.
@@ -779,8 +780,8 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     let (_, patch_raw) = measure(&patch);
     let ratio = |c: [f64; 3]| c[0] / c[1];
     let gained: Vec<f64> = (0..3).map(|i| bounce_raw[i] - ssdo_raw[i]).collect();
-    // Seed 002's patch form carries the same red, less of it (tests/reference_error.rs
-    // compares both with the reference).
+    // The patch form of Ritschel et al. 2009 carries the same red, less of it
+    // (tests/reference_error.rs compares both with the reference).
     let patch_gained: Vec<f64> = (0..3).map(|i| patch_raw[i] - ssdo_raw[i]).collect();
     eprintln!("bounce: patch form gained {patch_gained:.3?}");
     assert!(
@@ -1272,7 +1273,8 @@ fn no_output_is_ever_nan_or_inf() {
             }
         }
         // Stiff settings: one sample and a micro radius, every sample and a huge radius,
-        // no bias with the strongest strength and widest blur, the tiled noise without range check.
+        // no bias with the strongest strength and widest blur, the tiled noise without range
+        // check.
         cases.push(("room", &room, AoSettings { half_res: true, ..ao(technique, 1, 1e-4) }));
         cases.push(("plane", &plane, ao(technique, 256, 1e4)));
         cases.push(("room", &room, AoSettings { bias: 0.0, strength: 4.0, blur_radius: 16, ..ao(technique, 12, 2.0) }));

@@ -57,7 +57,8 @@ fn every_technique_stays_within_its_stated_error_of_the_reference_on_the_crease(
     }
     // The reference includes the light the lit wall bounces onto the floor: only the
     // bounce brings it, so it must bring the ambient light closer to the reference, in
-    // either form; the direction form (the default) closer than seed 002's patch form.
+    // either form; the direction form (the default) closer than the patch form of
+    // Ritschel et al. 2009.
     let of = |t, n| ambient.iter().find(|(a, b, _)| *a == t && *b == n).unwrap().2;
     for n in [12, 36] {
         let patch = errors(Technique::SsdoBounce, n, BounceForm::Patch, &reference).ambient_rel_rmse.unwrap();

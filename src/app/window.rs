@@ -1,5 +1,5 @@
 //! The desktop window (winit) with its egui panel, showing the headset session in one of
-//! seed 003's display modes (§5.2): `mirror` (both eyes side by side, as the headset's
+//! Belonogov 2018's display modes (§5.2): `mirror` (both eyes side by side, as the headset's
 //! compositor shows them) or `single-pass` (the scene rendered once more, mono, from the
 //! head's viewpoint at the window's size). `none` never opens a window (see `main.rs`).
 //!
@@ -404,7 +404,8 @@ impl WindowState {
                 .forget_lifetime();
             let count = bind_groups.len().max(1) as f32;
             for (i, group) in bind_groups.iter().enumerate() {
-                // Each image gets an equal slot; within it, the largest rectangle of its aspect.
+                // Each image gets an equal slot; within it, the largest rectangle of its
+                // aspect.
                 let mono = self.panel.mode == DisplayMode::SinglePass && kind == PictureKind::Eye;
                 let aspect = if mono { aw / ah } else { eye_aspect };
                 let (slot_w, slot_h) = (aw / count, ah);

@@ -452,7 +452,7 @@ pub struct ErrorFigures {
     /// top or bottom border, where samples that leave the image count as open: with
     /// `ao_rmse`, what a guard band could win. `None` when no such pixel is covered.
     pub ao_rmse_outer_border: Option<f64>,
-    /// Halos: the share (0..1) of the pixels beside a depth edge ([`near_depth_edge`])
+    /// Halos: the share (0..1) of the pixels beside a depth edge (`near_depth_edge`)
     /// that are too dark by more than [`HALO_DARKER`]. `None` when there is no edge.
     pub halo_share: Option<f64>,
 }

@@ -49,8 +49,11 @@ pub enum Resource {
     /// and world position relative to the scene anchor with the accumulated frame count
     /// in w (`Rgba32Float`). These persist from one frame to the next.
     HistoryValueA,
+    /// The other half of `HistoryValueA`'s ping-pong pair.
     HistoryValueB,
+    /// Accumulated world position and frame count, one half of a ping-pong pair.
     HistoryPositionA,
+    /// The other half of `HistoryPositionA`'s ping-pong pair.
     HistoryPositionB,
     /// Light-space depth of each shadowed directional light (one layer per light, square,
     /// `--shadow-size` texels a side), `Depth32Float`, 0 nearest the light, 1 = nothing.
@@ -103,6 +106,7 @@ impl Resource {
         matches!(self, Resource::RsmIndirect | Resource::RsmGeometry)
     }
 
+    /// The name `--explain` and error messages use (`ao-raw`, `color`, …).
     pub fn name(self) -> &'static str {
         match self {
             Resource::Depth => "depth",
@@ -131,6 +135,7 @@ impl Resource {
         }
     }
 
+    /// The texture format the resource is allocated with.
     pub fn format(self) -> wgpu::TextureFormat {
         match self {
             Resource::Depth | Resource::DepthLayer2 => wgpu::TextureFormat::Depth32Float,
@@ -160,8 +165,11 @@ impl Resource {
 /// What a pass declares for one frame.
 #[derive(Clone, Debug)]
 pub struct PassDecl {
+    /// The pass's name, as `--explain` and the GPU timings show it.
     pub name: &'static str,
+    /// Resources the pass reads.
     pub reads: Vec<Resource>,
+    /// Resources the pass writes.
     pub writes: Vec<Resource>,
     /// `Some(reason)` when the scene or settings rule the pass out for this frame.
     pub disabled: Option<String>,
@@ -170,17 +178,21 @@ pub struct PassDecl {
 }
 
 impl PassDecl {
+    /// A pass that reads and writes nothing yet.
     pub fn new(name: &'static str) -> PassDecl {
         PassDecl { name, reads: Vec::new(), writes: Vec::new(), disabled: None, note: None }
     }
+    /// Adds a resource the pass reads.
     pub fn read(mut self, r: Resource) -> Self {
         self.reads.push(r);
         self
     }
+    /// Adds a resource the pass writes.
     pub fn write(mut self, r: Resource) -> Self {
         self.writes.push(r);
         self
     }
+    /// Adds what `--explain` says about work left out inside the pass.
     pub fn note(mut self, note: impl Into<String>) -> Self {
         self.note = Some(note.into());
         self
@@ -199,6 +211,7 @@ impl PassDecl {
 pub struct Plan {
     /// Indices into the declarations, in execution order.
     pub run: Vec<usize>,
+    /// Names of the passes that run, in execution order.
     pub names: Vec<&'static str>,
     /// Notes of running passes (work they leave out internally).
     pub notes: Vec<(&'static str, String)>,
@@ -209,6 +222,7 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// Whether the pass of this name runs.
     pub fn runs(&self, name: &str) -> bool {
         self.names.contains(&name)
     }

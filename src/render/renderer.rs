@@ -46,6 +46,7 @@ pub const DEFAULT_FRAMES_IN_FLIGHT: usize = 2;
 pub struct FrameReport {
     /// This frame's number (counts every frame the renderer submitted).
     pub frame: u64,
+    /// The passes this frame ran and those left out, with the reason for each.
     pub plan: Plan,
     /// (span, GPU milliseconds) per pass of this frame, plus per-eye spans where a pass
     /// runs per eye: filled by [`Renderer::render_and_wait`]; after [`Renderer::render`]
@@ -78,11 +79,16 @@ pub enum Timing {
 }
 
 impl FrameReport {
+    /// The GPU milliseconds of one span (a pass name, or "`<pass> left`"), if it was timed.
     pub fn gpu_ms_of(&self, span: &str) -> Option<f64> {
         self.gpu_ms.iter().find(|(s, _)| s == span).map(|(_, ms)| *ms)
     }
 }
 
+/// Renders stereo frames of one scene: owns the uploaded scene, the passes and their
+/// targets, and the frames still on the GPU. Make it with [`Renderer::new`], render with
+/// [`Renderer::render`] (frame loops) or [`Renderer::render_and_wait`] (measurements), and
+/// read a target back with [`Renderer::read_f32`] or [`Renderer::read_bytes`].
 pub struct Renderer {
     gpu: Arc<Gpu>,
     scene: Scene,
@@ -123,6 +129,9 @@ struct InFlight {
 }
 
 impl Renderer {
+    /// Uploads the scene and builds every pass for these settings (validated first). The
+    /// stereo mode is fixed here: multiview when the adapter draws it reliably and
+    /// [`StereoMode::Auto`] allows it.
     pub fn new(gpu: Arc<Gpu>, scene: &Scene, settings: &Settings) -> Result<Renderer> {
         settings.validate()?;
         let multiview = match settings.stereo {
@@ -208,10 +217,12 @@ impl Renderer {
         self.frame_index
     }
 
+    /// The GPU this renderer draws on.
     pub fn gpu(&self) -> &Arc<Gpu> {
         &self.gpu
     }
 
+    /// The settings the next frame renders with.
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
@@ -231,6 +242,7 @@ impl Renderer {
         Ok(())
     }
 
+    /// How the next frames are submitted and timed.
     pub fn set_timing(&mut self, timing: Timing) {
         self.timing = timing;
     }

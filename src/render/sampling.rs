@@ -1,5 +1,6 @@
-//! Sample patterns for the occlusion kernels: Halton sequences (seed 000 uses bases 2,
-//! 3 and 5), hemisphere kernels for SSAO and SSDO, and HBAO's directions × steps split.
+//! Sample patterns for the occlusion kernels: Halton sequences (the Czech SSDO thesis uses
+//! bases 2, 3 and 5), hemisphere kernels for SSAO and SSDO, and HBAO's directions × steps
+//! split.
 
 use std::f64::consts::PI;
 
@@ -20,15 +21,15 @@ pub fn halton(mut index: u32, base: u32) -> f64 {
 pub enum HemisphereDensity {
     /// pdf ∝ cos θ: every sample carries equal weight in a cosine-weighted integral (SSAO).
     Cosine,
-    /// Uniform in solid angle, each sample covering Δω = 2π/N (SSDO, seed 002).
+    /// Uniform in solid angle, each sample covering Δω = 2π/N (SSDO, Ritschel et al. 2009).
     Uniform,
 }
 
 /// `n` offsets in the unit hemisphere around +Z, as [x, y, z, length]: xyz is the unit
 /// direction and `length` in (0, 1] the fraction of the radius. Directions use Halton
 /// bases 2 (azimuth) and 5 (elevation) and lengths base 3, skipping index 0 so no sample
-/// sits on the pole. SSAO lengths crowd towards the centre (lerp(0.1, 1, t²), seed 003
-/// §4.6); SSDO's λ is uniform in [0, r_max] (seed 002).
+/// sits on the pole. SSAO lengths crowd towards the centre (lerp(0.1, 1, t²), Belonogov 2018
+/// §4.6); SSDO's λ is uniform in [0, r_max] (Ritschel et al. 2009).
 pub fn hemisphere_kernel(n: u32, density: HemisphereDensity) -> Vec<[f32; 4]> {
     hemisphere_kernel_part(0, n, density)
 }

@@ -27,7 +27,7 @@ impl std::str::FromStr for StereoMode {
     }
 }
 
-/// What the desktop window shows (seed 003 §5.2).
+/// What the desktop window shows (Belonogov 2018 §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DisplayMode {
     /// No window: the headset alone.
@@ -65,14 +65,14 @@ impl std::str::FromStr for DisplayMode {
 pub enum Technique {
     /// No occlusion pass: the ambient term is unoccluded.
     None,
-    /// Normal-oriented hemisphere SSAO (seed 003 §3.2, seed 000 ch. 3).
+    /// Normal-oriented hemisphere SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3).
     #[default]
     Ssao,
-    /// Horizon-based AO, directions × steps ray-marched in depth (seed 003 §3.3).
+    /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
     Hbao,
-    /// Screen-space directional occlusion of the environment (seed 002 eq. 1).
+    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
     Ssdo,
-    /// SSDO plus one indirect bounce in the same loop (seed 002 eq. 2).
+    /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
     SsdoBounce,
     /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
     FetchOnly,
@@ -120,13 +120,17 @@ impl std::str::FromStr for Technique {
     }
 }
 
-/// Sampling quality presets: seed 003's kernel sizes N = 12, 24, 36, 64.
+/// Sampling quality presets: Belonogov 2018's kernel sizes N = 12, 24, 36, 64.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Quality {
+    /// N = 12.
     Low,
+    /// N = 24 (the default).
     #[default]
     Medium,
+    /// N = 36.
     High,
+    /// N = 64.
     Ultra,
 }
 
@@ -164,9 +168,9 @@ impl std::str::FromStr for Quality {
 /// Where each pixel's kernel rotation comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Noise {
-    /// A 5×5 tile of rotations repeated over the screen (seed 003).
+    /// A 5×5 tile of rotations repeated over the screen (Belonogov 2018).
     Tiled5x5,
-    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (seed 000).
+    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (the Czech SSDO thesis).
     #[default]
     Halton,
 }
@@ -185,9 +189,9 @@ impl std::str::FromStr for Noise {
 /// How SSDO's bounce weighs a blocking sample's sender.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BounceForm {
-    /// Seed 002 eq. 2: a patch of area π r²/N × strength at the sender pixel, weighted by
-    /// the sender and receiver cosines over d² (as a disc's solid angle, so a sender
-    /// touching the receiver stays bounded).
+    /// Ritschel et al. 2009 eq. 2: a patch of area π r²/N × strength at the sender pixel,
+    /// weighted by the sender and receiver cosines over d² (as a disc's solid angle, so a
+    /// sender touching the receiver stays bounded).
     Patch,
     /// The sender's radiance through the blocked direction's share of the hemisphere,
     /// 2π/N, × the receiver's cosine towards the sender, as eq. 1 treats unblocked
@@ -226,7 +230,8 @@ pub enum Denoise {
     /// (shaders/denoise.wgsl).
     #[default]
     Tile,
-    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; seed 000).
+    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; the Czech SSDO
+    /// thesis).
     Bilateral,
 }
 
@@ -253,6 +258,7 @@ impl std::str::FromStr for Denoise {
 /// Occlusion parameters shared by every technique.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AoSettings {
+    /// Which technique estimates the occlusion.
     pub technique: Technique,
     /// Depth taps per pixel, 1..=256 (a quality preset sets it).
     pub samples: u32,
@@ -269,11 +275,12 @@ pub struct AoSettings {
     pub bounce: f32,
     /// How the bounce weighs its senders.
     pub bounce_form: BounceForm,
+    /// Where each pixel's kernel rotation comes from.
     pub noise: Noise,
     /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
     pub half_res: bool,
-    /// Depth peeling for SSDO (seed 002 §4): a second depth layer, and a sample occludes
-    /// only between the first and second layer (inside an object). Off by default.
+    /// Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer, and a sample
+    /// occludes only between the first and second layer (inside an object). Off by default.
     pub depth_peeling: bool,
     /// Which spatial denoise runs.
     pub denoise: Denoise,
@@ -284,7 +291,7 @@ pub struct AoSettings {
     /// fraction of the centre's distance, loses most of its weight. Near 0 every
     /// neighbour's weight vanishes and the centre value is kept.
     pub blur_plane_sigma: f32,
-    /// Temporal accumulation by reverse reprojection (seed 001 §3.1).
+    /// Temporal accumulation by reverse reprojection (Lin's NCTU thesis §3.1).
     pub temporal: Temporal,
     /// GTAO: how far behind each depth sample the surface counts as solid, as a fraction
     /// of the radius (thin objects stop occluding behind themselves).
@@ -310,7 +317,7 @@ pub enum TemporalBlend {
     /// counts equally, so N frames of n samples approach one frame of N·n.
     #[default]
     Average,
-    /// Seed 001 eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
+    /// Lin's NCTU thesis eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
     /// V = c·V_{t−1} + (1 − c)·V_t.
     Confidence,
 }
@@ -329,16 +336,19 @@ impl std::str::FromStr for TemporalBlend {
 /// Temporal accumulation settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Temporal {
+    /// Accumulate occlusion over frames (off by default).
     pub enabled: bool,
-    /// Disocclusion threshold ε in metres on the world-position distance (seed 001 eq. 3).
-    /// The pass also allows two pixel footprints at the pixel's distance (an extension:
-    /// a fixed ε would reject every distant pixel, whose neighbour is centimetres away).
+    /// Disocclusion threshold ε in metres on the world-position distance (Lin's NCTU
+    /// thesis eq. 3). The pass also allows two pixel footprints at the pixel's distance (an
+    /// extension: a fixed ε would reject every distant pixel, whose neighbour is
+    /// centimetres away).
     pub epsilon_m: f32,
+    /// How a pixel's history and this frame's value are blended.
     pub blend: TemporalBlend,
     /// Frames after which a pixel counts as converged: the mean stops growing and
     /// becomes a moving average over this many frames.
     pub max_frames: u32,
-    /// Seed 001's confidence bias (only for the confidence blend).
+    /// The confidence bias of Lin's NCTU thesis (only for the confidence blend).
     pub confidence_bias: f32,
     /// Motion-adaptive window of the running mean: a pixel that moved m occlusion
     /// pixels since the last frame keeps at most max_frames / (1 + m / motion_px)
@@ -365,7 +375,9 @@ impl Default for Temporal {
 /// it costs no RMSE and leaves fewer halos (pixels beside depth edges too dark by > 0.1
 /// on the furnished room: 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
 pub const DEFAULT_THICKNESS: f32 = 0.75;
+/// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
 pub const DEFAULT_STEP_POWER: f32 = 1.5;
+/// GTAO's default: successive samples closer than this fraction of the radius are joined.
 pub const DEFAULT_CONNECT: f32 = 0.25;
 
 impl Default for AoSettings {
@@ -395,6 +407,7 @@ impl Default for AoSettings {
 }
 
 impl AoSettings {
+    /// Checks every value's range; the error names the value and its range.
     pub fn validate(&self) -> Result<()> {
         if !(1..=256).contains(&self.samples) {
             return Err(Error::input(format!("samples {} is not within 1..=256", self.samples)));
@@ -463,10 +476,16 @@ impl AoSettings {
     }
 }
 
+/// Everything a frame is rendered with: the headset, the stereo path, tone mapping,
+/// occlusion and shadows. Start from [`Settings::default`] and change what you need;
+/// [`Settings::validate`] (also run by
+/// [`Renderer::new`](crate::render::renderer::Renderer::new)) rejects values out of range
+/// with a one-line error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// The headset's per-eye size, refresh rate, IPD and fields of view.
     pub profile: HeadsetProfile,
+    /// How the G-buffer reaches both eye layers.
     pub stereo: StereoMode,
     /// Near plane in metres (the far plane is at infinity).
     pub near: f64,
@@ -474,13 +493,14 @@ pub struct Settings {
     pub exposure: f32,
     /// Reinhard's L_white: the smallest (exposed) luminance mapped to white.
     pub white_point: f32,
+    /// Ambient occlusion: technique, samples, radius, denoise, resolution, temporal.
     pub ao: AoSettings,
     /// Shadow maps and reflective shadow maps of directional lights.
     pub shadows: ShadowSettings,
 }
 
-/// Shadow maps with PCF (seed 000) and reflective shadow maps (seed 001) for the
-/// scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
+/// Shadow maps with PCF (the Czech SSDO thesis) and reflective shadow maps (Lin's NCTU thesis)
+/// for the scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
 /// directional light has neither, whatever these say.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadowSettings {
@@ -503,6 +523,7 @@ impl Default for ShadowSettings {
 }
 
 impl ShadowSettings {
+    /// Checks the map size, the RSM samples and the RSM radius.
     pub fn validate(&self) -> Result<()> {
         if !(16..=8192).contains(&self.size) {
             return Err(Error::input(format!("shadow map size {} is not within 16..=8192", self.size)));

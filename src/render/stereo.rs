@@ -13,11 +13,14 @@ pub const DEFAULT_NEAR: f64 = 0.05;
 /// The pose looks down its local −Z with +Y up.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeadPose {
+    /// World-space position in metres.
     pub position: DVec3,
+    /// World-from-local rotation (unit quaternion).
     pub orientation: DQuat,
 }
 
 impl HeadPose {
+    /// At the origin, looking down world −Z with +Y up.
     pub const IDENTITY: HeadPose = HeadPose { position: DVec3::ZERO, orientation: DQuat::IDENTITY };
 
     /// A pose at `eye` looking towards `target`, with world +Y as up (or +Z when looking
@@ -49,9 +52,13 @@ impl HeadPose {
 /// negative for a view that contains its own axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Fov {
+    /// Angle of the left edge (negative left of the view axis).
     pub left: f32,
+    /// Angle of the right edge.
     pub right: f32,
+    /// Angle of the top edge.
     pub up: f32,
+    /// Angle of the bottom edge (negative below the view axis).
     pub down: f32,
 }
 
@@ -66,6 +73,7 @@ impl Fov {
         Fov { left: -self.right, right: -self.left, up: self.up, down: self.down }
     }
 
+    /// Checks that every angle is finite and within ±90° and that the view is not empty.
     pub fn validate(&self) -> Result<(), String> {
         let half = std::f32::consts::FRAC_PI_2;
         for (name, a) in [("left", self.left), ("right", self.right), ("up", self.up), ("down", self.down)] {
@@ -119,15 +127,20 @@ pub fn view_position_from_depth(uv: [f64; 2], depth: f64, fov: &Fov, near: f64) 
 /// Which eye; the index is also the texture-array layer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EyeSide {
+    /// The left eye, layer 0.
     Left = 0,
+    /// The right eye, layer 1.
     Right = 1,
 }
 
 /// One eye: its pose in world space and its field of view.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Eye {
+    /// Which eye (and texture-array layer) this is.
     pub side: EyeSide,
+    /// The eye's own pose in world space.
     pub pose: HeadPose,
+    /// The eye's asymmetric field of view.
     pub fov: Fov,
 }
 
@@ -165,7 +178,9 @@ impl Eye {
 /// Both eyes of one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EyePair {
+    /// Left, then right.
     pub eyes: [Eye; 2],
+    /// Near plane in metres (the far plane is at infinity).
     pub near: f64,
 }
 
@@ -193,15 +208,21 @@ impl EyePair {
 /// Named real headsets are in `xr::profiles` (above this module).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeadsetProfile {
+    /// Short name (`vive`, `index`, …).
     pub name: &'static str,
+    /// Per-eye render width in pixels.
     pub width: u32,
+    /// Per-eye render height in pixels.
     pub height: u32,
     /// The rate in use; `budget_ms` follows it.
     pub refresh_hz: f64,
     /// The rates the headset can run at (`with_refresh` picks among them).
     pub refresh_rates_hz: &'static [f64],
+    /// Interpupillary distance in metres.
     pub ipd: f64,
+    /// The left eye's field of view.
     pub fov_left: Fov,
+    /// The right eye's field of view.
     pub fov_right: Fov,
 }
 
@@ -209,8 +230,8 @@ impl HeadsetProfile {
     /// An HTC Vive-class headset: 1080×1200 per eye at 90 Hz. The frustum is 52° up and
     /// down, 45° towards the nose, and outward as wide as square pixels require.
     /// Size: the Vive's own config, `eye_target_width/height_in_pixels` 1080×1200
-    /// (https://gist.github.com/ChristophHaag/c6235817421f2ce5da839772eff48f40); 90 Hz: its
-    /// hmdq dump (https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html). The
+    /// (<https://gist.github.com/ChristophHaag/c6235817421f2ce5da839772eff48f40>); 90 Hz: its
+    /// hmdq dump (<https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html>). The
     /// frustum is an approximation kept as is because earlier measurements used it (the
     /// dump measures 54.4° out, 46.8° nasal, 55.7° up, 55.9° down).
     pub fn vive() -> HeadsetProfile {
@@ -267,6 +288,8 @@ impl HeadsetProfile {
         1000.0 / self.refresh_hz
     }
 
+    /// Both eyes of this headset for a head pose: [`EyePair::from_head`] with its IPD and
+    /// fields of view.
     pub fn eyes(&self, head: &HeadPose, near: f64) -> EyePair {
         EyePair::from_head(head, self.ipd, self.fov_left, self.fov_right, near)
     }

@@ -2,7 +2,7 @@
 //! refresh rates the headset supports and the one it runs at by default.
 //!
 //! Fields of view are the frustum tangents a runtime reported for the left eye, as dumped
-//! by hmdq into the HMD Geometry Database (https://risa2000.github.io/hmdgdb/); that is what
+//! by hmdq into the HMD Geometry Database (<https://risa2000.github.io/hmdgdb/>); that is what
 //! an app gets from the runtime (OpenVR's GetProjectionRaw, OpenXR's xrLocateViews). The right
 //! eye is the left eye mirrored: each dump's right eye matches that to within 0.3°.
 

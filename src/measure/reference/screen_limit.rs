@@ -1,5 +1,5 @@
 //! The *screen-space limit*: the AO that a brute-force march over a frame's own depth
-//! buffer gives, for the pixels of a [`ReferenceImage`](super::ReferenceImage)'s grid.
+//! buffer gives, for the pixels of a [`ReferenceImage`]'s grid.
 //!
 //! Screen space sees one depth layer per eye. What no depth-buffer method can know (the
 //! back of anything, what lies behind a surface, what is off the image) is as unknown
@@ -27,7 +27,7 @@
 //! directions can reach (cosine weight ≲ 1e-4 of the hemisphere). A ray is blocked at its
 //! first blocked step; steps off the image, in front of the near plane or on the sky are
 //! open (the ray stops when it leaves the image: the image of a segment is a segment, and
-//! the image is convex). AO = unblocked rays / M, as the reference's 1 − (1/π)∫[hit]cos θ dω.
+//! the image is convex). AO = unblocked rays / M, as the reference's 1 − (1/π)∫\[hit\]cos θ dω.
 //!
 //! Thickness: the depth buffer cannot say how deep anything is. A step counts only within
 //! a finite thickness behind the visible surface, so an object in front of a far wall does

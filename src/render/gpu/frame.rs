@@ -280,15 +280,15 @@ fn other_from_view(views: &[Eye], index: usize) -> Mat4 {
 }
 
 /// HBAO's turn of its directions this frame (radians): the golden angle (137.5°) per frame.
-/// Seed 001 turns it 10° per frame; measured on the room (SSAO N = 8, 135×150 per eye),
-/// 10° steps leave successive patterns so alike that 8 frames cut the noise only from
+/// Lin's NCTU thesis turns it 10° per frame; measured on the room (SSAO N = 8, 135×150 per
+/// eye), 10° steps leave successive patterns so alike that 8 frames cut the noise only from
 /// 0.037 to 0.029, while golden-angle steps reach 0.012 (the 1/√8 of independent ones).
 pub fn temporal_angle(frame_index: u64) -> f32 {
     ((frame_index as f64 * 137.507_764f64).rem_euclid(360.0)).to_radians() as f32
 }
 
-/// Seed 001's range jitter (HBAO): the sample lengths scale by a factor in [0.9, 1] that follows
-/// the golden-ratio sequence, so successive frames reach different depths.
+/// The range jitter of Lin's NCTU thesis (HBAO): the sample lengths scale by a factor in [0.9,
+/// 1] that follows the golden-ratio sequence, so successive frames reach different depths.
 pub fn temporal_range_scale(frame_index: u64) -> f32 {
     let golden = 0.618_033_988_749_895_f64;
     (1.0 - 0.1 * (frame_index as f64 * golden).fract()) as f32

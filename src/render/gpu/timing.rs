@@ -97,7 +97,7 @@ impl PassTimer {
     }
 }
 
-/// Per-eye spans (a pass run once per eye) are labelled "<pass> left" / "<pass> right".
+/// Per-eye spans (a pass run once per eye) are labelled "`<pass> left`" / "`<pass> right`".
 pub fn is_per_eye(label: &str) -> bool {
     label.ends_with(" left") || label.ends_with(" right")
 }

@@ -48,6 +48,8 @@ impl DenoiseKernels {
     }
 }
 
+/// The spatial denoise of the occlusion: the tile denoise or the separable bilateral blur
+/// (module docs).
 pub struct BlurPass {
     /// The tile denoise by whether the occlusion carries light in rgb (SSDO) or AO alone.
     tile: [DenoiseKernels; 2],
@@ -55,6 +57,7 @@ pub struct BlurPass {
 }
 
 impl BlurPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         BlurPass {
             tile: [false, true].map(|carries_light| {

@@ -19,6 +19,8 @@ use crate::render::graph::{PassDecl, Resource};
 use std::sync::Mutex;
 use wgpu::util::DeviceExt;
 
+/// The composite: direct light plus the occluded ambient term in HDR, upsampling half-
+/// resolution AO inline (module docs).
 pub struct CompositePass {
     /// Variants by (half resolution, RSM bounce): pipeline constants, so a frame without
     /// them runs none of their code.
@@ -61,6 +63,7 @@ const SLOTS: [Slot; 15] = [
 ];
 
 impl CompositePass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "irradiance.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
         let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);

@@ -10,12 +10,14 @@ use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 use std::sync::Arc;
 
+/// Direct light of every light, shadowed where shadow maps exist (module docs).
 pub struct DirectLightPass {
     kernel: Kernel,
     light_space: Arc<LightSpace>,
 }
 
 impl DirectLightPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> Self {
         let slots = [
             Slot::Uniform,

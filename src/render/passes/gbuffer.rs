@@ -14,6 +14,8 @@ use wgpu::util::DeviceExt;
 
 const COLOR_TARGETS: [Resource; 3] = [Resource::Normals, Resource::Albedo, Resource::Emission];
 
+/// The G-buffer of both eyes: depth, normals, albedo and emission, multiview or one pass per
+/// eye (module docs).
 pub struct GBufferPass {
     frame_group: wgpu::BindGroup,
     /// One pass for both layers; `None` when the adapter lacks multiview.
@@ -24,6 +26,7 @@ pub struct GBufferPass {
 }
 
 impl GBufferPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
         let device = &gpu.device;
         let vs_fs = wgpu::ShaderStages::VERTEX_FRAGMENT;

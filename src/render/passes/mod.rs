@@ -27,7 +27,9 @@ use std::collections::BTreeMap;
 
 /// What passes may consult when declaring themselves for a frame.
 pub struct FrameSetup<'a> {
+    /// The scene being rendered.
     pub scene: &'a Scene,
+    /// This frame's settings.
     pub settings: &'a Settings,
     /// 2 for stereo, 1 for a mono view.
     pub views: u32,
@@ -43,12 +45,19 @@ pub struct FrameSetup<'a> {
 
 /// Everything a pass records with.
 pub struct FrameContext<'a> {
+    /// The device and queue.
     pub gpu: &'a Gpu,
+    /// The encoder the pass records into (with serial timing, a fresh one per pass).
     pub encoder: &'a mut wgpu::CommandEncoder,
+    /// The targets the graph allocated for this frame.
     pub targets: &'a BTreeMap<Resource, LayeredTarget>,
+    /// The frame's uniform and light buffers.
     pub frame: &'a FrameBuffers,
+    /// The scene uploaded to the GPU.
     pub scene: &'a GpuScene,
+    /// Timestamp scopes around each pass.
     pub timer: &'a PassTimer,
+    /// What the passes were declared with.
     pub setup: &'a FrameSetup<'a>,
 }
 
@@ -58,6 +67,7 @@ impl<'a> FrameContext<'a> {
         self.targets.get(&r).unwrap_or_else(|| panic!("{} was not allocated; the pass did not declare it", r.name()))
     }
 
+    /// The array view of a resource's target, for a bind group.
     pub fn view(&self, r: Resource) -> wgpu::BindingResource<'a> {
         wgpu::BindingResource::TextureView(&self.target(r).array_view)
     }
@@ -117,7 +127,11 @@ pub fn reuses_left_eye_upsample(settings: &Settings, layers: u32) -> bool {
     ao.stereo_reuse && ao.half_res && layers == 2 && ao.technique != Technique::None && !ao.technique.carries_light()
 }
 
+/// One pass of the frame graph: declares what it reads and writes for a frame, and
+/// records its GPU work when the plan keeps it.
 pub trait Pass {
+    /// What the pass reads and writes this frame, and whether it runs at all.
     fn declare(&self, setup: &FrameSetup) -> PassDecl;
+    /// Records the pass's commands into the frame's encoder.
     fn record(&self, ctx: &mut FrameContext);
 }

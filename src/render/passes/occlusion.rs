@@ -1,7 +1,8 @@
 //! The screen-space occlusion techniques that share one binding layout
-//! (shaders/occlusion.wgsl): SSAO (seed 003 §3.2, seed 000 ch. 3), HBAO (seed 003 §3.3),
-//! GTAO with a visibility bitmask and the fetch-only benchmark baseline. Each technique itself is its WGSL file; SSDO,
-//! which also reads the direct light, is `ssdo.rs`.
+//! (shaders/occlusion.wgsl): SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3), HBAO
+//! (Belonogov 2018 §3.3), GTAO with a visibility bitmask and the fetch-only benchmark baseline.
+//! Each technique itself is its WGSL file; SSDO, which also reads the direct light, is
+//! `ssdo.rs`.
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::gtao_inner_band;
@@ -66,7 +67,9 @@ struct GtaoKernels {
     right_eye: Kernel,
 }
 
-/// A technique's pipelines: one, or GTAO's three.
+/// A technique's pipelines: one, or GTAO's three. One value per pass, made once, so
+/// the size difference between the variants costs nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 enum Kernels {
     One(Kernel),
     Gtao(GtaoKernels),
@@ -84,14 +87,17 @@ impl OcclusionPass {
         OcclusionPass { technique, kernels: Kernels::One(kernel) }
     }
 
+    /// The occlusion pass of SSAO (shaders/ssao.wgsl).
     pub fn ssao(gpu: &Gpu) -> Self {
         Self::new(gpu, Technique::Ssao, "ssao.wgsl")
     }
 
+    /// The occlusion pass of HBAO (shaders/hbao.wgsl).
     pub fn hbao(gpu: &Gpu) -> Self {
         Self::new(gpu, Technique::Hbao, "hbao.wgsl")
     }
 
+    /// The occlusion pass of GTAO (shaders/gtao.wgsl), its three pipelines.
     pub fn gtao(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "occlusion.wgsl", "gtao.wgsl"];
         let label = Technique::Gtao.name();

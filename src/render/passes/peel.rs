@@ -1,4 +1,4 @@
-//! Depth peeling for SSDO (seed 002 §4): a second depth layer per eye, the nearest
+//! Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
 //! surface behind the G-buffer's depth (shaders/peel.wgsl). With it SSDO counts a sample
 //! as an occluder only between the first and second layer, inside an object, so thin
 //! objects in front of a background no longer cast a halo onto it. An optional quality
@@ -16,6 +16,7 @@ use crate::render::graph::{PassDecl, Resource};
 use crate::render::settings::Technique;
 use wgpu::util::DeviceExt;
 
+/// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
     pipeline: wgpu::RenderPipeline,
     frame_group: wgpu::BindGroup,
@@ -25,6 +26,7 @@ pub struct DepthPeelPass {
 }
 
 impl DepthPeelPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, frame: &FrameBuffers) -> Self {
         let device = &gpu.device;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

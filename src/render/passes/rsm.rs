@@ -1,4 +1,4 @@
-//! One bounce of directional light from reflective shadow maps (seed 001 §3.3,
+//! One bounce of directional light from reflective shadow maps (Lin's NCTU thesis §3.3,
 //! shaders/rsm.wgsl): at half resolution per axis, each pixel gathers N virtual point
 //! lights from the light-space pass's maps in a disk of radius R, with a pattern turned
 //! per pixel and per frame. The composite upsamples the irradiance (3×3 joint
@@ -25,15 +25,17 @@ struct RsmParamsUniform {
     _pad: [f32; 3],
 }
 
+/// One bounce of directional light from reflective shadow maps (module docs).
 pub struct RsmPass {
     kernel: Kernel,
     light_space: Arc<LightSpace>,
     params: wgpu::Buffer,
-    /// Frames this pass has gathered: turns the sampling pattern (seed 001).
+    /// Frames this pass has gathered: turns the sampling pattern (Lin's NCTU thesis).
     frame: Cell<u32>,
 }
 
 impl RsmPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> RsmPass {
         let slots = [
             Slot::Uniform,

@@ -1,6 +1,6 @@
-//! Shadow maps with 3×3 PCF (seed 000 §2.1, §5.1) and reflective shadow maps (seed 001
-//! §3.3) for the scene's directional lights: one light-space pass renders, per shadowed
-//! light, an orthographic depth map and, when reflective shadow maps are on, each
+//! Shadow maps with 3×3 PCF (the Czech SSDO thesis §2.1, §5.1) and reflective shadow maps
+//! (Lin's NCTU thesis §3.3) for the scene's directional lights: one light-space pass renders,
+//! per shadowed light, an orthographic depth map and, when reflective shadow maps are on, each
 //! texel's normal and flux. The direct pass looks the depth up (shaders/shadow.wgsl);
 //! the RSM gather (`rsm.rs`) turns the texels into virtual point lights.
 //!

@@ -1,5 +1,5 @@
-//! SSDO, with the optional bounce gathered in the same loop (seed 002 eqs. 1–2,
-//! seed 003 §4.1–4.2). The technique itself is shaders/ssdo.wgsl; a bounce strength of
+//! SSDO, with the optional bounce gathered in the same loop (Ritschel et al. 2009 eqs. 1–2,
+//! Belonogov 2018 §4.1–4.2). The technique itself is shaders/ssdo.wgsl; a bounce strength of
 //! 0 selects the pipeline compiled without bounce work, which also does not read the
 //! direct light, so the graph need not produce it for an occlusion-only frame.
 
@@ -11,6 +11,7 @@ use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 use crate::render::settings::{BounceForm, Technique};
 
+/// SSDO, with its bounce when the technique asks for it (module docs).
 pub struct SsdoPass {
     /// Pipelines by [depth peeling][bounce: none, direction form, patch form]: pipeline
     /// constants, so a frame runs no code of what it left out.
@@ -36,6 +37,7 @@ const SLOTS: [Slot; 9] = [
 ];
 
 impl SsdoPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         let files = ["common.wgsl", "irradiance.wgsl", "occlusion.wgsl", "ssdo.wgsl"];
         let no_direct = LayeredTarget::placeholder(&gpu.device, "no direct light", Resource::Direct.format());

@@ -1,4 +1,4 @@
-//! Temporal accumulation (seed 001 §3.1; shaders/temporal.wgsl): the occlusion of this
+//! Temporal accumulation (Lin's NCTU thesis §3.1; shaders/temporal.wgsl): the occlusion of this
 //! frame blended with the history reprojected from the previous frame. The history is
 //! two pairs of targets (value, world position + frame count) that swap roles every
 //! frame; they persist between frames because the renderer keeps targets whose size
@@ -28,6 +28,7 @@ struct TemporalUniform {
     _pad: u32,
 }
 
+/// Temporal accumulation of the occlusion by reverse reprojection (module docs).
 pub struct TemporalPass {
     kernel: Kernel,
     uniform: wgpu::Buffer,
@@ -45,6 +46,7 @@ fn history(frame_index: u64) -> ([Resource; 2], [Resource; 2]) {
 }
 
 impl TemporalPass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> TemporalPass {
         let slots = [
             Slot::Uniform,

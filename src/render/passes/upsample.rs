@@ -1,4 +1,4 @@
-//! 3×3 joint bilateral upsampling of half-resolution occlusion (seed 000) into a
+//! 3×3 joint bilateral upsampling of half-resolution occlusion (the Czech SSDO thesis) into a
 //! full-resolution target (shaders/upsample.wgsl). Frames upsample inside the composite
 //! instead, so the graph runs this pass only when AoFull itself is asked for (debug
 //! images, tests).
@@ -9,6 +9,7 @@ use crate::render::gpu::kernel::{Kernel, Slot};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 
+/// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
 pub struct UpsamplePass {
     kernel: Kernel,
     /// The right eye's dispatch that reuses the left eye's result.
@@ -16,6 +17,7 @@ pub struct UpsamplePass {
 }
 
 impl UpsamplePass {
+    /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         let slots = [
             Slot::Uniform,

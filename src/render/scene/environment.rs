@@ -129,8 +129,8 @@ impl Environment {
 
     /// Radiance (times `intensity`) as nine SH coefficients, low-passed to its first two
     /// bands (weights 1, 0.75, 0: band 1 as a three-band Hann window has it, band 2
-    /// dropped): the pre-filtered environment SSDO reads once per sample direction (seed
-    /// 002 asks for a pre-smoothed map). A linear function of the direction, so SSDO
+    /// dropped): the pre-filtered environment SSDO reads once per sample direction
+    /// (Ritschel et al. 2009 ask for a pre-smoothed map). A linear function of the direction, so SSDO
     /// sums it from the directions' first moments alone (the band-2 moments cost SSDO
     /// ≈ 8 % of its time on lavapipe at N = 12; the window gave band 2 only a quarter
     /// weight anyway). Evaluate with [`sh9_basis`] and clamp at 0.

@@ -24,8 +24,11 @@ pub use environment::Environment;
 /// placed far from the world origin keeps full f32 precision near the camera.
 #[derive(Clone, Debug)]
 pub struct Mesh {
+    /// Name from the source file (or the builtin's name).
     pub name: String,
+    /// World position (f64) that `positions` are relative to.
     pub origin: DVec3,
+    /// Vertex positions relative to `origin`.
     pub positions: Vec<Vec3>,
     /// Unit normals, one per position.
     pub normals: Vec<Vec3>,
@@ -52,13 +55,18 @@ impl Mesh {
 /// An RGBA8 texture in sRGB encoding, row-major from the top-left texel.
 #[derive(Clone, Debug)]
 pub struct Texture {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// `width × height` texels, four bytes each.
     pub rgba8: Vec<u8>,
 }
 
+/// A diffuse material, as an MTL entry describes it.
 #[derive(Clone, Debug)]
 pub struct Material {
+    /// Name from the source file (or the builtin's name).
     pub name: String,
     /// Linear diffuse reflectance (MTL `Kd`), each channel in [0, 1].
     pub diffuse: Vec3,
@@ -69,18 +77,34 @@ pub struct Material {
 }
 
 impl Material {
+    /// A material of one diffuse colour, neither emissive nor textured.
     pub fn plain(name: &str, diffuse: Vec3) -> Self {
         Material { name: name.into(), diffuse, emissive: Vec3::ZERO, diffuse_texture: None }
     }
 }
 
+/// A light source of the scene.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     /// Light arriving along `direction` (unit, pointing from the light into the scene);
     /// `intensity` is the irradiance on a surface facing it.
-    Directional { direction: Vec3, color: Vec3, intensity: f32 },
+    Directional {
+        /// Unit direction of travel, from the light into the scene.
+        direction: Vec3,
+        /// Linear RGB colour.
+        color: Vec3,
+        /// Irradiance on a surface facing the light.
+        intensity: f32,
+    },
     /// An isotropic point light; `intensity` is radiant intensity (irradiance at 1 m).
-    Point { position: DVec3, color: Vec3, intensity: f32 },
+    Point {
+        /// World position in metres.
+        position: DVec3,
+        /// Linear RGB colour.
+        color: Vec3,
+        /// Radiant intensity (irradiance at 1 m).
+        intensity: f32,
+    },
 }
 
 impl Light {
@@ -94,25 +118,33 @@ impl Light {
 /// Axis-aligned bounds in world space (f64).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The smallest corner (+∞ for empty bounds).
     pub min: DVec3,
+    /// The largest corner (−∞ for empty bounds).
     pub max: DVec3,
 }
 
 impl Aabb {
+    /// Bounds of nothing: extending them by a point gives that point.
     pub const EMPTY: Aabb = Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
+    /// Whether no point has been added.
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x
     }
+    /// Grows the bounds to contain `p`.
     pub fn extend(&mut self, p: DVec3) {
         self.min = self.min.min(p);
         self.max = self.max.max(p);
     }
+    /// The bounds of both.
     pub fn union(&self, o: &Aabb) -> Aabb {
         Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
+    /// The centre point.
     pub fn center(&self) -> DVec3 {
         (self.min + self.max) * 0.5
     }
+    /// Edge lengths along x, y and z.
     pub fn size(&self) -> DVec3 {
         self.max - self.min
     }
@@ -146,6 +178,7 @@ pub struct HeadPath {
 }
 
 impl HeadPath {
+    /// A head that stays at one pose.
     pub fn fixed(pose: HeadPose) -> Self {
         HeadPath { keys: vec![(0.0, pose)] }
     }
@@ -169,17 +202,27 @@ impl HeadPath {
     }
 }
 
+/// Everything rendered: meshes, their materials, lights, an optional environment and
+/// the head's path. Load one with [`Scene::load`] (`builtin:NAME`, a `.toml` scene file
+/// or an `.obj`).
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// Name from the source file (or the builtin's name).
     pub name: String,
+    /// The triangle meshes.
     pub meshes: Vec<Mesh>,
+    /// Materials, indexed by [`Mesh::material`].
     pub materials: Vec<Material>,
+    /// Directional and point lights (a default sun when the source names none).
     pub lights: Vec<Light>,
+    /// Distant environment light (ambient and SSDO's incoming radiance), if any.
     pub environment: Option<Environment>,
+    /// The head pose over time (one key for a still head).
     pub head: HeadPath,
 }
 
 impl Scene {
+    /// World-space bounds of every mesh.
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
         for m in &self.meshes {
@@ -198,6 +241,7 @@ impl Scene {
         ((0.08 * diagonal) as f32).clamp(0.01, 1.0)
     }
 
+    /// Triangles over all meshes.
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.indices.len() / 3).sum()
     }
