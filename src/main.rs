@@ -286,7 +286,7 @@ struct BenchArgs {
 struct RenderArgs {
     /// A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box,
     /// furnished, columns, flipped-normals).
-    #[arg(long, default_value = "builtin:room")]
+    #[arg(long, default_value = vrao::render::scene::RENDER_DEFAULT)]
     scene: String,
     /// Output directory.
     #[arg(long, default_value = "out")]
