@@ -123,4 +123,3 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
     }
     Ok(written)
 }
-

@@ -39,9 +39,15 @@ pub fn missing_capabilities(support: &AdapterSupport) -> Vec<String> {
         missing.push("compute shaders (DownlevelFlags::COMPUTE_SHADERS)".to_string());
     }
     for &format in &STORAGE_WRITE_FORMATS {
-        let flags = support.formats.iter().find(|(f, _)| *f == format).map_or(wgpu::TextureFormatFeatureFlags::empty(), |&(_, flags)| flags);
+        let flags = support
+            .formats
+            .iter()
+            .find(|(f, _)| *f == format)
+            .map_or(wgpu::TextureFormatFeatureFlags::empty(), |&(_, flags)| flags);
         if !flags.contains(wgpu::TextureFormatFeatureFlags::STORAGE_WRITE_ONLY) {
-            missing.push(format!("write-only {format:?} storage textures (TextureFormatFeatureFlags::STORAGE_WRITE_ONLY)"));
+            missing.push(format!(
+                "write-only {format:?} storage textures (TextureFormatFeatureFlags::STORAGE_WRITE_ONLY)"
+            ));
         }
     }
     // Every AO pass reads depth with `textureLoad`, which naga's GLSL writer cannot
