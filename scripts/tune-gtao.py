@@ -22,6 +22,8 @@ import tempfile
 import time
 
 SHARED = os.environ.get("VRAO_SCENES", os.path.join(os.path.dirname(__file__), "..", "..", "shared", "scenes"))
+# The scene files name the public scenes as "$VRAO_SCENES/...": the binary needs the variable.
+os.environ["VRAO_SCENES"] = os.path.abspath(SHARED)
 DEFAULT_SCENES = [
     "builtin:crease",
     "builtin:furnished",

@@ -286,7 +286,7 @@ struct BenchArgs {
 struct RenderArgs {
     /// A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box,
     /// furnished, columns, flipped-normals).
-    #[arg(long, default_value = "builtin:room")]
+    #[arg(long, default_value = vrao::render::scene::RENDER_DEFAULT)]
     scene: String,
     /// Output directory.
     #[arg(long, default_value = "out")]
@@ -601,11 +601,7 @@ fn render(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;
     renderer.set_timing(args.timing.resolve(&gpu));
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
-    let mut outputs = vec![Resource::Color];
-    if args.debug {
-        outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
-        outputs.extend(vrao::render::output::occlusion_outputs(&settings));
-    }
+    let outputs = vrao::render::output::outputs(&settings, args.debug);
     // Warm-up frames (pipeline compilation, first-touch allocation) are not measured.
     let warmup = if args.frames > 1 { (args.frames / 10).clamp(1, 10) } else { 0 };
     let mut timings = Vec::new();

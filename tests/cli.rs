@@ -67,6 +67,10 @@ fn render_writes_both_eyes_and_explains_the_graph() {
         let image = image::open(out_dir.join(format!("{name}.png"))).unwrap_or_else(|e| panic!("{name}.png: {e}"));
         assert_eq!((image.width(), image.height()), (96, 108), "{name}.png size");
     }
+    for name in ["ao_left", "ao_right"] {
+        assert!(out_dir.join(format!("{name}.png")).is_file(), "the final AO is written beside the eyes");
+    }
+    assert!(t.contains(&format!("wrote {}", out_dir.join("ao_left.png").display())), "says where: {t}");
     assert!(t.contains("ran       gbuffer") && t.contains("ran       tonemap"), "{t}");
     let left = std::fs::read(out_dir.join("left.png")).unwrap();
     let right = std::fs::read(out_dir.join("right.png")).unwrap();

@@ -319,15 +319,24 @@ fn sibenik_loads_flat() {
     assert!((bounds.min.y + 15.3123).abs() < 1e-3 && (bounds.max.x - 20.1411).abs() < 1e-3, "{bounds:?}");
 }
 
+/// The public scenes' folder as scene files see it (`$VRAO_SCENES`, which
+/// .cargo/config.toml sets for `cargo test`), or `None` after saying why the test is skipped.
+fn vrao_scenes() -> Option<PathBuf> {
+    let dir = std::env::var_os("VRAO_SCENES").map(PathBuf::from).filter(|d| d.join("sibenik/sibenik.obj").is_file());
+    if dir.is_none() {
+        assert!(std::env::var_os("CI").is_none(), "VRAO_SCENES does not name the public scenes");
+        eprintln!("skipped: VRAO_SCENES does not name the public scenes");
+    }
+    dir
+}
+
 #[test]
 fn example_scene_files_load() {
-    // The examples name the shared scenes by their place beside the repository.
-    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes");
-    if !assets.join("../../../shared/scenes/sibenik/sibenik.obj").is_file() {
-        assert!(std::env::var_os("CI").is_none(), "../shared/scenes is missing");
-        eprintln!("skipped: ../shared/scenes not found beside the repository");
+    // cornell.toml and sibenik.toml name the public scenes as "$VRAO_SCENES/...".
+    if vrao_scenes().is_none() {
         return;
     }
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes");
     let cornell = load(&assets.join("cornell.toml")).unwrap();
     assert_eq!(cornell.triangle_count(), 36);
     assert!(matches!(cornell.lights.as_slice(), [Light::Point { .. }]));
@@ -337,4 +346,58 @@ fn example_scene_files_load() {
     assert!(matches!(sibenik.lights.as_slice(), [Light::Directional { .. }]));
     let eye = sibenik.head.keys[0].1.position;
     assert!(sibenik.bounds().min.y < eye.y - 1.5, "standing on the floor");
+}
+
+/// Copies the directory `from` to `to`, recursively.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+#[test]
+fn scene_files_render_from_a_copy_of_assets_outside_the_repository() {
+    let Some(scenes) = vrao::render::scene::shared_scenes_dir() else {
+        assert!(std::env::var_os("CI").is_none(), "../shared/scenes is missing");
+        eprintln!("skipped: the public scenes are not beside the repository and VRAO_SCENES is unset");
+        return;
+    };
+    let scenes = scenes.canonicalize().unwrap();
+    let dir = TempDir::new("assets-copy");
+    copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets"), &dir.0.join("assets"));
+    let vrao = |scene: &Path, vrao_scenes: Option<&Path>| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_vrao"));
+        command.args(["render", "--width", "64", "--height", "64", "--out"]).arg(dir.0.join("out"));
+        command.arg("--scene").arg(scene).env_remove("VRAO_SCENES");
+        if let Some(v) = vrao_scenes {
+            command.env("VRAO_SCENES", v);
+        }
+        let out = command.output().unwrap();
+        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        (out.status.code(), text)
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.0.join("assets/scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 4, "{files:?}");
+    for file in &files {
+        let (code, text) = vrao(file, Some(&scenes));
+        assert_eq!(code, Some(0), "{}: {text}", file.display());
+    }
+    // Unset, the variable is named in one line with the file and line that needs it.
+    let cornell = dir.0.join("assets/scenes/cornell.toml");
+    let (code, text) = vrao(&cornell, None);
+    assert_eq!(code, Some(2), "{text}");
+    assert_eq!(text.lines().filter(|l| !l.trim().is_empty()).count(), 1, "{text}");
+    assert!(text.contains("VRAO_SCENES") && text.contains("cornell.toml:"), "{text}");
 }

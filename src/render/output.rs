@@ -63,12 +63,27 @@ pub fn occlusion_to_rgba(occlusion: &[f32]) -> Vec<u8> {
         .collect()
 }
 
-/// Writes `left.png` and `right.png` (or `mono.png` for one view), and with `debug`
-/// the depth, normals and albedo of each view. Returns the files written.
+/// What `vrao render` asks of a frame: the eyes' colour, the final AO (written beside
+/// the eyes) and, with `debug`, depth, normals, albedo and the raw AO.
+pub fn outputs(settings: &Settings, debug: bool) -> Vec<Resource> {
+    let mut outputs = vec![Resource::Color];
+    if debug {
+        outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
+        outputs.extend(occlusion_outputs(settings));
+    } else {
+        outputs.extend(crate::render::passes::final_occlusion(settings));
+    }
+    outputs
+}
+
+/// Writes `left.png` and `right.png` (or `mono.png` for one view) and, when a technique
+/// ran, the final AO as grey beside them (`ao_left.png`, `ao_right.png`): the picture of
+/// what the technique adds. With `debug` also the depth, normals, albedo and raw AO of
+/// each view. Returns the files written.
 pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(out).map_err(|e| Error::Output { path: out.into(), message: e.to_string() })?;
-    let profile = &renderer.settings().profile;
-    let (w, h) = (profile.width, profile.height);
+    let settings = renderer.settings();
+    let (w, h) = (settings.profile.width, settings.profile.height);
     let names: &[&str] = if views == 2 { &EYE_NAMES } else { &["mono"] };
     let mut written = Vec::new();
     let mut save_sized = |name: String, (w, h): (u32, u32), rgba: Vec<u8>| -> Result<()> {
@@ -77,30 +92,33 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
         written.push(path);
         Ok(())
     };
-    let mut save = |name: String, rgba: Vec<u8>| save_sized(name, (w, h), rgba);
     for (name, rgba) in names.iter().zip(renderer.read_bytes(Resource::Color)?) {
-        save(format!("{name}.png"), rgba)?;
+        save_sized(format!("{name}.png"), (w, h), rgba)?;
+    }
+    let occlusion = match settings.ao.technique {
+        Technique::None => Vec::new(),
+        // The final AO first; with `debug` also the raw AO before blur or upsampling.
+        _ if debug => occlusion_outputs(settings),
+        _ => crate::render::passes::final_occlusion(settings).into_iter().collect(),
+    };
+    for r in occlusion.into_iter().rev() {
+        let target = renderer.target(r).expect("occlusion was rendered");
+        let size = (target.width, target.height);
+        let label = if Some(r) == crate::render::passes::final_occlusion(settings) { "ao" } else { "ao_raw" };
+        for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
+            save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
+        }
     }
     if debug {
-        let near = renderer.settings().near;
+        let near = settings.near;
         for (name, depth) in names.iter().zip(renderer.read_f32(Resource::Depth)?) {
-            save(format!("depth_{name}.png"), depth_to_rgba(&depth, near))?;
+            save_sized(format!("depth_{name}.png"), (w, h), depth_to_rgba(&depth, near))?;
         }
         for (name, normals) in names.iter().zip(renderer.read_f32(Resource::Normals)?) {
-            save(format!("normals_{name}.png"), normals_to_rgba(&normals))?;
+            save_sized(format!("normals_{name}.png"), (w, h), normals_to_rgba(&normals))?;
         }
         for (name, albedo) in names.iter().zip(renderer.read_bytes(Resource::Albedo)?) {
-            save(format!("albedo_{name}.png"), albedo)?;
-        }
-        if renderer.settings().ao.technique != Technique::None {
-            for r in occlusion_outputs(renderer.settings()) {
-                let target = renderer.target(r).expect("occlusion was rendered");
-                let size = (target.width, target.height);
-                let label = if r == Resource::AoRaw { "ao_raw" } else { "ao" };
-                for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
-                    save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
-                }
-            }
+            save_sized(format!("albedo_{name}.png"), (w, h), albedo)?;
         }
     }
     Ok(written)

@@ -8,6 +8,7 @@ pub mod multiview_probe;
 pub mod raster;
 pub mod readback;
 pub mod scene;
+pub mod support;
 pub mod targets;
 pub mod timing;
 
@@ -209,7 +210,9 @@ impl Gpu {
     }
 }
 
-/// Prefers a hardware adapter; a CPU adapter (lavapipe) is the fall-back.
+/// Prefers a hardware adapter; a CPU adapter (lavapipe) is the fall-back. Adapters that
+/// lack something the renderer needs ([`support::missing_capabilities`]) are passed over;
+/// when only such adapters exist, the best one is refused with what it lacks.
 fn pick_adapter(instance: &wgpu::Instance, backends: wgpu::Backends) -> Result<wgpu::Adapter> {
     let adapters = pollster::block_on(instance.enumerate_adapters(backends));
     let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
@@ -219,18 +222,29 @@ fn pick_adapter(instance: &wgpu::Instance, backends: wgpu::Backends) -> Result<w
         wgpu::DeviceType::Other => 3,
         wgpu::DeviceType::Cpu => 4,
     };
-    adapters
+    let mut ranked: Vec<(wgpu::Adapter, Vec<String>)> = adapters
         .into_iter()
-        .filter(|a| {
-            // The renderer needs compute shaders and storage textures.
-            let d = a.get_downlevel_capabilities();
-            d.flags.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS)
+        .map(|a| {
+            let missing = support::missing_capabilities(&support::AdapterSupport::of(&a));
+            (a, missing)
         })
-        .min_by_key(rank)
-        .ok_or_else(|| {
-            Error::Device(format!(
-                "no adapter with compute shaders on backends {backends:?}; install a Vulkan driver \
-                 (for a CPU fall-back: apt install mesa-vulkan-drivers)"
-            ))
-        })
+        .collect();
+    ranked.sort_by_key(|(a, missing)| (!missing.is_empty(), rank(a)));
+    match ranked.into_iter().next() {
+        Some((adapter, missing)) if missing.is_empty() => Ok(adapter),
+        Some((adapter, missing)) => {
+            let info = adapter.get_info();
+            Err(Error::Device(format!(
+                "the {:?} adapter {} lacks {}; use Vulkan (--backend vulkan; for a CPU fall-back: apt \
+                 install mesa-vulkan-drivers)",
+                info.backend,
+                info.name,
+                missing.join(" and ")
+            )))
+        }
+        None => Err(Error::Device(format!(
+            "no adapter on backends {backends:?}; install a Vulkan driver \
+             (for a CPU fall-back: apt install mesa-vulkan-drivers)"
+        ))),
+    }
 }

@@ -1,12 +1,21 @@
 //! TOML scene files: meshes (OBJ files or built-in sets) placed in the world, lights, an
 //! environment and the head pose. Unknown keys are errors, so a typo does not silently
-//! fall back to a default. Paths are relative to the scene file.
+//! fall back to a default.
+//!
+//! Paths: a path is relative to the scene file, so a scene and the files it names move
+//! together; a path that begins with `$VRAO_SCENES/` names a file among the public scenes
+//! (Cornell box, Sibenik, the HDR maps: the repository does not carry them), under the
+//! folder the environment variable `VRAO_SCENES` names, wherever that is on this machine.
+//! With the variable unset such a path is an error that names the variable; there is no
+//! built-in fall-back, so a copied binary and a copied `assets/` behave alike. Inside this
+//! repository `.cargo/config.toml` sets it to `../shared/scenes` for `cargo run` and
+//! `cargo test`.
 //!
 //! ```toml
 //! name = "cornell"                 # optional; default: the file name without extension
 //!
 //! [[mesh]]                         # any number; each is an OBJ or a built-in scene's meshes
-//! obj = "models/box.obj"           # or: builtin = "plane" | "crease" | "room" | "sphere" | "box"
+//! obj = "models/box.obj"           # or "$VRAO_SCENES/cornell_box/CornellBox-Original.obj"; or: builtin = "plane" | "crease" | "room" | "sphere" | "box"
 //!                                  #   | "furnished" | "columns" | "flipped-normals" (meshes and
 //!                                  #   materials only: lights and head come from this file)
 //! translate = [0.0, 0.0, 0.0]      # metres (optional)
@@ -46,7 +55,7 @@ use crate::render::stereo::HeadPose;
 use glam::{DMat3, DVec3, EulerRot};
 use serde::Deserialize;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 #[derive(Deserialize)]
@@ -191,6 +200,22 @@ impl From<String> for Failure {
     }
 }
 
+/// The prefix of paths among the public scenes (see the top of this file).
+pub const SCENES_PREFIX: &str = "$VRAO_SCENES/";
+
+/// Where the path `value` of a `what` entry points: under `$VRAO_SCENES` for a path with
+/// [`SCENES_PREFIX`], otherwise relative to the scene file's `directory`.
+fn resolve(directory: &Path, what: &str, value: &str) -> std::result::Result<PathBuf, String> {
+    let Some(rest) = value.strip_prefix(SCENES_PREFIX) else { return Ok(directory.join(value)) };
+    match std::env::var_os("VRAO_SCENES").filter(|v| !v.is_empty()) {
+        Some(scenes) => Ok(PathBuf::from(scenes).join(rest)),
+        None => Err(format!(
+            "{what} '{value}' is among the public scenes: set VRAO_SCENES to the folder that holds them \
+             (cornell_box/, sibenik/, envmaps/)"
+        )),
+    }
+}
+
 fn load_mesh_entry(
     entry: &MeshEntry,
     directory: &Path,
@@ -199,7 +224,7 @@ fn load_mesh_entry(
     let transform = entry.transform()?;
     let (mut meshes, materials) = match (&entry.obj, &entry.builtin) {
         (Some(obj), None) => {
-            let file = directory.join(obj);
+            let file = resolve(directory, "mesh obj", obj)?;
             if !file.is_file() {
                 return Err(Failure::Here(format!("mesh obj '{obj}' not found (looked for {})", file.display())));
             }
@@ -313,7 +338,7 @@ fn load_environment(entry: &EnvironmentEntry, directory: &Path) -> std::result::
     let intensity = non_negative("environment intensity", entry.intensity.unwrap_or(1.0))?;
     match (&entry.hdr, entry.sky.as_deref()) {
         (Some(hdr), None) => {
-            let file = directory.join(hdr);
+            let file = resolve(directory, "environment hdr", hdr)?;
             if !file.is_file() {
                 return Err(Failure::Here(format!(
                     "environment hdr '{hdr}' not found (looked for {})",

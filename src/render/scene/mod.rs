@@ -268,6 +268,11 @@ impl Scene {
     }
 }
 
+/// The scene `vrao render` draws when none is named: the furnished room, whose table and
+/// chairs on thin legs, blind, shelves and room corners show what AO adds (contact shadows,
+/// crevices, corners) where the near-empty `room` shows almost nothing.
+pub const RENDER_DEFAULT: &str = "builtin:furnished";
+
 /// The shared scene directory (`../shared/scenes` beside the repository, or `$VRAO_SCENES`),
 /// when it exists.
 pub fn shared_scenes_dir() -> Option<PathBuf> {

@@ -1,0 +1,102 @@
+//! Whether an adapter can run the renderer, decided from what it reports before any
+//! pipeline is built: an adapter that cannot is refused with one line naming what it
+//! lacks, instead of a screen of validation errors from the first frame.
+
+/// Formats the compute kernels write as `texture_storage_2d_array<FORMAT, write>`
+/// (`Slot::Output`): colour, the AO targets and history, world positions, and the
+/// packed direct light.
+pub const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
+    wgpu::TextureFormat::Rgba8Unorm,
+    wgpu::TextureFormat::Rgba16Float,
+    wgpu::TextureFormat::Rgba32Float,
+    wgpu::TextureFormat::Rg32Uint,
+];
+
+/// What an adapter reports that the renderer depends on, as plain data so the decision
+/// can be tested without one.
+#[derive(Clone, Debug)]
+pub struct AdapterSupport {
+    pub backend: wgpu::Backend,
+    pub downlevel: wgpu::DownlevelFlags,
+    /// The format features of each of [`STORAGE_WRITE_FORMATS`].
+    pub formats: Vec<(wgpu::TextureFormat, wgpu::TextureFormatFeatureFlags)>,
+}
+
+impl AdapterSupport {
+    pub fn of(adapter: &wgpu::Adapter) -> AdapterSupport {
+        AdapterSupport {
+            backend: adapter.get_info().backend,
+            downlevel: adapter.get_downlevel_capabilities().flags,
+            formats: STORAGE_WRITE_FORMATS.iter().map(|&f| (f, adapter.get_texture_format_features(f).flags)).collect(),
+        }
+    }
+}
+
+/// What the renderer needs that `support` lacks, one phrase each; empty when it can run.
+pub fn missing_capabilities(support: &AdapterSupport) -> Vec<String> {
+    let mut missing = Vec::new();
+    if !support.downlevel.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
+        missing.push("compute shaders (DownlevelFlags::COMPUTE_SHADERS)".to_string());
+    }
+    for &format in &STORAGE_WRITE_FORMATS {
+        let flags = support
+            .formats
+            .iter()
+            .find(|(f, _)| *f == format)
+            .map_or(wgpu::TextureFormatFeatureFlags::empty(), |&(_, flags)| flags);
+        if !flags.contains(wgpu::TextureFormatFeatureFlags::STORAGE_WRITE_ONLY) {
+            missing.push(format!(
+                "write-only {format:?} storage textures (TextureFormatFeatureFlags::STORAGE_WRITE_ONLY)"
+            ));
+        }
+    }
+    // Every AO pass reads depth with `textureLoad`, which naga's GLSL writer cannot
+    // translate; no adapter flag says so, so the backend itself is the capability.
+    if support.backend == wgpu::Backend::Gl {
+        missing.push("textureLoad on depth textures (not translatable to GLSL)".to_string());
+    }
+    missing
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wgpu::TextureFormatFeatureFlags as F;
+
+    fn support(backend: wgpu::Backend, rg32uint: F) -> AdapterSupport {
+        let all = F::STORAGE_READ_ONLY | F::STORAGE_WRITE_ONLY | F::STORAGE_READ_WRITE;
+        AdapterSupport {
+            backend,
+            downlevel: wgpu::DownlevelFlags::all(),
+            formats: STORAGE_WRITE_FORMATS
+                .iter()
+                .map(|&f| (f, if f == wgpu::TextureFormat::Rg32Uint { rg32uint } else { all }))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_full_vulkan_adapter_lacks_nothing() {
+        assert!(missing_capabilities(&support(wgpu::Backend::Vulkan, F::STORAGE_WRITE_ONLY)).is_empty());
+    }
+
+    #[test]
+    fn gl_as_mesa_reports_it_lacks_rg32uint_storage_and_depth_loads() {
+        // What llvmpipe's GL 4.5 adapter reports: Rg32Uint is renderable but not storage.
+        let gl = support(wgpu::Backend::Gl, F::MULTISAMPLE_X4 | F::MULTISAMPLE_RESOLVE);
+        let missing = missing_capabilities(&gl);
+        assert_eq!(missing.len(), 2, "{missing:?}");
+        assert!(missing[0].contains("Rg32Uint") && missing[0].contains("STORAGE_WRITE_ONLY"), "{missing:?}");
+        assert!(missing[1].contains("textureLoad on depth"), "{missing:?}");
+    }
+
+    #[test]
+    fn no_compute_and_unreported_formats_are_named() {
+        let mut s = support(wgpu::Backend::Vulkan, F::STORAGE_WRITE_ONLY);
+        s.downlevel = wgpu::DownlevelFlags::empty();
+        s.formats.clear();
+        let missing = missing_capabilities(&s);
+        assert!(missing[0].contains("COMPUTE_SHADERS"), "{missing:?}");
+        assert_eq!(missing.len(), 1 + STORAGE_WRITE_FORMATS.len(), "{missing:?}");
+    }
+}
