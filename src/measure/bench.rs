@@ -20,6 +20,11 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
 
+mod run;
+pub use run::{
+    cases, format_duration, replot, run_bench, version, write_outputs, BenchOptions, BenchRun, ReferenceOptions,
+};
+
 /// One configuration of the sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchCase {
