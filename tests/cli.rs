@@ -278,3 +278,27 @@ fn main_rs_is_a_thin_dispatcher() {
         assert!(lines <= 600, "{} has {lines} lines", path.display());
     }
 }
+
+#[test]
+fn command_line_names_are_the_names_reports_print() {
+    use clap::ValueEnum;
+    use vrao::render::settings::{BounceForm, Denoise, DisplayMode, Quality, Technique};
+    fn check<T: ValueEnum + Copy + std::fmt::Debug>(all: &[T], name: impl Fn(T) -> &'static str) {
+        for &v in all {
+            let typed = v.to_possible_value().expect("no hidden variants");
+            assert_eq!(typed.get_name(), name(v), "{v:?}");
+            assert!(T::from_str(name(v), false).is_ok(), "{v:?}");
+        }
+    }
+    check(&Technique::ALL, Technique::name);
+    check(&Quality::ALL, Quality::name);
+    check(&BounceForm::ALL, BounceForm::name);
+    check(&Denoise::ALL, Denoise::name);
+    check(&DisplayMode::ALL, DisplayMode::name);
+    check(&vrao::xr::simulated::motion::HeadMotion::ALL, vrao::xr::simulated::motion::HeadMotion::name);
+    check(&vrao::app::BufferView::ALL, vrao::app::BufferView::name);
+    // Bench files name techniques; the governor parses them back.
+    for t in Technique::ALL {
+        assert_eq!(t.name().parse::<Technique>(), Ok(t));
+    }
+}

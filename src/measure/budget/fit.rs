@@ -73,7 +73,7 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
     let mut settings = settings.clone();
     let fit = match fit_file {
         Some((file, path)) => {
-            let fit = fit_setting(&file, path, &gpu, &settings, budget_ms, options.occlusion_only, &measure)?;
+            let fit = fit_setting(&file, path, &gpu, &settings, budget_ms, options.occlusion_only, measure)?;
             settings.ao = fit.ao.clone();
             Some(fit)
         }
