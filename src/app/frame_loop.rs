@@ -18,37 +18,27 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// Which headset `vrao run` drives.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum HeadsetChoice {
     /// OpenXR when a runtime answers, the simulated headset otherwise.
     #[default]
     Auto,
     /// OpenXR or an error (exit 2).
+    #[value(name = "openxr")]
     OpenXr,
     /// The simulated headset; OpenXR is never touched.
     Simulated,
 }
 
-impl std::str::FromStr for HeadsetChoice {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "auto" => Ok(HeadsetChoice::Auto),
-            "openxr" => Ok(HeadsetChoice::OpenXr),
-            "simulated" => Ok(HeadsetChoice::Simulated),
-            other => Err(format!("unknown headset '{other}' (expected auto, openxr or simulated)")),
-        }
-    }
-}
-
 /// What the desktop window shows of each eye (`vrao run --show`, the panel's "show"):
 /// the eye images, or one of the buffers behind them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum BufferView {
     /// The eye images (or, in the mirror, what the headset's compositor shows).
     #[default]
     Eyes,
     /// The occlusion the composite applies (blurred, upsampled or accumulated), as grey.
+    #[value(name = "ao")]
     FinalAo,
     /// The occlusion as the technique computed it, before any filter, as grey.
     RawAo,
@@ -83,16 +73,6 @@ impl BufferView {
             BufferView::Depth => Some(Resource::Depth),
             BufferView::Normals => Some(Resource::Normals),
         }
-    }
-}
-
-impl std::str::FromStr for BufferView {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        BufferView::ALL
-            .into_iter()
-            .find(|v| v.name() == s)
-            .ok_or_else(|| format!("unknown buffer '{s}' (expected eyes, ao, raw-ao, depth or normals)"))
     }
 }
 

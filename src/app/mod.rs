@@ -4,6 +4,8 @@
 mod frame_loop;
 pub mod governor;
 mod panel;
+mod session;
 pub mod window;
 
 pub use frame_loop::*;
+pub use session::{run_session, RunOptions};

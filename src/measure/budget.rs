@@ -15,6 +15,9 @@ use crate::render::renderer::{FrameReport, Renderer, Timing};
 use crate::render::stereo::EyePair;
 use serde::{Deserialize, Serialize};
 
+mod fit;
+pub use fit::{fit_setting, measure_budget, BudgetOptions, BudgetOutcome, Fit};
+
 /// Per-pass times of one budget run.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PassTimes {
@@ -56,6 +59,18 @@ pub struct BudgetReport {
 impl BudgetReport {
     pub fn within_budget(&self) -> bool {
         self.verdicts.iter().all(|v| v.pass)
+    }
+
+    /// `None` within budget; otherwise what is over it, as the error `vrao budget` exits 3 with.
+    pub fn over_budget(&self) -> Option<crate::render::error::Error> {
+        let over: Vec<&str> = self.verdicts.iter().filter(|v| !v.pass).map(|v| v.what.as_str()).collect();
+        (!over.is_empty()).then(|| {
+            crate::render::error::Error::OverBudget(format!(
+                "{} over the {:.3} ms stereo frame budget",
+                over.join(", "),
+                self.budget_ms
+            ))
+        })
     }
 
     /// The table `vrao budget` prints.

@@ -137,6 +137,20 @@ pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove])
     Ok(rows)
 }
 
+/// `vrao reprojection`: [`measure`] the [`default_movements`] from `scene`'s head pose
+/// at time 0 on a new device; also returns the adapter's name.
+pub fn study(
+    backend: crate::render::gpu::BackendChoice,
+    scene: &crate::render::scene::Scene,
+    settings: &crate::render::settings::Settings,
+) -> Result<(Vec<ReprojectionError>, String)> {
+    settings.validate()?;
+    let gpu = std::sync::Arc::new(crate::render::gpu::Gpu::new(backend)?);
+    let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
+    let rows = measure(&mut renderer, &scene.head.pose_at(0.0), &default_movements())?;
+    Ok((rows, gpu.adapter.get_info().name))
+}
+
 /// The benchmark's movements: rotations of 1–10° and translations of 1–10 cm.
 pub fn default_movements() -> Vec<HeadMove> {
     let steps = [1.0, 2.0, 5.0, 10.0];

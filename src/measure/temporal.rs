@@ -100,6 +100,64 @@ pub fn convergence(
     Ok(points)
 }
 
+/// The configurations `vrao temporal` compares, named: spatial-only settings (with and
+/// without blur, and with 4× the samples) next to temporal accumulation (averaged, with
+/// and without blur, and blended by confidence), all at `base`'s sample count N.
+pub fn configurations(base: &Settings) -> Vec<(String, Settings)> {
+    use crate::render::settings::TemporalBlend;
+    let n = base.ao.samples;
+    let blur = base.ao.blur_radius;
+    let with = |temporal: bool, blend: TemporalBlend, samples: u32, blur: u32| {
+        let mut s = base.clone();
+        s.ao.samples = samples;
+        s.ao.blur_radius = blur;
+        s.ao.temporal.enabled = temporal;
+        s.ao.temporal.blend = blend;
+        s
+    };
+    vec![
+        (format!("spatial N={n}, blur"), with(false, TemporalBlend::Average, n, blur)),
+        (format!("spatial N={n}, no blur"), with(false, TemporalBlend::Average, n, 0)),
+        (format!("spatial N={}, blur (4× the samples)", 4 * n), with(false, TemporalBlend::Average, 4 * n, blur)),
+        (format!("temporal N={n}, no blur"), with(true, TemporalBlend::Average, n, 0)),
+        (format!("temporal N={n}, blur"), with(true, TemporalBlend::Average, n, blur)),
+        (format!("temporal N={n}, confidence blend, no blur"), with(true, TemporalBlend::Confidence, n, 0)),
+    ]
+}
+
+/// The points of a temporal study and the adapter that measured them.
+#[derive(Clone, Debug)]
+pub struct TemporalStudy {
+    pub points: Vec<ConvergencePoint>,
+    pub adapter: String,
+}
+
+/// `vrao temporal`: [`convergence`] of every one of [`configurations`]`(base)` with a
+/// static head and with a yaw sweep, against a reference of `rays` rays per pixel at
+/// every 2nd pixel (cached in `cache`).
+pub fn study(
+    backend: crate::render::gpu::BackendChoice,
+    scene: &Scene,
+    base: &Settings,
+    rays: u32,
+    cache: &Path,
+) -> Result<TemporalStudy> {
+    base.validate()?;
+    let configurations = configurations(base);
+    for (_, s) in &configurations {
+        s.validate()?;
+    }
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let reference =
+        ReferenceSettings { radius: base.ao.radius as f64, rays_per_pixel: rays, stride: 2, near: base.near };
+    let mut points = Vec::new();
+    for motion in [HeadMotion::Static, HeadMotion::YawSweep] {
+        eprintln!("temporal: {} ({} configurations × 16 frames)", motion.name(), configurations.len());
+        points.extend(convergence(&gpu, scene, &configurations, motion, &reference, cache)?);
+    }
+    Ok(TemporalStudy { points, adapter: gpu.adapter.get_info().name })
+}
+
 /// A Markdown table: one row per configuration, one column per checkpoint, each cell
 /// "error against the reference / noise against the converged estimator".
 pub fn to_markdown(points: &[ConvergencePoint]) -> String {

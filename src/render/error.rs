@@ -34,8 +34,9 @@ impl Error {
     }
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Input { .. } | Error::Device(_) => EXIT_INPUT,
-            Error::Gpu(_) | Error::Output { .. } => 1,
+            // An output that cannot be written is the path the user gave (or its disk).
+            Error::Input { .. } | Error::Device(_) | Error::Output { .. } => EXIT_INPUT,
+            Error::Gpu(_) => 1,
             Error::OverBudget(_) => EXIT_OVER_BUDGET,
         }
     }

@@ -13,3 +13,4 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod stereo;
+pub mod still;

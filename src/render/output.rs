@@ -123,3 +123,10 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
     }
     Ok(written)
 }
+
+/// Writes `value` as pretty JSON to `path`; a failure names the path.
+pub fn write_json<T: serde::Serialize + ?Sized>(path: &Path, value: &T) -> Result<()> {
+    let json =
+        serde_json::to_string_pretty(value).map_err(|e| Error::Output { path: path.into(), message: e.to_string() })?;
+    std::fs::write(path, json).map_err(|e| Error::Output { path: path.into(), message: format!("cannot write: {e}") })
+}

@@ -78,6 +78,31 @@ pub enum Timing {
     Serial,
 }
 
+/// A [`Timing`], or `Auto`: decided once the adapter is known ([`TimingChoice::resolve`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum TimingChoice {
+    /// Serial on CPU adapters, pipelined on GPUs.
+    #[default]
+    Auto,
+    /// Always [`Timing::Pipelined`].
+    Pipelined,
+    /// Always [`Timing::Serial`].
+    Serial,
+}
+
+impl TimingChoice {
+    /// `Auto` is serial on CPU adapters, whose timestamps between passes in one
+    /// submission credit work to the wrong pass (lavapipe 22.x), and pipelined elsewhere.
+    pub fn resolve(self, gpu: &Gpu) -> Timing {
+        match self {
+            TimingChoice::Pipelined => Timing::Pipelined,
+            TimingChoice::Serial => Timing::Serial,
+            TimingChoice::Auto if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu => Timing::Serial,
+            TimingChoice::Auto => Timing::Pipelined,
+        }
+    }
+}
+
 impl FrameReport {
     /// The GPU milliseconds of one span (a pass name, or "`<pass> left`"), if it was timed.
     pub fn gpu_ms_of(&self, span: &str) -> Option<f64> {

@@ -4,7 +4,7 @@ use crate::render::error::{Error, Result};
 use crate::render::stereo::{HeadsetProfile, DEFAULT_NEAR};
 
 /// How the G-buffer reaches both eye layers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum StereoMode {
     /// Multiview when the adapter has it, one pass per eye otherwise.
     #[default]
@@ -15,20 +15,8 @@ pub enum StereoMode {
     Multipass,
 }
 
-impl std::str::FromStr for StereoMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(StereoMode::Auto),
-            "multiview" => Ok(StereoMode::Multiview),
-            "multipass" => Ok(StereoMode::Multipass),
-            other => Err(format!("unknown stereo mode '{other}' (expected auto, multiview or multipass)")),
-        }
-    }
-}
-
 /// What the desktop window shows (Belonogov 2018 §5.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum DisplayMode {
     /// No window: the headset alone.
     #[default]
@@ -50,18 +38,8 @@ impl DisplayMode {
     }
 }
 
-impl std::str::FromStr for DisplayMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        DisplayMode::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown display mode '{s}' (expected none, mirror or single-pass)"))
-    }
-}
-
 /// The occlusion technique.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Technique {
     /// No occlusion pass: the ambient term is unoccluded.
     None,
@@ -111,17 +89,19 @@ impl Technique {
     ];
 }
 
+/// Bench files name their techniques, and the governor and `vrao budget --fit` read them
+/// back; the names are the command line's (clap's `ValueEnum`).
 impl std::str::FromStr for Technique {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
+        <Technique as clap::ValueEnum>::from_str(s, false).map_err(|_| {
             format!("unknown technique '{s}' (expected none, ssao, hbao, gtao, ssdo, ssdo-bounce or fetch-only)")
         })
     }
 }
 
 /// Sampling quality presets: Belonogov 2018's kernel sizes N = 12, 24, 36, 64.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Quality {
     /// N = 12.
     Low,
@@ -155,39 +135,19 @@ impl Quality {
     }
 }
 
-impl std::str::FromStr for Quality {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Quality::ALL
-            .into_iter()
-            .find(|q| q.name() == s)
-            .ok_or_else(|| format!("unknown quality '{s}' (expected low, medium, high or ultra)"))
-    }
-}
-
 /// Where each pixel's kernel rotation comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Noise {
     /// A 5×5 tile of rotations repeated over the screen (Belonogov 2018).
+    #[value(name = "tiled", alias = "tiled5x5")]
     Tiled5x5,
     /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (the Czech SSDO thesis).
     #[default]
     Halton,
 }
 
-impl std::str::FromStr for Noise {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "tiled" | "tiled5x5" => Ok(Noise::Tiled5x5),
-            "halton" => Ok(Noise::Halton),
-            other => Err(format!("unknown noise '{other}' (expected tiled or halton)")),
-        }
-    }
-}
-
 /// How SSDO's bounce weighs a blocking sample's sender.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum BounceForm {
     /// Ritschel et al. 2009 eq. 2: a patch of area π r²/N × strength at the sender pixel,
     /// weighted by the sender and receiver cosines over d² (as a disc's solid angle, so a
@@ -213,18 +173,8 @@ impl BounceForm {
     }
 }
 
-impl std::str::FromStr for BounceForm {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        BounceForm::ALL
-            .into_iter()
-            .find(|f| f.name() == s)
-            .ok_or_else(|| format!("unknown bounce form '{s}' (expected direction or patch)"))
-    }
-}
-
 /// The spatial denoise of the occlusion.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Denoise {
     /// Edge-aware box over the 4×4 noise tile, 5 taps per axis in two passes
     /// (shaders/denoise.wgsl).
@@ -242,16 +192,6 @@ impl Denoise {
             Denoise::Tile => "tile",
             Denoise::Bilateral => "bilateral",
         }
-    }
-}
-
-impl std::str::FromStr for Denoise {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Denoise::ALL
-            .into_iter()
-            .find(|d| d.name() == s)
-            .ok_or_else(|| format!("unknown denoise '{s}' (expected tile or bilateral)"))
     }
 }
 
@@ -311,7 +251,7 @@ pub struct AoSettings {
 }
 
 /// How the temporal pass blends the new frame into the history.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum TemporalBlend {
     /// The running mean of the last `max_frames` frames: each frame's rotated pattern
     /// counts equally, so N frames of n samples approach one frame of N·n.
@@ -320,17 +260,6 @@ pub enum TemporalBlend {
     /// Lin's NCTU thesis eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
     /// V = c·V_{t−1} + (1 − c)·V_t.
     Confidence,
-}
-
-impl std::str::FromStr for TemporalBlend {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "average" => Ok(TemporalBlend::Average),
-            "confidence" => Ok(TemporalBlend::Confidence),
-            other => Err(format!("unknown temporal blend '{other}' (expected average or confidence)")),
-        }
-    }
 }
 
 /// Temporal accumulation settings.

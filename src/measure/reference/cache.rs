@@ -323,6 +323,16 @@ fn decode(bytes: &[u8], key: u64) -> std::result::Result<ReferenceImage, String>
     Ok(ReferenceImage { width, height, stride, layers, stats })
 }
 
+/// Where reference images are cached between runs: `$XDG_CACHE_HOME/vrao/reference`,
+/// else `~/.cache/vrao/reference`, else under the temporary directory.
+pub fn default_cache_dir() -> PathBuf {
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(std::env::temp_dir);
+    base.join("vrao").join("reference")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

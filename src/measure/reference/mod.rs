@@ -57,7 +57,7 @@ mod shading;
 #[cfg(test)]
 mod tests;
 
-pub use cache::{cache_file, cache_key, read_cache, trace_cached, write_cache, FORMAT_VERSION};
+pub use cache::{cache_file, cache_key, default_cache_dir, read_cache, trace_cached, write_cache, FORMAT_VERSION};
 pub use progress::{format_bar, ProgressBar};
 
 use crate::render::error::{Error, Result};

@@ -16,24 +16,12 @@ use crate::render::error::{Error, Result};
 use std::fmt::Write as _;
 
 /// Which wgpu backend to use. `Auto` prefers a real GPU and falls back to lavapipe.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum BackendChoice {
     #[default]
     Auto,
     Vulkan,
     Gl,
-}
-
-impl std::str::FromStr for BackendChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(BackendChoice::Auto),
-            "vulkan" => Ok(BackendChoice::Vulkan),
-            "gl" => Ok(BackendChoice::Gl),
-            other => Err(format!("unknown backend '{other}' (expected auto, vulkan or gl)")),
-        }
-    }
 }
 
 /// What the chosen device can do that the renderer cares about.

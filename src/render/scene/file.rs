@@ -120,7 +120,12 @@ struct HeadKey {
 /// Loads a scene file; every error names the file and, where it can, the line.
 pub fn load(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, format!("cannot read: {e}")))?;
-    parse(path, &text)
+    let scene = parse(path, &text)?;
+    // Without a mesh there is nothing to occlude: say so rather than render the sky.
+    if scene.meshes.is_empty() {
+        return Err(Error::in_file(path, "places no mesh (add a [[mesh]] with obj = \"...\" or builtin = \"...\")"));
+    }
+    Ok(scene)
 }
 
 /// The 1-based line holding byte `offset` of `text`.

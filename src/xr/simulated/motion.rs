@@ -6,7 +6,7 @@ use crate::render::stereo::HeadPose;
 use glam::{DQuat, DVec3};
 use std::f64::consts::TAU;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum HeadMotion {
     /// The scene's head pose (or its scripted path) as is.
     #[default]
@@ -51,16 +51,6 @@ impl HeadMotion {
             _ => (base.position + base.orientation * offset, base.orientation * turn),
         };
         HeadPose { position, orientation: orientation.normalize() }
-    }
-}
-
-impl std::str::FromStr for HeadMotion {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        HeadMotion::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown head motion '{s}' (expected static, yaw-sweep, figure-eight or head-roll)"))
     }
 }
 

@@ -10,13 +10,14 @@ use crate::render::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum ReprojectionMode {
     /// Orientation only: every pixel is treated as infinitely far.
     Rotational,
     /// Orientation and position, using the frame's depth; disocclusions take the
     /// background beside them.
     #[default]
+    #[value(alias = "positional")]
     Depth,
 }
 
@@ -25,17 +26,6 @@ impl ReprojectionMode {
         match self {
             ReprojectionMode::Rotational => "rotational",
             ReprojectionMode::Depth => "depth",
-        }
-    }
-}
-
-impl std::str::FromStr for ReprojectionMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "rotational" => Ok(ReprojectionMode::Rotational),
-            "depth" | "positional" => Ok(ReprojectionMode::Depth),
-            other => Err(format!("unknown reprojection '{other}' (expected rotational or depth)")),
         }
     }
 }

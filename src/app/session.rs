@@ -1,0 +1,177 @@
+//! `vrao run` as one call: the headset profile and size, the budget governor, the headset
+//! (OpenXR or simulated), Ctrl-C, and the frame loop with or without a window.
+
+use crate::app::governor::{Frontier, Governor, GovernorConfig};
+use crate::app::window::{run_window, WindowOptions};
+use crate::app::{open_headset, BufferView, FrameLoop, HeadsetChoice, RunSummary};
+use crate::render::error::{Error, Result};
+use crate::render::gpu::BackendChoice;
+use crate::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
+use crate::render::scene::Scene;
+use crate::render::settings::{DisplayMode, Settings};
+use crate::xr::simulated::motion::HeadMotion;
+use crate::xr::simulated::reproject::ReprojectionMode;
+use crate::xr::simulated::{SimulatedOptions, TimeMode};
+use std::path::PathBuf;
+
+/// How [`run_session`] runs; `Default` is a simulated-or-OpenXR Vive session with no
+/// window, the governor on, until 600 frames.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub backend: BackendChoice,
+    pub headset: HeadsetChoice,
+    pub display: DisplayMode,
+    /// Stop after this many frames (`None`: until the window closes; 600 without one).
+    pub frames: Option<u64>,
+    /// The simulated headset's head motion and compositor reprojection.
+    pub motion: HeadMotion,
+    pub reprojection: ReprojectionMode,
+    /// Non-empty: the simulated headset runs in virtual time, frames taking these render
+    /// times in ms (cycled).
+    pub virtual_time: Vec<f64>,
+    /// A profile name of [`crate::xr::profiles::by_name`], its refresh rate and per-eye
+    /// size overridden where given.
+    pub profile: String,
+    pub refresh: Option<f64>,
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    /// The budget governor, with this frontier (`None`: the built-in one).
+    pub governor: bool,
+    pub governor_frontier: Option<PathBuf>,
+    pub frames_in_flight: usize,
+    /// The desktop window's size, last picture and buffer view.
+    pub window: (u32, u32),
+    pub screenshot: Option<PathBuf>,
+    pub show: BufferView,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            backend: BackendChoice::Auto,
+            headset: HeadsetChoice::Auto,
+            display: DisplayMode::None,
+            frames: None,
+            motion: HeadMotion::Static,
+            reprojection: ReprojectionMode::Depth,
+            virtual_time: Vec::new(),
+            profile: "vive".into(),
+            refresh: None,
+            width: None,
+            height: None,
+            governor: true,
+            governor_frontier: None,
+            frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
+            window: (1280, 720),
+            screenshot: None,
+            show: BufferView::Eyes,
+        }
+    }
+}
+
+/// Runs a headset session on `scene` with `settings` (their profile is replaced by the
+/// one `options` names) and returns its summary. Prints which headset and governor it
+/// uses. The first Ctrl-C ends the session cleanly (the summary is still returned), a
+/// second one stops the process.
+pub fn run_session(scene: &Scene, settings: &Settings, options: &RunOptions) -> Result<RunSummary> {
+    let mut profile =
+        crate::xr::profiles::by_name(&options.profile).map_err(|e| Error::input(format!("--profile: {e}")))?;
+    if let Some(hz) = options.refresh {
+        profile = profile.with_refresh(hz).map_err(|e| Error::input(format!("--refresh: {e}")))?;
+    }
+    let size = match (options.width, options.height) {
+        (None, None) => None,
+        (w, h) => Some((w.unwrap_or(profile.width), h.unwrap_or(profile.height))),
+    };
+    if let Some((w, h)) = size {
+        profile = profile.with_render_size(w, h);
+    }
+    let mut settings = settings.clone();
+    settings.profile = profile;
+    settings.validate()?;
+    if options.display == DisplayMode::None && options.show != BufferView::Eyes {
+        return Err(Error::input(format!(
+            "--show {} needs a window (--display mirror or single-pass)",
+            options.show.name()
+        )));
+    }
+    let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };
+    let frames = options.frames.or((options.display == DisplayMode::None).then_some(600));
+    let simulated = SimulatedOptions {
+        profile: settings.profile,
+        near: settings.near,
+        path: scene.head.clone(),
+        motion: options.motion,
+        time: if options.virtual_time.is_empty() {
+            TimeMode::Real
+        } else {
+            TimeMode::Virtual { render_ms: options.virtual_time.clone() }
+        },
+        reprojection: options.reprojection,
+        compose: options.display == DisplayMode::Mirror,
+        frames,
+    };
+    let (headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend)?;
+    println!("headset: {message}");
+    let mut frame_loop = FrameLoop::new(gpu.clone(), scene, &settings, headset)?;
+    frame_loop.frame_limit = frames;
+    frame_loop.renderer.set_frames_in_flight(options.frames_in_flight);
+    if let Some(governor) = governor {
+        let frontier = governor.frontier();
+        println!(
+            "governor: on, {} levels from {} to {}; starting at {}",
+            frontier.len(),
+            frontier.levels()[0].setting,
+            frontier.levels()[frontier.top()].setting,
+            governor.current().setting
+        );
+        frame_loop.set_governor(governor)?;
+    }
+    // Ctrl-C ends the session cleanly (OpenXR walks to EXITING) and the report is still
+    // written; a second Ctrl-C while it ends is the default: the process stops.
+    let exit = frame_loop.exit_requested.clone();
+    let _ = ctrlc::set_handler(move || {
+        if exit.swap(true, std::sync::atomic::Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        eprintln!("Ctrl-C: ending the session");
+    });
+    if options.display == DisplayMode::None {
+        while frame_loop.step()?.is_some() {}
+        frame_loop.end()?;
+        Ok(RunSummary::of(&frame_loop))
+    } else {
+        let window = WindowOptions {
+            mode: options.display,
+            size: options.window,
+            screenshot: options.screenshot.clone(),
+            show: options.show,
+        };
+        run_window(frame_loop, scene, window)
+    }
+}
+
+/// The governor of a session: its frontier (the bench file given, or the built-in one)
+/// at the frame budget of the profile, starting at the level nearest the asked setting.
+fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
+    let frontier = match &options.governor_frontier {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
+            Frontier::from_json(&text, &path.display().to_string(), settings.ao.radius).map_err(Error::input)?
+        }
+        None => Frontier::builtin(),
+    };
+    let ao = &settings.ao;
+    let start = frontier
+        .levels()
+        .iter()
+        .position(|l| {
+            l.technique == ao.technique
+                && l.samples == ao.samples
+                && l.half_res == ao.half_res
+                && l.temporal == ao.temporal.enabled
+        })
+        .unwrap_or(frontier.top());
+    let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
+    Governor::new(frontier, config, start).map_err(Error::input)
+}

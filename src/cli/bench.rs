@@ -1,0 +1,188 @@
+//! `vrao bench`: sweep technique × samples × radius × resolution, timed and scored
+//! against the reference tracer.
+
+use super::{parse_budget_ms, GtaoArgs, SCENE_HELP};
+use clap::Args;
+use std::path::PathBuf;
+use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
+use vrao::measure::reference::default_cache_dir;
+use vrao::render::renderer::TimingChoice;
+use vrao::render::settings::{BounceForm, Denoise, Technique};
+use vrao::{BackendChoice, HeadsetProfile, Result, Scene, Settings};
+
+/// A sweep over a switch: off, on or both.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Sweep {
+    Off,
+    On,
+    Both,
+}
+
+impl Sweep {
+    fn values(self) -> Vec<bool> {
+        match self {
+            Sweep::Off => vec![false],
+            Sweep::On => vec![true],
+            Sweep::Both => vec![false, true],
+        }
+    }
+}
+
+/// The resolutions to sweep.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Resolution {
+    Full,
+    Half,
+    Both,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
+    scene: String,
+    /// Techniques to sweep, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "ssao,hbao,ssdo,ssdo-bounce", hide_possible_values = true)]
+    techniques: Vec<Technique>,
+    /// Sample counts, comma-separated (by default the grid of Belonogov 2018).
+    #[arg(long, value_delimiter = ',', default_value = "12,24,36,64")]
+    samples: Vec<u32>,
+    /// Radii in metres, comma-separated (default: the scene's radius × 0.5, 1, 2).
+    #[arg(long, value_delimiter = ',')]
+    radii: Vec<f32>,
+    /// Resolutions: full, half or both.
+    #[arg(long, default_value = "both", hide_possible_values = true)]
+    resolution: Resolution,
+    /// SSDO depth peeling: off, on or both (each SSDO case with and without; other
+    /// techniques never peel).
+    #[arg(long, default_value = "off", hide_possible_values = true)]
+    depth_peeling: Sweep,
+    /// Temporal accumulation: off, on or both (the error of a temporal row is its
+    /// converged value after warm-up + frames with a static head).
+    #[arg(long, default_value = "off", hide_possible_values = true)]
+    temporal: Sweep,
+    /// Also measure reflective shadow maps (one bounce of the directional lights) with
+    /// these VPL counts, comma-separated, gathering within each radius: rows "rsm", whose
+    /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
+    /// given for ssdo-bounce rows.
+    #[arg(long, value_delimiter = ',')]
+    rsm_samples: Vec<u32>,
+    /// Measured frames per case, after warm-up.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    frames: u32,
+    /// Warm-up frames per case (not measured).
+    #[arg(long, default_value_t = 3)]
+    warmup: u32,
+    /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
+    /// eq. 2).
+    #[arg(long, default_value = "direction", hide_possible_values = true)]
+    bounce_form: BounceForm,
+    #[command(flatten)]
+    gtao: GtaoArgs,
+    /// Spatial denoise of every row: tile (edge-aware, 5 taps per axis over the 4×4 noise
+    /// tile) or bilateral (11×11 at --blur 5).
+    #[arg(long, default_value = "tile", hide_possible_values = true)]
+    denoise: Denoise,
+    /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
+    #[arg(long, default_value_t = 5)]
+    blur: u32,
+    /// Measure this many cases at a time, round-robin one frame each, so that the
+    /// machine's drift during a long sweep falls on all of them alike (fair ratios
+    /// between techniques); each needs its own targets in memory at once.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    interleave: u32,
+    /// Render whole frames (direct light and composite too), not only the occlusion: the
+    /// composite is timed, and each half-resolution row gets the cost of upsampling as a
+    /// frame pays it, inline in the composite (its composite minus the full-resolution
+    /// row's; sweep --resolution both, ideally interleaved).
+    #[arg(long)]
+    frame: bool,
+    /// Per-eye width in pixels.
+    #[arg(long, default_value_t = 1080)]
+    width: u32,
+    /// Per-eye height in pixels.
+    #[arg(long, default_value_t = 1200)]
+    height: u32,
+    /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one
+    /// submission per pass, wall clock) or auto (serial on CPU adapters such as lavapipe,
+    /// whose timestamps misattribute work between passes; pipelined on GPUs).
+    #[arg(long, default_value = "auto", hide_possible_values = true)]
+    timing: TimingChoice,
+    /// Output directory for bench.csv, bench.json, bench.md and bench.png.
+    #[arg(long, default_value = "bench")]
+    out: PathBuf,
+    /// Reference rays per traced pixel (cosine-weighted, stratified).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    rays: u32,
+    /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    stride: u32,
+    /// Skip the reference: time only, no error columns.
+    #[arg(long)]
+    no_reference: bool,
+    /// Directory of cached reference images (default: $XDG_CACHE_HOME/vrao or ~/.cache/vrao).
+    #[arg(long)]
+    cache: Option<PathBuf>,
+    /// Budget per stereo frame in ms for the plot's budget line (each eye gets half).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_budget_ms, default_value_t = 1000.0 / 90.0)]
+    budget_ms: f64,
+    /// Measure nothing: rewrite the table, CSV, Markdown and plots of this bench.json
+    /// (Pareto fronts recomputed) into --out.
+    #[arg(long)]
+    replot: Option<PathBuf>,
+}
+
+pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
+    let run = match &args.replot {
+        Some(path) => replot(path)?,
+        None => {
+            let scene = Scene::load(&args.scene)?;
+            let mut base =
+                Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
+            base.ao.bounce_form = args.bounce_form;
+            args.gtao.apply(&mut base.ao);
+            (base.ao.denoise, base.ao.blur_radius) = (args.denoise, args.blur);
+            let options = BenchOptions {
+                backend,
+                techniques: args.techniques.clone(),
+                samples: args.samples.clone(),
+                radii: args.radii.clone(),
+                half_res: match args.resolution {
+                    Resolution::Full => vec![false],
+                    Resolution::Half => vec![true],
+                    Resolution::Both => vec![false, true],
+                },
+                depth_peeling: args.depth_peeling.values(),
+                temporal: args.temporal.values(),
+                rsm_samples: args.rsm_samples.clone(),
+                timing: args.timing,
+                warmup: args.warmup,
+                frames: args.frames,
+                interleave: args.interleave as usize,
+                whole_frame: args.frame,
+                reference: (!args.no_reference).then(|| ReferenceOptions {
+                    rays_per_pixel: args.rays,
+                    stride: args.stride,
+                    cache: args.cache.clone().unwrap_or_else(default_cache_dir),
+                }),
+                command: command_line(),
+            };
+            run_bench(&scene, &base, &options)?
+        }
+    };
+    print!("{}", write_outputs(&args.out, &run, args.budget_ms)?);
+    Ok(())
+}
+
+/// The command line as typed (arguments with spaces or quotes quoted), kept in bench.json.
+fn command_line() -> String {
+    std::env::args()
+        .map(|a| {
+            if !a.is_empty() && a.chars().all(|c| c.is_ascii_alphanumeric() || "-_./:=,+@%".contains(c)) {
+                a
+            } else {
+                format!("'{}'", a.replace('\'', r"'\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}

@@ -1,0 +1,248 @@
+//! The binary's subcommands, one file each: each parses its options and calls one
+//! library function. This file holds the options several of them share.
+
+pub mod bench;
+pub mod budget;
+pub mod info;
+pub mod render;
+pub mod reprojection;
+pub mod run;
+pub mod temporal;
+
+use clap::Args;
+use glam::DVec3;
+use vrao::render::passes::shadow::suggested_rsm_radius;
+use vrao::render::settings::{
+    AoSettings, BounceForm, Denoise, Noise, Quality, ShadowSettings, Technique, Temporal, TemporalBlend,
+    DEFAULT_CONNECT, DEFAULT_STEP_POWER, DEFAULT_THICKNESS,
+};
+use vrao::{HeadsetProfile, Scene, Settings};
+
+/// Help heading of the shadow options (part of every command that renders).
+const SHADOW_HEADING: &str = "Shadows and reflective shadow maps";
+
+/// A switch: on or off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OnOff {
+    On,
+    Off,
+}
+
+impl OnOff {
+    pub fn on(self) -> bool {
+        self == OnOff::On
+    }
+}
+
+/// Shadow options for directional lights.
+#[derive(Args, Clone)]
+pub struct LightArgs {
+    /// Shadow maps with 3×3 PCF for the directional lights: on or off (a scene with no
+    /// directional light has none either way).
+    #[arg(long, help_heading = SHADOW_HEADING, default_value = "on")]
+    shadows: OnOff,
+    /// Texels along each side of the square light-space maps.
+    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = 2048)]
+    shadow_size: u32,
+    /// One bounce of the directional lights from reflective shadow maps: on or off.
+    #[arg(long, help_heading = SHADOW_HEADING, default_value = "off")]
+    rsm: OnOff,
+    /// Virtual point lights gathered per pixel and light by the reflective shadow maps.
+    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = 64)]
+    rsm_samples: u32,
+    /// RSM gather radius in metres (default: a quarter of the scene's diagonal, within 0.1..=4 m).
+    #[arg(long, help_heading = SHADOW_HEADING, allow_negative_numbers = true)]
+    rsm_radius: Option<f32>,
+}
+
+impl LightArgs {
+    pub fn settings(&self, scene: &Scene) -> ShadowSettings {
+        ShadowSettings {
+            enabled: self.shadows.on(),
+            size: self.shadow_size,
+            rsm: self.rsm.on(),
+            rsm_samples: self.rsm_samples,
+            rsm_radius: self.rsm_radius.unwrap_or_else(|| suggested_rsm_radius(scene)),
+        }
+    }
+}
+
+/// GTAO's free parameters (the render commands and the bench).
+#[derive(Args, Clone)]
+pub struct GtaoArgs {
+    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
+    /// radius (thin objects stop occluding behind themselves).
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_THICKNESS)]
+    thickness: f32,
+    /// GTAO: the samples' spread along a half-slice, 1..=2 (1 even, 2 quadratic: crowded
+    /// near the pixel).
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_STEP_POWER)]
+    step_power: f32,
+    /// GTAO: successive samples closer in distance than this fraction of the radius
+    /// join into one surface (0: never).
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_CONNECT)]
+    connect: f32,
+    /// Compute both eyes on their own; by default the right eye takes the left eye's value
+    /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
+    /// every technique's denoise, and the upsampled AO of all but SSDO).
+    #[arg(long)]
+    independent_eyes: bool,
+}
+
+impl GtaoArgs {
+    pub fn apply(&self, ao: &mut AoSettings) {
+        (ao.thickness, ao.step_power, ao.connect) = (self.thickness, self.step_power, self.connect);
+        ao.stereo_reuse = !self.independent_eyes;
+    }
+}
+
+/// Occlusion options (shared by every command that renders).
+#[derive(Args, Clone)]
+pub struct AoArgs {
+    #[command(flatten)]
+    pub lights: LightArgs,
+    /// Occlusion technique: none, ssao, hbao, gtao (the default: the most accurate per
+    /// millisecond), ssdo, ssdo-bounce or fetch-only (the benchmark baseline with SSAO's
+    /// depth taps and no occlusion arithmetic).
+    #[arg(long, default_value = "gtao", hide_possible_values = true)]
+    technique: Technique,
+    /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
+    #[arg(long, default_value = "medium", hide_possible_values = true)]
+    quality: Quality,
+    /// Depth taps per pixel, 1..=256 (overrides --quality).
+    #[arg(long)]
+    samples: Option<u32>,
+    /// Occlusion radius in metres (default: 8 % of the scene's diagonal, within 0.01..=1 m).
+    #[arg(long, allow_negative_numbers = true)]
+    radius: Option<f32>,
+    /// Occlusion weight, 0..=4 (1 = full occlusion).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    strength: f32,
+    /// Depth bias as a fraction of the radius.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    bias: f32,
+    /// SSDO bounce strength (ssdo-bounce); 0 leaves the bounce out.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    bounce: f32,
+    /// How the bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
+    /// the receiver cosine) or patch (Ritschel et al. 2009 eq. 2: area π r²/N, both
+    /// cosines, 1/d²).
+    #[arg(long, default_value = "direction", hide_possible_values = true)]
+    bounce_form: BounceForm,
+    /// Compute occlusion at half resolution per axis and upsample it.
+    #[arg(long)]
+    half_res: bool,
+    /// SSDO quality mode (Ritschel et al. 2009 §4): peel a second depth layer per eye; a
+    /// sample then occludes only inside an object (between the layers), which removes the
+    /// halos of thin objects in front of a background. Assumes closed geometry.
+    #[arg(long)]
+    depth_peeling: bool,
+    /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
+    /// bilateral (separable, --blur px either side).
+    #[arg(long, default_value = "tile", hide_possible_values = true)]
+    denoise: Denoise,
+    /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns any denoise off.
+    #[arg(long, default_value_t = 5)]
+    blur: u32,
+    /// Blur depth-edge width as a fraction of the pixel's distance (smaller keeps sharper edges).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    blur_sigma: f32,
+    /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
+    #[arg(long, default_value = "halton", hide_possible_values = true)]
+    noise: Noise,
+    #[command(flatten)]
+    gtao: GtaoArgs,
+    /// Turn SSAO's range check (depth constraint) off.
+    #[arg(long)]
+    no_range_check: bool,
+    /// Accumulate occlusion over frames by reverse reprojection; the sampling pattern
+    /// changes every frame (SSAO/SSDO: the next part of a longer Halton kernel; HBAO:
+    /// turned by the golden angle, its range jittered).
+    #[arg(long)]
+    temporal: bool,
+    /// Temporal disocclusion threshold in metres (plus two pixel footprints).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    temporal_epsilon: f32,
+    /// Temporal blend: average (running mean) or confidence (the history weighed by how
+    /// well it agrees with the new frame).
+    #[arg(long, default_value = "average", hide_possible_values = true)]
+    temporal_blend: TemporalBlend,
+    /// Frames after which a pixel counts as converged.
+    #[arg(long, default_value_t = 16)]
+    temporal_frames: u32,
+    /// Motion-adaptive temporal window: a pixel that moved m pixels since the last frame
+    /// averages at most frames / (1 + m / this) frames (at least 4); 0 turns it off.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
+    temporal_motion_px: f32,
+}
+
+impl AoArgs {
+    /// Settings for a Vive-class headset at `width`×`height` per eye with these occlusion,
+    /// shadow and RSM options (the commands that render frames share this).
+    pub fn eye_settings(&self, scene: &Scene, width: u32, height: u32) -> Settings {
+        Settings {
+            profile: HeadsetProfile::with_size("vive", width, height),
+            ao: self.settings(scene),
+            shadows: self.lights.settings(scene),
+            ..Settings::default()
+        }
+    }
+
+    pub fn settings(&self, scene: &Scene) -> AoSettings {
+        AoSettings {
+            technique: self.technique,
+            samples: self.samples.unwrap_or(self.quality.samples()),
+            radius: self.radius.unwrap_or_else(|| scene.suggested_ao_radius()),
+            strength: self.strength,
+            bias: self.bias,
+            range_check: !self.no_range_check,
+            bounce: self.bounce,
+            bounce_form: self.bounce_form,
+            noise: self.noise,
+            half_res: self.half_res,
+            depth_peeling: self.depth_peeling,
+            denoise: self.denoise,
+            blur_radius: self.blur,
+            blur_plane_sigma: self.blur_sigma,
+            temporal: Temporal {
+                enabled: self.temporal,
+                epsilon_m: self.temporal_epsilon,
+                blend: self.temporal_blend,
+                max_frames: self.temporal_frames,
+                motion_px: self.temporal_motion_px,
+                ..Default::default()
+            },
+            thickness: self.gtao.thickness,
+            step_power: self.gtao.step_power,
+            connect: self.gtao.connect,
+            stereo_reuse: !self.gtao.independent_eyes,
+        }
+    }
+}
+
+/// `X,Y,Z` in metres, each finite.
+pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("'{s}' is not X,Y,Z"));
+    }
+    let mut v = [0.0; 3];
+    for (slot, part) in v.iter_mut().zip(&parts) {
+        *slot = part.parse::<f64>().map_err(|_| format!("'{part}' in '{s}' is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("'{part}' in '{s}' is not finite"));
+        }
+    }
+    Ok(DVec3::from_array(v))
+}
+
+/// A frame budget in milliseconds: finite and positive.
+pub fn parse_budget_ms(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(ms) if ms.is_finite() && ms > 0.0 => Ok(ms),
+        _ => Err(format!("'{s}' is not a positive number of milliseconds")),
+    }
+}
+
+/// The `--scene` help every command shares.
+pub const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals)";

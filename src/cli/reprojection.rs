@@ -1,0 +1,39 @@
+//! `vrao reprojection`: how far a warped frame is from a fresh render.
+
+use super::{AoArgs, SCENE_HELP};
+use clap::Args;
+use std::path::PathBuf;
+use vrao::measure::reprojection::{study, to_markdown};
+use vrao::{BackendChoice, Result, Scene};
+
+#[derive(Args)]
+pub struct ReprojectionArgs {
+    #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
+    scene: String,
+    /// Per-eye width in pixels.
+    #[arg(long, default_value_t = 1080)]
+    width: u32,
+    /// Per-eye height in pixels.
+    #[arg(long, default_value_t = 1200)]
+    height: u32,
+    /// Write the rows as JSON here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    ao: AoArgs,
+}
+
+pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
+    let scene = Scene::load(&args.scene)?;
+    let settings = args.ao.eye_settings(&scene, args.width, args.height);
+    let (rows, adapter) = study(backend, &scene, &settings)?;
+    println!(
+        "reprojection of '{}' at {}x{} per eye on {adapter}: RMSE of colour (0..1, both eyes) against a fresh render",
+        scene.name, args.width, args.height
+    );
+    print!("{}", to_markdown(&rows));
+    match &args.out {
+        Some(path) => vrao::render::output::write_json(path, &rows),
+        None => Ok(()),
+    }
+}

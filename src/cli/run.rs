@@ -1,0 +1,118 @@
+//! `vrao run`: a headset session (OpenXR or the simulated headset), with a desktop window.
+
+use super::{AoArgs, OnOff, SCENE_HELP};
+use clap::Args;
+use std::path::PathBuf;
+use vrao::app::{run_session, BufferView, HeadsetChoice, RunOptions};
+use vrao::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
+use vrao::render::settings::DisplayMode;
+use vrao::xr::simulated::motion::HeadMotion;
+use vrao::xr::simulated::reproject::ReprojectionMode;
+use vrao::{BackendChoice, Result, Scene, Settings};
+
+#[derive(Args)]
+pub struct RunArgs {
+    #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
+    scene: String,
+    /// Headset: auto (OpenXR if a runtime answers, else simulated), openxr or simulated.
+    #[arg(long, default_value = "auto", hide_possible_values = true)]
+    headset: HeadsetChoice,
+    /// Desktop window: none, mirror (both eyes side by side) or single-pass (mono view).
+    #[arg(long, default_value = "mirror", hide_possible_values = true)]
+    display: DisplayMode,
+    /// Stop after this many frames (default: until the window is closed; 600 without one).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    frames: Option<u64>,
+    /// Simulated head motion: static, yaw-sweep, figure-eight or head-roll.
+    #[arg(long, default_value = "static", hide_possible_values = true)]
+    motion: HeadMotion,
+    /// Simulated compositor reprojection: rotational or depth.
+    #[arg(long, default_value = "depth", hide_possible_values = true)]
+    reprojection: ReprojectionMode,
+    /// Run the simulated headset in virtual time, each frame taking these render times
+    /// in ms (cycled): deterministic counters.
+    #[arg(long, value_delimiter = ',')]
+    virtual_time: Vec<f64>,
+    /// Headset profile of the simulated headset: vive, vive-pro-2, index, quest-2,
+    /// quest-3 or pico-4 (per-eye size, field of view, refresh rate; the frame budget
+    /// follows the rate). An OpenXR runtime's recommended size and views win over it.
+    #[arg(long, default_value = "vive")]
+    profile: String,
+    /// Refresh rate in Hz, one the profile supports (default: the profile's).
+    #[arg(long)]
+    refresh: Option<f64>,
+    /// Per-eye width to render at (default: the profile's; with OpenXR, the runtime's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Per-eye height to render at (default: the profile's; with OpenXR, the runtime's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Budget governor: on (choose the AO setting by error per millisecond so that each
+    /// frame's GPU time stays under the display period) or off (keep the settings).
+    #[arg(long, default_value = "on", hide_possible_values = true)]
+    governor: OnOff,
+    /// The governor's frontier: a bench JSON made by `vrao bench` (default: the built-in
+    /// one, measured on the furnished room; see assets/governor/README.md).
+    #[arg(long)]
+    governor_frontier: Option<PathBuf>,
+    /// Frames the GPU may work on at once.
+    #[arg(long, default_value_t = DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
+    frames_in_flight: u64,
+    /// Window size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    window: (u32, u32),
+    /// Save a screenshot of the window to this PNG after the last frame.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    /// What the window shows of each eye: eyes, ao (the final AO), raw-ao (before any
+    /// filter), depth or normals; the panel can change it.
+    #[arg(long, default_value = "eyes", hide_possible_values = true)]
+    show: BufferView,
+    /// Write the frame counters and per-pass medians to this JSON file.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    #[command(flatten)]
+    ao: AoArgs,
+}
+
+pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
+    let scene = Scene::load(&args.scene)?;
+    // The session replaces the profile with the one --profile names.
+    let settings =
+        Settings { ao: args.ao.settings(&scene), shadows: args.ao.lights.settings(&scene), ..Settings::default() };
+    let options = RunOptions {
+        backend,
+        headset: args.headset,
+        display: args.display,
+        frames: args.frames,
+        motion: args.motion,
+        reprojection: args.reprojection,
+        virtual_time: args.virtual_time,
+        profile: args.profile,
+        refresh: args.refresh,
+        width: args.width,
+        height: args.height,
+        governor: args.governor.on(),
+        governor_frontier: args.governor_frontier,
+        frames_in_flight: args.frames_in_flight as usize,
+        window: args.window,
+        screenshot: args.screenshot,
+        show: args.show,
+    };
+    let summary = run_session(&scene, &settings, &options)?;
+    println!("{}", summary.to_text());
+    match &args.report {
+        Some(path) => vrao::render::output::write_json(path, &summary),
+        None => Ok(()),
+    }
+}
+
+/// `WIDTHxHEIGHT`, each within 1..=16384.
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let parsed =
+        s.split_once('x').and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
+        _ => Err(format!("'{s}' is not WIDTHxHEIGHT within 1..=16384")),
+    }
+}

@@ -1,0 +1,486 @@
+//! A sweep's rows as records (Pareto fronts marked), and those as CSV, Markdown, JSON
+//! and plots.
+
+// The bench's types and imports (this file is a part of bench.rs split out for size).
+use super::*;
+
+/// The records of measured rows, with the Pareto front marked.
+pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
+    let mut out: Vec<BenchRecord> = rows
+        .iter()
+        .map(|row| {
+            let c = &row.case;
+            let name = row.pass;
+            let spread = row.spans.iter().find(|s| s.label == name).map_or(0.0, |s| s.p75_ms / s.p25_ms.max(1e-9));
+            let per_eye = |p: &str| row.median_ms(p) / row.views as f64;
+            BenchRecord {
+                technique: if name == RSM_PASS { RSM_PASS.to_string() } else { c.technique.name().to_string() },
+                samples: c.samples,
+                radius_m: c.radius,
+                resolution: if c.half_res { "half" } else { "full" }.to_string(),
+                technique_ms_per_eye: per_eye(name),
+                blur_ms_per_eye: per_eye("blur"),
+                upsample_ms_per_eye: per_eye("upsample"),
+                occlusion_ms_per_eye: row.occlusion_ms_per_eye(),
+                p75_over_p25: spread,
+                ao_rmse: row.error.as_ref().map(|e| e.ao_rmse),
+                ao_bias: row.error.as_ref().map(|e| e.ao_bias),
+                ao_bias_dark: row.error.as_ref().and_then(|e| e.ao_bias_dark),
+                ao_rmse_falloff: row.error.as_ref().map(|e| e.ao_rmse_falloff),
+                ao_rmse_vs_limit: row.error.as_ref().and_then(|e| e.ao_rmse_vs_limit),
+                limit_rmse: row.error.as_ref().and_then(|e| e.limit_rmse),
+                limit_bias: row.error.as_ref().and_then(|e| e.limit_bias),
+                ao_rmse_outer_border: row.error.as_ref().and_then(|e| e.ao_rmse_outer_border),
+                halo_share: row.error.as_ref().and_then(|e| e.halo_share),
+                flip_mean: row.error.as_ref().and_then(|e| e.flip_mean),
+                stereo_inconsistent: row.stereo.and_then(|c| c.inconsistent),
+                stereo_inconsistent_inner_border: row.stereo.and_then(|c| c.inner_border),
+                stereo_inconsistent_interior: row.stereo.and_then(|c| c.interior),
+                ao_ssim: row.error.as_ref().map(|e| e.ao_ssim),
+                ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
+                pareto: false,
+                depth_peeling: c.depth_peeling,
+                peel_ms_per_eye: per_eye("depth-peel"),
+                bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
+                bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
+                temporal: c.temporal,
+                composite_ms_per_eye: per_eye("composite"),
+                frame_upsample_ms_per_eye: None,
+            }
+        })
+        .collect();
+    for i in 0..out.len() {
+        let half = &out[i];
+        if half.resolution != "half" || half.composite_ms_per_eye <= 0.0 {
+            continue;
+        }
+        let full = full_resolution_partner(&out, half).filter(|f| f.composite_ms_per_eye > 0.0);
+        out[i].frame_upsample_ms_per_eye = full.map(|f| half.composite_ms_per_eye - f.composite_ms_per_eye);
+    }
+    mark_pareto(&mut out);
+    out
+}
+
+/// The full-resolution record of the same technique and setting as `half`.
+fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -> Option<&'a BenchRecord> {
+    let h = half;
+    records.iter().find(|f| {
+        f.resolution == "full"
+            && (f.technique.as_str(), f.samples, f.radius_m, f.depth_peeling, f.temporal)
+                == (h.technique.as_str(), h.samples, h.radius_m, h.depth_peeling, h.temporal)
+    })
+}
+
+/// Marks each record on the Pareto front of AO RMSE against occlusion ms per eye. Each
+/// radius is its own target quantity (AO within r), so errors compare only within one
+/// radius: one front per radius.
+pub fn mark_pareto(out: &mut [BenchRecord]) {
+    out.iter_mut().for_each(|r| r.pareto = false);
+    let mut radii: Vec<f32> = out.iter().map(|r| r.radius_m).collect();
+    radii.sort_by(f32::total_cmp);
+    radii.dedup();
+    for radius in radii {
+        let members: Vec<usize> = (0..out.len()).filter(|&i| out[i].radius_m == radius).collect();
+        let points: Vec<(f64, f64)> =
+            members.iter().map(|&i| (out[i].occlusion_ms_per_eye, out[i].ao_rmse.unwrap_or(f64::NAN))).collect();
+        for k in metrics::pareto_front(&points) {
+            out[members[k]].pareto = true;
+        }
+    }
+}
+
+/// One column of the CSV and of the Markdown table: its CSV name, its Markdown
+/// header, the CSV value (full precision) and the Markdown value (rounded to what it means).
+struct Column {
+    name: &'static str,
+    header: &'static str,
+    csv: fn(&BenchRecord) -> String,
+    markdown: fn(&BenchRecord) -> String,
+    /// Shown in the Markdown table only when some row has something there.
+    optional: bool,
+}
+
+fn fixed(v: Option<f64>, decimals: usize) -> String {
+    v.map_or(String::new(), |v| format!("{v:.decimals$}"))
+}
+
+fn percent(v: Option<f64>) -> String {
+    v.map_or(String::new(), |v| format!("{:.1} %", v * 100.0))
+}
+
+fn yes(b: bool) -> String {
+    if b { "yes" } else { "" }.to_string()
+}
+
+/// Every column, the ones a reader compares first first.
+/// A column of an error figure (`Option<f64>` field): 4 decimals in CSV, 3 in Markdown.
+macro_rules! figure_column {
+    ($field:ident, $header:literal, $optional:literal) => {
+        Column {
+            name: stringify!($field),
+            header: $header,
+            csv: |r| fixed(r.$field, 4),
+            markdown: |r| fixed(r.$field, 3),
+            optional: $optional,
+        }
+    };
+}
+
+/// A column of a share (`Option<f64>` in 0..1): 4 decimals in CSV, a percentage in Markdown.
+macro_rules! share_column {
+    ($field:ident, $header:literal) => {
+        Column {
+            name: stringify!($field),
+            header: $header,
+            csv: |r| fixed(r.$field, 4),
+            markdown: |r| percent(r.$field),
+            optional: false,
+        }
+    };
+}
+
+const COLUMNS: &[Column] = &[
+    Column {
+        name: "technique",
+        header: "technique",
+        csv: |r| r.technique.clone(),
+        markdown: |r| r.technique.clone(),
+        optional: false,
+    },
+    Column {
+        name: "samples",
+        header: "N",
+        csv: |r| r.samples.to_string(),
+        markdown: |r| r.samples.to_string(),
+        optional: false,
+    },
+    Column {
+        name: "radius_m",
+        header: "r (m)",
+        csv: |r| format!("{}", r.radius_m),
+        markdown: |r| format!("{}", r.radius_m),
+        optional: false,
+    },
+    Column {
+        name: "resolution",
+        header: "res",
+        csv: |r| r.resolution.clone(),
+        markdown: |r| r.resolution.clone(),
+        optional: false,
+    },
+    Column {
+        name: "occlusion_ms_per_eye",
+        header: "ms/eye",
+        csv: |r| format!("{:.3}", r.occlusion_ms_per_eye),
+        markdown: |r| format!("{:.1}", r.occlusion_ms_per_eye),
+        optional: false,
+    },
+    figure_column!(ao_rmse, "RMSE", false),
+    figure_column!(ao_bias, "bias", false),
+    figure_column!(ao_bias_dark, "bias (ref < 0.8)", false),
+    figure_column!(ao_rmse_vs_limit, "RMSE vs limit", false),
+    figure_column!(limit_rmse, "limit RMSE", false),
+    figure_column!(limit_bias, "limit bias", false),
+    figure_column!(ao_rmse_outer_border, "RMSE outer border", false),
+    share_column!(halo_share, "halo"),
+    figure_column!(flip_mean, "FLIP", false),
+    share_column!(stereo_inconsistent, "stereo ≠"),
+    share_column!(stereo_inconsistent_inner_border, "≠ inner border"),
+    share_column!(stereo_inconsistent_interior, "≠ interior"),
+    figure_column!(ao_rmse_falloff, "RMSE falloff", false),
+    figure_column!(ao_ssim, "SSIM", false),
+    figure_column!(ambient_rel_rmse, "ambient rel. RMSE", true),
+    Column {
+        name: "technique_ms_per_eye",
+        header: "technique ms",
+        csv: |r| format!("{:.3}", r.technique_ms_per_eye),
+        markdown: |r| format!("{:.1}", r.technique_ms_per_eye),
+        optional: false,
+    },
+    Column {
+        name: "blur_ms_per_eye",
+        header: "blur ms",
+        csv: |r| format!("{:.3}", r.blur_ms_per_eye),
+        markdown: |r| format!("{:.1}", r.blur_ms_per_eye),
+        optional: false,
+    },
+    Column {
+        name: "upsample_ms_per_eye",
+        header: "upsample ms",
+        csv: |r| format!("{:.3}", r.upsample_ms_per_eye),
+        markdown: |r| if r.resolution == "half" { format!("{:.1}", r.upsample_ms_per_eye) } else { String::new() },
+        optional: true,
+    },
+    Column {
+        name: "p75_over_p25",
+        header: "p75/p25",
+        csv: |r| format!("{:.3}", r.p75_over_p25),
+        markdown: |r| format!("{:.2}", r.p75_over_p25),
+        optional: false,
+    },
+    Column { name: "pareto", header: "Pareto", csv: |r| yes(r.pareto), markdown: |r| yes(r.pareto), optional: true },
+    Column {
+        name: "depth_peeling",
+        header: "peeled",
+        csv: |r| yes(r.depth_peeling),
+        markdown: |r| yes(r.depth_peeling),
+        optional: true,
+    },
+    Column {
+        name: "peel_ms_per_eye",
+        header: "peel ms",
+        csv: |r| format!("{:.3}", r.peel_ms_per_eye),
+        markdown: |r| if r.depth_peeling { format!("{:.1}", r.peel_ms_per_eye) } else { String::new() },
+        optional: true,
+    },
+    figure_column!(bounce_rel_rmse, "bounce rel. RMSE", true),
+    figure_column!(bounce_rel_bias, "bounce rel. bias", true),
+    Column {
+        name: "temporal",
+        header: "temporal",
+        csv: |r| yes(r.temporal),
+        markdown: |r| yes(r.temporal),
+        optional: true,
+    },
+    Column {
+        name: "composite_ms_per_eye",
+        header: "composite ms",
+        csv: |r| format!("{:.3}", r.composite_ms_per_eye),
+        markdown: |r| {
+            if r.composite_ms_per_eye > 0.0 {
+                format!("{:.1}", r.composite_ms_per_eye)
+            } else {
+                String::new()
+            }
+        },
+        optional: true,
+    },
+    Column {
+        name: "frame_upsample_ms_per_eye",
+        header: "frame upsample ms",
+        csv: |r| fixed(r.frame_upsample_ms_per_eye, 3),
+        markdown: |r| fixed(r.frame_upsample_ms_per_eye, 1),
+        optional: true,
+    },
+];
+
+/// The CSV: every column of every record, full precision (shares as fractions 0..1).
+pub fn to_csv(records: &[BenchRecord]) -> String {
+    let mut s = COLUMNS.iter().map(|c| c.name).collect::<Vec<_>>().join(",") + "\n";
+    for r in records {
+        s += &(COLUMNS.iter().map(|c| (c.csv)(r)).collect::<Vec<_>>().join(",") + "\n");
+    }
+    s
+}
+
+/// The table of records as Markdown, rounded for reading (RMSE and bias to 3 decimals, ms
+/// to 1, shares in percent to 1); optional columns only where some row has a value.
+pub fn to_markdown(records: &[BenchRecord]) -> String {
+    let shown: Vec<&Column> =
+        COLUMNS.iter().filter(|c| !c.optional || records.iter().any(|r| !(c.markdown)(r).is_empty())).collect();
+    let mut s = format!(
+        "| {} |\n|{}\n",
+        shown.iter().map(|c| c.header).collect::<Vec<_>>().join(" | "),
+        "---|".repeat(shown.len())
+    );
+    for r in records {
+        let _ = writeln!(s, "| {} |", shown.iter().map(|c| (c.markdown)(r)).collect::<Vec<_>>().join(" | "));
+    }
+    s
+}
+
+/// What the columns mean, for the foot of bench.md.
+pub const COLUMN_NOTES: &str = "\
+- **RMSE**, **bias**: the AO against the ray-traced reference's hard cut-off AO (cosine-weighted \
+visibility within r), the target every technique is scored against; bias is mean(estimate − \
+reference), > 0 too light; **bias (ref < 0.8)** over the pixels the reference finds occluded. \
+**RMSE falloff**: against the reference with HBAO's linear falloff 1 − d/r instead, for comparison.
+- **limit RMSE**, **limit bias**: the *screen-space limit* (a brute-force march over this frame's \
+own depth buffer: many rays of length r, a thickness, off-image open) against the reference: the \
+error of seeing one depth layer per eye, which no screen-space technique can remove. The same \
+for every row of a radius.
+- **RMSE vs limit**: the technique against that limit: its *estimator* error (too few samples, \
+falloffs, one sample point per direction, noise). A technique with RMSE ≈ limit RMSE and a small \
+RMSE vs limit is as good as screen space gets; a large RMSE vs limit is the estimator's own fault.
+- **RMSE outer border**: RMSE over the pixels within 40 px of an eye's outer, top or bottom \
+border, where samples that leave the image count as open (the other eye sees no further there): \
+compared with RMSE, what rendering a guard band around the image could win.
+- **halo**: share of the pixels beside a depth edge (within one reference cell) that are too \
+dark by more than 0.1: occlusion spilling from a near object onto the far surface behind it.
+- **FLIP**: mean ꟻLIP of the AO image against the reference AO (both as grey images, sky 1) at \
+the headset's pixels per degree over the reference's stride: how visible the difference is; \
+noise and blotches count more than a smooth offset of the same RMSE.
+- **stereo ≠**: share of the surface points both eyes see whose final AO differs between the \
+eyes by more than 0.02 (both directions pooled), overall, within 40 px of each eye's inner \
+(nasal) border, and farther than 40 px from every border.
+- **ms/eye**: occlusion cost per eye (technique + blur + upsampling), median over the measured frames.
+";
+
+/// The header of bench.md: scene, adapter, version, command line and how it was measured.
+pub fn markdown_header(file: &BenchFile) -> String {
+    let mut s = format!("# vrao bench: {}\n\n", file.scene);
+    let driver = if file.driver.is_empty() { String::new() } else { format!(", driver {}", file.driver) };
+    let _ = writeln!(s, "- adapter: {} ({}{driver})", file.adapter, file.backend);
+    if !file.version.is_empty() {
+        let _ = writeln!(s, "- vrao {}", file.version);
+    }
+    if !file.command.is_empty() {
+        let _ = writeln!(s, "- command: `{}`", file.command);
+    }
+    let _ = writeln!(
+        s,
+        "- {}×{} per eye, {} timing, {} warm-up + {} measured frames per case",
+        file.width, file.height, file.timing, file.warmup, file.frames
+    );
+    if let Some(r) = &file.reference {
+        let _ = writeln!(
+            s,
+            "- reference: {} rays per pixel at every {} pixels (its AO noise, RMS standard error: {:.4})",
+            r.rays_per_pixel, r.stride, r.ao_noise_rms
+        );
+        if let Some(l) = &file.limit {
+            let _ = writeln!(
+                s,
+                "- screen-space limit: {} rays × {} steps per pixel on the same pixels, thickness {} r",
+                l.rays_per_pixel, l.steps, l.thickness_of_radius
+            );
+        }
+        if let Some(ppd) = file.pixels_per_degree {
+            let _ = writeln!(
+                s,
+                "- FLIP at {ppd:.1} pixels per degree, {:.1} on the reference's grid",
+                ppd / r.stride.max(1) as f64
+            );
+        }
+    }
+    s + "\n"
+}
+
+/// bench.md: the header, the table, what the columns mean, and the ratios.
+pub fn markdown_report(file: &BenchFile) -> String {
+    let mut s = markdown_header(file) + &to_markdown(&file.records);
+    if file.reference.is_some() {
+        s += "\n";
+        s += COLUMN_NOTES;
+    }
+    s + &ratios_markdown(&file.records)
+}
+
+/// The ratios a sweep is judged by, as Markdown (empty when no row has a partner):
+/// - half / full resolution of each case: occlusion ms per eye (technique + blur + the
+///   stand-alone upsample pass) and, with `--frame`, the same with the frame's inline
+///   upsampling instead of the pass;
+/// - each technique's pass against SSAO's at the same setting and resolution;
+/// - each technique's pass against fetch-only's (the same depth taps, no arithmetic):
+///   how far it is from the memory limit.
+pub fn ratios_markdown(records: &[BenchRecord]) -> String {
+    let mut s = String::new();
+    let plain = |r: &&BenchRecord| !r.depth_peeling && !r.temporal;
+    let mut half_full = String::new();
+    for half in records.iter().filter(|r| r.resolution == "half") {
+        let Some(full) = full_resolution_partner(records, half) else {
+            continue;
+        };
+        let in_frame = half.frame_upsample_ms_per_eye.map_or(String::new(), |up| {
+            format!("{:.3}", (half.occlusion_ms_per_eye - half.upsample_ms_per_eye + up) / full.occlusion_ms_per_eye)
+        });
+        let _ = writeln!(
+            half_full,
+            "| {} | {} | {} | {:.3} | {in_frame} |",
+            half.technique,
+            half.samples,
+            half.radius_m,
+            half.occlusion_ms_per_eye / full.occlusion_ms_per_eye
+        );
+    }
+    if !half_full.is_empty() {
+        s += "\nHalf / full resolution, occlusion ms per eye (technique + blur + upsampling):\n\n";
+        s += "| technique | samples | radius_m | with the upsample pass | with the frame's inline upsampling |\n|---|---|---|---|---|\n";
+        s += &half_full;
+    }
+    for (against, title) in [
+        ("ssao", "Technique pass against SSAO's at the same setting and resolution"),
+        ("fetch-only", "Technique pass against fetch-only's (same depth taps, no arithmetic)"),
+    ] {
+        let mut table = String::new();
+        for r in records.iter().filter(plain).filter(|r| r.technique != against && r.technique != "rsm") {
+            let partner = records.iter().filter(plain).find(|b| {
+                b.technique == against
+                    && (b.samples, b.radius_m, &b.resolution) == (r.samples, r.radius_m, &r.resolution)
+            });
+            if let Some(b) = partner {
+                let ratio = r.technique_ms_per_eye / b.technique_ms_per_eye;
+                let occlusion = r.occlusion_ms_per_eye / b.occlusion_ms_per_eye;
+                let _ = writeln!(
+                    table,
+                    "| {} | {} | {} | {} | {ratio:.3} | {occlusion:.3} |",
+                    r.technique, r.samples, r.radius_m, r.resolution
+                );
+            }
+        }
+        if !table.is_empty() {
+            let _ = write!(s, "\n{title}:\n\n| technique | samples | radius_m | resolution | technique pass | occlusion (with blur, upsampling) |\n|---|---|---|---|---|---|\n{table}");
+        }
+    }
+    s
+}
+
+pub fn to_json(file: &BenchFile) -> String {
+    serde_json::to_string_pretty(file).expect("bench records serialise")
+}
+
+/// Reads a bench JSON file (for `vrao budget --fit`).
+pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
+    serde_json::from_str(&text).map_err(|e| Error::at_line(path, e.line(), format!("not a vrao bench file: {e}")))
+}
+
+/// The plot of error against per-eye ms for the rows of one radius, with that radius's
+/// Pareto front and the budget line.
+pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterPlot {
+    const COLOURS: [[u8; 3]; 8] = [
+        [31, 119, 180],
+        [255, 127, 14],
+        [44, 160, 44],
+        [214, 39, 40],
+        [148, 103, 189],
+        [140, 86, 75],
+        [23, 190, 207],
+        [188, 189, 34],
+    ];
+    let rows: Vec<&BenchRecord> =
+        file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
+    let mut series: Vec<Series> = Vec::new();
+    for r in &rows {
+        let label = format!(
+            "{}{}{} {}",
+            r.technique,
+            if r.depth_peeling { " peeled" } else { "" },
+            if r.temporal { " temporal" } else { "" },
+            r.resolution
+        );
+        let point = (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN));
+        match series.iter_mut().find(|s| s.label == label) {
+            Some(s) => s.points.push(point),
+            None => {
+                let color = COLOURS[series.len() % COLOURS.len()];
+                series.push(Series { label, color, points: vec![point] });
+            }
+        }
+    }
+    let mut pareto: Vec<(f64, f64)> =
+        rows.iter().filter(|r| r.pareto).map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
+    pareto.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ScatterPlot {
+        title: format!(
+            "{}: AO error against time, r = {radius_m} m, {}x{} per eye, {}",
+            file.scene, file.width, file.height, file.adapter
+        ),
+        x_label: "occlusion ms per eye (technique + blur + upsample)".into(),
+        y_label: "AO RMSE vs reference".into(),
+        series,
+        pareto,
+        vertical_line: Some((budget_ms_per_eye, format!("budget {budget_ms_per_eye:.2} ms/eye"))),
+        log_x: true,
+    }
+}

@@ -1,0 +1,175 @@
+//! `vrao budget` as one call: open the device, optionally pick the setting from a bench
+//! file (the least AO error that fits the budget), and measure it.
+
+use super::{run, BudgetReport, BudgetRun};
+use crate::measure::bench::BenchFile;
+use crate::render::error::{Error, Result};
+use crate::render::gpu::{BackendChoice, Gpu};
+use crate::render::graph::Resource;
+use crate::render::renderer::{Renderer, TimingChoice};
+use crate::render::scene::Scene;
+use crate::render::settings::{AoSettings, Settings, Technique};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// How [`measure_budget`] measures.
+#[derive(Clone, Debug)]
+pub struct BudgetOptions {
+    pub backend: BackendChoice,
+    pub timing: TimingChoice,
+    /// Measured frames (each: the stereo frame, then each eye alone), after warm-up.
+    pub frames: u32,
+    pub warmup: u32,
+    /// The stereo frame budget in ms; `None`: the profile's refresh interval.
+    pub budget_ms: Option<f64>,
+    /// Measure the occlusion passes alone instead of the whole frame.
+    pub occlusion_only: bool,
+    /// A bench JSON (made by `vrao bench` on this device) to pick the setting from.
+    pub fit: Option<PathBuf>,
+}
+
+/// The setting `--fit` chose and why.
+#[derive(Clone, Debug)]
+pub struct Fit {
+    pub ao: AoSettings,
+    /// Doubts about the bench file (measured at another size).
+    pub warnings: Vec<String>,
+    /// Which row was chosen, and why ("fit: ...").
+    pub notes: Vec<String>,
+}
+
+/// What [`measure_budget`] measured.
+#[derive(Clone, Debug)]
+pub struct BudgetOutcome {
+    pub report: BudgetReport,
+    pub fit: Option<Fit>,
+}
+
+/// Measures `settings` (or, with `options.fit`, the bench row that fits the budget best)
+/// on `scene` against the frame budget.
+pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOptions) -> Result<BudgetOutcome> {
+    let budget_ms = options.budget_ms.unwrap_or(settings.profile.budget_ms());
+    if !(budget_ms.is_finite() && budget_ms > 0.0) {
+        return Err(Error::input(format!("--budget-ms {budget_ms} must be a positive number of milliseconds")));
+    }
+    settings.validate()?;
+    let fit_file = match &options.fit {
+        Some(path) => Some((crate::measure::bench::read_json(path)?, path)),
+        None => None,
+    };
+    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let timing = options.timing.resolve(&gpu);
+    let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+    let measure = |settings: &Settings, frames: u32| -> Result<BudgetReport> {
+        let output = if options.occlusion_only {
+            crate::render::passes::final_occlusion(settings)
+                .ok_or_else(|| Error::input("--measure occlusion needs an occlusion technique"))?
+        } else {
+            Resource::Color
+        };
+        let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
+        run(&mut renderer, &eyes, BudgetRun { timing, warmup: options.warmup, frames, budget_ms, output })
+    };
+    let mut settings = settings.clone();
+    let fit = match fit_file {
+        Some((file, path)) => {
+            let fit = fit_setting(&file, path, &gpu, &settings, budget_ms, options.occlusion_only, measure)?;
+            settings.ao = fit.ao.clone();
+            Some(fit)
+        }
+        None => None,
+    };
+    let report = measure(&settings, options.frames)?;
+    Ok(BudgetOutcome { report, fit })
+}
+
+/// `--fit`: the bench row with the least AO error whose occlusion cost fits what the
+/// budget leaves per eye after the passes every frame pays (measured here with no
+/// occlusion, by `measure(settings, frames)`), returned as the settings to measure.
+pub fn fit_setting(
+    file: &BenchFile,
+    path: &Path,
+    gpu: &Gpu,
+    settings: &Settings,
+    budget_ms: f64,
+    occlusion_only: bool,
+    measure: impl Fn(&Settings, u32) -> Result<BudgetReport>,
+) -> Result<Fit> {
+    let adapter = gpu.adapter.get_info().name;
+    if file.adapter != adapter {
+        return Err(Error::in_file(
+            path,
+            format!("was measured on '{}', not on this device '{adapter}'; run vrao bench here first", file.adapter),
+        ));
+    }
+    let (mut warnings, mut notes) = (Vec::new(), Vec::new());
+    if (file.width, file.height) != (settings.profile.width, settings.profile.height) {
+        warnings.push(format!(
+            "warning: {} was measured at {}x{} per eye, this budget is for {}x{}",
+            path.display(),
+            file.width,
+            file.height,
+            settings.profile.width,
+            settings.profile.height
+        ));
+    }
+    // What every frame pays besides the occlusion, per eye (eyes measured alone).
+    let base_ms = if occlusion_only {
+        0.0
+    } else {
+        let mut base = settings.clone();
+        base.ao.technique = Technique::None;
+        let report = measure(&base, 5)?;
+        report.verdicts.iter().filter(|v| v.what != "stereo frame").map(|v| v.ms).fold(0.0, f64::max)
+    };
+    let left_per_eye = budget_ms / 2.0 - base_ms;
+    // Errors compare only within one radius (each radius is its own target quantity):
+    // take the rows of the radius asked for, or of the bench radius nearest to it.
+    let measured: Vec<_> = file.records.iter().filter(|r| r.ao_rmse.is_some_and(f64::is_finite)).collect();
+    let Some(radius) = measured
+        .iter()
+        .map(|r| r.radius_m)
+        .min_by(|a, b| (a - settings.ao.radius).abs().total_cmp(&(b - settings.ao.radius).abs()))
+    else {
+        return Err(Error::in_file(path, "has no rows with an error against the reference"));
+    };
+    if radius != settings.ao.radius {
+        notes.push(format!(
+            "fit: the bench has no rows at r = {} m; using its nearest radius, {radius} m",
+            settings.ao.radius
+        ));
+    }
+    let with_error: Vec<_> = measured.into_iter().filter(|r| r.radius_m == radius).collect();
+    let fitting: Vec<_> = with_error.iter().filter(|r| r.occlusion_ms_per_eye <= left_per_eye).collect();
+    let chosen = match fitting.iter().min_by(|a, b| a.ao_rmse.unwrap().total_cmp(&b.ao_rmse.unwrap())) {
+        Some(r) => {
+            notes.push(format!(
+                "fit: {} — AO RMSE {:.4}, the least of the {} of {} bench rows whose occlusion ({:.3} ms per eye) fits the {:.3} ms per eye left after {:.3} ms of the other passes",
+                r.setting(),
+                r.ao_rmse.unwrap(),
+                fitting.len(),
+                with_error.len(),
+                r.occlusion_ms_per_eye,
+                left_per_eye,
+                base_ms
+            ));
+            r
+        }
+        None => {
+            let cheapest =
+                with_error.iter().min_by(|a, b| a.occlusion_ms_per_eye.total_cmp(&b.occlusion_ms_per_eye)).unwrap();
+            notes.push(format!(
+                "fit: no bench row fits the {:.3} ms per eye left after {:.3} ms of the other passes; the cheapest, {} ({:.3} ms per eye), is measured",
+                left_per_eye, base_ms, cheapest.setting(), cheapest.occlusion_ms_per_eye
+            ));
+            cheapest
+        }
+    };
+    let mut ao = settings.ao.clone();
+    ao.technique = chosen.technique.parse().map_err(|e: String| Error::in_file(path, e))?;
+    ao.samples = chosen.samples;
+    ao.radius = chosen.radius_m;
+    ao.half_res = chosen.resolution == "half";
+    ao.depth_peeling = chosen.depth_peeling;
+    Ok(Fit { ao, warnings, notes })
+}
