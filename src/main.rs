@@ -874,7 +874,11 @@ fn write_bench(args: &BenchArgs, file: &vrao::measure::bench::BenchFile, radii: 
         // One plot per radius (errors compare only within a radius); bench.png is the
         // middle radius, the scene's suggested one by default.
         for (i, &radius) in radii.iter().enumerate() {
-            let name = if i == radii.len() / 2 { "bench.png".to_string() } else { format!("bench-r{radius}.png") };
+            let name = if i == radii.len() / 2 {
+                "bench.png".to_string()
+            } else {
+                vrao::measure::bench::plot_file_name(radius)
+            };
             plot(file, radius, args.budget_ms / 2.0).save_png(&args.out.join(&name), 1280, 800)?;
             written += &format!(", {name}");
         }
