@@ -27,7 +27,8 @@ impl ProgressBar {
         } else {
             indicatif::ProgressDrawTarget::hidden()
         };
-        let bar = indicatif::ProgressBar::with_draw_target(Some(0), target);
+        // No length until the first update: a length of 0 would draw as 100 %.
+        let bar = indicatif::ProgressBar::with_draw_target(None, target);
         let style = indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] {percent:>3}% {msg} ETA {eta}")
             .expect("the template is valid")
             .progress_chars("#>.");
@@ -39,9 +40,10 @@ impl ProgressBar {
     /// Records `p` and moves the bar (indicatif limits the redraws).
     pub fn update(&mut self, p: Progress) {
         self.last = Some(p);
+        // Position last: each setter may redraw, and the last one should show all three.
+        self.bar.set_message(format!("{}/s", si(rays_per_second(&p), "rays")));
         self.bar.set_length(p.total as u64);
         self.bar.set_position(p.done as u64);
-        self.bar.set_message(format!("{}/s", si(rays_per_second(&p), "rays")));
     }
 
     /// Clears the bar and prints one summary line. Does nothing the second time.
