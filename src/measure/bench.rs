@@ -4,13 +4,13 @@
 
 use crate::measure::analytic::luminance;
 use crate::measure::metrics;
-use crate::measure::plot::{ScatterPlot, Series};
+use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{ReferenceImage, ReferencePixel};
 use crate::measure::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency, BORDER_PX};
-pub use crate::render::bench_file::{BenchFile, BenchRecord, LimitInfo, ReferenceInfo};
+pub use crate::render::bench_file::{significant, BenchFile, BenchRecord, LimitInfo, ReferenceInfo};
 use crate::render::error::{Error, Result};
-use crate::render::gpu::timing::{summarize, SpanSummary};
+use crate::render::gpu::timing::{is_per_eye, summarize, SpanSummary};
 use crate::render::gpu::Gpu;
 use crate::render::passes::final_occlusion;
 use crate::render::renderer::{Renderer, Timing};
@@ -89,11 +89,24 @@ impl BenchRow {
     /// Reflective shadow maps (pass `rsm`): the gather plus the light-space pass that
     /// renders the maps.
     pub fn occlusion_ms_per_eye(&self) -> f64 {
+        self.occlusion_passes().iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
+    }
+
+    fn occlusion_passes(&self) -> Vec<&str> {
         if self.pass == RSM_PASS {
-            return (self.median_ms(RSM_PASS) + self.median_ms("shadow")) / self.views as f64;
+            vec![RSM_PASS, "shadow"]
+        } else {
+            vec![self.pass, "depth-peel", "temporal", "blur", "upsample"]
         }
-        let passes = [self.pass, "depth-peel", "temporal", "blur", "upsample"];
-        passes.iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
+    }
+
+    /// Per eye, the passes of the measured frames besides the occlusion (per-eye spans
+    /// lie inside their pass's and are not added): what the occlusion shares the frame
+    /// budget with, for the plot's budget line.
+    pub fn other_ms_per_eye(&self) -> f64 {
+        let occlusion = self.occlusion_passes();
+        let other = self.spans.iter().filter(|s| !is_per_eye(&s.label) && !occlusion.contains(&s.label.as_str()));
+        other.map(|s| s.median_ms).sum::<f64>() / self.views as f64
     }
 }
 

@@ -81,13 +81,34 @@ pub struct BenchRecord {
     /// the same sweep). Frames do not run the stand-alone upsample pass.
     #[serde(default)]
     pub frame_upsample_ms_per_eye: Option<f64>,
+    /// The measured frames' passes besides the occlusion, per eye (the G-buffer; with
+    /// `--frame` also shadows, direct light and composite): what the occlusion shares
+    /// the frame budget with. None in files written before it was recorded.
+    #[serde(default)]
+    pub other_ms_per_eye: Option<f64>,
 }
 
 impl BenchRecord {
     pub fn setting(&self) -> String {
         let peel = if self.depth_peeling { " peeled" } else { "" };
         let temporal = if self.temporal { " temporal" } else { "" };
-        format!("{}{peel}{temporal} N={} r={} m {}", self.technique, self.samples, self.radius_m, self.resolution)
+        let r = significant(self.radius_m as f64, 2);
+        format!("{}{peel}{temporal} N={} r={r} m {}", self.technique, self.samples, self.resolution)
+    }
+}
+
+/// `x` rounded to `digits` significant digits without trailing zeros, for text and file
+/// names: 0.25612497 → "0.26", 0.5 → "0.5", 12.3 → "12" (at 2 digits).
+pub fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 
@@ -138,4 +159,19 @@ pub struct ReferenceInfo {
     pub ao_noise_rms: f64,
     /// Tracer throughput on this machine (rays per second, all cores), when it traced.
     pub rays_per_second: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::significant;
+
+    #[test]
+    fn significant_digits_without_float_noise() {
+        assert_eq!(significant(0.25612497f32 as f64, 2), "0.26");
+        assert_eq!(significant(0.5f32 as f64, 2), "0.5");
+        assert_eq!(significant(12.3, 2), "12");
+        assert_eq!(significant(0.004987, 2), "0.005");
+        assert_eq!(significant(0.0996, 2), "0.1");
+        assert_eq!(significant(0.0, 2), "0");
+    }
 }

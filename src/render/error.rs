@@ -1,6 +1,5 @@
 //! One error type for the library; the CLI maps it to exit codes.
 
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// Exit code for bad input or an unusable device (clear error, never a panic).
@@ -8,18 +7,32 @@ pub const EXIT_INPUT: i32 = 2;
 /// Exit code for a run that finished but did not fit its frame budget.
 pub const EXIT_OVER_BUDGET: i32 = 3;
 
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Malformed or missing input. `file` and `line` name the place when known.
+    #[error("{}", place(file.as_deref(), *line, message))]
     Input { file: Option<PathBuf>, line: Option<usize>, message: String },
     /// No usable GPU adapter or device.
+    #[error("no usable GPU: {0}")]
     Device(String),
     /// A GPU operation failed while running (validation, lost device, readback).
+    #[error("GPU error: {0}")]
     Gpu(String),
     /// Writing an output failed.
+    #[error("{}: {message}", path.display())]
     Output { path: PathBuf, message: String },
     /// The run finished but did not fit its frame budget (`vrao budget`).
+    #[error("{0}")]
     OverBudget(String),
+}
+
+/// "file:line: message", "file: message" or "message", as much as is known.
+fn place(file: Option<&Path>, line: Option<usize>, message: &str) -> String {
+    match (file, line) {
+        (Some(file), Some(line)) => format!("{}:{line}: {message}", file.display()),
+        (Some(file), None) => format!("{}: {message}", file.display()),
+        (None, _) => message.to_string(),
+    }
 }
 
 impl Error {
@@ -42,24 +55,22 @@ impl Error {
     }
 }
 
-impl fmt::Display for Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Input { file: Some(file), line: Some(line), message } => {
-                write!(f, "{}:{}: {}", file.display(), line, message)
-            }
-            Error::Input { file: Some(file), line: None, message } => {
-                write!(f, "{}: {}", file.display(), message)
-            }
-            Error::Input { file: None, message, .. } => write!(f, "{message}"),
-            Error::Device(m) => write!(f, "no usable GPU: {m}"),
-            Error::Gpu(m) => write!(f, "GPU error: {m}"),
-            Error::Output { path, message } => write!(f, "{}: {}", path.display(), message),
-            Error::OverBudget(m) => write!(f, "{m}"),
-        }
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_the_place_when_known() {
+        let f = Path::new("a/scene.toml");
+        assert_eq!(Error::at_line(f, 3, "bad key").to_string(), "a/scene.toml:3: bad key");
+        assert_eq!(Error::in_file(f, "missing").to_string(), "a/scene.toml: missing");
+        assert_eq!(Error::input("plain").to_string(), "plain");
+        assert_eq!(Error::Device("none".into()).to_string(), "no usable GPU: none");
+        assert_eq!(Error::Gpu("lost".into()).to_string(), "GPU error: lost");
+        let out = Error::Output { path: PathBuf::from("o.png"), message: "denied".into() };
+        assert_eq!(out.to_string(), "o.png: denied");
+        assert_eq!(Error::OverBudget("over".into()).to_string(), "over");
     }
 }
-
-impl std::error::Error for Error {}
-
-pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -46,6 +46,7 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 temporal: c.temporal,
                 composite_ms_per_eye: per_eye("composite"),
                 frame_upsample_ms_per_eye: None,
+                other_ms_per_eye: Some(row.other_ms_per_eye()),
             }
         })
         .collect();
@@ -158,7 +159,7 @@ const COLUMNS: &[Column] = &[
         name: "radius_m",
         header: "r (m)",
         csv: |r| format!("{}", r.radius_m),
-        markdown: |r| format!("{}", r.radius_m),
+        markdown: |r| significant(r.radius_m as f64, 2),
         optional: false,
     },
     Column {
@@ -389,7 +390,7 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
             "| {} | {} | {} | {:.3} | {in_frame} |",
             half.technique,
             half.samples,
-            half.radius_m,
+            significant(half.radius_m as f64, 2),
             half.occlusion_ms_per_eye / full.occlusion_ms_per_eye
         );
     }
@@ -414,7 +415,10 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
                 let _ = writeln!(
                     table,
                     "| {} | {} | {} | {} | {ratio:.3} | {occlusion:.3} |",
-                    r.technique, r.samples, r.radius_m, r.resolution
+                    r.technique,
+                    r.samples,
+                    significant(r.radius_m as f64, 2),
+                    r.resolution
                 );
             }
         }
@@ -435,52 +439,85 @@ pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
     serde_json::from_str(&text).map_err(|e| Error::at_line(path, e.line(), format!("not a vrao bench file: {e}")))
 }
 
-/// The plot of error against per-eye ms for the rows of one radius, with that radius's
-/// Pareto front and the budget line.
+/// The plot's file name for one radius, rounded so that it carries no float noise:
+/// `bench-r0.26.png`.
+pub fn plot_file_name(radius_m: f32) -> String {
+    format!("bench-r{}.png", significant(radius_m as f64, 2))
+}
+
+/// The plot of AO error against occlusion ms per eye for the rows of one radius, every
+/// point labelled with its setting, with that radius's Pareto front and a budget line.
+///
+/// The x axis is the occlusion's time alone (what the Pareto front and `vrao budget
+/// --fit` rank by), so the budget line is the occlusion's share of the frame: the
+/// per-eye budget minus the other passes the bench measured in the same frames (the
+/// median over the radius's rows). A file without those times gets the whole per-eye
+/// budget, labelled as such.
 pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterPlot {
-    const COLOURS: [[u8; 3]; 8] = [
-        [31, 119, 180],
-        [255, 127, 14],
-        [44, 160, 44],
-        [214, 39, 40],
-        [148, 103, 189],
-        [140, 86, 75],
-        [23, 190, 207],
-        [188, 189, 34],
+    // One hue per technique variant, dark at full and light at half resolution.
+    const HUES: [([u8; 3], [u8; 3]); 6] = [
+        ([31, 90, 180], [120, 170, 230]),
+        ([220, 110, 0], [250, 180, 100]),
+        ([30, 130, 40], [130, 200, 120]),
+        ([190, 30, 40], [240, 130, 130]),
+        ([110, 60, 170], [190, 160, 220]),
+        ([120, 75, 40], [200, 160, 120]),
     ];
     let rows: Vec<&BenchRecord> =
         file.records.iter().filter(|r| r.radius_m == radius_m && r.ao_rmse.is_some()).collect();
-    let mut series: Vec<Series> = Vec::new();
+    let (mut series, mut variants): (Vec<Series>, Vec<String>) = (Vec::new(), Vec::new());
     for r in &rows {
-        let label = format!(
-            "{}{}{} {}",
+        let technique = format!(
+            "{}{}{}",
             r.technique,
             if r.depth_peeling { " peeled" } else { "" },
-            if r.temporal { " temporal" } else { "" },
-            r.resolution
+            if r.temporal { " temporal" } else { "" }
         );
-        let point = (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN));
+        let label = format!("{technique} {}", r.resolution);
+        if !variants.contains(&technique) {
+            variants.push(technique.clone());
+        }
+        let point = Point {
+            x: r.occlusion_ms_per_eye,
+            y: r.ao_rmse.unwrap_or(f64::NAN),
+            label: format!("{technique} N={} {}", r.samples, r.resolution),
+        };
         match series.iter_mut().find(|s| s.label == label) {
             Some(s) => s.points.push(point),
             None => {
-                let color = COLOURS[series.len() % COLOURS.len()];
+                let hue = HUES[variants.iter().position(|v| v == &technique).unwrap_or(0) % HUES.len()];
+                let color = if r.resolution == "half" { hue.1 } else { hue.0 };
                 series.push(Series { label, color, points: vec![point] });
             }
         }
     }
-    let mut pareto: Vec<(f64, f64)> =
+    let pareto: Vec<(f64, f64)> =
         rows.iter().filter(|r| r.pareto).map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
-    pareto.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut other: Vec<f64> = rows.iter().filter_map(|r| r.other_ms_per_eye).collect();
+    other.sort_by(f64::total_cmp);
+    let line = match other.get(other.len() / 2) {
+        Some(&other) => {
+            let share = (budget_ms_per_eye - other).max(0.0);
+            let label = format!(
+                "occlusion budget {share:.2} ms/eye\n({budget_ms_per_eye:.2} per eye \u{2212} {other:.2} other passes)"
+            );
+            (share, label)
+        }
+        None => (budget_ms_per_eye, format!("whole budget {budget_ms_per_eye:.2} ms/eye\n(other passes not recorded)")),
+    };
     ScatterPlot {
         title: format!(
-            "{}: AO error against time, r = {radius_m} m, {}x{} per eye, {}",
-            file.scene, file.width, file.height, file.adapter
+            "{}: AO error against time, r = {} m, {}x{} per eye, {}",
+            file.scene,
+            significant(radius_m as f64, 2),
+            file.width,
+            file.height,
+            file.adapter
         ),
         x_label: "occlusion ms per eye (technique + blur + upsample)".into(),
-        y_label: "AO RMSE vs reference".into(),
+        y_label: "AO RMSE against the reference".into(),
         series,
         pareto,
-        vertical_line: Some((budget_ms_per_eye, format!("budget {budget_ms_per_eye:.2} ms/eye"))),
-        log_x: true,
+        vertical_line: Some(line),
     }
 }

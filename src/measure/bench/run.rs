@@ -279,7 +279,7 @@ pub fn write_outputs(out: &Path, run: &BenchRun, budget_ms: f64) -> Result<Strin
         // One plot per radius (errors compare only within a radius); bench.png is the
         // middle radius, the scene's suggested one by default.
         for (i, &radius) in run.radii.iter().enumerate() {
-            let name = if i == run.radii.len() / 2 { "bench.png".to_string() } else { format!("bench-r{radius}.png") };
+            let name = if i == run.radii.len() / 2 { "bench.png".to_string() } else { super::plot_file_name(radius) };
             plot(file, radius, budget_ms / 2.0).save_png(&out.join(&name), 1280, 800)?;
             written += &format!(", {name}");
         }

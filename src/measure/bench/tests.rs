@@ -124,3 +124,23 @@ fn csv_markdown_and_json_hold_every_row() {
     let back: BenchFile = serde_json::from_str(&json).unwrap();
     assert_eq!(back.records, recs);
 }
+
+#[test]
+fn the_plot_labels_every_point_and_bounds_occlusion_by_its_share_of_the_budget() {
+    let mut f = file(records(&[row(Technique::Ssao, 10.0, 0.1), row(Technique::Hbao, 14.0, 0.08)]));
+    let p = plot(&f, 0.5, 55.5);
+    let labels: Vec<&str> = p.series.iter().flat_map(|s| s.points.iter().map(|p| p.label.as_str())).collect();
+    assert_eq!(labels, ["ssao N=12 full", "hbao N=12 full"]);
+    // Occlusion ms on x, so the line is what the per-eye budget leaves after the other
+    // passes of the same frames (the G-buffer, 50 ms for both eyes).
+    assert_eq!(f.records[0].other_ms_per_eye, Some(25.0));
+    let (x, label) = p.vertical_line.clone().unwrap();
+    assert_eq!(x, 30.5);
+    assert!(label.starts_with("occlusion budget 30.50 ms/eye"), "{label}");
+    // A file from before the other passes were recorded: the whole budget, said so.
+    f.records.iter_mut().for_each(|r| r.other_ms_per_eye = None);
+    let (x, label) = plot(&f, 0.5, 55.5).vertical_line.unwrap();
+    assert!(x == 55.5 && label.contains("other passes not recorded"), "{label}");
+    assert_eq!(plot_file_name(0.25612497), "bench-r0.26.png");
+    assert!(p.title.contains("r = 0.5 m"), "{}", p.title);
+}

@@ -47,7 +47,7 @@
 //! are the work units of a rayon parallel iterator over all cores.
 //!
 //! [`trace_cached`] keeps results on disk keyed by an FNV-1a hash of everything that
-//! determines them; [`ProgressBar`] shows progress on a terminal.
+//! determines them; [`ProgressBar`] shows progress on a terminal (indicatif).
 
 mod cache;
 mod geometry;
@@ -58,7 +58,7 @@ mod shading;
 mod tests;
 
 pub use cache::{cache_file, cache_key, default_cache_dir, read_cache, trace_cached, write_cache, FORMAT_VERSION};
-pub use progress::{format_bar, ProgressBar};
+pub use progress::ProgressBar;
 
 use crate::render::error::{Error, Result};
 use crate::render::scene::Scene;

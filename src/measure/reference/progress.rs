@@ -1,22 +1,15 @@
-//! A one-line progress bar on stderr for long traces:
-//! `\r[#####.....] 42% 1.2 Mrays/s ETA 0:35`.
+//! The reference tracer's [`Progress`] shown with indicatif: a bar on a terminal
+//! (`reference [#####.....]  42% 1.2 Mrays/s ETA 35s`), nothing otherwise, and one
+//! summary line at the end either way (logs keep how fast the trace ran).
 
 use super::Progress;
-use std::io::{IsTerminal, Write};
-use std::time::{Duration, Instant};
+use std::io::IsTerminal;
+use std::time::Duration;
 
-/// Cells of the bar between the brackets.
-const BAR_CELLS: usize = 30;
-/// At most this many redraws a second.
-const REDRAW_INTERVAL: Duration = Duration::from_millis(250);
-
-/// Draws [`Progress`] on stderr. On a terminal it redraws one line at most four times a
-/// second; otherwise it stays silent until [`finish`](Self::finish), which prints one
-/// summary line either way.
+/// Draws [`Progress`] on stderr; see the module documentation.
 pub struct ProgressBar {
     label: String,
-    terminal: bool,
-    last_draw: Option<Instant>,
+    bar: indicatif::ProgressBar,
     last: Option<Progress>,
     finished: bool,
 }
@@ -28,58 +21,52 @@ impl ProgressBar {
     }
 
     fn with_terminal(label: &str, terminal: bool) -> ProgressBar {
-        ProgressBar { label: label.to_string(), terminal, last_draw: None, last: None, finished: false }
+        // Hidden off a terminal: a log file gets the summary line, not redraws.
+        let target = if terminal {
+            indicatif::ProgressDrawTarget::stderr_with_hz(4)
+        } else {
+            indicatif::ProgressDrawTarget::hidden()
+        };
+        // No length until the first update: a length of 0 would draw as 100 %.
+        let bar = indicatif::ProgressBar::with_draw_target(None, target);
+        let style = indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] {percent:>3}% {msg} ETA {eta}")
+            .expect("the template is valid")
+            .progress_chars("#>.");
+        bar.set_style(style);
+        bar.set_prefix(label.to_string());
+        ProgressBar { label: label.to_string(), bar, last: None, finished: false }
     }
 
-    /// Records `p` and redraws when on a terminal and the last redraw is old enough.
+    /// Records `p` and moves the bar (indicatif limits the redraws).
     pub fn update(&mut self, p: Progress) {
         self.last = Some(p);
-        if !self.terminal || self.finished {
-            return;
-        }
-        let now = Instant::now();
-        if self.last_draw.is_some_and(|t| now.duration_since(t) < REDRAW_INTERVAL) {
-            return;
-        }
-        self.last_draw = Some(now);
-        let mut err = std::io::stderr().lock();
-        // A progress bar that cannot be drawn is not worth failing the trace for.
-        let _ = write!(err, "\r{} {}", self.label, format_bar(&p));
-        let _ = err.flush();
+        // Position last: each setter may redraw, and the last one should show all three.
+        self.bar.set_message(format!("{}/s", si(rays_per_second(&p), "rays")));
+        self.bar.set_length(p.total as u64);
+        self.bar.set_position(p.done as u64);
     }
 
-    /// Ends the bar with one summary line (on a terminal in place of the bar) and a
-    /// newline. Does nothing the second time.
+    /// Clears the bar and prints one summary line. Does nothing the second time.
     pub fn finish(&mut self) {
-        if self.finished {
+        if std::mem::replace(&mut self.finished, true) {
             return;
         }
-        self.finished = true;
-        let line = self.summary();
-        let mut err = std::io::stderr().lock();
-        // On a terminal the summary overwrites the bar (and clears what is left of it).
-        let _ = if self.terminal { writeln!(err, "\r{line}\x1b[K") } else { writeln!(err, "{line}") };
+        self.bar.finish_and_clear();
+        eprintln!("{}", self.summary());
     }
 
     /// "reference: 12.3 Mrays in 0:04 (3.1 Mrays/s)".
     pub fn summary(&self) -> String {
         let p = self.last.unwrap_or(Progress { done: 0, total: 0, rays: 0, elapsed: Duration::ZERO });
+        let s = p.elapsed.as_secs();
         format!(
-            "{}: {} in {} ({}/s)",
+            "{}: {} in {}:{:02} ({}/s)",
             self.label,
             si(p.rays as f64, "rays"),
-            clock(p.elapsed),
+            s / 60,
+            s % 60,
             si(rays_per_second(&p), "rays")
         )
-    }
-}
-
-impl Drop for ProgressBar {
-    /// A bar left on a terminal would leave the shell prompt after it.
-    fn drop(&mut self) {
-        if self.terminal && self.last_draw.is_some() && !self.finished {
-            let _ = writeln!(std::io::stderr());
-        }
     }
 }
 
@@ -92,23 +79,8 @@ fn rays_per_second(p: &Progress) -> f64 {
     }
 }
 
-/// `[#####.....] 42% 1.2 Mrays/s ETA 0:35` for `p` (no carriage return).
-pub fn format_bar(p: &Progress) -> String {
-    let fraction = if p.total > 0 { (p.done as f64 / p.total as f64).clamp(0.0, 1.0) } else { 1.0 };
-    let filled = ((fraction * BAR_CELLS as f64).floor() as usize).min(BAR_CELLS);
-    let bar: String = "#".repeat(filled) + &".".repeat(BAR_CELLS - filled);
-    let eta = if p.done >= p.total {
-        "done".to_string()
-    } else if p.done == 0 {
-        "ETA --:--".to_string()
-    } else {
-        let remaining = p.elapsed.as_secs_f64() * (p.total - p.done) as f64 / p.done as f64;
-        format!("ETA {}", clock(Duration::from_secs_f64(remaining.min(1e9))))
-    };
-    format!("[{bar}] {:>3}% {}/s {eta}", (fraction * 100.0).floor() as u32, si(rays_per_second(p), "rays"))
-}
-
-/// A count of `unit` with a metric prefix and one decimal: "950 rays", "1.2 krays", "3.4 Mrays".
+/// A count of `unit` with a metric prefix and one decimal: "950 rays", "3.4 Mrays"
+/// (indicatif's human counts group digits instead, unreadable at billions of rays).
 fn si(x: f64, unit: &str) -> String {
     let x = if x.is_finite() { x.max(0.0) } else { 0.0 };
     for (scale, prefix) in [(1e9, "G"), (1e6, "M"), (1e3, "k")] {
@@ -117,16 +89,6 @@ fn si(x: f64, unit: &str) -> String {
         }
     }
     format!("{x:.0} {unit}")
-}
-
-/// m:ss, or h:mm:ss from an hour on.
-fn clock(d: Duration) -> String {
-    let s = d.as_secs();
-    if s >= 3600 {
-        format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
-    } else {
-        format!("{}:{:02}", s / 60, s % 60)
-    }
 }
 
 #[cfg(test)]
@@ -138,26 +100,16 @@ mod tests {
     }
 
     #[test]
-    fn bar_shows_fraction_rate_and_eta() {
-        assert_eq!(
-            format_bar(&progress(42, 100, 12_000_000, 10.0)),
-            "[############..................]  42% 1.2 Mrays/s ETA 0:13"
-        );
-        assert_eq!(format_bar(&progress(0, 100, 0, 0.0)), "[..............................]   0% 0 rays/s ETA --:--");
-        assert_eq!(format_bar(&progress(7, 7, 900, 1.0)), "[##############################] 100% 900 rays/s done");
-        assert_eq!(format_bar(&progress(0, 0, 0, 0.0)), "[##############################] 100% 0 rays/s done");
-        assert_eq!(clock(Duration::from_secs(3725)), "1:02:05");
-        assert_eq!(si(2.5e9, "rays"), "2.5 Grays");
-    }
-
-    #[test]
-    fn summary_and_silence_off_a_terminal() {
+    fn hidden_off_a_terminal_with_a_summary() {
         let mut bar = ProgressBar::with_terminal("reference", false);
+        assert!(bar.bar.is_hidden());
         bar.update(progress(5, 10, 3_400_000, 2.0));
-        assert!(bar.last_draw.is_none(), "nothing drawn off a terminal");
+        assert_eq!((bar.bar.position(), bar.bar.length()), (5, Some(10)));
         assert_eq!(bar.summary(), "reference: 3.4 Mrays in 0:02 (1.7 Mrays/s)");
         bar.finish();
         bar.finish();
-        assert!(bar.finished);
+        assert!(bar.bar.is_finished());
+        assert_eq!(si(2.5e9, "rays"), "2.5 Grays");
+        assert_eq!(si(950.0, "rays"), "950 rays");
     }
 }

@@ -2,7 +2,6 @@
 //! readback. Everything GPU-side that is not a technique lives here.
 
 pub mod frame;
-pub mod half;
 pub mod kernel;
 pub mod multiview_probe;
 pub mod raster;

@@ -1,6 +1,5 @@
 //! Copies layered textures back to the CPU (debug images, tests, error measurement).
 
-use super::half::f16_to_f32;
 use super::targets::LayeredTarget;
 use super::Gpu;
 use crate::render::error::{Error, Result};
@@ -82,7 +81,7 @@ pub fn read_layers_f32(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<f32>
         .into_iter()
         .map(|bytes| {
             if half {
-                bytes.chunks_exact(2).map(|c| f16_to_f32(u16::from_le_bytes([c[0], c[1]]))).collect()
+                bytes.chunks_exact(2).map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32()).collect()
             } else {
                 bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
             }

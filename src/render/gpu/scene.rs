@@ -1,7 +1,6 @@
 //! The scene on the GPU: one vertex and one index buffer for all meshes, positions
 //! relative to an f64 anchor, and one uniform + texture per material.
 
-use super::half::f32_to_f16;
 use super::Gpu;
 use crate::render::scene::{Environment, Scene};
 use bytemuck::{Pod, Zeroable};
@@ -183,6 +182,13 @@ fn rgba8_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8]) 
     texture.create_view(&Default::default())
 }
 
+/// `v` as f16 bits, saturated to ±65504 and NaN as 0: `half` alone would give Inf or
+/// NaN, and an upload must never carry a non-finite value.
+fn saturating_f16(v: f32) -> u16 {
+    let max = half::f16::MAX.to_f32();
+    half::f16::from_f32(if v.is_nan() { 0.0 } else { v.clamp(-max, max) }).to_bits()
+}
+
 /// The environment's radiance (times its intensity) as Rgba16Float, for the sky behind
 /// the scene. Values beyond the half range saturate rather than turn into Inf.
 fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureView {
@@ -190,7 +196,7 @@ fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureVie
         Some(e) => (e.width, e.height, e.texels.iter().map(|t| t.map(|c| c * e.intensity)).collect()),
         None => (1, 1, vec![[0.0; 3]]),
     };
-    let data: Vec<u16> = texels.iter().flat_map(|t| [t[0], t[1], t[2], 1.0]).map(f32_to_f16).collect();
+    let data: Vec<u16> = texels.iter().flat_map(|t| [t[0], t[1], t[2], 1.0]).map(saturating_f16).collect();
     let texture = gpu.device.create_texture_with_data(
         &gpu.queue,
         &wgpu::TextureDescriptor {
@@ -243,4 +249,20 @@ fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             },
         ],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::saturating_f16;
+    use half::f16;
+
+    #[test]
+    fn environment_texels_saturate_and_never_carry_nan() {
+        let back = |v: f32| f16::from_bits(saturating_f16(v)).to_f32();
+        assert_eq!(back(1.0), 1.0);
+        assert_eq!(back(-2.5), -2.5);
+        assert_eq!(back(1e30), 65504.0);
+        assert_eq!(back(f32::NEG_INFINITY), -65504.0);
+        assert_eq!(back(f32::NAN), 0.0);
+    }
 }
