@@ -7,7 +7,7 @@
 //! front (a line through its points in x order) and an optional dashed vertical line
 //! (the budget) with a label. Non-finite points are skipped.
 //!
-//! Text: [`Backend`] wraps plotters' bitmap backend and draws text itself, with ab_glyph
+//! Text: `Backend` wraps plotters' bitmap backend and draws text itself, with ab_glyph
 //! and the Hack font that `epaint_default_fonts` embeds. No system font lookup (a bare
 //! machine draws the same plot), and each glyph keeps its side bearing, which plotters'
 //! own `ab_glyph` text path (0.3.7) drops.
