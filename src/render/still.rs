@@ -38,12 +38,13 @@ pub struct Still {
 /// (and with `debug` the buffers behind them) into `options.out`.
 pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) -> Result<Still> {
     settings.validate()?;
-    // An unwritable directory fails now, not after the frames.
+    // A refused adapter leaves nothing behind; an unwritable directory fails before
+    // the frames, not after.
+    let gpu = Arc::new(Gpu::new(options.backend)?);
     std::fs::create_dir_all(&options.out).map_err(|e| Error::Output {
         path: options.out.clone(),
         message: format!("cannot create this directory: {e}"),
     })?;
-    let gpu = Arc::new(Gpu::new(options.backend)?);
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     renderer.set_timing(options.timing.resolve(&gpu));
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
