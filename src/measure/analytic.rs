@@ -25,10 +25,8 @@ use crate::render::stereo::Eye;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 
-/// Rec. 709 / sRGB luminance of a linear RGB colour.
-pub fn luminance(rgb: [f32; 3]) -> f64 {
-    0.2126 * rgb[0] as f64 + 0.7152 * rgb[1] as f64 + 0.0722 * rgb[2] as f64
-}
+pub use crate::measure::metrics::luminance;
+pub use crate::render::stereo::pixel_ray;
 
 /// GLSL/WGSL `smoothstep`: 0 below `edge0`, 1 above `edge1`, Hermite in between.
 pub fn smoothstep(edge0: f64, edge1: f64, x: f64) -> f64 {
@@ -396,14 +394,6 @@ pub fn screen_space_expectation(
     } else {
         1.0
     }
-}
-
-/// The world-space direction (unit) through the centre of `pixel` of an eye whose image
-/// is `size` pixels (x right, y down from the top-left corner).
-pub fn pixel_ray(eye: &Eye, size: (u32, u32), pixel: (f64, f64)) -> DVec3 {
-    let [l, r, u, d] = eye.fov.tangents();
-    let (s, t) = (pixel.0 / size.0 as f64, pixel.1 / size.1 as f64);
-    (eye.pose.orientation * DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0)).normalize()
 }
 
 /// HBAO as the renderer runs it (shaders/hbao.wgsl).

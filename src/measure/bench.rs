@@ -2,8 +2,8 @@
 //! pass per eye over many frames, as a table, CSV and Markdown. (Error against the
 //! reference tracer joins these rows when the tracer exists.)
 
-use crate::measure::analytic::luminance;
 use crate::measure::metrics;
+use crate::measure::metrics::luminance;
 use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{ReferenceImage, ReferencePixel};

@@ -16,6 +16,11 @@
 //!
 //! All accumulation is in `f64`.
 
+/// Rec. 709 / sRGB luminance of a linear RGB colour.
+pub fn luminance(rgb: [f32; 3]) -> f64 {
+    0.2126 * rgb[0] as f64 + 0.7152 * rgb[1] as f64 + 0.0722 * rgb[2] as f64
+}
+
 /// Side of the standard SSIM window (Wang et al. 2004): 11 × 11.
 pub const SSIM_WINDOW: usize = 11;
 /// Standard deviation of the SSIM Gaussian window, in pixels.

@@ -300,6 +300,14 @@ pub fn forward(pose: &HeadPose) -> Vec3 {
     (pose.orientation * -DVec3::Z).as_vec3()
 }
 
+/// The world-space direction (unit) through the centre of `pixel` of an eye whose image
+/// is `size` pixels (x right, y down from the top-left corner).
+pub fn pixel_ray(eye: &Eye, size: (u32, u32), pixel: (f64, f64)) -> DVec3 {
+    let [l, r, u, d] = eye.fov.tangents();
+    let (s, t) = (pixel.0 / size.0 as f64, pixel.1 / size.1 as f64);
+    (eye.pose.orientation * DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0)).normalize()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,11 +1,11 @@
 //! The CPU ray tracer that computes ground truth for the GPU occlusion techniques.
 //!
 //! For every traced pixel of every eye it follows the pixel's centre ray
-//! ([`crate::measure::analytic::pixel_ray`], from the near plane on, as the rasteriser clips) to
+//! ([`crate::render::stereo::pixel_ray`], from the near plane on, as the rasteriser clips) to
 //! the first surface and there estimates, with the same M stratified cosine-weighted
 //! directions about the shading normal, one ray each:
 //!
-//! - `ao`: V = 1 − (1/π) ∫ [hit within r] cos θ dω ([`crate::measure::analytic`]'s reference AO);
+//! - `ao`: V = 1 − (1/π) ∫ [hit within r] cos θ dω (the test oracle `measure::analytic` computes it in closed form);
 //! - `ao_falloff`: the same with each occluded direction weighted by W(d) = max(0, 1 − d/r);
 //! - `environment_visible`: ∫ L_env(ω) [no hit within r] cos θ dω from the real lat-long
 //!   map ([`Environment::sample`](crate::render::scene::Environment::sample)), what SSDO approximates;
@@ -271,7 +271,7 @@ pub fn trace(
         let pixels = (0..gw)
             .map(|i| {
                 let (x, y) = pixel_of(size, settings.stride, i, j);
-                let dir = crate::measure::analytic::pixel_ray(&eye, size, (x as f64 + 0.5, y as f64 + 0.5));
+                let dir = crate::render::stereo::pixel_ray(&eye, size, (x as f64 + 0.5, y as f64 + 0.5));
                 let along = dir.dot(forward);
                 let dir32 = dir.as_vec3();
                 row_rays += 1;
@@ -364,7 +364,7 @@ pub fn world_position(image: &ReferenceImage, eye: &Eye, layer: usize, i: u32, j
     }
     let (x, y) = image.pixel_of(i, j);
     let eye = Eye { pose: eye.pose.sanitized(), ..*eye };
-    let dir = crate::measure::analytic::pixel_ray(&eye, (image.width, image.height), (x as f64 + 0.5, y as f64 + 0.5));
+    let dir = crate::render::stereo::pixel_ray(&eye, (image.width, image.height), (x as f64 + 0.5, y as f64 + 0.5));
     let along = dir.dot(eye.pose.orientation * DVec3::NEG_Z);
     Some(eye.pose.position + dir * (p.depth as f64 / along))
 }
