@@ -4,6 +4,7 @@
 mod frame_loop;
 pub mod governor;
 mod panel;
+mod picture;
 mod session;
 pub mod window;
 

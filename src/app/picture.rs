@@ -1,0 +1,151 @@
+//! The window's picture pipelines: a full-screen triangle drawing one 2D view into a
+//! viewport — an eye image (filtered), or one of the buffers behind it texel for texel
+//! (shaders/mirror.wgsl).
+
+use crate::app::BufferView;
+use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::Gpu;
+
+/// How a picture image is drawn: the eye image filtered, or a buffer texel for texel
+/// (shaders/mirror.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PictureKind {
+    Eye,
+    Occlusion,
+    Normals,
+    Depth,
+}
+
+impl PictureKind {
+    pub(super) fn of(view: BufferView) -> PictureKind {
+        match view {
+            BufferView::Eyes => PictureKind::Eye,
+            BufferView::FinalAo | BufferView::RawAo => PictureKind::Occlusion,
+            BufferView::Normals => PictureKind::Normals,
+            BufferView::Depth => PictureKind::Depth,
+        }
+    }
+}
+
+/// The picture's pipelines: a full-screen triangle drawing one 2D view into a viewport,
+/// one pipeline per [`PictureKind`].
+pub(super) struct Blit {
+    eye: wgpu::RenderPipeline,
+    occlusion: wgpu::RenderPipeline,
+    normals: wgpu::RenderPipeline,
+    depth: wgpu::RenderPipeline,
+    eye_layout: wgpu::BindGroupLayout,
+    float_layout: wgpu::BindGroupLayout,
+    depth_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+/// A bind group layout of one fragment-stage texture or sampler per entry.
+fn fragment_layout(gpu: &Gpu, label: &str, entries: &[(u32, wgpu::BindingType)]) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = entries
+        .iter()
+        .map(|&(binding, ty)| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty,
+            count: None,
+        })
+        .collect();
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+}
+
+fn texture_binding(sample_type: wgpu::TextureSampleType) -> wgpu::BindingType {
+    wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false }
+}
+
+impl Blit {
+    pub(super) fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> Blit {
+        let device = &gpu.device;
+        let eye_layout = fragment_layout(
+            gpu,
+            "mirror",
+            &[
+                (0, texture_binding(wgpu::TextureSampleType::Float { filterable: true })),
+                (1, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+            ],
+        );
+        let float_layout = fragment_layout(
+            gpu,
+            "buffer view",
+            &[(2, texture_binding(wgpu::TextureSampleType::Float { filterable: false }))],
+        );
+        let depth_layout = fragment_layout(gpu, "depth view", &[(3, texture_binding(wgpu::TextureSampleType::Depth))]);
+        let module = shader_module(device, "mirror", &["mirror.wgsl"]);
+        let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry_point),
+                bind_group_layouts: &[Some(layout)],
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    buffers: &[],
+                    compilation_options: Default::default(),
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry_point),
+                    targets: &[Some(format.into())],
+                    compilation_options: Default::default(),
+                }),
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("mirror"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Blit {
+            eye: pipeline(&eye_layout, "fs_main"),
+            occlusion: pipeline(&float_layout, "fs_occlusion"),
+            normals: pipeline(&float_layout, "fs_normals"),
+            depth: pipeline(&depth_layout, "fs_depth"),
+            eye_layout,
+            float_layout,
+            depth_layout,
+            sampler,
+        }
+    }
+
+    pub(super) fn pipeline(&self, kind: PictureKind) -> &wgpu::RenderPipeline {
+        match kind {
+            PictureKind::Eye => &self.eye,
+            PictureKind::Occlusion => &self.occlusion,
+            PictureKind::Normals => &self.normals,
+            PictureKind::Depth => &self.depth,
+        }
+    }
+
+    pub(super) fn bind_group(&self, gpu: &Gpu, kind: PictureKind, view: &wgpu::TextureView) -> wgpu::BindGroup {
+        let texture = wgpu::BindingResource::TextureView(view);
+        let (layout, entries) = match kind {
+            PictureKind::Eye => (
+                &self.eye_layout,
+                vec![
+                    wgpu::BindGroupEntry { binding: 0, resource: texture },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                ],
+            ),
+            PictureKind::Occlusion | PictureKind::Normals => {
+                (&self.float_layout, vec![wgpu::BindGroupEntry { binding: 2, resource: texture }])
+            }
+            PictureKind::Depth => (&self.depth_layout, vec![wgpu::BindGroupEntry { binding: 3, resource: texture }]),
+        };
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mirror"), layout, entries: &entries })
+    }
+}
