@@ -399,7 +399,8 @@ impl RunSummary {
                 let ao = &frame_loop.renderer.settings().ao;
                 let resolution = if ao.half_res { "half" } else { "full" };
                 let temporal = if ao.temporal.enabled { " temporal" } else { "" };
-                format!("{}{temporal} N={} r={} m {resolution}", ao.technique.name(), ao.samples, ao.radius)
+                let r = crate::render::output::significant(ao.radius as f64, 3);
+                format!("{}{temporal} N={} r={r} m {resolution}", ao.technique.name(), ao.samples)
             },
             openxr: frame_loop.headset.openxr_report(),
         }

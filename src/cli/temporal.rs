@@ -38,7 +38,7 @@ pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
         args.width,
         args.height,
         base.ao.technique.name(),
-        base.ao.radius,
+        vrao::render::output::significant(base.ao.radius as f64, 3),
         study.adapter
     );
     print!("{}", to_markdown(&study.points));

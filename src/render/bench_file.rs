@@ -92,23 +92,8 @@ impl BenchRecord {
     pub fn setting(&self) -> String {
         let peel = if self.depth_peeling { " peeled" } else { "" };
         let temporal = if self.temporal { " temporal" } else { "" };
-        let r = significant(self.radius_m as f64, 2);
+        let r = crate::render::output::significant(self.radius_m as f64, 2);
         format!("{}{peel}{temporal} N={} r={r} m {}", self.technique, self.samples, self.resolution)
-    }
-}
-
-/// `x` rounded to `digits` significant digits without trailing zeros, for text and file
-/// names: 0.25612497 → "0.26", 0.5 → "0.5", 12.3 → "12" (at 2 digits).
-pub fn significant(x: f64, digits: i32) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{x:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
     }
 }
 
@@ -163,7 +148,7 @@ pub struct ReferenceInfo {
 
 #[cfg(test)]
 mod tests {
-    use super::significant;
+    use crate::render::output::significant;
 
     #[test]
     fn significant_digits_without_float_noise() {

@@ -130,3 +130,18 @@ pub fn write_json<T: serde::Serialize + ?Sized>(path: &Path, value: &T) -> Resul
         serde_json::to_string_pretty(value).map_err(|e| Error::Output { path: path.into(), message: e.to_string() })?;
     std::fs::write(path, json).map_err(|e| Error::Output { path: path.into(), message: format!("cannot write: {e}") })
 }
+
+/// `x` rounded to `digits` significant digits without trailing zeros, for text and file
+/// names: 0.25612497 → "0.26", 0.5 → "0.5", 12.3 → "12" (at 2 digits).
+pub fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}

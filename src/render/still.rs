@@ -77,7 +77,7 @@ pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) 
         if renderer.uses_multiview() { "multiview" } else { "multipass" },
         settings.ao.technique.name(),
         settings.ao.samples,
-        settings.ao.radius,
+        crate::render::output::significant(settings.ao.radius as f64, 3),
         if settings.ao.half_res { ", half resolution" } else { "" },
     );
     let mut explain = report.plan.to_string();
