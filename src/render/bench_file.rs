@@ -6,12 +6,19 @@ use serde::{Deserialize, Serialize};
 /// One row as written to CSV, JSON and Markdown.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BenchRecord {
+    /// Technique name as on the command line (`ssao`, `hbao`, `gtao`, `ssdo`, …).
     pub technique: String,
+    /// Samples per pixel (N) the case asked for.
     pub samples: u32,
+    /// Occlusion radius in metres.
     pub radius_m: f32,
+    /// `full` or `half`: the resolution the occlusion ran at.
     pub resolution: String,
+    /// Median GPU ms per eye of the technique's own pass.
     pub technique_ms_per_eye: f64,
+    /// Median GPU ms per eye of the bilateral blur (0 when off).
     pub blur_ms_per_eye: f64,
+    /// Median GPU ms per eye of the half-to-full upsample (0 at full resolution).
     pub upsample_ms_per_eye: f64,
     /// Technique + blur + upsample per eye: the occlusion's cost.
     pub occlusion_ms_per_eye: f64,
@@ -35,6 +42,7 @@ pub struct BenchRecord {
     /// the same for every row of a radius).
     #[serde(default)]
     pub limit_rmse: Option<f64>,
+    /// Mean (limit − reference) AO: > 0 the screen-space limit is too light.
     #[serde(default)]
     pub limit_bias: Option<f64>,
     /// RMSE within 40 px of the outer, top and bottom borders (`measure::bench::ErrorFigures::ao_rmse_outer_border`).
@@ -51,22 +59,28 @@ pub struct BenchRecord {
     /// every border.
     #[serde(default)]
     pub stereo_inconsistent: Option<f64>,
+    /// [`Self::stereo_inconsistent`] within 40 px of the inner (nasal) border.
     #[serde(default)]
     pub stereo_inconsistent_inner_border: Option<f64>,
+    /// [`Self::stereo_inconsistent`] farther than 40 px from every border.
     #[serde(default)]
     pub stereo_inconsistent_interior: Option<f64>,
+    /// Mean SSIM of the AO against the reference (1 = identical).
     pub ao_ssim: Option<f64>,
+    /// RMSE of the ambient light's luminance relative to the reference's mean.
     pub ambient_rel_rmse: Option<f64>,
     /// On the Pareto front of AO RMSE against occlusion ms per eye.
     pub pareto: bool,
     /// SSDO with depth peeling; its second-layer pass is in `occlusion_ms_per_eye`.
     #[serde(default)]
     pub depth_peeling: bool,
+    /// Median GPU ms per eye of the depth-peeling pass (0 without peeling).
     #[serde(default)]
     pub peel_ms_per_eye: f64,
     /// One-bounce irradiance against the reference's bounce (ssdo-bounce, rsm rows).
     #[serde(default)]
     pub bounce_rel_rmse: Option<f64>,
+    /// Mean relative bias of the one-bounce irradiance against the reference's.
     #[serde(default)]
     pub bounce_rel_bias: Option<f64>,
     /// Temporal accumulation on; its pass is in `occlusion_ms_per_eye`.
@@ -89,6 +103,7 @@ pub struct BenchRecord {
 }
 
 impl BenchRecord {
+    /// The row's setting in one line, e.g. `ssao N=16 r=0.5 m full`, for tables and logs.
     pub fn setting(&self) -> String {
         let peel = if self.depth_peeling { " peeled" } else { "" };
         let temporal = if self.temporal { " temporal" } else { "" };
@@ -100,14 +115,23 @@ impl BenchRecord {
 /// A whole sweep: where it ran, how, and every row.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BenchFile {
+    /// Scene name or file the sweep rendered.
     pub scene: String,
+    /// GPU adapter name as wgpu reports it.
     pub adapter: String,
+    /// wgpu backend (e.g. `Vulkan`).
     pub backend: String,
+    /// Driver name and version as the adapter reports them.
     pub driver: String,
+    /// Width of each eye's image in pixels.
     pub width: u32,
+    /// Height of each eye's image in pixels.
     pub height: u32,
+    /// Timing mode, lower case (`serial` or `pipelined`): how passes were submitted.
     pub timing: String,
+    /// Frames rendered and discarded before timing began, per case.
     pub warmup: u32,
+    /// Frames timed per case (the medians are over these).
     pub frames: u32,
     /// The reference tracer's settings and noise, when errors were measured.
     pub reference: Option<ReferenceInfo>,
@@ -123,13 +147,16 @@ pub struct BenchFile {
     /// The command line that measured this.
     #[serde(default)]
     pub command: String,
+    /// One row per measured case, in sweep order.
     pub records: Vec<BenchRecord>,
 }
 
 /// The screen-space limit's march (the reference tracer's `LimitSettings`).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct LimitInfo {
+    /// Rays marched per pixel.
     pub rays_per_pixel: u32,
+    /// Steps along each ray.
     pub steps: u32,
     /// Thickness as a fraction of the radius.
     pub thickness_of_radius: f64,
@@ -138,7 +165,9 @@ pub struct LimitInfo {
 /// The reference tracer's settings and noise, when errors were measured.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ReferenceInfo {
+    /// Rays traced per pixel.
     pub rays_per_pixel: u32,
+    /// Every `stride`-th pixel in x and y was traced (1: all).
     pub stride: u32,
     /// RMS over hit pixels of the reference AO's standard error (worst radius).
     pub ao_noise_rms: f64,

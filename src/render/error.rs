@@ -7,11 +7,19 @@ pub const EXIT_INPUT: i32 = 2;
 /// Exit code for a run that finished but did not fit its frame budget.
 pub const EXIT_OVER_BUDGET: i32 = 3;
 
+/// Every failure vrao reports; each maps to a process exit code ([`Error::exit_code`]).
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Malformed or missing input. `file` and `line` name the place when known.
     #[error("{}", place(file.as_deref(), *line, message))]
-    Input { file: Option<PathBuf>, line: Option<usize>, message: String },
+    Input {
+        /// The file the input came from, when there was one.
+        file: Option<PathBuf>,
+        /// The 1-based line in `file`, when known.
+        line: Option<usize>,
+        /// What is wrong, for the user.
+        message: String,
+    },
     /// No usable GPU adapter or device.
     #[error("no usable GPU: {0}")]
     Device(String),
@@ -20,7 +28,12 @@ pub enum Error {
     Gpu(String),
     /// Writing an output failed.
     #[error("{}: {message}", path.display())]
-    Output { path: PathBuf, message: String },
+    Output {
+        /// The file that could not be written.
+        path: PathBuf,
+        /// Why, as the OS or encoder said it.
+        message: String,
+    },
     /// The run finished but did not fit its frame budget (`vrao budget`).
     #[error("{0}")]
     OverBudget(String),
@@ -36,15 +49,19 @@ fn place(file: Option<&Path>, line: Option<usize>, message: &str) -> String {
 }
 
 impl Error {
+    /// Malformed or missing input with no file to name.
     pub fn input(message: impl Into<String>) -> Self {
         Error::Input { file: None, line: None, message: message.into() }
     }
+    /// Malformed input in `file`.
     pub fn in_file(file: &Path, message: impl Into<String>) -> Self {
         Error::Input { file: Some(file.to_path_buf()), line: None, message: message.into() }
     }
+    /// Malformed input at `line` (1-based) of `file`.
     pub fn at_line(file: &Path, line: usize, message: impl Into<String>) -> Self {
         Error::Input { file: Some(file.to_path_buf()), line: Some(line), message: message.into() }
     }
+    /// The process exit code for this error: 2 bad input/device/output, 1 GPU failure, 3 over budget.
     pub fn exit_code(&self) -> i32 {
         match self {
             // An output that cannot be written is the path the user gave (or its disk).
@@ -55,6 +72,7 @@ impl Error {
     }
 }
 
+/// vrao's result type, with [`Error`] as the default error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 #[cfg(test)]

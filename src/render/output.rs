@@ -6,6 +6,7 @@ use crate::render::renderer::Renderer;
 use crate::render::settings::{Settings, Technique};
 use std::path::{Path, PathBuf};
 
+/// File-name parts of layer 0 and layer 1, in that order.
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
 
 fn save_rgba(path: &Path, width: u32, height: u32, rgba: Vec<u8>) -> Result<()> {

@@ -28,7 +28,9 @@ pub enum DisplayMode {
 }
 
 impl DisplayMode {
+    /// Every mode, in the order the CLI lists them.
     pub const ALL: [DisplayMode; 3] = [DisplayMode::None, DisplayMode::Mirror, DisplayMode::SinglePass];
+    /// The mode's command-line name (`none`, `mirror`, `single-pass`).
     pub fn name(self) -> &'static str {
         match self {
             DisplayMode::None => "none",
@@ -60,6 +62,7 @@ pub enum Technique {
 }
 
 impl Technique {
+    /// The technique's command-line name (`ssao`, `hbao`, …), also used in file names and reports.
     pub fn name(self) -> &'static str {
         match self {
             Technique::None => "none",
@@ -78,6 +81,7 @@ impl Technique {
         matches!(self, Technique::Ssdo | Technique::SsdoBounce)
     }
 
+    /// Every technique, in the order the CLI and the bench list them.
     pub const ALL: [Technique; 7] = [
         Technique::None,
         Technique::Ssao,
@@ -115,7 +119,9 @@ pub enum Quality {
 }
 
 impl Quality {
+    /// Every preset, lowest first.
     pub const ALL: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
+    /// The preset's command-line name.
     pub fn name(self) -> &'static str {
         match self {
             Quality::Low => "low",
@@ -164,7 +170,9 @@ pub enum BounceForm {
 }
 
 impl BounceForm {
+    /// Both forms, the default first.
     pub const ALL: [BounceForm; 2] = [BounceForm::Direction, BounceForm::Patch];
+    /// The form's command-line name.
     pub fn name(self) -> &'static str {
         match self {
             BounceForm::Patch => "patch",
@@ -186,7 +194,9 @@ pub enum Denoise {
 }
 
 impl Denoise {
+    /// Both denoisers, the default first.
     pub const ALL: [Denoise; 2] = [Denoise::Tile, Denoise::Bilateral];
+    /// The denoiser's command-line name.
     pub fn name(self) -> &'static str {
         match self {
             Denoise::Tile => "tile",

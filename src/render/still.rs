@@ -13,7 +13,9 @@ use std::sync::Arc;
 /// How [`render_still`] renders and what it writes.
 #[derive(Clone, Debug)]
 pub struct StillOptions {
+    /// Which wgpu backend to ask for.
     pub backend: BackendChoice,
+    /// How passes are submitted and timed (`Auto` decides once the adapter is known).
     pub timing: TimingChoice,
     /// Frames to render (at least 1); with more than one, a tenth (1 to 10) are warm-up
     /// and the rest are timed.
@@ -31,6 +33,7 @@ pub struct Still {
     pub summary: String,
     /// Which passes ran and why the others were left out, then the per-pass timing table.
     pub explain: String,
+    /// Every file written, in writing order.
     pub written: Vec<PathBuf>,
 }
 

@@ -10,27 +10,41 @@ use crate::render::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, Mat3, Mat4, Vec3};
 
+/// One eye's matrices as the shaders read them (`Eye` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct EyeUniform {
+    /// Clip from the scene's anchor frame (geometry is stored relative to the f64 anchor).
     pub clip_from_anchored: [[f32; 4]; 4],
+    /// View from the anchor frame (normals use its rotation).
     pub view_from_anchored: [[f32; 4]; 4],
+    /// World from view, rotation only (environment lookups).
     pub world_from_view: [[f32; 4]; 4],
+    /// tan(left), tan(right), tan(up), tan(down) of the eye's asymmetric frustum.
     pub tangents: [f32; 4],
     /// The other eye's view from this eye's view (identity for a mono view).
     pub other_from_view: [[f32; 4]; 4],
 }
 
+/// Per-frame constants of every pass (`Frame` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct FrameUniform {
+    /// Both eyes (eye 1 repeats eye 0 for a mono view).
     pub eyes: [EyeUniform; 2],
+    /// Full-resolution image size in pixels, per eye.
     pub size: [u32; 2],
+    /// Layers of the targets: 2 for stereo, 1 for mono.
     pub layers: u32,
+    /// Lights per eye in the light buffer.
     pub light_count: u32,
+    /// Near plane in metres (reversed-Z, far plane at infinity).
     pub near: f32,
+    /// Linear exposure before tone mapping.
     pub exposure: f32,
+    /// Reinhard's L_white: the smallest exposed luminance mapped to white.
     pub white_point: f32,
+    /// 1 when the scene has an environment light, else 0.
     pub has_environment: u32,
     /// The environment light as quadratics in each eye's view-space direction
     /// (`quadratic_in_view`; zero without an environment): [irradiance of eye 0, of
@@ -39,33 +53,52 @@ pub struct FrameUniform {
     pub environment_quadratics: [[[f32; 4]; 10]; 4],
 }
 
+/// One light in one eye's view space (`Light` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct LightUniform {
+    /// Directional: the direction the light travels; point: view-space position (m).
     pub pos_or_dir: [f32; 4],
+    /// Colour × intensity in rgb.
     pub radiance: [f32; 4],
+    /// x: 0 directional, 1 point.
     pub kind: [u32; 4],
 }
 
+/// The occlusion passes' parameters (`AoParams` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct AoParamsUniform {
+    /// Size of the occlusion targets in pixels (half the full size, rounded up, at half resolution).
     pub ao_size: [u32; 2],
+    /// Full-resolution pixels per occlusion pixel along each axis: 1 or 2.
     pub scale: u32,
+    /// SSAO/SSDO samples per pixel.
     pub samples: u32,
+    /// HBAO directions (directions × steps ≈ samples).
     pub directions: u32,
+    /// HBAO steps per direction.
     pub steps: u32,
+    /// How the composite applies occlusion: 0 none, 1 scalar AO, 2 directional (SSDO).
     pub technique: u32,
+    /// 0 tiled 5×5 rotations, 1 Halton/R2 per-pixel rotation.
     pub noise: u32,
+    /// World-space occlusion radius in metres.
     pub radius: f32,
+    /// Occlusion weight in [0, 4].
     pub strength: f32,
+    /// Depth bias as a fraction of the radius.
     pub bias: f32,
+    /// 1: occluders beyond the radius fade out (range check).
     pub range_check: u32,
+    /// SSDO bounce strength (0: no bounce work).
     pub bounce: f32,
     /// Extra rotation of every pixel's pattern this frame (HBAO with temporal
     /// accumulation turns its directions by the golden angle per frame; 0 otherwise).
     pub frame_angle: f32,
+    /// Bilateral blur radius in occlusion pixels.
     pub blur_radius: u32,
+    /// Depth-edge width of the blur, as a fraction of the centre pixel's distance.
     pub blur_plane_sigma: f32,
     /// Scale of the sample lengths this frame (HBAO's temporal range jitter; 1 otherwise).
     pub range_scale: f32,
@@ -95,7 +128,9 @@ pub const MAX_KERNEL_SAMPLES: usize = 256;
 
 /// The uniform and light buffers of one frame.
 pub struct FrameBuffers {
+    /// The [`FrameUniform`].
     pub frame: wgpu::Buffer,
+    /// [`LightUniform`]s of both eyes (at least one element: wgpu rejects empty bindings).
     pub lights: wgpu::Buffer,
     /// `AoParams` of common.wgsl.
     pub ao: wgpu::Buffer,
@@ -115,6 +150,7 @@ pub fn ao_extent(width: u32, height: u32, half_res: bool) -> (u32, u32) {
 }
 
 impl FrameBuffers {
+    /// Allocates the buffers, with room for `light_count` lights per eye; the renderer fills them each frame.
     pub fn new(device: &wgpu::Device, light_count: usize) -> FrameBuffers {
         // Both eyes' copies; at least one element since wgpu rejects empty bindings.
         let light_capacity = (light_count * 2).max(1);

@@ -181,6 +181,7 @@ pub struct Kernel {
 }
 
 impl Kernel {
+    /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding `slots`.
     pub fn new(gpu: &Gpu, label: &str, files: &[&str], entry: &str, slots: &[Slot]) -> Kernel {
         Self::with_constants(gpu, label, files, entry, slots, &[])
     }

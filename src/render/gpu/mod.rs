@@ -17,9 +17,12 @@ use std::fmt::Write as _;
 /// Which wgpu backend to use. `Auto` prefers a real GPU and falls back to lavapipe.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum BackendChoice {
+    /// Whichever backend has a real GPU, falling back to lavapipe (software Vulkan).
     #[default]
     Auto,
+    /// Vulkan only.
     Vulkan,
+    /// OpenGL (ES) only, for machines without Vulkan.
     Gl,
 }
 
@@ -37,10 +40,15 @@ pub struct Capabilities {
 
 /// The adapter, device and queue every pass shares.
 pub struct Gpu {
+    /// The wgpu instance the adapter came from (also makes window surfaces).
     pub instance: wgpu::Instance,
+    /// The chosen adapter.
     pub adapter: wgpu::Adapter,
+    /// The logical device every resource is made on.
     pub device: wgpu::Device,
+    /// The device's only queue.
     pub queue: wgpu::Queue,
+    /// What the device can do that the renderer cares about.
     pub caps: Capabilities,
     /// The first wgpu error no scope caught (validation, out of memory, lost device):
     /// kept here instead of wgpu's default panic, and returned by [`Gpu::take_error`].
@@ -158,6 +166,7 @@ impl Gpu {
         Ok(())
     }
 
+    /// Blocks until all submitted work has finished, then returns the first uncaught wgpu error, if any.
     pub fn wait_idle(&self) -> Result<()> {
         self.device
             .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })

@@ -7,48 +7,68 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use wgpu::util::DeviceExt;
 
+/// One mesh vertex as the vertex buffer holds it.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct Vertex {
+    /// Position in metres relative to [`GpuScene::anchor`].
     pub position: [f32; 3],
+    /// Unit surface normal in world space.
     pub normal: [f32; 3],
+    /// Texture coordinates of the diffuse texture.
     pub uv: [f32; 2],
 }
 
+/// One material's constants (`Material` uniform of the G-buffer shader).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct MaterialUniform {
+    /// Diffuse albedo in rgb; w is 1 when a diffuse texture multiplies it, else 0.
     pub diffuse: [f32; 4],
+    /// Emitted radiance in rgb; w unused.
     pub emission: [f32; 4],
 }
 
+/// One material on the GPU: its uniform and diffuse texture.
 pub struct GpuMaterial {
+    /// The [`MaterialUniform`].
     pub uniform: wgpu::Buffer,
+    /// The diffuse texture, or a 1×1 white placeholder without one.
     pub texture: wgpu::TextureView,
+    /// Whether `texture` is the material's own texture rather than the placeholder.
     pub has_texture: bool,
 }
 
 /// A contiguous range of indices drawn with one material.
 pub struct Draw {
+    /// Indices into [`GpuScene::indices`] to draw.
     pub indices: std::ops::Range<u32>,
+    /// Index into [`GpuScene::materials`] and `material_groups`.
     pub material: usize,
 }
 
+/// The scene's meshes, materials and environment uploaded once, shared by every pass.
 pub struct GpuScene {
     /// Every position on the GPU is relative to this world point (f64), so geometry far
     /// from the world origin keeps f32 precision.
     pub anchor: DVec3,
+    /// Every mesh's [`Vertex`]es, concatenated.
     pub vertices: wgpu::Buffer,
+    /// Every mesh's u32 indices, offset into `vertices`.
     pub indices: wgpu::Buffer,
+    /// One draw per contiguous run of one material.
     pub draws: Vec<Draw>,
+    /// The scene's materials, in scene order.
     pub materials: Vec<GpuMaterial>,
     /// Layout of a material's bind group (uniform, diffuse texture, sampler; fragment
     /// stage), and one bind group per material: the G-buffer and the light-space pass
     /// both draw the scene with them.
     pub material_layout: wgpu::BindGroupLayout,
+    /// One bind group per material, in `materials` order (layout: `material_layout`).
     pub material_groups: Vec<wgpu::BindGroup>,
     /// The environment as a filterable equirectangular texture (1×1 black without one).
     pub environment: wgpu::TextureView,
+    /// Sampler of the materials' diffuse textures.
     pub sampler: wgpu::Sampler,
 }
 
@@ -66,6 +86,7 @@ impl GpuScene {
         }
     }
 
+    /// Uploads `scene`'s geometry (relative to the centre of its bounds), materials and environment.
     pub fn upload(gpu: &Gpu, scene: &Scene) -> GpuScene {
         let bounds = scene.bounds();
         let anchor = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };

@@ -16,13 +16,16 @@ pub const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
 /// can be tested without one.
 #[derive(Clone, Debug)]
 pub struct AdapterSupport {
+    /// The adapter's backend.
     pub backend: wgpu::Backend,
+    /// The adapter's downlevel flags (compute, storage support).
     pub downlevel: wgpu::DownlevelFlags,
     /// The format features of each of [`STORAGE_WRITE_FORMATS`].
     pub formats: Vec<(wgpu::TextureFormat, wgpu::TextureFormatFeatureFlags)>,
 }
 
 impl AdapterSupport {
+    /// Reads the support figures from a real adapter.
     pub fn of(adapter: &wgpu::Adapter) -> AdapterSupport {
         AdapterSupport {
             backend: adapter.get_info().backend,

@@ -3,18 +3,24 @@
 
 /// A 2D array texture with a view of the whole array and one view per layer.
 pub struct LayeredTarget {
+    /// The texture itself (for copies and readback).
     pub texture: wgpu::Texture,
     /// All layers, as `texture_2d_array` / `texture_storage_2d_array` / multiview attachment.
     pub array_view: wgpu::TextureView,
     /// One single-layer 2D view per layer, for per-eye render passes.
     pub layer_views: Vec<wgpu::TextureView>,
+    /// The texel format.
     pub format: wgpu::TextureFormat,
+    /// Width of each layer in pixels.
     pub width: u32,
+    /// Height of each layer in pixels.
     pub height: u32,
+    /// Number of layers: 2 for stereo, 1 for mono.
     pub layers: u32,
 }
 
 impl LayeredTarget {
+    /// Makes a `width` × `height` × `layers` texture with the given usages and its views.
     pub fn new(
         device: &wgpu::Device,
         label: &str,
@@ -49,6 +55,7 @@ impl LayeredTarget {
         LayeredTarget::new(device, label, format, (1, 1, 2), wgpu::TextureUsages::TEXTURE_BINDING)
     }
 
+    /// (width, height, layers).
     pub fn extent(&self) -> (u32, u32, u32) {
         (self.width, self.height, self.layers)
     }

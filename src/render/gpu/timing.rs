@@ -10,7 +10,9 @@ use std::collections::VecDeque;
 /// recorded; per-eye spans ([`is_per_eye`]) lie inside their pass's span.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameTiming {
+    /// The renderer's frame number the spans belong to.
     pub frame: u64,
+    /// (label, GPU ms) of every span, in recording order.
     pub spans: Vec<(String, f64)>,
     /// GPU time of the whole frame: the sum of its passes' spans (not the per-eye ones).
     pub total_ms: f64,
@@ -48,6 +50,7 @@ impl PassTimer {
         Ok(PassTimer { profiler, pending: VecDeque::new(), timestamp_period: gpu.queue.get_timestamp_period() })
     }
 
+    /// Whether timestamp queries are on (false where the device has none: spans then read 0 frames).
     pub fn enabled(&self) -> bool {
         self.profiler.settings().enable_timer_queries
     }
@@ -57,6 +60,7 @@ impl PassTimer {
         Span(self.profiler.begin_query(label, encoder))
     }
 
+    /// Closes `span` on `encoder`.
     pub fn end(&self, encoder: &mut wgpu::CommandEncoder, span: Span) {
         self.profiler.end_query(encoder, span.0);
     }
@@ -114,13 +118,19 @@ fn flatten(results: &[wgpu_profiler::GpuTimerQueryResult], out: &mut Vec<(String
 /// One span's times over many frames.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SpanSummary {
+    /// The span's label (a pass name, or a per-eye span such as `ssao/left`).
     pub label: String,
+    /// Frames the span was seen in.
     pub frames: usize,
+    /// Median GPU ms.
     pub median_ms: f64,
     /// Interquartile range: the spread that one slow frame does not distort.
     pub p25_ms: f64,
+    /// 75th percentile GPU ms (with `p25_ms`, the interquartile range).
     pub p75_ms: f64,
+    /// Fastest frame's GPU ms.
     pub min_ms: f64,
+    /// Slowest frame's GPU ms.
     pub max_ms: f64,
 }
 

@@ -40,8 +40,11 @@ const BORDER_TEXELS: f64 = 4.0;
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct ShadowLightUniform {
+    /// Light clip from the scene's anchor frame (orthographic, fitted to the scene).
     pub clip_from_anchored: [[f32; 4]; 4],
+    /// Light view from the scene's anchor frame.
     pub view_from_anchored: [[f32; 4]; 4],
+    /// Colour × intensity in rgb; w unused.
     pub radiance: [f32; 4],
     /// Texel size p (m), depth range (m), half the map's side (m), unused.
     pub extent: [f32; 4],
@@ -53,9 +56,13 @@ pub struct ShadowLightUniform {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct ShadowsUniform {
+    /// Number of shadowed lights in `lights` (0: shadows off).
     pub count: u32,
+    /// Side of each shadow map layer in texels.
     pub size: u32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: [u32; 2],
+    /// The shadowed lights; only the first `count` are used.
     pub lights: [ShadowLightUniform; MAX_SHADOWED_LIGHTS],
 }
 
@@ -129,6 +136,7 @@ pub struct LightFit {
     pub half_extent: f64,
     /// Depth range of the box in metres.
     pub range: f64,
+    /// The light's colour × intensity.
     pub radiance: Vec3,
 }
 
@@ -186,6 +194,7 @@ impl LightFit {
         clip_from_view * self.view_from_anchored
     }
 
+    /// The light's `ShadowLight` for a map of `size` × `size` texels.
     pub fn uniform(&self, size: u32) -> ShadowLightUniform {
         let half_side = self.half_side(size);
         ShadowLightUniform {
@@ -201,6 +210,7 @@ impl LightFit {
 /// What the light-space pass, the direct pass and the RSM gather share: the fits, the
 /// `Shadows` uniforms (all lights, and none), the comparison sampler and placeholders.
 pub struct LightSpace {
+    /// One fit per shadowed light, in [`shadow_casters`] order.
     pub fits: Vec<LightFit>,
     /// `Shadows` with every fitted light; the light-space pass writes it when it runs.
     pub uniform: wgpu::Buffer,
@@ -213,6 +223,7 @@ pub struct LightSpace {
 }
 
 impl LightSpace {
+    /// Fits every shadow-casting light of `scene` (positions relative to `anchor`) and makes the shared buffers.
     pub fn new(gpu: &Gpu, scene: &Scene, anchor: DVec3) -> LightSpace {
         let fits = shadow_casters(scene)
             .into_iter()
@@ -269,6 +280,7 @@ pub struct ShadowPass {
 }
 
 impl ShadowPass {
+    /// Makes the light-space pipelines (depth-only, and reflective for the RSM) and one bind group per fitted light.
     pub fn new(gpu: &Gpu, scene: &GpuScene, light_space: Arc<LightSpace>) -> ShadowPass {
         let device = &gpu.device;
         let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -23,13 +23,17 @@ pub const FLOOR_HALF_SIZE: f64 = 20.0;
 /// x in ±`CREASE_HALF_WIDTH` and y in [0, `CREASE_WALL_HEIGHT`]. The floor (y = 0, facing
 /// +Y) runs from the wall to z = `CREASE_FLOOR_END_Z`, past the eye.
 pub const CREASE_WALL_Z: f64 = -3.0;
+/// "crease": half the wall's width along x (m).
 pub const CREASE_HALF_WIDTH: f64 = 5.0;
+/// "crease": the wall's height (m).
 pub const CREASE_WALL_HEIGHT: f64 = 5.0;
+/// "crease": z where the floor ends, behind the eye (m).
 pub const CREASE_FLOOR_END_Z: f64 = 5.0;
 /// "crease": the eye, looking at the middle of the crease line (0, 0, `CREASE_WALL_Z`).
 pub const CREASE_EYE: DVec3 = DVec3::new(0.0, 1.2, 0.0);
 /// "sphere": a sphere resting on the floor.
 pub const SPHERE_CENTER: DVec3 = DVec3::new(0.0, 1.0, 0.0);
+/// "sphere": its radius (m), so it touches the floor at the origin.
 pub const SPHERE_RADIUS: f64 = 1.0;
 /// "room": the inside of a closed box, normals facing in. The −X wall is red, the +X wall
 /// green, the rest white; a 0.8 m cube stands on the floor; a point light hangs below the
@@ -37,10 +41,15 @@ pub const SPHERE_RADIUS: f64 = 1.0;
 /// `ROOM_AMBIENT` intensity stands in for the light bounced around the room, so the
 /// ambient term (what occlusion attenuates) is not zero.
 pub const ROOM_AMBIENT: f32 = 0.5;
+/// "room": the inside's lower corner (m).
 pub const ROOM_MIN: DVec3 = DVec3::new(-2.0, 0.0, -4.0);
+/// "room": the inside's upper corner (m).
 pub const ROOM_MAX: DVec3 = DVec3::new(2.0, 3.0, 0.0);
+/// "room": the cube's lower corner (m).
 pub const ROOM_BOX_MIN: DVec3 = DVec3::new(0.0, 0.0, -3.0);
+/// "room": the cube's upper corner (m).
 pub const ROOM_BOX_MAX: DVec3 = DVec3::new(0.8, 0.8, -2.2);
+/// "room": the point light's position (m).
 pub const ROOM_LIGHT: DVec3 = DVec3::new(0.0, 2.7, -2.0);
 
 const WHITE: f32 = 0.8;

@@ -19,16 +19,21 @@ use glam::{DVec3, Vec3};
 /// "columns": the head, standing 2 m in front of the bench, looking down the scene towards
 /// the wall: far floor and wall lie beside every column.
 pub const COLUMNS_EYE: DVec3 = DVec3::new(0.2, 1.6, 0.9);
+/// "columns": the point the head looks at (m).
 pub const COLUMNS_LOOK_AT: DVec3 = DVec3::new(-0.1, 0.8, -3.0);
 /// Round columns: 0.2 m radius, 3 m tall, centred at these (x, z).
 pub const COLUMN_RADIUS: f64 = 0.2;
+/// Height of every round column (m).
 pub const COLUMN_HEIGHT: f64 = 3.0;
+/// (x, z) of each column's axis (m).
 pub const COLUMN_SITES: [[f64; 2]; 4] = [[-2.2, -2.0], [-0.7, -3.6], [1.1, -2.4], [2.5, -4.6]];
 /// The thin pole: 1.5 cm radius, 2.2 m tall.
 pub const POLE_RADIUS: f64 = 0.015;
+/// (x, z) of the thin pole's axis (m).
 pub const POLE_SITE: [f64; 2] = [0.35, -1.0];
 /// The floating slab, 8 cm thick, 55 cm above the floor.
 pub const SLAB_MIN: DVec3 = DVec3::new(-2.4, 0.55, -1.9);
+/// The floating slab's upper corner (m).
 pub const SLAB_MAX: DVec3 = DVec3::new(-1.0, 0.63, -0.9);
 /// The wall (x in ±6 m, 3.5 m high) runs from z = `WALL_Z` back 0.3 m; it has three
 /// doorways 1.2 m wide and 2.4 m high, centred at x = −3, 0, 3.

@@ -18,9 +18,12 @@ use std::path::Path;
 /// become infinity on the GPU.
 pub const MAX_RADIANCE: f32 = 65504.0;
 
+/// Distant light as an equirectangular radiance map with its SH9 irradiance (layout in the module docs).
 #[derive(Clone, Debug)]
 pub struct Environment {
+    /// Texels per row (azimuth).
     pub width: u32,
+    /// Rows (polar angle, top row straight up).
     pub height: u32,
     /// Linear RGB radiance, row-major from the top (+Y) row; finite, in [0, `MAX_RADIANCE`].
     /// Not scaled by `intensity`.

@@ -17,37 +17,49 @@ use glam::{DVec3, Vec3};
 
 /// The room's inside: 5 m wide (x), 2.7 m high, 6 m deep (z from −6 to 0).
 pub const FURNISHED_MIN: DVec3 = DVec3::new(-2.5, 0.0, -6.0);
+/// The room's inside, upper corner (m).
 pub const FURNISHED_MAX: DVec3 = DVec3::new(2.5, 2.7, 0.0);
 /// The window-like recess in the back wall (z = −6): its opening spans these x and y and
 /// it goes `FURNISHED_RECESS_DEPTH` into the wall, to a pale "glass" back.
 pub const FURNISHED_WINDOW_MIN: [f64; 2] = [-1.6, 0.9];
+/// The recess opening's upper (x, y) corner (m).
 pub const FURNISHED_WINDOW_MAX: [f64; 2] = [-0.2, 2.2];
+/// How far the recess goes into the back wall (m).
 pub const FURNISHED_RECESS_DEPTH: f64 = 0.25;
 /// Irradiance scale of the default sky standing in for bounced light.
 pub const FURNISHED_AMBIENT: f32 = 0.5;
+/// The ceiling point light's position (m).
 pub const FURNISHED_LIGHT: DVec3 = DVec3::new(0.0, 2.3, -3.2);
+/// The ceiling point light's intensity.
 pub const FURNISHED_LIGHT_INTENSITY: f32 = 6.0;
 /// Standing 1.7 m from the front wall, right of the middle, eyes 1.6 m up, looking past
 /// the table towards the blind: the chairs' legs, the shelves, the back-left wall–floor
 /// and wall–ceiling corners are in view.
 pub const FURNISHED_EYE: DVec3 = DVec3::new(1.0, 1.6, -1.7);
+/// The point the head looks at (m).
 pub const FURNISHED_LOOK_AT: DVec3 = DVec3::new(-0.6, 0.75, -5.0);
 
 /// The table top: 1.6 m × 0.9 m, 0.04 m thick, its upper face 0.75 m above the floor, on
 /// four legs 0.05 m square.
 pub const TABLE_MIN: DVec3 = DVec3::new(-1.3, 0.71, -4.3);
+/// The table top's upper corner (m).
 pub const TABLE_MAX: DVec3 = DVec3::new(0.3, 0.75, -3.4);
+/// Side of the table's square legs (m).
 pub const TABLE_LEG: f64 = 0.05;
 /// The wall shelves (boards 2 cm thick, 25 cm deep) on the back wall span these x; their
 /// upper faces are at these heights.
 pub const SHELF_X: [f64; 2] = [0.5, 1.8];
+/// Heights of the shelves' upper faces above the floor (m).
 pub const SHELF_HEIGHTS: [f64; 4] = [1.0, 1.35, 1.7, 2.05];
 /// Chair legs are 0.03 m square.
 pub const CHAIR_LEG: f64 = 0.03;
 /// Blind slats: thickness, chord (depth), vertical pitch and tilt about the x axis.
 pub const SLAT_THICKNESS: f64 = 0.006;
+/// Blind slat chord (depth across the slat, m).
 pub const SLAT_CHORD: f64 = 0.05;
+/// Vertical distance between slats (m).
 pub const SLAT_PITCH: f64 = 0.035;
+/// Slat tilt about the x axis (degrees).
 pub const SLAT_TILT_DEG: f64 = 25.0;
 
 const SKIRTING_HEIGHT: f64 = 0.08;

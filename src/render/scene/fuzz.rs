@@ -22,8 +22,10 @@ pub enum Target {
 }
 
 impl Target {
+    /// Every target, for loops over all of them.
     pub const ALL: [Target; 3] = [Target::Obj, Target::Mtl, Target::SceneFile];
 
+    /// The file extension the fuzzed bytes are written with.
     pub fn extension(self) -> &'static str {
         match self {
             Target::Obj => "obj",
@@ -135,6 +137,7 @@ pub struct Mutator {
 }
 
 impl Mutator {
+    /// A generator started from `seed` (any value; the same seed gives the same mutations).
     pub fn new(seed: u64) -> Mutator {
         Mutator { state: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1 }
     }

@@ -15,9 +15,13 @@ pub const DEFAULT_CREASE_DEG: f32 = 60.0;
 /// Vertex arrays and a triangle list, as the normal computation reads and writes them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Geometry {
+    /// Vertex positions (m).
     pub positions: Vec<Vec3>,
+    /// Vertex normals, one per position (unit length once computed).
     pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position, or empty.
     pub uvs: Vec<Vec2>,
+    /// Triangle list: three indices into `positions` per face.
     pub indices: Vec<u32>,
 }
 
