@@ -15,10 +15,12 @@ use serde::Serialize;
 /// One frame the headset asks the application to render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameRequest {
+    /// The frame's number, counting from 0 in the order the headset handed frames out.
     pub index: u64,
     /// When the frame's photons are predicted to reach the eyes, in seconds on the
     /// headset's clock; the eye poses are predicted for this time.
     pub display_time: f64,
+    /// Both eyes' poses and fields of view, predicted for `display_time`.
     pub eyes: EyePair,
     /// Per-eye size the headset wants, in pixels.
     pub size: (u32, u32),
@@ -30,9 +32,13 @@ pub struct FrameRequest {
 /// What the application hands to the headset: both eyes' colour and depth (2-layer
 /// targets, layer 0 = left) and the eyes they were rendered for.
 pub struct SubmittedFrame<'a> {
+    /// Colour, sRGB-encoded, one layer per eye.
     pub color: &'a LayeredTarget,
+    /// Reversed-Z depth (infinite far plane), one layer per eye; the positional warp reads it.
     pub depth: &'a LayeredTarget,
+    /// The eyes the frame was rendered for.
     pub eyes: &'a EyePair,
+    /// Near plane (m) the depth was rendered with.
     pub near: f64,
 }
 
@@ -50,6 +56,7 @@ pub struct FrameCounters {
     pub submitted: u64,
     /// Latency from pose sampling to display, over displayed vsyncs (ms).
     pub latency_median_ms: f64,
+    /// 95th percentile of the same latency (ms).
     pub latency_p95_ms: f64,
 }
 
@@ -82,6 +89,7 @@ pub trait Headset {
     fn display_image(&self) -> Option<&LayeredTarget> {
         None
     }
+    /// The counters so far (the run summary prints them).
     fn counters(&self) -> FrameCounters;
     /// Asks the session to end (the user quit): the following `wait_frame` calls return
     /// `None` once the headset has wound down (OpenXR: xrRequestExitSession, then

@@ -67,17 +67,26 @@ impl std::fmt::Display for Unavailable {
 /// A step of OpenXR's session life cycle (XrSessionState), as the headset saw it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum SessionPhase {
+    /// Created, not yet ready to begin.
     Idle,
+    /// Ready: the application begins the session.
     Ready,
+    /// Running, frames not shown yet.
     Synchronized,
+    /// Frames shown, input not focused on the application.
     Visible,
+    /// Frames shown and input focused: the normal running state.
     Focused,
+    /// The runtime asks the application to end the session.
     Stopping,
+    /// The session is being lost (device unplugged, runtime failing).
     LossPending,
+    /// The session is over; the application may leave.
     Exiting,
 }
 
 impl SessionPhase {
+    /// The state's OpenXR name without the prefix (`IDLE`, `READY`, …).
     pub fn name(self) -> &'static str {
         match self {
             SessionPhase::Idle => "IDLE",

@@ -223,6 +223,7 @@ impl OpenXrHeadset {
         self.machine.states()
     }
 
+    /// Frame and layer counts beyond the common [`FrameCounters`].
     pub fn stats(&self) -> OpenXrStats {
         self.stats
     }

@@ -81,6 +81,7 @@ pub struct SessionMachine {
 }
 
 impl SessionMachine {
+    /// A machine before any event (no state seen yet).
     pub fn new() -> SessionMachine {
         SessionMachine::default()
     }
@@ -252,11 +253,14 @@ impl SessionMachine {
 /// run while leaving, do not count.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameBudget {
+    /// Stop after this many rendered frames (`None`: no limit).
     pub limit: Option<u64>,
+    /// Frames submitted with an image so far.
     pub rendered: u64,
 }
 
 impl FrameBudget {
+    /// A budget of `limit` rendered frames, none rendered yet.
     pub fn new(limit: Option<u64>) -> FrameBudget {
         FrameBudget { limit, rendered: 0 }
     }
@@ -268,6 +272,7 @@ impl FrameBudget {
         }
     }
 
+    /// True once `limit` frames have been rendered.
     pub fn reached(&self) -> bool {
         self.limit.is_some_and(|n| self.rendered >= n)
     }

@@ -204,6 +204,7 @@ pub struct EyeBlit {
 }
 
 impl EyeBlit {
+    /// Builds the pipeline for a `color` swapchain format and, when given, a `depth` one.
     pub fn new(device: &wgpu::Device, color: wgpu::TextureFormat, depth: Option<wgpu::TextureFormat>) -> EyeBlit {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("openxr blit"),

@@ -17,11 +17,20 @@ use std::time::{Duration, Instant};
 /// virtual (advanced only by the caller, for deterministic tests and simulations).
 #[derive(Clone, Debug)]
 pub enum Clock {
-    Real { start: Instant },
-    Virtual { now: f64 },
+    /// Wall-clock time since the session started.
+    Real {
+        /// When the session started.
+        start: Instant,
+    },
+    /// Time the caller sets (`advance`, `wait_until`): deterministic tests and simulations.
+    Virtual {
+        /// The current time in seconds.
+        now: f64,
+    },
 }
 
 impl Clock {
+    /// A real clock starting now.
     pub fn real() -> Clock {
         Clock::Real { start: Instant::now() }
     }
@@ -59,9 +68,15 @@ impl Clock {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VsyncOutcome {
     /// A new frame, rendered for this vsync.
-    Presented { frame: u64 },
+    Presented {
+        /// The frame's number ([`FrameRequest::index`](crate::xr::FrameRequest::index)).
+        frame: u64,
+    },
     /// Frame `frame` warped to this vsync's pose (late, or shown again).
-    Reprojected { frame: u64 },
+    Reprojected {
+        /// The frame's number.
+        frame: u64,
+    },
     /// Nothing to show yet (before the first frame).
     Empty,
 }
@@ -90,6 +105,7 @@ pub struct Compositor {
 }
 
 impl Compositor {
+    /// A compositor for a display refreshing at `refresh_hz`; vsync 1 is the first.
     pub fn new(refresh_hz: f64) -> Compositor {
         Compositor {
             period: 1.0 / refresh_hz,
@@ -101,10 +117,12 @@ impl Compositor {
         }
     }
 
+    /// The display period in seconds.
     pub fn period(&self) -> f64 {
         self.period
     }
 
+    /// Time of vsync number `vsync` in seconds (vsync × period).
     pub fn vsync_time(&self, vsync: u64) -> f64 {
         vsync as f64 * self.period
     }
@@ -159,6 +177,7 @@ impl Compositor {
         self.pending.clear();
     }
 
+    /// The counters so far, with the latency median and p95 over the displayed vsyncs.
     pub fn counters(&self) -> FrameCounters {
         let mut c = self.counters;
         if !self.latencies_ms.is_empty() {

@@ -32,16 +32,26 @@ pub enum TimeMode {
     Real,
     /// Virtual time: each submitted frame takes the next of these render times (ms,
     /// cycled), so the same script always gives the same counters.
-    Virtual { render_ms: Vec<f64> },
+    Virtual {
+        /// Render time of each frame in ms, cycled.
+        render_ms: Vec<f64>,
+    },
 }
 
+/// How the simulated headset is set up.
 #[derive(Clone, Debug)]
 pub struct SimulatedOptions {
+    /// Display refresh rate, per-eye size, fields of view and eye separation.
     pub profile: HeadsetProfile,
+    /// Near plane (m) of the eye projections.
     pub near: f64,
+    /// The scene's head pose or scripted path.
     pub path: HeadPath,
+    /// Motion added on top of `path`.
     pub motion: HeadMotion,
+    /// Real or virtual time.
     pub time: TimeMode,
+    /// How the compositor reprojects a late or repeated frame.
     pub reprojection: ReprojectionMode,
     /// Compute the display image (the compositor's output) for the mirror window.
     pub compose: bool,
@@ -69,6 +79,7 @@ struct Rendering {
     finished_at: Arc<Mutex<Option<f64>>>,
 }
 
+/// A headset without hardware: vsyncs on a real or virtual clock, a compositor that reprojects late frames, frame counters as SteamVR reports them.
 pub struct SimulatedHeadset {
     options: SimulatedOptions,
     rendering: VecDeque<Rendering>,
@@ -90,6 +101,7 @@ pub struct SimulatedHeadset {
 }
 
 impl SimulatedHeadset {
+    /// A headset with `options`; fails on an empty or non-finite virtual render-time script.
     pub fn new(options: SimulatedOptions) -> Result<SimulatedHeadset> {
         if let TimeMode::Virtual { render_ms } = &options.time {
             if render_ms.is_empty() || render_ms.iter().any(|ms| !(ms.is_finite() && *ms >= 0.0)) {

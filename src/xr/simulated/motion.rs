@@ -6,6 +6,7 @@ use crate::render::stereo::HeadPose;
 use glam::{DQuat, DVec3};
 use std::f64::consts::TAU;
 
+/// Head motion the simulated headset adds to the scene's pose, for testing stereo and reprojection under movement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum HeadMotion {
     /// The scene's head pose (or its scripted path) as is.
@@ -20,9 +21,11 @@ pub enum HeadMotion {
 }
 
 impl HeadMotion {
+    /// Every motion, in the order the CLI lists them.
     pub const ALL: [HeadMotion; 4] =
         [HeadMotion::Static, HeadMotion::YawSweep, HeadMotion::FigureEight, HeadMotion::HeadRoll];
 
+    /// The motion's `--motion` name.
     pub fn name(self) -> &'static str {
         match self {
             HeadMotion::Static => "static",

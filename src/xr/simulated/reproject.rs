@@ -10,6 +10,7 @@ use crate::render::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
+/// How the simulated compositor warps a frame to a newer head pose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum ReprojectionMode {
     /// Orientation only: every pixel is treated as infinitely far.
@@ -22,6 +23,7 @@ pub enum ReprojectionMode {
 }
 
 impl ReprojectionMode {
+    /// The mode's `--reprojection` name.
     pub fn name(self) -> &'static str {
         match self {
             ReprojectionMode::Rotational => "rotational",
@@ -43,6 +45,7 @@ struct ReprojectUniform {
     near: f32,
 }
 
+/// The compositor's late warp: rotational and positional reprojection kernels and their uniform.
 pub struct Reprojector {
     splat: Kernel,
     positional: Kernel,
@@ -63,6 +66,7 @@ const SLOTS: [Slot; 6] = [
 ];
 
 impl Reprojector {
+    /// Compiles the warp's kernels (splat, positional, rotational).
     pub fn new(gpu: &Gpu) -> Reprojector {
         let files = ["common.wgsl", "reproject.wgsl"];
         let variant = |label, entry, positional: bool| {
