@@ -49,9 +49,11 @@ pub enum BufferView {
 }
 
 impl BufferView {
+    /// Every view, in the order the panel cycles through them.
     pub const ALL: [BufferView; 5] =
         [BufferView::Eyes, BufferView::FinalAo, BufferView::RawAo, BufferView::Depth, BufferView::Normals];
 
+    /// The view's `--show` name.
     pub fn name(self) -> &'static str {
         match self {
             BufferView::Eyes => "eyes",
@@ -116,17 +118,21 @@ pub fn open_headset(
 /// after they were submitted), for the profiler graph.
 #[derive(Clone, Debug, Default)]
 pub struct PassHistory {
+    /// The most recent frames' GPU times, oldest first, at most `capacity`.
     pub frames: VecDeque<FrameTiming>,
     /// CPU time spent encoding each recent frame (ms), newest last.
     pub cpu_encode_ms: VecDeque<f64>,
+    /// How many frames (and CPU encode times) are kept.
     pub capacity: usize,
 }
 
 impl PassHistory {
+    /// An empty history keeping the last `capacity` frames.
     pub fn new(capacity: usize) -> PassHistory {
         PassHistory { frames: VecDeque::with_capacity(capacity), cpu_encode_ms: VecDeque::new(), capacity }
     }
 
+    /// Adds a frame's GPU times, dropping the oldest when full.
     pub fn push(&mut self, timing: FrameTiming) {
         if self.frames.len() == self.capacity {
             self.frames.pop_front();
@@ -134,6 +140,7 @@ impl PassHistory {
         self.frames.push_back(timing);
     }
 
+    /// Adds a frame's CPU encode time (ms), dropping the oldest when full.
     pub fn push_cpu_encode(&mut self, ms: f64) {
         if self.cpu_encode_ms.len() == self.capacity {
             self.cpu_encode_ms.pop_front();
@@ -144,16 +151,22 @@ impl PassHistory {
 
 /// What one step of the loop did.
 pub struct Step {
+    /// The frame the headset asked for.
     pub request: FrameRequest,
+    /// The renderer's report, or `None` when the headset said not to render this frame.
     pub report: Option<FrameReport>,
 }
 
 /// The headset frame loop. Frames are submitted without waiting for the GPU; their GPU
 /// times come back later and feed the history, the over-budget count and the governor.
 pub struct FrameLoop {
+    /// The device the renderer and headset share.
     pub gpu: Arc<Gpu>,
+    /// The stereo renderer; the governor changes its AO settings between frames.
     pub renderer: Renderer,
+    /// The simulated or OpenXR headset that paces the loop and takes the images.
     pub headset: Box<dyn Headset>,
+    /// Recent per-pass GPU times for the panel and the run summary.
     pub history: PassHistory,
     /// Frames rendered (handed to the headset with an image).
     pub frames: u64,
@@ -163,9 +176,11 @@ pub struct FrameLoop {
     pub budget_ms: f64,
     /// Frames whose GPU time exceeded `budget_ms`, and all frames whose time came back.
     pub over_budget_frames: u64,
+    /// Frames whose GPU time has come back (the denominator of `over_budget_frames`).
     pub timed_frames: u64,
     /// Every frame's GPU time and CPU encode time (ms), for the run's medians.
     pub gpu_frame_ms: Vec<f64>,
+    /// Every frame's CPU encode time (ms).
     pub cpu_encode_ms: Vec<f64>,
     /// Set (by Ctrl-C) to end the session cleanly after the current frame.
     pub exit_requested: Arc<AtomicBool>,
@@ -325,25 +340,33 @@ fn median(values: &[f64]) -> f64 {
 /// and how often it was missed, the headset's counters and per-pass medians.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct RunSummary {
+    /// The headset's name (simulated profile or OpenXR runtime and system).
     pub headset: String,
+    /// The GPU adapter's name.
     pub adapter: String,
     /// Frames rendered and handed to the headset.
     pub frames_rendered: u64,
     /// The most frames the GPU worked on at once, and the limit.
     pub frames_in_flight_max: usize,
+    /// The renderer's limit on frames in flight.
     pub frames_in_flight_limit: usize,
     /// The display period (ms) and the frames whose GPU time exceeded it (of those timed).
     pub budget_ms: f64,
+    /// Timed frames whose GPU time exceeded `budget_ms`.
     pub over_budget_frames: u64,
+    /// Frames whose GPU time came back.
     pub timed_frames: u64,
     /// Medians over the run: GPU time per frame (both eyes), CPU encode time per frame,
     /// and their ratio.
     pub gpu_frame_ms_median: f64,
+    /// Median CPU encode time per frame (ms).
     pub cpu_encode_ms_median: f64,
+    /// `cpu_encode_ms_median` / `gpu_frame_ms_median`.
     pub cpu_encode_share_of_gpu: f64,
     /// How the passes were timed: pipelined, and on a CPU adapter every
     /// [`SERIAL_EVERY`]th frame serial (one submission per pass).
     pub timing: String,
+    /// The headset's frame counters: submitted, presented, reprojected, dropped, latency.
     pub counters: crate::xr::FrameCounters,
     /// (pass, median GPU ms for both eyes) over the recent frames.
     pub pass_medians_ms: Vec<(String, f64)>,
@@ -352,13 +375,16 @@ pub struct RunSummary {
     /// The budget governor: on or off, every change it made, and the AO setting the run
     /// ended with.
     pub governor: String,
+    /// Every change the governor made, in order.
     pub governor_changes: Vec<GovernorChange>,
+    /// The AO setting of the last frame, e.g. `gtao N=24 r=0.3 m half`.
     pub final_ao_setting: String,
     /// The OpenXR session's states, layers and loss reason (OpenXR headsets only).
     pub openxr: Option<crate::xr::openxr::OpenXrReport>,
 }
 
 impl RunSummary {
+    /// Summarizes the loop as it stands (call it when the loop has ended).
     pub fn of(frame_loop: &FrameLoop) -> RunSummary {
         // On a CPU adapter the per-pass medians come from the frames timed pass by pass.
         let serial_only = frame_loop.history.frames.iter().any(|f| f.serial);
@@ -406,6 +432,7 @@ impl RunSummary {
         }
     }
 
+    /// The summary as the few lines `vrao run` prints.
     pub fn to_text(&self) -> String {
         let c = &self.counters;
         let passes: Vec<String> = self.pass_medians_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect();

@@ -41,9 +41,13 @@ pub const BUILTIN_RADIUS_M: f32 = 0.3;
 pub struct Level {
     /// [`BenchRecord::setting`], e.g. "gtao N=24 r=0.3 m half".
     pub setting: String,
+    /// The technique of the setting.
     pub technique: Technique,
+    /// Samples per pixel (N).
     pub samples: u32,
+    /// Occlusion at half resolution.
     pub half_res: bool,
+    /// Temporal accumulation on.
     pub temporal: bool,
     /// AO RMSE against the reference.
     pub ao_rmse: f64,
@@ -137,6 +141,7 @@ impl Frontier {
         Frontier::from_json(BUILTIN_JSON, BUILTIN_PATH, BUILTIN_RADIUS_M).expect("the built-in frontier parses")
     }
 
+    /// Every level, cheapest (most error) first.
     pub fn levels(&self) -> &[Level] {
         &self.levels
     }
@@ -146,6 +151,7 @@ impl Frontier {
         self.levels.len()
     }
 
+    /// Always false (a frontier has at least one level); here for clippy's `len_without_is_empty`.
     pub fn is_empty(&self) -> bool {
         self.levels.is_empty()
     }
@@ -174,7 +180,9 @@ pub struct GovernorConfig {
     pub calm_frames_to_raise: usize,
     /// Frames since the last change before a raise.
     pub min_frames_between_raises: u64,
+    /// Levels to drop on a frame over `drop_above` (≥ 1).
     pub drop_step: usize,
+    /// Levels to raise after enough calm frames (≥ 1).
     pub raise_step: usize,
     /// Measurements of this many frames after a change's frame are ignored: GPU times
     /// arrive a frame or two late, so those frames may still have had the old level.
@@ -191,6 +199,7 @@ impl Default for GovernorConfig {
 }
 
 impl GovernorConfig {
+    /// The default thresholds for a display at `hz` (period 1000 / hz ms).
     pub fn for_refresh_hz(hz: f64) -> GovernorConfig {
         GovernorConfig {
             period_ms: 1000.0 / hz,
@@ -242,6 +251,7 @@ pub struct GovernorChange {
     pub frame: u64,
     /// [`Level::setting`] before and after.
     pub from: String,
+    /// The level's setting after the change.
     pub to: String,
     /// The measured or predicted time and the threshold it crossed.
     pub reason: String,
@@ -297,22 +307,27 @@ impl Governor {
         })
     }
 
+    /// Index of the current level in the frontier.
     pub fn level(&self) -> usize {
         self.level
     }
 
+    /// The current level.
     pub fn current(&self) -> &Level {
         &self.frontier.levels[self.level]
     }
 
+    /// Every change made so far, in order.
     pub fn changes(&self) -> &[GovernorChange] {
         &self.changes
     }
 
+    /// The frontier the governor moves along.
     pub fn frontier(&self) -> &Frontier {
         &self.frontier
     }
 
+    /// The thresholds it runs with.
     pub fn config(&self) -> &GovernorConfig {
         &self.config
     }

@@ -18,13 +18,17 @@ use std::path::PathBuf;
 /// window, the governor on, until 600 frames.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
+    /// Which wgpu backend to ask for.
     pub backend: BackendChoice,
+    /// Simulated headset, OpenXR, or whichever is available.
     pub headset: HeadsetChoice,
+    /// What the desktop window shows (`None`: no window).
     pub display: DisplayMode,
     /// Stop after this many frames (`None`: until the window closes; 600 without one).
     pub frames: Option<u64>,
     /// The simulated headset's head motion and compositor reprojection.
     pub motion: HeadMotion,
+    /// How the simulated compositor reprojects a late frame.
     pub reprojection: ReprojectionMode,
     /// Non-empty: the simulated headset runs in virtual time, frames taking these render
     /// times in ms (cycled).
@@ -32,16 +36,23 @@ pub struct RunOptions {
     /// A profile name of [`crate::xr::profiles::by_name`], its refresh rate and per-eye
     /// size overridden where given.
     pub profile: String,
+    /// Refresh rate override (Hz).
     pub refresh: Option<f64>,
+    /// Per-eye width override (pixels).
     pub width: Option<u32>,
+    /// Per-eye height override (pixels).
     pub height: Option<u32>,
     /// The budget governor, with this frontier (`None`: the built-in one).
     pub governor: bool,
+    /// A bench JSON to take the frontier from (`None`: the built-in one).
     pub governor_frontier: Option<PathBuf>,
+    /// Frames the GPU may work on at once (at least 1).
     pub frames_in_flight: usize,
     /// The desktop window's size, last picture and buffer view.
     pub window: (u32, u32),
+    /// Save the window's last picture to this PNG.
     pub screenshot: Option<PathBuf>,
+    /// Which buffer the window shows (eyes, AO, depth, …); needs a window.
     pub show: BufferView,
 }
 

@@ -24,7 +24,9 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
+/// How the desktop window is opened and what it shows.
 pub struct WindowOptions {
+    /// Mirror both eyes, or render a mono view at the window's size.
     pub mode: DisplayMode,
     /// Initial inner size in physical pixels.
     pub size: (u32, u32),
