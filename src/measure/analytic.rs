@@ -106,8 +106,11 @@ pub fn crease_visibility_quadrature(distance_to_wall: f64, radius: f64, falloff:
 /// A parallelogram `corner + a u + b v` for a, b in [0, 1]; rays hit it from both sides.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rect {
+    /// One corner (m).
     pub corner: DVec3,
+    /// First edge from `corner` (m).
     pub u: DVec3,
+    /// Second edge from `corner` (m).
     pub v: DVec3,
 }
 
@@ -293,12 +296,14 @@ pub fn ssdo_crease_expectation_with_depth_scale(
 /// A pinhole eye for screen-space estimators: a point's depth is (p − eye) · forward.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DepthView {
+    /// The eye's position (m).
     pub eye: DVec3,
     /// Unit view axis.
     pub forward: DVec3,
 }
 
 impl DepthView {
+    /// Distance of `p` along the view axis from the eye (m; negative behind it).
     pub fn depth(&self, p: DVec3) -> f64 {
         (p - self.eye).dot(self.forward)
     }
@@ -329,7 +334,9 @@ pub enum Estimator {
 /// Parameters of [`screen_space_expectation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorParams {
+    /// SSAO or SSDO.
     pub estimator: Estimator,
+    /// Sampling radius r (m).
     pub radius: f64,
     /// Fraction of the radius: the depth tolerance (and SSAO's normal offset).
     pub bias: f64,
@@ -399,10 +406,13 @@ pub fn screen_space_expectation(
 /// HBAO as the renderer runs it (shaders/hbao.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HbaoParams {
+    /// Sampling radius r (m).
     pub radius: f64,
     /// Fraction of the radius; the angle bias is sin h₀ = min(5 · bias, 0.9).
     pub bias: f64,
+    /// Directions marched per rotation.
     pub directions: u32,
+    /// Steps along each direction.
     pub steps: u32,
     /// Per-pixel rotations averaged (evenly spaced over 2π).
     pub rotations: u32,

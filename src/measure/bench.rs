@@ -36,9 +36,13 @@ pub use run::{
 /// One configuration of the sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchCase {
+    /// The occlusion technique.
     pub technique: Technique,
+    /// Samples per pixel (N).
     pub samples: u32,
+    /// Occlusion radius (m).
     pub radius: f32,
+    /// Occlusion at half resolution, then upsampled.
     pub half_res: bool,
     /// SSDO with depth peeling (a second depth layer; its pass counts as occlusion cost).
     pub depth_peeling: bool,
@@ -50,8 +54,11 @@ pub struct BenchCase {
 /// How each case is run: frames (after warm-up) and the timing mode.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measurement {
+    /// Serial (true per-pass times) or pipelined submission.
     pub timing: Timing,
+    /// Frames rendered and discarded before timing.
     pub warmup: u32,
+    /// Frames timed (the medians are over these).
     pub frames: u32,
     /// Render whole frames (direct light and composite too), not only the occlusion:
     /// rows then time the composite, which upsamples half-resolution occlusion inline.
@@ -63,7 +70,9 @@ pub struct Measurement {
 /// One measured row: the case and per-pass medians over the measured frames.
 #[derive(Clone, Debug)]
 pub struct BenchRow {
+    /// The configuration measured.
     pub case: BenchCase,
+    /// Median and spread of every span over the measured frames.
     pub spans: Vec<SpanSummary>,
     /// Views the occlusion passes covered in one dispatch (per-eye = total / views).
     pub views: u32,

@@ -21,42 +21,60 @@ pub use fit::{fit_setting, measure_budget, BudgetOptions, BudgetOutcome, Fit};
 /// Per-pass times of one budget run.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PassTimes {
+    /// The pass's span label.
     pub pass: String,
     /// Both eyes in one frame (one dispatch covering both layers, or both per-eye passes).
     pub stereo: Option<SpanSummary>,
+    /// The left eye rendered alone.
     pub left: Option<SpanSummary>,
+    /// The right eye rendered alone.
     pub right: Option<SpanSummary>,
 }
 
 /// The verdict for one eye or for the whole stereo frame.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Verdict {
+    /// `left eye`, `right eye` or `stereo frame`.
     pub what: String,
     /// Sum of the per-pass medians.
     pub ms: f64,
+    /// Half the stereo budget for an eye, the whole budget for the stereo frame (ms).
     pub budget_ms: f64,
+    /// `ms` ≤ `budget_ms`.
     pub pass: bool,
 }
 
+/// What `vrao budget` measured: per-pass times of the stereo frame and of each eye alone, and the verdicts.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BudgetReport {
+    /// GPU adapter name.
     pub adapter: String,
+    /// wgpu backend.
     pub backend: String,
+    /// Per-eye width in pixels.
     pub width: u32,
+    /// Per-eye height in pixels.
     pub height: u32,
+    /// Timing mode, lower case (`serial` or `pipelined`).
     pub timing: String,
+    /// Frames discarded before timing.
     pub warmup: u32,
+    /// Frames timed.
     pub frames: u32,
     /// What the frames produced: the eye colour (a whole frame) or the occlusion alone.
     pub output: String,
+    /// The stereo frame budget (ms).
     pub budget_ms: f64,
+    /// Every pass's times, in frame order.
     pub passes: Vec<PassTimes>,
     /// CPU time spent encoding the stereo frame, the left and the right eye frame.
     pub cpu_encode: Vec<SpanSummary>,
+    /// Left eye, right eye and stereo frame against their budgets.
     pub verdicts: Vec<Verdict>,
 }
 
 impl BudgetReport {
+    /// True when every verdict passed.
     pub fn within_budget(&self) -> bool {
         self.verdicts.iter().all(|v| v.pass)
     }
@@ -123,11 +141,15 @@ impl BudgetReport {
 /// How the budget run measures.
 #[derive(Clone, Copy, Debug)]
 pub struct BudgetRun {
+    /// Serial (true per-pass times) or pipelined submission.
     pub timing: Timing,
+    /// Frames discarded before timing.
     pub warmup: u32,
+    /// Frames timed.
     pub frames: u32,
     /// The stereo frame budget in milliseconds.
     pub budget_ms: f64,
+    /// The target the frames render up to: the eye colour (whole frame) or the occlusion alone.
     pub output: Resource,
 }
 

@@ -37,25 +37,35 @@ const GRID: RGBColor = RGBColor(232, 232, 232);
 /// One point and the text drawn beside it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Point {
+    /// x in data units (ms on the bench plots).
     pub x: f64,
+    /// y in data units (an error figure on the bench plots).
     pub y: f64,
+    /// Text drawn beside the point (empty: none).
     pub label: String,
 }
 
 /// One set of points with a colour and a legend label.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Series {
+    /// Legend text.
     pub label: String,
+    /// sRGB colour of the points.
     pub color: [u8; 3],
+    /// The points; non-finite ones are skipped.
     pub points: Vec<Point>,
 }
 
 /// A scatter plot; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ScatterPlot {
+    /// Title above the plot.
     pub title: String,
+    /// x-axis caption.
     pub x_label: String,
+    /// y-axis caption.
     pub y_label: String,
+    /// The point sets, each in its colour, named in the legend.
     pub series: Vec<Series>,
     /// Points of the Pareto front, joined by a line in x order (they need not be sorted).
     pub pareto: Vec<(f64, f64)>,

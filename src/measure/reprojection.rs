@@ -20,6 +20,7 @@ pub enum HeadMove {
 }
 
 impl HeadMove {
+    /// `pose` after the move: yaw about the world vertical, or sideways along the head's +X.
     pub fn apply(self, pose: &HeadPose) -> HeadPose {
         match self {
             HeadMove::RotateDegrees(deg) => HeadPose {
@@ -33,6 +34,7 @@ impl HeadMove {
         }
     }
 
+    /// The move in words, e.g. `rotate 5°`.
     pub fn describe(self) -> String {
         match self {
             HeadMove::RotateDegrees(d) => format!("rotate {d}°"),
@@ -44,10 +46,13 @@ impl HeadMove {
 /// RMSE (colour values 0..1, both eyes, every pixel) of a warped frame against a fresh one.
 #[derive(Clone, Debug, Serialize)]
 pub struct ReprojectionError {
+    /// The head movement between rendering and display.
     pub movement: HeadMove,
     /// Not warping at all: the old frame shown as it is.
     pub stale_rmse: f64,
+    /// With the rotational warp (orientation only).
     pub rotational_rmse: f64,
+    /// With the depth-based (positional) warp.
     pub depth_rmse: f64,
 }
 
@@ -157,6 +162,7 @@ pub fn default_movements() -> Vec<HeadMove> {
     steps.iter().map(|&d| HeadMove::RotateDegrees(d)).chain(steps.iter().map(|&c| HeadMove::TranslateCm(c))).collect()
 }
 
+/// The rows as a Markdown table, one movement a row.
 pub fn to_markdown(rows: &[ReprojectionError]) -> String {
     let mut s = String::from("| movement | no warp RMSE | rotational RMSE | depth-based RMSE |\n|---|---|---|---|\n");
     for r in rows {

@@ -38,7 +38,9 @@ pub const BORDER_PX: u32 = 40;
 /// depth (0 on the sky) and the AO (one value a pixel).
 #[derive(Clone, Copy, Debug)]
 pub struct EyeImages<'a> {
+    /// Reversed-Z depth, one value a pixel (0 on the sky).
     pub depth: &'a [f32],
+    /// The final AO, one value a pixel.
     pub ao: &'a [f32],
 }
 

@@ -18,9 +18,13 @@ use std::sync::Arc;
 /// The error after `frame` frames of one configuration.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConvergencePoint {
+    /// What was varied, e.g. `temporal N=8, blur`.
     pub configuration: String,
+    /// The head motion's name (`static`, `yaw-sweep`).
     pub motion: String,
+    /// Frames rendered so far (1 = the first frame).
     pub frame: u32,
+    /// AO RMSE against the traced reference.
     pub ao_rmse: f64,
     /// RMSE against the same technique's converged value at this pose (256 samples, no
     /// blur, no reuse): the noise left, without the estimator's bias.
@@ -128,7 +132,9 @@ pub fn configurations(base: &Settings) -> Vec<(String, Settings)> {
 /// The points of a temporal study and the adapter that measured them.
 #[derive(Clone, Debug)]
 pub struct TemporalStudy {
+    /// Every configuration's points, frame by frame.
     pub points: Vec<ConvergencePoint>,
+    /// The adapter that measured them.
     pub adapter: String,
 }
 

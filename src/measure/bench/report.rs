@@ -429,6 +429,7 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
     s
 }
 
+/// The bench file as pretty-printed JSON (`bench.json`).
 pub fn to_json(file: &BenchFile) -> String {
     serde_json::to_string_pretty(file).expect("bench records serialise")
 }

@@ -18,21 +18,30 @@ use std::sync::Arc;
 /// What a bench sweeps and how it measures.
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
+    /// Which wgpu backend to ask for.
     pub backend: BackendChoice,
+    /// Techniques to sweep.
     pub techniques: Vec<Technique>,
+    /// Samples per pixel (N) to sweep.
     pub samples: Vec<u32>,
     /// Radii in metres (empty: the scene's suggested radius × 0.5, 1 and 2).
     pub radii: Vec<f32>,
     /// The resolutions (`true`: half), depth-peeling and temporal modes to sweep; depth
     /// peeling applies to the SSDO techniques only.
     pub half_res: Vec<bool>,
+    /// Depth peeling off/on to sweep (SSDO techniques only).
     pub depth_peeling: Vec<bool>,
+    /// Temporal accumulation off/on to sweep.
     pub temporal: Vec<bool>,
     /// VPL counts of reflective-shadow-map rows (empty: none).
     pub rsm_samples: Vec<u32>,
+    /// Serial, pipelined or auto (decided once the adapter is known).
     pub timing: TimingChoice,
+    /// Frames discarded before timing, per case.
     pub warmup: u32,
+    /// Frames timed per case.
     pub frames: u32,
+    /// Cases measured at a time, round-robin one frame each (1: each case on its own).
     pub interleave: usize,
     /// Render whole frames, not only the occlusion.
     pub whole_frame: bool,
@@ -45,6 +54,7 @@ pub struct BenchOptions {
 /// The reference each row is scored against.
 #[derive(Clone, Debug)]
 pub struct ReferenceOptions {
+    /// Rays traced per pixel (1..=`MAX_RAYS_PER_PIXEL`).
     pub rays_per_pixel: u32,
     /// Traced at every `stride`-th pixel in x and y.
     pub stride: u32,
@@ -56,7 +66,9 @@ pub struct ReferenceOptions {
 /// measured it.
 #[derive(Clone, Debug)]
 pub struct BenchRun {
+    /// What was measured, as written to bench.json.
     pub file: BenchFile,
+    /// The radii (m) the rows cover: as given, or the scene's suggested radius × 0.5, 1 and 2.
     pub radii: Vec<f32>,
     /// "name (backend, driver)".
     pub adapter: String,

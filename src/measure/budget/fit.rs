@@ -15,10 +15,13 @@ use std::sync::Arc;
 /// How [`measure_budget`] measures.
 #[derive(Clone, Debug)]
 pub struct BudgetOptions {
+    /// Which wgpu backend to ask for.
     pub backend: BackendChoice,
+    /// Serial, pipelined or auto (decided once the adapter is known).
     pub timing: TimingChoice,
     /// Measured frames (each: the stereo frame, then each eye alone), after warm-up.
     pub frames: u32,
+    /// Frames discarded before timing.
     pub warmup: u32,
     /// The stereo frame budget in ms; `None`: the profile's refresh interval.
     pub budget_ms: Option<f64>,
@@ -31,6 +34,7 @@ pub struct BudgetOptions {
 /// The setting `--fit` chose and why.
 #[derive(Clone, Debug)]
 pub struct Fit {
+    /// The AO settings of the chosen row.
     pub ao: AoSettings,
     /// Doubts about the bench file (measured at another size).
     pub warnings: Vec<String>,
@@ -41,7 +45,9 @@ pub struct Fit {
 /// What [`measure_budget`] measured.
 #[derive(Clone, Debug)]
 pub struct BudgetOutcome {
+    /// The measured times and verdicts.
     pub report: BudgetReport,
+    /// The setting `--fit` chose, when it was asked for.
     pub fit: Option<Fit>,
 }
 

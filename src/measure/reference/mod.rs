@@ -96,6 +96,7 @@ impl ReferenceSettings {
         ReferenceSettings { radius, rays_per_pixel: 256, stride: 1, near: DEFAULT_NEAR }
     }
 
+    /// Checks every field; the error names the field and value.
     pub fn validate(&self) -> Result<()> {
         if !(self.radius.is_finite() && self.radius > 0.0) {
             return Err(Error::input(format!("reference radius {} must be finite and > 0", self.radius)));
@@ -120,10 +121,13 @@ impl ReferenceSettings {
 /// everything else 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReferencePixel {
+    /// A surface was hit through this pixel.
     pub hit: bool,
     /// View-space depth (−z in metres, what the depth buffer encodes as near / depth); 0 on the sky.
     pub depth: f32,
+    /// Cosine-weighted visibility within r (1 = unoccluded).
     pub ao: f32,
+    /// The same with each occluded direction weighted by 1 − d/r (linear falloff).
     pub ao_falloff: f32,
     /// Standard error of `ao` as estimated from its own samples (conservative, see the module docs).
     pub ao_std_error: f32,
@@ -136,6 +140,7 @@ pub struct ReferencePixel {
 }
 
 impl ReferencePixel {
+    /// A pixel that sees the sky: no hit, AO 1, no light.
     pub const SKY: ReferencePixel = ReferencePixel {
         hit: false,
         depth: 0.0,
@@ -161,6 +166,7 @@ pub struct ReferenceStats {
     pub rays_per_second: f64,
     /// RMS of `ao_std_error` over the hit pixels (0 when none is hit).
     pub noise: f64,
+    /// Pixels (over all eyes) that hit a surface.
     pub hit_pixels: u64,
     /// True when the image was read from a cache file (the other numbers are the original trace's).
     pub from_cache: bool,
@@ -171,11 +177,14 @@ pub struct ReferenceStats {
 pub struct ReferenceImage {
     /// Size of the GPU image per eye.
     pub width: u32,
+    /// Size of the GPU image per eye (pixels).
     pub height: u32,
+    /// Every `stride`-th GPU pixel in x and y was traced.
     pub stride: u32,
     /// Per eye (layer 0 = left, 1 = right): a row-major grid of
     /// [`grid_size`](Self::grid_size) cells; cell (i, j) is the GPU pixel [`pixel_of`](Self::pixel_of)(i, j).
     pub layers: Vec<Vec<ReferencePixel>>,
+    /// How the trace went: time, rays, noise, cache.
     pub stats: ReferenceStats,
 }
 
@@ -203,6 +212,7 @@ impl ReferenceImage {
 pub struct Progress {
     /// Pixels finished, of `total` (over all eyes).
     pub done: usize,
+    /// Pixels to trace over all eyes.
     pub total: usize,
     /// Rays traced so far.
     pub rays: u64,

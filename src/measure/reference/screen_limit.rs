@@ -93,6 +93,7 @@ impl LimitSettings {
         LimitSettings::new(radius, reference.stride, near)
     }
 
+    /// Checks every field; the error names the field and value.
     pub fn validate(&self) -> Result<()> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if !positive(self.radius) || !positive(self.thickness) || !positive(self.near) {
@@ -112,8 +113,11 @@ impl LimitSettings {
 /// and view-space normals (RGBA, w unused), `width × height` row-major.
 #[derive(Clone, Copy, Debug)]
 pub struct EyeBuffers<'a> {
+    /// Reversed-Z depth, one value a pixel (0 on the sky).
     pub depth: &'a [f32],
+    /// View-space normals, four floats a pixel (w unused).
     pub normals: &'a [f32],
+    /// The eye's field of view (to turn pixels into view rays).
     pub fov: Fov,
 }
 
@@ -122,6 +126,7 @@ pub struct EyeBuffers<'a> {
 pub struct LimitPixel {
     /// The depth buffer has a surface here (false on the sky, where `ao` is 1).
     pub hit: bool,
+    /// Share of the rays from the surface that leave the radius unblocked by the depth buffer (1 on the sky).
     pub ao: f32,
     /// Standard error of `ao` from its own rays (√(p(1 − p)/(M − 1)); conservative, as
     /// the reference's: stratification makes the real error smaller).
@@ -131,19 +136,25 @@ pub struct LimitPixel {
 /// The limit for every eye on a grid of `stride`, laid out as a reference image's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScreenLimit {
+    /// Width of the GPU image per eye (pixels).
     pub width: u32,
+    /// Height of the GPU image per eye (pixels).
     pub height: u32,
+    /// Every `stride`-th GPU pixel in x and y was marched.
     pub stride: u32,
+    /// How the limit was marched.
     pub settings: LimitSettings,
     /// Per eye, row-major over [`grid_size`](Self::grid_size).
     pub layers: Vec<Vec<LimitPixel>>,
 }
 
 impl ScreenLimit {
+    /// Cells per row and column: ⌈width / stride⌉ × ⌈height / stride⌉.
     pub fn grid_size(&self) -> (u32, u32) {
         grid_size((self.width, self.height), self.stride)
     }
 
+    /// The limit at grid cell (i, j) of eye `layer`.
     pub fn get(&self, layer: usize, i: u32, j: u32) -> &LimitPixel {
         &self.layers[layer][(j * self.grid_size().0 + i) as usize]
     }
