@@ -30,7 +30,7 @@ pub struct EyeUniform {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct FrameUniform {
-    /// Both eyes (eye 1 repeats eye 0 for a mono view).
+    /// The views of layer 0 and layer 1 (layer 1 all zeros for a mono view).
     pub eyes: [EyeUniform; 2],
     /// Full-resolution image size in pixels, per eye.
     pub size: [u32; 2],
