@@ -2,9 +2,9 @@
 //! the temporal and reprojection studies, stereo consistency, reports and plots. Builds
 //! on `render` and `xr`, never on `app`.
 
-/// Closed-form and quadrature expectations the tests compare the GPU against: a test
-/// oracle, built for the crate's own tests and with the `testing` feature (which the
-/// integration tests turn on through the dev-dependency on vrao itself).
+// Closed-form and quadrature expectations the tests compare the GPU against: a test
+// oracle, built for the crate's own tests and with the `testing` feature (which the
+// integration tests turn on through the dev-dependency on vrao itself).
 #[cfg(any(test, feature = "testing"))]
 pub mod analytic;
 pub mod bench;
