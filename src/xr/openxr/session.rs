@@ -28,9 +28,11 @@ use crate::render::stereo::{Eye, EyePair, EyeSide, Fov, HeadPose};
 use crate::xr::simulated::SimulatedHeadset;
 use crate::xr::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use glam::{DQuat, DVec3, Quat, Vec3};
+use layer::{end_frame, Layer};
 use openxr as xr;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tracking::{fov_from_xr, pose_from_xr, Tracking};
 
 const VIEW_TYPE: xr::ViewConfigurationType = xr::ViewConfigurationType::PRIMARY_STEREO;
 /// How often an idle session (not running) is polled for events.
@@ -107,112 +109,6 @@ fn failed(what: &str) -> impl Fn(xr::sys::Result) -> Unavailable + '_ {
 }
 
 impl OpenXrHeadset {
-    /// Creates the instance (with XR_KHR_vulkan_enable2, and XR_KHR_composition_layer_depth
-    /// and XR_KHR_convert_timespec_time when offered), finds the head-mounted display,
-    /// has the runtime create the Vulkan instance and device, wraps them as the `Gpu`,
-    /// and creates the session, a LOCAL reference space and the swapchains. The session
-    /// begins at its READY state, from `wait_frame`.
-    pub fn open(options: OpenXrOptions) -> std::result::Result<(OpenXrHeadset, Arc<Gpu>), Unavailable> {
-        let entry = load_entry()?;
-        let slot = InstanceSlot::take()?;
-        let available = entry.enumerate_extensions().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
-        if !available.khr_vulkan_enable2 {
-            return Err(Unavailable::Unsupported("no XR_KHR_vulkan_enable2".into()));
-        }
-        let mut extensions = xr::ExtensionSet::default();
-        extensions.khr_vulkan_enable2 = true;
-        extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
-        extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
-        let instance = entry
-            .create_instance(&application_info(), &extensions, &[], &())
-            .map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
-        let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
-        let runtime = format!("{} {}", props.runtime_name, props.runtime_version);
-        let system = instance
-            .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)
-            .map_err(|e| Unavailable::NoHeadset(format!("{runtime}: xrGetSystem(HEAD_MOUNTED_DISPLAY): {e}")))?;
-        let system_name =
-            instance.system_properties(system).map(|p| p.system_name).unwrap_or_else(|_| "unnamed system".into());
-        let view_types =
-            instance.enumerate_view_configurations(system).map_err(failed("xrEnumerateViewConfigurations"))?;
-        if !view_types.contains(&VIEW_TYPE) {
-            return Err(Unavailable::Unsupported(format!("{system_name} has no PRIMARY_STEREO view configuration")));
-        }
-        let views = instance
-            .enumerate_view_configuration_views(system, VIEW_TYPE)
-            .map_err(failed("xrEnumerateViewConfigurationViews"))?;
-        if views.len() != 2 {
-            return Err(Unavailable::Unsupported(format!("PRIMARY_STEREO has {} views", views.len())));
-        }
-        // One size for both eyes (vrao renders them as two layers of one target).
-        let recommended = (
-            views.iter().map(|v| v.recommended_image_rect_width).max().unwrap_or(0).max(1),
-            views.iter().map(|v| v.recommended_image_rect_height).max().unwrap_or(0).max(1),
-        );
-        let max = (
-            views.iter().map(|v| v.max_image_rect_width).min().unwrap_or(0).max(1),
-            views.iter().map(|v| v.max_image_rect_height).min().unwrap_or(0).max(1),
-        );
-        let wanted = options.size.unwrap_or(recommended);
-        let size = (wanted.0.clamp(1, max.0), wanted.1.clamp(1, max.1));
-        let blend_mode = instance
-            .enumerate_environment_blend_modes(system, VIEW_TYPE)
-            .ok()
-            .and_then(|modes| modes.first().copied())
-            .unwrap_or(xr::EnvironmentBlendMode::OPAQUE);
-
-        let (gpu, binding) = vulkan::create_gpu(&instance, system).map_err(Unavailable::Failed)?;
-        let gpu = Arc::new(gpu);
-        // SAFETY: the binding names the instance, physical device and device the runtime
-        // created for this system, and one queue of the family the device was made with;
-        // wgpu and the runtime only use that queue from this thread.
-        let (session, frame_waiter, frame_stream) =
-            unsafe { instance.create_session::<xr::Vulkan>(system, &binding.session_create_info()) }
-                .map_err(failed("xrCreateSession"))?;
-        let space = session
-            .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
-            .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
-        let swapchains =
-            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)
-                .map_err(Unavailable::Failed)?;
-        let swapchain_text = swapchains.describe();
-        let depth = swapchains.has_depth();
-        let xr = Xr {
-            swapchains,
-            space,
-            frame_stream,
-            frame_waiter,
-            session,
-            instance,
-            _slot: slot,
-            blend_mode,
-            clock: extensions.khr_convert_timespec_time,
-        };
-        let budget = FrameBudget::new(options.frames);
-        let headset = OpenXrHeadset {
-            gpu: gpu.clone(),
-            options,
-            xr: Some(xr),
-            runtime,
-            system: system_name,
-            recommended,
-            size,
-            depth,
-            swapchain_text,
-            machine: SessionMachine::new(),
-            budget,
-            stats: OpenXrStats::default(),
-            counters: FrameCounters::default(),
-            latencies_ms: Vec::new(),
-            next_index: 0,
-            pending: None,
-            tracking: Tracking::default(),
-            opened: Instant::now(),
-            fallback: None,
-        };
-        Ok((headset, gpu))
-    }
-
     /// The runtime's name and version.
     pub fn runtime(&self) -> &str {
         &self.runtime
@@ -534,186 +430,6 @@ fn phase_of(state: xr::SessionState) -> Option<SessionPhase> {
     })
 }
 
-/// The views frames are rendered with, when tracking is partial or lost too.
-#[derive(Default)]
-struct Tracking {
-    /// The last views with a valid orientation: used whole when orientation is lost.
-    last: Option<[xr::View; 2]>,
-    /// The last views with a valid position as well: where the head is held while only
-    /// orientation is tracked.
-    anchor: Option<[xr::View; 2]>,
-    /// Within a position-loss episode (warned about at its start only).
-    position_lost: bool,
-}
-
-impl Tracking {
-    /// The views to render with, from what xrLocateViews answered; and a warning when a
-    /// position-loss episode begins (not every frame of it).
-    fn merge(&mut self, flags: xr::ViewStateFlags, located: &[xr::View]) -> ([xr::View; 2], Option<&'static str>) {
-        let orientation = flags.contains(xr::ViewStateFlags::ORIENTATION_VALID) && located.len() == 2;
-        // Without POSITION_VALID the located positions are undefined.
-        let position = orientation && flags.contains(xr::ViewStateFlags::POSITION_VALID);
-        let views = if position {
-            self.anchor = Some([located[0], located[1]]);
-            [located[0], located[1]]
-        } else if orientation {
-            orientation_only(&[located[0], located[1]], &self.anchor.unwrap_or(default_views()))
-        } else {
-            self.last.unwrap_or(default_views())
-        };
-        if orientation {
-            self.last = Some(views);
-        }
-        let warning = (!position && !self.position_lost).then_some(if orientation {
-            "position tracking lost: orientation only, the head held at its last position"
-        } else {
-            "tracking lost: the last pose is held"
-        });
-        self.position_lost = !position;
-        (views, warning)
-    }
-}
-
-/// Orientation-only tracking: each located view's orientation and field of view, with
-/// the head held where `anchor` (the last views with a valid position) had it. The eyes
-/// keep their offsets from the head's centre, turned with the head, so the stereo
-/// baseline follows the head.
-fn orientation_only(located: &[xr::View; 2], anchor: &[xr::View; 2]) -> [xr::View; 2] {
-    let vec = |v: xr::Vector3f| Vec3::new(v.x, v.y, v.z);
-    let quat = |q: xr::Quaternionf| Quat::from_xyzw(q.x, q.y, q.z, q.w).normalize();
-    let center = (vec(anchor[0].pose.position) + vec(anchor[1].pose.position)) * 0.5;
-    std::array::from_fn(|i| {
-        let offset = quat(anchor[i].pose.orientation).inverse() * (vec(anchor[i].pose.position) - center);
-        let p = center + quat(located[i].pose.orientation) * offset;
-        xr::View {
-            pose: xr::Posef {
-                orientation: located[i].pose.orientation,
-                position: xr::Vector3f { x: p.x, y: p.y, z: p.z },
-            },
-            fov: located[i].fov,
-        }
-    })
-}
-
-/// The projection layer of one frame.
-struct Layer {
-    views: [xr::View; 2],
-    sub_images: [SubImage; 2],
-    near: f64,
-}
-
-/// xrEndFrame with the projection layer (and per-view depth when the swapchains have
-/// it), or with no layer.
-fn end_frame(xr: &mut Xr, display_time: xr::Time, layer: Option<&Layer>) -> std::result::Result<(), xr::sys::Result> {
-    use xr::sys;
-    let rect = |s: &SubImage| sys::Rect2Di {
-        offset: sys::Offset2Di { x: 0, y: 0 },
-        extent: sys::Extent2Di { width: s.width as i32, height: s.height as i32 },
-    };
-    let mut depth_infos = [None, None];
-    let mut projection_views = Vec::with_capacity(2);
-    let projection;
-    let mut layers: Vec<*const sys::CompositionLayerBaseHeader> = Vec::new();
-    if let Some(layer) = layer {
-        for (eye, depth_info) in depth_infos.iter_mut().enumerate() {
-            let s = &layer.sub_images[eye];
-            if let Some(depth) = xr.swapchains.depth_swapchain(s.swapchain) {
-                // Reversed-Z with an infinite far plane: window depth 0 is infinitely
-                // far and 1 is the near plane. The extension's nearZ and farZ are the
-                // distances of minDepth and maxDepth ("a nearZ greater than farZ means
-                // reversed depth"), so minDepth 0 ↔ nearZ = far and maxDepth 1 ↔ farZ =
-                // the near plane. nearZ is f32::MAX, not +∞: a runtime linearising depth
-                // with ∞ gets NaN (∞/∞, ∞·0), and no depth value tells the two apart.
-                *depth_info = Some(sys::CompositionLayerDepthInfoKHR {
-                    ty: sys::CompositionLayerDepthInfoKHR::TYPE,
-                    next: std::ptr::null(),
-                    sub_image: sys::SwapchainSubImage {
-                        swapchain: depth.as_raw(),
-                        image_rect: rect(s),
-                        image_array_index: s.array_index,
-                    },
-                    min_depth: 0.0,
-                    max_depth: 1.0,
-                    near_z: f32::MAX,
-                    far_z: layer.near as f32,
-                });
-            }
-        }
-        for (eye, view) in layer.views.iter().enumerate() {
-            let s = &layer.sub_images[eye];
-            projection_views.push(sys::CompositionLayerProjectionView {
-                ty: sys::CompositionLayerProjectionView::TYPE,
-                next: depth_infos[eye].as_ref().map_or(std::ptr::null(), |d| d as *const _ as *const _),
-                pose: view.pose,
-                fov: view.fov,
-                sub_image: sys::SwapchainSubImage {
-                    swapchain: xr.swapchains.color_swapchain(s.swapchain).as_raw(),
-                    image_rect: rect(s),
-                    image_array_index: s.array_index,
-                },
-            });
-        }
-        projection = sys::CompositionLayerProjection {
-            ty: sys::CompositionLayerProjection::TYPE,
-            next: std::ptr::null(),
-            layer_flags: sys::CompositionLayerFlags::EMPTY,
-            space: xr.space.as_raw(),
-            view_count: projection_views.len() as u32,
-            views: projection_views.as_ptr(),
-        };
-        layers.push(&projection as *const _ as *const sys::CompositionLayerBaseHeader);
-    }
-    let info = sys::FrameEndInfo {
-        ty: sys::FrameEndInfo::TYPE,
-        next: std::ptr::null(),
-        display_time,
-        environment_blend_mode: xr.blend_mode,
-        layer_count: layers.len() as u32,
-        layers: if layers.is_empty() { std::ptr::null() } else { layers.as_ptr() },
-    };
-    // SAFETY: every pointer in `info` (layers, views, depth infos) points at locals that
-    // live until the call returns; the frame was begun with xrBeginFrame.
-    let result = unsafe { (xr.instance.fp().end_frame)(xr.session.as_raw(), &info) };
-    if result.into_raw() < 0 {
-        Err(result)
-    } else {
-        Ok(())
-    }
-}
-
-fn pose_from_xr(pose: &xr::Posef) -> HeadPose {
-    let o = pose.orientation;
-    let p = pose.position;
-    HeadPose {
-        position: DVec3::new(p.x as f64, p.y as f64, p.z as f64),
-        orientation: DQuat::from_xyzw(o.x as f64, o.y as f64, o.z as f64, o.w as f64),
-    }
-    .sanitized()
-}
-
-/// OpenXR's XrFovf and vrao's `Fov` are the same four angles with the same signs (left
-/// and down negative).
-fn fov_from_xr(fov: &xr::Fovf) -> Fov {
-    Fov { left: fov.angle_left, right: fov.angle_right, up: fov.angle_up, down: fov.angle_down }
-}
-
-/// Both views before tracking.
-fn default_views() -> [xr::View; 2] {
-    [default_view(-1.0), default_view(1.0)]
-}
-
-/// A view before tracking: 32 mm to the side, 45° each way.
-fn default_view(side: f32) -> xr::View {
-    let a = std::f32::consts::FRAC_PI_4;
-    xr::View {
-        pose: xr::Posef {
-            orientation: xr::Quaternionf::IDENTITY,
-            position: xr::Vector3f { x: side * 0.032, y: 0.0, z: 0.0 },
-        },
-        fov: xr::Fovf { angle_left: -a, angle_right: a, angle_up: a, angle_down: -a },
-    }
-}
-
 fn percentile(sorted: &[f64], p: f64) -> f64 {
     if sorted.is_empty() {
         return 0.0;
@@ -866,5 +582,8 @@ impl Drop for OpenXrHeadset {
     }
 }
 
+mod layer;
+mod open;
 #[cfg(test)]
 mod tests;
+mod tracking;

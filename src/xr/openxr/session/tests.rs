@@ -1,5 +1,6 @@
 //! Tests of `session.rs`.
 
+use super::tracking::{default_view, orientation_only};
 use super::*;
 
 #[test]

@@ -1,0 +1,112 @@
+//! Opening the OpenXR headset: instance, system, the runtime-created Vulkan device
+//! wrapped as the `Gpu`, the session and its swapchains.
+
+use super::*;
+
+impl OpenXrHeadset {
+    /// Creates the instance (with XR_KHR_vulkan_enable2, and XR_KHR_composition_layer_depth
+    /// and XR_KHR_convert_timespec_time when offered), finds the head-mounted display,
+    /// has the runtime create the Vulkan instance and device, wraps them as the `Gpu`,
+    /// and creates the session, a LOCAL reference space and the swapchains. The session
+    /// begins at its READY state, from `wait_frame`.
+    pub fn open(options: OpenXrOptions) -> std::result::Result<(OpenXrHeadset, Arc<Gpu>), Unavailable> {
+        let entry = load_entry()?;
+        let slot = InstanceSlot::take()?;
+        let available = entry.enumerate_extensions().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        if !available.khr_vulkan_enable2 {
+            return Err(Unavailable::Unsupported("no XR_KHR_vulkan_enable2".into()));
+        }
+        let mut extensions = xr::ExtensionSet::default();
+        extensions.khr_vulkan_enable2 = true;
+        extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
+        extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
+        let instance = entry
+            .create_instance(&application_info(), &extensions, &[], &())
+            .map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        let runtime = format!("{} {}", props.runtime_name, props.runtime_version);
+        let system = instance
+            .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)
+            .map_err(|e| Unavailable::NoHeadset(format!("{runtime}: xrGetSystem(HEAD_MOUNTED_DISPLAY): {e}")))?;
+        let system_name =
+            instance.system_properties(system).map(|p| p.system_name).unwrap_or_else(|_| "unnamed system".into());
+        let view_types =
+            instance.enumerate_view_configurations(system).map_err(failed("xrEnumerateViewConfigurations"))?;
+        if !view_types.contains(&VIEW_TYPE) {
+            return Err(Unavailable::Unsupported(format!("{system_name} has no PRIMARY_STEREO view configuration")));
+        }
+        let views = instance
+            .enumerate_view_configuration_views(system, VIEW_TYPE)
+            .map_err(failed("xrEnumerateViewConfigurationViews"))?;
+        if views.len() != 2 {
+            return Err(Unavailable::Unsupported(format!("PRIMARY_STEREO has {} views", views.len())));
+        }
+        // One size for both eyes (vrao renders them as two layers of one target).
+        let recommended = (
+            views.iter().map(|v| v.recommended_image_rect_width).max().unwrap_or(0).max(1),
+            views.iter().map(|v| v.recommended_image_rect_height).max().unwrap_or(0).max(1),
+        );
+        let max = (
+            views.iter().map(|v| v.max_image_rect_width).min().unwrap_or(0).max(1),
+            views.iter().map(|v| v.max_image_rect_height).min().unwrap_or(0).max(1),
+        );
+        let wanted = options.size.unwrap_or(recommended);
+        let size = (wanted.0.clamp(1, max.0), wanted.1.clamp(1, max.1));
+        let blend_mode = instance
+            .enumerate_environment_blend_modes(system, VIEW_TYPE)
+            .ok()
+            .and_then(|modes| modes.first().copied())
+            .unwrap_or(xr::EnvironmentBlendMode::OPAQUE);
+
+        let (gpu, binding) = vulkan::create_gpu(&instance, system).map_err(Unavailable::Failed)?;
+        let gpu = Arc::new(gpu);
+        // SAFETY: the binding names the instance, physical device and device the runtime
+        // created for this system, and one queue of the family the device was made with;
+        // wgpu and the runtime only use that queue from this thread.
+        let (session, frame_waiter, frame_stream) =
+            unsafe { instance.create_session::<xr::Vulkan>(system, &binding.session_create_info()) }
+                .map_err(failed("xrCreateSession"))?;
+        let space = session
+            .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
+            .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
+        let swapchains =
+            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)
+                .map_err(Unavailable::Failed)?;
+        let swapchain_text = swapchains.describe();
+        let depth = swapchains.has_depth();
+        let xr = Xr {
+            swapchains,
+            space,
+            frame_stream,
+            frame_waiter,
+            session,
+            instance,
+            _slot: slot,
+            blend_mode,
+            clock: extensions.khr_convert_timespec_time,
+        };
+        let budget = FrameBudget::new(options.frames);
+        let headset = OpenXrHeadset {
+            gpu: gpu.clone(),
+            options,
+            xr: Some(xr),
+            runtime,
+            system: system_name,
+            recommended,
+            size,
+            depth,
+            swapchain_text,
+            machine: SessionMachine::new(),
+            budget,
+            stats: OpenXrStats::default(),
+            counters: FrameCounters::default(),
+            latencies_ms: Vec::new(),
+            next_index: 0,
+            pending: None,
+            tracking: Tracking::default(),
+            opened: Instant::now(),
+            fallback: None,
+        };
+        Ok((headset, gpu))
+    }
+}
