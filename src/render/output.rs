@@ -3,7 +3,7 @@
 use crate::render::error::{Error, Result};
 use crate::render::graph::Resource;
 use crate::render::renderer::Renderer;
-use crate::render::settings::{Settings, Technique};
+use crate::render::settings::Settings;
 use std::path::{Path, PathBuf};
 
 /// File-name parts of layer 0 and layer 1, in that order.
@@ -64,16 +64,24 @@ pub fn occlusion_to_rgba(occlusion: &[f32]) -> Vec<u8> {
         .collect()
 }
 
+/// The occlusion `vrao render` writes: the final AO, and with `debug` also the raw AO
+/// (nothing when no technique runs).
+fn occlusion_written(settings: &Settings, debug: bool) -> Vec<Resource> {
+    if debug {
+        occlusion_outputs(settings)
+    } else {
+        crate::render::passes::final_occlusion(settings).into_iter().collect()
+    }
+}
+
 /// What `vrao render` asks of a frame: the eyes' colour, the final AO (written beside
 /// the eyes) and, with `debug`, depth, normals, albedo and the raw AO.
 pub fn outputs(settings: &Settings, debug: bool) -> Vec<Resource> {
     let mut outputs = vec![Resource::Color];
     if debug {
         outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
-        outputs.extend(occlusion_outputs(settings));
-    } else {
-        outputs.extend(crate::render::passes::final_occlusion(settings));
     }
+    outputs.extend(occlusion_written(settings, debug));
     outputs
 }
 
@@ -96,16 +104,12 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
     for (name, rgba) in names.iter().zip(renderer.read_bytes(Resource::Color)?) {
         save_sized(format!("{name}.png"), (w, h), rgba)?;
     }
-    let occlusion = match settings.ao.technique {
-        Technique::None => Vec::new(),
-        // The final AO first; with `debug` also the raw AO before blur or upsampling.
-        _ if debug => occlusion_outputs(settings),
-        _ => crate::render::passes::final_occlusion(settings).into_iter().collect(),
-    };
-    for r in occlusion.into_iter().rev() {
+    // The final AO first, then (with `debug`) the raw AO before blur or upsampling.
+    let final_ao = crate::render::passes::final_occlusion(settings);
+    for r in occlusion_written(settings, debug).into_iter().rev() {
         let target = renderer.target(r).expect("occlusion was rendered");
         let size = (target.width, target.height);
-        let label = if Some(r) == crate::render::passes::final_occlusion(settings) { "ao" } else { "ao_raw" };
+        let label = if Some(r) == final_ao { "ao" } else { "ao_raw" };
         for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
             save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
         }
