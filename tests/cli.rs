@@ -300,7 +300,6 @@ fn command_line_names_are_the_names_reports_print() {
     check(&Denoise::ALL, Denoise::name);
     check(&DisplayMode::ALL, DisplayMode::name);
     check(&vrao::xr::simulated::motion::HeadMotion::ALL, vrao::xr::simulated::motion::HeadMotion::name);
-    check(&vrao::app::BufferView::ALL, vrao::app::BufferView::name);
     // Bench files name techniques; the governor parses them back.
     for t in Technique::ALL {
         assert_eq!(t.name().parse::<Technique>(), Ok(t));

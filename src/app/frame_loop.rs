@@ -49,21 +49,6 @@ pub enum BufferView {
 }
 
 impl BufferView {
-    /// Every view, in the order the panel cycles through them.
-    pub const ALL: [BufferView; 5] =
-        [BufferView::Eyes, BufferView::FinalAo, BufferView::RawAo, BufferView::Depth, BufferView::Normals];
-
-    /// The view's `--show` name.
-    pub fn name(self) -> &'static str {
-        match self {
-            BufferView::Eyes => "eyes",
-            BufferView::FinalAo => "ao",
-            BufferView::RawAo => "raw-ao",
-            BufferView::Depth => "depth",
-            BufferView::Normals => "normals",
-        }
-    }
-
     /// The renderer's resource that holds this view under `settings`; `None` for the eye
     /// images and for AO when no technique runs.
     pub fn resource(self, settings: &Settings) -> Option<Resource> {

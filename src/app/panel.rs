@@ -115,7 +115,7 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
             ui.radio_value(&mut panel.mode, DisplayMode::SinglePass, "single-pass");
         });
         egui::ComboBox::from_label("show (each eye)").selected_text(buffer_label(panel.show)).show_ui(ui, |ui| {
-            for view in BufferView::ALL {
+            for &view in <BufferView as clap::ValueEnum>::value_variants() {
                 ui.selectable_value(&mut panel.show, view, buffer_label(view));
             }
         });

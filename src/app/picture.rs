@@ -6,29 +6,9 @@ use crate::app::BufferView;
 use crate::render::gpu::kernel::shader_module;
 use crate::render::gpu::Gpu;
 
-/// How a picture image is drawn: the eye image filtered, or a buffer texel for texel
-/// (shaders/mirror.wgsl).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum PictureKind {
-    Eye,
-    Occlusion,
-    Normals,
-    Depth,
-}
-
-impl PictureKind {
-    pub(super) fn of(view: BufferView) -> PictureKind {
-        match view {
-            BufferView::Eyes => PictureKind::Eye,
-            BufferView::FinalAo | BufferView::RawAo => PictureKind::Occlusion,
-            BufferView::Normals => PictureKind::Normals,
-            BufferView::Depth => PictureKind::Depth,
-        }
-    }
-}
-
 /// The picture's pipelines: a full-screen triangle drawing one 2D view into a viewport,
-/// one pipeline per [`PictureKind`].
+/// one pipeline per kind of picture: the eye image (filtered), occlusion as grey, normals,
+/// depth (texel for texel).
 pub(super) struct Blit {
     eye: wgpu::RenderPipeline,
     occlusion: wgpu::RenderPipeline,
@@ -122,29 +102,29 @@ impl Blit {
         }
     }
 
-    pub(super) fn pipeline(&self, kind: PictureKind) -> &wgpu::RenderPipeline {
-        match kind {
-            PictureKind::Eye => &self.eye,
-            PictureKind::Occlusion => &self.occlusion,
-            PictureKind::Normals => &self.normals,
-            PictureKind::Depth => &self.depth,
+    pub(super) fn pipeline(&self, shown: BufferView) -> &wgpu::RenderPipeline {
+        match shown {
+            BufferView::Eyes => &self.eye,
+            BufferView::FinalAo | BufferView::RawAo => &self.occlusion,
+            BufferView::Normals => &self.normals,
+            BufferView::Depth => &self.depth,
         }
     }
 
-    pub(super) fn bind_group(&self, gpu: &Gpu, kind: PictureKind, view: &wgpu::TextureView) -> wgpu::BindGroup {
+    pub(super) fn bind_group(&self, gpu: &Gpu, shown: BufferView, view: &wgpu::TextureView) -> wgpu::BindGroup {
         let texture = wgpu::BindingResource::TextureView(view);
-        let (layout, entries) = match kind {
-            PictureKind::Eye => (
+        let (layout, entries) = match shown {
+            BufferView::Eyes => (
                 &self.eye_layout,
                 vec![
                     wgpu::BindGroupEntry { binding: 0, resource: texture },
                     wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
                 ],
             ),
-            PictureKind::Occlusion | PictureKind::Normals => {
+            BufferView::FinalAo | BufferView::RawAo | BufferView::Normals => {
                 (&self.float_layout, vec![wgpu::BindGroupEntry { binding: 2, resource: texture }])
             }
-            PictureKind::Depth => (&self.depth_layout, vec![wgpu::BindGroupEntry { binding: 3, resource: texture }]),
+            BufferView::Depth => (&self.depth_layout, vec![wgpu::BindGroupEntry { binding: 3, resource: texture }]),
         };
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mirror"), layout, entries: &entries })
     }

@@ -103,7 +103,7 @@ pub fn run_session(scene: &Scene, settings: &Settings, options: &RunOptions) -> 
     if options.display == DisplayMode::None && options.show != BufferView::Eyes {
         return Err(Error::input(format!(
             "--show {} needs a window (--display mirror or single-pass)",
-            options.show.name()
+            clap::ValueEnum::to_possible_value(&options.show).map_or_else(String::new, |v| v.get_name().to_string())
         )));
     }
     let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };

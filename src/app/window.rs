@@ -8,7 +8,7 @@
 //! outdated surface is reconfigured.
 
 use super::panel::{panel_ui, PanelInfo, PanelState, PANEL_WIDTH};
-use super::picture::{Blit, PictureKind};
+use super::picture::Blit;
 use crate::app::{BufferView, FrameLoop, RunSummary};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::Gpu;
@@ -341,18 +341,15 @@ impl WindowState {
 }
 
 impl WindowState {
-    /// The images the picture shows and how to draw them: the two eyes (mirror), the
-    /// mono view, or each eye's buffer that the panel's "show" picks.
-    fn picture_images<'a>(&'a self, frame_loop: &'a FrameLoop) -> (PictureKind, Vec<&'a wgpu::TextureView>) {
+    /// The images the picture shows: the two eyes (mirror), the mono view, or each eye's
+    /// buffer that the panel's "show" picks.
+    fn picture_images<'a>(&'a self, frame_loop: &'a FrameLoop) -> Vec<&'a wgpu::TextureView> {
         if self.panel.show != BufferView::Eyes {
             let target =
                 self.panel.show.resource(frame_loop.renderer.settings()).and_then(|r| frame_loop.renderer.target(r));
-            return (
-                PictureKind::of(self.panel.show),
-                target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default(),
-            );
+            return target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default();
         }
-        let images = match self.panel.mode {
+        match self.panel.mode {
             DisplayMode::SinglePass => match self.mono.as_ref().and_then(|m| m.target(Resource::Color)) {
                 Some(target) => vec![&target.layer_views[0]],
                 None => vec![],
@@ -362,8 +359,7 @@ impl WindowState {
                 let target = frame_loop.headset.display_image().or_else(|| frame_loop.renderer.target(Resource::Color));
                 target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default()
             }
-        };
-        (PictureKind::Eye, images)
+        }
     }
 
     /// Records and submits the picture (eye images fitted into the area right of the
@@ -378,13 +374,13 @@ impl WindowState {
         let gpu = &frame_loop.gpu;
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window") });
         let buffers = self.egui_renderer.update_buffers(&gpu.device, &gpu.queue, &mut encoder, paint_jobs, screen);
-        let (kind, images) = self.picture_images(frame_loop);
+        let (shown, images) = (self.panel.show, self.picture_images(frame_loop));
         let eye_aspect = {
             let p = &frame_loop.renderer.settings().profile;
             p.width as f32 / p.height as f32
         };
         let (ax, ay, aw, ah) = self.picture_area(PANEL_WIDTH * screen.pixels_per_point);
-        let bind_groups: Vec<wgpu::BindGroup> = images.iter().map(|v| self.blit.bind_group(gpu, kind, v)).collect();
+        let bind_groups: Vec<wgpu::BindGroup> = images.iter().map(|v| self.blit.bind_group(gpu, shown, v)).collect();
         {
             let mut pass = encoder
                 .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -408,7 +404,7 @@ impl WindowState {
             for (i, group) in bind_groups.iter().enumerate() {
                 // Each image gets an equal slot; within it, the largest rectangle of its
                 // aspect.
-                let mono = self.panel.mode == DisplayMode::SinglePass && kind == PictureKind::Eye;
+                let mono = self.panel.mode == DisplayMode::SinglePass && shown == BufferView::Eyes;
                 let aspect = if mono { aw / ah } else { eye_aspect };
                 let (slot_w, slot_h) = (aw / count, ah);
                 let (w, h) =
@@ -416,7 +412,7 @@ impl WindowState {
                 let x = ax + slot_w * i as f32 + (slot_w - w) * 0.5;
                 let y = ay + (slot_h - h) * 0.5;
                 pass.set_viewport(x, y, w.max(1.0), h.max(1.0), 0.0, 1.0);
-                pass.set_pipeline(self.blit.pipeline(kind));
+                pass.set_pipeline(self.blit.pipeline(shown));
                 pass.set_bind_group(0, group, &[]);
                 pass.draw(0..3, 0..1);
             }
