@@ -12,9 +12,10 @@
 
 use std::sync::Arc;
 
-use vrao::render::passes::final_occlusion;
+use vrao::render::graph::FINAL_AO;
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::settings::{AoSettings, Technique};
-use vrao::{BackendChoice, Gpu, HeadsetProfile, Renderer, Resource, Scene, Settings};
+use vrao::{BackendChoice, Gpu, HeadsetProfile, Renderer, Scene, Settings};
 
 fn main() -> std::process::ExitCode {
     match run() {
@@ -50,8 +51,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     // Both eyes from the scene's head pose at t = 0.
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     // The final AO: denoised and, at half resolution, upsampled to full resolution.
-    let ao = final_occlusion(&settings).expect("a technique runs");
-    renderer.render_and_wait(&eyes.eyes, &[Resource::Color, ao])?;
+    let ao = FINAL_AO;
+    renderer.render_and_wait(&eyes.eyes, &[COLOR, ao])?;
 
     println!(
         "'{}' ({} triangles) on {}, {}x{} per eye, {}:",

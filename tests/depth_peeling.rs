@@ -9,7 +9,10 @@ mod common;
 use glam::{DVec3, Vec3};
 use vrao::measure::bench::error_figures;
 use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
-use vrao::render::passes::final_occlusion;
+use vrao::render::graph::FINAL_AO;
+use vrao::render::passes::gbuffer::DEPTH;
+use vrao::render::passes::peel::DEPTH_LAYER_2;
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::settings::{AoSettings, Technique};
 use vrao::{HeadsetProfile, Renderer, Resource, Scene, Settings};
 
@@ -39,7 +42,7 @@ fn board_scene(gap: f64) -> Scene {
 /// that every value is finite and the AO within [0, 1].
 fn render(scene: &Scene, s: &Settings) -> Vec<Vec<f32>> {
     let (gpu, _one_at_a_time) = common::gpu();
-    let output = final_occlusion(s).unwrap();
+    let output = FINAL_AO;
     let mut renderer = Renderer::new(gpu, scene, s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     let report = renderer.render(&eyes.eyes, &[output]).unwrap();
@@ -190,21 +193,21 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
     let reason =
         |p: &vrao::render::graph::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
     for technique in [Technique::Ssdo, Technique::SsdoBounce] {
-        let on = plan(technique, true, &[Resource::Color]);
+        let on = plan(technique, true, &[COLOR]);
         assert!(on.runs("depth-peel"), "{on}");
         let order: Vec<_> =
             on.names.iter().filter(|n| ["gbuffer", "depth-peel", "ssdo", "ssdo-bounce"].contains(n)).collect();
         assert_eq!(order[..2], [&"gbuffer", &"depth-peel"], "{on}");
-        assert!(on.resources.contains(&Resource::DepthLayer2));
-        let off = plan(technique, false, &[Resource::Color]);
-        assert!(!off.runs("depth-peel") && !off.resources.contains(&Resource::DepthLayer2), "{off}");
+        assert!(on.resources.contains(&DEPTH_LAYER_2));
+        let off = plan(technique, false, &[COLOR]);
+        assert!(!off.runs("depth-peel") && !off.resources.contains(&DEPTH_LAYER_2), "{off}");
         assert!(reason(&off).unwrap().contains("depth peeling is off"), "{off}");
         // Only depth asked for: nothing reads the second layer.
-        let depth_only = plan(technique, true, &[Resource::Depth]);
+        let depth_only = plan(technique, true, &[DEPTH]);
         assert!(!depth_only.runs("depth-peel"), "{depth_only}");
     }
     for technique in [Technique::None, Technique::Ssao, Technique::Hbao] {
-        let p = plan(technique, true, &[Resource::Color]);
+        let p = plan(technique, true, &[COLOR]);
         assert!(!p.runs("depth-peel"), "{p}");
         let why = reason(&p).unwrap();
         assert!(why.contains(&format!("technique is {}", technique.name())), "{why}");

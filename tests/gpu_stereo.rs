@@ -3,8 +3,11 @@
 mod common;
 
 use glam::DVec3;
+use vrao::render::passes::composite::HDR;
+use vrao::render::passes::gbuffer::{ALBEDO, DEPTH, NORMALS};
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::stereo::{view_position_from_depth, HeadsetProfile};
-use vrao::{HeadPose, Renderer, Resource, Scene, Settings, StereoMode};
+use vrao::{HeadPose, Renderer, Scene, Settings, StereoMode};
 
 fn settings(width: u32, height: u32, stereo: StereoMode) -> Settings {
     Settings { profile: HeadsetProfile::with_size("test", width, height), stereo, ..Settings::default() }
@@ -37,8 +40,8 @@ fn a_point_lands_on_the_analytic_pixel_in_each_eye() {
         let scene = common::bare_scene(vec![common::disc("marker", center, (distance * 0.06) as f32, 0)]);
         let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
         let eyes = s.profile.eyes(&HeadPose::IDENTITY, s.near);
-        renderer.render(&eyes.eyes, &[Resource::Depth]).unwrap();
-        let depth = renderer.read_f32(Resource::Depth).unwrap();
+        renderer.render(&eyes.eyes, &[DEPTH]).unwrap();
+        let depth = renderer.read_f32(DEPTH).unwrap();
         let mut measured_x = [0.0; 2];
         for (layer, eye) in eyes.eyes.iter().enumerate() {
             let (uv, _) = eye.project(center, s.near).unwrap();
@@ -76,8 +79,8 @@ fn depth_reconstructs_view_position_from_5cm_to_10km() {
         )]);
         let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
         let eyes = s.profile.eyes(&HeadPose::IDENTITY, s.near);
-        renderer.render(&eyes.eyes, &[Resource::Depth]).unwrap();
-        let depth = renderer.read_f32(Resource::Depth).unwrap();
+        renderer.render(&eyes.eyes, &[DEPTH]).unwrap();
+        let depth = renderer.read_f32(DEPTH).unwrap();
         let mut worst: f64 = 0.0;
         for (layer, eye) in eyes.eyes.iter().enumerate() {
             let eye_to_wall = distance; // the eyes are offset along x only, the wall is z = −distance
@@ -102,7 +105,7 @@ fn render_all(gpu: &std::sync::Arc<vrao::Gpu>, scene: &Scene, stereo: StereoMode
     let s = settings(128, 144, stereo);
     let mut renderer = Renderer::new(gpu.clone(), scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
-    let outputs = [Resource::Color, Resource::Depth, Resource::Normals, Resource::Albedo];
+    let outputs = [COLOR, DEPTH, NORMALS, ALBEDO];
     renderer.render(&eyes.eyes, &outputs).unwrap();
     outputs.iter().map(|&r| renderer.read_bytes(r).unwrap()).collect()
 }
@@ -199,7 +202,7 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
     let s = settings(64, 72, StereoMode::Auto);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
-    let report = renderer.render_and_wait(&eyes.eyes, &[Resource::Normals]).unwrap();
+    let report = renderer.render_and_wait(&eyes.eyes, &[NORMALS]).unwrap();
     assert_eq!(report.plan.names, vec!["gbuffer"]);
     let left_out: Vec<_> = report.plan.left_out.iter().map(|(n, _)| *n).collect();
     assert_eq!(
@@ -221,11 +224,11 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
             "tonemap",
         ]
     );
-    assert!(renderer.target(Resource::Hdr).is_none(), "no HDR target is allocated when nothing needs it");
+    assert!(renderer.target(HDR).is_none(), "no HDR target is allocated when nothing needs it");
     if gpu.caps.timestamps {
         assert!(report.gpu_ms_of("gbuffer").is_some() && report.gpu_ms_of("composite").is_none());
     }
-    let report = renderer.render(&eyes.eyes, &[Resource::Color]).unwrap();
+    let report = renderer.render(&eyes.eyes, &[COLOR]).unwrap();
     assert_eq!(report.plan.names, vec!["gbuffer", "direct", "ssao", "blur", "composite", "tonemap"]);
 }
 
@@ -236,11 +239,11 @@ fn lit_room_is_finite_and_not_flat() {
     let s = settings(96, 108, StereoMode::Auto);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
-    renderer.render(&eyes.eyes, &[Resource::Color, Resource::Hdr]).unwrap();
-    for layer in renderer.read_f32(Resource::Hdr).unwrap() {
+    renderer.render(&eyes.eyes, &[COLOR, HDR]).unwrap();
+    for layer in renderer.read_f32(HDR).unwrap() {
         assert!(layer.iter().all(|v| v.is_finite() && *v >= 0.0), "HDR holds a non-finite or negative value");
     }
-    for layer in renderer.read_bytes(Resource::Color).unwrap() {
+    for layer in renderer.read_bytes(COLOR).unwrap() {
         let lum: Vec<f64> = layer.chunks_exact(4).map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64).collect();
         let mean = lum.iter().sum::<f64>() / lum.len() as f64;
         let var = lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64;
@@ -256,7 +259,7 @@ fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
     let eyes = renderer.settings().profile.eyes(&scene.head.pose_at(0.0), renderer.settings().near);
     let mut timings = Vec::new();
     for frame in 0..6u64 {
-        let report = renderer.render(&eyes.eyes, &[Resource::Color]).unwrap();
+        let report = renderer.render(&eyes.eyes, &[COLOR]).unwrap();
         assert_eq!(report.frame, frame);
         assert!(report.gpu_ms.is_empty(), "render does not wait for its own times");
         assert!((1..=2).contains(&report.frames_in_flight), "{}", report.frames_in_flight);
@@ -280,6 +283,6 @@ fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
     // With one frame in flight, each frame waits for the one before.
     renderer.set_frames_in_flight(1);
     for _ in 0..3 {
-        assert_eq!(renderer.render(&eyes.eyes, &[Resource::Color]).unwrap().frames_in_flight, 1);
+        assert_eq!(renderer.render(&eyes.eyes, &[COLOR]).unwrap().frames_in_flight, 1);
     }
 }

@@ -9,7 +9,12 @@ mod common;
 use glam::{DQuat, DVec3, Vec3};
 use std::sync::Arc;
 use vrao::render::gpu::targets::LayeredTarget;
-use vrao::render::graph::Resource;
+use vrao::render::graph::FINAL_AO;
+use vrao::render::passes::blur::AO_BLURRED;
+use vrao::render::passes::composite::HDR;
+use vrao::render::passes::gbuffer::DEPTH;
+use vrao::render::passes::occlusion::AO_RAW;
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::scene::{Light, Material, Scene};
 use vrao::render::settings::{AoSettings, Denoise, Technique};
 use vrao::render::stereo::{Fov, HeadPose};
@@ -34,11 +39,11 @@ fn settings(size: (u32, u32), ao: AoSettings) -> Settings {
 fn render_checked(gpu: &Arc<Gpu>, label: &str, scene: &Scene, s: &Settings, head: &HeadPose) -> Outputs {
     let mut renderer = Renderer::new(gpu.clone(), scene, s).unwrap_or_else(|e| panic!("{label}: {e}"));
     let eyes = s.profile.eyes(head, s.near);
-    let mut intermediate = vec![Resource::AoRaw];
+    let mut intermediate = vec![AO_RAW];
     if s.ao.blur_radius > 0 {
-        intermediate.push(Resource::AoBlurred);
+        intermediate.push(AO_BLURRED);
     }
-    let final_ao = vrao::render::passes::final_occlusion(s).unwrap();
+    let final_ao = FINAL_AO;
     // The occlusion chain (with the standalone upsample at half resolution) ...
     let mut wanted = intermediate.clone();
     wanted.push(final_ao);
@@ -53,14 +58,14 @@ fn render_checked(gpu: &Arc<Gpu>, label: &str, scene: &Scene, s: &Settings, head
     }
     let ao = renderer.read_f32(final_ao).unwrap();
     // ... and the whole frame (the composite upsamples half-resolution AO itself).
-    renderer.render(&eyes.eyes, &[Resource::Hdr, Resource::Color, Resource::Depth]).unwrap();
-    let hdr = renderer.read_f32(Resource::Hdr).unwrap();
+    renderer.render(&eyes.eyes, &[HDR, COLOR, DEPTH]).unwrap();
+    let hdr = renderer.read_f32(HDR).unwrap();
     for (layer, values) in hdr.iter().enumerate() {
         let bad = values.iter().filter(|v| !v.is_finite() || **v < 0.0).count();
         assert_eq!(bad, 0, "{label}: hdr layer {layer} holds {bad} NaN/Inf/negative values");
     }
-    let color = renderer.read_bytes(Resource::Color).unwrap();
-    let depth = renderer.read_f32(Resource::Depth).unwrap();
+    let color = renderer.read_bytes(COLOR).unwrap();
+    let depth = renderer.read_f32(DEPTH).unwrap();
     assert!(depth.iter().flatten().all(|d| d.is_finite() && (0.0..=1.0).contains(d)), "{label}: depth");
     renderer.gpu().take_error().unwrap_or_else(|e| panic!("{label}: {e}"));
     Outputs { ao, hdr, color }
@@ -202,9 +207,9 @@ fn a_blur_sigma_near_zero_keeps_the_centre_value() {
         let label = format!("{} blur sigma 1e-30", technique.name());
         let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
         let eyes = s.profile.eyes(&room_head(), s.near);
-        renderer.render(&eyes.eyes, &[Resource::AoRaw, Resource::AoBlurred]).unwrap();
-        let raw = renderer.read_f32(Resource::AoRaw).unwrap();
-        let blurred = renderer.read_f32(Resource::AoBlurred).unwrap();
+        renderer.render(&eyes.eyes, &[AO_RAW, AO_BLURRED]).unwrap();
+        let raw = renderer.read_f32(AO_RAW).unwrap();
+        let blurred = renderer.read_f32(AO_BLURRED).unwrap();
         // Every neighbour lies off the centre's plane by more than 1e-30 of its distance
         // (rounding alone does that), so its weight underflows and the centre stays.
         let (mut same, mut total) = (0, 0);
@@ -343,7 +348,7 @@ fn depth_target(gpu: &Gpu, (w, h): (u32, u32), value: f32) -> LayeredTarget {
     let target = LayeredTarget::new(
         &gpu.device,
         "history depth",
-        Resource::Depth.format(),
+        DEPTH.format(),
         (w, h, 2),
         wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
     );
@@ -374,8 +379,8 @@ fn a_reprojection_history_without_usable_depth_falls_back_to_the_rotational_warp
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let head = room_head();
     let source = s.profile.eyes(&head, s.near);
-    renderer.render(&source.eyes, &[Resource::Color]).unwrap();
-    let color = renderer.target(Resource::Color).unwrap();
+    renderer.render(&source.eyes, &[COLOR]).unwrap();
+    let color = renderer.target(COLOR).unwrap();
     let moved = HeadPose {
         position: head.position + DVec3::new(0.05, 0.0, 0.0),
         orientation: DQuat::from_rotation_y(0.05) * head.orientation,
@@ -428,7 +433,7 @@ fn error_against_the_reference_does_not_grow_when_the_scene_moves_1e5_m_out() {
         .unwrap();
         for technique in TECHNIQUES {
             let s = settings(size, AoSettings { technique, radius: 0.5, ..AoSettings::default() });
-            let output = vrao::render::passes::final_occlusion(&s).unwrap();
+            let output = FINAL_AO;
             let mut renderer = Renderer::new(gpu.clone(), scene, &s).unwrap();
             renderer.render(&eyes.eyes, &[output]).unwrap();
             let e = vrao::measure::bench::error_figures(technique, &renderer.read_f32(output).unwrap(), &reference);

@@ -15,6 +15,12 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 use vrao::measure::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
 use vrao::measure::stereo_consistency::{stereo_consistency, EyeImages};
+use vrao::render::passes::blur::AO_BLURRED;
+use vrao::render::passes::composite::HDR;
+use vrao::render::passes::gbuffer::DEPTH;
+use vrao::render::passes::occlusion::{AO_GEOMETRY, AO_RAW};
+use vrao::render::passes::tonemap::COLOR;
+use vrao::render::passes::upsample::AO_FULL;
 use vrao::render::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
 use vrao::render::scene::builtin::{CREASE_WALL_Z, ROOM_MAX, ROOM_MIN};
 use vrao::render::scene::{environment, Environment, Scene};
@@ -52,9 +58,9 @@ fn render(gpu: &Arc<Gpu>, scene: &Scene, s: &Settings, head: &HeadPose, outputs:
     let mut renderer = Renderer::new(gpu.clone(), scene, s).unwrap();
     let eyes = s.profile.eyes(head, s.near);
     let mut wanted = outputs.to_vec();
-    wanted.push(Resource::Depth);
+    wanted.push(DEPTH);
     let report = renderer.render(&eyes.eyes, &wanted).unwrap();
-    let depth = renderer.read_f32(Resource::Depth).unwrap();
+    let depth = renderer.read_f32(DEPTH).unwrap();
     let (w, h) = (s.profile.width, s.profile.height);
     let world = common::world_positions(&depth, &eyes.eyes, w, h, s.near);
     let outputs = outputs.iter().map(|&r| (r, renderer.read_f32(r).unwrap())).collect();
@@ -114,7 +120,7 @@ fn mean(values: impl IntoIterator<Item = f64>) -> f64 {
 /// The blur's effect on a field that is smooth within each surface: a normalised
 /// separable Gaussian (σ = radius / 2, taps within ±radius, off-image taps skipped) that
 /// only averages pixels of the same surface class. On a plane the renderer's bilateral
-/// weights (shaders/bilateral.wgsl: tangent-plane distance and normal agreement) are 1
+/// weights (src/render/passes/blur/bilateral.wgsl: tangent-plane distance and normal agreement) are 1
 /// between same-plane pixels and vanish across a crease or a depth step, so this is what
 /// the blur does to an expectation image. Class 0 pixels are neither changed nor used.
 fn same_surface_blur(values: &[f64], class: &[u8], width: u32, height: u32, radius: i32) -> Vec<f64> {
@@ -160,8 +166,8 @@ fn open_plane_is_unoccluded_for_every_technique() {
     for (samples, radius) in [(24, 0.5), (64, 2.0)] {
         for technique in AO_TECHNIQUES {
             let s = settings(96, 108, ao(technique, samples, radius));
-            let f = render(&gpu, &scene, &s, &head, &[Resource::AoRaw, Resource::AoBlurred]);
-            for r in [Resource::AoRaw, Resource::AoBlurred] {
+            let f = render(&gpu, &scene, &s, &head, &[AO_RAW, AO_BLURRED]);
+            for r in [AO_RAW, AO_BLURRED] {
                 let mut worst = (f64::INFINITY, 0, 0, 0);
                 let mut covered = 0;
                 for (l, x, y) in f.pixels() {
@@ -277,7 +283,7 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
     settings.ao.noise = Noise::Halton;
     // The blur is simulated below as a same-surface box of the bilateral's radius.
     settings.ao.denoise = Denoise::Bilateral;
-    let f = render(gpu, &scene, &settings, &crease_head(), &[Resource::AoRaw, Resource::AoBlurred]);
+    let f = render(gpu, &scene, &settings, &crease_head(), &[AO_RAW, AO_BLURRED]);
     let r = CREASE_RADIUS;
     // SSAO and SSDO by their depth-test simulation, HBAO by its march (None).
     let estimator = match technique {
@@ -390,7 +396,7 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
                 }
                 let b = &mut bins[bin];
                 b.pixels += 1;
-                b.raw += f.ao(Resource::AoRaw, layer, x, y);
+                b.raw += f.ao(AO_RAW, layer, x, y);
                 b.expected_raw += expected[i];
                 b.closed_raw += closed[i];
                 b.reference += analytic::crease_visibility(d, r);
@@ -398,7 +404,7 @@ fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
                 let window_ok = near_other(blur, &|q| class[q] != class[i] || modelled[q]);
                 if window_ok {
                     b.blurred_pixels += 1;
-                    b.blurred += f.ao(Resource::AoBlurred, layer, x, y);
+                    b.blurred += f.ao(AO_BLURRED, layer, x, y);
                     b.expected_blurred += expected_blurred[i];
                     b.falloff_blurred += falloff_blurred[i];
                 }
@@ -640,7 +646,7 @@ fn ssdo_shadows_the_side_away_from_a_single_light_where_ssao_cannot() {
     let head = HeadPose::look_at(DVec3::new(0.0, 3.2, 3.6), DVec3::new(0.0, 0.3, 0.0)).unwrap();
     let luminance_of = |technique: Technique| {
         let s = settings(160, 180, ao(technique, 64, 1.5));
-        let f = render(&gpu, &scene, &s, &head, &[Resource::Hdr]);
+        let f = render(&gpu, &scene, &s, &head, &[HDR]);
         // Floor beside the sphere, on the side away from the light (−X) and on the lit
         // side (+X), mirror images of each other for this eye.
         let (mut away, mut lit) = (Vec::new(), Vec::new());
@@ -651,7 +657,7 @@ fn ssdo_shadows_the_side_away_from_a_single_light_where_ssao_cannot() {
             if p.y.abs() > 1e-3 || p.z.abs() > 0.5 || !(1.1..=1.6).contains(&p.x.abs()) {
                 continue;
             }
-            let lum = analytic::luminance(f.rgb(Resource::Hdr, l, x, y));
+            let lum = analytic::luminance(f.rgb(HDR, l, x, y));
             if p.x < 0.0 {
                 away.push(lum)
             } else {
@@ -699,11 +705,11 @@ fn ssdo_on_an_open_plane_gathers_the_unoccluded_ambient() {
     scene.lights.clear();
     let head = scene.head.pose_at(0.0);
     let floor_luminance = |scene: &Scene, technique: Technique, samples: u32| {
-        let f = render(&gpu, scene, &settings(96, 108, ao(technique, samples, 0.5)), &head, &[Resource::Hdr]);
+        let f = render(&gpu, scene, &settings(96, 108, ao(technique, samples, 0.5)), &head, &[HDR]);
         mean(
             f.pixels()
                 .filter(|&(l, x, y)| f.world(l, x, y).is_some())
-                .map(|(l, x, y)| analytic::luminance(f.rgb(Resource::Hdr, l, x, y))),
+                .map(|(l, x, y)| analytic::luminance(f.rgb(HDR, l, x, y))),
         )
     };
     let mut failures = Vec::new();
@@ -748,7 +754,7 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
         let mut a = ao(technique, 64, 1.0);
         a.bounce = bounce;
         a.bounce_form = form;
-        render(&gpu, &scene, &settings(128, 144, a), &head, &[Resource::Hdr, Resource::AoRaw])
+        render(&gpu, &scene, &settings(128, 144, a), &head, &[HDR, AO_RAW])
     };
     let run = |technique: Technique, bounce: f32| run_form(technique, bounce, BounceForm::Direction);
     let ssdo = run(Technique::Ssdo, 1.0);
@@ -765,7 +771,7 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
                 continue;
             }
             n += 1;
-            let (c, a) = (f.rgb(Resource::Hdr, l, x, y), f.rgb(Resource::AoRaw, l, x, y));
+            let (c, a) = (f.rgb(HDR, l, x, y), f.rgb(AO_RAW, l, x, y));
             for i in 0..3 {
                 hdr[i] += c[i] as f64;
                 raw[i] += a[i] as f64;
@@ -807,7 +813,7 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     );
     assert!(ratio(bounce_hdr) > 1.03 * ratio(ssdo_hdr), "no red bleeding: r/g {bounce_hdr:?} vs {ssdo_hdr:?}");
     // Bounce strength 0 is SSDO exactly (the same pass runs).
-    for r in [Resource::Hdr, Resource::AoRaw] {
+    for r in [HDR, AO_RAW] {
         let worst = ssdo.outputs[&r]
             .iter()
             .flatten()
@@ -819,9 +825,8 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     // With the bounce, the occluder probe reads distances packed with the direct light
     // instead of the depth buffer (one fetch for both): it must block exactly the same
     // directions, so the visibility (AoRaw alpha) is SSDO's to the f16 target's precision.
-    let alpha = |f: &Frame| {
-        f.outputs[&Resource::AoRaw].iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>()
-    };
+    let alpha =
+        |f: &Frame| f.outputs[&AO_RAW].iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>();
     let worst = alpha(&ssdo).iter().zip(alpha(&bounce)).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
     assert!(worst <= 1e-3, "the bounce changed which directions are blocked: visibility differs by {worst}");
 }
@@ -845,7 +850,7 @@ fn blur_keeps_a_depth_edge() {
     let mut a = ao(Technique::Ssao, 32, 1.0);
     a.range_check = false;
     let s = settings(128, 144, a);
-    let f = render(&gpu, &scene, &s, &HeadPose::IDENTITY, &[Resource::AoRaw, Resource::AoBlurred]);
+    let f = render(&gpu, &scene, &s, &HeadPose::IDENTITY, &[AO_RAW, AO_BLURRED]);
     let (w, h) = (f.width, f.height);
     let blur = s.ao.blur_radius as i32;
     let (mut near, mut far) =
@@ -853,7 +858,7 @@ fn blur_keeps_a_depth_edge() {
     for layer in 0..2 {
         // 1 = panel (about 2 m away), 2 = wall (about 4 m).
         let class: Vec<u8> = f.world[layer].iter().map(|p| p.map_or(0, |p| if p.z > -3.0 { 1 } else { 2 })).collect();
-        let raw: Vec<f64> = (0..w * h).map(|i| f.outputs[&Resource::AoRaw][layer][4 * i as usize + 3] as f64).collect();
+        let raw: Vec<f64> = (0..w * h).map(|i| f.outputs[&AO_RAW][layer][4 * i as usize + 3] as f64).collect();
         let same = same_surface_blur(&raw, &class, w, h, blur);
         // A geometry-unaware blur of the same raw AO, to show the test would catch one.
         let naive = same_surface_blur(&raw, &vec![1; raw.len()], w, h, blur);
@@ -874,7 +879,7 @@ fn blur_keeps_a_depth_edge() {
                 if !(1..=2).contains(&dist) {
                     continue;
                 }
-                let blurred = f.ao(Resource::AoBlurred, layer, x as u32, y as u32);
+                let blurred = f.ao(AO_BLURRED, layer, x as u32, y as u32);
                 let side = if c == 1 { &mut near } else { &mut far };
                 side.0.push(raw[i]);
                 side.1.push(blurred);
@@ -926,12 +931,12 @@ fn half_resolution_stays_close_to_full_resolution() {
         let full = settings(128, 144, ao(technique, 24, 1.0));
         let mut half = full.clone();
         half.ao.half_res = true;
-        let f = render(&gpu, &scene, &full, &head, &[Resource::AoBlurred]);
-        let g = render(&gpu, &scene, &half, &head, &[Resource::AoFull]);
+        let f = render(&gpu, &scene, &full, &head, &[AO_BLURRED]);
+        let g = render(&gpu, &scene, &half, &head, &[AO_FULL]);
         let pairs: Vec<(f64, f64)> = f
             .pixels()
             .filter(|&(l, x, y)| f.world(l, x, y).is_some())
-            .map(|(l, x, y)| (f.ao(Resource::AoBlurred, l, x, y), g.ao(Resource::AoFull, l, x, y)))
+            .map(|(l, x, y)| (f.ao(AO_BLURRED, l, x, y), g.ao(AO_FULL, l, x, y)))
             .collect();
         let diffs: Vec<f64> = pairs.iter().map(|(a, b)| (a - b).abs()).collect();
         let mad = mean(diffs.iter().copied());
@@ -973,10 +978,9 @@ fn odd_sizes_work_at_half_resolution() {
         let mut a = ao(technique, 12, 0.5);
         a.half_res = true;
         let s = settings(97, 109, a);
-        let outputs = [Resource::AoRaw, Resource::AoBlurred, Resource::AoFull, Resource::Hdr];
+        let outputs = [AO_RAW, AO_BLURRED, AO_FULL, HDR];
         let f = render(&gpu, &scene, &s, &head, &outputs);
-        for (r, (w, h)) in [(Resource::AoRaw, (49, 55)), (Resource::AoBlurred, (49, 55)), (Resource::AoFull, (97, 109))]
-        {
+        for (r, (w, h)) in [(AO_RAW, (49, 55)), (AO_BLURRED, (49, 55)), (AO_FULL, (97, 109))] {
             for layer in &f.outputs[&r] {
                 assert_eq!(layer.len(), w * h * 4, "{} {}: not {w}×{h}", technique.name(), r.name());
                 assert!(layer.iter().all(|v| v.is_finite()), "{} {}: not finite", technique.name(), r.name());
@@ -984,8 +988,7 @@ fn odd_sizes_work_at_half_resolution() {
             }
         }
         // The last row and column of the full-res AO carry values, not a cleared edge.
-        let last_column_lit =
-            (0..109).filter(|&y| f.world(0, 96, y).is_some()).all(|y| f.ao(Resource::AoFull, 0, 96, y) > 0.0);
+        let last_column_lit = (0..109).filter(|&y| f.world(0, 96, y).is_some()).all(|y| f.ao(AO_FULL, 0, 96, y) > 0.0);
         assert!(last_column_lit, "{}: last column of ao-full is empty", technique.name());
     }
 }
@@ -1000,7 +1003,7 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
     let head = scene.head.pose_at(0.0);
     for technique in AO_TECHNIQUES {
         let s = settings(128, 144, ao(technique, 32, 1.0));
-        let f = render(&gpu, &scene, &s, &head, &[Resource::AoBlurred]);
+        let f = render(&gpu, &scene, &s, &head, &[AO_BLURRED]);
         let (mut diffs, mut signed, mut occluded, mut unmatched) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let margin = 16;
         for y in margin..f.height - margin {
@@ -1015,7 +1018,7 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
                 if (q - p).length() > 0.01 * (p - f.eyes.eyes[0].pose.position).length() {
                     continue;
                 }
-                let (left, right) = (f.ao(Resource::AoBlurred, 0, x, y), f.ao(Resource::AoBlurred, 1, rx, ry));
+                let (left, right) = (f.ao(AO_BLURRED, 0, x, y), f.ao(AO_BLURRED, 1, rx, ry));
                 let d = left - right;
                 diffs.push(d.abs());
                 signed.push(d);
@@ -1023,7 +1026,7 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
                     occluded.push(d.abs());
                     // The same pixel of the right eye (no reprojection): what a test that
                     // ignored parallax would compare.
-                    unmatched.push((left - f.ao(Resource::AoBlurred, 1, x, y)).abs());
+                    unmatched.push((left - f.ao(AO_BLURRED, 1, x, y)).abs());
                 }
             }
         }
@@ -1070,8 +1073,8 @@ fn flipped_normals_give_no_zero_ao_and_no_black_pixel() {
             a.half_res = half_res;
             let s = settings(270, 300, a);
             // The final full-resolution AO.
-            let final_ao = if half_res { Resource::AoFull } else { Resource::AoBlurred };
-            let f = render(&gpu, &scene, &s, &head, &[final_ao, Resource::Hdr]);
+            let final_ao = if half_res { AO_FULL } else { AO_BLURRED };
+            let f = render(&gpu, &scene, &s, &head, &[final_ao, HDR]);
             let (mut surface, mut zero_ao, mut black) = (0, Vec::new(), Vec::new());
             for (l, x, y) in f.pixels() {
                 if f.world(l, x, y).is_none() {
@@ -1081,7 +1084,7 @@ fn flipped_normals_give_no_zero_ao_and_no_black_pixel() {
                 if f.ao(final_ao, l, x, y) <= 0.0 {
                     zero_ao.push((l, x, y));
                 }
-                if f.rgb(Resource::Hdr, l, x, y).iter().all(|&c| c <= 0.0) {
+                if f.rgb(HDR, l, x, y).iter().all(|&c| c <= 0.0) {
                     black.push((l, x, y));
                 }
             }
@@ -1104,14 +1107,14 @@ fn every_pixel_is_computed_in_both_eyes() {
     let head = scene.head.pose_at(0.0);
     for technique in AO_TECHNIQUES {
         let s = settings(97, 109, ao(technique, 12, 0.5));
-        let f = render(&gpu, &scene, &s, &head, &[Resource::AoGeometry, Resource::AoRaw]);
+        let f = render(&gpu, &scene, &s, &head, &[AO_GEOMETRY, AO_RAW]);
         let missing: Vec<_> = f
             .pixels()
             // The geometry's distance (.a) is > 0 wherever a pixel was computed; NaN or 0
             // means never written.
             .filter(|&(l, x, y)| {
                 f.world(l, x, y).is_some()
-                    && f.ao(Resource::AoGeometry, l, x, y).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+                    && f.ao(AO_GEOMETRY, l, x, y).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
             })
             .collect();
         assert!(
@@ -1142,9 +1145,9 @@ fn the_right_eye_reuses_the_left_eye_where_it_sees_the_same_point() {
             let mut a = ao(technique, 24, 0.3);
             (a.stereo_reuse, a.half_res) = (reuse, half_res);
             let s = settings(540, 600, a);
-            let final_ao = if half_res { Resource::AoFull } else { Resource::AoBlurred };
-            let f = render(&gpu, &scene, &s, &head, &[final_ao, Resource::Depth]);
-            let depth = &f.outputs[&Resource::Depth];
+            let final_ao = if half_res { AO_FULL } else { AO_BLURRED };
+            let f = render(&gpu, &scene, &s, &head, &[final_ao, DEPTH]);
+            let depth = &f.outputs[&DEPTH];
             let ao: Vec<Vec<f32>> = f.outputs[&final_ao].iter().map(|l| l.chunks(4).map(|p| p[3]).collect()).collect();
             let images = [0, 1].map(|l| EyeImages { depth: &depth[l], ao: &ao[l] });
             let c = stereo_consistency(&f.eyes.eyes, images, (f.width, f.height), f.eyes.near);
@@ -1177,7 +1180,7 @@ fn the_composite_shows_the_ao_the_bench_scores_and_the_right_eye_takes_the_left_
     for (technique, reuse) in [(Technique::Gtao, true), (Technique::Hbao, true), (Technique::Gtao, false)] {
         let mut a = ao(technique, 12, 0.3);
         (a.stereo_reuse, a.half_res) = (reuse, true);
-        let f = render(&gpu, &scene, &settings(96, 112, a), &head, &[Resource::AoFull, Resource::Hdr]);
+        let f = render(&gpu, &scene, &settings(96, 112, a), &head, &[AO_FULL, HDR]);
         let case = format!("{technique:?}, reuse {reuse}");
         let mut surface = 0;
         for (l, x, y) in f.pixels() {
@@ -1185,7 +1188,7 @@ fn the_composite_shows_the_ao_the_bench_scores_and_the_right_eye_takes_the_left_
                 continue;
             }
             surface += 1;
-            let (shown, scored) = (f.ao(Resource::Hdr, l, x, y), f.ao(Resource::AoFull, l, x, y));
+            let (shown, scored) = (f.ao(HDR, l, x, y), f.ao(AO_FULL, l, x, y));
             assert!((shown - scored).abs() < 2e-3, "{case}: eye {l} ({x}, {y}) shows {shown}, scored {scored}");
         }
         assert!(surface > 10_000, "{case}: {surface} surface pixels");
@@ -1202,7 +1205,7 @@ fn the_composite_shows_the_ao_the_bench_scores_and_the_right_eye_takes_the_left_
                 continue;
             }
             compared += 1;
-            let (right, left) = (f.ao(Resource::AoFull, 1, x, y), f.ao(Resource::AoFull, 0, lx, ly));
+            let (right, left) = (f.ao(AO_FULL, 1, x, y), f.ao(AO_FULL, 0, lx, ly));
             equal += usize::from((right - left).abs() < 2e-3);
         }
         eprintln!("{case}: {equal} of {compared} right-eye pixels hold the left eye's AO");
@@ -1225,7 +1228,7 @@ fn marches_past_the_inner_border_continue_in_the_other_eye() {
     let mut a = ao(Technique::Gtao, 64, 1.0);
     a.stereo_reuse = false;
     let s = settings(128, 144, a);
-    let f = render(&gpu, &scene, &s, &head, &[Resource::AoRaw]);
+    let f = render(&gpu, &scene, &s, &head, &[AO_RAW]);
     let band = 12;
     let (mut signed, mut occlusion) = (Vec::new(), Vec::new());
     // Left eye: inner border on the right; right eye: on the left.
@@ -1241,7 +1244,7 @@ fn marches_past_the_inner_border_continue_in_the_other_eye() {
                 if (q - p).length() > 0.01 * (p - f.eyes.eyes[layer].pose.position).length() {
                     continue;
                 }
-                let (here, there) = (f.ao(Resource::AoRaw, layer, x, y), f.ao(Resource::AoRaw, other, ox, oy));
+                let (here, there) = (f.ao(AO_RAW, layer, x, y), f.ao(AO_RAW, other, ox, oy));
                 signed.push(here - there);
                 occlusion.push(1.0 - there);
             }
@@ -1287,19 +1290,19 @@ fn no_output_is_ever_nan_or_inf() {
     for (name, scene, a) in cases {
         let label = format!("{name} {} N={} r={} half={}", a.technique.name(), a.samples, a.radius, a.half_res);
         let (w, h) = if a.half_res { (97, 109) } else { (96, 108) };
-        let mut outputs = vec![Resource::AoRaw, Resource::Hdr];
+        let mut outputs = vec![AO_RAW, HDR];
         if a.blur_radius > 0 {
-            outputs.push(Resource::AoBlurred);
+            outputs.push(AO_BLURRED);
         }
         if a.half_res {
-            outputs.push(Resource::AoFull);
+            outputs.push(AO_FULL);
         }
         let f = render(&gpu, scene, &settings(w, h, a), &scene.head.pose_at(0.0), &outputs);
         for r in outputs {
             for layer in &f.outputs[&r] {
                 let bad = layer.iter().filter(|v| !v.is_finite()).count();
                 assert_eq!(bad, 0, "{label}: {} holds {bad} NaN/Inf values", r.name());
-                if r == Resource::Hdr {
+                if r == HDR {
                     assert!(layer.iter().all(|v| *v >= 0.0), "{label}: negative radiance");
                 } else {
                     assert!(
@@ -1321,7 +1324,7 @@ fn the_plan_explains_what_occlusion_left_out() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:room").unwrap();
     let head = scene.head.pose_at(0.0);
-    let plan_for = |a: AoSettings| render(&gpu, &scene, &settings(64, 72, a), &head, &[Resource::Color]).report.plan;
+    let plan_for = |a: AoSettings| render(&gpu, &scene, &settings(64, 72, a), &head, &[COLOR]).report.plan;
 
     let none = plan_for(AoSettings { technique: Technique::None, ..AoSettings::default() });
     eprintln!("technique none:\n{none}");
@@ -1359,8 +1362,7 @@ fn the_plan_explains_what_occlusion_left_out() {
     assert!(on.left_out.iter().any(|(pass, why)| *pass == "upsample" && why.contains("ao-full")), "{:?}", on.left_out);
     let half_bounce =
         AoSettings { technique: Technique::SsdoBounce, bounce: 1.0, half_res: true, ..AoSettings::default() };
-    let debug =
-        render(&gpu, &scene, &settings(64, 72, half_bounce), &head, &[Resource::Color, Resource::AoFull]).report.plan;
+    let debug = render(&gpu, &scene, &settings(64, 72, half_bounce), &head, &[COLOR, AO_FULL]).report.plan;
     assert!(debug.runs("upsample") && debug.runs("composite"), "{:?}", debug.names);
     for (technique, pass) in [(Technique::Ssao, "ssao"), (Technique::Hbao, "hbao"), (Technique::Ssdo, "ssdo")] {
         let plan = plan_for(AoSettings { technique, blur_radius: 0, ..AoSettings::default() });
@@ -1387,13 +1389,13 @@ fn the_composite_upsamples_half_resolution_occlusion_inline() {
     let head = scene.head.pose_at(0.0);
     for technique in [Technique::Ssao, Technique::Ssdo] {
         let base = AoSettings { technique, samples: 32, radius: 1.0, ..AoSettings::default() };
-        let full = render(&gpu, &scene, &settings(128, 144, base.clone()), &head, &[Resource::Hdr]);
+        let full = render(&gpu, &scene, &settings(128, 144, base.clone()), &head, &[HDR]);
         let half_settings = AoSettings { half_res: true, ..base };
-        let half = render(&gpu, &scene, &settings(128, 144, half_settings), &head, &[Resource::Hdr]);
+        let half = render(&gpu, &scene, &settings(128, 144, half_settings), &head, &[HDR]);
         assert!(!half.report.plan.runs("upsample"), "the frame upsampled in a pass of its own");
         let (mut diff, mut total) = (0.0, 0.0);
         for layer in 0..2 {
-            let (a, b) = (&full.outputs[&Resource::Hdr][layer], &half.outputs[&Resource::Hdr][layer]);
+            let (a, b) = (&full.outputs[&HDR][layer], &half.outputs[&HDR][layer]);
             for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
                 diff += (0..3).map(|c| (x[c] - y[c]).abs() as f64).sum::<f64>();
                 total += (0..3).map(|c| x[c].abs() as f64).sum::<f64>();

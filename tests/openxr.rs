@@ -15,7 +15,8 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use vrao::render::gpu::readback::{read_layers, read_layers_f32};
 use vrao::render::gpu::targets::LayeredTarget;
-use vrao::render::graph::Resource;
+use vrao::render::passes::gbuffer::DEPTH;
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::scene::Scene;
 use vrao::render::settings::Settings;
 use vrao::render::stereo::HeadsetProfile;
@@ -195,9 +196,9 @@ fn fill_depth(gpu: &Gpu, depth: &LayeredTarget) {
 /// value and a spread of depths, as the renderer would hand them over.
 fn eye_targets(gpu: &Gpu, (width, height): (u32, u32)) -> (LayeredTarget, LayeredTarget, Vec<Vec<u8>>, Vec<Vec<f32>>) {
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-    let color = LayeredTarget::new(&gpu.device, "eye colour", Resource::Color.format(), (width, height, 2), usage);
+    let color = LayeredTarget::new(&gpu.device, "eye colour", COLOR.format(), (width, height, 2), usage);
     let depth_usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let depth = LayeredTarget::new(&gpu.device, "eye depth", Resource::Depth.format(), (width, height, 2), depth_usage);
+    let depth = LayeredTarget::new(&gpu.device, "eye depth", DEPTH.format(), (width, height, 2), depth_usage);
     let texels = (width * height) as usize;
     let color_bytes: Vec<Vec<u8>> = (0..2)
         .map(|layer| {
@@ -318,9 +319,9 @@ fn run_frames(
             eye.fov.validate().expect("the runtime's fov is a valid frustum");
             assert!(eye.pose.position.is_finite());
         }
-        renderer.render(&request.eyes.eyes, &[Resource::Color, Resource::Depth]).expect("render");
-        let color = renderer.target(Resource::Color).unwrap();
-        let depth = renderer.target(Resource::Depth).unwrap();
+        renderer.render(&request.eyes.eyes, &[COLOR, DEPTH]).expect("render");
+        let color = renderer.target(COLOR).unwrap();
+        let depth = renderer.target(DEPTH).unwrap();
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
         headset.submit(gpu, &request, Some(frame)).expect("submit");
         rendered += 1;

@@ -5,7 +5,7 @@ mod common;
 
 use vrao::measure::bench::{error_figures, ErrorFigures};
 use vrao::measure::reference::{trace, ReferenceSettings};
-use vrao::render::passes::final_occlusion;
+use vrao::render::graph::FINAL_AO;
 use vrao::render::settings::{BounceForm, Technique};
 use vrao::{HeadsetProfile, Renderer, Scene, Settings};
 
@@ -25,7 +25,7 @@ fn errors(
     settings.ao.samples = samples;
     settings.ao.radius = RADIUS;
     settings.ao.bounce_form = form;
-    let output = final_occlusion(&settings).unwrap();
+    let output = FINAL_AO;
     let mut renderer = Renderer::new(gpu, &scene, &settings).unwrap();
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     renderer.render(&eyes.eyes, &[output]).unwrap();

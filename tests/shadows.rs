@@ -13,6 +13,13 @@ use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use vrao::measure::analytic::luminance;
+use vrao::render::passes::composite::HDR;
+use vrao::render::passes::direct::DIRECT;
+use vrao::render::passes::gbuffer::DEPTH;
+use vrao::render::passes::occlusion::AO_RAW;
+use vrao::render::passes::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
+use vrao::render::passes::shadow::{RSM_FLUX, RSM_NORMAL, SHADOW_MAP};
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
 use vrao::render::scene::{Light, Material, Scene};
 use vrao::render::settings::Technique;
@@ -55,12 +62,12 @@ fn render_frames(gpu: &Arc<Gpu>, scene: &Scene, s: &Settings, outputs: &[Resourc
     let mut renderer = Renderer::new(gpu.clone(), scene, s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     let mut wanted = outputs.to_vec();
-    wanted.push(Resource::Depth);
+    wanted.push(DEPTH);
     for _ in 0..frames {
         renderer.render(&eyes.eyes, &wanted).unwrap();
     }
     renderer.gpu().take_error().unwrap();
-    let depth = renderer.read_f32(Resource::Depth).unwrap();
+    let depth = renderer.read_f32(DEPTH).unwrap();
     let (w, h) = (s.profile.width, s.profile.height);
     let world = common::world_positions(&depth, &eyes.eyes, w, h, s.near);
     let outputs = outputs.iter().map(|&r| (r, renderer.read_f32(r).unwrap())).collect();
@@ -120,10 +127,10 @@ fn a_box_shadows_the_floor_its_light_direction_says_and_the_lit_floor_keeps_n_do
     let albedo = scene.materials[0].diffuse.x as f64;
     let lit_expected = albedo / std::f64::consts::PI * intensity as f64 * towards.y;
     let s = settings(128, 144);
-    let shadowed = render(&gpu, &scene, &s, &[Resource::Direct, Resource::Hdr]);
+    let shadowed = render(&gpu, &scene, &s, &[DIRECT, HDR]);
     let mut off = s.clone();
     off.shadows.enabled = false;
-    let unshadowed = render(&gpu, &scene, &off, &[Resource::Direct]);
+    let unshadowed = render(&gpu, &scene, &off, &[DIRECT]);
     // PCF reaches 1.5 texels (2.8 cm texels here) and the bias shifts edges by less than
     // a texel: 10 cm from the analytic edge every tap agrees.
     let margin = 0.10;
@@ -132,12 +139,12 @@ fn a_box_shadows_the_floor_its_light_direction_says_and_the_lit_floor_keeps_n_do
         if p.y.abs() > 1e-3 || p.x.abs().max(p.z.abs()) < 0.5 + 1e-3 {
             continue; // not the floor, or under the box
         }
-        let radiance = shadowed.rgb(Resource::Direct, l, i)[0] as f64;
-        let hdr = luminance(shadowed.rgb(Resource::Hdr, l, i));
+        let radiance = shadowed.rgb(DIRECT, l, i)[0] as f64;
+        let hdr = luminance(shadowed.rgb(HDR, l, i));
         match shadow_class(p, towards, margin) {
             Some(true) => dark.push((radiance, hdr)),
             Some(false) => {
-                let reference = unshadowed.rgb(Resource::Direct, l, i)[0] as f64;
+                let reference = unshadowed.rgb(DIRECT, l, i)[0] as f64;
                 worst_lit = worst_lit.max((radiance - lit_expected).abs() / lit_expected);
                 worst_ratio = worst_ratio.max((radiance / reference - 1.0).abs());
                 lit.push((radiance, hdr));
@@ -189,10 +196,10 @@ fn an_open_plane_has_no_shadow_acne_from_high_to_grazing_sun() {
             let expected = albedo / std::f64::consts::PI * 3.0 * towards.y;
             let mut s = settings(96, 108);
             s.shadows.size = size;
-            let f = render(&gpu, &scene, &s, &[Resource::Direct]);
+            let f = render(&gpu, &scene, &s, &[DIRECT]);
             let (mut worst, mut n) = (0.0f64, 0);
             for (l, i, _) in f.surface_pixels() {
-                let radiance = f.rgb(Resource::Direct, l, i)[0] as f64;
+                let radiance = f.rgb(DIRECT, l, i)[0] as f64;
                 worst = worst.max((radiance / expected - 1.0).abs());
                 n += 1;
             }
@@ -222,34 +229,34 @@ fn only_directional_lights_get_a_shadow_pass_and_explain_says_why() {
     // The room has one point light: no shadow pass, and --explain says why.
     let room = Scene::load("builtin:room").unwrap();
     assert!(room.lights.iter().all(|l| matches!(l, Light::Point { .. })));
-    let p = plan(&room, &settings(32, 32), &[Resource::Color]);
+    let p = plan(&room, &settings(32, 32), &[COLOR]);
     println!("{p}");
     assert!(!p.runs("shadow") && !p.runs("rsm"));
-    assert!(!p.resources.contains(&Resource::ShadowMap));
+    assert!(!p.resources.contains(&SHADOW_MAP));
     assert!(reason(&p, "shadow").unwrap().contains("point light"), "{p}");
     let mut rsm = settings(32, 32);
     rsm.shadows.rsm = true;
-    assert!(reason(&plan(&room, &rsm, &[Resource::Color]), "rsm").unwrap().contains("no directional light"));
+    assert!(reason(&plan(&room, &rsm, &[COLOR]), "rsm").unwrap().contains("no directional light"));
     // Under the sun it runs, before the direct pass that reads it ...
     let boxed = Scene::load("builtin:box").unwrap();
-    let p = plan(&boxed, &settings(32, 32), &[Resource::Color]);
+    let p = plan(&boxed, &settings(32, 32), &[COLOR]);
     let at = |name: &str| p.names.iter().position(|n| *n == name).unwrap();
     assert!(at("shadow") < at("direct"), "{p}");
     assert!(reason(&p, "rsm").unwrap().contains("--rsm on"));
     // ... not with --shadows off ...
     let mut off = settings(32, 32);
     off.shadows.enabled = false;
-    let p = plan(&boxed, &off, &[Resource::Color]);
+    let p = plan(&boxed, &off, &[COLOR]);
     assert!(!p.runs("shadow") && reason(&p, "shadow").unwrap().contains("--shadows off"), "{p}");
     // ... except for the reflective shadow maps, which need the light-space pass anyway;
     // the direct pass then reads no shadow map.
     off.shadows.rsm = true;
-    let p = plan(&boxed, &off, &[Resource::Color]);
+    let p = plan(&boxed, &off, &[COLOR]);
     assert!(p.runs("shadow") && p.runs("rsm"), "{p}");
     // And a frame that needs no direct light (the AO alone) leaves it out.
     let mut ao = settings(32, 32);
     ao.ao.technique = Technique::Ssao;
-    let p = plan(&boxed, &ao, &[Resource::AoRaw]);
+    let p = plan(&boxed, &ao, &[AO_RAW]);
     assert!(!p.runs("shadow") && reason(&p, "shadow").unwrap().contains("shadow-map"), "{p}");
 }
 
@@ -271,7 +278,7 @@ fn a_sunlit_red_wall_bleeds_red_onto_the_floor_near_it_through_the_rsm_bounce() 
     s.shadows.rsm = true;
     s.shadows.rsm_samples = 128;
     s.shadows.rsm_radius = 2.0;
-    let outputs = [Resource::Direct, Resource::Hdr];
+    let outputs = [DIRECT, HDR];
     let f = render_frames(&gpu, &red_wall_crease(2.0), &s, &outputs, 2);
     // The bounce alone: what the composite added to the direct light (no sky, no AO).
     let floor_albedo = 0.8f32;
@@ -280,7 +287,7 @@ fn a_sunlit_red_wall_bleeds_red_onto_the_floor_near_it_through_the_rsm_bounce() 
         if p.y.abs() > 1e-3 || p.x.abs() > CREASE_HALF_WIDTH - 2.5 {
             continue;
         }
-        let (hdr, direct) = (f.rgb(Resource::Hdr, l, i), f.rgb(Resource::Direct, l, i));
+        let (hdr, direct) = (f.rgb(HDR, l, i), f.rgb(DIRECT, l, i));
         // Irradiance = (HDR − direct) · π / albedo.
         let e = [0, 1, 2].map(|c| ((hdr[c] - direct[c]) * std::f32::consts::PI / floor_albedo) as f64);
         let from_wall = p.z - CREASE_WALL_Z;
@@ -310,7 +317,7 @@ fn a_sunlit_red_wall_bleeds_red_onto_the_floor_near_it_through_the_rsm_bounce() 
     // crease sees the wall over half its hemisphere: E ≤ π L · ½ = 0.64. Plausible range.
     assert!(near_r > 0.05 && near_r < 0.7, "near-wall red irradiance {near_r}");
     // Every value is finite and non-negative.
-    assert!(f.outputs[&Resource::Hdr].iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(f.outputs[&HDR].iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
 }
 
 #[test]
@@ -329,8 +336,8 @@ fn the_rsm_bounce_matches_the_reference_bounce_on_average() {
     let rs = ReferenceSettings { radius: radius as f64, rays_per_pixel: 256, stride: 2, near: s.near };
     let reference = trace(&scene, &eyes.eyes, size, &rs, &mut |_| {}).unwrap();
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
-    renderer.render(&eyes.eyes, &[Resource::RsmIndirect]).unwrap();
-    let irradiance = renderer.read_f32(Resource::RsmIndirect).unwrap();
+    renderer.render(&eyes.eyes, &[RSM_INDIRECT]).unwrap();
+    let irradiance = renderer.read_f32(RSM_INDIRECT).unwrap();
     let b = vrao::measure::bench::bounce_figures(&irradiance, size.0.div_ceil(2), 2, &reference).unwrap();
     eprintln!("red wall, r = R = {radius} m, 256 VPLs: RSM bounce vs reference: {b:?}");
     // Unbiased up to the different neighbourhoods and the RSM's missing visibility: mean
@@ -343,22 +350,22 @@ fn the_rsm_bounce_adds_nothing_without_light_and_nothing_when_off() {
     let (gpu, _guard) = common::gpu();
     let mut s = settings(64, 56);
     s.shadows.rsm = true;
-    let outputs = [Resource::Direct, Resource::Hdr, Resource::RsmIndirect];
+    let outputs = [DIRECT, HDR, RSM_INDIRECT];
     // The sun at zero intensity: the maps hold zero flux, the gather finds nothing.
     let dark = render(&gpu, &red_wall_crease(0.0), &s, &outputs);
-    let indirect_max = dark.outputs[&Resource::RsmIndirect]
+    let indirect_max = dark.outputs[&RSM_INDIRECT]
         .iter()
         .flat_map(|layer| layer.chunks(4).flat_map(|t| t[..3].to_vec()))
         .fold(0.0f32, |m, v| m.max(v.abs()));
-    let hdr_max = dark.outputs[&Resource::Hdr].iter().flatten().step_by(4).fold(0.0f32, |m, v| m.max(v.abs()));
+    let hdr_max = dark.outputs[&HDR].iter().flatten().step_by(4).fold(0.0f32, |m, v| m.max(v.abs()));
     eprintln!("light off: max RSM irradiance {indirect_max}, max HDR {hdr_max}");
     assert!(indirect_max == 0.0 && hdr_max == 0.0);
     // RSM off: the image is the direct light alone, exactly (no sky, no AO).
     let mut off = s.clone();
     off.shadows.rsm = false;
-    let f = render(&gpu, &red_wall_crease(2.0), &off, &[Resource::Direct, Resource::Hdr]);
+    let f = render(&gpu, &red_wall_crease(2.0), &off, &[DIRECT, HDR]);
     for (l, i, _) in f.surface_pixels() {
-        let (hdr, direct) = (f.rgb(Resource::Hdr, l, i), f.rgb(Resource::Direct, l, i));
+        let (hdr, direct) = (f.rgb(HDR, l, i), f.rgb(DIRECT, l, i));
         for c in 0..3 {
             assert!((hdr[c] - direct[c]).abs() <= 1e-3 * direct[c].abs() + 1e-6, "{hdr:?} vs {direct:?}");
         }
@@ -366,22 +373,14 @@ fn the_rsm_bounce_adds_nothing_without_light_and_nothing_when_off() {
     // No light at all: the pass is left out.
     let mut unlit = red_wall_crease(2.0);
     unlit.lights.clear();
-    let p = Renderer::new(gpu.clone(), &unlit, &s).unwrap().plan(2, &[Resource::Color]).unwrap();
+    let p = Renderer::new(gpu.clone(), &unlit, &s).unwrap().plan(2, &[COLOR]).unwrap();
     assert!(!p.runs("rsm") && !p.runs("shadow"), "{p}");
 }
 
 #[test]
 fn no_shadow_or_rsm_output_is_ever_nan_or_inf() {
     let (gpu, _guard) = common::gpu();
-    let outputs = [
-        Resource::ShadowMap,
-        Resource::RsmNormal,
-        Resource::RsmFlux,
-        Resource::RsmIndirect,
-        Resource::RsmGeometry,
-        Resource::Direct,
-        Resource::Hdr,
-    ];
+    let outputs = [SHADOW_MAP, RSM_NORMAL, RSM_FLUX, RSM_INDIRECT, RSM_GEOMETRY, DIRECT, HDR];
     let base = {
         let mut s = settings(97, 109); // odd: the half-resolution targets round up
         s.shadows.rsm = true;
@@ -432,10 +431,10 @@ fn no_shadow_or_rsm_output_is_ever_nan_or_inf() {
             for (layer, values) in layers.iter().enumerate() {
                 let bad = values.iter().filter(|v| !v.is_finite()).count();
                 assert_eq!(bad, 0, "{label}: {} layer {layer} holds {bad} NaN/Inf", r.name());
-                if *r == Resource::ShadowMap {
+                if *r == SHADOW_MAP {
                     assert!(values.iter().all(|d| (0.0..=1.0).contains(d)), "{label}: shadow depth outside [0, 1]");
                 }
-                if matches!(r, Resource::Hdr | Resource::RsmIndirect | Resource::RsmFlux) {
+                if [HDR, RSM_INDIRECT, RSM_FLUX].contains(r) {
                     assert!(values.iter().all(|v| *v >= 0.0), "{label}: negative {}", r.name());
                 }
             }

@@ -7,6 +7,9 @@ mod common;
 
 use glam::{DQuat, DVec3};
 use vrao::render::graph::Resource;
+use vrao::render::passes::occlusion::{AO_GEOMETRY, AO_RAW};
+use vrao::render::passes::temporal::{AO_ACCUMULATED, HISTORY_POSITION, HISTORY_VALUE};
+use vrao::render::passes::tonemap::COLOR;
 use vrao::render::settings::{AoSettings, Technique};
 use vrao::render::stereo::HeadPose;
 use vrao::{HeadsetProfile, Renderer, Scene, Settings};
@@ -35,13 +38,13 @@ fn with_a_static_head_the_noise_falls_as_frames_accumulate() {
     // What the estimator converges to: many samples, no reuse, no blur.
     let mut converged = Renderer::new(gpu.clone(), &scene, &settings(false, 256)).unwrap();
     let eyes = settings(false, 256).profile.eyes(&head, settings(false, 256).near);
-    converged.render(&eyes.eyes, &[Resource::AoRaw]).unwrap();
-    let target = ao_of(&converged.read_f32(Resource::AoRaw).unwrap());
+    converged.render(&eyes.eyes, &[AO_RAW]).unwrap();
+    let target = ao_of(&converged.read_f32(AO_RAW).unwrap());
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings(true, 8)).unwrap();
     let mut noise = Vec::new();
     for _ in 0..8 {
-        renderer.render(&eyes.eyes, &[Resource::AoAccumulated]).unwrap();
-        let accumulated = renderer.read_f32(Resource::AoAccumulated).unwrap();
+        renderer.render(&eyes.eyes, &[AO_ACCUMULATED]).unwrap();
+        let accumulated = renderer.read_f32(AO_ACCUMULATED).unwrap();
         assert!(accumulated.iter().flatten().all(|v| v.is_finite()));
         noise.push(rmse(&ao_of(&accumulated), &target));
     }
@@ -52,7 +55,7 @@ fn with_a_static_head_the_noise_falls_as_frames_accumulate() {
 
 /// AO of the pixels that see geometry (sky pixels hold 1 whatever happens).
 fn surface_ao(renderer: &Renderer, r: Resource) -> Vec<f32> {
-    let geometry = renderer.read_f32(Resource::AoGeometry).unwrap();
+    let geometry = renderer.read_f32(AO_GEOMETRY).unwrap();
     let values = renderer.read_f32(r).unwrap();
     geometry
         .iter()
@@ -73,19 +76,19 @@ fn a_jump_to_a_new_view_discards_the_history_instead_of_smearing_it() {
     // surfaces now seen sat at the same place in the previous frame's view.
     let back = HeadPose::look_at(DVec3::new(0.0, 1.6, -0.5), DVec3::new(0.0, 1.2, -4.0)).unwrap();
     let side = HeadPose::look_at(DVec3::new(-1.8, 1.6, -2.0), DVec3::new(2.0, 1.0, -2.0)).unwrap();
-    let outputs = [Resource::AoAccumulated, Resource::AoRaw, Resource::AoGeometry];
+    let outputs = [AO_ACCUMULATED, AO_RAW, AO_GEOMETRY];
     for _ in 0..6 {
         renderer.render(&s.profile.eyes(&back, s.near).eyes, &outputs).unwrap();
     }
     renderer.render(&s.profile.eyes(&side, s.near).eyes, &outputs).unwrap();
-    let raw = surface_ao(&renderer, Resource::AoRaw);
-    let accumulated = surface_ao(&renderer, Resource::AoAccumulated);
+    let raw = surface_ao(&renderer, AO_RAW);
+    let accumulated = surface_ao(&renderer, AO_ACCUMULATED);
     // Only points seen in both views (parts of the floor and ceiling) may reuse their
     // history; what they reuse must be their own (it brings them closer to the converged
     // value), never another surface's (which would pull them away).
     let mut converged = Renderer::new(gpu.clone(), &scene, &settings(false, 256)).unwrap();
-    converged.render(&s.profile.eyes(&side, s.near).eyes, &[Resource::AoRaw, Resource::AoGeometry]).unwrap();
-    let target = surface_ao(&converged, Resource::AoRaw);
+    converged.render(&s.profile.eyes(&side, s.near).eyes, &[AO_RAW, AO_GEOMETRY]).unwrap();
+    let target = surface_ao(&converged, AO_RAW);
     let mean_error = |v: &[f32]| v.iter().zip(&target).map(|(a, b)| (a - b).abs() as f64).sum::<f64>() / v.len() as f64;
     let fresh = raw.iter().zip(&accumulated).filter(|(a, b)| (*a - *b).abs() < 1e-3).count();
     assert!(fresh as f64 > 0.7 * raw.len() as f64, "{fresh} of {} surface pixels started afresh", raw.len());
@@ -98,8 +101,8 @@ fn a_jump_to_a_new_view_discards_the_history_instead_of_smearing_it() {
     // A 1 cm step keeps the history of nearly every surface pixel.
     let stepped = HeadPose { position: side.position + DVec3::new(0.0, 0.0, 0.01), orientation: side.orientation };
     renderer.render(&s.profile.eyes(&stepped, s.near).eyes, &outputs).unwrap();
-    let raw = surface_ao(&renderer, Resource::AoRaw);
-    let accumulated = surface_ao(&renderer, Resource::AoAccumulated);
+    let raw = surface_ao(&renderer, AO_RAW);
+    let accumulated = surface_ao(&renderer, AO_ACCUMULATED);
     // Reused pixels hold the mean of two frames' patterns, which differ.
     let reused = raw.iter().zip(&accumulated).filter(|(a, b)| (*a - *b).abs() > 1e-4).count();
     let occluded = raw.iter().filter(|a| **a < 0.999).count();
@@ -109,7 +112,7 @@ fn a_jump_to_a_new_view_discards_the_history_instead_of_smearing_it() {
 /// The largest accumulated frame count over both history buffers (one holds this
 /// frame's counts, the other the last frame's), on surface pixels.
 fn largest_count(renderer: &Renderer) -> f32 {
-    [Resource::HistoryPositionA, Resource::HistoryPositionB]
+    [HISTORY_POSITION[0], HISTORY_POSITION[1]]
         .iter()
         .flat_map(|&r| renderer.read_f32(r).unwrap().into_iter().flatten().skip(3).step_by(4))
         .fold(0.0, f32::max)
@@ -133,12 +136,12 @@ fn a_turning_head_shortens_the_window_and_a_still_one_keeps_it() {
         s.ao.temporal.motion_px = motion_px;
         let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
         for _ in 0..20 {
-            renderer.render(&s.profile.eyes(&head, s.near).eyes, &[Resource::AoAccumulated]).unwrap();
+            renderer.render(&s.profile.eyes(&head, s.near).eyes, &[AO_ACCUMULATED]).unwrap();
         }
         let still = largest_count(&renderer);
         for k in 1..=8 {
-            renderer.render(&s.profile.eyes(&turned(k), s.near).eyes, &[Resource::AoAccumulated]).unwrap();
-            let values = renderer.read_f32(Resource::AoAccumulated).unwrap();
+            renderer.render(&s.profile.eyes(&turned(k), s.near).eyes, &[AO_ACCUMULATED]).unwrap();
+            let values = renderer.read_f32(AO_ACCUMULATED).unwrap();
             assert!(values.iter().flatten().all(|v| v.is_finite()));
         }
         let turning = largest_count(&renderer);
@@ -160,11 +163,10 @@ fn a_history_holding_nan_is_discarded() {
     let s = settings(true, 8);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
-    renderer.render(&eyes.eyes, &[Resource::AoAccumulated]).unwrap();
+    renderer.render(&eyes.eyes, &[AO_ACCUMULATED]).unwrap();
     // Poison both history pairs: NaN values (f16 0x7E00) and NaN positions.
-    for r in [Resource::HistoryValueA, Resource::HistoryValueB, Resource::HistoryPositionA, Resource::HistoryPositionB]
-    {
-        let target = renderer.target(r).expect("the temporal pass keeps its history");
+    for r in [HISTORY_VALUE[0], HISTORY_VALUE[1], HISTORY_POSITION[0], HISTORY_POSITION[1]] {
+        let target = renderer.kept_target(r).expect("the temporal pass keeps its history");
         let texel: Vec<u8> = if r.format() == wgpu::TextureFormat::Rgba16Float {
             std::iter::repeat_n(0x7E00u16.to_le_bytes(), 4).flatten().collect()
         } else {
@@ -187,10 +189,10 @@ fn a_history_holding_nan_is_discarded() {
             target.texture.size(),
         );
     }
-    renderer.render(&eyes.eyes, &[Resource::AoAccumulated, Resource::AoRaw]).unwrap();
-    let accumulated = renderer.read_f32(Resource::AoAccumulated).unwrap();
+    renderer.render(&eyes.eyes, &[AO_ACCUMULATED, AO_RAW]).unwrap();
+    let accumulated = renderer.read_f32(AO_ACCUMULATED).unwrap();
     assert!(accumulated.iter().flatten().all(|v| v.is_finite()), "NaN history leaked into the output");
-    assert_eq!(ao_of(&accumulated), ao_of(&renderer.read_f32(Resource::AoRaw).unwrap()), "NaN history was reused");
+    assert_eq!(ao_of(&accumulated), ao_of(&renderer.read_f32(AO_RAW).unwrap()), "NaN history was reused");
 }
 
 #[test]
@@ -198,9 +200,9 @@ fn the_graph_leaves_the_temporal_pass_out_when_it_is_off() {
     let (gpu, _lock) = common::gpu();
     let scene = Scene::load("builtin:room").unwrap();
     let off = Renderer::new(gpu.clone(), &scene, &settings(false, 8)).unwrap();
-    let plan = off.plan(2, &[Resource::Color]).unwrap();
+    let plan = off.plan(2, &[COLOR]).unwrap();
     assert!(!plan.names.contains(&"temporal"));
     assert!(plan.left_out.iter().any(|(name, why)| *name == "temporal" && why.contains("--temporal")), "{plan}");
     let on = Renderer::new(gpu, &scene, &settings(true, 8)).unwrap();
-    assert!(on.plan(2, &[Resource::Color]).unwrap().names.contains(&"temporal"));
+    assert!(on.plan(2, &[COLOR]).unwrap().names.contains(&"temporal"));
 }

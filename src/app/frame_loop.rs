@@ -6,14 +6,17 @@ use crate::app::governor::{Governor, GovernorChange};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::timing::FrameTiming;
 use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::graph::Resource;
+use crate::render::graph::{Resource, FINAL_AO};
+use crate::render::passes::gbuffer::{DEPTH, NORMALS};
+use crate::render::passes::occlusion::AO_RAW;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::{FrameReport, Renderer, Timing};
 use crate::render::scene::Scene;
 use crate::render::settings::Settings;
 use crate::xr::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::xr::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::xr::{FrameRequest, Headset, SubmittedFrame};
-use std::collections::VecDeque;
+use std::collections::{BTreeSet, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
@@ -49,16 +52,17 @@ pub enum BufferView {
 }
 
 impl BufferView {
-    /// The renderer's resource that holds this view under `settings`; `None` for the eye
-    /// images and for AO when no technique runs.
+    /// The renderer's resource that holds this view under `settings` (the final AO is
+    /// the graph's named output); `None` for the eye images and for AO when no technique
+    /// runs.
     pub fn resource(self, settings: &Settings) -> Option<Resource> {
         let any_ao = settings.ao.technique != crate::render::settings::Technique::None;
         match self {
             BufferView::Eyes => None,
-            BufferView::FinalAo => crate::render::passes::final_occlusion(settings),
-            BufferView::RawAo => any_ao.then_some(Resource::AoRaw),
-            BufferView::Depth => Some(Resource::Depth),
-            BufferView::Normals => Some(Resource::Normals),
+            BufferView::FinalAo => any_ao.then_some(FINAL_AO),
+            BufferView::RawAo => any_ao.then_some(AO_RAW),
+            BufferView::Depth => Some(DEPTH),
+            BufferView::Normals => Some(NORMALS),
         }
     }
 }
@@ -173,17 +177,15 @@ pub struct FrameLoop {
     /// On a CPU adapter, every [`SERIAL_EVERY`]-th frame is submitted pass by pass.
     cpu_adapter: bool,
     serial_frames: VecDeque<u64>,
+    /// Spans of the passes the governor's AO setting changes (the rest of the frame does
+    /// not depend on it), as the frames' plans name them.
+    occlusion_passes: BTreeSet<&'static str>,
     /// Chooses the AO setting from the measured GPU times (`None`: settings fixed).
     pub governor: Option<Governor>,
     /// The buffer the window shows; every frame also produces it (an AO buffer the
     /// composite would otherwise fuse away, such as the upsampled AO, adds its pass).
     pub buffer_view: BufferView,
 }
-
-/// Spans of the passes the governor's AO setting changes (the rest of the frame does
-/// not depend on it).
-const AO_PASSES: [&str; 9] =
-    ["ssao", "hbao", "gtao", "ssdo", "fetch-only", "depth-peel", "temporal", "blur", "upsample"];
 
 /// On a CPU adapter (lavapipe), timestamps within one submission credit work to the
 /// wrong pass, and one submission per pass keeps frames from overlapping (each
@@ -202,6 +204,7 @@ impl FrameLoop {
         Ok(FrameLoop {
             cpu_adapter,
             serial_frames: VecDeque::new(),
+            occlusion_passes: BTreeSet::new(),
             governor: None,
             buffer_view: BufferView::Eyes,
             gpu,
@@ -242,20 +245,21 @@ impl FrameLoop {
         if serial {
             self.serial_frames.push_back(self.renderer.frame_index());
         }
-        let mut outputs = vec![Resource::Color, Resource::Depth];
+        let mut outputs = vec![COLOR, DEPTH];
         outputs.extend(self.buffer_view.resource(self.renderer.settings()));
         let (headset, gpu) = (&mut self.headset, &self.gpu);
         let report = self.renderer.render_with(&request.eyes.eyes, &outputs, |encoder, targets| {
-            if let (Some(color), Some(depth)) = (targets.get(&Resource::Color), targets.get(&Resource::Depth)) {
+            if let (Some(color), Some(depth)) = (targets.get(&COLOR), targets.get(&DEPTH)) {
                 headset.record_frame(gpu, encoder, &request, color, depth);
             }
         })?;
-        let color = self.renderer.target(Resource::Color).ok_or_else(|| Error::Gpu("no eye colour".into()))?;
-        let depth = self.renderer.target(Resource::Depth).ok_or_else(|| Error::Gpu("no eye depth".into()))?;
+        let color = self.renderer.target(COLOR).ok_or_else(|| Error::Gpu("no eye colour".into()))?;
+        let depth = self.renderer.target(DEPTH).ok_or_else(|| Error::Gpu("no eye depth".into()))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
         self.headset.submit(&self.gpu, &request, Some(frame))?;
         self.frames += 1;
         self.cpu_encode_ms.push(report.cpu_encode_ms);
+        self.occlusion_passes.extend(report.plan.occlusion_passes());
         self.history.push_cpu_encode(report.cpu_encode_ms);
         self.take_timings(report.finished.clone());
         Ok(Some(Step { request, report: Some(report) }))
@@ -274,8 +278,12 @@ impl FrameLoop {
             }
             self.gpu_frame_ms.push(timing.total_ms);
             if let Some(governor) = &mut self.governor {
-                let ao_ms: f64 =
-                    timing.spans.iter().filter(|(pass, _)| AO_PASSES.contains(&pass.as_str())).map(|(_, ms)| ms).sum();
+                let ao_ms: f64 = timing
+                    .spans
+                    .iter()
+                    .filter(|(pass, _)| self.occlusion_passes.contains(pass.as_str()))
+                    .map(|(_, ms)| ms)
+                    .sum();
                 if let Some(change) = governor.observe_with_ao(timing.frame, timing.total_ms, ao_ms) {
                     log::info!(
                         "governor, frame {}: {} -> {} ({})",

@@ -12,7 +12,7 @@ use super::picture::Blit;
 use crate::app::{BufferView, FrameLoop, RunSummary};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::Gpu;
-use crate::render::graph::Resource;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::Renderer;
 use crate::render::scene::Scene;
 use crate::render::settings::{DisplayMode, Quality};
@@ -259,7 +259,7 @@ impl WindowState {
         let tan_side = tan_up * w as f64 / h as f64;
         let fov =
             Fov { left: -(tan_side.atan() as f32), right: tan_side.atan() as f32, up: left.fov.up, down: -left.fov.up };
-        mono.render(&[EyePair::mono(&head, fov)], &[Resource::Color])?;
+        mono.render(&[EyePair::mono(&head, fov)], &[COLOR])?;
         Ok(())
     }
 
@@ -350,13 +350,13 @@ impl WindowState {
             return target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default();
         }
         match self.panel.mode {
-            DisplayMode::SinglePass => match self.mono.as_ref().and_then(|m| m.target(Resource::Color)) {
+            DisplayMode::SinglePass => match self.mono.as_ref().and_then(|m| m.target(COLOR)) {
                 Some(target) => vec![&target.layer_views[0]],
                 None => vec![],
             },
             _ => {
                 // What the headset shows (the compositor's output), else the eye buffers.
-                let target = frame_loop.headset.display_image().or_else(|| frame_loop.renderer.target(Resource::Color));
+                let target = frame_loop.headset.display_image().or_else(|| frame_loop.renderer.target(COLOR));
                 target.map(|t| t.layer_views.iter().take(2).collect()).unwrap_or_default()
             }
         }

@@ -403,7 +403,7 @@ pub fn screen_space_expectation(
     }
 }
 
-/// HBAO as the renderer runs it (shaders/hbao.wgsl).
+/// HBAO as the renderer runs it (src/render/passes/hbao/hbao.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HbaoParams {
     /// Sampling radius r (m).

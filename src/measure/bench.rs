@@ -12,8 +12,11 @@ pub use crate::render::bench_file::{BenchFile, BenchRecord, LimitInfo, Reference
 use crate::render::error::{Error, Result};
 use crate::render::gpu::timing::{is_per_eye, summarize, SpanSummary};
 use crate::render::gpu::Gpu;
+use crate::render::graph::FINAL_AO;
 pub use crate::render::output::significant;
-use crate::render::passes::final_occlusion;
+use crate::render::passes::composite::HDR;
+use crate::render::passes::gbuffer::{DEPTH, NORMALS};
+use crate::render::passes::rsm::RSM_INDIRECT;
 use crate::render::renderer::{Renderer, Timing};
 use crate::render::scene::Scene;
 use crate::render::settings::{Settings, Technique};
@@ -78,6 +81,9 @@ pub struct BenchRow {
     pub views: u32,
     /// The pass that ran the technique.
     pub pass: &'static str,
+    /// The passes whose spans are the occlusion's cost (the graph's occlusion chain, or
+    /// the RSM gather and its light-space pass).
+    pub occlusion_passes: Vec<&'static str>,
     /// Error against the reference, when one was traced for this row's radius.
     pub error: Option<ErrorFigures>,
     /// Error of the one-bounce irradiance against the reference's `bounce` (ssdo-bounce
@@ -94,27 +100,19 @@ impl BenchRow {
         self.spans.iter().find(|s| s.label == span).map_or(0.0, |s| s.median_ms)
     }
 
-    /// Occlusion cost per eye: technique (+ depth peel) + blur + upsample, both-eye
-    /// dispatches halved.
+    /// Occlusion cost per eye: the occlusion passes' medians (technique, depth peel,
+    /// temporal, denoise, upsample as the graph ran them), both-eye dispatches halved.
     /// Reflective shadow maps (pass `rsm`): the gather plus the light-space pass that
     /// renders the maps.
     pub fn occlusion_ms_per_eye(&self) -> f64 {
-        self.occlusion_passes().iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
-    }
-
-    fn occlusion_passes(&self) -> Vec<&str> {
-        if self.pass == RSM_PASS {
-            vec![RSM_PASS, "shadow"]
-        } else {
-            vec![self.pass, "depth-peel", "temporal", "blur", "upsample"]
-        }
+        self.occlusion_passes.iter().map(|p| self.median_ms(p)).sum::<f64>() / self.views as f64
     }
 
     /// Per eye, the passes of the measured frames besides the occlusion (per-eye spans
     /// lie inside their pass's and are not added): what the occlusion shares the frame
     /// budget with, for the plot's budget line.
     pub fn other_ms_per_eye(&self) -> f64 {
-        let occlusion = self.occlusion_passes();
+        let occlusion = &self.occlusion_passes;
         let other = self.spans.iter().filter(|s| !is_per_eye(&s.label) && !occlusion.contains(&s.label.as_str()));
         other.map(|s| s.median_ms).sum::<f64>() / self.views as f64
     }
@@ -169,7 +167,10 @@ impl CaseRun {
         settings.ao.half_res = case.half_res;
         settings.ao.depth_peeling = case.depth_peeling;
         settings.ao.temporal.enabled = case.temporal;
-        let output = final_occlusion(&settings).ok_or_else(|| Error::input("bench needs an occlusion technique"))?;
+        if settings.ao.technique == Technique::None {
+            return Err(Error::input("bench needs an occlusion technique"));
+        }
+        let output = FINAL_AO;
         if timing == Timing::Pipelined && !gpu.caps.timestamps {
             return Err(Error::Device(format!(
                 "{} has no timestamp queries; use serial timing",
@@ -181,7 +182,7 @@ impl CaseRun {
         let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
         let mut outputs = vec![output];
         if how.whole_frame {
-            outputs.push(crate::render::graph::Resource::Hdr);
+            outputs.push(HDR);
         }
         Ok(CaseRun { case: case.clone(), settings, output, outputs, renderer, eyes, timing, timings: Vec::new() })
     }
@@ -202,8 +203,8 @@ impl CaseRun {
     /// The screen-space limit of the last frame for the radius and grid of `reference`
     /// (the march over its depth buffer and normals, [`screen_space_limit`]).
     fn screen_limit(&self, reference: &ReferenceImage) -> Result<ScreenLimit> {
-        let depth = self.renderer.read_f32(crate::render::graph::Resource::Depth)?;
-        let normals = self.renderer.read_f32(crate::render::graph::Resource::Normals)?;
+        let depth = self.renderer.read_f32(DEPTH)?;
+        let normals = self.renderer.read_f32(NORMALS)?;
         let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
             .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: self.eyes.eyes[k].fov })
             .collect();
@@ -225,7 +226,7 @@ impl CaseRun {
         let error = reference
             .map(|reference| score(self.case.technique, &occlusion, reference, limit, self.pixels_per_degree()));
         let stereo = {
-            let depth = self.renderer.read_f32(crate::render::graph::Resource::Depth)?;
+            let depth = self.renderer.read_f32(DEPTH)?;
             let ao: Vec<Vec<f32>> = occlusion.iter().map(|l| l.iter().skip(3).step_by(4).copied().collect()).collect();
             let size = (settings.profile.width, settings.profile.height);
             (depth.len() == 2 && ao.len() == 2).then(|| {
@@ -255,10 +256,12 @@ impl CaseRun {
             }
             _ => None,
         };
+        let occlusion_passes = self.renderer.last_plan().map_or_else(Vec::new, |plan| plan.occlusion_passes());
         Ok(BenchRow {
             spans: summarize(&self.timings),
             views: 2,
             pass: settings.ao.pass_name(),
+            occlusion_passes,
             error,
             bounce,
             stereo,
@@ -300,14 +303,14 @@ pub fn measure_rsm(
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let mut timings = Vec::new();
     for frame in 0..warmup + frames {
-        let report = renderer.render_and_wait(&eyes.eyes, &[crate::render::graph::Resource::RsmIndirect])?;
+        let report = renderer.render_and_wait(&eyes.eyes, &[RSM_INDIRECT])?;
         if frame >= warmup {
             timings.push(if timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
         }
     }
     let bounce = match reference {
         Some(reference) => {
-            let irradiance = renderer.read_f32(crate::render::graph::Resource::RsmIndirect)?;
+            let irradiance = renderer.read_f32(RSM_INDIRECT)?;
             bounce_figures(&irradiance, settings.profile.width.div_ceil(2), 2, reference)
         }
         None => None,
@@ -320,7 +323,16 @@ pub fn measure_rsm(
         depth_peeling: false,
         temporal: false,
     };
-    Ok(BenchRow { case, spans: summarize(&timings), views: 2, pass: RSM_PASS, error: None, bounce, stereo: None })
+    Ok(BenchRow {
+        case,
+        spans: summarize(&timings),
+        views: 2,
+        pass: RSM_PASS,
+        occlusion_passes: vec![RSM_PASS, "shadow"],
+        error: None,
+        bounce,
+        stereo: None,
+    })
 }
 
 /// A one-bounce irradiance estimate against the reference's `bounce`, by luminance over

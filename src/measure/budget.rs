@@ -11,6 +11,7 @@
 use crate::render::error::Result;
 use crate::render::gpu::timing::{summarize, SpanSummary};
 use crate::render::graph::Resource;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::{FrameReport, Renderer, Timing};
 use crate::render::stereo::EyePair;
 use serde::{Deserialize, Serialize};
@@ -218,11 +219,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         timing: format!("{:?}", how.timing).to_lowercase(),
         warmup: how.warmup,
         frames: how.frames,
-        output: if how.output == Resource::Color {
-            "whole frame".into()
-        } else {
-            format!("{} only", how.output.name())
-        },
+        output: if how.output == COLOR { "whole frame".into() } else { format!("{} only", how.output.name()) },
         budget_ms: how.budget_ms,
         passes,
         cpu_encode,

@@ -3,7 +3,8 @@
 
 use crate::render::error::Result;
 use crate::render::gpu::readback::read_layers;
-use crate::render::graph::Resource;
+use crate::render::passes::gbuffer::DEPTH;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::Renderer;
 use crate::render::stereo::HeadPose;
 use crate::xr::simulated::reproject::{output_target, ReprojectionMode, Reprojector};
@@ -75,29 +76,19 @@ fn rmse(a: &[Vec<u8>], b: &[Vec<u8>]) -> f64 {
 pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove]) -> Result<Vec<ReprojectionError>> {
     let gpu = renderer.gpu().clone();
     let settings = renderer.settings().clone();
-    let outputs = [Resource::Color, Resource::Depth];
+    let outputs = [COLOR, DEPTH];
     let source_eyes = settings.profile.eyes(head, settings.near);
     renderer.render(&source_eyes.eyes, &outputs)?;
-    let stale = read_layers(&gpu, renderer.target(Resource::Color).expect("rendered"))?;
+    let stale = read_layers(&gpu, renderer.target(COLOR).expect("rendered"))?;
     // Keep the source frame: the fresh renders below reuse the renderer's targets.
-    let extent = renderer.target(Resource::Color).expect("rendered").extent();
+    let extent = renderer.target(COLOR).expect("rendered").extent();
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-    let color = crate::render::gpu::targets::LayeredTarget::new(
-        &gpu.device,
-        "source colour",
-        Resource::Color.format(),
-        extent,
-        usage,
-    );
-    let depth = crate::render::gpu::targets::LayeredTarget::new(
-        &gpu.device,
-        "source depth",
-        Resource::Depth.format(),
-        extent,
-        usage,
-    );
+    let color =
+        crate::render::gpu::targets::LayeredTarget::new(&gpu.device, "source colour", COLOR.format(), extent, usage);
+    let depth =
+        crate::render::gpu::targets::LayeredTarget::new(&gpu.device, "source depth", DEPTH.format(), extent, usage);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    for (resource, copy) in [(Resource::Color, &color), (Resource::Depth, &depth)] {
+    for (resource, copy) in [(COLOR, &color), (DEPTH, &depth)] {
         let from = renderer.target(resource).expect("rendered");
         encoder.copy_texture_to_texture(
             from.texture.as_image_copy(),
@@ -112,7 +103,7 @@ pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove])
     for &movement in movements {
         let target_eyes = settings.profile.eyes(&movement.apply(head), settings.near);
         renderer.render(&target_eyes.eyes, &outputs)?;
-        let fresh = read_layers(&gpu, renderer.target(Resource::Color).expect("rendered"))?;
+        let fresh = read_layers(&gpu, renderer.target(COLOR).expect("rendered"))?;
         let mut warped = |mode| -> Result<Vec<Vec<u8>>> {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             reprojector.record(

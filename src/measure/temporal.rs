@@ -6,7 +6,7 @@ use crate::measure::bench::error_figures;
 use crate::measure::reference::{trace_cached, ReferenceImage, ReferenceSettings};
 use crate::render::error::Result;
 use crate::render::gpu::Gpu;
-use crate::render::passes::final_occlusion;
+use crate::render::graph::FINAL_AO;
 use crate::render::renderer::Renderer;
 use crate::render::scene::Scene;
 use crate::render::settings::Settings;
@@ -55,16 +55,14 @@ pub fn convergence(
         converged_settings.ao.samples = 256;
         converged_settings.ao.blur_radius = 0;
         converged_settings.ao.temporal.enabled = false;
-        let converged_output = final_occlusion(&converged_settings).expect("an occlusion technique");
         let mut converged = Renderer::new(gpu.clone(), scene, &converged_settings)?;
         let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
         renderer.set_timing(crate::render::renderer::Timing::Serial);
-        let output = final_occlusion(settings).expect("an occlusion technique");
         let mut times = Vec::new();
         for frame in 1..=*CHECKPOINTS.last().unwrap() {
             let head = motion.pose_at(&scene.head, frame as f64 * dt);
             let eyes = settings.profile.eyes(&head, settings.near);
-            let report = renderer.render_and_wait(&eyes.eyes, &[output])?;
+            let report = renderer.render_and_wait(&eyes.eyes, &[FINAL_AO])?;
             let ms: f64 = report
                 .wall_ms
                 .iter()
@@ -81,10 +79,10 @@ pub fn convergence(
                 references.push((key, trace_cached(cache, scene, &eyes.eyes, size, reference, &mut |_| {})?));
             }
             let reference = &references.iter().find(|(k, _)| *k == key).expect("traced above").1;
-            let image = renderer.read_f32(output)?;
+            let image = renderer.read_f32(FINAL_AO)?;
             let e = error_figures(settings.ao.technique, &image, reference);
-            converged.render(&eyes.eyes, &[converged_output])?;
-            let target = converged.read_f32(converged_output)?;
+            converged.render(&eyes.eyes, &[FINAL_AO])?;
+            let target = converged.read_f32(FINAL_AO)?;
             let ao = |layers: &[Vec<f32>]| {
                 layers.iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>()
             };

@@ -1,202 +1,244 @@
-//! The frame graph. Each pass declares what it reads and writes, and whether the scene
-//! and settings let it exist at all. Given the outputs a frame must produce, the graph
-//! keeps exactly the passes those outputs depend on and says why every other pass was
-//! left out. Passes are declared in execution order, so the kept ones run in that order.
+//! The frame graph. Each pass declares, in one builder chain ([`PassDecl`]), what it
+//! reads and writes (mostly through its kernels' binding lists), what it provides under a
+//! named output, and whether the scene and settings let it exist at all. Given the
+//! outputs a frame must produce, the graph keeps exactly the passes those outputs depend
+//! on and says why every other pass was left out. Passes are declared in execution
+//! order, so the kept ones run in that order.
+//!
+//! Textures are [`Resource`] handles declared as constants by the pass that creates
+//! them, with their size class and format; there is no table of every texture. Named
+//! outputs ([`OCCLUSION`], [`FINAL_AO`]) are aliases: each pass on the AO chain provides
+//! its result under one, and a reader of the alias gets whatever the last enabled pass
+//! before it provided.
 
-use std::collections::BTreeSet;
+use crate::render::gpu::kernel::Bind;
+use crate::render::passes::FrameSetup;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
-/// A resource that flows between passes (a layered texture, one layer per view).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Resource {
-    /// Reversed-Z depth, `Depth32Float`.
-    Depth,
-    /// Depth peeling's second layer (SSDO's quality mode): the nearest surface behind
-    /// `Depth`, reversed-Z `Depth32Float`, 0 where nothing lies behind.
-    DepthLayer2,
-    /// View-space unit normals, `Rgba16Float` (w unused).
-    Normals,
-    /// Diffuse albedo, `Rgba8UnormSrgb` (reads back linear).
-    Albedo,
-    /// Emitted radiance, `Rgba16Float`.
-    Emission,
-    /// Outgoing direct radiance (lights and emission) and the view distance, packed in
-    /// `Rg32Uint` (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the
-    /// composite's base, and depth test plus sender radiance of SSDO's bounce in a
-    /// single fetch.
-    Direct,
-    /// Occlusion as computed (at AO resolution), `Rgba16Float`: rgb = SSDO's gathered
-    /// irradiance (environment through unblocked directions plus the bounce), a = AO.
-    AoRaw,
-    /// Normal (xyz) and view distance (w, 0 on the sky) at each occlusion pixel,
-    /// `Rgba32Float`, written by the technique so the blur and upsample need one fetch
-    /// per tap instead of depth, normal and a reconstruction.
-    AoGeometry,
-    /// Horizontally blurred occlusion (first half of the separable bilateral blur).
-    AoBlurH,
-    /// Bilaterally blurred occlusion, at AO resolution.
-    AoBlurred,
-    /// Occlusion upsampled from half to full resolution (3×3 joint bilateral).
-    AoFull,
-    /// Lit scene radiance before tone mapping, `Rgba16Float`.
-    Hdr,
-    /// Tone-mapped, sRGB-encoded eye colour, `Rgba8Unorm`.
-    Color,
-    /// Occlusion accumulated over frames by reverse reprojection (temporal pass), at AO
-    /// resolution, `Rgba16Float`, laid out as `AoRaw`.
-    AoAccumulated,
-    /// The temporal history, ping-ponged between frames: accumulated value (`Rgba16Float`)
-    /// and world position relative to the scene anchor with the accumulated frame count
-    /// in w (`Rgba32Float`). These persist from one frame to the next.
-    HistoryValueA,
-    /// The other half of `HistoryValueA`'s ping-pong pair.
-    HistoryValueB,
-    /// Accumulated world position and frame count, one half of a ping-pong pair.
-    HistoryPositionA,
-    /// The other half of `HistoryPositionA`'s ping-pong pair.
-    HistoryPositionB,
-    /// Light-space depth of each shadowed directional light (one layer per light, square,
-    /// `--shadow-size` texels a side), `Depth32Float`, 0 nearest the light, 1 = nothing.
-    ShadowMap,
-    /// Reflective shadow map: light-view normal per light-space texel, `Rgba16Float`.
-    RsmNormal,
-    /// Reflective shadow map: flux density (albedo × light irradiance) per texel, `Rgba16Float`.
-    RsmFlux,
-    /// One-bounce irradiance gathered from the reflective shadow maps, half resolution
-    /// per axis, `Rgba16Float` (rgb).
-    RsmIndirect,
-    /// Normal (xyz) and view distance (w) at each `RsmIndirect` pixel, `Rgba32Float`, for
-    /// the composite's joint bilateral upsampling.
-    RsmGeometry,
+/// How large a texture is, per layer.
+#[derive(Clone, Copy, Debug)]
+pub enum Size {
+    /// The eyes' full resolution.
+    Full,
+    /// The occlusion's resolution: half per axis (rounded up) with `--half-res`.
+    Occlusion,
+    /// Always half per axis (rounded up), whatever `--half-res` says.
+    Half,
+    /// Width × height × layers worked out by the creating pass (the lights' maps: one
+    /// layer per shadowed light, `--shadow-size` a side), from the frame's setup and the
+    /// device's largest 2D texture side.
+    Computed(fn(&FrameSetup, u32) -> (u32, u32, u32)),
+}
+
+/// How a texture is written, which decides its usages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Written {
+    /// By render passes, as a colour or depth attachment.
+    Attachment,
+    /// By compute kernels, as a write-only storage texture.
+    Storage,
+}
+
+/// What a [`Resource`] is: a texture the graph allocates, or a named output the graph
+/// resolves to one.
+#[derive(Clone, Copy, Debug)]
+pub enum Kind {
+    /// A layered texture (one layer per view, or per light for light-space maps).
+    Texture {
+        /// Its size class.
+        size: Size,
+        /// How it is written.
+        written: Written,
+    },
+    /// A named output: the texture the last enabled pass before the reader provided
+    /// under this name; with none, what `fallback` names.
+    Alias {
+        /// The named output this one falls back to when no pass provides it.
+        fallback: Option<&'static Resource>,
+    },
+}
+
+/// A texture that flows between passes, or a named output of the graph. Two handles are
+/// the same resource when their names are (names are unique; the plan checks).
+#[derive(Clone, Copy, Debug)]
+pub struct Resource {
+    name: &'static str,
+    format: wgpu::TextureFormat,
+    kind: Kind,
 }
 
 impl Resource {
-    /// Resources that live at the occlusion resolution (half per axis with `--half-res`).
-    pub fn at_ao_resolution(self) -> bool {
-        matches!(
-            self,
-            Resource::AoRaw
-                | Resource::AoGeometry
-                | Resource::AoBlurH
-                | Resource::AoBlurred
-                | Resource::AoAccumulated
-                | Resource::HistoryValueA
-                | Resource::HistoryValueB
-                | Resource::HistoryPositionA
-                | Resource::HistoryPositionB
-        )
+    /// A texture written by compute kernels.
+    pub const fn storage(name: &'static str, size: Size, format: wgpu::TextureFormat) -> Resource {
+        Resource { name, format, kind: Kind::Texture { size, written: Written::Storage } }
     }
 
-    /// Written by render passes (attachments) rather than by compute kernels.
-    pub fn is_attachment(self) -> bool {
-        matches!(
-            self,
-            Resource::Depth | Resource::DepthLayer2 | Resource::Normals | Resource::Albedo | Resource::Emission
-        ) || self.in_light_space()
+    /// A texture written by render passes.
+    pub const fn attachment(name: &'static str, size: Size, format: wgpu::TextureFormat) -> Resource {
+        Resource { name, format, kind: Kind::Texture { size, written: Written::Attachment } }
     }
 
-    /// Resources of the directional lights' maps (sized by the shadow settings, one
-    /// layer per shadowed light) rather than of the eyes.
-    pub fn in_light_space(self) -> bool {
-        matches!(self, Resource::ShadowMap | Resource::RsmNormal | Resource::RsmFlux)
+    /// A named output whose textures all have `format`, falling back to another named
+    /// output when no pass provides it.
+    pub const fn alias(
+        name: &'static str,
+        format: wgpu::TextureFormat,
+        fallback: Option<&'static Resource>,
+    ) -> Resource {
+        Resource { name, format, kind: Kind::Alias { fallback } }
     }
 
-    /// Resources always at half resolution per axis (rounded up), whatever `--half-res` says.
-    pub fn at_half_resolution(self) -> bool {
-        matches!(self, Resource::RsmIndirect | Resource::RsmGeometry)
+    /// The name `--explain`, labels and error messages use (`ao-raw`, `color`, …).
+    pub const fn name(self) -> &'static str {
+        self.name
     }
 
-    /// The name `--explain` and error messages use (`ao-raw`, `color`, …).
-    pub fn name(self) -> &'static str {
-        match self {
-            Resource::Depth => "depth",
-            Resource::DepthLayer2 => "depth-layer-2",
-            Resource::Normals => "normals",
-            Resource::Albedo => "albedo",
-            Resource::Emission => "emission",
-            Resource::Direct => "direct",
-            Resource::AoRaw => "ao-raw",
-            Resource::AoGeometry => "ao-geometry",
-            Resource::AoBlurH => "ao-blur-h",
-            Resource::AoBlurred => "ao-blurred",
-            Resource::AoFull => "ao-full",
-            Resource::Hdr => "hdr",
-            Resource::Color => "color",
-            Resource::AoAccumulated => "ao-accumulated",
-            Resource::HistoryValueA => "history-value-a",
-            Resource::HistoryValueB => "history-value-b",
-            Resource::HistoryPositionA => "history-position-a",
-            Resource::HistoryPositionB => "history-position-b",
-            Resource::ShadowMap => "shadow-map",
-            Resource::RsmNormal => "rsm-normal",
-            Resource::RsmFlux => "rsm-flux",
-            Resource::RsmIndirect => "rsm-indirect",
-            Resource::RsmGeometry => "rsm-geometry",
-        }
+    /// The texel format.
+    pub const fn format(self) -> wgpu::TextureFormat {
+        self.format
     }
 
-    /// The texture format the resource is allocated with.
-    pub fn format(self) -> wgpu::TextureFormat {
-        match self {
-            Resource::Depth | Resource::DepthLayer2 => wgpu::TextureFormat::Depth32Float,
-            Resource::Normals
-            | Resource::Emission
-            | Resource::AoRaw
-            | Resource::AoBlurH
-            | Resource::AoBlurred
-            | Resource::AoFull
-            | Resource::AoAccumulated
-            | Resource::HistoryValueA
-            | Resource::HistoryValueB
-            | Resource::Hdr => wgpu::TextureFormat::Rgba16Float,
-            Resource::Albedo => wgpu::TextureFormat::Rgba8UnormSrgb,
-            Resource::AoGeometry | Resource::HistoryPositionA | Resource::HistoryPositionB => {
-                wgpu::TextureFormat::Rgba32Float
-            }
-            Resource::Color => wgpu::TextureFormat::Rgba8Unorm,
-            Resource::ShadowMap => wgpu::TextureFormat::Depth32Float,
-            Resource::RsmNormal | Resource::RsmFlux | Resource::RsmIndirect => wgpu::TextureFormat::Rgba16Float,
-            Resource::RsmGeometry => wgpu::TextureFormat::Rgba32Float,
-            Resource::Direct => wgpu::TextureFormat::Rg32Uint,
-        }
+    /// Texture or named output.
+    pub const fn kind(self) -> Kind {
+        self.kind
+    }
+
+    /// Whether this is a named output rather than a texture.
+    pub fn is_alias(self) -> bool {
+        matches!(self.kind, Kind::Alias { .. })
     }
 }
+
+impl PartialEq for Resource {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+impl Eq for Resource {}
+impl std::hash::Hash for Resource {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.name.hash(state);
+    }
+}
+impl PartialOrd for Resource {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Resource {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.name.cmp(other.name)
+    }
+}
+
+/// The occlusion at occlusion resolution as the AO chain has it so far: the technique
+/// provides its raw AO, temporal accumulation and the denoise each replace it. Layout as
+/// the techniques write it: rgb = SSDO's gathered irradiance, a = AO.
+pub const OCCLUSION: Resource = Resource::alias("occlusion", wgpu::TextureFormat::Rgba16Float, None);
+
+/// The final AO at full resolution: the upsampled occlusion, or [`OCCLUSION`] itself
+/// when the occlusion runs at full resolution. What the outputs, the bench and the
+/// window's buffer view read.
+pub const FINAL_AO: Resource = Resource::alias("final-ao", wgpu::TextureFormat::Rgba16Float, Some(&OCCLUSION));
 
 /// What a pass declares for one frame.
 #[derive(Clone, Debug)]
 pub struct PassDecl {
     /// The pass's name, as `--explain` and the GPU timings show it.
     pub name: &'static str,
-    /// Resources the pass reads.
+    /// Resources the pass reads (named outputs resolved once planned).
     pub reads: Vec<Resource>,
     /// Resources the pass writes.
     pub writes: Vec<Resource>,
+    /// (named output, what the pass provides under it).
+    pub provides: Vec<(Resource, Resource)>,
+    /// Reads a binding list names that the pass does not read this frame: a placeholder
+    /// of the same format is bound instead.
+    pub unbound: Vec<Resource>,
+    /// Whether the pass is part of the occlusion's cost (what the governor changes and
+    /// the bench times).
+    pub occlusion_cost: bool,
     /// `Some(reason)` when the scene or settings rule the pass out for this frame.
     pub disabled: Option<String>,
     /// What `--explain` should add about work left out inside a running pass.
     pub note: Option<String>,
+    /// Named outputs read, and the textures they stood for at this pass (filled by the plan).
+    pub resolved: Vec<(Resource, Resource)>,
 }
 
 impl PassDecl {
     /// A pass that reads and writes nothing yet.
     pub fn new(name: &'static str) -> PassDecl {
-        PassDecl { name, reads: Vec::new(), writes: Vec::new(), disabled: None, note: None }
+        PassDecl {
+            name,
+            reads: Vec::new(),
+            writes: Vec::new(),
+            provides: Vec::new(),
+            unbound: Vec::new(),
+            occlusion_cost: false,
+            disabled: None,
+            note: None,
+            resolved: Vec::new(),
+        }
     }
-    /// Adds a resource the pass reads.
+
+    /// Adds a resource the pass reads (one it wrote itself earlier in the chain is
+    /// internal to the pass and not a read).
     pub fn read(mut self, r: Resource) -> Self {
-        self.reads.push(r);
+        if !self.writes.contains(&r) && !self.reads.contains(&r) {
+            self.reads.push(r);
+        }
         self
     }
+
     /// Adds a resource the pass writes.
     pub fn write(mut self, r: Resource) -> Self {
-        self.writes.push(r);
+        if !self.writes.contains(&r) {
+            self.writes.push(r);
+        }
         self
     }
-    /// Adds what `--explain` says about work left out inside the pass.
+
+    /// Reads and writes what a kernel's binding list names, in its order.
+    pub fn bindings(self, binds: &[Bind]) -> Self {
+        binds.iter().fold(self, |decl, bind| match *bind {
+            Bind::Read(r) => decl.read(r),
+            Bind::Write(r) => decl.write(r),
+            _ => decl,
+        })
+    }
+
+    /// This frame the pass does not read `r`, which its binding list names: it is not a
+    /// dependency and a placeholder is bound in its place.
+    pub fn unbind(mut self, r: Resource) -> Self {
+        self.reads.retain(|x| *x != r);
+        self.unbound.push(r);
+        self
+    }
+
+    /// Provides `texture` (which the pass writes) under the named output `alias`.
+    pub fn provide(mut self, alias: Resource, texture: Resource) -> Self {
+        self.provides.push((alias, texture));
+        self
+    }
+
+    /// Marks the pass as part of the occlusion's cost.
+    pub fn occlusion_cost(mut self) -> Self {
+        self.occlusion_cost = true;
+        self
+    }
+
+    /// Adds what `--explain` says about work left out inside the pass (after any earlier note).
     pub fn note(mut self, note: impl Into<String>) -> Self {
-        self.note = Some(note.into());
+        let note = note.into();
+        self.note = Some(match self.note {
+            Some(earlier) => format!("{earlier}; {note}"),
+            None => note,
+        });
         self
     }
+
     /// Rules the pass out when `condition` holds, with `reason` shown by `--explain`.
     pub fn disabled_if(mut self, condition: bool, reason: impl Into<String>) -> Self {
         if condition && self.disabled.is_none() {
@@ -204,27 +246,57 @@ impl PassDecl {
         }
         self
     }
+
+    /// The texture `r` stands for in this pass: itself, or what a named output resolved to.
+    pub fn resolve(&self, r: Resource) -> Resource {
+        self.resolved.iter().find(|(alias, _)| *alias == r).map_or(r, |(_, texture)| *texture)
+    }
 }
 
 /// The passes one frame runs and the ones it leaves out.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Plan {
     /// Indices into the declarations, in execution order.
     pub run: Vec<usize>,
     /// Names of the passes that run, in execution order.
     pub names: Vec<&'static str>,
+    /// The declarations of the passes that run, named outputs resolved.
+    pub decls: Vec<PassDecl>,
     /// Notes of running passes (work they leave out internally).
     pub notes: Vec<(&'static str, String)>,
     /// (pass, reason) for every pass that does not run.
     pub left_out: Vec<(&'static str, String)>,
-    /// Every resource a running pass reads or writes (what the frame must allocate).
+    /// Every texture a running pass reads or writes (what the frame must allocate).
     pub resources: BTreeSet<Resource>,
+    /// Each named output and the texture it stands for after the last pass.
+    pub aliases: BTreeMap<Resource, Resource>,
+}
+
+impl PartialEq for Plan {
+    fn eq(&self, other: &Self) -> bool {
+        self.run == other.run && self.left_out == other.left_out && self.notes == other.notes
+    }
 }
 
 impl Plan {
     /// Whether the pass of this name runs.
     pub fn runs(&self, name: &str) -> bool {
         self.names.contains(&name)
+    }
+
+    /// The texture `r` stands for after the frame: itself, or what a named output
+    /// resolved to (`None` for a named output no enabled pass provides).
+    pub fn resolve(&self, r: Resource) -> Option<Resource> {
+        if r.is_alias() {
+            self.aliases.get(&r).copied()
+        } else {
+            Some(r)
+        }
+    }
+
+    /// The running passes that make up the occlusion's cost, in order.
+    pub fn occlusion_passes(&self) -> Vec<&'static str> {
+        self.decls.iter().filter(|d| d.occlusion_cost).map(|d| d.name).collect()
     }
 }
 
@@ -249,10 +321,41 @@ impl fmt::Display for Plan {
     }
 }
 
-/// Keeps the passes `outputs` depend on. An output that no enabled pass produces is an
-/// error naming it (a renderer bug or an impossible request, never silently dropped).
+/// Named outputs as provided so far, in declaration order.
+#[derive(Default)]
+struct Provided(BTreeMap<Resource, Resource>);
+
+impl Provided {
+    /// What `alias` stands for now: the last provider's texture, or its fallback's.
+    fn get(&self, alias: Resource) -> Option<Resource> {
+        match (self.0.get(&alias), alias.kind) {
+            (Some(texture), _) => Some(*texture),
+            (None, Kind::Alias { fallback: Some(fallback) }) => self.get(*fallback),
+            _ => None,
+        }
+    }
+}
+
+/// Resolves every named output the passes read, then keeps the passes `outputs` depend
+/// on. An output that no enabled pass produces is an error naming it (a renderer bug or
+/// an impossible request, never silently dropped).
 pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
-    let mut needed: BTreeSet<Resource> = outputs.iter().copied().collect();
+    let decls = resolve_aliases(decls)?;
+    let mut provided = Provided::default();
+    for decl in decls.iter().filter(|d| d.disabled.is_none()) {
+        provided.0.extend(decl.provides.iter().copied());
+    }
+    let mut aliases = BTreeMap::new();
+    for alias in decls.iter().flat_map(|d| d.provides.iter().map(|p| p.0)).chain(outputs.iter().copied()) {
+        if let Some(texture) = alias.is_alias().then(|| provided.get(alias)).flatten() {
+            aliases.insert(alias, texture);
+        }
+    }
+    let mut needed = BTreeSet::new();
+    for &output in outputs {
+        let texture = if output.is_alias() { aliases.get(&output).copied() } else { Some(output) };
+        needed.insert(texture.ok_or_else(|| format!("nothing provides '{}' for this frame", output.name()))?);
+    }
     let mut keep = vec![false; decls.len()];
     // Walk backwards: a pass is kept if it writes something needed downstream.
     for (i, decl) in decls.iter().enumerate().rev() {
@@ -270,9 +373,16 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
             return Err(format!("nothing produces '{}' for this frame", r.name()));
         }
     }
-    let mut plan =
-        Plan { run: Vec::new(), names: Vec::new(), notes: Vec::new(), left_out: Vec::new(), resources: needed };
-    for (i, decl) in decls.iter().enumerate() {
+    let mut plan = Plan {
+        run: Vec::new(),
+        names: Vec::new(),
+        decls: Vec::new(),
+        notes: Vec::new(),
+        left_out: Vec::new(),
+        resources: needed,
+        aliases,
+    };
+    for (i, decl) in decls.into_iter().enumerate() {
         if keep[i] {
             plan.resources.extend(decl.writes.iter().copied());
             plan.run.push(i);
@@ -280,6 +390,7 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
             if let Some(note) = &decl.note {
                 plan.notes.push((decl.name, note.clone()));
             }
+            plan.decls.push(decl);
         } else if let Some(reason) = &decl.disabled {
             plan.left_out.push((decl.name, reason.clone()));
         } else {
@@ -291,29 +402,85 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
     Ok(plan)
 }
 
+/// Replaces each named output an enabled pass reads by what the enabled passes before it
+/// provided, recording the substitution in the pass's `resolved`.
+fn resolve_aliases(decls: &[PassDecl]) -> Result<Vec<PassDecl>, String> {
+    let mut provided = Provided::default();
+    let mut resolved = decls.to_vec();
+    for decl in resolved.iter_mut() {
+        if decl.disabled.is_some() {
+            continue;
+        }
+        for read in decl.reads.iter_mut().filter(|r| r.is_alias()) {
+            let alias = *read;
+            let texture = provided.get(alias).ok_or_else(|| {
+                format!("pass '{}' reads '{}', which no pass before it provides", decl.name, alias.name())
+            })?;
+            decl.resolved.push((alias, texture));
+            *read = texture;
+        }
+        for (alias, texture) in &decl.provides {
+            if alias.format() != texture.format() {
+                return Err(format!(
+                    "pass '{}' provides '{}' as '{}' of another format",
+                    decl.name,
+                    alias.name(),
+                    texture.name()
+                ));
+            }
+            provided.0.insert(*alias, *texture);
+        }
+    }
+    Ok(resolved)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use Resource::*;
+    use wgpu::TextureFormat::{Depth32Float, Rgba16Float, Rgba8Unorm};
+
+    const DEPTH: Resource = Resource::attachment("depth", Size::Full, Depth32Float);
+    const NORMALS: Resource = Resource::attachment("normals", Size::Full, Rgba16Float);
+    const HDR: Resource = Resource::storage("hdr", Size::Full, Rgba16Float);
+    const COLOR: Resource = Resource::storage("color", Size::Full, Rgba8Unorm);
+    const EMISSION: Resource = Resource::attachment("emission", Size::Full, Rgba16Float);
+    const RAW: Resource = Resource::storage("raw", Size::Occlusion, Rgba16Float);
+    const BLURRED: Resource = Resource::storage("blurred", Size::Occlusion, Rgba16Float);
+    const FULL: Resource = Resource::storage("full", Size::Full, Rgba16Float);
 
     fn decls() -> Vec<PassDecl> {
         vec![
-            PassDecl::new("gbuffer").write(Depth).write(Normals).write(Albedo),
-            PassDecl::new("lighting").read(Depth).read(Normals).read(Albedo).write(Hdr),
-            PassDecl::new("tonemap").read(Hdr).write(Color),
+            PassDecl::new("gbuffer").write(DEPTH).write(NORMALS),
+            PassDecl::new("lighting").read(DEPTH).read(NORMALS).write(HDR),
+            PassDecl::new("tonemap").read(HDR).write(COLOR),
+        ]
+    }
+
+    /// technique → blur → upsample, and a composite that reads the occlusion.
+    fn ao_chain(blur: bool, half_res: bool) -> Vec<PassDecl> {
+        vec![
+            PassDecl::new("gbuffer").write(DEPTH).write(NORMALS),
+            PassDecl::new("ssao").read(DEPTH).write(RAW).provide(OCCLUSION, RAW),
+            PassDecl::new("blur").read(OCCLUSION).write(BLURRED).provide(OCCLUSION, BLURRED).disabled_if(!blur, "off"),
+            PassDecl::new("upsample")
+                .read(OCCLUSION)
+                .write(FULL)
+                .provide(FINAL_AO, FULL)
+                .disabled_if(!half_res, "full"),
+            PassDecl::new("composite").read(DEPTH).read(OCCLUSION).write(HDR),
         ]
     }
 
     #[test]
     fn color_pulls_in_the_whole_chain() {
-        let plan = plan(&decls(), &[Color]).unwrap();
+        let plan = plan(&decls(), &[COLOR]).unwrap();
         assert_eq!(plan.names, vec!["gbuffer", "lighting", "tonemap"]);
         assert!(plan.left_out.is_empty());
     }
 
     #[test]
     fn a_pass_whose_output_nobody_reads_is_left_out() {
-        let plan = plan(&decls(), &[Normals]).unwrap();
+        let plan = plan(&decls(), &[NORMALS]).unwrap();
         assert_eq!(plan.names, vec!["gbuffer"]);
         let names: Vec<_> = plan.left_out.iter().map(|(n, _)| *n).collect();
         assert_eq!(names, vec!["lighting", "tonemap"]);
@@ -323,8 +490,8 @@ mod tests {
     #[test]
     fn disabled_pass_is_left_out_with_its_reason() {
         let mut d = decls();
-        d.push(PassDecl::new("mirror").read(Color).write(Emission).disabled_if(true, "display mode is none"));
-        let plan = plan(&d, &[Color]).unwrap();
+        d.push(PassDecl::new("mirror").read(COLOR).write(EMISSION).disabled_if(true, "display mode is none"));
+        let plan = plan(&d, &[COLOR]).unwrap();
         assert_eq!(plan.left_out, vec![("mirror", "display mode is none".to_string())]);
     }
 
@@ -332,6 +499,57 @@ mod tests {
     fn an_output_nobody_produces_is_an_error() {
         let mut d = decls();
         d[2].disabled = Some("off".into());
-        assert!(plan(&d, &[Color]).unwrap_err().contains("color"));
+        assert!(plan(&d, &[COLOR]).unwrap_err().contains("color"));
+    }
+
+    #[test]
+    fn the_final_ao_is_the_last_texture_the_ao_chain_provides() {
+        for (blur, half_res, last) in
+            [(true, true, FULL), (false, true, FULL), (true, false, BLURRED), (false, false, RAW)]
+        {
+            let plan = plan(&ao_chain(blur, half_res), &[FINAL_AO]).unwrap();
+            assert_eq!(plan.resolve(FINAL_AO), Some(last), "blur {blur} half {half_res}");
+            assert!(plan.resources.contains(&last));
+            // The composite is not needed for the AO alone; each stage reads the one before.
+            assert!(!plan.runs("composite"));
+            if half_res {
+                let upsample = plan.decls.iter().find(|d| d.name == "upsample").unwrap();
+                assert_eq!(upsample.resolve(OCCLUSION), if blur { BLURRED } else { RAW });
+            }
+        }
+    }
+
+    #[test]
+    fn a_reader_of_a_named_output_gets_what_the_passes_before_it_provided() {
+        let plan = plan(&ao_chain(true, true), &[HDR]).unwrap();
+        // The composite reads the blurred occlusion, not the upsampled one after it.
+        assert_eq!(plan.names, vec!["gbuffer", "ssao", "blur", "composite"]);
+        let composite = plan.decls.last().unwrap();
+        assert_eq!(composite.reads, vec![DEPTH, BLURRED]);
+    }
+
+    #[test]
+    fn a_named_output_nobody_provides_is_an_error() {
+        let mut d = ao_chain(true, true);
+        d[1].disabled = Some("technique is none".into());
+        d[2].disabled = Some("technique is none".into());
+        d[3].disabled = Some("technique is none".into());
+        // A reader of a named output nobody provides is an error too (the composite
+        // unbinds the occlusion when no technique runs).
+        assert!(plan(&d, &[DEPTH]).unwrap_err().contains("'composite' reads 'occlusion'"));
+        d.pop();
+        assert!(plan(&d, &[FINAL_AO]).unwrap_err().contains("final-ao"));
+        assert!(plan(&d, &[DEPTH]).unwrap().resolve(FINAL_AO).is_none());
+    }
+
+    #[test]
+    fn an_unbound_read_is_no_dependency() {
+        let d = vec![
+            PassDecl::new("gbuffer").write(DEPTH),
+            PassDecl::new("shadow").write(EMISSION),
+            PassDecl::new("lighting").read(EMISSION).read(DEPTH).write(HDR).unbind(EMISSION),
+        ];
+        let plan = plan(&d, &[HDR]).unwrap();
+        assert!(!plan.runs("shadow"), "{plan}");
     }
 }

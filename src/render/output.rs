@@ -1,9 +1,12 @@
 //! Writes eye images and debug views as PNG files.
 
 use crate::render::error::{Error, Result};
-use crate::render::graph::Resource;
+use crate::render::graph::{Resource, FINAL_AO};
+use crate::render::passes::gbuffer::{ALBEDO, DEPTH, NORMALS};
+use crate::render::passes::occlusion::AO_RAW;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::Renderer;
-use crate::render::settings::Settings;
+use crate::render::settings::{Settings, Technique};
 use std::path::{Path, PathBuf};
 
 /// File-name parts of layer 0 and layer 1, in that order.
@@ -44,15 +47,6 @@ pub fn normals_to_rgba(normals: &[f32]) -> Vec<u8> {
         .collect()
 }
 
-/// The occlusion resources `--debug` writes: raw, and final (blurred and/or upsampled).
-pub fn occlusion_outputs(settings: &Settings) -> Vec<Resource> {
-    match crate::render::passes::final_occlusion(settings) {
-        Some(last) if last != Resource::AoRaw => vec![Resource::AoRaw, last],
-        Some(_) => vec![Resource::AoRaw],
-        None => Vec::new(),
-    }
-}
-
 /// The AO channel (alpha) of an occlusion target as grey.
 pub fn occlusion_to_rgba(occlusion: &[f32]) -> Vec<u8> {
     occlusion
@@ -64,24 +58,28 @@ pub fn occlusion_to_rgba(occlusion: &[f32]) -> Vec<u8> {
         .collect()
 }
 
-/// The occlusion `vrao render` writes: the final AO, and with `debug` also the raw AO
-/// (nothing when no technique runs).
-fn occlusion_written(settings: &Settings, debug: bool) -> Vec<Resource> {
-    if debug {
-        occlusion_outputs(settings)
-    } else {
-        crate::render::passes::final_occlusion(settings).into_iter().collect()
+/// The occlusion `vrao render` writes, with the file names' labels: the final AO (the
+/// graph's named output), and with `debug` also the raw AO (nothing when no technique
+/// runs).
+fn occlusion_written(settings: &Settings, debug: bool) -> Vec<(&'static str, Resource)> {
+    let mut written = Vec::new();
+    if settings.ao.technique != Technique::None {
+        written.push(("ao", FINAL_AO));
+        if debug {
+            written.push(("ao_raw", AO_RAW));
+        }
     }
+    written
 }
 
 /// What `vrao render` asks of a frame: the eyes' colour, the final AO (written beside
 /// the eyes) and, with `debug`, depth, normals, albedo and the raw AO.
 pub fn outputs(settings: &Settings, debug: bool) -> Vec<Resource> {
-    let mut outputs = vec![Resource::Color];
+    let mut outputs = vec![COLOR];
     if debug {
-        outputs.extend([Resource::Depth, Resource::Normals, Resource::Albedo]);
+        outputs.extend([DEPTH, NORMALS, ALBEDO]);
     }
-    outputs.extend(occlusion_written(settings, debug));
+    outputs.extend(occlusion_written(settings, debug).into_iter().map(|(_, r)| r));
     outputs
 }
 
@@ -101,28 +99,26 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
         written.push(path);
         Ok(())
     };
-    for (name, rgba) in names.iter().zip(renderer.read_bytes(Resource::Color)?) {
+    for (name, rgba) in names.iter().zip(renderer.read_bytes(COLOR)?) {
         save_sized(format!("{name}.png"), (w, h), rgba)?;
     }
     // The final AO first, then (with `debug`) the raw AO before blur or upsampling.
-    let final_ao = crate::render::passes::final_occlusion(settings);
-    for r in occlusion_written(settings, debug).into_iter().rev() {
-        let target = renderer.target(r).expect("occlusion was rendered");
+    for (label, r) in occlusion_written(settings, debug) {
+        let target = renderer.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
         let size = (target.width, target.height);
-        let label = if Some(r) == final_ao { "ao" } else { "ao_raw" };
         for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
             save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
         }
     }
     if debug {
         let near = settings.near;
-        for (name, depth) in names.iter().zip(renderer.read_f32(Resource::Depth)?) {
+        for (name, depth) in names.iter().zip(renderer.read_f32(DEPTH)?) {
             save_sized(format!("depth_{name}.png"), (w, h), depth_to_rgba(&depth, near))?;
         }
-        for (name, normals) in names.iter().zip(renderer.read_f32(Resource::Normals)?) {
+        for (name, normals) in names.iter().zip(renderer.read_f32(NORMALS)?) {
             save_sized(format!("normals_{name}.png"), (w, h), normals_to_rgba(&normals))?;
         }
-        for (name, albedo) in names.iter().zip(renderer.read_bytes(Resource::Albedo)?) {
+        for (name, albedo) in names.iter().zip(renderer.read_bytes(ALBEDO)?) {
             save_sized(format!("albedo_{name}.png"), (w, h), albedo)?;
         }
     }

@@ -16,24 +16,12 @@ use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::timing::{FrameTiming, PassTimer};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{self, Plan, Resource};
-use crate::render::passes::blur::BlurPass;
-use crate::render::passes::composite::CompositePass;
-use crate::render::passes::direct::DirectLightPass;
-use crate::render::passes::gbuffer::GBufferPass;
-use crate::render::passes::occlusion::OcclusionPass;
-use crate::render::passes::peel::DepthPeelPass;
-use crate::render::passes::rsm::RsmPass;
-use crate::render::passes::shadow::{LightSpace, ShadowPass};
-use crate::render::passes::ssdo::SsdoPass;
-use crate::render::passes::temporal::TemporalPass;
-use crate::render::passes::tonemap::TonemapPass;
-use crate::render::passes::upsample::UpsamplePass;
-use crate::render::passes::{FrameContext, FrameSetup, Pass};
+use crate::render::graph::{self, Kind, Plan, Resource, Size, Written};
+use crate::render::passes::{self, FrameContext, FrameSetup, Pass};
 use crate::render::scene::Scene;
 use crate::render::settings::{Settings, StereoMode};
 use crate::render::stereo::Eye;
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
@@ -123,6 +111,8 @@ pub struct Renderer {
     frame: FrameBuffers,
     passes: Vec<Box<dyn Pass>>,
     targets: BTreeMap<Resource, LayeredTarget>,
+    /// 1×1 stand-ins, by format, for what binding lists name but a pass does not read.
+    placeholders: HashMap<wgpu::TextureFormat, LayeredTarget>,
     timer: PassTimer,
     timing: Timing,
     /// Frames rendered so far, and the views of the last one (temporal reuse).
@@ -179,26 +169,7 @@ impl Renderer {
         };
         let gpu_scene = GpuScene::upload(&gpu, scene);
         let frame = FrameBuffers::new(&gpu.device, scene.lights.len());
-        // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
-        let light_space = Arc::new(LightSpace::new(&gpu, scene, gpu_scene.anchor));
-        // Declaration order is execution order.
-        let passes: Vec<Box<dyn Pass>> = vec![
-            Box::new(GBufferPass::new(&gpu, &gpu_scene, &frame)),
-            Box::new(ShadowPass::new(&gpu, &gpu_scene, light_space.clone())),
-            Box::new(DirectLightPass::new(&gpu, light_space.clone())),
-            Box::new(RsmPass::new(&gpu, light_space.clone())),
-            Box::new(OcclusionPass::ssao(&gpu)),
-            Box::new(OcclusionPass::hbao(&gpu)),
-            Box::new(OcclusionPass::gtao(&gpu)),
-            Box::new(DepthPeelPass::new(&gpu, &frame)),
-            Box::new(SsdoPass::new(&gpu)),
-            Box::new(OcclusionPass::fetch_only(&gpu)),
-            Box::new(TemporalPass::new(&gpu)),
-            Box::new(BlurPass::new(&gpu)),
-            Box::new(UpsamplePass::new(&gpu)),
-            Box::new(CompositePass::new(&gpu)),
-            Box::new(TonemapPass::new(&gpu)),
-        ];
+        let passes = passes::all(&gpu, scene, &gpu_scene, &frame);
         let timer = PassTimer::new(&gpu)?;
         gpu.take_error()?;
         Ok(Renderer {
@@ -210,6 +181,7 @@ impl Renderer {
             frame,
             passes,
             targets: BTreeMap::new(),
+            placeholders: HashMap::new(),
             timer,
             timing: Timing::Pipelined,
             frame_index: 0,
@@ -411,6 +383,8 @@ impl Renderer {
                 gpu: &self.gpu,
                 encoder: &mut encoder,
                 targets: &self.targets,
+                placeholders: &self.placeholders,
+                decl: &plan.decls[step],
                 frame: &self.frame,
                 scene: &self.gpu_scene,
                 timer: &self.timer,
@@ -466,67 +440,99 @@ impl Renderer {
     }
 
     /// (Re)creates the targets this plan touches at their size for this frame; targets
-    /// of another size are dropped, so a resource no pass needs costs no memory.
+    /// of another size are dropped, so a resource no pass needs costs no memory. Makes
+    /// the placeholders the plan's passes bind in place of what they do not read.
     fn allocate_targets(&mut self, plan: &Plan, layers: u32) {
-        let p = &self.settings.profile;
-        let (ao_w, ao_h) = ao_extent(p.width, p.height, self.settings.ao.half_res);
-        let (half_w, half_h) = ao_extent(p.width, p.height, true);
-        let light = crate::render::passes::shadow::light_extent(
-            &self.scene,
-            &self.settings,
-            self.gpu.device.limits().max_texture_dimension_2d,
-        );
-        let extent_of = |r: Resource| {
-            if r.in_light_space() {
-                light
-            } else if r.at_half_resolution() {
-                (half_w, half_h, layers)
-            } else if r.at_ao_resolution() {
-                (ao_w, ao_h, layers)
-            } else {
-                (p.width, p.height, layers)
-            }
-        };
-        let before = self.targets.len();
-        self.targets.retain(|r, t| t.extent() == extent_of(*r));
-        let mut changed = self.targets.len() != before;
-        for &r in &plan.resources {
-            self.targets.entry(r).or_insert_with(|| {
+        let setup = self.setup(layers);
+        let max_side = self.gpu.device.limits().max_texture_dimension_2d;
+        let extent_of = |r: Resource| extent(r, &setup, max_side);
+        let stale: Vec<Resource> =
+            self.targets.iter().filter(|(r, t)| t.extent() != extent_of(**r)).map(|(r, _)| *r).collect();
+        let wanted: Vec<(Resource, (u32, u32, u32))> = plan.resources.iter().map(|&r| (r, extent_of(r))).collect();
+        let mut changed = !stale.is_empty();
+        for r in stale {
+            self.targets.remove(&r);
+        }
+        for (r, extent) in wanted {
+            let Kind::Texture { written, .. } = r.kind() else { unreachable!("the plan resolves named outputs") };
+            let target = self.targets.entry(r).or_insert_with(|| {
                 changed = true;
-                let usage = if r.is_attachment() {
-                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
-                } else {
-                    // COPY_DST: tests poison histories and targets by writing them.
-                    wgpu::TextureUsages::STORAGE_BINDING
-                        | wgpu::TextureUsages::TEXTURE_BINDING
-                        | wgpu::TextureUsages::COPY_DST
+                let usage = match written {
+                    Written::Attachment => {
+                        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
+                    }
+                    // COPY_DST: tests poison targets by writing them.
+                    Written::Storage => {
+                        wgpu::TextureUsages::STORAGE_BINDING
+                            | wgpu::TextureUsages::TEXTURE_BINDING
+                            | wgpu::TextureUsages::COPY_DST
+                    }
                 };
-                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent_of(r), usage)
+                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent, usage)
             });
+            // Names are the identity of textures: two declarations under one name must agree.
+            debug_assert_eq!(target.format, r.format(), "two textures are named {}", r.name());
+        }
+        for decl in &plan.decls {
+            for r in &decl.unbound {
+                self.placeholders.entry(r.format()).or_insert_with(|| {
+                    changed = true;
+                    LayeredTarget::placeholder(&self.gpu.device, "placeholder", r.format())
+                });
+            }
         }
         if changed {
             crate::render::gpu::kernel::invalidate_bind_groups();
         }
     }
 
-    /// The target a previous frame wrote, if that frame needed it.
+    /// The plan of the last frame, if one was rendered.
+    pub fn last_plan(&self) -> Option<&Plan> {
+        self.plan_cache.as_ref().map(|(_, plan)| plan)
+    }
+
+    /// The target a previous frame wrote, if that frame needed it (a named output: its
+    /// texture as the last frame resolved it).
     pub fn target(&self, r: Resource) -> Option<&LayeredTarget> {
+        let r = match r.is_alias() {
+            true => self.last_plan()?.resolve(r)?,
+            false => r,
+        };
         self.targets.get(&r)
+    }
+
+    /// A target a pass keeps itself from frame to frame (the temporal history), or one
+    /// the graph allocated ([`Renderer::target`]).
+    pub fn kept_target(&self, r: Resource) -> Option<LayeredTarget> {
+        self.target(r).cloned().or_else(|| self.passes.iter().find_map(|p| p.kept_target(r)))
     }
 
     /// Raw bytes per layer of a resource the last frame produced.
     pub fn read_bytes(&self, r: Resource) -> Result<Vec<Vec<u8>>> {
-        let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
-        readback::read_layers(&self.gpu, target)
+        let target = self.kept_target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        readback::read_layers(&self.gpu, &target)
     }
 
-    /// Values per layer (channels interleaved) of a float or depth resource; `Direct`
-    /// decodes to rgba radiance (a = 0).
+    /// Values per layer (channels interleaved) of a float or depth resource; the packed
+    /// direct light decodes to rgba radiance (a = 0).
     pub fn read_f32(&self, r: Resource) -> Result<Vec<Vec<f32>>> {
-        let target = self.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
-        if r == Resource::Direct {
-            return Ok(readback::decode_direct(readback::read_layers(&self.gpu, target)?));
+        let target = self.kept_target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        if target.format == passes::direct::DIRECT.format() {
+            return Ok(readback::decode_direct(readback::read_layers(&self.gpu, &target)?));
         }
-        readback::read_layers_f32(&self.gpu, target)
+        readback::read_layers_f32(&self.gpu, &target)
     }
+}
+
+/// Width × height × layers of a texture this frame.
+fn extent(r: Resource, setup: &FrameSetup, max_side: u32) -> (u32, u32, u32) {
+    let p = &setup.settings.profile;
+    let Kind::Texture { size, .. } = r.kind() else { unreachable!("named outputs have no size") };
+    let (width, height) = match size {
+        Size::Full => (p.width, p.height),
+        Size::Occlusion => ao_extent(p.width, p.height, setup.settings.ao.half_res),
+        Size::Half => ao_extent(p.width, p.height, true),
+        Size::Computed(extent) => return extent(setup, max_side),
+    };
+    (width, height, setup.views)
 }

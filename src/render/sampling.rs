@@ -69,18 +69,6 @@ pub fn hbao_directions_steps(samples: u32) -> (u32, u32) {
     (directions, (samples / directions).max(1))
 }
 
-/// GTAO's slices and steps per half-slice for a budget of `samples` depth taps
-/// (slices × 2 × steps ≈ samples): 12 → 2×3, 24 → 2×6, 36 → 2×9, 64 → 2×16. Steps before
-/// slices: the 4×4 noise tile turns each pixel's slices, so the denoise averages 16 × 2
-/// directions anyway, while the occluders a sparse march steps over stay missed (a
-/// bias, not noise). Measured at N = 24, half resolution, 540×600 (furnished, Sibenik,
-/// Cornell): 3×4 gave RMSE 0.052 / 0.064 / 0.044 and bias where the reference is below
-/// 0.8 of +0.11 / +0.15 / +0.06; 2×6 gave 0.047 / 0.059 / 0.037 and +0.08 / +0.12 / +0.04.
-pub fn gtao_slices_steps(samples: u32) -> (u32, u32) {
-    let slices = if samples < 128 { 2 } else { 4 };
-    (slices, (samples / (2 * slices)).max(1))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,13 +112,6 @@ mod tests {
         let mean = |d| hemisphere_kernel(256, d).iter().map(|s| s[2] as f64).sum::<f64>() / 256.0;
         assert!((mean(HemisphereDensity::Cosine) - 2.0 / 3.0).abs() < 0.01);
         assert!((mean(HemisphereDensity::Uniform) - 0.5).abs() < 0.01);
-    }
-
-    #[test]
-    fn gtao_presets_spend_ssao_tap_counts() {
-        for (samples, split) in [(12, (2, 3)), (24, (2, 6)), (36, (2, 9)), (64, (2, 16)), (1, (2, 1)), (256, (4, 32))] {
-            assert_eq!(gtao_slices_steps(samples), split);
-        }
     }
 
     #[test]

@@ -185,7 +185,7 @@ impl BounceForm {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Denoise {
     /// Edge-aware box over the 4×4 noise tile, 5 taps per axis in two passes
-    /// (shaders/denoise.wgsl).
+    /// (src/render/passes/blur/denoise.wgsl).
     #[default]
     Tile,
     /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; the Czech SSDO

@@ -18,6 +18,7 @@ fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
         spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
         views: 2,
         pass: technique.name(),
+        occlusion_passes: vec![technique.name(), "blur"],
         error: Some(ErrorFigures {
             ao_rmse,
             ao_bias: -0.05,

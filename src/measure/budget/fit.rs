@@ -5,7 +5,7 @@ use super::{run, BudgetReport, BudgetRun};
 use crate::measure::bench::BenchFile;
 use crate::render::error::{Error, Result};
 use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::graph::Resource;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::{Renderer, TimingChoice};
 use crate::render::scene::Scene;
 use crate::render::settings::{AoSettings, Settings, Technique};
@@ -68,10 +68,12 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let measure = |settings: &Settings, frames: u32| -> Result<BudgetReport> {
         let output = if options.occlusion_only {
-            crate::render::passes::final_occlusion(settings)
-                .ok_or_else(|| Error::input("--measure occlusion needs an occlusion technique"))?
+            if settings.ao.technique == crate::render::settings::Technique::None {
+                return Err(Error::input("--measure occlusion needs an occlusion technique"));
+            }
+            crate::render::graph::FINAL_AO
         } else {
-            Resource::Color
+            COLOR
         };
         let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
         run(&mut renderer, &eyes, BudgetRun { timing, warmup: options.warmup, frames, budget_ms, output })

@@ -10,7 +10,7 @@
 //! - `environment_visible`: ∫ L_env(ω) [no hit within r] cos θ dω from the real lat-long
 //!   map ([`Environment::sample`](crate::render::scene::Environment::sample)), what SSDO approximates;
 //! - `bounce`: ∫ [hit within r] L_direct(hit, towards the receiver) cos θ dω, one bounce of
-//!   the direct model of `shaders/direct.wgsl` (albedo/π · Σ light irradiance + emission, at
+//!   the direct model of `src/render/passes/direct/direct.wgsl` (albedo/π · Σ light irradiance + emission, at
 //!   the hit triangle's interpolated normal and albedo; zero on a back face), directional
 //!   lights shadowed by a shadow ray from the hit (the truth the GPU's shadow maps
 //!   approximate; with `--shadows off` on the GPU the difference shows up as error);

@@ -1,5 +1,5 @@
 //! The estimators at one surface point: stratified cosine-weighted directions, one ray
-//! each, and the direct-light model of `shaders/direct.wgsl` at the points they hit,
+//! each, and the direct-light model of `src/render/passes/direct/direct.wgsl` at the points they hit,
 //! with directional light shadowed by a shadow ray (what the GPU's shadow maps
 //! approximate).
 

@@ -1,8 +1,9 @@
 //! Per-frame uniforms shared by every pass (mirrors `Frame`, `Eye` and `Light` in
-//! shaders/common.wgsl), built in f64 and rounded once.
+//! src/render/gpu/shaders/common.wgsl), built in f64 and rounded once.
 
 use super::scene::GpuScene;
-use crate::render::sampling::{gtao_slices_steps, hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
+use crate::render::passes::gtao::{gtao_inner_band, gtao_slices_steps};
+use crate::render::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
 use crate::render::scene::environment::quadratic_in_view;
 use crate::render::scene::{Light, Scene};
 use crate::render::settings::{Noise, Settings, Technique};
@@ -109,18 +110,10 @@ pub struct AoParamsUniform {
     /// GTAO: distance gap (fraction of the radius) under which successive samples join.
     pub connect: f32,
     /// GTAO: width in occlusion pixels of the band along each eye's inner border that
-    /// runs with the other-eye lookups ([`gtao_inner_band`]).
+    /// runs with the other-eye lookups (`passes::gtao::gtao_inner_band`).
     pub inner_band: u32,
     /// The WGSL struct's size is a multiple of its 8-byte alignment (`ao_size`).
     pub padding: u32,
-}
-
-/// GTAO's inner-border band for occlusion targets `width` pixels wide: a quarter of the
-/// width (whole 8-pixel workgroups). Only marches from this band look past the inner
-/// border into the other eye; one from further in that would cross it (its radius spans
-/// more than a quarter of the image: a surface very near the eye) stops there instead.
-pub fn gtao_inner_band(width: u32) -> u32 {
-    (width / 4).next_multiple_of(8).min(width)
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).

@@ -1,8 +1,9 @@
-//! The wgpu plumbing written once: shader modules from `shaders/`, and compute kernels
-//! whose bind-group layout, bind group and dispatch follow from a list of slots. A pass
-//! names its slots and binds resources in the same order; binding `i` is slot `i`.
+//! The wgpu plumbing written once: shader modules from WGSL files kept beside their
+//! passes, and compute kernels whose bind-group layout follows from a binding list
+//! ([`Bind`]); binding `i` is entry `i`.
 
 use super::Gpu;
+use crate::render::graph::Resource;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -24,59 +25,51 @@ pub fn invalidate_bind_groups() {
 /// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
 pub const TILE: u32 = 8;
 
-/// WGSL sources, compiled into the binary so it runs from any directory.
-const SHADERS: &[(&str, &str)] = &[
-    ("common.wgsl", include_str!("../../../shaders/common.wgsl")),
-    ("occlusion.wgsl", include_str!("../../../shaders/occlusion.wgsl")),
-    ("ssao.wgsl", include_str!("../../../shaders/ssao.wgsl")),
-    ("hbao.wgsl", include_str!("../../../shaders/hbao.wgsl")),
-    ("gtao.wgsl", include_str!("../../../shaders/gtao.wgsl")),
-    ("ssdo.wgsl", include_str!("../../../shaders/ssdo.wgsl")),
-    ("fetch.wgsl", include_str!("../../../shaders/fetch.wgsl")),
-    ("bilateral.wgsl", include_str!("../../../shaders/bilateral.wgsl")),
-    ("denoise.wgsl", include_str!("../../../shaders/denoise.wgsl")),
-    ("denoise_stereo.wgsl", include_str!("../../../shaders/denoise_stereo.wgsl")),
-    ("joint_upsample.wgsl", include_str!("../../../shaders/joint_upsample.wgsl")),
-    ("upsample.wgsl", include_str!("../../../shaders/upsample.wgsl")),
-    ("composite.wgsl", include_str!("../../../shaders/composite.wgsl")),
-    ("irradiance.wgsl", include_str!("../../../shaders/irradiance.wgsl")),
-    ("gbuffer.wgsl", include_str!("../../../shaders/gbuffer.wgsl")),
-    ("gbuffer_multiview.wgsl", include_str!("../../../shaders/gbuffer_multiview.wgsl")),
-    ("gbuffer_multipass.wgsl", include_str!("../../../shaders/gbuffer_multipass.wgsl")),
-    ("peel.wgsl", include_str!("../../../shaders/peel.wgsl")),
-    ("multiview_probe.wgsl", include_str!("../../../shaders/multiview_probe.wgsl")),
-    ("direct.wgsl", include_str!("../../../shaders/direct.wgsl")),
-    ("shadow.wgsl", include_str!("../../../shaders/shadow.wgsl")),
-    ("shadow_map.wgsl", include_str!("../../../shaders/shadow_map.wgsl")),
-    ("rsm.wgsl", include_str!("../../../shaders/rsm.wgsl")),
-    ("tonemap.wgsl", include_str!("../../../shaders/tonemap.wgsl")),
-    ("reproject.wgsl", include_str!("../../../shaders/reproject.wgsl")),
-    ("mirror.wgsl", include_str!("../../../shaders/mirror.wgsl")),
-    ("temporal.wgsl", include_str!("../../../shaders/temporal.wgsl")),
-];
+/// One WGSL file, compiled into the binary so it runs from any directory; `path` is
+/// relative to the repository root (for `VRAO_SHADER_DIR`). Make one with [`wgsl!`](crate::wgsl).
+#[derive(Clone, Copy, Debug)]
+pub struct Shader {
+    /// The file, relative to the repository root.
+    pub path: &'static str,
+    /// Its text as compiled in.
+    pub source: &'static str,
+}
 
-/// A shader module made of the named files, concatenated in order (common first), so
+/// A [`Shader`] of a WGSL file named by its path from the repository root; the file
+/// lives beside the code that uses it (`src/render/passes/<pass>/<pass>.wgsl`).
+#[macro_export]
+macro_rules! wgsl {
+    ($path:literal) => {
+        $crate::render::gpu::kernel::Shader {
+            path: $path,
+            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/", $path)),
+        }
+    };
+}
+
+/// `common.wgsl`: the frame's uniforms and helpers every pass shares.
+pub const COMMON: Shader = crate::wgsl!("src/render/gpu/shaders/common.wgsl");
+
+/// `irradiance.wgsl`: the environment's irradiance and radiance quadratics.
+pub const IRRADIANCE: Shader = crate::wgsl!("src/render/gpu/shaders/irradiance.wgsl");
+
+/// A shader module made of the given files, concatenated in order (common first), so
 /// passes share `common.wgsl` without string formatting.
-pub fn shader_module(device: &wgpu::Device, label: &str, files: &[&str]) -> wgpu::ShaderModule {
-    // Shader development: `VRAO_SHADER_DIR=shaders` reads the files from disk, so an
-    // edited shader runs without rebuilding the binary.
+pub fn shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
+    // Shader development: `VRAO_SHADER_DIR=.` (the repository root) reads the files from
+    // disk, so an edited shader runs without rebuilding the binary.
     let shader_dir = std::env::var_os("VRAO_SHADER_DIR").map(std::path::PathBuf::from);
     let mut source = String::new();
     for file in files {
-        let text = SHADERS
-            .iter()
-            .find(|(name, _)| name == file)
-            .map(|(_, text)| *text)
-            .unwrap_or_else(|| panic!("shader {file} is not registered in SHADERS"));
         match &shader_dir {
-            Some(dir) => match std::fs::read_to_string(dir.join(file)) {
+            Some(dir) => match std::fs::read_to_string(dir.join(file.path)) {
                 Ok(text) => source.push_str(&text),
                 Err(error) => {
-                    eprintln!("error: VRAO_SHADER_DIR: cannot read {}: {error}", dir.join(file).display());
+                    eprintln!("error: VRAO_SHADER_DIR: cannot read {}: {error}", dir.join(file.path).display());
                     std::process::exit(2);
                 }
             },
-            None => source.push_str(text),
+            None => source.push_str(file.source),
         }
         source.push('\n');
     }
@@ -84,6 +77,52 @@ pub fn shader_module(device: &wgpu::Device, label: &str, files: &[&str]) -> wgpu
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     })
+}
+
+/// One binding of a kernel, in binding order. A pass's binding list is the one place
+/// that says what the kernel binds: the bind group layout, the pass's reads and writes
+/// ([`PassDecl::bindings`](crate::render::graph::PassDecl::bindings)) and the resources
+/// bound each frame all follow from it.
+#[derive(Clone, Copy, Debug)]
+pub enum Bind {
+    /// The frame's uniforms (`Frame` of common.wgsl).
+    Frame,
+    /// The occlusion parameters (`AoParams` of common.wgsl).
+    AoParams,
+    /// The occlusion's hemisphere kernel (storage, read).
+    SampleKernel,
+    /// Both eyes' lights (storage, read).
+    Lights,
+    /// The scene's environment map (`texture_2d<f32>`, filterable).
+    Environment,
+    /// The environment's filtering sampler.
+    EnvironmentSampler,
+    /// A texture of the graph the pass reads: `texture_depth_2d_array` for depth,
+    /// `texture_2d_array<u32>` for unsigned formats, `texture_2d_array<f32>` otherwise.
+    Read(Resource),
+    /// A texture of the graph the pass writes: `texture_storage_2d_array<format, write>`.
+    Write(Resource),
+    /// Something the pass binds itself (its own uniform, a layer view, …), given at dispatch.
+    Own(Slot),
+}
+
+impl Bind {
+    /// The slot type this binding has in the layout.
+    pub fn slot(self) -> Slot {
+        match self {
+            Bind::Frame | Bind::AoParams => Slot::Uniform,
+            Bind::SampleKernel | Bind::Lights => Slot::ReadBuffer,
+            Bind::Environment => Slot::Texture2d,
+            Bind::EnvironmentSampler => Slot::Sampler,
+            Bind::Read(r) if r.format().is_depth_stencil_format() => Slot::Depth,
+            Bind::Read(r) if r.format().sample_type(None, None) == Some(wgpu::TextureSampleType::Uint) => {
+                Slot::UintLayers
+            }
+            Bind::Read(_) => Slot::Layers,
+            Bind::Write(r) => Slot::Output(r.format()),
+            Bind::Own(slot) => slot,
+        }
+    }
 }
 
 /// What a kernel binds at one binding index.
@@ -114,7 +153,8 @@ pub enum Slot {
 }
 
 impl Slot {
-    fn layout_entry(self, binding: u32) -> wgpu::BindGroupLayoutEntry {
+    /// The layout entry of this slot at `binding`, seen by the `visibility` stages.
+    pub fn layout_entry(self, binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
         let ty = match self {
             Slot::Depth => wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Depth,
@@ -164,7 +204,7 @@ impl Slot {
                 min_binding_size: None,
             },
         };
-        wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+        wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None }
     }
 }
 
@@ -181,22 +221,24 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding `slots`.
-    pub fn new(gpu: &Gpu, label: &str, files: &[&str], entry: &str, slots: &[Slot]) -> Kernel {
-        Self::with_constants(gpu, label, files, entry, slots, &[])
+    /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding `binds`.
+    pub fn new(gpu: &Gpu, label: &str, files: &[Shader], entry: &str, binds: &[Bind]) -> Kernel {
+        Self::with_constants(gpu, label, files, entry, binds, &[])
     }
 
     /// A kernel whose WGSL `override` constants take the given values.
     pub fn with_constants(
         gpu: &Gpu,
         label: &str,
-        files: &[&str],
+        files: &[Shader],
         entry: &str,
-        slots: &[Slot],
+        binds: &[Bind],
         constants: &[(&str, f64)],
     ) -> Kernel {
         let device = &gpu.device;
-        let entries: Vec<_> = slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32)).collect();
+        let slots: Vec<Slot> = binds.iter().map(|b| b.slot()).collect();
+        let entries: Vec<_> =
+            slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32, wgpu::ShaderStages::COMPUTE)).collect();
         let layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -217,7 +259,7 @@ impl Kernel {
             label: label.to_string(),
             pipeline,
             layout,
-            slots: slots.to_vec(),
+            slots,
             bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
         }
     }

@@ -2,20 +2,12 @@
 //! the OpenXR blit): a uniform-buffer binding, the scene's vertex layout, and one 2D
 //! view per layer of an array texture.
 
+use super::kernel::Slot;
 use super::scene::Vertex;
 
 /// A uniform-buffer binding at `binding`, seen by the `visibility` stages.
 pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
+    Slot::Uniform.layout_entry(binding, visibility)
 }
 
 /// The scene's vertices (position, normal, uv) as the raster passes read them.

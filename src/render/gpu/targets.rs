@@ -1,7 +1,9 @@
 //! Layered render targets: one 2D array texture, layer 0 = left eye, layer 1 = right eye
 //! (one layer for a mono view).
 
-/// A 2D array texture with a view of the whole array and one view per layer.
+/// A 2D array texture with a view of the whole array and one view per layer (a clone
+/// shares the texture: wgpu handles are reference-counted).
+#[derive(Clone)]
 pub struct LayeredTarget {
     /// The texture itself (for copies and readback).
     pub texture: wgpu::Texture,

@@ -1,14 +1,21 @@
-//! One file per pass. A pass declares what it reads and writes for this frame (the
-//! graph decides whether it runs) and records its GPU work when it does.
+//! One folder per pass: its Rust (`mod.rs`) and its WGSL. A pass declares, in one
+//! builder chain, the textures it creates (constants with their size class and format),
+//! what it reads and writes (its kernels' binding lists), what it provides under the
+//! graph's named outputs, and whether it runs this frame; the graph decides which passes
+//! run, and each records its GPU work when it does. [`all`] lists them in execution order.
 
 pub mod blur;
 pub mod composite;
 pub mod direct;
+pub mod fetch_only;
 pub mod gbuffer;
+pub mod gtao;
+pub mod hbao;
 pub mod occlusion;
 pub mod peel;
 pub mod rsm;
 pub mod shadow;
+pub mod ssao;
 pub mod ssdo;
 pub mod temporal;
 pub mod tonemap;
@@ -16,14 +23,40 @@ pub mod upsample;
 
 use crate::render::gpu::frame::ao_extent;
 use crate::render::gpu::frame::FrameBuffers;
+use crate::render::gpu::kernel::Bind;
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::timing::PassTimer;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 use crate::render::scene::Scene;
-use crate::render::settings::{Settings, Technique};
-use std::collections::BTreeMap;
+use crate::render::settings::Settings;
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+
+/// Every pass, in execution order (declaration order is execution order). A new pass
+/// or technique is one line here plus its own folder.
+pub fn all(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameBuffers) -> Vec<Box<dyn Pass>> {
+    // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
+    let light_space = Arc::new(shadow::LightSpace::new(gpu, scene, gpu_scene.anchor));
+    vec![
+        Box::new(gbuffer::GBufferPass::new(gpu, gpu_scene, frame)),
+        Box::new(shadow::ShadowPass::new(gpu, gpu_scene, light_space.clone())),
+        Box::new(direct::DirectLightPass::new(gpu, light_space.clone())),
+        Box::new(rsm::RsmPass::new(gpu, light_space)),
+        Box::new(ssao::pass(gpu)),
+        Box::new(hbao::pass(gpu)),
+        Box::new(gtao::GtaoPass::new(gpu)),
+        Box::new(peel::DepthPeelPass::new(gpu, frame)),
+        Box::new(ssdo::SsdoPass::new(gpu)),
+        Box::new(fetch_only::pass(gpu)),
+        Box::new(temporal::TemporalPass::new(gpu)),
+        Box::new(blur::BlurPass::new(gpu)),
+        Box::new(upsample::UpsamplePass::new(gpu)),
+        Box::new(composite::CompositePass::new(gpu)),
+        Box::new(tonemap::TonemapPass::new(gpu)),
+    ]
+}
 
 /// What passes may consult when declaring themselves for a frame.
 pub struct FrameSetup<'a> {
@@ -51,6 +84,11 @@ pub struct FrameContext<'a> {
     pub encoder: &'a mut wgpu::CommandEncoder,
     /// The targets the graph allocated for this frame.
     pub targets: &'a BTreeMap<Resource, LayeredTarget>,
+    /// 1×1 stand-ins, by format, for what a binding list names but the pass does not
+    /// read this frame ([`PassDecl::unbind`]).
+    pub placeholders: &'a HashMap<wgpu::TextureFormat, LayeredTarget>,
+    /// This pass's declaration for the frame, named outputs resolved.
+    pub decl: &'a PassDecl,
     /// The frame's uniform and light buffers.
     pub frame: &'a FrameBuffers,
     /// The scene uploaded to the GPU.
@@ -62,14 +100,57 @@ pub struct FrameContext<'a> {
 }
 
 impl<'a> FrameContext<'a> {
-    /// The target of a resource the graph allocated for this frame.
+    /// The target of a resource the graph allocated for this frame (a named output: the
+    /// texture it stands for at this pass).
     pub fn target(&self, r: Resource) -> &'a LayeredTarget {
+        let r = self.decl.resolve(r);
         self.targets.get(&r).unwrap_or_else(|| panic!("{} was not allocated; the pass did not declare it", r.name()))
     }
 
-    /// The array view of a resource's target, for a bind group.
+    /// The array view of a resource's target, for a bind group (a placeholder's when the
+    /// pass does not read it this frame).
     pub fn view(&self, r: Resource) -> wgpu::BindingResource<'a> {
+        if self.decl.unbound.contains(&r) {
+            let placeholder = self.placeholders.get(&r.format()).expect("the renderer makes each unbound format's");
+            return wgpu::BindingResource::TextureView(&placeholder.array_view);
+        }
         wgpu::BindingResource::TextureView(&self.target(r).array_view)
+    }
+
+    /// The resources of a binding list, in its order; `own` fills its [`Bind::Own`]
+    /// entries, in order.
+    pub fn bind<'b>(&self, binds: &[Bind], own: &[wgpu::BindingResource<'b>]) -> Vec<wgpu::BindingResource<'b>>
+    where
+        'a: 'b,
+    {
+        let mut own = own.iter();
+        let resources: Vec<_> = binds
+            .iter()
+            .map(|bind| match *bind {
+                Bind::Frame => self.frame.frame.as_entire_binding(),
+                Bind::AoParams => self.frame.ao.as_entire_binding(),
+                Bind::SampleKernel => self.frame.kernel.as_entire_binding(),
+                Bind::Lights => self.frame.lights.as_entire_binding(),
+                Bind::Environment => wgpu::BindingResource::TextureView(&self.scene.environment),
+                Bind::EnvironmentSampler => wgpu::BindingResource::Sampler(&self.scene.sampler),
+                Bind::Read(r) | Bind::Write(r) => self.view(r),
+                Bind::Own(_) => own.next().expect("one own resource per Bind::Own").clone(),
+            })
+            .collect();
+        debug_assert!(own.next().is_none(), "{}: more own resources than Bind::Own entries", self.decl.name);
+        resources
+    }
+
+    /// A one-layer array view of `layer` of a resource's target (the stereo reuse binds
+    /// the left eye's layer for the right eye's dispatch).
+    pub fn layer_view(&self, r: Resource, layer: u32) -> wgpu::TextureView {
+        self.target(r).texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(r.name()),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
     }
 
     /// Width × height × layers of this frame's full-resolution targets.
@@ -93,40 +174,6 @@ impl<'a> FrameContext<'a> {
     }
 }
 
-/// The occlusion the blur reads: the technique's own, or its temporal accumulation.
-pub fn occlusion_source(settings: &Settings) -> Resource {
-    if settings.ao.temporal.enabled {
-        Resource::AoAccumulated
-    } else {
-        Resource::AoRaw
-    }
-}
-
-/// The occlusion the blur-and-upsample chain starts from, if any technique runs.
-pub fn occlusion_before_upsample(settings: &Settings) -> Option<Resource> {
-    match (settings.ao.technique, settings.ao.blur_radius) {
-        (Technique::None, _) => None,
-        (_, 0) => Some(occlusion_source(settings)),
-        _ => Some(Resource::AoBlurred),
-    }
-}
-
-/// The full-resolution occlusion the composite reads, if any technique runs.
-pub fn final_occlusion(settings: &Settings) -> Option<Resource> {
-    let ao = occlusion_before_upsample(settings)?;
-    Some(if settings.ao.half_res { Resource::AoFull } else { ao })
-}
-
-/// Whether the right eye takes the left eye's upsampled AO instead of upsampling its own
-/// wherever the left eye sees the same point (shaders/joint_upsample.wgsl
-/// `right_eye_quad`): with the stereo reuse, two views and half-resolution occlusion of
-/// an AO-only technique (SSDO's rgb carries gathered light, which the composite's alpha,
-/// where the left eye's AO waits for the right eye, cannot hold).
-pub fn reuses_left_eye_upsample(settings: &Settings, layers: u32) -> bool {
-    let ao = &settings.ao;
-    ao.stereo_reuse && ao.half_res && layers == 2 && ao.technique != Technique::None && !ao.technique.carries_light()
-}
-
 /// One pass of the frame graph: declares what it reads and writes for a frame, and
 /// records its GPU work when the plan keeps it.
 pub trait Pass {
@@ -134,4 +181,9 @@ pub trait Pass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl;
     /// Records the pass's commands into the frame's encoder.
     fn record(&self, ctx: &mut FrameContext);
+    /// A target the pass keeps itself from one frame to the next (the temporal
+    /// history), for inspection; the graph allocates every other target.
+    fn kept_target(&self, _r: Resource) -> Option<LayeredTarget> {
+        None
+    }
 }

@@ -16,7 +16,8 @@ use super::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
-use crate::render::graph::Resource;
+use crate::render::passes::gbuffer::DEPTH;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::scene::HeadPath;
 use crate::render::stereo::{EyePair, HeadsetProfile};
 use compositor::{Clock, Compositor, VsyncOutcome};
@@ -271,8 +272,8 @@ impl SimulatedHeadset {
                 self.held.push(HeldFrame {
                     frame: index,
                     eyes: *eyes,
-                    color: LayeredTarget::new(&gpu.device, "held colour", Resource::Color.format(), extent, usage),
-                    depth: LayeredTarget::new(&gpu.device, "held depth", Resource::Depth.format(), extent, usage),
+                    color: LayeredTarget::new(&gpu.device, "held colour", COLOR.format(), extent, usage),
+                    depth: LayeredTarget::new(&gpu.device, "held depth", DEPTH.format(), extent, usage),
                 });
                 self.held.len() - 1
             }

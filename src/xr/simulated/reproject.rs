@@ -1,11 +1,11 @@
-//! The compositor's late warp (shaders/reproject.wgsl): a finished stereo frame is
+//! The compositor's late warp (reproject.wgsl): a finished stereo frame is
 //! re-presented at a newer head pose, rotationally (orientation only, a homography per
 //! eye) or positionally (the submitted depth forward-splatted into the new view).
 
-use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
-use crate::render::graph::Resource;
+use crate::render::passes::tonemap::COLOR;
 use crate::render::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
@@ -32,7 +32,7 @@ impl ReprojectionMode {
     }
 }
 
-/// Mirrors `Reproject` in shaders/reproject.wgsl.
+/// Mirrors `Reproject` in reproject.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct ReprojectUniform {
@@ -56,21 +56,23 @@ pub struct Reprojector {
     splatted: Option<wgpu::Buffer>,
 }
 
-const SLOTS: [Slot; 6] = [
-    Slot::Uniform,
-    Slot::Depth,
-    Slot::FilterableLayers,
-    Slot::Sampler,
-    Slot::ReadWriteBuffer,
-    Slot::Output(wgpu::TextureFormat::Rgba8Unorm),
+/// reproject.wgsl's bindings: the warp's uniform, the held depth and colour and their
+/// sampler, the splatted depths, the warped colour out (all the compositor's own).
+const BINDINGS: [Bind; 6] = [
+    Bind::Own(Slot::Uniform),
+    Bind::Own(Slot::Depth),
+    Bind::Own(Slot::FilterableLayers),
+    Bind::Own(Slot::Sampler),
+    Bind::Own(Slot::ReadWriteBuffer),
+    Bind::Own(Slot::Output(wgpu::TextureFormat::Rgba8Unorm)),
 ];
 
 impl Reprojector {
     /// Compiles the warp's kernels (splat, positional, rotational).
     pub fn new(gpu: &Gpu) -> Reprojector {
-        let files = ["common.wgsl", "reproject.wgsl"];
+        let files = [COMMON, crate::wgsl!("src/xr/simulated/reproject.wgsl")];
         let variant = |label, entry, positional: bool| {
-            Kernel::with_constants(gpu, label, &files, entry, &SLOTS, &[("POSITIONAL", f64::from(positional))])
+            Kernel::with_constants(gpu, label, &files, entry, &BINDINGS, &[("POSITIONAL", f64::from(positional))])
         };
         Reprojector {
             splat: variant("reproject splat", "splat", true),
@@ -158,7 +160,7 @@ pub fn output_target(gpu: &Gpu, (width, height, layers): (u32, u32, u32)) -> Lay
     LayeredTarget::new(
         &gpu.device,
         "compositor output",
-        Resource::Color.format(),
+        COLOR.format(),
         (width, height, layers),
         wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
     )

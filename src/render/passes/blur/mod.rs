@@ -1,20 +1,52 @@
 //! The spatial denoise of the occlusion, at occlusion resolution, each layer alone, as a
-//! horizontal then a vertical dispatch through `AoBlurH`: the default edge-aware box
-//! matched to the 4×4 noise tile (shaders/denoise.wgsl), or the geometry-aware 11×11
-//! bilateral blur (shaders/bilateral.wgsl).
+//! horizontal then a vertical dispatch through [`AO_BLUR_H`]: the default edge-aware box
+//! matched to the 4×4 noise tile (denoise.wgsl), or the geometry-aware 11×11 bilateral
+//! blur (bilateral.wgsl). Both share denoise_stereo.wgsl, the right eye's reuse of the
+//! left eye.
 
-use super::occlusion::layer_view;
-use super::{occlusion_before_upsample, occlusion_source, FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Kernel, Slot};
+use super::gbuffer::DEPTH;
+use super::occlusion::AO_GEOMETRY;
+use super::{FrameContext, FrameSetup, Pass};
+use crate::render::gpu::kernel::{Bind, Kernel, Shader, Slot, COMMON};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::render::settings::{Denoise, Technique};
 
-/// Pixels per invocation of the tile denoise (`RUN` in shaders/denoise.wgsl).
+/// Horizontally denoised occlusion (first half of the separable filter).
+pub const AO_BLUR_H: Resource = Resource::storage("ao-blur-h", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+
+/// The denoised occlusion, at AO resolution.
+pub const AO_BLURRED: Resource = Resource::storage("ao-blurred", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+
+/// Bindings of both denoise shaders with the occlusion in and the horizontal result
+/// out: frame, AO parameters, geometry, input, output, depth and, at 6, the output's
+/// left-eye layer for the right eye's vertical dispatch (the geometry stands in before it).
+const HORIZONTAL: [Bind; 7] = [
+    Bind::Frame,
+    Bind::AoParams,
+    Bind::Read(AO_GEOMETRY),
+    Bind::Read(OCCLUSION),
+    Bind::Write(AO_BLUR_H),
+    Bind::Read(DEPTH),
+    Bind::Own(Slot::Layers),
+];
+
+/// [`HORIZONTAL`] with the horizontal result in and the denoised occlusion out.
+const VERTICAL: [Bind; 7] = [
+    HORIZONTAL[0],
+    HORIZONTAL[1],
+    HORIZONTAL[2],
+    Bind::Read(AO_BLUR_H),
+    Bind::Write(AO_BLURRED),
+    HORIZONTAL[5],
+    HORIZONTAL[6],
+];
+
+/// Pixels per invocation of the tile denoise (`RUN` in denoise.wgsl).
 const DENOISE_RUN: u32 = 4;
 
 /// One denoise kind's pipelines: horizontal, vertical, and the right eye's vertical
-/// dispatch that reuses the left eye (shaders/denoise_stereo.wgsl).
+/// dispatch that reuses the left eye (denoise_stereo.wgsl).
 struct DenoiseKernels {
     horizontal: Kernel,
     vertical: Kernel,
@@ -23,27 +55,18 @@ struct DenoiseKernels {
 
 impl DenoiseKernels {
     /// `constants`: the shader's pipeline constants besides `RIGHT_EYE`.
-    fn new(gpu: &Gpu, shader: &str, horizontal: &str, vertical: &str, constants: &[(&str, f64)]) -> Self {
-        let slots = [
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Output(Resource::AoBlurred.format()),
-            Slot::Depth,
-            Slot::Layers,
-        ];
-        let files = ["common.wgsl", "denoise_stereo.wgsl", shader];
-        let kernel = |entry: &str, right_eye: bool| {
+    fn new(gpu: &Gpu, shader: Shader, horizontal: &str, vertical: &str, constants: &[(&str, f64)]) -> Self {
+        let files = [COMMON, crate::wgsl!("src/render/passes/blur/denoise_stereo.wgsl"), shader];
+        let kernel = |entry: &str, binds: &[Bind], right_eye: bool| {
             let mut constants = constants.to_vec();
             constants.push(("RIGHT_EYE", f64::from(right_eye)));
             let label = if right_eye { format!("{entry} right eye") } else { entry.to_string() };
-            Kernel::with_constants(gpu, &label, &files, entry, &slots, &constants)
+            Kernel::with_constants(gpu, &label, &files, entry, binds, &constants)
         };
         DenoiseKernels {
-            horizontal: kernel(horizontal, false),
-            vertical: kernel(vertical, false),
-            right_eye_vertical: kernel(vertical, true),
+            horizontal: kernel(horizontal, &HORIZONTAL, false),
+            vertical: kernel(vertical, &VERTICAL, false),
+            right_eye_vertical: kernel(vertical, &VERTICAL, true),
         }
     }
 }
@@ -62,9 +85,13 @@ impl BlurPass {
         BlurPass {
             tile: [false, true].map(|carries_light| {
                 let constants = [("CARRIES_LIGHT", f64::from(carries_light))];
-                DenoiseKernels::new(gpu, "denoise.wgsl", "denoise_horizontal", "denoise_vertical", &constants)
+                let shader = crate::wgsl!("src/render/passes/blur/denoise.wgsl");
+                DenoiseKernels::new(gpu, shader, "denoise_horizontal", "denoise_vertical", &constants)
             }),
-            bilateral: DenoiseKernels::new(gpu, "bilateral.wgsl", "blur_horizontal", "blur_vertical", &[]),
+            bilateral: {
+                let shader = crate::wgsl!("src/render/passes/blur/bilateral.wgsl");
+                DenoiseKernels::new(gpu, shader, "blur_horizontal", "blur_vertical", &[])
+            },
         }
     }
 }
@@ -73,18 +100,15 @@ impl Pass for BlurPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
         PassDecl::new("blur")
-            .read(Resource::Depth)
-            .read(Resource::AoGeometry)
-            .read(occlusion_source(setup.settings))
-            .write(Resource::AoBlurH)
-            .write(Resource::AoBlurred)
+            .bindings(&HORIZONTAL)
+            .bindings(&VERTICAL)
+            .provide(OCCLUSION, AO_BLURRED)
+            .occlusion_cost()
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to blur")
             .disabled_if(ao.blur_radius == 0, "blur radius is 0")
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        debug_assert_eq!(occlusion_before_upsample(ctx.setup.settings), Some(Resource::AoBlurred));
-        let source = occlusion_source(ctx.setup.settings);
         let ao = &ctx.setup.settings.ao;
         let kernels = match ao.denoise {
             Denoise::Tile => &self.tile[usize::from(ao.technique.carries_light())],
@@ -105,33 +129,20 @@ impl Pass for BlurPass {
         // cost a fifth of the denoise (80–101 against 64–84 ms per eye, lavapipe).
         let reuse = ao.stereo_reuse && ao.half_res && layers == 2;
         let device = &ctx.gpu.device;
-        let horizontal = resources(ctx, source, Resource::AoBlurH);
+        // Binding 6 is unused before the right eye's vertical dispatch: the geometry stands in.
+        let stand_in = [ctx.view(AO_GEOMETRY)];
+        let horizontal = ctx.bind(&HORIZONTAL, &stand_in);
         kernels.horizontal.dispatch(device, ctx.encoder, &horizontal, horizontal_grid);
         // The vertical pass: both eyes alike, or the left eye and then the right eye
         // reusing it.
-        let mut vertical = resources(ctx, Resource::AoBlurH, Resource::AoBlurred);
+        let mut vertical = ctx.bind(&VERTICAL, &stand_in);
         let filtered_layers = if reuse { 1 } else { layers };
         kernels.vertical.dispatch(device, ctx.encoder, &vertical, (vertical_grid.0, vertical_grid.1, filtered_layers));
         if reuse {
-            let (right, left) = (layer_view(ctx, Resource::AoBlurred, 1), layer_view(ctx, Resource::AoBlurred, 0));
+            let (right, left) = (ctx.layer_view(AO_BLURRED, 1), ctx.layer_view(AO_BLURRED, 0));
             vertical[4] = wgpu::BindingResource::TextureView(&right);
             vertical[6] = wgpu::BindingResource::TextureView(&left);
             kernels.right_eye_vertical.dispatch(device, ctx.encoder, &vertical, (vertical_grid.0, vertical_grid.1, 1));
         }
     }
-}
-
-/// Bindings of both denoise shaders: frame, AO parameters, geometry, input, output,
-/// depth and, at 6, the output's left-eye layer for the right eye's vertical dispatch
-/// (AoGeometry stands in before it).
-fn resources<'a>(ctx: &FrameContext<'a>, input: Resource, output: Resource) -> [wgpu::BindingResource<'a>; 7] {
-    [
-        ctx.frame.frame.as_entire_binding(),
-        ctx.frame.ao.as_entire_binding(),
-        ctx.view(Resource::AoGeometry),
-        ctx.view(input),
-        ctx.view(output),
-        ctx.view(Resource::Depth),
-        ctx.view(Resource::AoGeometry),
-    ]
 }

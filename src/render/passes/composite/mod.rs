@@ -9,15 +9,22 @@
 //! alpha wherever the left eye sees the same point; the quads it does not fully see are
 //! listed on the GPU and composited by an indirect dispatch over just them.
 
-use super::occlusion::layer_view;
+use super::direct::DIRECT;
+use super::gbuffer::{ALBEDO, DEPTH, NORMALS};
+use super::occlusion::AO_GEOMETRY;
+use super::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
 use super::shadow::rsm_active;
-use super::{occlusion_before_upsample, reuses_left_eye_upsample, FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Kernel, Slot};
-use crate::render::gpu::targets::LayeredTarget;
+use super::upsample::{reuses_left_eye_upsample, JOINT_UPSAMPLE_WGSL};
+use super::{FrameContext, FrameSetup, Pass};
+use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON, IRRADIANCE};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
+use crate::render::settings::Technique;
 use std::sync::Mutex;
 use wgpu::util::DeviceExt;
+
+/// Lit scene radiance before tone mapping.
+pub const HDR: Resource = Resource::storage("hdr", Size::Full, wgpu::TextureFormat::Rgba16Float);
 
 /// The composite: direct light plus the occluded ambient term in HDR, upsampling half-
 /// resolution AO inline (module docs).
@@ -37,36 +44,38 @@ pub struct CompositePass {
     /// The indirect arguments copied out of the list (a buffer may not be both the
     /// dispatch's read-write binding and its arguments).
     fallback_args: wgpu::Buffer,
-    /// Bound in place of occlusion or its geometry where the shader does not read them.
-    unused: LayeredTarget,
 }
 
 /// Bytes of `FallbackQuads` before its list: the indirect arguments (x, y, z) and the count.
 const FALLBACK_HEADER_BYTES: u64 = 16;
 
-const SLOTS: [Slot; 15] = [
-    Slot::Uniform,
-    Slot::Uniform,
-    Slot::Depth,
-    Slot::Layers,
-    Slot::Layers,
-    Slot::UintLayers,
-    Slot::Layers,
-    Slot::Texture2d,
-    Slot::Sampler,
-    Slot::Output(wgpu::TextureFormat::Rgba16Float),
-    Slot::Layers,
-    Slot::Layers,
-    Slot::Layers,
-    Slot::Layers,
-    Slot::ReadWriteBuffer,
+/// composite.wgsl's bindings: frame, AO parameters, the G-buffer, the direct light, the
+/// occlusion, the environment, the HDR out, the occlusion's geometry, the RSM bounce and
+/// its geometry and, for the right eye's dispatches, the output's left-eye layer and the
+/// fallback list.
+const BINDINGS: [Bind; 15] = [
+    Bind::Frame,
+    Bind::AoParams,
+    Bind::Read(DEPTH),
+    Bind::Read(NORMALS),
+    Bind::Read(ALBEDO),
+    Bind::Read(DIRECT),
+    Bind::Read(OCCLUSION),
+    Bind::Environment,
+    Bind::EnvironmentSampler,
+    Bind::Write(HDR),
+    Bind::Read(AO_GEOMETRY),
+    Bind::Read(RSM_INDIRECT),
+    Bind::Read(RSM_GEOMETRY),
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::ReadWriteBuffer),
 ];
 
 impl CompositePass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = ["common.wgsl", "irradiance.wgsl", "joint_upsample.wgsl", "composite.wgsl"];
-        let unused = LayeredTarget::placeholder(&gpu.device, "unused occlusion", wgpu::TextureFormat::Rgba16Float);
+        let files =
+            [COMMON, IRRADIANCE, JOINT_UPSAMPLE_WGSL, crate::wgsl!("src/render/passes/composite/composite.wgsl")];
         let variant = |half_res: bool, rsm: bool, right_eye: bool, fallback: bool| {
             let constants = [
                 ("HALF_RES", f64::from(half_res)),
@@ -79,7 +88,7 @@ impl CompositePass {
                 (true, false) => "composite right eye",
                 (true, true) => "composite right eye fallback",
             };
-            Kernel::with_constants(gpu, label, &files, "main", &SLOTS, &constants)
+            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
         };
         let fallback_header = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("composite fallback header"),
@@ -101,62 +110,34 @@ impl CompositePass {
             right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true)),
             fallback: Mutex::new(None),
             fallback_header,
-            unused,
         }
     }
 }
 
 impl Pass for CompositePass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        let decl = PassDecl::new("composite")
-            .read(Resource::Depth)
-            .read(Resource::Normals)
-            .read(Resource::Albedo)
-            .read(Resource::Direct)
-            .write(Resource::Hdr);
-        let decl = match occlusion_before_upsample(setup.settings) {
-            None => decl,
-            Some(occlusion) if setup.settings.ao.half_res => decl
-                .read(occlusion)
-                .read(Resource::AoGeometry)
-                .note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)"),
-            Some(occlusion) => decl.read(occlusion),
-        };
-        if rsm_active(setup.scene, setup.settings) {
-            decl.read(Resource::RsmIndirect).read(Resource::RsmGeometry)
+        let settings = setup.settings;
+        let mut decl = PassDecl::new("composite").bindings(&BINDINGS);
+        if settings.ao.technique == Technique::None {
+            decl = decl.unbind(OCCLUSION).unbind(AO_GEOMETRY);
+        } else if settings.ao.half_res {
+            decl = decl.note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)");
         } else {
+            decl = decl.unbind(AO_GEOMETRY);
+        }
+        if rsm_active(setup.scene, settings) {
             decl
+        } else {
+            decl.unbind(RSM_INDIRECT).unbind(RSM_GEOMETRY)
         }
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let unused = || wgpu::BindingResource::TextureView(&self.unused.array_view);
         let half_res = ctx.setup.settings.ao.half_res;
         let rsm = rsm_active(ctx.setup.scene, ctx.setup.settings);
-        let (occlusion, geometry) = match occlusion_before_upsample(ctx.setup.settings) {
-            Some(occlusion) if half_res => (ctx.view(occlusion), ctx.view(Resource::AoGeometry)),
-            Some(occlusion) => (ctx.view(occlusion), unused()),
-            None => (unused(), unused()),
-        };
-        let mut resources = [
-            ctx.frame.frame.as_entire_binding(),
-            ctx.frame.ao.as_entire_binding(),
-            ctx.view(Resource::Depth),
-            ctx.view(Resource::Normals),
-            ctx.view(Resource::Albedo),
-            ctx.view(Resource::Direct),
-            occlusion,
-            wgpu::BindingResource::TextureView(&ctx.scene.environment),
-            wgpu::BindingResource::Sampler(&ctx.scene.sampler),
-            ctx.view(Resource::Hdr),
-            geometry,
-            // One bounce from reflective shadow maps (passes/rsm.rs), when on.
-            if rsm { ctx.view(Resource::RsmIndirect) } else { unused() },
-            if rsm { ctx.view(Resource::RsmGeometry) } else { unused() },
-            // The output's left-eye layer and the fallback list, for the right eye's dispatches.
-            unused(),
-            self.fallback_header.as_entire_binding(),
-        ];
+        // The output's left-eye layer is unused before the right eye's dispatch: the
+        // geometry (or its placeholder) stands in.
+        let mut resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), self.fallback_header.as_entire_binding()]);
         // One invocation per quad of 2×2 pixels (composite.wgsl): both eyes alike, or the
         // left eye, then the right eye reusing its AO, then the quads it listed.
         let (w, h, layers) = ctx.quad_extent();
@@ -167,7 +148,7 @@ impl Pass for CompositePass {
         if reuse {
             let fallback = self.fallback_list(device, u64::from(w) * u64::from(h));
             ctx.encoder.copy_buffer_to_buffer(&self.fallback_header, 0, &fallback, 0, FALLBACK_HEADER_BYTES);
-            let (right, left) = (layer_view(ctx, Resource::Hdr, 1), layer_view(ctx, Resource::Hdr, 0));
+            let (right, left) = (ctx.layer_view(HDR, 1), ctx.layer_view(HDR, 0));
             resources[9] = wgpu::BindingResource::TextureView(&right);
             resources[13] = wgpu::BindingResource::TextureView(&left);
             resources[14] = fallback.as_entire_binding();

@@ -1,14 +1,35 @@
 //! Direct light from the scene's point and directional lights, plus emission, as
 //! outgoing radiance. The composite builds on it; SSDO's bounce reads it as L_pixel.
-//! Directional lights are shadowed by their shadow maps (3×3 PCF, passes/shadow.rs)
-//! when shadows are on.
+//! Directional lights are shadowed by their shadow maps (3×3 PCF, passes/shadow) when
+//! shadows are on.
 
-use super::shadow::{shadows_active, LightSpace};
+use super::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS};
+use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size};
 use std::sync::Arc;
+
+/// Outgoing direct radiance (lights and emission) and the view distance, packed
+/// (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the composite's base, and
+/// the depth test plus sender radiance of SSDO's bounce in a single fetch.
+pub const DIRECT: Resource = Resource::storage("direct", Size::Full, wgpu::TextureFormat::Rg32Uint);
+
+/// direct.wgsl's bindings: the G-buffer in, the direct light out, and the shadows
+/// (their `Shadows` uniform, every light's map, the comparison sampler).
+const BINDINGS: [Bind; 10] = [
+    Bind::Frame,
+    Bind::Lights,
+    Bind::Read(DEPTH),
+    Bind::Read(NORMALS),
+    Bind::Read(ALBEDO),
+    Bind::Read(EMISSION),
+    Bind::Write(DIRECT),
+    Bind::Own(Slot::Uniform),
+    Bind::Read(SHADOW_MAP),
+    Bind::Own(Slot::ComparisonSampler),
+];
 
 /// Direct light of every light, shadowed where shadow maps exist (module docs).
 pub struct DirectLightPass {
@@ -19,63 +40,27 @@ pub struct DirectLightPass {
 impl DirectLightPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> Self {
-        let slots = [
-            Slot::Uniform,
-            Slot::ReadBuffer,
-            Slot::Depth,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Output(Resource::Direct.format()),
-            Slot::Uniform,
-            Slot::Depth,
-            Slot::ComparisonSampler,
-        ];
-        let kernel = Kernel::new(gpu, "direct", &["common.wgsl", "shadow.wgsl", "direct.wgsl"], "main", &slots);
-        DirectLightPass { kernel, light_space }
+        let files = [COMMON, SHADOW_WGSL, crate::wgsl!("src/render/passes/direct/direct.wgsl")];
+        DirectLightPass { kernel: Kernel::new(gpu, "direct", &files, "main", &BINDINGS), light_space }
     }
 }
 
 impl Pass for DirectLightPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        let decl = PassDecl::new("direct")
-            .read(Resource::Depth)
-            .read(Resource::Normals)
-            .read(Resource::Albedo)
-            .read(Resource::Emission)
-            .write(Resource::Direct);
+        let decl = PassDecl::new("direct").bindings(&BINDINGS);
         if shadows_active(setup.scene, setup.settings) {
-            decl.read(Resource::ShadowMap)
-                .note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
+            decl.note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
         } else {
-            decl
+            decl.unbind(SHADOW_MAP)
         }
     }
 
     fn record(&self, ctx: &mut FrameContext) {
+        // Shadows (shadow.wgsl): every light's map, or no light and a placeholder map.
         let shadowed = shadows_active(ctx.setup.scene, ctx.setup.settings);
-        let resources = [
-            ctx.frame.frame.as_entire_binding(),
-            ctx.frame.lights.as_entire_binding(),
-            ctx.view(Resource::Depth),
-            ctx.view(Resource::Normals),
-            ctx.view(Resource::Albedo),
-            ctx.view(Resource::Emission),
-            ctx.view(Resource::Direct),
-            // Shadows (shaders/shadow.wgsl): every light's map, or no light and a placeholder.
-            if shadowed {
-                self.light_space.uniform.as_entire_binding()
-            } else {
-                self.light_space.none.as_entire_binding()
-            },
-            if shadowed {
-                ctx.view(Resource::ShadowMap)
-            } else {
-                wgpu::BindingResource::TextureView(&self.light_space.placeholder_depth.array_view)
-            },
-            wgpu::BindingResource::Sampler(&self.light_space.comparison),
-        ];
-        let extent = ctx.extent();
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        let shadows = if shadowed { &self.light_space.uniform } else { &self.light_space.none };
+        let own = [shadows.as_entire_binding(), wgpu::BindingResource::Sampler(&self.light_space.comparison)];
+        let resources = ctx.bind(&BINDINGS, &own);
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.extent());
     }
 }

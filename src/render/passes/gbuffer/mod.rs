@@ -4,15 +4,27 @@
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
-use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::kernel::{shader_module, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size};
 use std::num::NonZeroU32;
 use wgpu::util::DeviceExt;
 
-const COLOR_TARGETS: [Resource; 3] = [Resource::Normals, Resource::Albedo, Resource::Emission];
+/// Reversed-Z depth of every eye layer.
+pub const DEPTH: Resource = Resource::attachment("depth", Size::Full, wgpu::TextureFormat::Depth32Float);
+/// View-space unit normals (w unused).
+pub const NORMALS: Resource = Resource::attachment("normals", Size::Full, wgpu::TextureFormat::Rgba16Float);
+/// Diffuse albedo (sRGB-encoded, reads back linear).
+pub const ALBEDO: Resource = Resource::attachment("albedo", Size::Full, wgpu::TextureFormat::Rgba8UnormSrgb);
+/// Emitted radiance.
+pub const EMISSION: Resource = Resource::attachment("emission", Size::Full, wgpu::TextureFormat::Rgba16Float);
+
+const COLOR_TARGETS: [Resource; 3] = [NORMALS, ALBEDO, EMISSION];
+
+/// gbuffer.wgsl: the vertex transform and fragment shader both paths share.
+const GBUFFER_WGSL: Shader = crate::wgsl!("src/render/passes/gbuffer/gbuffer.wgsl");
 
 /// The G-buffer of both eyes: depth, normals, albedo and emission, multiview or one pass per
 /// eye (module docs).
@@ -56,8 +68,11 @@ impl GBufferPass {
                 bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout)],
                 immediate_size: 0,
             });
-            let module =
-                shader_module(device, "gbuffer multiview", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multiview.wgsl"]);
+            let module = shader_module(
+                device,
+                "gbuffer multiview",
+                &[COMMON, GBUFFER_WGSL, crate::wgsl!("src/render/passes/gbuffer/gbuffer_multiview.wgsl")],
+            );
             pipeline(device, &layout, &module, NonZeroU32::new(0b11))
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -65,8 +80,11 @@ impl GBufferPass {
             bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
-        let module =
-            shader_module(device, "gbuffer multipass", &["common.wgsl", "gbuffer.wgsl", "gbuffer_multipass.wgsl"]);
+        let module = shader_module(
+            device,
+            "gbuffer multipass",
+            &[COMMON, GBUFFER_WGSL, crate::wgsl!("src/render/passes/gbuffer/gbuffer_multipass.wgsl")],
+        );
         let multipass = pipeline(device, &layout, &module, None);
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer frame"),
@@ -97,7 +115,7 @@ fn pipeline(
         // towards the eye instead.
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: Some(wgpu::DepthStencilState {
-            format: Resource::Depth.format(),
+            format: DEPTH.format(),
             depth_write_enabled: Some(true),
             depth_compare: Some(wgpu::CompareFunction::Greater), // reversed Z
             stencil: Default::default(),
@@ -117,11 +135,7 @@ fn pipeline(
 
 impl Pass for GBufferPass {
     fn declare(&self, _: &FrameSetup) -> PassDecl {
-        PassDecl::new("gbuffer")
-            .write(Resource::Depth)
-            .write(Resource::Normals)
-            .write(Resource::Albedo)
-            .write(Resource::Emission)
+        PassDecl::new("gbuffer").write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION)
     }
 
     fn record(&self, ctx: &mut FrameContext) {
@@ -169,7 +183,7 @@ fn begin<'e, 't>(
         label: Some("gbuffer"),
         color_attachments: &color,
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: views(Resource::Depth),
+            view: views(DEPTH),
             depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
             stencil_ops: None,
         }),

@@ -1,5 +1,5 @@
 //! Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
-//! surface behind the G-buffer's depth (shaders/peel.wgsl). With it SSDO counts a sample
+//! surface behind the G-buffer's depth (peel.wgsl). With it SSDO counts a sample
 //! as an occluder only between the first and second layer, inside an object, so thin
 //! objects in front of a background no longer cast a halo onto it. An optional quality
 //! mode (`ao.depth_peeling`): the pass exists only while SSDO runs with peeling on.
@@ -9,12 +9,18 @@
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
-use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::kernel::{shader_module, COMMON};
 use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size};
+use crate::render::passes::gbuffer::DEPTH;
 use crate::render::settings::Technique;
 use wgpu::util::DeviceExt;
+
+/// Depth peeling's second layer (SSDO's quality mode): the nearest surface behind
+/// [`DEPTH`], reversed-Z, 0 where nothing lies behind.
+pub const DEPTH_LAYER_2: Resource =
+    Resource::attachment("depth-layer-2", Size::Full, wgpu::TextureFormat::Depth32Float);
 
 /// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
@@ -54,7 +60,7 @@ impl DepthPeelPass {
             bind_group_layouts: &[Some(&frame_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, "depth peel", &["common.wgsl", "peel.wgsl"]);
+        let module = shader_module(device, "depth peel", &[COMMON, crate::wgsl!("src/render/passes/peel/peel.wgsl")]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("depth peel"),
             layout: Some(&layout),
@@ -67,7 +73,7 @@ impl DepthPeelPass {
             // No culling, as in the G-buffer: the back faces are what this pass is for.
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: Resource::DepthLayer2.format(),
+                format: DEPTH_LAYER_2.format(),
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::Greater), // reversed Z
                 stencil: Default::default(),
@@ -104,8 +110,9 @@ impl Pass for DepthPeelPass {
         let ao = &setup.settings.ao;
         let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
         PassDecl::new("depth-peel")
-            .read(Resource::Depth)
-            .write(Resource::DepthLayer2)
+            .read(DEPTH)
+            .write(DEPTH_LAYER_2)
+            .occlusion_cost()
             .disabled_if(!ao.depth_peeling, "depth peeling is off (--depth-peeling turns it on for SSDO)")
             .disabled_if(
                 !ssdo,
@@ -114,8 +121,8 @@ impl Pass for DepthPeelPass {
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let first = ctx.view(Resource::Depth);
-        let second = ctx.target(Resource::DepthLayer2);
+        let first = ctx.view(DEPTH);
+        let second = ctx.target(DEPTH_LAYER_2);
         for layer in 0..ctx.setup.views as usize {
             let eye_group = ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("depth peel eye"),

@@ -1,20 +1,21 @@
 //! One bounce of directional light from reflective shadow maps (Lin's NCTU thesis §3.3,
-//! shaders/rsm.wgsl): at half resolution per axis, each pixel gathers N virtual point
+//! rsm.wgsl): at half resolution per axis, each pixel gathers N virtual point
 //! lights from the light-space pass's maps in a disk of radius R, with a pattern turned
 //! per pixel and per frame. The composite upsamples the irradiance (3×3 joint
-//! bilateral, shaders/rsm_upsample.wgsl) and adds irradiance × albedo/π to the ambient.
+//! bilateral, in composite.wgsl) and adds irradiance × albedo/π to the ambient.
 
-use super::shadow::{rsm_active, shadow_casters, LightSpace};
+use super::gbuffer::{DEPTH, NORMALS};
+use super::shadow::{rsm_active, shadow_casters, LightSpace, RSM_FLUX, RSM_NORMAL, SHADOW_MAP, SHADOW_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::ao_extent;
-use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size};
 use bytemuck::{Pod, Zeroable};
 use std::cell::Cell;
 use std::sync::Arc;
 
-/// `RsmParams` of shaders/rsm.wgsl.
+/// `RsmParams` of rsm.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct RsmParamsUniform {
@@ -24,6 +25,29 @@ struct RsmParamsUniform {
     radius: f32,
     _pad: [f32; 3],
 }
+
+/// One-bounce irradiance gathered from the reflective shadow maps, half resolution per
+/// axis (rgb).
+pub const RSM_INDIRECT: Resource = Resource::storage("rsm-indirect", Size::Half, wgpu::TextureFormat::Rgba16Float);
+
+/// Normal (xyz) and view distance (w) at each [`RSM_INDIRECT`] pixel, for the
+/// composite's joint bilateral upsampling.
+pub const RSM_GEOMETRY: Resource = Resource::storage("rsm-geometry", Size::Half, wgpu::TextureFormat::Rgba32Float);
+
+/// rsm.wgsl's bindings: frame, the lights' `Shadows`, the gather's parameters, the
+/// G-buffer and the light-space maps in, the irradiance and its geometry out.
+const BINDINGS: [Bind; 10] = [
+    Bind::Frame,
+    Bind::Own(Slot::Uniform),
+    Bind::Own(Slot::Uniform),
+    Bind::Read(DEPTH),
+    Bind::Read(NORMALS),
+    Bind::Read(SHADOW_MAP),
+    Bind::Read(RSM_NORMAL),
+    Bind::Read(RSM_FLUX),
+    Bind::Write(RSM_INDIRECT),
+    Bind::Write(RSM_GEOMETRY),
+];
 
 /// One bounce of directional light from reflective shadow maps (module docs).
 pub struct RsmPass {
@@ -37,19 +61,8 @@ pub struct RsmPass {
 impl RsmPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> RsmPass {
-        let slots = [
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Depth,
-            Slot::Layers,
-            Slot::Depth,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Output(Resource::RsmIndirect.format()),
-            Slot::Output(Resource::RsmGeometry.format()),
-        ];
-        let kernel = Kernel::new(gpu, "rsm", &["common.wgsl", "shadow.wgsl", "rsm.wgsl"], "main", &slots);
+        let files = [COMMON, SHADOW_WGSL, crate::wgsl!("src/render/passes/rsm/rsm.wgsl")];
+        let kernel = Kernel::new(gpu, "rsm", &files, "main", &BINDINGS);
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rsm params"),
             size: std::mem::size_of::<RsmParamsUniform>() as u64,
@@ -65,13 +78,7 @@ impl Pass for RsmPass {
         let s = &setup.settings.shadows;
         let lights = shadow_casters(setup.scene).len();
         PassDecl::new("rsm")
-            .read(Resource::Depth)
-            .read(Resource::Normals)
-            .read(Resource::ShadowMap)
-            .read(Resource::RsmNormal)
-            .read(Resource::RsmFlux)
-            .write(Resource::RsmIndirect)
-            .write(Resource::RsmGeometry)
+            .bindings(&BINDINGS)
             .disabled_if(lights == 0, "no directional light to bounce (reflective shadow maps need one)")
             .disabled_if(!s.rsm, "reflective shadow maps are off (--rsm on adds one bounce of the sun)")
             .note(format!(
@@ -92,18 +99,8 @@ impl Pass for RsmPass {
         let params =
             RsmParamsUniform { low_size: [w, h], samples: s.rsm_samples, frame, radius: s.rsm_radius, _pad: [0.0; 3] };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let resources = [
-            ctx.frame.frame.as_entire_binding(),
-            self.light_space.uniform.as_entire_binding(),
-            self.params.as_entire_binding(),
-            ctx.view(Resource::Depth),
-            ctx.view(Resource::Normals),
-            ctx.view(Resource::ShadowMap),
-            ctx.view(Resource::RsmNormal),
-            ctx.view(Resource::RsmFlux),
-            ctx.view(Resource::RsmIndirect),
-            ctx.view(Resource::RsmGeometry),
-        ];
+        let own = [self.light_space.uniform.as_entire_binding(), self.params.as_entire_binding()];
+        let resources = ctx.bind(&BINDINGS, &own);
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, (w, h, ctx.setup.views));
     }
 }

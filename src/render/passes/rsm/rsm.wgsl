@@ -13,7 +13,7 @@
 // original RSM). A VPL within its own area of p counts as a disk, Φ/(π d² + A) instead
 // of Φ/(π d²), so close VPLs stay finite.
 // Writes the irradiance (rgb) and the pixel's geometry (normal, view distance; the form
-// of AoGeometry) for the composite's joint bilateral upsampling (rsm_upsample.wgsl).
+// of AoGeometry) for the composite's joint bilateral upsampling (composite.wgsl).
 
 struct RsmParams {
     // Half-resolution target size.

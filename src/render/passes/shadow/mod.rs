@@ -1,8 +1,8 @@
 //! Shadow maps with 3×3 PCF (the Czech SSDO thesis §2.1, §5.1) and reflective shadow maps
 //! (Lin's NCTU thesis §3.3) for the scene's directional lights: one light-space pass renders,
 //! per shadowed light, an orthographic depth map and, when reflective shadow maps are on, each
-//! texel's normal and flux. The direct pass looks the depth up (shaders/shadow.wgsl);
-//! the RSM gather (`rsm.rs`) turns the texels into virtual point lights.
+//! texel's normal and flux. The direct pass looks the depth up (shadow.wgsl);
+//! the RSM gather (`passes/rsm`) turns the texels into virtual point lights.
 //!
 //! The fit: each light's orthographic box encloses every vertex of the scene, in f64
 //! light coordinates relative to the scene's anchor, square in the map plane (square
@@ -18,17 +18,30 @@
 //! reduction) are the way to spend texels on what is near; see the report.
 
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::kernel::{shader_module, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::GpuScene;
-use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::scene::{Light, Scene};
 use crate::render::settings::Settings;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, DVec4, Vec3};
 use std::sync::Arc;
+
+/// Light-space depth of each shadowed directional light (one layer per light, square,
+/// `--shadow-size` texels a side), 0 nearest the light, 1 = nothing.
+pub const SHADOW_MAP: Resource =
+    Resource::attachment("shadow-map", Size::Computed(light_extent), wgpu::TextureFormat::Depth32Float);
+/// Reflective shadow map: light-view normal per light-space texel.
+pub const RSM_NORMAL: Resource =
+    Resource::attachment("rsm-normal", Size::Computed(light_extent), wgpu::TextureFormat::Rgba16Float);
+/// Reflective shadow map: flux density (albedo × light irradiance) per texel.
+pub const RSM_FLUX: Resource =
+    Resource::attachment("rsm-flux", Size::Computed(light_extent), wgpu::TextureFormat::Rgba16Float);
+
+/// shadow.wgsl: the `Shadows` uniform and the PCF lookup the direct and RSM passes share.
+pub const SHADOW_WGSL: Shader = crate::wgsl!("src/render/passes/shadow/shadow.wgsl");
 
 /// Most directional lights with a shadow map (layers of the light-space targets).
 pub const MAX_SHADOWED_LIGHTS: usize = 4;
@@ -36,7 +49,7 @@ pub const MAX_SHADOWED_LIGHTS: usize = 4;
 /// Texels of border around the fitted box on each side (the PCF and bilinear reach).
 const BORDER_TEXELS: f64 = 4.0;
 
-/// `ShadowLight` of shaders/shadow.wgsl.
+/// `ShadowLight` of shadow.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct ShadowLightUniform {
@@ -52,7 +65,7 @@ pub struct ShadowLightUniform {
     pub index: [u32; 4],
 }
 
-/// `Shadows` of shaders/shadow.wgsl.
+/// `Shadows` of shadow.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct ShadowsUniform {
@@ -119,9 +132,9 @@ pub fn suggested_rsm_radius(scene: &Scene) -> f32 {
 
 /// Width × height × layers of the light-space targets: the map size (within the
 /// device's limit) and one layer per shadowed light.
-pub fn light_extent(scene: &Scene, settings: &Settings, max_dimension: u32) -> (u32, u32, u32) {
-    let size = settings.shadows.size.min(max_dimension).max(16);
-    (size, size, shadow_casters(scene).len().max(1) as u32)
+pub fn light_extent(setup: &FrameSetup, max_dimension: u32) -> (u32, u32, u32) {
+    let size = setup.settings.shadows.size.min(max_dimension).max(16);
+    (size, size, shadow_casters(setup.scene).len().max(1) as u32)
 }
 
 /// One light's orthographic fit, in f64.
@@ -208,7 +221,7 @@ impl LightFit {
 }
 
 /// What the light-space pass, the direct pass and the RSM gather share: the fits, the
-/// `Shadows` uniforms (all lights, and none), the comparison sampler and placeholders.
+/// `Shadows` uniforms (all lights, and none), and the comparison sampler.
 pub struct LightSpace {
     /// One fit per shadowed light, in [`shadow_casters`] order.
     pub fits: Vec<LightFit>,
@@ -218,8 +231,6 @@ pub struct LightSpace {
     pub none: wgpu::Buffer,
     /// Bilinear depth comparison (lit where reference ≤ stored depth).
     pub comparison: wgpu::Sampler,
-    /// Bound in place of the shadow map when it was not rendered.
-    pub placeholder_depth: LayeredTarget,
 }
 
 impl LightSpace {
@@ -254,8 +265,7 @@ impl LightSpace {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        let placeholder_depth = LayeredTarget::placeholder(device, "no shadow map", Resource::ShadowMap.format());
-        LightSpace { fits, uniform, none, comparison, placeholder_depth }
+        LightSpace { fits, uniform, none, comparison }
     }
 
     /// The `Shadows` uniform for maps of `size` texels a side.
@@ -292,7 +302,11 @@ impl ShadowPass {
             bind_group_layouts: &[Some(&light_layout), Some(&scene.material_layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, "shadow map", &["common.wgsl", "shadow.wgsl", "shadow_map.wgsl"]);
+        let module = shader_module(
+            device,
+            "shadow map",
+            &[COMMON, SHADOW_WGSL, crate::wgsl!("src/render/passes/shadow/shadow_map.wgsl")],
+        );
         let depth_only = pipeline(device, &layout, &module, false);
         let reflective = pipeline(device, &layout, &module, true);
         let light_buffers: Vec<wgpu::Buffer> = light_space
@@ -327,7 +341,7 @@ fn pipeline(
     module: &wgpu::ShaderModule,
     reflective: bool,
 ) -> wgpu::RenderPipeline {
-    let targets = [Resource::RsmNormal, Resource::RsmFlux].map(|r| Some(wgpu::ColorTargetState::from(r.format())));
+    let targets = [RSM_NORMAL, RSM_FLUX].map(|r| Some(wgpu::ColorTargetState::from(r.format())));
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(if reflective { "reflective shadow map" } else { "shadow map" }),
         layout: Some(layout),
@@ -340,7 +354,7 @@ fn pipeline(
         // Two-sided, as the G-buffer: both faces of a surface cast.
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: Some(wgpu::DepthStencilState {
-            format: Resource::ShadowMap.format(),
+            format: SHADOW_MAP.format(),
             depth_write_enabled: Some(true),
             depth_compare: Some(wgpu::CompareFunction::Less),
             stencil: Default::default(),
@@ -361,9 +375,9 @@ fn pipeline(
 impl Pass for ShadowPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let (scene, settings) = (setup.scene, setup.settings);
-        let mut decl = PassDecl::new("shadow").write(Resource::ShadowMap);
+        let mut decl = PassDecl::new("shadow").write(SHADOW_MAP);
         if rsm_active(scene, settings) {
-            decl = decl.write(Resource::RsmNormal).write(Resource::RsmFlux);
+            decl = decl.write(RSM_NORMAL).write(RSM_FLUX);
         }
         let lights = self.light_space.fits.len();
         let size = settings.shadows.size;
@@ -384,7 +398,7 @@ impl Pass for ShadowPass {
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let size = ctx.target(Resource::ShadowMap).width;
+        let size = ctx.target(SHADOW_MAP).width;
         let uniform = self.light_space.shadows_uniform(size);
         ctx.gpu.queue.write_buffer(&self.light_space.uniform, 0, bytemuck::bytes_of(&uniform));
         let reflective = rsm_active(ctx.setup.scene, ctx.setup.settings);
@@ -402,12 +416,12 @@ impl Pass for ShadowPass {
                     },
                 })
             };
-            let colors = if reflective { vec![color(Resource::RsmNormal), color(Resource::RsmFlux)] } else { vec![] };
+            let colors = if reflective { vec![color(RSM_NORMAL), color(RSM_FLUX)] } else { vec![] };
             let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
                 color_attachments: &colors,
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &targets[&Resource::ShadowMap].layer_views[layer],
+                    view: &targets[&SHADOW_MAP].layer_views[layer],
                     depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                     stencil_ops: None,
                 }),

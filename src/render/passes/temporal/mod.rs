@@ -1,18 +1,55 @@
-//! Temporal accumulation (Lin's NCTU thesis §3.1; shaders/temporal.wgsl): the occlusion of this
+//! Temporal accumulation (Lin's NCTU thesis §3.1; temporal.wgsl): the occlusion of this
 //! frame blended with the history reprojected from the previous frame. The history is
 //! two pairs of targets (value, world position + frame count) that swap roles every
-//! frame; they persist between frames because the renderer keeps targets whose size
-//! does not change.
+//! frame; the pass owns them, so they persist from frame to frame whatever the graph
+//! allocates, and makes them again only when the occlusion's size changes.
 
+use super::occlusion::AO_GEOMETRY;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::kernel::{invalidate_bind_groups, Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::render::settings::{Technique, TemporalBlend};
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
+use std::sync::Mutex;
 
-/// Mirrors `Temporal` in shaders/temporal.wgsl.
+/// Occlusion accumulated over frames by reverse reprojection, at AO resolution, laid out
+/// as the raw occlusion.
+pub const AO_ACCUMULATED: Resource =
+    Resource::storage("ao-accumulated", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+
+/// The history's accumulated values, a ping-pong pair the pass keeps (not the graph's).
+pub const HISTORY_VALUE: [Resource; 2] = [
+    Resource::storage("history-value-a", Size::Occlusion, wgpu::TextureFormat::Rgba16Float),
+    Resource::storage("history-value-b", Size::Occlusion, wgpu::TextureFormat::Rgba16Float),
+];
+
+/// The history's world positions relative to the scene anchor, with the accumulated
+/// frame count in w: a ping-pong pair the pass keeps.
+pub const HISTORY_POSITION: [Resource; 2] = [
+    Resource::storage("history-position-a", Size::Occlusion, wgpu::TextureFormat::Rgba32Float),
+    Resource::storage("history-position-b", Size::Occlusion, wgpu::TextureFormat::Rgba32Float),
+];
+
+/// temporal.wgsl's bindings: frame, AO parameters, the pass's uniform, the occlusion
+/// and its geometry, last frame's history (value, position), the accumulation out and
+/// this frame's history out (value, position).
+const BINDINGS: [Bind; 10] = [
+    Bind::Frame,
+    Bind::AoParams,
+    Bind::Own(Slot::Uniform),
+    Bind::Read(AO_GEOMETRY),
+    Bind::Read(OCCLUSION),
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::Layers),
+    Bind::Write(AO_ACCUMULATED),
+    Bind::Own(Slot::Output(HISTORY_VALUE[0].format())),
+    Bind::Own(Slot::Output(HISTORY_POSITION[0].format())),
+];
+
+/// Mirrors `Temporal` in temporal.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct TemporalUniform {
@@ -32,62 +69,56 @@ struct TemporalUniform {
 pub struct TemporalPass {
     kernel: Kernel,
     uniform: wgpu::Buffer,
-}
-
-/// This frame's (read, write) history targets: (value, position) pairs swap each frame.
-fn history(frame_index: u64) -> ([Resource; 2], [Resource; 2]) {
-    let a = [Resource::HistoryValueA, Resource::HistoryPositionA];
-    let b = [Resource::HistoryValueB, Resource::HistoryPositionB];
-    if frame_index.is_multiple_of(2) {
-        (a, b)
-    } else {
-        (b, a)
-    }
+    /// [value a, value b, position a, position b], made at the occlusion's size.
+    history: Mutex<Vec<LayeredTarget>>,
 }
 
 impl TemporalPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> TemporalPass {
-        let slots = [
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Output(Resource::AoAccumulated.format()),
-            Slot::Output(Resource::HistoryValueA.format()),
-            Slot::Output(Resource::HistoryPositionA.format()),
-        ];
+        let files = [COMMON, crate::wgsl!("src/render/passes/temporal/temporal.wgsl")];
         TemporalPass {
-            kernel: Kernel::new(gpu, "temporal", &["common.wgsl", "temporal.wgsl"], "main", &slots),
+            kernel: Kernel::new(gpu, "temporal", &files, "main", &BINDINGS),
             uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("temporal"),
                 size: std::mem::size_of::<TemporalUniform>() as u64,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
+            history: Mutex::new(Vec::new()),
         }
+    }
+
+    /// The history targets at `extent`, made (zeroed) when they are missing or of another
+    /// size; `true` when they were just made and hold no history.
+    fn history_at(&self, device: &wgpu::Device, extent: (u32, u32, u32)) -> (Vec<LayeredTarget>, bool) {
+        let mut history = self.history.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let fresh = history.first().is_none_or(|t| t.extent() != extent);
+        if fresh {
+            // COPY_DST: tests poison the history by writing it.
+            let usage = wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST;
+            *history = HISTORY_VALUE
+                .iter()
+                .chain(&HISTORY_POSITION)
+                .map(|r| LayeredTarget::new(device, r.name(), r.format(), extent, usage))
+                .collect();
+            invalidate_bind_groups();
+        }
+        (history.clone(), fresh)
     }
 }
 
 impl Pass for TemporalPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
-        let mut decl = PassDecl::new("temporal")
-            .read(Resource::AoGeometry)
-            .read(Resource::AoRaw)
-            .write(Resource::AoAccumulated)
+        PassDecl::new("temporal")
+            .bindings(&BINDINGS)
+            .provide(OCCLUSION, AO_ACCUMULATED)
+            .occlusion_cost()
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to accumulate")
-            .disabled_if(!ao.temporal.enabled, "temporal accumulation is off (--temporal)");
-        // Both history pairs are read and written (their roles swap every frame).
-        for r in
-            [Resource::HistoryValueA, Resource::HistoryPositionA, Resource::HistoryValueB, Resource::HistoryPositionB]
-        {
-            decl = decl.read(r).write(r);
-        }
-        decl
+            .disabled_if(!ao.temporal.enabled, "temporal accumulation is off (--temporal)")
     }
 
     fn record(&self, ctx: &mut FrameContext) {
@@ -115,7 +146,9 @@ impl Pass for TemporalPass {
             TemporalBlend::Average => 0,
             TemporalBlend::Confidence => 1,
         };
-        u.history_valid = setup.previous_views.is_some() as u32;
+        let extent = ctx.ao_extent();
+        let (history, fresh) = self.history_at(&ctx.gpu.device, extent);
+        u.history_valid = (setup.previous_views.is_some() && !fresh) as u32;
         // The frame's own views (an OpenXR runtime's, every frame), not the profile's.
         let p = &setup.settings.profile;
         let fov = current.first().map_or(p.fov_left, |eye| eye.fov);
@@ -123,19 +156,25 @@ impl Pass for TemporalPass {
         let scale = if setup.settings.ao.half_res { 2.0 } else { 1.0 };
         u.pixel_tangent = ((r - l) / p.width as f64 * scale) as f32;
         ctx.gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&u));
-        let (read, write) = history(setup.frame_index);
-        let resources = [
-            ctx.frame.frame.as_entire_binding(),
-            ctx.frame.ao.as_entire_binding(),
+        // This frame reads one (value, position) pair and writes the other; they swap each frame.
+        let (read, write) = if setup.frame_index.is_multiple_of(2) { (0, 1) } else { (1, 0) };
+        fn view(t: &LayeredTarget) -> wgpu::BindingResource<'_> {
+            wgpu::BindingResource::TextureView(&t.array_view)
+        }
+        let own = [
             self.uniform.as_entire_binding(),
-            ctx.view(Resource::AoGeometry),
-            ctx.view(Resource::AoRaw),
-            ctx.view(read[0]),
-            ctx.view(read[1]),
-            ctx.view(Resource::AoAccumulated),
-            ctx.view(write[0]),
-            ctx.view(write[1]),
+            view(&history[read]),
+            view(&history[2 + read]),
+            view(&history[write]),
+            view(&history[2 + write]),
         ];
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.ao_extent());
+        // The history views live in `history` (clones of the pass's handles) until the dispatch.
+        let resources = ctx.bind(&BINDINGS, &own);
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+    }
+
+    fn kept_target(&self, r: Resource) -> Option<LayeredTarget> {
+        let index = HISTORY_VALUE.iter().chain(&HISTORY_POSITION).position(|h| *h == r)?;
+        self.history.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).get(index).cloned()
     }
 }

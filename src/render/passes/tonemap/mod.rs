@@ -1,9 +1,15 @@
 //! Reinhard tone mapping with a white point (the Czech SSDO thesis, eq. 2.4) and sRGB encoding.
 
+use super::composite::HDR;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Kernel, Slot};
+use crate::render::gpu::kernel::{Bind, Kernel, COMMON};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size};
+
+/// Tone-mapped, sRGB-encoded eye colour.
+pub const COLOR: Resource = Resource::storage("color", Size::Full, wgpu::TextureFormat::Rgba8Unorm);
+
+const BINDINGS: [Bind; 3] = [Bind::Frame, Bind::Read(HDR), Bind::Write(COLOR)];
 
 /// Tone mapping of the HDR radiance into the eye colour (module docs).
 pub struct TonemapPass {
@@ -13,19 +19,18 @@ pub struct TonemapPass {
 impl TonemapPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let slots = [Slot::Uniform, Slot::Layers, Slot::Output(Resource::Color.format())];
-        TonemapPass { kernel: Kernel::new(gpu, "tonemap", &["common.wgsl", "tonemap.wgsl"], "main", &slots) }
+        let files = [COMMON, crate::wgsl!("src/render/passes/tonemap/tonemap.wgsl")];
+        TonemapPass { kernel: Kernel::new(gpu, "tonemap", &files, "main", &BINDINGS) }
     }
 }
 
 impl Pass for TonemapPass {
     fn declare(&self, _: &FrameSetup) -> PassDecl {
-        PassDecl::new("tonemap").read(Resource::Hdr).write(Resource::Color)
+        PassDecl::new("tonemap").bindings(&BINDINGS)
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let resources = [ctx.frame.frame.as_entire_binding(), ctx.view(Resource::Hdr), ctx.view(Resource::Color)];
-        let extent = ctx.extent();
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        let resources = ctx.bind(&BINDINGS, &[]);
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.extent());
     }
 }

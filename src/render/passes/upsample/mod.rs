@@ -1,13 +1,47 @@
-//! 3×3 joint bilateral upsampling of half-resolution occlusion (the Czech SSDO thesis) into a
-//! full-resolution target (shaders/upsample.wgsl). Frames upsample inside the composite
-//! instead, so the graph runs this pass only when AoFull itself is asked for (debug
-//! images, tests).
+//! 3×3 joint bilateral upsampling of half-resolution occlusion (the Czech SSDO thesis)
+//! into a full-resolution target (upsample.wgsl, on joint_upsample.wgsl, which the
+//! composite shares). Frames upsample inside the composite instead, so the graph runs
+//! this pass only when the full-resolution AO itself is asked for (the final AO of the
+//! outputs, the bench, the window's buffer view, tests).
 
-use super::occlusion::layer_view;
-use super::{occlusion_before_upsample, reuses_left_eye_upsample, FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Kernel, Slot};
+use super::gbuffer::{DEPTH, NORMALS};
+use super::occlusion::AO_GEOMETRY;
+use super::{FrameContext, FrameSetup, Pass};
+use crate::render::gpu::kernel::{Bind, Kernel, Shader, Slot, COMMON};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
+use crate::render::settings::{Settings, Technique};
+
+/// The occlusion upsampled from half to full resolution.
+pub const AO_FULL: Resource = Resource::storage("ao-full", Size::Full, wgpu::TextureFormat::Rgba16Float);
+
+/// joint_upsample.wgsl: the 3×3 joint bilateral weights and the right eye's reuse of the
+/// left eye's result, shared with the composite.
+pub const JOINT_UPSAMPLE_WGSL: Shader = crate::wgsl!("src/render/passes/upsample/joint_upsample.wgsl");
+
+/// upsample.wgsl's bindings: frame, AO parameters, the G-buffer and the occlusion's
+/// geometry, the occlusion in, the full-resolution AO out and, at 7, its left-eye layer
+/// for the right eye's dispatch (the geometry stands in before it).
+const BINDINGS: [Bind; 8] = [
+    Bind::Frame,
+    Bind::AoParams,
+    Bind::Read(DEPTH),
+    Bind::Read(NORMALS),
+    Bind::Read(AO_GEOMETRY),
+    Bind::Read(OCCLUSION),
+    Bind::Write(AO_FULL),
+    Bind::Own(Slot::Layers),
+];
+
+/// Whether the right eye takes the left eye's upsampled AO instead of upsampling its own
+/// wherever the left eye sees the same point (joint_upsample.wgsl `right_eye_quad`): with
+/// the stereo reuse, two views and half-resolution occlusion of an AO-only technique
+/// (SSDO's rgb carries gathered light, which the composite's alpha, where the left eye's
+/// AO waits for the right eye, cannot hold).
+pub fn reuses_left_eye_upsample(settings: &Settings, layers: u32) -> bool {
+    let ao = &settings.ao;
+    ao.stereo_reuse && ao.half_res && layers == 2 && ao.technique != Technique::None && !ao.technique.carries_light()
+}
 
 /// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
 pub struct UpsamplePass {
@@ -19,19 +53,9 @@ pub struct UpsamplePass {
 impl UpsamplePass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let slots = [
-            Slot::Uniform,
-            Slot::Uniform,
-            Slot::Depth,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Layers,
-            Slot::Output(Resource::AoFull.format()),
-            Slot::Layers,
-        ];
-        let files = ["common.wgsl", "joint_upsample.wgsl", "upsample.wgsl"];
+        let files = [COMMON, JOINT_UPSAMPLE_WGSL, crate::wgsl!("src/render/passes/upsample/upsample.wgsl")];
         let kernel = |label: &str, right_eye: bool| {
-            Kernel::with_constants(gpu, label, &files, "main", &slots, &[("RIGHT_EYE", f64::from(right_eye))])
+            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &[("RIGHT_EYE", f64::from(right_eye))])
         };
         UpsamplePass { kernel: kernel("upsample", false), right_eye: kernel("upsample right eye", true) }
     }
@@ -39,32 +63,17 @@ impl UpsamplePass {
 
 impl Pass for UpsamplePass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        let decl = PassDecl::new("upsample")
-            .read(Resource::Depth)
-            .read(Resource::Normals)
-            .read(Resource::AoGeometry)
-            .write(Resource::AoFull);
-        match occlusion_before_upsample(setup.settings) {
-            None => decl.disabled_if(true, "technique is none: nothing to upsample"),
-            Some(input) => {
-                decl.read(input).disabled_if(!setup.settings.ao.half_res, "occlusion runs at full resolution")
-            }
-        }
+        let ao = &setup.settings.ao;
+        PassDecl::new("upsample")
+            .bindings(&BINDINGS)
+            .provide(FINAL_AO, AO_FULL)
+            .occlusion_cost()
+            .disabled_if(ao.technique == Technique::None, "technique is none: nothing to upsample")
+            .disabled_if(!ao.half_res, "occlusion runs at full resolution")
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let input = occlusion_before_upsample(ctx.setup.settings).expect("upsample runs only with a technique");
-        let mut resources = [
-            ctx.frame.frame.as_entire_binding(),
-            ctx.frame.ao.as_entire_binding(),
-            ctx.view(Resource::Depth),
-            ctx.view(Resource::Normals),
-            ctx.view(Resource::AoGeometry),
-            ctx.view(input),
-            ctx.view(Resource::AoFull),
-            // The left eye's layer for the right eye's dispatch; AoGeometry stands in.
-            ctx.view(Resource::AoGeometry),
-        ];
+        let mut resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY)]);
         // One invocation per quad of 2×2 full-res pixels (upsample.wgsl): both eyes
         // alike, or the left eye and then the right eye reusing it.
         let (w, h, layers) = ctx.quad_extent();
@@ -72,7 +81,7 @@ impl Pass for UpsamplePass {
         let device = &ctx.gpu.device;
         self.kernel.dispatch(device, ctx.encoder, &resources, (w, h, if reuse { 1 } else { layers }));
         if reuse {
-            let (right, left) = (layer_view(ctx, Resource::AoFull, 1), layer_view(ctx, Resource::AoFull, 0));
+            let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));
             resources[6] = wgpu::BindingResource::TextureView(&right);
             resources[7] = wgpu::BindingResource::TextureView(&left);
             self.right_eye.dispatch(device, ctx.encoder, &resources, (w, h, 1));

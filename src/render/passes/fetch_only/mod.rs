@@ -1,0 +1,12 @@
+//! The benchmark baseline: SSAO's depth taps without the occlusion arithmetic
+//! (fetch_only.wgsl), on the shared occlusion layout, so the bench can tell memory from
+//! arithmetic.
+
+use super::occlusion::TechniquePass;
+use crate::render::gpu::Gpu;
+use crate::render::settings::Technique;
+
+/// The fetch-only pass.
+pub fn pass(gpu: &Gpu) -> TechniquePass {
+    TechniquePass::new(gpu, Technique::FetchOnly, crate::wgsl!("src/render/passes/fetch_only/fetch_only.wgsl"))
+}

@@ -1,0 +1,11 @@
+//! SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3): the hemisphere kernel's
+//! samples tested against the depth buffer (ssao.wgsl), on the shared occlusion layout.
+
+use super::occlusion::TechniquePass;
+use crate::render::gpu::Gpu;
+use crate::render::settings::Technique;
+
+/// The occlusion pass of SSAO.
+pub fn pass(gpu: &Gpu) -> TechniquePass {
+    TechniquePass::new(gpu, Technique::Ssao, crate::wgsl!("src/render/passes/ssao/ssao.wgsl"))
+}
