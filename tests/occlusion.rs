@@ -15,10 +15,12 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 use vrao::measure::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
 use vrao::measure::stereo_consistency::{stereo_consistency, EyeImages};
+use vrao::render::graph::FINAL_AO;
 use vrao::render::passes::blur::AO_BLURRED;
 use vrao::render::passes::composite::HDR;
 use vrao::render::passes::gbuffer::DEPTH;
 use vrao::render::passes::occlusion::{AO_GEOMETRY, AO_RAW};
+use vrao::render::passes::temporal::AO_ACCUMULATED;
 use vrao::render::passes::tonemap::COLOR;
 use vrao::render::passes::upsample::AO_FULL;
 use vrao::render::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
@@ -1318,6 +1320,41 @@ fn no_output_is_ever_nan_or_inf() {
 
 // ---------------------------------------------------------------------------------------
 // The plan (`--explain`)
+
+/// The final AO is the graph's named output: the last texture the AO chain provides for
+/// these settings, and the occlusion's cost is the chain's passes (what the governor
+/// and the bench time).
+#[test]
+fn the_final_ao_is_what_the_ao_chain_last_provided() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let cases = [
+        // (technique, blur radius, half resolution, temporal) → final AO, occlusion passes
+        (Technique::Gtao, 4, false, false, AO_BLURRED, vec!["gtao", "blur"]),
+        (Technique::Gtao, 4, true, false, AO_FULL, vec!["gtao", "blur", "upsample"]),
+        (Technique::Ssao, 0, false, false, AO_RAW, vec!["ssao"]),
+        (Technique::Hbao, 0, false, true, AO_ACCUMULATED, vec!["hbao", "temporal"]),
+        (Technique::Ssdo, 4, true, true, AO_FULL, vec!["ssdo", "temporal", "blur", "upsample"]),
+    ];
+    for (technique, blur_radius, half_res, temporal, expected, chain) in cases {
+        let mut ao = AoSettings { technique, blur_radius, half_res, ..AoSettings::default() };
+        ao.temporal.enabled = temporal;
+        let renderer = Renderer::new(gpu.clone(), &scene, &settings(64, 72, ao)).unwrap();
+        let plan = renderer.plan(2, &[FINAL_AO]).unwrap();
+        let label = format!("{technique:?} blur {blur_radius} half {half_res} temporal {temporal}");
+        assert_eq!(plan.resolve(FINAL_AO), Some(expected), "{label}\n{plan}");
+        assert_eq!(plan.occlusion_passes(), chain, "{label}");
+        // The composite of a frame reads the occlusion at occlusion resolution, never the
+        // standalone upsample's output: a frame of the eyes alone runs no upsample.
+        let frame = renderer.plan(2, &[COLOR]).unwrap();
+        assert!(!frame.runs("upsample"), "{label}\n{frame}");
+    }
+    let none = AoSettings { technique: Technique::None, ..AoSettings::default() };
+    let renderer = Renderer::new(gpu.clone(), &scene, &settings(64, 72, none)).unwrap();
+    assert!(renderer.plan(2, &[COLOR]).unwrap().resolve(FINAL_AO).is_none());
+    let error = renderer.plan(2, &[FINAL_AO]).unwrap_err().to_string();
+    assert!(error.contains("final-ao"), "{error}");
+}
 
 #[test]
 fn the_plan_explains_what_occlusion_left_out() {

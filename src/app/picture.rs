@@ -3,7 +3,7 @@
 //! (mirror.wgsl).
 
 use crate::app::BufferView;
-use crate::render::gpu::kernel::shader_module;
+use crate::render::gpu::kernel::{shader_module, wgsl};
 use crate::render::gpu::Gpu;
 
 /// The picture's pipelines: a full-screen triangle drawing one 2D view into a viewport,
@@ -55,7 +55,7 @@ impl Blit {
             &[(2, texture_binding(wgpu::TextureSampleType::Float { filterable: false }))],
         );
         let depth_layout = fragment_layout(gpu, "depth view", &[(3, texture_binding(wgpu::TextureSampleType::Depth))]);
-        let module = shader_module(device, "mirror", &[crate::wgsl!("src/app/mirror.wgsl")]);
+        let module = shader_module(device, "mirror", &[wgsl!("src/app/mirror.wgsl")]);
         let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(entry_point),

@@ -26,7 +26,7 @@ pub fn invalidate_bind_groups() {
 pub const TILE: u32 = 8;
 
 /// One WGSL file, compiled into the binary so it runs from any directory; `path` is
-/// relative to the repository root (for `VRAO_SHADER_DIR`). Make one with [`wgsl!`](crate::wgsl).
+/// relative to the repository root (for `VRAO_SHADER_DIR`). Make one with [`wgsl!`].
 #[derive(Clone, Copy, Debug)]
 pub struct Shader {
     /// The file, relative to the repository root.
@@ -37,7 +37,6 @@ pub struct Shader {
 
 /// A [`Shader`] of a WGSL file named by its path from the repository root; the file
 /// lives beside the code that uses it (`src/render/passes/<pass>/<pass>.wgsl`).
-#[macro_export]
 macro_rules! wgsl {
     ($path:literal) => {
         $crate::render::gpu::kernel::Shader {
@@ -47,11 +46,13 @@ macro_rules! wgsl {
     };
 }
 
+pub(crate) use wgsl;
+
 /// `common.wgsl`: the frame's uniforms and helpers every pass shares.
-pub const COMMON: Shader = crate::wgsl!("src/render/gpu/shaders/common.wgsl");
+pub const COMMON: Shader = wgsl!("src/render/gpu/shaders/common.wgsl");
 
 /// `irradiance.wgsl`: the environment's irradiance and radiance quadratics.
-pub const IRRADIANCE: Shader = crate::wgsl!("src/render/gpu/shaders/irradiance.wgsl");
+pub const IRRADIANCE: Shader = wgsl!("src/render/gpu/shaders/irradiance.wgsl");
 
 /// A shader module made of the given files, concatenated in order (common first), so
 /// passes share `common.wgsl` without string formatting.

@@ -7,6 +7,7 @@ use super::kernel::shader_module;
 use super::readback::read_layers;
 use super::targets::LayeredTarget;
 use super::Gpu;
+use crate::render::gpu::kernel::wgsl;
 use std::num::NonZeroU32;
 
 const SIZE: u32 = 16;
@@ -17,7 +18,7 @@ pub fn multiview_reaches_every_layer(gpu: &Gpu) -> bool {
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let target =
         LayeredTarget::new(device, "multiview probe", format, (SIZE, SIZE, 2), wgpu::TextureUsages::RENDER_ATTACHMENT);
-    let module = shader_module(device, "multiview probe", &[crate::wgsl!("src/render/gpu/multiview_probe.wgsl")]);
+    let module = shader_module(device, "multiview probe", &[wgsl!("src/render/gpu/multiview_probe.wgsl")]);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("multiview probe"),
         bind_group_layouts: &[],

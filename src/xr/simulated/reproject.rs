@@ -2,7 +2,7 @@
 //! re-presented at a newer head pose, rotationally (orientation only, a homography per
 //! eye) or positionally (the submitted depth forward-splatted into the new view).
 
-use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::passes::tonemap::COLOR;
@@ -70,7 +70,7 @@ const BINDINGS: [Bind; 6] = [
 impl Reprojector {
     /// Compiles the warp's kernels (splat, positional, rotational).
     pub fn new(gpu: &Gpu) -> Reprojector {
-        let files = [COMMON, crate::wgsl!("src/xr/simulated/reproject.wgsl")];
+        let files = [COMMON, wgsl!("src/xr/simulated/reproject.wgsl")];
         let variant = |label, entry, positional: bool| {
             Kernel::with_constants(gpu, label, &files, entry, &BINDINGS, &[("POSITIONAL", f64::from(positional))])
         };

@@ -7,7 +7,7 @@
 use super::gbuffer::DEPTH;
 use super::occlusion::AO_GEOMETRY;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, Shader, Slot, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::render::settings::{Denoise, Technique};
@@ -56,7 +56,7 @@ struct DenoiseKernels {
 impl DenoiseKernels {
     /// `constants`: the shader's pipeline constants besides `RIGHT_EYE`.
     fn new(gpu: &Gpu, shader: Shader, horizontal: &str, vertical: &str, constants: &[(&str, f64)]) -> Self {
-        let files = [COMMON, crate::wgsl!("src/render/passes/blur/denoise_stereo.wgsl"), shader];
+        let files = [COMMON, wgsl!("src/render/passes/blur/denoise_stereo.wgsl"), shader];
         let kernel = |entry: &str, binds: &[Bind], right_eye: bool| {
             let mut constants = constants.to_vec();
             constants.push(("RIGHT_EYE", f64::from(right_eye)));
@@ -85,11 +85,11 @@ impl BlurPass {
         BlurPass {
             tile: [false, true].map(|carries_light| {
                 let constants = [("CARRIES_LIGHT", f64::from(carries_light))];
-                let shader = crate::wgsl!("src/render/passes/blur/denoise.wgsl");
+                let shader = wgsl!("src/render/passes/blur/denoise.wgsl");
                 DenoiseKernels::new(gpu, shader, "denoise_horizontal", "denoise_vertical", &constants)
             }),
             bilateral: {
-                let shader = crate::wgsl!("src/render/passes/blur/bilateral.wgsl");
+                let shader = wgsl!("src/render/passes/blur/bilateral.wgsl");
                 DenoiseKernels::new(gpu, shader, "blur_horizontal", "blur_vertical", &[])
             },
         }

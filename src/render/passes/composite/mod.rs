@@ -16,7 +16,7 @@ use super::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
 use super::shadow::rsm_active;
 use super::upsample::{reuses_left_eye_upsample, JOINT_UPSAMPLE_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON, IRRADIANCE};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, IRRADIANCE};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::render::settings::Technique;
@@ -74,8 +74,7 @@ const BINDINGS: [Bind; 15] = [
 impl CompositePass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files =
-            [COMMON, IRRADIANCE, JOINT_UPSAMPLE_WGSL, crate::wgsl!("src/render/passes/composite/composite.wgsl")];
+        let files = [COMMON, IRRADIANCE, JOINT_UPSAMPLE_WGSL, wgsl!("src/render/passes/composite/composite.wgsl")];
         let variant = |half_res: bool, rsm: bool, right_eye: bool, fallback: bool| {
             let constants = [
                 ("HALF_RES", f64::from(half_res)),

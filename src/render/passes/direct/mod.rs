@@ -6,7 +6,7 @@
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS};
 use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use std::sync::Arc;
@@ -40,7 +40,7 @@ pub struct DirectLightPass {
 impl DirectLightPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> Self {
-        let files = [COMMON, SHADOW_WGSL, crate::wgsl!("src/render/passes/direct/direct.wgsl")];
+        let files = [COMMON, SHADOW_WGSL, wgsl!("src/render/passes/direct/direct.wgsl")];
         DirectLightPass { kernel: Kernel::new(gpu, "direct", &files, "main", &BINDINGS), light_space }
     }
 }

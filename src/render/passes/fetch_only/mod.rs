@@ -3,10 +3,11 @@
 //! arithmetic.
 
 use super::occlusion::TechniquePass;
+use crate::render::gpu::kernel::wgsl;
 use crate::render::gpu::Gpu;
 use crate::render::settings::Technique;
 
 /// The fetch-only pass.
 pub fn pass(gpu: &Gpu) -> TechniquePass {
-    TechniquePass::new(gpu, Technique::FetchOnly, crate::wgsl!("src/render/passes/fetch_only/fetch_only.wgsl"))
+    TechniquePass::new(gpu, Technique::FetchOnly, wgsl!("src/render/passes/fetch_only/fetch_only.wgsl"))
 }

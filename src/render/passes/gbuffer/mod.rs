@@ -4,7 +4,7 @@
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
-use crate::render::gpu::kernel::{shader_module, Shader, COMMON};
+use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::Gpu;
@@ -24,7 +24,7 @@ pub const EMISSION: Resource = Resource::attachment("emission", Size::Full, wgpu
 const COLOR_TARGETS: [Resource; 3] = [NORMALS, ALBEDO, EMISSION];
 
 /// gbuffer.wgsl: the vertex transform and fragment shader both paths share.
-const GBUFFER_WGSL: Shader = crate::wgsl!("src/render/passes/gbuffer/gbuffer.wgsl");
+const GBUFFER_WGSL: Shader = wgsl!("src/render/passes/gbuffer/gbuffer.wgsl");
 
 /// The G-buffer of both eyes: depth, normals, albedo and emission, multiview or one pass per
 /// eye (module docs).
@@ -71,7 +71,7 @@ impl GBufferPass {
             let module = shader_module(
                 device,
                 "gbuffer multiview",
-                &[COMMON, GBUFFER_WGSL, crate::wgsl!("src/render/passes/gbuffer/gbuffer_multiview.wgsl")],
+                &[COMMON, GBUFFER_WGSL, wgsl!("src/render/passes/gbuffer/gbuffer_multiview.wgsl")],
             );
             pipeline(device, &layout, &module, NonZeroU32::new(0b11))
         });
@@ -83,7 +83,7 @@ impl GBufferPass {
         let module = shader_module(
             device,
             "gbuffer multipass",
-            &[COMMON, GBUFFER_WGSL, crate::wgsl!("src/render/passes/gbuffer/gbuffer_multipass.wgsl")],
+            &[COMMON, GBUFFER_WGSL, wgsl!("src/render/passes/gbuffer/gbuffer_multipass.wgsl")],
         );
         let multipass = pipeline(device, &layout, &module, None);
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {

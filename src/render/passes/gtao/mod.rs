@@ -5,7 +5,7 @@
 
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::PassDecl;
 use crate::render::settings::Technique;
@@ -54,7 +54,7 @@ pub struct GtaoPass {
 impl GtaoPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = [COMMON, OCCLUSION_WGSL, crate::wgsl!("src/render/passes/gtao/gtao.wgsl")];
+        let files = [COMMON, OCCLUSION_WGSL, wgsl!("src/render/passes/gtao/gtao.wgsl")];
         let label = Technique::Gtao.name();
         let kernel = |band: bool, right: bool| {
             let constants = [

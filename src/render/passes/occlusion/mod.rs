@@ -5,7 +5,7 @@
 //! are passes of their own in their folders.
 
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, Shader, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Shader, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::render::passes::gbuffer::{DEPTH, NORMALS};
@@ -21,7 +21,7 @@ pub const AO_RAW: Resource = Resource::storage("ao-raw", Size::Occlusion, wgpu::
 pub const AO_GEOMETRY: Resource = Resource::storage("ao-geometry", Size::Occlusion, wgpu::TextureFormat::Rgba32Float);
 
 /// occlusion.wgsl: the layout and helpers every technique's WGSL builds on.
-pub const OCCLUSION_WGSL: Shader = crate::wgsl!("src/render/passes/occlusion/occlusion.wgsl");
+pub const OCCLUSION_WGSL: Shader = wgsl!("src/render/passes/occlusion/occlusion.wgsl");
 
 /// Bindings 0–6 of occlusion.wgsl: frame, AO parameters, sample kernel, depth, normals,
 /// raw occlusion out, AO geometry out.

@@ -9,7 +9,7 @@
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
-use crate::render::gpu::kernel::{shader_module, COMMON};
+use crate::render::gpu::kernel::{shader_module, wgsl, COMMON};
 use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
@@ -60,7 +60,7 @@ impl DepthPeelPass {
             bind_group_layouts: &[Some(&frame_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, "depth peel", &[COMMON, crate::wgsl!("src/render/passes/peel/peel.wgsl")]);
+        let module = shader_module(device, "depth peel", &[COMMON, wgsl!("src/render/passes/peel/peel.wgsl")]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("depth peel"),
             layout: Some(&layout),

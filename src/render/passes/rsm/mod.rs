@@ -8,7 +8,7 @@ use super::gbuffer::{DEPTH, NORMALS};
 use super::shadow::{rsm_active, shadow_casters, LightSpace, RSM_FLUX, RSM_NORMAL, SHADOW_MAP, SHADOW_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::ao_extent;
-use crate::render::gpu::kernel::{Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use bytemuck::{Pod, Zeroable};
@@ -61,7 +61,7 @@ pub struct RsmPass {
 impl RsmPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> RsmPass {
-        let files = [COMMON, SHADOW_WGSL, crate::wgsl!("src/render/passes/rsm/rsm.wgsl")];
+        let files = [COMMON, SHADOW_WGSL, wgsl!("src/render/passes/rsm/rsm.wgsl")];
         let kernel = Kernel::new(gpu, "rsm", &files, "main", &BINDINGS);
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rsm params"),

@@ -18,7 +18,7 @@
 //! reduction) are the way to spend texels on what is near; see the report.
 
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{shader_module, Shader, COMMON};
+use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::Gpu;
@@ -41,7 +41,7 @@ pub const RSM_FLUX: Resource =
     Resource::attachment("rsm-flux", Size::Computed(light_extent), wgpu::TextureFormat::Rgba16Float);
 
 /// shadow.wgsl: the `Shadows` uniform and the PCF lookup the direct and RSM passes share.
-pub const SHADOW_WGSL: Shader = crate::wgsl!("src/render/passes/shadow/shadow.wgsl");
+pub const SHADOW_WGSL: Shader = wgsl!("src/render/passes/shadow/shadow.wgsl");
 
 /// Most directional lights with a shadow map (layers of the light-space targets).
 pub const MAX_SHADOWED_LIGHTS: usize = 4;
@@ -305,7 +305,7 @@ impl ShadowPass {
         let module = shader_module(
             device,
             "shadow map",
-            &[COMMON, SHADOW_WGSL, crate::wgsl!("src/render/passes/shadow/shadow_map.wgsl")],
+            &[COMMON, SHADOW_WGSL, wgsl!("src/render/passes/shadow/shadow_map.wgsl")],
         );
         let depth_only = pipeline(device, &layout, &module, false);
         let reflective = pipeline(device, &layout, &module, true);

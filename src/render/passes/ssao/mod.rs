@@ -2,10 +2,11 @@
 //! samples tested against the depth buffer (ssao.wgsl), on the shared occlusion layout.
 
 use super::occlusion::TechniquePass;
+use crate::render::gpu::kernel::wgsl;
 use crate::render::gpu::Gpu;
 use crate::render::settings::Technique;
 
 /// The occlusion pass of SSAO.
 pub fn pass(gpu: &Gpu) -> TechniquePass {
-    TechniquePass::new(gpu, Technique::Ssao, crate::wgsl!("src/render/passes/ssao/ssao.wgsl"))
+    TechniquePass::new(gpu, Technique::Ssao, wgsl!("src/render/passes/ssao/ssao.wgsl"))
 }

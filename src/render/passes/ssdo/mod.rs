@@ -8,7 +8,7 @@ use super::direct::DIRECT;
 use super::occlusion::{self, technique_decl, OCCLUSION_WGSL};
 use super::peel::DEPTH_LAYER_2;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, COMMON, IRRADIANCE};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, COMMON, IRRADIANCE};
 use crate::render::gpu::Gpu;
 use crate::render::graph::PassDecl;
 use crate::render::settings::{BounceForm, Technique};
@@ -37,7 +37,7 @@ pub struct SsdoPass {
 impl SsdoPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = [COMMON, IRRADIANCE, OCCLUSION_WGSL, crate::wgsl!("src/render/passes/ssdo/ssdo.wgsl")];
+        let files = [COMMON, IRRADIANCE, OCCLUSION_WGSL, wgsl!("src/render/passes/ssdo/ssdo.wgsl")];
         let labels = [
             ["ssdo", "ssdo-bounce", "ssdo-bounce patch"],
             ["ssdo peeled", "ssdo-bounce peeled", "ssdo-bounce patch peeled"],

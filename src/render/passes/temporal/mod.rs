@@ -6,7 +6,7 @@
 
 use super::occlusion::AO_GEOMETRY;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{invalidate_bind_groups, Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::kernel::{invalidate_bind_groups, wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
@@ -76,7 +76,7 @@ pub struct TemporalPass {
 impl TemporalPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> TemporalPass {
-        let files = [COMMON, crate::wgsl!("src/render/passes/temporal/temporal.wgsl")];
+        let files = [COMMON, wgsl!("src/render/passes/temporal/temporal.wgsl")];
         TemporalPass {
             kernel: Kernel::new(gpu, "temporal", &files, "main", &BINDINGS),
             uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {

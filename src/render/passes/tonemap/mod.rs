@@ -2,7 +2,7 @@
 
 use super::composite::HDR;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 
@@ -19,7 +19,7 @@ pub struct TonemapPass {
 impl TonemapPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = [COMMON, crate::wgsl!("src/render/passes/tonemap/tonemap.wgsl")];
+        let files = [COMMON, wgsl!("src/render/passes/tonemap/tonemap.wgsl")];
         TonemapPass { kernel: Kernel::new(gpu, "tonemap", &files, "main", &BINDINGS) }
     }
 }

@@ -7,7 +7,7 @@
 use super::gbuffer::{DEPTH, NORMALS};
 use super::occlusion::AO_GEOMETRY;
 use super::{FrameContext, FrameSetup, Pass};
-use crate::render::gpu::kernel::{Bind, Kernel, Shader, Slot, COMMON};
+use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
 use crate::render::settings::{Settings, Technique};
@@ -17,7 +17,7 @@ pub const AO_FULL: Resource = Resource::storage("ao-full", Size::Full, wgpu::Tex
 
 /// joint_upsample.wgsl: the 3×3 joint bilateral weights and the right eye's reuse of the
 /// left eye's result, shared with the composite.
-pub const JOINT_UPSAMPLE_WGSL: Shader = crate::wgsl!("src/render/passes/upsample/joint_upsample.wgsl");
+pub const JOINT_UPSAMPLE_WGSL: Shader = wgsl!("src/render/passes/upsample/joint_upsample.wgsl");
 
 /// upsample.wgsl's bindings: frame, AO parameters, the G-buffer and the occlusion's
 /// geometry, the occlusion in, the full-resolution AO out and, at 7, its left-eye layer
@@ -53,7 +53,7 @@ pub struct UpsamplePass {
 impl UpsamplePass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = [COMMON, JOINT_UPSAMPLE_WGSL, crate::wgsl!("src/render/passes/upsample/upsample.wgsl")];
+        let files = [COMMON, JOINT_UPSAMPLE_WGSL, wgsl!("src/render/passes/upsample/upsample.wgsl")];
         let kernel = |label: &str, right_eye: bool| {
             Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &[("RIGHT_EYE", f64::from(right_eye))])
         };
