@@ -26,7 +26,8 @@ pub fn invalidate_bind_groups() {
 pub const TILE: u32 = 8;
 
 /// One WGSL file, compiled into the binary so it runs from any directory; `path` is
-/// relative to the repository root (for `VRAO_SHADER_DIR`). Make one with [`wgsl!`].
+/// relative to the repository root (for `VRAO_SHADER_DIR`). Made by the crate-internal
+/// `wgsl!` macro from that path.
 #[derive(Clone, Copy, Debug)]
 pub struct Shader {
     /// The file, relative to the repository root.
