@@ -77,7 +77,7 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
         let ao = &mut panel.settings.ao;
         egui::ComboBox::from_label("technique").selected_text(ao.technique.name()).show_ui(ui, |ui| {
             // Every technique but the bench's fetch-only baseline, which is not an occlusion.
-            for t in Technique::ALL.into_iter().filter(|t| *t != Technique::FetchOnly) {
+            for &t in Technique::all().iter().filter(|t| **t != Technique::FetchOnly) {
                 ui.selectable_value(&mut ao.technique, t, t.name());
             }
         });

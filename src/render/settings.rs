@@ -50,15 +50,15 @@ pub enum Technique {
     Ssao,
     /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
     Hbao,
+    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
+    /// (Jimenez et al. 2016, Therrien et al. 2023).
+    Gtao,
     /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
     Ssdo,
     /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
     SsdoBounce,
     /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
     FetchOnly,
-    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
-    /// (Jimenez et al. 2016, Therrien et al. 2023).
-    Gtao,
 }
 
 impl Technique {
@@ -81,16 +81,10 @@ impl Technique {
         matches!(self, Technique::Ssdo | Technique::SsdoBounce)
     }
 
-    /// Every technique, in the order the CLI and the bench list them.
-    pub const ALL: [Technique; 7] = [
-        Technique::None,
-        Technique::Ssao,
-        Technique::Hbao,
-        Technique::Gtao,
-        Technique::Ssdo,
-        Technique::SsdoBounce,
-        Technique::FetchOnly,
-    ];
+    /// Every technique, in the order the CLI and the bench list them (declaration order).
+    pub fn all() -> &'static [Technique] {
+        <Technique as clap::ValueEnum>::value_variants()
+    }
 }
 
 /// Bench files name their techniques, and the governor and `vrao budget --fit` read them

@@ -2,7 +2,6 @@
 //! src/render/gpu/shaders/common.wgsl), built in f64 and rounded once.
 
 use super::scene::GpuScene;
-use crate::render::passes::gtao::{gtao_inner_band, gtao_slices_steps};
 use crate::render::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
 use crate::render::scene::environment::quadratic_in_view;
 use crate::render::scene::{Light, Scene};
@@ -103,15 +102,6 @@ pub struct AoParamsUniform {
     pub blur_plane_sigma: f32,
     /// Scale of the sample lengths this frame (HBAO's temporal range jitter; 1 otherwise).
     pub range_scale: f32,
-    /// GTAO: thickness of the slab behind each depth sample, as a fraction of the radius.
-    pub thickness: f32,
-    /// GTAO: the samples' spread along a half-slice (1 even, 2 quadratic).
-    pub step_power: f32,
-    /// GTAO: distance gap (fraction of the radius) under which successive samples join.
-    pub connect: f32,
-    /// GTAO: width in occlusion pixels of the band along each eye's inner border that
-    /// runs with the other-eye lookups (`passes::gtao::gtao_inner_band`).
-    pub inner_band: u32,
     /// The WGSL struct's size is a multiple of its 8-byte alignment (`ao_size`).
     pub padding: u32,
 }
@@ -181,23 +171,21 @@ impl FrameBuffers {
     pub fn update_ao(&self, queue: &wgpu::Queue, settings: &Settings, frame_index: u64) {
         let ao = &settings.ao;
         let (width, height) = ao_extent(settings.profile.width, settings.profile.height, ao.half_res);
-        let (directions, steps) = match ao.technique {
-            Technique::Gtao => gtao_slices_steps(ao.samples),
-            _ => hbao_directions_steps(ao.samples),
-        };
-        let density = match ao.technique {
-            Technique::Ssdo | Technique::SsdoBounce => HemisphereDensity::Uniform,
-            _ => HemisphereDensity::Cosine,
-        };
+        let (directions, steps) = hbao_directions_steps(ao.samples);
+        // SSDO weighs each direction's light by cos θ itself, so its samples are uniform.
+        let density = if ao.technique.carries_light() { HemisphereDensity::Uniform } else { HemisphereDensity::Cosine };
         // With temporal accumulation each frame of the window takes its own part of a
         // longer Halton kernel, so the accumulated samples are as stratified as one
         // kernel of window × N. Measured (room, SSAO N = 8, 270×300, noise against the
         // converged estimator after 8 frames): golden-angle turns of one kernel 0.0122,
         // parts plus turns 0.0125, parts alone 0.0078 — turning a part breaks the
         // stratification between parts. So the hemisphere techniques change their pattern
-        // by parts and only HBAO, whose directions are not a Halton kernel, turns.
+        // by parts and only the marching techniques (HBAO, GTAO), whose directions are not
+        // a Halton kernel, turn.
         let part = if ao.temporal.enabled { (frame_index % ao.temporal.max_frames as u64) as u32 } else { 0 };
-        let turns = ao.temporal.enabled && matches!(ao.technique, Technique::Hbao | Technique::Gtao);
+        let hemisphere =
+            matches!(ao.technique, Technique::Ssao | Technique::Ssdo | Technique::SsdoBounce | Technique::FetchOnly);
+        let turns = ao.temporal.enabled && !hemisphere;
         let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
         let params = AoParamsUniform {
             ao_size: [width, height],
@@ -207,8 +195,8 @@ impl FrameBuffers {
             steps,
             technique: match ao.technique {
                 Technique::None => 0,
-                Technique::Ssao | Technique::Hbao | Technique::Gtao | Technique::FetchOnly => 1,
-                Technique::Ssdo | Technique::SsdoBounce => 2,
+                t if t.carries_light() => 2,
+                _ => 1,
             },
             noise: match ao.noise {
                 Noise::Tiled5x5 => 0,
@@ -225,10 +213,6 @@ impl FrameBuffers {
             blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
             blur_plane_sigma: ao.blur_plane_sigma,
             range_scale: if turns { temporal_range_scale(frame_index) } else { 1.0 },
-            thickness: ao.thickness,
-            step_power: ao.step_power,
-            connect: ao.connect,
-            inner_band: gtao_inner_band(width),
             padding: 0,
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));

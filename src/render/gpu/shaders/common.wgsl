@@ -103,16 +103,6 @@ struct AoParams {
     blur_plane_sigma: f32,
     // Sample-length scale this frame (temporal range jitter; 1 otherwise).
     range_scale: f32,
-    // GTAO: the slab behind each depth sample, as a fraction of the radius.
-    thickness: f32,
-    // GTAO: sample i of n along a half-slice lies at r · t ((2 − P) + (P − 1) t), with
-    // t = (i + jitter) / n and P = step_power in 1..=2.
-    step_power: f32,
-    // GTAO: successive samples closer in distance than this fraction of the radius lie
-    // on one continuous surface (0: never).
-    connect: f32,
-    // GTAO: columns along each eye's inner border marched with the other-eye lookups.
-    inner_band: u32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

@@ -23,7 +23,7 @@
 //
 // Samples that leave the eye's image through its inner border are looked up in the other
 // eye's layer (occlusion.wgsl `surface_at`, guessing the last sample's distance). The
-// marching eye runs as two dispatches of this file: the band of `ao.inner_band` columns
+// marching eye runs as two dispatches of this file: the band of `gtao.inner_band` columns
 // along its inner border with those lookups compiled in (INNER_BAND = true), and the
 // rest of the image without them, where a march that leaves the image stops (open). The
 // lookups' code, even never taken, made every pixel's march about half as slow again.
@@ -50,13 +50,31 @@ override RIGHT_EYE: bool = false;
 @group(0) @binding(7) var left_occlusion: texture_2d_array<f32>;
 @group(0) @binding(8) var left_geometry: texture_2d_array<f32>;
 
+// GTAO's own parameters (passes/gtao/mod.rs `GtaoUniform`).
+struct GtaoParams {
+    // Slices per pixel and depth samples along each half-slice (slices × 2 × steps ≈ N).
+    slices: u32,
+    steps: u32,
+    // The slab behind each depth sample, as a fraction of the radius.
+    thickness: f32,
+    // Sample i of n along a half-slice lies at r · t ((2 − P) + (P − 1) t), with
+    // t = (i + jitter) / n and P = step_power in 1..=2.
+    step_power: f32,
+    // Successive samples closer in distance than this fraction of the radius lie on one
+    // continuous surface (0: never).
+    connect: f32,
+    // Columns along each eye's inner border marched with the other-eye lookups.
+    inner_band: u32,
+};
+@group(0) @binding(9) var<uniform> gtao: GtaoParams;
+
 // The occlusion pixel of invocation `id` in this dispatch's part of the image, or none
 // (x = ao_size.x) past its part's width.
 fn dispatch_pixel(id: vec3<u32>) -> vec3<u32> {
     if (RIGHT_EYE) {
         return vec3<u32>(id.x, id.y, 1u);
     }
-    let band = min(ao.inner_band, ao.ao_size.x);
+    let band = min(gtao.inner_band, ao.ao_size.x);
     let band_on_left = id.z < frame.layers && other_eye_side(frame.eyes[min(id.z, 1u)]) < 0.0;
     var x = ao.ao_size.x;
     if (INNER_BAND) {
@@ -179,7 +197,7 @@ fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
     // t ((2 − P) + (P − 1) t): between even (P = 1) and quadratic (P = 2); two
     // multiply-adds, where t^P cost a pow per sample (12 % of the pass on lavapipe) and
     // measured no better (P = 1.5 on four scenes: equal RMSE within 0.001).
-    return max(t * mix(1.0, t, ao.step_power - 1.0) * march_px, f32(i) + 1.0);
+    return max(t * mix(1.0, t, gtao.step_power - 1.0) * march_px, f32(i) + 1.0);
 }
 
 // Marks the sectors that the depth sample `surface` (view space, w = 0 when none) blocks
@@ -264,12 +282,12 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let march_px = min(radius_px, f32(frame.size.x + frame.size.y));
     var limits: SampleLimits;
     limits.radius2 = radius * radius;
-    limits.thickness = ao.thickness * radius;
-    limits.connect = ao.connect * radius;
+    limits.thickness = gtao.thickness * radius;
+    limits.connect = gtao.connect * radius;
     let size = vec2<f32>(frame.size);
     let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
-    let slices = max(ao.directions, 1u);
-    let steps = max(ao.steps, 1u);
+    let slices = max(gtao.slices, 1u);
+    let steps = max(gtao.steps, 1u);
     // Whether any step can leave the image through the inner border, the only one the
     // other eye sees past (steps are at least a pixel apart, so the march reaches at most
     // max(march_px, steps) pixels out).

@@ -9,10 +9,12 @@ use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::PassDecl;
 use crate::render::settings::Technique;
+use bytemuck::{Pod, Zeroable};
 
-/// The shared bindings and, at 7 and 8, the raw occlusion's and its geometry's left-eye
-/// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`).
-const BINDINGS: [Bind; 9] = [
+/// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
+/// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`),
+/// and at 9 GTAO's own parameters.
+const BINDINGS: [Bind; 10] = [
     occlusion::BINDINGS[0],
     occlusion::BINDINGS[1],
     occlusion::BINDINGS[2],
@@ -22,7 +24,22 @@ const BINDINGS: [Bind; 9] = [
     occlusion::BINDINGS[6],
     Bind::Own(Slot::Layers),
     Bind::Own(Slot::Layers),
+    Bind::Own(Slot::Uniform),
 ];
+
+/// `GtaoParams` of gtao.wgsl: what GTAO reads besides the shared `AoParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GtaoUniform {
+    slices: u32,
+    steps: u32,
+    thickness: f32,
+    step_power: f32,
+    connect: f32,
+    inner_band: u32,
+    /// A uniform struct's size is a multiple of 16 bytes.
+    padding: [u32; 2],
+}
 
 /// GTAO's slices and steps per half-slice for a budget of `samples` depth taps
 /// (slices × 2 × steps ≈ samples): 12 → 2×3, 24 → 2×6, 36 → 2×9, 64 → 2×16. Steps before
@@ -44,11 +61,12 @@ pub fn gtao_inner_band(width: u32) -> u32 {
     (width / 4).next_multiple_of(8).min(width)
 }
 
-/// GTAO's three pipelines (module docs).
+/// GTAO's three pipelines (module docs) and its parameters.
 pub struct GtaoPass {
     interior: Kernel,
     inner_band: Kernel,
     right_eye: Kernel,
+    params: wgpu::Buffer,
 }
 
 impl GtaoPass {
@@ -64,7 +82,18 @@ impl GtaoPass {
             ];
             Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
         };
-        GtaoPass { interior: kernel(false, false), inner_band: kernel(true, false), right_eye: kernel(false, true) }
+        let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gtao params"),
+            size: std::mem::size_of::<GtaoUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        GtaoPass {
+            interior: kernel(false, false),
+            inner_band: kernel(true, false),
+            right_eye: kernel(false, true),
+            params,
+        }
     }
 }
 
@@ -76,14 +105,26 @@ impl Pass for GtaoPass {
     fn record(&self, ctx: &mut FrameContext) {
         let (width, height, layers) = ctx.ao_extent();
         let device = &ctx.gpu.device;
+        let ao = &ctx.setup.settings.ao;
+        let (slices, steps) = gtao_slices_steps(ao.samples);
+        let band = gtao_inner_band(width);
+        let params = GtaoUniform {
+            slices,
+            steps,
+            thickness: ao.thickness,
+            step_power: ao.step_power,
+            connect: ao.connect,
+            inner_band: band,
+            padding: [0; 2],
+        };
+        ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
         // Bindings 7 and 8 are unused before the right eye's dispatch: the normals stand in.
         let normals = ctx.view(super::gbuffer::NORMALS);
-        let mut resources = ctx.bind(&BINDINGS, &[normals.clone(), normals]);
-        let reuse = ctx.setup.settings.ao.stereo_reuse && layers == 2;
+        let mut resources = ctx.bind(&BINDINGS, &[normals.clone(), normals, self.params.as_entire_binding()]);
+        let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        let band = gtao_inner_band(width);
         self.interior.dispatch(device, ctx.encoder, &resources, (width - band, height, marched_layers));
         self.inner_band.dispatch(device, ctx.encoder, &resources, (band, height, marched_layers));
         if !reuse {
