@@ -1,6 +1,6 @@
 //! Eyes: head pose, IPD, per-eye asymmetric field of view (OpenXR's form) and the
 //! reversed-Z infinite-far projection. `view_position_from_depth` is the one place that
-//! turns a depth sample back into a view-space position; `src/render/gpu/shaders/common.wgsl` mirrors it.
+//! turns a depth sample back into a view-space position; `shaders/common.wgsl` mirrors it.
 
 use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
 

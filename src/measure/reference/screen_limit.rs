@@ -10,7 +10,7 @@
 //!
 //! At a grid pixel with depth d > 0 the receiver P is the view-space position the GPU
 //! reconstructs (`stereo::view_position_from_depth` at the pixel centre, as
-//! `src/render/gpu/shaders/common.wgsl` does) and n the G-buffer's view-space normal, flipped to face the
+//! `shaders/common.wgsl` does) and n the G-buffer's view-space normal, flipped to face the
 //! eye. M cosine-weighted directions about n (a jittered ⌊√M⌋² grid mapped by the
 //! concentric map, as the reference tracer draws them, from a PCG32 stream seeded by the
 //! eye layer and pixel: deterministic and independent of threads) are each marched to

@@ -1,5 +1,5 @@
 //! Per-frame uniforms shared by every pass (mirrors `Frame`, `Eye` and `Light` in
-//! src/render/gpu/shaders/common.wgsl), built in f64 and rounded once.
+//! shaders/common.wgsl), built in f64 and rounded once.
 
 use super::scene::GpuScene;
 use crate::render::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};

@@ -50,10 +50,10 @@ macro_rules! wgsl {
 pub(crate) use wgsl;
 
 /// `common.wgsl`: the frame's uniforms and helpers every pass shares.
-pub const COMMON: Shader = wgsl!("src/render/gpu/shaders/common.wgsl");
+pub const COMMON: Shader = wgsl!("shaders/common.wgsl");
 
 /// `irradiance.wgsl`: the environment's irradiance and radiance quadratics.
-pub const IRRADIANCE: Shader = wgsl!("src/render/gpu/shaders/irradiance.wgsl");
+pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");
 
 /// A shader module made of the given files, concatenated in order (common first), so
 /// passes share `common.wgsl` without string formatting.
