@@ -14,18 +14,8 @@ use bytemuck::{Pod, Zeroable};
 /// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
 /// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`),
 /// and at 9 GTAO's own parameters.
-const BINDINGS: [Bind; 10] = [
-    occlusion::BINDINGS[0],
-    occlusion::BINDINGS[1],
-    occlusion::BINDINGS[2],
-    occlusion::BINDINGS[3],
-    occlusion::BINDINGS[4],
-    occlusion::BINDINGS[5],
-    occlusion::BINDINGS[6],
-    Bind::Own(Slot::Layers),
-    Bind::Own(Slot::Layers),
-    Bind::Own(Slot::Uniform),
-];
+const BINDINGS: [Bind; 10] =
+    occlusion::bindings_and([Bind::Own(Slot::Layers), Bind::Own(Slot::Layers), Bind::Own(Slot::Uniform)]);
 
 /// `GtaoParams` of gtao.wgsl: what GTAO reads besides the shared `AoParams`.
 #[repr(C)]

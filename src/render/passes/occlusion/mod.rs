@@ -35,6 +35,19 @@ pub const BINDINGS: [Bind; 7] = [
     Bind::Write(AO_GEOMETRY),
 ];
 
+/// [`BINDINGS`] followed by a technique's own bindings (from binding 7 on); `M` is the
+/// total, checked when the constant is made.
+pub const fn bindings_and<const N: usize, const M: usize>(own: [Bind; N]) -> [Bind; M] {
+    assert!(M == BINDINGS.len() + N, "M must be 7 + N");
+    let mut all = [Bind::Frame; M];
+    let mut i = 0;
+    while i < M {
+        all[i] = if i < BINDINGS.len() { BINDINGS[i] } else { own[i - BINDINGS.len()] };
+        i += 1;
+    }
+    all
+}
+
 /// A technique pass's declaration: its bindings (the G-buffer in, the raw occlusion and
 /// its geometry out), the raw occlusion provided as the AO chain's start, counted as the
 /// occlusion's cost, and left out unless the chosen technique is one of `runs_for`.

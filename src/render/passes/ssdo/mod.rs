@@ -15,17 +15,7 @@ use crate::render::settings::{BounceForm, Technique};
 
 /// The shared occlusion bindings plus the direct light (binding 7, the bounce's senders)
 /// and the second depth layer (binding 8, depth peeling).
-const BINDINGS: [Bind; 9] = [
-    occlusion::BINDINGS[0],
-    occlusion::BINDINGS[1],
-    occlusion::BINDINGS[2],
-    occlusion::BINDINGS[3],
-    occlusion::BINDINGS[4],
-    occlusion::BINDINGS[5],
-    occlusion::BINDINGS[6],
-    Bind::Read(DIRECT),
-    Bind::Read(DEPTH_LAYER_2),
-];
+const BINDINGS: [Bind; 9] = occlusion::bindings_and([Bind::Read(DIRECT), Bind::Read(DEPTH_LAYER_2)]);
 
 /// SSDO, with its bounce when the technique asks for it (module docs).
 pub struct SsdoPass {
