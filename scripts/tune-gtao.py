@@ -6,7 +6,7 @@ For every combination of the grid it benches `gtao` on every scene at three radi
 scene's default radius × 0.5, 1, 2) and ranks the combinations by the mean over (scene,
 radius) of RMSE + |bias| against the hard cut-off reference. It writes the full table
 and the ranking as Markdown (default docs/gtao-tuning.md) and prints the winner; the
-winner goes into src/settings.rs (DEFAULT_THICKNESS, DEFAULT_STEP_POWER, DEFAULT_CONNECT).
+winner goes into src/render/passes/gtao/mod.rs (GtaoSettings: its defaults).
 
 usage: python3 scripts/tune-gtao.py [--vrao target/release/vrao] [--size 270x300]
        [--samples 24] [--scenes a,b,...] [--out docs/gtao-tuning.md]

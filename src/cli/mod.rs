@@ -13,8 +13,7 @@ use clap::Args;
 use glam::DVec3;
 use vrao::render::passes::shadow::suggested_rsm_radius;
 use vrao::render::settings::{
-    AoSettings, BounceForm, Denoise, Noise, Quality, ShadowSettings, Technique, Temporal, TemporalBlend,
-    DEFAULT_CONNECT, DEFAULT_STEP_POWER, DEFAULT_THICKNESS,
+    AoSettings, BounceForm, Denoise, GtaoSettings, Noise, Quality, ShadowSettings, Technique, Temporal, TemporalBlend,
 };
 use vrao::{HeadsetProfile, Scene, Settings};
 
@@ -67,21 +66,12 @@ impl LightArgs {
     }
 }
 
-/// GTAO's free parameters (the render commands and the bench).
+/// GTAO's free parameters (its pass's own settings) and the stereo reuse (the render
+/// commands and the bench).
 #[derive(Args, Clone)]
 pub struct GtaoArgs {
-    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
-    /// radius (thin objects stop occluding behind themselves).
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_THICKNESS)]
-    thickness: f32,
-    /// GTAO: the samples' spread along a half-slice, 1..=2 (1 even, 2 quadratic: crowded
-    /// near the pixel).
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_STEP_POWER)]
-    step_power: f32,
-    /// GTAO: successive samples closer in distance than this fraction of the radius
-    /// join into one surface (0: never).
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_CONNECT)]
-    connect: f32,
+    #[command(flatten)]
+    gtao: GtaoSettings,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
     /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
     /// every technique's denoise, and the upsampled AO of all but SSDO).
@@ -91,7 +81,7 @@ pub struct GtaoArgs {
 
 impl GtaoArgs {
     pub fn apply(&self, ao: &mut AoSettings) {
-        (ao.thickness, ao.step_power, ao.connect) = (self.thickness, self.step_power, self.connect);
+        ao.gtao = self.gtao.clone();
         ao.stereo_reuse = !self.independent_eyes;
     }
 }
@@ -212,9 +202,7 @@ impl AoArgs {
                 motion_px: self.temporal_motion_px,
                 ..Default::default()
             },
-            thickness: self.gtao.thickness,
-            step_power: self.gtao.step_power,
-            connect: self.gtao.connect,
+            gtao: self.gtao.gtao.clone(),
             stereo_reuse: !self.gtao.independent_eyes,
         }
     }

@@ -1,6 +1,7 @@
 //! Render settings, validated once so passes can trust them.
 
 use crate::render::error::{Error, Result};
+pub use crate::render::passes::gtao::GtaoSettings;
 use crate::render::stereo::{HeadsetProfile, DEFAULT_NEAR};
 
 /// How the G-buffer reaches both eye layers.
@@ -93,7 +94,8 @@ impl std::str::FromStr for Technique {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         <Technique as clap::ValueEnum>::from_str(s, false).map_err(|_| {
-            format!("unknown technique '{s}' (expected none, ssao, hbao, gtao, ssdo, ssdo-bounce or fetch-only)")
+            let names: Vec<&str> = Technique::all().iter().map(|t| t.name()).collect();
+            format!("unknown technique '{s}' (expected one of {})", names.join(", "))
         })
     }
 }
@@ -237,15 +239,8 @@ pub struct AoSettings {
     pub blur_plane_sigma: f32,
     /// Temporal accumulation by reverse reprojection (Lin's NCTU thesis §3.1).
     pub temporal: Temporal,
-    /// GTAO: how far behind each depth sample the surface counts as solid, as a fraction
-    /// of the radius (thin objects stop occluding behind themselves).
-    pub thickness: f32,
-    /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
-    /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
-    pub step_power: f32,
-    /// GTAO: successive samples whose distances differ by less than this fraction of the
-    /// radius lie on one continuous surface, which also blocks the angles between them.
-    pub connect: f32,
+    /// GTAO's own parameters (passes/gtao).
+    pub gtao: GtaoSettings,
     /// With two views, the right eye takes the left eye's value wherever the left eye
     /// sees the same surface point: GTAO's march (the right eye marches only the rest and
     /// costs a fraction) and, at half resolution, every technique's denoise (its vertical
@@ -303,16 +298,6 @@ impl Default for Temporal {
     }
 }
 
-/// GTAO's defaults, tuned against the reference (scripts/tune-gtao.py and
-/// docs/gtao-tuning.md). Thickness 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps
-/// it costs no RMSE and leaves fewer halos (pixels beside depth edges too dark by > 0.1
-/// on the furnished room: 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
-pub const DEFAULT_THICKNESS: f32 = 0.75;
-/// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
-pub const DEFAULT_STEP_POWER: f32 = 1.5;
-/// GTAO's default: successive samples closer than this fraction of the radius are joined.
-pub const DEFAULT_CONNECT: f32 = 0.25;
-
 impl Default for AoSettings {
     fn default() -> Self {
         AoSettings {
@@ -331,9 +316,7 @@ impl Default for AoSettings {
             blur_radius: 5,
             blur_plane_sigma: 0.02,
             temporal: Temporal::default(),
-            thickness: DEFAULT_THICKNESS,
-            step_power: DEFAULT_STEP_POWER,
-            connect: DEFAULT_CONNECT,
+            gtao: GtaoSettings::default(),
             stereo_reuse: true,
         }
     }
@@ -373,21 +356,7 @@ impl AoSettings {
         if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
             return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
         }
-        if !(self.thickness.is_finite() && (0.0..=100.0).contains(&self.thickness)) {
-            return Err(Error::input(format!(
-                "thickness {} is not within 0..=100 (a fraction of the radius)",
-                self.thickness
-            )));
-        }
-        if !(self.step_power.is_finite() && (1.0..=2.0).contains(&self.step_power)) {
-            return Err(Error::input(format!("step power {} is not within 1..=2", self.step_power)));
-        }
-        if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
-            return Err(Error::input(format!(
-                "connect {} is not within 0..=100 (a fraction of the radius)",
-                self.connect
-            )));
-        }
+        self.gtao.validate()?;
         if self.blur_radius > 16 {
             return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));
         }

@@ -239,6 +239,16 @@ impl Kernel {
     ) -> Kernel {
         let device = &gpu.device;
         let slots: Vec<Slot> = binds.iter().map(|b| b.slot()).collect();
+        // The start-up check refuses adapters that cannot write these formats; a kernel
+        // writing another would fail on them only at its first frame.
+        for slot in &slots {
+            if let Slot::Output(format) = slot {
+                assert!(
+                    super::support::STORAGE_WRITE_FORMATS.contains(format),
+                    "kernel {label} writes {format:?}: add it to support::STORAGE_WRITE_FORMATS"
+                );
+            }
+        }
         let entries: Vec<_> =
             slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32, wgpu::ShaderStages::COMPUTE)).collect();
         let layout =

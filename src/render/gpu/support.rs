@@ -4,7 +4,8 @@
 
 /// Formats the compute kernels write as `texture_storage_2d_array<FORMAT, write>`
 /// (`Slot::Output`): colour, the AO targets and history, world positions, and the
-/// packed direct light.
+/// packed direct light. Checked when each kernel is made (`Kernel::with_constants`), so
+/// a pass that writes another format fails every test until it is listed here.
 pub const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
     wgpu::TextureFormat::Rgba8Unorm,
     wgpu::TextureFormat::Rgba16Float,
