@@ -60,7 +60,8 @@ pub enum Kind {
 }
 
 /// A texture that flows between passes, or a named output of the graph. Two handles are
-/// the same resource when their names are (names are unique; the plan checks).
+/// the same resource when their names are: names are unique (the renderer asserts that
+/// what it allocates under one name has one format).
 #[derive(Clone, Copy, Debug)]
 pub struct Resource {
     name: &'static str,

@@ -244,7 +244,7 @@ pub struct AoSettings {
     /// With two views, the right eye takes the left eye's value wherever the left eye
     /// sees the same surface point: GTAO's march (the right eye marches only the rest and
     /// costs a fraction) and, at half resolution, every technique's denoise (its vertical
-    /// pass) and the AO-only techniques' upsample (`passes::reuses_left_eye_upsample`).
+    /// pass) and the AO-only techniques' upsample (`passes::upsample::reuses_left_eye_upsample`).
     /// Off: each eye computes everything alone.
     pub stereo_reuse: bool,
 }

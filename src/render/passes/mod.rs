@@ -34,8 +34,9 @@ use crate::render::settings::Settings;
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
-/// Every pass, in execution order (declaration order is execution order). A new pass
-/// or technique is one line here plus its own folder.
+/// Every pass, in execution order (declaration order is execution order). A new pass is
+/// its own folder, its `pub mod` line above and one entry here; a new technique also
+/// names itself in `settings::Technique` (its command-line name).
 pub fn all(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameBuffers) -> Vec<Box<dyn Pass>> {
     // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
     let light_space = Arc::new(shadow::LightSpace::new(gpu, scene, gpu_scene.anchor));
