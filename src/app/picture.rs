@@ -4,6 +4,7 @@
 
 use crate::app::BufferView;
 use crate::render::gpu::kernel::{shader_module, wgsl};
+use crate::render::gpu::raster::fullscreen_pipeline;
 use crate::render::gpu::Gpu;
 
 /// The picture's pipelines: a full-screen triangle drawing one 2D view into a viewport,
@@ -62,27 +63,7 @@ impl Blit {
                 bind_group_layouts: &[Some(layout)],
                 immediate_size: 0,
             });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    buffers: &[],
-                    compilation_options: Default::default(),
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(entry_point),
-                    targets: &[Some(format.into())],
-                    compilation_options: Default::default(),
-                }),
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
-                multiview_mask: None,
-                cache: None,
-            })
+            fullscreen_pipeline(device, entry_point, &pipeline_layout, (&module, entry_point), format, None, None)
         };
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("mirror"),

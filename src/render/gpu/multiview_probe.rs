@@ -8,6 +8,7 @@ use super::readback::read_layers;
 use super::targets::LayeredTarget;
 use super::Gpu;
 use crate::render::gpu::kernel::wgsl;
+use crate::render::gpu::raster::fullscreen_pipeline;
 use std::num::NonZeroU32;
 
 const SIZE: u32 = 16;
@@ -24,27 +25,8 @@ pub fn multiview_reaches_every_layer(gpu: &Gpu) -> bool {
         bind_group_layouts: &[],
         immediate_size: 0,
     });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("multiview probe"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: Default::default(),
-        depth_stencil: None,
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(format.into())],
-        }),
-        multiview_mask: NonZeroU32::new(0b11),
-        cache: None,
-    });
+    let mask = NonZeroU32::new(0b11);
+    let pipeline = fullscreen_pipeline(device, "multiview probe", &layout, (&module, "fs_main"), format, None, mask);
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -1,6 +1,7 @@
-//! Pieces every raster pipeline of vrao repeats (G-buffer, depth peeling, shadow maps,
-//! the OpenXR blit): a uniform-buffer binding, the scene's vertex layout, and one 2D
-//! view per layer of an array texture.
+//! Pieces every raster pipeline of vrao repeats: a uniform-buffer binding, the scene's
+//! vertex layout, the mesh-drawing pipeline (G-buffer, depth peeling, shadow maps), the
+//! full-screen pipeline (window picture, OpenXR blit, multiview probe), and one 2D view
+//! per layer of an array texture.
 
 use super::kernel::Slot;
 use super::scene::Vertex;
@@ -21,6 +22,95 @@ pub fn mesh_vertex_buffer(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexB
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes,
     }
+}
+
+/// What differs between the mesh-drawing pipelines (G-buffer, depth peeling, shadow maps).
+pub struct MeshPipeline<'a> {
+    /// The pipeline's label.
+    pub label: &'a str,
+    /// Its bind group layouts.
+    pub layout: &'a wgpu::PipelineLayout,
+    /// The module holding both entry points.
+    pub module: &'a wgpu::ShaderModule,
+    /// The vertex entry point and the vertex attributes it reads ([`MESH_ATTRIBUTES`] or
+    /// a prefix of them).
+    pub vertex: (&'a str, &'a [wgpu::VertexAttribute]),
+    /// The depth attachment's format and test.
+    pub depth: (wgpu::TextureFormat, wgpu::CompareFunction),
+    /// The fragment entry point and its colour targets; `None` for depth only.
+    pub fragment: Option<(&'a str, &'a [Option<wgpu::ColorTargetState>])>,
+    /// Multiview's view mask, if the pipeline draws every layer at once.
+    pub multiview_mask: Option<std::num::NonZeroU32>,
+}
+
+/// A pipeline that draws the scene's meshes two-sided, writing depth (OBJ windings are
+/// not trusted: the G-buffer faces normals towards the eye, depth peeling wants the back
+/// faces, and both faces of a surface cast shadows).
+pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipeline {
+    let (format, compare) = p.depth;
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(p.label),
+        layout: Some(p.layout),
+        vertex: wgpu::VertexState {
+            module: p.module,
+            entry_point: Some(p.vertex.0),
+            compilation_options: Default::default(),
+            buffers: &[Some(mesh_vertex_buffer(p.vertex.1))],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: p.fragment.map(|(entry, targets)| wgpu::FragmentState {
+            module: p.module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets,
+        }),
+        multiview_mask: p.multiview_mask,
+        cache: None,
+    })
+}
+
+/// A full-screen pipeline: `vs_main` of the shader's module draws one triangle over the
+/// target (no vertex buffer) and its `fragment` entry point writes one colour target of
+/// `format`, with an optional depth attachment (the window's picture, the OpenXR blit,
+/// the multiview probe).
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    (module, fragment): (&wgpu::ShaderModule, &str),
+    format: wgpu::TextureFormat,
+    depth_stencil: Option<wgpu::DepthStencilState>,
+    multiview_mask: Option<std::num::NonZeroU32>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask,
+        cache: None,
+    })
 }
 
 /// A 2D view of each of the first `layers` layers of `texture` (render attachments and

@@ -15,6 +15,7 @@
 //! channel without banding), then float16, then UNORM. Depth goes through the same pass
 //! (frag_depth), which also leaves it in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
 
+use crate::render::gpu::raster::fullscreen_pipeline;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use ash::vk;
@@ -232,33 +233,23 @@ impl EyeBlit {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("openxr blit"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: depth.map(|format| wgpu::DepthStencilState {
-                format,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(if depth.is_some() { "fs_color_depth" } else { "fs_color" }),
-                compilation_options: Default::default(),
-                targets: &[Some(color.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
+        let depth_stencil = depth.map(|format| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
         });
+        let fragment = if depth.is_some() { "fs_color_depth" } else { "fs_color" };
+        let pipeline = fullscreen_pipeline(
+            device,
+            "openxr blit",
+            &pipeline_layout,
+            (&module, fragment),
+            color,
+            depth_stencil,
+            None,
+        );
         EyeBlit { layout, pipeline, depth: depth.is_some() }
     }
 

@@ -5,7 +5,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
-use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
+use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
@@ -102,35 +102,19 @@ fn pipeline(
     multiview_mask: Option<NonZeroU32>,
 ) -> wgpu::RenderPipeline {
     let targets = COLOR_TARGETS.map(|r| Some(wgpu::ColorTargetState::from(r.format())));
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("gbuffer"),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
+    mesh_pipeline(
+        device,
+        MeshPipeline {
+            label: "gbuffer",
+            layout,
             module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(mesh_vertex_buffer(&MESH_ATTRIBUTES))],
+            vertex: ("vs_main", &MESH_ATTRIBUTES),
+            // Reversed Z: nearer is greater.
+            depth: (DEPTH.format(), wgpu::CompareFunction::Greater),
+            fragment: Some(("fs_main", &targets)),
+            multiview_mask,
         },
-        // No culling: OBJ windings are not trusted; the fragment shader faces normals
-        // towards the eye instead.
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH.format(),
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Greater), // reversed Z
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &targets,
-        }),
-        multiview_mask,
-        cache: None,
-    })
+    )
 }
 
 impl Pass for GBufferPass {

@@ -10,7 +10,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::{shader_module, wgsl, COMMON};
-use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
+use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::passes::gbuffer::DEPTH;
@@ -61,34 +61,19 @@ impl DepthPeelPass {
             immediate_size: 0,
         });
         let module = shader_module(device, "depth peel", &[COMMON, wgsl!("src/render/passes/peel/peel.wgsl")]);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("depth peel"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
+        let pipeline = mesh_pipeline(
+            device,
+            MeshPipeline {
+                label: "depth peel",
+                layout: &layout,
                 module: &module,
-                entry_point: Some("vs_peel"),
-                compilation_options: Default::default(),
-                buffers: &[Some(mesh_vertex_buffer(&MESH_ATTRIBUTES[..1]))],
+                vertex: ("vs_peel", &MESH_ATTRIBUTES[..1]),
+                // Reversed Z; two-sided: the back faces are what this pass is for.
+                depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
+                fragment: Some(("fs_peel", &[])),
+                multiview_mask: None,
             },
-            // No culling, as in the G-buffer: the back faces are what this pass is for.
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_LAYER_2.format(),
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater), // reversed Z
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_peel"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("depth peel frame"),
             layout: &frame_layout,

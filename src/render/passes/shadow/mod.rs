@@ -19,7 +19,7 @@
 
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
-use crate::render::gpu::raster::{mesh_vertex_buffer, uniform_entry, MESH_ATTRIBUTES};
+use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
@@ -342,34 +342,19 @@ fn pipeline(
     reflective: bool,
 ) -> wgpu::RenderPipeline {
     let targets = [RSM_NORMAL, RSM_FLUX].map(|r| Some(wgpu::ColorTargetState::from(r.format())));
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(if reflective { "reflective shadow map" } else { "shadow map" }),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
+    mesh_pipeline(
+        device,
+        MeshPipeline {
+            label: if reflective { "reflective shadow map" } else { "shadow map" },
+            layout,
             module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(mesh_vertex_buffer(&MESH_ATTRIBUTES))],
+            vertex: ("vs_main", &MESH_ATTRIBUTES),
+            // 0 nearest the light.
+            depth: (SHADOW_MAP.format(), wgpu::CompareFunction::Less),
+            fragment: reflective.then_some(("fs_rsm", &targets[..])),
+            multiview_mask: None,
         },
-        // Two-sided, as the G-buffer: both faces of a surface cast.
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: SHADOW_MAP.format(),
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: reflective.then_some(wgpu::FragmentState {
-            module,
-            entry_point: Some("fs_rsm"),
-            compilation_options: Default::default(),
-            targets: &targets,
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+    )
 }
 
 impl Pass for ShadowPass {
