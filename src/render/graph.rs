@@ -341,17 +341,11 @@ impl Provided {
 /// on. An output that no enabled pass produces is an error naming it (a renderer bug or
 /// an impossible request, never silently dropped).
 pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
-    let decls = resolve_aliases(decls)?;
-    let mut provided = Provided::default();
-    for decl in decls.iter().filter(|d| d.disabled.is_none()) {
-        provided.0.extend(decl.provides.iter().copied());
-    }
-    let mut aliases = BTreeMap::new();
-    for alias in decls.iter().flat_map(|d| d.provides.iter().map(|p| p.0)).chain(outputs.iter().copied()) {
-        if let Some(texture) = alias.is_alias().then(|| provided.get(alias)).flatten() {
-            aliases.insert(alias, texture);
-        }
-    }
+    let (decls, provided) = resolve_aliases(decls)?;
+    // Each named output a pass provides or the frame asks for, as it stands after the last pass.
+    let named = decls.iter().flat_map(|d| d.provides.iter().map(|p| p.0)).chain(outputs.iter().copied());
+    let aliases: BTreeMap<Resource, Resource> =
+        named.filter(|r| r.is_alias()).filter_map(|alias| Some((alias, provided.get(alias)?))).collect();
     let mut needed = BTreeSet::new();
     for &output in outputs {
         let texture = if output.is_alias() { aliases.get(&output).copied() } else { Some(output) };
@@ -404,8 +398,9 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
 }
 
 /// Replaces each named output an enabled pass reads by what the enabled passes before it
-/// provided, recording the substitution in the pass's `resolved`.
-fn resolve_aliases(decls: &[PassDecl]) -> Result<Vec<PassDecl>, String> {
+/// provided, recording the substitution in the pass's `resolved`; also returns what the
+/// named outputs stand for after the last pass.
+fn resolve_aliases(decls: &[PassDecl]) -> Result<(Vec<PassDecl>, Provided), String> {
     let mut provided = Provided::default();
     let mut resolved = decls.to_vec();
     for decl in resolved.iter_mut() {
@@ -432,7 +427,7 @@ fn resolve_aliases(decls: &[PassDecl]) -> Result<Vec<PassDecl>, String> {
             provided.0.insert(*alias, *texture);
         }
     }
-    Ok(resolved)
+    Ok((resolved, provided))
 }
 
 #[cfg(test)]

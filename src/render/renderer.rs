@@ -494,10 +494,7 @@ impl Renderer {
     /// The target a previous frame wrote, if that frame needed it (a named output: its
     /// texture as the last frame resolved it).
     pub fn target(&self, r: Resource) -> Option<&LayeredTarget> {
-        let r = match r.is_alias() {
-            true => self.last_plan()?.resolve(r)?,
-            false => r,
-        };
+        let r = if r.is_alias() { self.last_plan()?.resolve(r)? } else { r };
         self.targets.get(&r)
     }
 

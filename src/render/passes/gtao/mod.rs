@@ -12,6 +12,13 @@ use crate::render::graph::PassDecl;
 use crate::render::settings::Technique;
 use bytemuck::{Pod, Zeroable};
 
+/// GTAO's default slab behind each depth sample, a fraction of the radius.
+const DEFAULT_THICKNESS: f32 = 0.75;
+/// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
+const DEFAULT_STEP_POWER: f32 = 1.5;
+/// GTAO's default: successive samples closer than this fraction of the radius are joined.
+const DEFAULT_CONNECT: f32 = 0.25;
+
 /// GTAO's own settings (`AoSettings::gtao`), and their command-line flags. The defaults
 /// are tuned against the reference (scripts/tune-gtao.py and docs/gtao-tuning.md).
 #[derive(Clone, Debug, PartialEq, clap::Args)]
@@ -21,22 +28,22 @@ pub struct GtaoSettings {
     // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
     // fewer halos (pixels beside depth edges too dark by > 0.1 on the furnished room:
     // 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.75)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_THICKNESS)]
     pub thickness: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
     /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.5)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_STEP_POWER)]
     pub step_power: f32,
     /// GTAO: successive samples whose distances differ by less than this fraction of the
     /// radius lie on one continuous surface, which also blocks the angles between them
     /// (0: never).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.25)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_CONNECT)]
     pub connect: f32,
 }
 
 impl Default for GtaoSettings {
     fn default() -> Self {
-        GtaoSettings { thickness: 0.75, step_power: 1.5, connect: 0.25 }
+        GtaoSettings { thickness: DEFAULT_THICKNESS, step_power: DEFAULT_STEP_POWER, connect: DEFAULT_CONNECT }
     }
 }
 
