@@ -1,11 +1,16 @@
 //! The scene on the GPU: one vertex and one index buffer for all meshes, positions
 //! relative to an f64 anchor, and one uniform + texture per material.
 
+use super::kernel::{wgsl, Shader};
 use super::Gpu;
 use crate::render::scene::{Environment, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use wgpu::util::DeviceExt;
+
+/// mesh.wgsl: the material bind group, `VertexIn` and the material's albedo, shared by
+/// the passes that draw the meshes with their materials.
+pub const MESH_WGSL: Shader = wgsl!("shaders/mesh.wgsl");
 
 /// One mesh vertex as the vertex buffer holds it.
 #[repr(C)]

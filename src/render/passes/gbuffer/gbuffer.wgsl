@@ -4,19 +4,7 @@
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 
-struct Material {
-    diffuse: vec4<f32>,   // rgb linear; w = 1 when a texture modulates it
-    emission: vec4<f32>,
-};
-@group(1) @binding(0) var<uniform> material: Material;
-@group(1) @binding(1) var diffuse_texture: texture_2d<f32>;
-@group(1) @binding(2) var diffuse_sampler: sampler;
-
-struct VertexIn {
-    @location(0) position: vec3<f32>,   // relative to the scene anchor
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-};
+// Material bindings, `VertexIn` and `material_albedo`: shaders/mesh.wgsl.
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -53,13 +41,10 @@ fn fs_main(in: VertexOut) -> GBufferOut {
     if (dot(n, -in.view_position) < 0.0) {
         n = -n;
     }
-    // Sampled in uniform control flow, every fragment (untextured materials bind a white
-    // texel): sampling inside the branch made lavapipe 22.3 leak ~0.4 MB per draw.
-    let texel = textureSample(diffuse_texture, diffuse_sampler, in.uv).rgb;
-    let albedo = material.diffuse.rgb * select(vec3<f32>(1.0), texel, material.diffuse.w > 0.5);
+    let albedo = material_albedo(in.uv);
     var out: GBufferOut;
     out.normal = vec4<f32>(finite_or_zero3(n), 0.0);
-    out.albedo = vec4<f32>(clamp(albedo, vec3<f32>(0.0), vec3<f32>(1.0)), 1.0);
+    out.albedo = vec4<f32>(albedo, 1.0);
     out.emission = vec4<f32>(finite_or_zero3(material.emission.rgb), 0.0);
     return out;
 }

@@ -6,7 +6,7 @@ use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
-use crate::render::gpu::scene::GpuScene;
+use crate::render::gpu::scene::{GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use std::num::NonZeroU32;
@@ -71,7 +71,7 @@ impl GBufferPass {
             let module = shader_module(
                 device,
                 "gbuffer multiview",
-                &[COMMON, GBUFFER_WGSL, wgsl!("src/render/passes/gbuffer/gbuffer_multiview.wgsl")],
+                &[COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/render/passes/gbuffer/gbuffer_multiview.wgsl")],
             );
             pipeline(device, &layout, &module, NonZeroU32::new(0b11))
         });
@@ -83,7 +83,7 @@ impl GBufferPass {
         let module = shader_module(
             device,
             "gbuffer multipass",
-            &[COMMON, GBUFFER_WGSL, wgsl!("src/render/passes/gbuffer/gbuffer_multipass.wgsl")],
+            &[COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/render/passes/gbuffer/gbuffer_multipass.wgsl")],
         );
         let multipass = pipeline(device, &layout, &module, None);
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {

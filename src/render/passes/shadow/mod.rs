@@ -20,7 +20,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
-use crate::render::gpu::scene::GpuScene;
+use crate::render::gpu::scene::{GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::scene::{Light, Scene};
@@ -305,7 +305,7 @@ impl ShadowPass {
         let module = shader_module(
             device,
             "shadow map",
-            &[COMMON, SHADOW_WGSL, wgsl!("src/render/passes/shadow/shadow_map.wgsl")],
+            &[COMMON, SHADOW_WGSL, MESH_WGSL, wgsl!("src/render/passes/shadow/shadow_map.wgsl")],
         );
         let depth_only = pipeline(device, &layout, &module, false);
         let reflective = pipeline(device, &layout, &module, true);

@@ -5,19 +5,7 @@
 
 @group(0) @binding(0) var<uniform> light: ShadowLight;
 
-struct Material {
-    diffuse: vec4<f32>,   // rgb linear; w = 1 when a texture modulates it
-    emission: vec4<f32>,
-};
-@group(1) @binding(0) var<uniform> material: Material;
-@group(1) @binding(1) var diffuse_texture: texture_2d<f32>;
-@group(1) @binding(2) var diffuse_sampler: sampler;
-
-struct VertexIn {
-    @location(0) position: vec3<f32>,   // relative to the scene anchor
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-};
+// Material bindings, `VertexIn` and `material_albedo`: shaders/mesh.wgsl.
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -52,9 +40,7 @@ fn fs_rsm(in: VertexOut) -> RsmOut {
     if (n.z < 0.0) {
         n = -n;
     }
-    // Sampled in uniform control flow (see gbuffer.wgsl).
-    let texel = textureSample(diffuse_texture, diffuse_sampler, in.uv).rgb;
-    let albedo = clamp(material.diffuse.rgb * select(vec3<f32>(1.0), texel, material.diffuse.w > 0.5), vec3<f32>(0.0), vec3<f32>(1.0));
+    let albedo = material_albedo(in.uv);
     var out: RsmOut;
     out.normal = vec4<f32>(finite_or_zero3(n), 0.0);
     out.flux = vec4<f32>(finite_or_zero3(albedo * light.radiance.rgb), 0.0);
