@@ -4,15 +4,26 @@
 //! [`Renderer`] with [`Settings`], and render an [`EyePair`] into layered targets.
 //!
 //! Four folders with a dependency rule (checked by `tests/layout.rs`): [`render`]
-//! imports none of the others; [`xr`] (headsets) imports only `render`; [`app`] (the
-//! frame loop, governor and window) and [`measure`] (reference, metrics, bench, studies)
-//! import `render` and `xr` but not each other. The CLI (`src/cli/`) is the binary's.
+//! imports none of the others; `xr` (headsets) imports only `render`; `app` (the frame
+//! loop, governor and window) and `measure` (reference, metrics, bench, studies) import
+//! `render` and `xr` but not each other. The CLI (`src/cli/`) is the binary's.
+//!
+//! Cargo features: [`render`] is always built and needs only wgpu, the scene and image
+//! loaders and serde. `app` (default) adds `app`, `measure` and `xr` with what they use
+//! (winit, egui, clap, the reference tracer's rayon and BVH, the bench's plots and FLIP);
+//! the `vrao` binary needs it. `xr` (default, implies `app`) adds the OpenXR headset.
+//! `testing` adds the test oracle `measure::analytic` (with `app`). The renderer alone:
+//! `vrao = { version = "0.1", default-features = false }`.
 
+#[cfg(feature = "app")]
 pub mod app;
+#[cfg(feature = "app")]
 pub mod measure;
 pub mod render;
+#[cfg(feature = "app")]
 pub mod xr;
 
+pub use render::ao;
 pub use render::error::{Error, Result};
 pub use render::gpu::{BackendChoice, Gpu};
 pub use render::graph::Resource;

@@ -160,7 +160,7 @@ fn unclipped_scene() -> Scene {
 fn multiview_and_multipass_give_the_same_pixels() {
     let (gpu, _guard) = common::gpu();
     if !gpu.caps.multiview {
-        eprintln!("skipped: adapter '{}' has no multiview", gpu.adapter.get_info().name);
+        eprintln!("skipped: adapter '{}' has no multiview", gpu.info.name.clone());
         return;
     }
     // Geometry no driver has to clip: both paths must agree byte for byte on every adapter.
@@ -177,7 +177,7 @@ fn multiview_and_multipass_give_the_same_pixels() {
 fn the_multiview_probe_predicts_clipped_geometry() {
     let (gpu, _guard) = common::gpu();
     if !gpu.caps.multiview {
-        eprintln!("skipped: adapter '{}' has no multiview", gpu.adapter.get_info().name);
+        eprintln!("skipped: adapter '{}' has no multiview", gpu.info.name.clone());
         return;
     }
     // The room's walls reach past every edge of the view, so the driver must clip them.
@@ -211,10 +211,10 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
             "shadow",
             "direct",
             "rsm",
+            "depth-peel",
             "ssao",
             "hbao",
             "gtao",
-            "depth-peel",
             "ssdo",
             "fetch-only",
             "temporal",
@@ -277,7 +277,7 @@ fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
     }
     // A frame of a CPU adapter takes milliseconds: the next one is encoded and handed
     // over while it is still on the GPU.
-    if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+    if gpu.info.clone().device_type == wgpu::DeviceType::Cpu {
         assert_eq!(renderer.frames_in_flight_max(), 2);
     }
     // With one frame in flight, each frame waits for the one before.

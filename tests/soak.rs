@@ -68,13 +68,13 @@ fn five_thousand_frames_keep_memory_and_gpu_resources_flat() {
         if step.request.index + 1 == WARMUP {
             gpu.wait_idle().unwrap();
             rss_start = rss_kib();
-            objects_start = live_gpu_objects(&gpu.instance);
+            objects_start = live_gpu_objects(gpu.instance.as_ref().expect("Gpu::new opens an instance"));
         }
     }
     frame_loop.end().unwrap();
     gpu.wait_idle().unwrap();
     let rss_end = rss_kib();
-    let objects_end = live_gpu_objects(&gpu.instance);
+    let objects_end = live_gpu_objects(gpu.instance.as_ref().expect("Gpu::new opens an instance"));
     let counters = frame_loop.headset.counters();
     eprintln!(
         "soak: {FRAMES} frames; RSS after {WARMUP} frames {rss_start} KiB, at the end {rss_end} KiB; counters {counters:?}; live GPU objects {objects_end:?}"

@@ -153,15 +153,15 @@ impl WindowState {
         let window = Arc::new(
             event_loop.create_window(attributes).map_err(|e| Error::Device(format!("cannot create a window: {e}")))?,
         );
-        let surface = gpu
-            .instance
+        let (instance, adapter) = gpu_instance_adapter(gpu)?;
+        let surface = instance
             .create_surface(window.clone())
             .map_err(|e| Error::Device(format!("cannot draw into the window: {e}")))?;
-        let caps = surface.get_capabilities(&gpu.adapter);
+        let caps = surface.get_capabilities(adapter);
         // The eye images hold sRGB-encoded values: a non-sRGB surface shows them as they are.
         let format =
             caps.formats.iter().copied().find(|f| !f.is_srgb()).or_else(|| caps.formats.first().copied()).ok_or_else(
-                || Error::Device(format!("{} cannot present to this window", gpu.adapter.get_info().name)),
+                || Error::Device(format!("{} cannot present to this window", gpu.info.name)),
             )?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
@@ -194,7 +194,7 @@ impl WindowState {
             window,
             surface,
             config,
-            blit: Blit::new(gpu, format),
+            blit: Blit::new(gpu, format)?,
             egui_ctx,
             egui_winit,
             egui_renderer,
@@ -317,8 +317,8 @@ impl WindowState {
             }
             wgpu::CurrentSurfaceTexture::Lost => {
                 // A lost surface is made anew from the window.
-                self.surface = gpu
-                    .instance
+                self.surface = gpu_instance_adapter(&gpu)?
+                    .0
                     .create_surface(self.window.clone())
                     .map_err(|e| Error::Device(format!("cannot recreate the window surface: {e}")))?;
                 self.surface.configure(&gpu.device, &self.config);
@@ -460,5 +460,14 @@ impl WindowState {
         pixels.chunks_exact_mut(4).for_each(|p| p[3] = 255);
         image::save_buffer(path, &pixels, width, height, image::ColorType::Rgba8)
             .map_err(|e| Error::Output { path: path.to_path_buf(), message: e.to_string() })
+    }
+}
+
+/// The instance and adapter a window surface is made with: every `Gpu` vrao opens has
+/// them; a host's device ([`Gpu::from_host`]) does not.
+fn gpu_instance_adapter(gpu: &Gpu) -> Result<(&wgpu::Instance, &wgpu::Adapter)> {
+    match (&gpu.instance, &gpu.adapter) {
+        (Some(instance), Some(adapter)) => Ok((instance, adapter)),
+        _ => Err(Error::Device("a window needs the wgpu instance and adapter vrao opened itself".into())),
     }
 }

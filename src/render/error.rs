@@ -34,6 +34,11 @@ pub enum Error {
         /// Why, as the OS or encoder said it.
         message: String,
     },
+    /// The frame graph could not plan a frame: a pass reads what nothing before it
+    /// provides, or a requested output has no producer. A fault in vrao (or in a pass an
+    /// embedder added), not in the input or the GPU.
+    #[error("frame graph: {0}")]
+    Plan(String),
     /// The run finished but did not fit its frame budget (`vrao budget`).
     #[error("{0}")]
     OverBudget(String),
@@ -66,7 +71,7 @@ impl Error {
         match self {
             // An output that cannot be written is the path the user gave (or its disk).
             Error::Input { .. } | Error::Device(_) | Error::Output { .. } => EXIT_INPUT,
-            Error::Gpu(_) => 1,
+            Error::Gpu(_) | Error::Plan(_) => 1,
             Error::OverBudget(_) => EXIT_OVER_BUDGET,
         }
     }

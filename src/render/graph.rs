@@ -11,6 +11,7 @@
 //! its result under one, and a reader of the alias gets whatever the last enabled pass
 //! before it provided.
 
+use crate::render::error::{Error, Result};
 use crate::render::gpu::kernel::Bind;
 use crate::render::passes::FrameSetup;
 use std::collections::{BTreeMap, BTreeSet};
@@ -51,6 +52,9 @@ pub enum Kind {
         /// How it is written.
         written: Written,
     },
+    /// A texture the frame brings from outside the graph (a host application's depth
+    /// buffer): never allocated by the graph, and produced by no pass.
+    Imported,
     /// A named output: the texture the last enabled pass before the reader provided
     /// under this name; with none, what `fallback` names.
     Alias {
@@ -78,6 +82,12 @@ impl Resource {
     /// A texture written by render passes.
     pub const fn attachment(name: &'static str, size: Size, format: wgpu::TextureFormat) -> Resource {
         Resource { name, format, kind: Kind::Texture { size, written: Written::Attachment } }
+    }
+
+    /// A texture imported from outside the graph each frame; `format` is the format its
+    /// readers' layouts assume (depth: any depth format).
+    pub const fn imported(name: &'static str, format: wgpu::TextureFormat) -> Resource {
+        Resource { name, format, kind: Kind::Imported }
     }
 
     /// A named output whose textures all have `format`, falling back to another named
@@ -267,7 +277,8 @@ pub struct Plan {
     pub notes: Vec<(&'static str, String)>,
     /// (pass, reason) for every pass that does not run.
     pub left_out: Vec<(&'static str, String)>,
-    /// Every texture a running pass reads or writes (what the frame must allocate).
+    /// Every texture a running pass reads or writes (what the frame must allocate; the
+    /// imported textures are not among them).
     pub resources: BTreeSet<Resource>,
     /// Each named output and the texture it stands for after the last pass.
     pub aliases: BTreeMap<Resource, Resource>,
@@ -338,9 +349,12 @@ impl Provided {
 }
 
 /// Resolves every named output the passes read, then keeps the passes `outputs` depend
-/// on. An output that no enabled pass produces is an error naming it (a renderer bug or
-/// an impossible request, never silently dropped).
-pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
+/// on. `imported` are textures the frame brings from outside the graph (a host's depth
+/// buffer, the renderer's G-buffer handed to the AO engine): they need no producing pass,
+/// and the graph neither allocates nor drops them. An output that no enabled pass
+/// produces is an error naming it (a renderer bug or an impossible request, never
+/// silently dropped).
+pub fn plan(decls: &[PassDecl], outputs: &[Resource], imported: &[Resource]) -> Result<Plan> {
     let (decls, provided) = resolve_aliases(decls)?;
     // Each named output a pass provides or the frame asks for, as it stands after the last pass.
     let named = decls.iter().flat_map(|d| d.provides.iter().map(|p| p.0)).chain(outputs.iter().copied());
@@ -349,7 +363,9 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
     let mut needed = BTreeSet::new();
     for &output in outputs {
         let texture = if output.is_alias() { aliases.get(&output).copied() } else { Some(output) };
-        needed.insert(texture.ok_or_else(|| format!("nothing provides '{}' for this frame", output.name()))?);
+        needed.insert(
+            texture.ok_or_else(|| Error::Plan(format!("nothing provides '{}' for this frame", output.name())))?,
+        );
     }
     let mut keep = vec![false; decls.len()];
     // Walk backwards: a pass is kept if it writes something needed downstream.
@@ -363,9 +379,9 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
         }
     }
     for r in &needed {
-        let produced = decls.iter().zip(&keep).any(|(d, k)| *k && d.writes.contains(r));
+        let produced = imported.contains(r) || decls.iter().zip(&keep).any(|(d, k)| *k && d.writes.contains(r));
         if !produced {
-            return Err(format!("nothing produces '{}' for this frame", r.name()));
+            return Err(Error::Plan(format!("nothing produces '{}' for this frame", r.name())));
         }
     }
     let mut plan = Plan {
@@ -374,7 +390,7 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
         decls: Vec::new(),
         notes: Vec::new(),
         left_out: Vec::new(),
-        resources: needed,
+        resources: needed.into_iter().filter(|r| !imported.contains(r)).collect(),
         aliases,
     };
     for (i, decl) in decls.into_iter().enumerate() {
@@ -400,7 +416,7 @@ pub fn plan(decls: &[PassDecl], outputs: &[Resource]) -> Result<Plan, String> {
 /// Replaces each named output an enabled pass reads by what the enabled passes before it
 /// provided, recording the substitution in the pass's `resolved`; also returns what the
 /// named outputs stand for after the last pass.
-fn resolve_aliases(decls: &[PassDecl]) -> Result<(Vec<PassDecl>, Provided), String> {
+fn resolve_aliases(decls: &[PassDecl]) -> Result<(Vec<PassDecl>, Provided)> {
     let mut provided = Provided::default();
     let mut resolved = decls.to_vec();
     for decl in resolved.iter_mut() {
@@ -410,19 +426,19 @@ fn resolve_aliases(decls: &[PassDecl]) -> Result<(Vec<PassDecl>, Provided), Stri
         for read in decl.reads.iter_mut().filter(|r| r.is_alias()) {
             let alias = *read;
             let texture = provided.get(alias).ok_or_else(|| {
-                format!("pass '{}' reads '{}', which no pass before it provides", decl.name, alias.name())
+                Error::Plan(format!("pass '{}' reads '{}', which no pass before it provides", decl.name, alias.name()))
             })?;
             decl.resolved.push((alias, texture));
             *read = texture;
         }
         for (alias, texture) in &decl.provides {
             if alias.format() != texture.format() {
-                return Err(format!(
+                return Err(Error::Plan(format!(
                     "pass '{}' provides '{}' as '{}' of another format",
                     decl.name,
                     alias.name(),
                     texture.name()
-                ));
+                )));
             }
             provided.0.insert(*alias, *texture);
         }
@@ -469,14 +485,14 @@ mod tests {
 
     #[test]
     fn color_pulls_in_the_whole_chain() {
-        let plan = plan(&decls(), &[COLOR]).unwrap();
+        let plan = plan(&decls(), &[COLOR], &[]).unwrap();
         assert_eq!(plan.names, vec!["gbuffer", "lighting", "tonemap"]);
         assert!(plan.left_out.is_empty());
     }
 
     #[test]
     fn a_pass_whose_output_nobody_reads_is_left_out() {
-        let plan = plan(&decls(), &[NORMALS]).unwrap();
+        let plan = plan(&decls(), &[NORMALS], &[]).unwrap();
         assert_eq!(plan.names, vec!["gbuffer"]);
         let names: Vec<_> = plan.left_out.iter().map(|(n, _)| *n).collect();
         assert_eq!(names, vec!["lighting", "tonemap"]);
@@ -487,7 +503,7 @@ mod tests {
     fn disabled_pass_is_left_out_with_its_reason() {
         let mut d = decls();
         d.push(PassDecl::new("mirror").read(COLOR).write(EMISSION).disabled_if(true, "display mode is none"));
-        let plan = plan(&d, &[COLOR]).unwrap();
+        let plan = plan(&d, &[COLOR], &[]).unwrap();
         assert_eq!(plan.left_out, vec![("mirror", "display mode is none".to_string())]);
     }
 
@@ -495,7 +511,7 @@ mod tests {
     fn an_output_nobody_produces_is_an_error() {
         let mut d = decls();
         d[2].disabled = Some("off".into());
-        assert!(plan(&d, &[COLOR]).unwrap_err().contains("color"));
+        assert!(plan(&d, &[COLOR], &[]).unwrap_err().to_string().contains("color"));
     }
 
     #[test]
@@ -503,7 +519,7 @@ mod tests {
         for (blur, half_res, last) in
             [(true, true, FULL), (false, true, FULL), (true, false, BLURRED), (false, false, RAW)]
         {
-            let plan = plan(&ao_chain(blur, half_res), &[FINAL_AO]).unwrap();
+            let plan = plan(&ao_chain(blur, half_res), &[FINAL_AO], &[]).unwrap();
             assert_eq!(plan.resolve(FINAL_AO), Some(last), "blur {blur} half {half_res}");
             assert!(plan.resources.contains(&last));
             // The composite is not needed for the AO alone; each stage reads the one before.
@@ -517,7 +533,7 @@ mod tests {
 
     #[test]
     fn a_reader_of_a_named_output_gets_what_the_passes_before_it_provided() {
-        let plan = plan(&ao_chain(true, true), &[HDR]).unwrap();
+        let plan = plan(&ao_chain(true, true), &[HDR], &[]).unwrap();
         // The composite reads the blurred occlusion, not the upsampled one after it.
         assert_eq!(plan.names, vec!["gbuffer", "ssao", "blur", "composite"]);
         let composite = plan.decls.last().unwrap();
@@ -532,10 +548,10 @@ mod tests {
         d[3].disabled = Some("technique is none".into());
         // A reader of a named output nobody provides is an error too (the composite
         // unbinds the occlusion when no technique runs).
-        assert!(plan(&d, &[DEPTH]).unwrap_err().contains("'composite' reads 'occlusion'"));
+        assert!(plan(&d, &[DEPTH], &[]).unwrap_err().to_string().contains("'composite' reads 'occlusion'"));
         d.pop();
-        assert!(plan(&d, &[FINAL_AO]).unwrap_err().contains("final-ao"));
-        assert!(plan(&d, &[DEPTH]).unwrap().resolve(FINAL_AO).is_none());
+        assert!(plan(&d, &[FINAL_AO], &[]).unwrap_err().to_string().contains("final-ao"));
+        assert!(plan(&d, &[DEPTH], &[]).unwrap().resolve(FINAL_AO).is_none());
     }
 
     #[test]
@@ -545,7 +561,7 @@ mod tests {
             PassDecl::new("shadow").write(EMISSION),
             PassDecl::new("lighting").read(EMISSION).read(DEPTH).write(HDR).unbind(EMISSION),
         ];
-        let plan = plan(&d, &[HDR]).unwrap();
+        let plan = plan(&d, &[HDR], &[]).unwrap();
         assert!(!plan.runs("shadow"), "{plan}");
     }
 }

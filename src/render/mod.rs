@@ -2,8 +2,10 @@
 //! views, scenes and settings. It imports nothing else of vrao: `xr`, `app` and
 //! `measure` build on it (checked by `tests/layout.rs`).
 
+pub mod ao;
 pub mod bench_file;
 pub mod error;
+pub mod frame_targets;
 pub mod gpu;
 pub mod graph;
 pub mod output;
@@ -12,5 +14,6 @@ pub mod renderer;
 pub mod sampling;
 pub mod scene;
 pub mod settings;
+pub mod stats;
 pub mod stereo;
 pub mod still;

@@ -8,20 +8,21 @@
 //! frames later in [`FrameReport::finished`]. Only pixel readbacks and
 //! [`Renderer::render_and_wait`] (measurements) wait.
 
+use crate::render::ao::AoEngine;
 use crate::render::error::{Error, Result};
-use crate::render::gpu::frame::ao_extent;
-use crate::render::gpu::frame::FrameBuffers;
+use crate::render::frame_targets::FrameTargets;
+use crate::render::gpu::frame::{FrameBuffers, FrameLighting};
 use crate::render::gpu::readback;
 use crate::render::gpu::scene::GpuScene;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::timing::{FrameTiming, PassTimer};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{self, Kind, Plan, Resource, Size, Written};
+use crate::render::graph::{self, Plan, Resource};
 use crate::render::passes::{self, FrameContext, FrameSetup, Pass};
 use crate::render::scene::Scene;
 use crate::render::settings::{Settings, StereoMode};
 use crate::render::stereo::Eye;
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
@@ -67,7 +68,8 @@ pub enum Timing {
 }
 
 /// A [`Timing`], or `Auto`: decided once the adapter is known ([`TimingChoice::resolve`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum TimingChoice {
     /// Serial on CPU adapters, pipelined on GPUs.
     #[default]
@@ -85,7 +87,7 @@ impl TimingChoice {
         match self {
             TimingChoice::Pipelined => Timing::Pipelined,
             TimingChoice::Serial => Timing::Serial,
-            TimingChoice::Auto if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu => Timing::Serial,
+            TimingChoice::Auto if gpu.info.clone().device_type == wgpu::DeviceType::Cpu => Timing::Serial,
             TimingChoice::Auto => Timing::Pipelined,
         }
     }
@@ -109,10 +111,14 @@ pub struct Renderer {
     multiview: bool,
     gpu_scene: GpuScene,
     frame: FrameBuffers,
-    passes: Vec<Box<dyn Pass>>,
-    targets: BTreeMap<Resource, LayeredTarget>,
-    /// 1×1 stand-ins, by format, for what binding lists name but a pass does not read.
-    placeholders: HashMap<wgpu::TextureFormat, LayeredTarget>,
+    /// The passes before the AO chain (G-buffer, lights), [`passes::scene_passes`].
+    scene_passes: Vec<Box<dyn Pass>>,
+    /// The AO engine, whose chain runs over the G-buffer's depth and normals, with the
+    /// renderer's SSDO among its techniques.
+    ao: AoEngine,
+    /// The passes after the AO chain (composite, tone mapping), [`passes::output_passes`].
+    output_passes: Vec<Box<dyn Pass>>,
+    targets: FrameTargets,
     timer: PassTimer,
     timing: Timing,
     /// Frames rendered so far, and the views of the last one (temporal reuse).
@@ -163,13 +169,15 @@ impl Renderer {
             StereoMode::Multiview => {
                 return Err(Error::input(format!(
                     "--stereo multiview: adapter '{}' has no multiview; use --stereo multipass",
-                    gpu.adapter.get_info().name
+                    gpu.info.name.clone()
                 )))
             }
         };
         let gpu_scene = GpuScene::upload(&gpu, scene);
         let frame = FrameBuffers::new(&gpu.device, scene.lights.len());
-        let passes = passes::all(&gpu, scene, &gpu_scene, &frame);
+        let scene_passes = passes::scene_passes(&gpu, scene, &gpu_scene, &frame);
+        let ao = AoEngine::with_light_gathering(gpu.clone(), vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]);
+        let output_passes = passes::output_passes(&gpu);
         let timer = PassTimer::new(&gpu)?;
         gpu.take_error()?;
         Ok(Renderer {
@@ -179,9 +187,10 @@ impl Renderer {
             multiview,
             gpu_scene,
             frame,
-            passes,
-            targets: BTreeMap::new(),
-            placeholders: HashMap::new(),
+            scene_passes,
+            ao,
+            output_passes,
+            targets: FrameTargets::default(),
             timer,
             timing: Timing::Pipelined,
             frame_index: 0,
@@ -249,9 +258,17 @@ impl Renderer {
         self.multiview
     }
 
+    /// Every pass in execution order: the scene's, the AO engine's chain, the outputs'.
+    fn passes(&self) -> Vec<&dyn Pass> {
+        let scene = self.scene_passes.iter().map(|p| p.as_ref());
+        let output = self.output_passes.iter().map(|p| p.as_ref());
+        scene.chain(self.ao.chain()).chain(output).collect()
+    }
+
     fn setup(&self, views: u32) -> FrameSetup<'_> {
         FrameSetup {
-            scene: &self.scene,
+            scene: Some(&self.scene),
+            anchor: self.gpu_scene.anchor,
             settings: &self.settings,
             views,
             multiview: self.multiview,
@@ -264,8 +281,8 @@ impl Renderer {
     /// The plan for a frame of `views` layers that must produce `outputs`.
     pub fn plan(&self, views: u32, outputs: &[Resource]) -> Result<Plan> {
         let setup = self.setup(views);
-        let decls: Vec<_> = self.passes.iter().map(|p| p.declare(&setup)).collect();
-        graph::plan(&decls, outputs).map_err(Error::Gpu)
+        let decls: Vec<_> = self.passes().iter().map(|p| p.declare(&setup)).collect();
+        graph::plan(&decls, outputs, &[])
     }
 
     /// This frame's plan: the last one while its key holds, a new one otherwise.
@@ -355,52 +372,74 @@ impl Renderer {
         wait_each_pass: bool,
         append: impl FnOnce(&mut wgpu::CommandEncoder, &BTreeMap<Resource, LayeredTarget>),
     ) -> Result<FrameReport> {
+        let plan = self.begin_frame(views, outputs)?;
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let (cpu_encode_ms, mut wall_ms) = self.record_passes(&plan, views, &mut encoder, wait_each_pass)?;
+        append(&mut encoder, &self.targets.targets);
+        let (frames_in_flight, last_wall_ms) = self.submit(encoder, wait_each_pass)?;
+        if let (Some(ms), Some(last)) = (last_wall_ms, plan.names.last()) {
+            wall_ms.push((last.to_string(), ms));
+        }
+        self.frame_index += 1;
+        self.previous_views = views.to_vec();
+        let finished = self.timer.finished();
+        self.gpu.take_error()?;
+        let frame = self.frame_index - 1;
+        Ok(FrameReport { frame, plan, gpu_ms: Vec::new(), cpu_encode_ms, wall_ms, frames_in_flight, finished })
+    }
+
+    /// Checks the views, waits until another frame may be in flight, plans the frame,
+    /// allocates its targets and writes its uniforms.
+    fn begin_frame(&mut self, views: &[Eye], outputs: &[Resource]) -> Result<Plan> {
         if views.is_empty() || views.len() > 2 {
             return Err(Error::input(format!("a frame has 1 or 2 views, not {}", views.len())));
         }
         self.throttle()?;
         let layers = views.len() as u32;
         let plan = self.frame_plan(layers, outputs)?;
-        self.allocate_targets(&plan, layers);
-        self.frame.update(&self.gpu.queue, &self.scene, &self.gpu_scene, views, &self.settings);
+        let mut targets = std::mem::take(&mut self.targets);
+        targets.allocate(&self.gpu.device, &plan, &self.setup(layers));
+        self.targets = targets;
+        let lighting = FrameLighting::of(&self.scene, &self.gpu_scene);
+        self.frame.update(&self.gpu.queue, &lighting, views, &self.settings);
         self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
-        let setup = FrameSetup {
-            scene: &self.scene,
-            settings: &self.settings,
-            views: layers,
-            multiview: self.multiview,
-            frame_index: self.frame_index,
-            current_views: views,
-            previous_views: (self.previous_views.len() == views.len()).then_some(&self.previous_views[..]),
-        };
-        let mut encoder =
-            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        Ok(plan)
+    }
+
+    /// Records the plan's passes, each in a timestamp span; with [`Timing::Serial`] each
+    /// pass but the last is submitted on its own (and with `wait_each_pass` waited for).
+    /// Returns the CPU encode time and the wall-clock times of the passes waited for.
+    fn record_passes(
+        &mut self,
+        plan: &Plan,
+        views: &[Eye],
+        encoder: &mut wgpu::CommandEncoder,
+        wait_each_pass: bool,
+    ) -> Result<(f64, Vec<(String, f64)>)> {
+        let setup = FrameSetup { current_views: views, ..self.setup(views.len() as u32) };
+        let passes = self.passes();
         let mut wall_ms = Vec::new();
         let mut cpu_encode_ms = 0.0;
         for (step, (&index, name)) in plan.run.iter().zip(&plan.names).enumerate() {
             let encode_start = Instant::now();
             let mut ctx = FrameContext {
                 gpu: &self.gpu,
-                encoder: &mut encoder,
-                targets: &self.targets,
-                placeholders: &self.placeholders,
+                encoder: &mut *encoder,
+                targets: &self.targets.targets,
+                placeholders: &self.targets.placeholders,
                 decl: &plan.decls[step],
                 frame: &self.frame,
-                scene: &self.gpu_scene,
+                scene: Some(&self.gpu_scene),
                 timer: &self.timer,
                 setup: &setup,
             };
-            let span = ctx.timer.begin(ctx.encoder, name);
-            self.passes[index].record(&mut ctx);
-            ctx.timer.end(ctx.encoder, span);
+            passes::record(passes[index], &mut ctx);
             let last = step + 1 == plan.run.len();
-            if last {
-                self.timer.resolve(&mut encoder);
-            }
             cpu_encode_ms += encode_start.elapsed().as_secs_f64() * 1e3;
             if self.timing == Timing::Serial && !last {
                 let finished =
-                    std::mem::replace(&mut encoder, self.gpu.device.create_command_encoder(&Default::default()));
+                    std::mem::replace(encoder, self.gpu.device.create_command_encoder(&Default::default()));
                 let submitted = Instant::now();
                 self.gpu.queue.submit([finished.finish()]);
                 if wait_each_pass {
@@ -409,7 +448,16 @@ impl Renderer {
                 }
             }
         }
-        append(&mut encoder, &self.targets);
+        let resolve_start = Instant::now();
+        self.timer.resolve(encoder);
+        cpu_encode_ms += resolve_start.elapsed().as_secs_f64() * 1e3;
+        Ok((cpu_encode_ms, wall_ms))
+    }
+
+    /// Submits the frame's last encoder without waiting for the GPU (unless serial timing
+    /// waits for each pass: then also the wall-clock ms of the last one) and tracks it
+    /// as in flight. Returns the frames in flight, this one included.
+    fn submit(&mut self, encoder: wgpu::CommandEncoder, wait_each_pass: bool) -> Result<(usize, Option<f64>)> {
         // In flight: the frames the GPU has not finished as this one is handed over
         // (counted before the submit call, which on lavapipe returns only once the
         // previous submission has finished: wgpu chains submissions with semaphores
@@ -418,10 +466,10 @@ impl Renderer {
         let frames_in_flight = self.in_flight.len() + 1;
         let submitted = Instant::now();
         let submission = self.gpu.queue.submit([encoder.finish()]);
+        let mut last_wall_ms = None;
         if self.timing == Timing::Serial && wait_each_pass {
             self.gpu.wait_idle()?;
-            let last = plan.names.last().map(|n| n.to_string()).unwrap_or_default();
-            wall_ms.push((last, submitted.elapsed().as_secs_f64() * 1e3));
+            last_wall_ms = Some(submitted.elapsed().as_secs_f64() * 1e3);
         }
         let done = Arc::new(AtomicBool::new(false));
         let signal = done.clone();
@@ -431,59 +479,7 @@ impl Renderer {
         self.frames_in_flight_max = self.frames_in_flight_max.max(frames_in_flight);
         // Collect the times of earlier frames that finished meanwhile (never waits).
         self.gpu.poll()?;
-        let finished = self.timer.finished();
-        self.gpu.take_error()?;
-        let frame = self.frame_index;
-        self.frame_index += 1;
-        self.previous_views = views.to_vec();
-        Ok(FrameReport { frame, plan, gpu_ms: Vec::new(), cpu_encode_ms, wall_ms, frames_in_flight, finished })
-    }
-
-    /// (Re)creates the targets this plan touches at their size for this frame; targets
-    /// of another size are dropped, so a resource no pass needs costs no memory. Makes
-    /// the placeholders the plan's passes bind in place of what they do not read.
-    fn allocate_targets(&mut self, plan: &Plan, layers: u32) {
-        let setup = self.setup(layers);
-        let max_side = self.gpu.device.limits().max_texture_dimension_2d;
-        let extent_of = |r: Resource| extent(r, &setup, max_side);
-        let stale: Vec<Resource> =
-            self.targets.iter().filter(|(r, t)| t.extent() != extent_of(**r)).map(|(r, _)| *r).collect();
-        let wanted: Vec<(Resource, (u32, u32, u32))> = plan.resources.iter().map(|&r| (r, extent_of(r))).collect();
-        let mut changed = !stale.is_empty();
-        for r in stale {
-            self.targets.remove(&r);
-        }
-        for (r, extent) in wanted {
-            let Kind::Texture { written, .. } = r.kind() else { unreachable!("the plan resolves named outputs") };
-            let target = self.targets.entry(r).or_insert_with(|| {
-                changed = true;
-                let usage = match written {
-                    Written::Attachment => {
-                        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
-                    }
-                    // COPY_DST: tests poison targets by writing them.
-                    Written::Storage => {
-                        wgpu::TextureUsages::STORAGE_BINDING
-                            | wgpu::TextureUsages::TEXTURE_BINDING
-                            | wgpu::TextureUsages::COPY_DST
-                    }
-                };
-                LayeredTarget::new(&self.gpu.device, r.name(), r.format(), extent, usage)
-            });
-            // Names are the identity of textures: two declarations under one name must agree.
-            debug_assert_eq!(target.format, r.format(), "two textures are named {}", r.name());
-        }
-        for decl in &plan.decls {
-            for r in &decl.unbound {
-                self.placeholders.entry(r.format()).or_insert_with(|| {
-                    changed = true;
-                    LayeredTarget::placeholder(&self.gpu.device, "placeholder", r.format())
-                });
-            }
-        }
-        if changed {
-            crate::render::gpu::kernel::invalidate_bind_groups();
-        }
+        Ok((frames_in_flight, last_wall_ms))
     }
 
     /// The plan of the last frame, if one was rendered.
@@ -495,13 +491,13 @@ impl Renderer {
     /// texture as the last frame resolved it).
     pub fn target(&self, r: Resource) -> Option<&LayeredTarget> {
         let r = if r.is_alias() { self.last_plan()?.resolve(r)? } else { r };
-        self.targets.get(&r)
+        self.targets.targets.get(&r)
     }
 
     /// A target a pass keeps itself from frame to frame (the temporal history), or one
     /// the graph allocated ([`Renderer::target`]).
     pub fn kept_target(&self, r: Resource) -> Option<LayeredTarget> {
-        self.target(r).cloned().or_else(|| self.passes.iter().find_map(|p| p.kept_target(r)))
+        self.target(r).cloned().or_else(|| self.passes().iter().find_map(|p| p.kept_target(r)))
     }
 
     /// Raw bytes per layer of a resource the last frame produced.
@@ -519,17 +515,4 @@ impl Renderer {
         }
         readback::read_layers_f32(&self.gpu, &target)
     }
-}
-
-/// Width × height × layers of a texture this frame.
-fn extent(r: Resource, setup: &FrameSetup, max_side: u32) -> (u32, u32, u32) {
-    let p = &setup.settings.profile;
-    let Kind::Texture { size, .. } = r.kind() else { unreachable!("named outputs have no size") };
-    let (width, height) = match size {
-        Size::Full => (p.width, p.height),
-        Size::Occlusion => ao_extent(p.width, p.height, setup.settings.ao.half_res),
-        Size::Half => ao_extent(p.width, p.height, true),
-        Size::Computed(extent) => return extent(setup, max_side),
-    };
-    (width, height, setup.views)
 }

@@ -3,12 +3,12 @@
 
 use super::scene::GpuScene;
 use crate::render::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
-use crate::render::scene::environment::quadratic_in_view;
+use crate::render::scene::environment::{quadratic_in_view, Environment};
 use crate::render::scene::{Light, Scene};
 use crate::render::settings::{Noise, Settings, Technique};
 use crate::render::stereo::Eye;
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, Mat3, Mat4, Vec3};
+use glam::{DMat4, DVec3, Mat3, Mat4, Vec3};
 
 /// One eye's matrices as the shaders read them (`Eye` of common.wgsl; layout must match).
 #[repr(C)]
@@ -108,6 +108,28 @@ pub struct AoParamsUniform {
 
 /// Most samples a kernel may hold (the settings' limit on N).
 pub const MAX_KERNEL_SAMPLES: usize = 256;
+
+/// What of a scene the frame uniforms carry: the anchor the geometry is stored
+/// relative to, the lights and the environment. The AO engine has [`FrameLighting::NONE`].
+#[derive(Clone, Copy)]
+pub struct FrameLighting<'a> {
+    /// The f64 origin of the anchored frame.
+    pub anchor: DVec3,
+    /// The scene's lights.
+    pub lights: &'a [Light],
+    /// The scene's environment light, if any.
+    pub environment: Option<&'a Environment>,
+}
+
+impl FrameLighting<'_> {
+    /// No lights, no environment, the world origin as the anchor (a host's views).
+    pub const NONE: FrameLighting<'static> = FrameLighting { anchor: DVec3::ZERO, lights: &[], environment: None };
+
+    /// A scene's lighting, anchored where its geometry was uploaded.
+    pub fn of<'a>(scene: &'a Scene, gpu_scene: &GpuScene) -> FrameLighting<'a> {
+        FrameLighting { anchor: gpu_scene.anchor, lights: &scene.lights, environment: scene.environment.as_ref() }
+    }
+}
 
 /// The uniform and light buffers of one frame.
 pub struct FrameBuffers {
@@ -220,30 +242,31 @@ impl FrameBuffers {
     }
 
     /// Writes this frame's views (1 or 2), lights in each view's space, and settings.
-    pub fn update(&self, queue: &wgpu::Queue, scene: &Scene, gpu_scene: &GpuScene, views: &[Eye], settings: &Settings) {
+    pub fn update(&self, queue: &wgpu::Queue, lighting: &FrameLighting, views: &[Eye], settings: &Settings) {
+        let FrameLighting { anchor, lights: scene_lights, environment } = *lighting;
         let to_cols = |m: Mat4| m.to_cols_array_2d();
         let mut eyes = [EyeUniform::zeroed(); 2];
         let mut environment_quadratics = [[[0.0; 4]; 10]; 4];
         let mut lights = Vec::with_capacity(self.light_capacity);
         for (index, (slot, eye)) in eyes.iter_mut().zip(views).enumerate() {
             let view_from_world = eye.view_from_world();
-            let view_from_anchored = view_from_world * DMat4::from_translation(gpu_scene.anchor);
+            let view_from_anchored = view_from_world * DMat4::from_translation(anchor);
             let [l, r, u, d] = eye.fov.tangents();
             let world_from_view = eye.pose.orientation.as_quat();
-            if let Some(env) = &scene.environment {
+            if let Some(env) = environment {
                 let rotation = Mat3::from_quat(world_from_view);
                 let in_view = |q: [Vec3; 10]| quadratic_in_view(&q, rotation).map(|c| c.extend(0.0).to_array());
                 environment_quadratics[index] = in_view(env.irradiance_quadratic());
                 environment_quadratics[2 + index] = in_view(env.radiance_quadratic());
             }
             *slot = EyeUniform {
-                clip_from_anchored: to_cols(eye.clip_from_anchored(gpu_scene.anchor, settings.near)),
+                clip_from_anchored: to_cols(eye.clip_from_anchored(anchor, settings.near)),
                 view_from_anchored: to_cols(view_from_anchored.as_mat4()),
                 world_from_view: to_cols(Mat4::from_quat(world_from_view)),
                 tangents: [l as f32, r as f32, u as f32, d as f32],
                 other_from_view: to_cols(other_from_view(views, index)),
             };
-            for light in &scene.lights {
+            for light in scene_lights {
                 lights.push(match *light {
                     Light::Directional { direction, color, intensity } => LightUniform {
                         pos_or_dir: view_from_world
@@ -267,11 +290,11 @@ impl FrameBuffers {
             eyes,
             size: [settings.profile.width, settings.profile.height],
             layers: views.len() as u32,
-            light_count: scene.lights.len() as u32,
+            light_count: scene_lights.len() as u32,
             near: settings.near as f32,
             exposure: settings.exposure,
             white_point: settings.white_point,
-            has_environment: scene.environment.is_some() as u32,
+            has_environment: environment.is_some() as u32,
             environment_quadratics,
         };
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));

@@ -15,7 +15,8 @@ use crate::render::error::{Error, Result};
 use std::fmt::Write as _;
 
 /// Which wgpu backend to use. `Auto` prefers a real GPU and falls back to lavapipe.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum BackendChoice {
     /// Whichever backend has a real GPU, falling back to lavapipe (software Vulkan).
     #[default]
@@ -40,10 +41,13 @@ pub struct Capabilities {
 
 /// The adapter, device and queue every pass shares.
 pub struct Gpu {
-    /// The wgpu instance the adapter came from (also makes window surfaces).
-    pub instance: wgpu::Instance,
-    /// The chosen adapter.
-    pub adapter: wgpu::Adapter,
+    /// The wgpu instance the adapter came from (also makes window surfaces); `None` for a
+    /// host's device ([`Gpu::from_host`]), which vrao did not open.
+    pub instance: Option<wgpu::Instance>,
+    /// The chosen adapter (`None` for a host's device).
+    pub adapter: Option<wgpu::Adapter>,
+    /// The adapter's name, backend, type and driver.
+    pub info: wgpu::AdapterInfo,
     /// The logical device every resource is made on.
     pub device: wgpu::Device,
     /// The device's only queue.
@@ -83,7 +87,7 @@ impl Gpu {
         let desc = Self::device_descriptor(&adapter);
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
             .map_err(|e| Error::Device(format!("{} refused a device: {e}", adapter.get_info().name)))?;
-        Ok(Self::from_device(instance, adapter, device, queue))
+        Self::from_device(instance, adapter, device, queue)
     }
 
     /// The features and limits vrao asks of `adapter`: multiview and timestamp queries
@@ -125,18 +129,16 @@ impl Gpu {
     }
 
     /// The `Gpu` for a device opened with [`Gpu::device_descriptor`] (by wgpu, or wrapped
-    /// from a device an OpenXR runtime created): capabilities from the device's features,
-    /// GPU errors kept for [`Gpu::take_error`], and the multiview probe run.
+    /// from a device an OpenXR runtime created): the adapter is checked for what the
+    /// kernels need (a refusal names what it lacks), GPU errors are kept for
+    /// [`Gpu::take_error`], and the multiview probe runs.
     pub fn from_device(
         instance: wgpu::Instance,
         adapter: wgpu::Adapter,
         device: wgpu::Device,
         queue: wgpu::Queue,
-    ) -> Gpu {
-        let features = device.features();
-        let multiview = features.contains(wgpu::Features::MULTIVIEW);
-        let timestamps =
-            features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+    ) -> Result<Gpu> {
+        refuse_missing(&adapter.get_info(), support::missing_capabilities(&support::AdapterSupport::of(&adapter)))?;
         let uncaptured = std::sync::Arc::new(std::sync::Mutex::new(None));
         let sink = uncaptured.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
@@ -144,10 +146,47 @@ impl Gpu {
             let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
             slot.get_or_insert_with(|| e.to_string());
         }));
-        let caps = Capabilities { multiview, multiview_reliable: false, timestamps };
-        let mut gpu = Gpu { instance, adapter, device, queue, caps, uncaptured };
-        gpu.caps.multiview_reliable = multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
-        gpu
+        let info = adapter.get_info();
+        let mut gpu = Gpu {
+            caps: Self::capabilities_of(&device),
+            instance: Some(instance),
+            adapter: Some(adapter),
+            info,
+            device,
+            queue,
+            uncaptured,
+        };
+        gpu.caps.multiview_reliable = gpu.caps.multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
+        Ok(gpu)
+    }
+
+    /// The `Gpu` for a device a host application opened and keeps (the AO engine's):
+    /// checked for what the kernels need from the device alone (its backend, limits and
+    /// features; a refusal is one `Error::Device` naming what is missing), and the host's
+    /// uncaptured-error handler is left alone. Multiview is not probed: the engine's
+    /// passes are compute kernels that never draw.
+    pub fn from_host(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Gpu> {
+        let info = device.adapter_info();
+        refuse_missing(&info, support::missing_device_capabilities(&support::DeviceSupport::of(device)))?;
+        Ok(Gpu {
+            caps: Capabilities { multiview: false, ..Self::capabilities_of(device) },
+            instance: None,
+            adapter: None,
+            info,
+            device: device.clone(),
+            queue: queue.clone(),
+            uncaptured: std::sync::Arc::new(std::sync::Mutex::new(None)),
+        })
+    }
+
+    fn capabilities_of(device: &wgpu::Device) -> Capabilities {
+        let features = device.features();
+        Capabilities {
+            multiview: features.contains(wgpu::Features::MULTIVIEW),
+            multiview_reliable: false,
+            timestamps: features
+                .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
+        }
     }
 
     /// The first GPU error since the last call, as `Error::Gpu` (then cleared).
@@ -176,7 +215,7 @@ impl Gpu {
 
     /// Human-readable description for `vrao info`.
     pub fn describe(&self) -> String {
-        let info = self.adapter.get_info();
+        let info = &self.info;
         let limits = self.device.limits();
         let yes_no = |b: bool| if b { "yes" } else { "no" };
         let mut s = String::new();
@@ -206,6 +245,19 @@ impl Gpu {
     }
 }
 
+/// `Error::Device` naming what `missing` lists, unless it is empty.
+fn refuse_missing(info: &wgpu::AdapterInfo, missing: Vec<String>) -> Result<()> {
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Device(format!(
+        "the {:?} adapter {} lacks {}; use Vulkan (for a CPU fall-back: apt install mesa-vulkan-drivers)",
+        info.backend,
+        info.name,
+        missing.join(" and ")
+    )))
+}
+
 /// Prefers a hardware adapter; a CPU adapter (lavapipe) is the fall-back. Adapters that
 /// lack something the renderer needs ([`support::missing_capabilities`]) are passed over;
 /// when only such adapters exist, the best one is refused with what it lacks.
@@ -229,14 +281,8 @@ fn pick_adapter(instance: &wgpu::Instance, backends: wgpu::Backends) -> Result<w
     match ranked.into_iter().next() {
         Some((adapter, missing)) if missing.is_empty() => Ok(adapter),
         Some((adapter, missing)) => {
-            let info = adapter.get_info();
-            Err(Error::Device(format!(
-                "the {:?} adapter {} lacks {}; use Vulkan (--backend vulkan; for a CPU fall-back: apt \
-                 install mesa-vulkan-drivers)",
-                info.backend,
-                info.name,
-                missing.join(" and ")
-            )))
+            refuse_missing(&adapter.get_info(), missing)?;
+            unreachable!("an adapter that lacks something is refused")
         }
         None => Err(Error::Device(format!(
             "no adapter on backends {backends:?}; install a Vulkan driver \

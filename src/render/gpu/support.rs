@@ -62,6 +62,52 @@ pub fn missing_capabilities(support: &AdapterSupport) -> Vec<String> {
     missing
 }
 
+/// What the kernels need that a device alone can say (a host's device, whose adapter
+/// vrao never sees): its backend, and the limits a compute pass over layered targets uses.
+#[derive(Clone, Debug)]
+pub struct DeviceSupport {
+    /// The backend the device runs on.
+    pub backend: wgpu::Backend,
+    /// The device's limits.
+    pub limits: wgpu::Limits,
+}
+
+impl DeviceSupport {
+    /// What `device` reports.
+    pub fn of(device: &wgpu::Device) -> DeviceSupport {
+        DeviceSupport { backend: device.adapter_info().backend, limits: device.limits() }
+    }
+}
+
+/// Storage textures the busiest AO kernel writes at once (temporal accumulation: the
+/// accumulated AO and the two history targets).
+const STORAGE_TEXTURES_PER_KERNEL: u32 = 3;
+
+/// What a host's device lacks for the AO engine's kernels. The formats the kernels write
+/// ([`STORAGE_WRITE_FORMATS`]) are write-only storage formats of every non-GL backend's
+/// baseline (WebGPU's core set), so the backend and the limits decide.
+pub fn missing_device_capabilities(support: &DeviceSupport) -> Vec<String> {
+    let mut missing = Vec::new();
+    let limits = &support.limits;
+    let tile = super::kernel::TILE;
+    if limits.max_compute_workgroups_per_dimension == 0 || limits.max_compute_invocations_per_workgroup < tile * tile {
+        missing.push(format!("compute shaders with {tile}×{tile} workgroups"));
+    }
+    if limits.max_storage_textures_per_shader_stage < STORAGE_TEXTURES_PER_KERNEL {
+        missing.push(format!(
+            "{STORAGE_TEXTURES_PER_KERNEL} storage textures per shader stage (the device allows {})",
+            limits.max_storage_textures_per_shader_stage
+        ));
+    }
+    if limits.max_texture_array_layers < 2 {
+        missing.push("2-layer array textures (one layer per eye)".to_string());
+    }
+    if support.backend == wgpu::Backend::Gl {
+        missing.push("textureLoad on depth textures and storage formats beyond GL's (the GL backend)".to_string());
+    }
+    missing
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -77,6 +123,17 @@ mod tests {
                 .map(|&f| (f, if f == wgpu::TextureFormat::Rg32Uint { rg32uint } else { all }))
                 .collect(),
         }
+    }
+
+    #[test]
+    fn a_host_device_is_checked_by_its_limits_and_backend() {
+        let vulkan = DeviceSupport { backend: wgpu::Backend::Vulkan, limits: wgpu::Limits::default() };
+        assert!(missing_device_capabilities(&vulkan).is_empty());
+        let no_compute = DeviceSupport { backend: wgpu::Backend::Vulkan, limits: wgpu::Limits::downlevel_webgl2_defaults() };
+        let missing = missing_device_capabilities(&no_compute);
+        assert!(missing.iter().any(|m| m.contains("compute")), "{missing:?}");
+        let gl = DeviceSupport { backend: wgpu::Backend::Gl, limits: wgpu::Limits::default() };
+        assert_eq!(missing_device_capabilities(&gl).len(), 1);
     }
 
     #[test]

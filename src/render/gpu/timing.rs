@@ -4,6 +4,7 @@
 
 use super::Gpu;
 use crate::render::error::{Error, Result};
+use crate::render::stats::Sorted;
 use std::collections::VecDeque;
 
 /// One finished frame's spans: (label, GPU milliseconds) in the order they were
@@ -48,6 +49,19 @@ impl PassTimer {
         let profiler = wgpu_profiler::GpuProfiler::new(&gpu.device, settings)
             .map_err(|e| Error::Gpu(format!("GPU profiler: {e}")))?;
         Ok(PassTimer { profiler, pending: VecDeque::new(), timestamp_period: gpu.queue.get_timestamp_period() })
+    }
+
+    /// A timer that records no queries (the AO engine on a host's encoder, which the
+    /// engine does not submit).
+    pub fn disabled(gpu: &Gpu) -> Result<PassTimer> {
+        let settings = wgpu_profiler::GpuProfilerSettings {
+            enable_timer_queries: false,
+            enable_debug_groups: false,
+            max_num_pending_frames: MAX_PENDING_FRAMES,
+        };
+        let profiler = wgpu_profiler::GpuProfiler::new(&gpu.device, settings)
+            .map_err(|e| Error::Gpu(format!("GPU profiler: {e}")))?;
+        Ok(PassTimer { profiler, pending: VecDeque::new(), timestamp_period: 1.0 })
     }
 
     /// Whether timestamp queries are on (false where the device has none: spans then read 0 frames).
@@ -106,6 +120,16 @@ pub fn is_per_eye(label: &str) -> bool {
     label.ends_with(" left") || label.ends_with(" right")
 }
 
+/// The summed GPU ms of `passes` in one frame's `spans`, or the first of them that has no
+/// span: every pass that runs is timed under its name, so a missing one means a name
+/// and its span disagree, and counting it as 0 ms would hide that.
+pub fn passes_ms<'a>(spans: &[(String, f64)], passes: &[&'a str]) -> std::result::Result<f64, &'a str> {
+    passes.iter().try_fold(0.0, |sum, &pass| match spans.iter().find(|(label, _)| label == pass) {
+        Some((_, ms)) => Ok(sum + ms),
+        None => Err(pass),
+    })
+}
+
 fn flatten(results: &[wgpu_profiler::GpuTimerQueryResult], out: &mut Vec<(String, f64)>) {
     for r in results {
         if let Some(time) = &r.time {
@@ -134,7 +158,8 @@ pub struct SpanSummary {
     pub max_ms: f64,
 }
 
-/// Median and spread of every span over frames, in the order spans first appear.
+/// Median and spread of every span over frames, in the order spans first appear
+/// (quantiles as [`crate::render::stats`] defines them).
 pub fn summarize(frames: &[Vec<(String, f64)>]) -> Vec<SpanSummary> {
     let mut labels: Vec<&str> = Vec::new();
     for frame in frames {
@@ -147,28 +172,21 @@ pub fn summarize(frames: &[Vec<(String, f64)>]) -> Vec<SpanSummary> {
     labels
         .into_iter()
         .map(|label| {
-            let mut times: Vec<f64> =
-                frames.iter().flat_map(|f| f.iter().filter(|(l, _)| l == label).map(|(_, ms)| *ms)).collect();
-            times.sort_by(f64::total_cmp);
+            let times =
+                Sorted::new(frames.iter().flat_map(|f| f.iter().filter(|(l, _)| l == label).map(|(_, ms)| *ms)));
+            // Every label was seen in some frame, so it has at least one time.
+            let at = |q: f64| times.quantile(q).expect("a label comes from a frame");
             SpanSummary {
                 label: label.to_string(),
                 frames: times.len(),
-                median_ms: quantile(&times, 0.5),
-                p25_ms: quantile(&times, 0.25),
-                p75_ms: quantile(&times, 0.75),
-                min_ms: times[0],
-                max_ms: times[times.len() - 1],
+                median_ms: at(0.5),
+                p25_ms: at(0.25),
+                p75_ms: at(0.75),
+                min_ms: at(0.0),
+                max_ms: at(1.0),
             }
         })
         .collect()
-}
-
-/// Linear-interpolated quantile of sorted, non-empty values.
-pub fn quantile(sorted: &[f64], q: f64) -> f64 {
-    let pos = q.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
-    let (i, frac) = (pos.floor() as usize, pos.fract());
-    let next = sorted[(i + 1).min(sorted.len() - 1)];
-    sorted[i] + (next - sorted[i]) * frac
 }
 
 #[cfg(test)]
@@ -185,6 +203,13 @@ mod tests {
         assert_eq!(s.len(), 2);
         assert_eq!((s[0].median_ms, s[0].p25_ms, s[0].p75_ms, s[0].min_ms, s[0].max_ms), (3.0, 2.0, 4.0, 1.0, 5.0));
         assert_eq!(s[1].median_ms, 30.0);
-        assert_eq!(quantile(&[1.0, 2.0], 0.5), 1.5);
+    }
+
+    #[test]
+    fn pass_times_add_up_and_a_missing_span_is_named() {
+        let spans = vec![("ssao".to_string(), 1.5), ("ssao left".to_string(), 0.75), ("blur".to_string(), 0.25)];
+        assert_eq!(passes_ms(&spans, &["ssao", "blur"]), Ok(1.75));
+        assert_eq!(passes_ms(&spans, &[]), Ok(0.0));
+        assert_eq!(passes_ms(&spans, &["ssao", "upsample"]), Err("upsample"));
     }
 }

@@ -34,10 +34,12 @@ use crate::render::settings::Settings;
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
-/// Every pass, in execution order (declaration order is execution order). A new pass is
-/// its own folder, its `pub mod` line above and one entry here; a new technique also
-/// names itself in `settings::Technique` (its command-line name).
-pub fn all(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameBuffers) -> Vec<Box<dyn Pass>> {
+/// The renderer's passes before the AO chain, in execution order: the G-buffer, the
+/// directional lights' maps and direct light, their bounce, and the second depth layer
+/// SSDO may read. A new pass is its own folder, its `pub mod` line above and one entry
+/// here, in [`ao_chain`] or in [`output_passes`]; a new technique also names itself in
+/// `settings::Technique` (its command-line name).
+pub fn scene_passes(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameBuffers) -> Vec<Box<dyn Pass>> {
     // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
     let light_space = Arc::new(shadow::LightSpace::new(gpu, scene, gpu_scene.anchor));
     vec![
@@ -45,24 +47,39 @@ pub fn all(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameBuffers)
         Box::new(shadow::ShadowPass::new(gpu, gpu_scene, light_space.clone())),
         Box::new(direct::DirectLightPass::new(gpu, light_space.clone())),
         Box::new(rsm::RsmPass::new(gpu, light_space)),
-        Box::new(ssao::pass(gpu)),
-        Box::new(hbao::pass(gpu)),
-        Box::new(gtao::GtaoPass::new(gpu)),
         Box::new(peel::DepthPeelPass::new(gpu, frame)),
-        Box::new(ssdo::SsdoPass::new(gpu)),
-        Box::new(fetch_only::pass(gpu)),
-        Box::new(temporal::TemporalPass::new(gpu)),
-        Box::new(blur::BlurPass::new(gpu)),
-        Box::new(upsample::UpsamplePass::new(gpu)),
-        Box::new(composite::CompositePass::new(gpu)),
-        Box::new(tonemap::TonemapPass::new(gpu)),
     ]
+}
+
+/// The AO chain, in execution order: each technique (one runs), then `light_gathering`
+/// (the renderer's SSDO, which reads the renderer's direct light), temporal accumulation,
+/// the denoise and the upsampling to full resolution. It reads the depth and normals and
+/// provides [`crate::render::graph::OCCLUSION`] and
+/// [`crate::render::graph::FINAL_AO`]: the [`crate::render::ao::AoEngine`] owns it.
+pub fn ao_chain(gpu: &Gpu, light_gathering: Vec<Box<dyn Pass>>) -> Vec<Box<dyn Pass>> {
+    let mut chain: Vec<Box<dyn Pass>> =
+        vec![Box::new(ssao::pass(gpu)), Box::new(hbao::pass(gpu)), Box::new(gtao::GtaoPass::new(gpu))];
+    chain.extend(light_gathering);
+    chain.push(Box::new(fetch_only::pass(gpu)));
+    chain.push(Box::new(temporal::TemporalPass::new(gpu)));
+    chain.push(Box::new(blur::BlurPass::new(gpu)));
+    chain.push(Box::new(upsample::UpsamplePass::new(gpu)));
+    chain
+}
+
+/// The renderer's passes after the AO chain: the HDR composite and the tone mapping.
+pub fn output_passes(gpu: &Gpu) -> Vec<Box<dyn Pass>> {
+    vec![Box::new(composite::CompositePass::new(gpu)), Box::new(tonemap::TonemapPass::new(gpu))]
 }
 
 /// What passes may consult when declaring themselves for a frame.
 pub struct FrameSetup<'a> {
-    /// The scene being rendered.
-    pub scene: &'a Scene,
+    /// The scene being rendered; `None` in the AO engine, which has none (its passes
+    /// never ask: [`FrameSetup::scene`]).
+    pub scene: Option<&'a Scene>,
+    /// The f64 origin that view-from-anchored matrices start from (the scene's anchor;
+    /// the world origin for a host's views).
+    pub anchor: glam::DVec3,
     /// This frame's settings.
     pub settings: &'a Settings,
     /// 2 for stereo, 1 for a mono view.
@@ -92,15 +109,28 @@ pub struct FrameContext<'a> {
     pub decl: &'a PassDecl,
     /// The frame's uniform and light buffers.
     pub frame: &'a FrameBuffers,
-    /// The scene uploaded to the GPU.
-    pub scene: &'a GpuScene,
+    /// The scene uploaded to the GPU (`None` in the AO engine: [`FrameContext::gpu_scene`]).
+    pub scene: Option<&'a GpuScene>,
     /// Timestamp scopes around each pass.
     pub timer: &'a PassTimer,
     /// What the passes were declared with.
     pub setup: &'a FrameSetup<'a>,
 }
 
+impl<'a> FrameSetup<'a> {
+    /// The scene, for the renderer's own passes (G-buffer, lights, composite), which run
+    /// only in the renderer, where there is one.
+    pub fn scene(&self) -> &'a Scene {
+        self.scene.expect("a scene pass runs only in the renderer, which has a scene")
+    }
+}
+
 impl<'a> FrameContext<'a> {
+    /// The uploaded scene, for the renderer's raster passes (see [`FrameSetup::scene`]).
+    pub fn gpu_scene(&self) -> &'a GpuScene {
+        self.scene.expect("a scene pass runs only in the renderer, which has a scene")
+    }
+
     /// The target of a resource the graph allocated for this frame (a named output: the
     /// texture it stands for at this pass).
     pub fn target(&self, r: Resource) -> &'a LayeredTarget {
@@ -124,16 +154,39 @@ impl<'a> FrameContext<'a> {
     where
         'a: 'b,
     {
+        self.bind_overriding(binds, own, &[])
+    }
+
+    /// [`FrameContext::bind`], with the entries that read or write a named resource
+    /// bound to another view of it instead (the right eye's dispatch of the stereo reuse
+    /// writes layer 1 alone). Every override must name a resource of the list.
+    pub fn bind_overriding<'b>(
+        &self,
+        binds: &[Bind],
+        own: &[wgpu::BindingResource<'b>],
+        overrides: &[(Resource, wgpu::BindingResource<'b>)],
+    ) -> Vec<wgpu::BindingResource<'b>>
+    where
+        'a: 'b,
+    {
+        debug_assert!(
+            overrides.iter().all(|(r, _)| binds.iter().any(|b| matches!(*b, Bind::Read(x) | Bind::Write(x) if x == *r))),
+            "{}: an override names a resource the binding list does not",
+            self.decl.name
+        );
         let mut own = own.iter();
         let resources: Vec<_> = binds
             .iter()
             .map(|bind| match *bind {
+                Bind::Read(r) | Bind::Write(r) if overrides.iter().any(|(x, _)| *x == r) => {
+                    overrides.iter().find(|(x, _)| *x == r).expect("checked by the guard").1.clone()
+                }
                 Bind::Frame => self.frame.frame.as_entire_binding(),
                 Bind::AoParams => self.frame.ao.as_entire_binding(),
                 Bind::SampleKernel => self.frame.kernel.as_entire_binding(),
                 Bind::Lights => self.frame.lights.as_entire_binding(),
-                Bind::Environment => wgpu::BindingResource::TextureView(&self.scene.environment),
-                Bind::EnvironmentSampler => wgpu::BindingResource::Sampler(&self.scene.sampler),
+                Bind::Environment => wgpu::BindingResource::TextureView(&self.gpu_scene().environment),
+                Bind::EnvironmentSampler => wgpu::BindingResource::Sampler(&self.gpu_scene().sampler),
                 Bind::Read(r) | Bind::Write(r) => self.view(r),
                 Bind::Own(_) => own.next().expect("one own resource per Bind::Own").clone(),
             })
@@ -175,9 +228,17 @@ impl<'a> FrameContext<'a> {
     }
 }
 
+/// Records one pass inside its timestamp span.
+pub fn record(pass: &dyn Pass, ctx: &mut FrameContext) {
+    let span = ctx.timer.begin(ctx.encoder, ctx.decl.name);
+    pass.record(ctx);
+    ctx.timer.end(ctx.encoder, span);
+}
+
 /// One pass of the frame graph: declares what it reads and writes for a frame, and
-/// records its GPU work when the plan keeps it.
-pub trait Pass {
+/// records its GPU work when the plan keeps it. Send and Sync, so that an embedder may
+/// keep the AO engine in a multi-threaded app's state.
+pub trait Pass: Send + Sync {
     /// What the pass reads and writes this frame, and whether it runs at all.
     fn declare(&self, setup: &FrameSetup) -> PassDecl;
     /// Records the pass's commands into the frame's encoder.

@@ -9,6 +9,7 @@
 //! when the last wgpu handle goes, after the OpenXR session: enable2 makes the
 //! application the owner of both.
 
+use super::RuntimeFailure;
 use crate::render::gpu::Gpu;
 use ash::vk;
 use ash::vk::Handle as _;
@@ -37,7 +38,7 @@ impl Binding {
 
 /// The Vulkan version to create the instance with: what the loader offers, capped at
 /// 1.3 (wgpu-hal's ceiling) and at the runtime's maximum.
-fn api_version(entry: &ash::Entry, requirements: &openxr::vulkan::Requirements) -> Result<u32, String> {
+fn api_version(entry: &ash::Entry, requirements: &openxr::vulkan::Requirements) -> Result<u32, RuntimeFailure> {
     // SAFETY: a plain query of the loader.
     let loader = unsafe { entry.try_enumerate_instance_version() }
         .map_err(|e| format!("vkEnumerateInstanceVersion: {e}"))?
@@ -48,13 +49,13 @@ fn api_version(entry: &ash::Entry, requirements: &openxr::vulkan::Requirements) 
     let min = requirements.min_api_version_supported;
     let runtime_min = vk::make_api_version(0, min.major() as u32, min.minor() as u32, 0);
     if version < runtime_min {
-        return Err(format!(
+        return Err(RuntimeFailure(format!(
             "the runtime needs Vulkan {}.{}, the loader offers {}.{}",
             min.major(),
             min.minor(),
             vk::api_version_major(loader),
             vk::api_version_minor(loader)
-        ));
+        )));
     }
     Ok(version)
 }
@@ -64,8 +65,9 @@ fn names(list: &[&'static CStr]) -> Vec<*const c_char> {
 }
 
 /// Creates the Vulkan instance and device through the runtime and wraps them as vrao's
-/// `Gpu` (same features, limits and multiview probe as `Gpu::new`).
-pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Result<(Gpu, Binding), String> {
+/// `Gpu` (same features, limits and multiview probe as `Gpu::new`). Each failing call's
+/// message (a `String`) becomes the [`RuntimeFailure`] through `?`.
+pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Result<(Gpu, Binding), RuntimeFailure> {
     // xrGetVulkanGraphicsRequirements2KHR must come before the instance is created.
     let requirements = xr
         .graphics_requirements::<openxr::Vulkan>(system)
@@ -191,7 +193,7 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
     // SAFETY: the hal device was opened from this adapter with `desc`'s features/limits.
     let (device, queue) = unsafe { adapter.create_device_from_hal(open, &desc) }
         .map_err(|e| format!("{adapter_name} refused a device: {e}"))?;
-    let gpu = Gpu::from_device(instance, adapter, device, queue);
+    let gpu = Gpu::from_device(instance, adapter, device, queue).map_err(|e| e.to_string())?;
     let binding = Binding { instance: vk_instance, physical_device, device: vk_device, queue_family_index };
     Ok((gpu, binding))
 }

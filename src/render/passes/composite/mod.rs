@@ -23,6 +23,10 @@ use crate::render::settings::Technique;
 use std::sync::Mutex;
 use wgpu::util::DeviceExt;
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "composite";
+
 /// Lit scene radiance before tone mapping.
 pub const HDR: Resource = Resource::storage("hdr", Size::Full, wgpu::TextureFormat::Rgba16Float);
 
@@ -116,7 +120,7 @@ impl CompositePass {
 impl Pass for CompositePass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let settings = setup.settings;
-        let mut decl = PassDecl::new("composite").bindings(&BINDINGS);
+        let mut decl = PassDecl::new(NAME).bindings(&BINDINGS);
         if settings.ao.technique == Technique::None {
             decl = decl.unbind(OCCLUSION).unbind(AO_GEOMETRY);
         } else if settings.ao.half_res {
@@ -124,7 +128,7 @@ impl Pass for CompositePass {
         } else {
             decl = decl.unbind(AO_GEOMETRY);
         }
-        if rsm_active(setup.scene, settings) {
+        if rsm_active(setup.scene(), settings) {
             decl
         } else {
             decl.unbind(RSM_INDIRECT).unbind(RSM_GEOMETRY)
@@ -133,10 +137,10 @@ impl Pass for CompositePass {
 
     fn record(&self, ctx: &mut FrameContext) {
         let half_res = ctx.setup.settings.ao.half_res;
-        let rsm = rsm_active(ctx.setup.scene, ctx.setup.settings);
+        let rsm = rsm_active(ctx.setup.scene(), ctx.setup.settings);
         // The output's left-eye layer is unused before the right eye's dispatch: the
         // geometry (or its placeholder) stands in.
-        let mut resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), self.fallback_header.as_entire_binding()]);
+        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), self.fallback_header.as_entire_binding()]);
         // One invocation per quad of 2×2 pixels (composite.wgsl): both eyes alike, or the
         // left eye, then the right eye reusing its AO, then the quads it listed.
         let (w, h, layers) = ctx.quad_extent();
@@ -147,10 +151,14 @@ impl Pass for CompositePass {
         if reuse {
             let fallback = self.fallback_list(device, u64::from(w) * u64::from(h));
             ctx.encoder.copy_buffer_to_buffer(&self.fallback_header, 0, &fallback, 0, FALLBACK_HEADER_BYTES);
+            // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists
+            // the quads it could not reuse in `fallback`.
             let (right, left) = (ctx.layer_view(HDR, 1), ctx.layer_view(HDR, 0));
-            resources[9] = wgpu::BindingResource::TextureView(&right);
-            resources[13] = wgpu::BindingResource::TextureView(&left);
-            resources[14] = fallback.as_entire_binding();
+            let resources = ctx.bind_overriding(
+                &BINDINGS,
+                &[wgpu::BindingResource::TextureView(&left), fallback.as_entire_binding()],
+                &[(HDR, wgpu::BindingResource::TextureView(&right))],
+            );
             self.right_eye[rsm as usize].dispatch(device, ctx.encoder, &resources, (w, h, 1));
             ctx.encoder.copy_buffer_to_buffer(&fallback, 0, &self.fallback_args, 0, 12);
             let args = &self.fallback_args;

@@ -11,6 +11,10 @@ use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use std::sync::Arc;
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "direct";
+
 /// Outgoing direct radiance (lights and emission) and the view distance, packed
 /// (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the composite's base, and
 /// the depth test plus sender radiance of SSDO's bounce in a single fetch.
@@ -47,8 +51,8 @@ impl DirectLightPass {
 
 impl Pass for DirectLightPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        let decl = PassDecl::new("direct").bindings(&BINDINGS);
-        if shadows_active(setup.scene, setup.settings) {
+        let decl = PassDecl::new(NAME).bindings(&BINDINGS);
+        if shadows_active(setup.scene(), setup.settings) {
             decl.note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
         } else {
             decl.unbind(SHADOW_MAP)
@@ -57,7 +61,7 @@ impl Pass for DirectLightPass {
 
     fn record(&self, ctx: &mut FrameContext) {
         // Shadows (shadow.wgsl): every light's map, or no light and a placeholder map.
-        let shadowed = shadows_active(ctx.setup.scene, ctx.setup.settings);
+        let shadowed = shadows_active(ctx.setup.scene(), ctx.setup.settings);
         let shadows = if shadowed { &self.light_space.uniform } else { &self.light_space.none };
         let own = [shadows.as_entire_binding(), wgpu::BindingResource::Sampler(&self.light_space.comparison)];
         let resources = ctx.bind(&BINDINGS, &own);

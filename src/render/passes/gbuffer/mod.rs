@@ -12,6 +12,10 @@ use crate::render::graph::{PassDecl, Resource, Size};
 use std::num::NonZeroU32;
 use wgpu::util::DeviceExt;
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "gbuffer";
+
 /// Reversed-Z depth of every eye layer.
 pub const DEPTH: Resource = Resource::attachment("depth", Size::Full, wgpu::TextureFormat::Depth32Float);
 /// View-space unit normals (w unused).
@@ -119,10 +123,11 @@ fn pipeline(
 
 impl Pass for GBufferPass {
     fn declare(&self, _: &FrameSetup) -> PassDecl {
-        PassDecl::new("gbuffer").write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION)
+        PassDecl::new(NAME).write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION)
     }
 
     fn record(&self, ctx: &mut FrameContext) {
+        let gpu_scene = ctx.gpu_scene();
         let multiview = ctx.setup.multiview && ctx.setup.views == 2;
         if multiview {
             let pipeline = self.multiview.as_ref().expect("multiview requested without adapter support");
@@ -130,7 +135,7 @@ impl Pass for GBufferPass {
             let mut pass = begin(ctx.encoder, views, NonZeroU32::new(0b11));
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &self.frame_group, &[]);
-            ctx.scene.draw(&mut pass, Some(1));
+            gpu_scene.draw(&mut pass, Some(1));
         } else {
             for layer in 0..ctx.setup.views as usize {
                 let label = if layer == 0 { "gbuffer left" } else { "gbuffer right" };
@@ -141,7 +146,7 @@ impl Pass for GBufferPass {
                     pass.set_pipeline(&self.multipass);
                     pass.set_bind_group(0, &self.frame_group, &[]);
                     pass.set_bind_group(2, &self.eye_select[layer], &[]);
-                    ctx.scene.draw(&mut pass, Some(1));
+                    gpu_scene.draw(&mut pass, Some(1));
                 }
                 ctx.timer.end(ctx.encoder, span);
             }

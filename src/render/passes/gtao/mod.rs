@@ -21,23 +21,24 @@ const DEFAULT_CONNECT: f32 = 0.25;
 
 /// GTAO's own settings (`AoSettings::gtao`), and their command-line flags. The defaults
 /// are tuned against the reference (scripts/tune-gtao.py and docs/gtao-tuning.md).
-#[derive(Clone, Debug, PartialEq, clap::Args)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "app", derive(clap::Args))]
 pub struct GtaoSettings {
     /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
     /// radius (thin objects stop occluding behind themselves).
     // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
     // fewer halos (pixels beside depth edges too dark by > 0.1 on the furnished room:
     // 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_THICKNESS)]
+    #[cfg_attr(feature = "app", arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_THICKNESS))]
     pub thickness: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
     /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_STEP_POWER)]
+    #[cfg_attr(feature = "app", arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_STEP_POWER))]
     pub step_power: f32,
     /// GTAO: successive samples whose distances differ by less than this fraction of the
     /// radius lie on one continuous surface, which also blocks the angles between them
     /// (0: never).
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_CONNECT)]
+    #[cfg_attr(feature = "app", arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_CONNECT))]
     pub connect: f32,
 }
 
@@ -171,7 +172,7 @@ impl Pass for GtaoPass {
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
         // Bindings 7 and 8 are unused before the right eye's dispatch: the normals stand in.
         let normals = ctx.view(super::gbuffer::NORMALS);
-        let mut resources = ctx.bind(&BINDINGS, &[normals.clone(), normals, self.params.as_entire_binding()]);
+        let resources = ctx.bind(&BINDINGS, &[normals.clone(), normals, self.params.as_entire_binding()]);
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
         self.interior.dispatch(device, ctx.encoder, &resources, (width - band, height, marched_layers));
@@ -179,12 +180,16 @@ impl Pass for GtaoPass {
         if !reuse {
             return;
         }
+        // The right eye writes layer 1 of the occlusion and its geometry alone, and reads
+        // the left eye's layer 0 of both.
         let (ao_right, geometry_right) = (ctx.layer_view(AO_RAW, 1), ctx.layer_view(AO_GEOMETRY, 1));
         let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
-        resources[5] = wgpu::BindingResource::TextureView(&ao_right);
-        resources[6] = wgpu::BindingResource::TextureView(&geometry_right);
-        resources[7] = wgpu::BindingResource::TextureView(&ao_left);
-        resources[8] = wgpu::BindingResource::TextureView(&geometry_left);
+        let view = wgpu::BindingResource::TextureView;
+        let resources = ctx.bind_overriding(
+            &BINDINGS,
+            &[view(&ao_left), view(&geometry_left), self.params.as_entire_binding()],
+            &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))],
+        );
         self.right_eye.dispatch(device, ctx.encoder, &resources, (width, height, 1));
     }
 }

@@ -17,6 +17,10 @@ use crate::render::passes::gbuffer::DEPTH;
 use crate::render::settings::Technique;
 use wgpu::util::DeviceExt;
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "depth-peel";
+
 /// Depth peeling's second layer (SSDO's quality mode): the nearest surface behind
 /// [`DEPTH`], reversed-Z, 0 where nothing lies behind.
 pub const DEPTH_LAYER_2: Resource =
@@ -94,11 +98,11 @@ impl Pass for DepthPeelPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
         let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
-        PassDecl::new("depth-peel")
+        PassDecl::new(NAME)
             .read(DEPTH)
             .write(DEPTH_LAYER_2)
             .occlusion_cost()
-            .disabled_if(!ao.depth_peeling, "depth peeling is off (--depth-peeling turns it on for SSDO)")
+            .disabled_if(!ao.depth_peeling, "depth peeling is off (an SSDO quality mode)")
             .disabled_if(
                 !ssdo,
                 format!("technique is {}: only SSDO tests occluders against a second depth layer", ao.technique.name()),
@@ -106,6 +110,7 @@ impl Pass for DepthPeelPass {
     }
 
     fn record(&self, ctx: &mut FrameContext) {
+        let gpu_scene = ctx.gpu_scene();
         let first = ctx.view(DEPTH);
         let second = ctx.target(DEPTH_LAYER_2);
         for layer in 0..ctx.setup.views as usize {
@@ -140,7 +145,7 @@ impl Pass for DepthPeelPass {
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.frame_group, &[]);
                 pass.set_bind_group(1, &eye_group, &[]);
-                ctx.scene.draw(&mut pass, None);
+                gpu_scene.draw(&mut pass, None);
             }
             ctx.timer.end(ctx.encoder, span);
         }

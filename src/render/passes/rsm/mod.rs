@@ -12,8 +12,12 @@ use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use bytemuck::{Pod, Zeroable};
-use std::cell::Cell;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
+
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "rsm";
 
 /// `RsmParams` of rsm.wgsl.
 #[repr(C)]
@@ -55,7 +59,7 @@ pub struct RsmPass {
     light_space: Arc<LightSpace>,
     params: wgpu::Buffer,
     /// Frames this pass has gathered: turns the sampling pattern (Lin's NCTU thesis).
-    frame: Cell<u32>,
+    frame: AtomicU32,
 }
 
 impl RsmPass {
@@ -69,18 +73,18 @@ impl RsmPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        RsmPass { kernel, light_space, params, frame: Cell::new(0) }
+        RsmPass { kernel, light_space, params, frame: AtomicU32::new(0) }
     }
 }
 
 impl Pass for RsmPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let s = &setup.settings.shadows;
-        let lights = shadow_casters(setup.scene).len();
-        PassDecl::new("rsm")
+        let lights = shadow_casters(setup.scene()).len();
+        PassDecl::new(NAME)
             .bindings(&BINDINGS)
             .disabled_if(lights == 0, "no directional light to bounce (reflective shadow maps need one)")
-            .disabled_if(!s.rsm, "reflective shadow maps are off (--rsm on adds one bounce of the sun)")
+            .disabled_if(!s.rsm, "reflective shadow maps are off (turned on, they add one bounce of the sun)")
             .note(format!(
                 "{} VPLs per pixel and light within {} m, half resolution, pattern turned per frame{}",
                 s.rsm_samples,
@@ -90,12 +94,11 @@ impl Pass for RsmPass {
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        debug_assert!(rsm_active(ctx.setup.scene, ctx.setup.settings));
+        debug_assert!(rsm_active(ctx.setup.scene(), ctx.setup.settings));
         let p = &ctx.setup.settings.profile;
         let (w, h) = ao_extent(p.width, p.height, true);
         let s = &ctx.setup.settings.shadows;
-        let frame = self.frame.get();
-        self.frame.set(frame.wrapping_add(1));
+        let frame = self.frame.fetch_add(1, Ordering::Relaxed);
         let params =
             RsmParamsUniform { low_size: [w, h], samples: s.rsm_samples, frame, radius: s.rsm_radius, _pad: [0.0; 3] };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));

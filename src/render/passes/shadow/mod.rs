@@ -29,6 +29,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, DVec4, Vec3};
 use std::sync::Arc;
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "shadow";
+
 /// Light-space depth of each shadowed directional light (one layer per light, square,
 /// `--shadow-size` texels a side), 0 nearest the light, 1 = nothing.
 pub const SHADOW_MAP: Resource =
@@ -117,7 +121,7 @@ fn left_out_because(scene: &Scene, settings: &Settings) -> Option<String> {
         });
     }
     if !settings.shadows.enabled && !settings.shadows.rsm {
-        return Some("shadows are off (--shadows off) and reflective shadow maps are off".to_string());
+        return Some("shadows are off and reflective shadow maps are off".to_string());
     }
     None
 }
@@ -134,7 +138,7 @@ pub fn suggested_rsm_radius(scene: &Scene) -> f32 {
 /// device's limit) and one layer per shadowed light.
 pub fn light_extent(setup: &FrameSetup, max_dimension: u32) -> (u32, u32, u32) {
     let size = setup.settings.shadows.size.min(max_dimension).max(16);
-    (size, size, shadow_casters(setup.scene).len().max(1) as u32)
+    (size, size, shadow_casters(setup.scene()).len().max(1) as u32)
 }
 
 /// One light's orthographic fit, in f64.
@@ -359,8 +363,8 @@ fn pipeline(
 
 impl Pass for ShadowPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        let (scene, settings) = (setup.scene, setup.settings);
-        let mut decl = PassDecl::new("shadow").write(SHADOW_MAP);
+        let (scene, settings) = (setup.scene(), setup.settings);
+        let mut decl = PassDecl::new(NAME).write(SHADOW_MAP);
         if rsm_active(scene, settings) {
             decl = decl.write(RSM_NORMAL).write(RSM_FLUX);
         }
@@ -383,10 +387,11 @@ impl Pass for ShadowPass {
     }
 
     fn record(&self, ctx: &mut FrameContext) {
+        let gpu_scene = ctx.gpu_scene();
         let size = ctx.target(SHADOW_MAP).width;
         let uniform = self.light_space.shadows_uniform(size);
         ctx.gpu.queue.write_buffer(&self.light_space.uniform, 0, bytemuck::bytes_of(&uniform));
-        let reflective = rsm_active(ctx.setup.scene, ctx.setup.settings);
+        let reflective = rsm_active(ctx.setup.scene(), ctx.setup.settings);
         let targets = ctx.targets;
         for (layer, (buffer, group)) in self.light_buffers.iter().zip(&self.light_groups).enumerate() {
             ctx.gpu.queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniform.lights[layer]));
@@ -416,7 +421,7 @@ impl Pass for ShadowPass {
             });
             pass.set_pipeline(if reflective { &self.reflective } else { &self.depth_only });
             pass.set_bind_group(0, group, &[]);
-            ctx.scene.draw(&mut pass, Some(1));
+            gpu_scene.draw(&mut pass, Some(1));
         }
     }
 }

@@ -15,6 +15,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 use std::sync::Mutex;
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "temporal";
+
 /// Occlusion accumulated over frames by reverse reprojection, at AO resolution, laid out
 /// as the raw occlusion.
 pub const AO_ACCUMULATED: Resource =
@@ -113,19 +117,19 @@ impl TemporalPass {
 impl Pass for TemporalPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
-        PassDecl::new("temporal")
+        PassDecl::new(NAME)
             .bindings(&BINDINGS)
             .provide(OCCLUSION, AO_ACCUMULATED)
             .occlusion_cost()
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to accumulate")
-            .disabled_if(!ao.temporal.enabled, "temporal accumulation is off (--temporal)")
+            .disabled_if(!ao.temporal.enabled, "temporal accumulation is off")
     }
 
     fn record(&self, ctx: &mut FrameContext) {
         let setup = ctx.setup;
         let t = &setup.settings.ao.temporal;
         let near = setup.settings.near;
-        let anchor = ctx.scene.anchor;
+        let anchor = setup.anchor;
         let mut u = TemporalUniform::zeroed();
         let views = setup.views as usize;
         let current = setup.current_views;

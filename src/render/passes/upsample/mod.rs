@@ -12,6 +12,10 @@ use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
 use crate::render::settings::{Settings, Technique};
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "upsample";
+
 /// The occlusion upsampled from half to full resolution.
 pub const AO_FULL: Resource = Resource::storage("ao-full", Size::Full, wgpu::TextureFormat::Rgba16Float);
 
@@ -64,7 +68,7 @@ impl UpsamplePass {
 impl Pass for UpsamplePass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
-        PassDecl::new("upsample")
+        PassDecl::new(NAME)
             .bindings(&BINDINGS)
             .provide(FINAL_AO, AO_FULL)
             .occlusion_cost()
@@ -73,7 +77,7 @@ impl Pass for UpsamplePass {
     }
 
     fn record(&self, ctx: &mut FrameContext) {
-        let mut resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY)]);
+        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY)]);
         // One invocation per quad of 2×2 full-res pixels (upsample.wgsl): both eyes
         // alike, or the left eye and then the right eye reusing it.
         let (w, h, layers) = ctx.quad_extent();
@@ -81,9 +85,13 @@ impl Pass for UpsamplePass {
         let device = &ctx.gpu.device;
         self.kernel.dispatch(device, ctx.encoder, &resources, (w, h, if reuse { 1 } else { layers }));
         if reuse {
+            // The right eye writes layer 1 alone and reads the left eye's layer 0.
             let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));
-            resources[6] = wgpu::BindingResource::TextureView(&right);
-            resources[7] = wgpu::BindingResource::TextureView(&left);
+            let resources = ctx.bind_overriding(
+                &BINDINGS,
+                &[wgpu::BindingResource::TextureView(&left)],
+                &[(AO_FULL, wgpu::BindingResource::TextureView(&right))],
+            );
             self.right_eye.dispatch(device, ctx.encoder, &resources, (w, h, 1));
         }
     }

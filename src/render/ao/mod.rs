@@ -1,0 +1,464 @@
+//! The AO engine: vrao's ambient occlusion over depth (and optionally normals) that
+//! someone else rendered. A wgpu program makes an [`AoEngine`] from its own device and
+//! queue, and each frame hands it its depth buffer and each view's matrices; the engine
+//! records its passes into the program's command encoder and returns the AO, a layered
+//! texture the program samples. vrao's own [`crate::render::renderer::Renderer`] runs the
+//! same chain over its G-buffer ([`AoEngine::chain`]): one implementation.
+//!
+//! What the engine runs, in order: [`import`] (the host's depth in any convention into
+//! reversed-Z infinite-far `Depth32Float`, and its normals, or normals rebuilt from the
+//! depth, into view space), the chosen technique, temporal accumulation, the denoise and
+//! the upsampling from half resolution, each left out when the settings do not need it.
+//! SSDO is not offered: it gathers light from the renderer's direct-light buffer and
+//! environment, which a host's renderer does not have in vrao's form.
+//!
+//! Conventions (what [`AoFrame`] must hold): right-handed view space (x right, y up,
+//! looking down −z, as glam's `camera::rh::view::look_at_mat4`); perspective projections with clip w = −z
+//! and depth in 0..1 (wgpu's), standard or reversed, finite or infinite far, as the
+//! frame's [`DepthConvention`] says; one depth layer per view.
+
+pub mod import;
+
+use crate::render::error::{Error, Result};
+use crate::render::frame_targets::FrameTargets;
+use crate::render::gpu::frame::{FrameBuffers, FrameLighting};
+use crate::render::gpu::timing::PassTimer;
+use crate::render::gpu::Gpu;
+use crate::render::graph::{self, Plan, FINAL_AO};
+use crate::render::passes::{self, FrameContext, FrameSetup, Pass};
+use crate::render::settings::{AoSettings, Settings, Technique};
+use crate::render::stereo::{Eye, EyeSide, Fov, HeadPose, HeadsetProfile};
+use glam::{DMat4, DQuat, Mat4};
+use import::{ImportPass, ImportSource, HOST_DEPTH, HOST_NORMALS};
+use std::sync::Arc;
+
+/// How the host's depth buffer maps distance to depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DepthConvention {
+    /// Near plane at depth 1 and far at 0 (reversed-Z); false: near at 0, far at 1.
+    pub reversed_z: bool,
+    /// The far plane is at infinity (the projection has no far distance).
+    pub infinite_far: bool,
+}
+
+impl DepthConvention {
+    /// Reversed-Z with the far plane at infinity: vrao's own, and the best precision.
+    pub const REVERSED_INFINITE: DepthConvention = DepthConvention { reversed_z: true, infinite_far: true };
+    /// Depth 0 at the near plane and 1 at a finite far plane (glam's `camera::rh::proj::directx::perspective`).
+    pub const STANDARD_FINITE: DepthConvention = DepthConvention { reversed_z: false, infinite_far: false };
+}
+
+/// The space the host's normals are in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NormalSpace {
+    /// View space of each view (what vrao's G-buffer holds).
+    View,
+    /// World space: the engine turns them by each view's rotation.
+    World,
+}
+
+/// How the host's normal texture stores a unit vector.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NormalEncoding {
+    /// xyz in −1..1 (float or snorm formats).
+    Signed,
+    /// xyz × 0.5 + 0.5 (unorm formats such as `Rgb10a2Unorm` or `Rgba8Unorm`).
+    Unsigned,
+}
+
+/// The host's normals: a float-sampled texture with one layer per view.
+#[derive(Clone, Copy, Debug)]
+pub struct HostNormals<'a> {
+    /// The texture (`TEXTURE_BINDING`; xyz read, w ignored).
+    pub texture: &'a wgpu::Texture,
+    /// The space the normals are in.
+    pub space: NormalSpace,
+    /// How they are encoded.
+    pub encoding: NormalEncoding,
+}
+
+/// One view's matrices, as the host rendered its depth with them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewMatrices {
+    /// View from world: a rigid transform (rotation and translation).
+    pub view: Mat4,
+    /// Clip from view: a perspective projection (clip w = −z).
+    pub projection: Mat4,
+}
+
+/// What the host gives the engine each frame.
+#[derive(Clone, Copy, Debug)]
+pub struct AoFrame<'a> {
+    /// The depth buffer: `Depth32Float`, `Depth24Plus`, `Depth16Unorm` (or a depth-stencil
+    /// format), one layer per view (a 2-layer array for stereo, a plain 2D texture for
+    /// mono), the engine's size, one sample, `TEXTURE_BINDING`.
+    pub depth: &'a wgpu::Texture,
+    /// How `depth` maps distance to depth.
+    pub depth_convention: DepthConvention,
+    /// The host's normals, or `None` to rebuild them from the depth.
+    pub normals: Option<HostNormals<'a>>,
+    /// Each view's matrices, one per view (left eye first).
+    pub views: &'a [ViewMatrices],
+}
+
+/// What the engine is made for: the AO settings, the size of each view and their number.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AoConfig {
+    /// Technique, quality, radius, resolution, denoise, temporal accumulation.
+    pub settings: AoSettings,
+    /// Width of each view in pixels.
+    pub width: u32,
+    /// Height of each view in pixels.
+    pub height: u32,
+    /// 1 (mono) or 2 (stereo).
+    pub views: u32,
+}
+
+/// The engine's AO for the frame just recorded: full resolution, one layer per view,
+/// `Rgba16Float` with the ambient visibility (1 open, 0 fully occluded) in alpha.
+pub struct AoOutput<'a> {
+    /// The texture (it can be sampled and copied from).
+    pub texture: &'a wgpu::Texture,
+    /// A `D2Array` view of all its layers.
+    pub view: &'a wgpu::TextureView,
+}
+
+/// vrao's AO chain, driven by a host's depth or by vrao's renderer.
+pub struct AoEngine {
+    gpu: Arc<Gpu>,
+    chain: Vec<Box<dyn Pass>>,
+    /// What only a host's engine has (`None` inside the renderer).
+    host: Option<HostState>,
+}
+
+/// The engine's own frame state when a host drives it.
+struct HostState {
+    config: AoConfig,
+    import: ImportPass,
+    frame: FrameBuffers,
+    targets: FrameTargets,
+    timer: PassTimer,
+    frame_index: u64,
+    previous_views: Vec<Eye>,
+    last_plan: Option<Plan>,
+}
+
+impl AoEngine {
+    /// The engine on a host's device: the device is checked for what the kernels need
+    /// (a refusal names the missing capability) and the settings are validated. The
+    /// host's uncaptured-error handler is left alone.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, config: &AoConfig) -> Result<AoEngine> {
+        let gpu = Arc::new(Gpu::from_host(device, queue)?);
+        host_settings(config, crate::render::stereo::DEFAULT_NEAR)?;
+        // The pipelines are checked here, so a device that cannot build them is refused
+        // once, as a typed error, instead of through the host's error handler each frame.
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let chain = passes::ao_chain(&gpu, Vec::new());
+        let host = HostState {
+            config: config.clone(),
+            import: ImportPass::new(&gpu),
+            frame: FrameBuffers::new(&gpu.device, 0),
+            targets: FrameTargets::default(),
+            timer: PassTimer::disabled(&gpu)?,
+            frame_index: 0,
+            previous_views: Vec::new(),
+            last_plan: None,
+        };
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
+        }
+        Ok(AoEngine { gpu, chain, host: Some(host) })
+    }
+
+    /// The renderer's engine: its chain also holds `light_gathering` (SSDO, which reads
+    /// the renderer's direct light) after the built-in techniques.
+    pub(crate) fn with_light_gathering(gpu: Arc<Gpu>, light_gathering: Vec<Box<dyn Pass>>) -> AoEngine {
+        let chain = passes::ao_chain(&gpu, light_gathering);
+        AoEngine { gpu, chain, host: None }
+    }
+
+    /// The chain's passes in execution order (the renderer records them in its own graph,
+    /// between its G-buffer and its composite).
+    pub fn chain(&self) -> impl Iterator<Item = &dyn Pass> {
+        self.chain.iter().map(|p| p.as_ref())
+    }
+
+    /// Changes the AO settings (validated; a different technique or resolution
+    /// restarts temporal accumulation).
+    pub fn set_settings(&mut self, settings: &AoSettings) -> Result<()> {
+        let host = self.host_mut()?;
+        let config = AoConfig { settings: settings.clone(), ..host.config.clone() };
+        host_settings(&config, crate::render::stereo::DEFAULT_NEAR)?;
+        if config.settings != host.config.settings {
+            host.previous_views.clear();
+        }
+        host.config = config;
+        Ok(())
+    }
+
+    /// The configuration the next frame runs with.
+    pub fn config(&self) -> Option<&AoConfig> {
+        self.host.as_ref().map(|h| &h.config)
+    }
+
+    /// Forgets the previous frame (a camera cut): temporal accumulation starts afresh.
+    pub fn reset_history(&mut self) {
+        if let Some(host) = &mut self.host {
+            host.previous_views.clear();
+        }
+    }
+
+    /// The passes the last frame ran and the ones it left out, with the reasons.
+    pub fn last_plan(&self) -> Option<&Plan> {
+        self.host.as_ref().and_then(|h| h.last_plan.as_ref())
+    }
+
+    fn host_mut(&mut self) -> Result<&mut HostState> {
+        self.host.as_mut().ok_or_else(|| Error::input("the renderer's AO engine is driven by the renderer"))
+    }
+
+    /// Records one frame of AO into `encoder` from the host's depth (and normals) and
+    /// returns the AO texture; the host submits the encoder. Bad input (a texture of the
+    /// wrong size, format or usage, matrices that are not a rigid view and a perspective
+    /// projection of the stated depth convention) is an `Error::Input` naming it, before
+    /// anything is recorded.
+    pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder, frame: &AoFrame) -> Result<AoOutput<'_>> {
+        let gpu = self.gpu.clone();
+        let host = self.host.as_mut().ok_or_else(|| Error::input("the renderer's AO engine is driven by the renderer"))?;
+        let config = &host.config;
+        let (eyes, near) = eyes_of(frame, config.views)?;
+        let source = ImportSource::check(frame, config)?;
+        let settings = host_settings(config, near)?;
+        let layers = config.views;
+        host.targets.import(HOST_DEPTH, source.depth_target(frame.depth, layers));
+        if let Some(normals) = &frame.normals {
+            host.targets.import(HOST_NORMALS, source.normals_target(normals.texture, layers));
+        }
+        host.import.set_source(source);
+        let previous = (host.previous_views.len() == eyes.len()).then_some(&host.previous_views[..]);
+        let setup = FrameSetup {
+            scene: None,
+            anchor: glam::DVec3::ZERO,
+            settings: &settings,
+            views: layers,
+            multiview: false,
+            frame_index: host.frame_index,
+            current_views: &eyes,
+            previous_views: previous,
+        };
+        let passes: Vec<&dyn Pass> = std::iter::once(&host.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();
+        let decls: Vec<_> = passes.iter().map(|p| p.declare(&setup)).collect();
+        let imported = if frame.normals.is_some() { vec![HOST_DEPTH, HOST_NORMALS] } else { vec![HOST_DEPTH] };
+        let plan = graph::plan(&decls, &[FINAL_AO], &imported)?;
+        host.targets.allocate(&gpu.device, &plan, &setup);
+        host.frame.update(&gpu.queue, &FrameLighting::NONE, &eyes, &settings);
+        host.frame.update_ao(&gpu.queue, &settings, host.frame_index);
+        for (step, &index) in plan.run.iter().enumerate() {
+            let mut ctx = FrameContext {
+                gpu: &gpu,
+                encoder: &mut *encoder,
+                targets: &host.targets.targets,
+                placeholders: &host.targets.placeholders,
+                decl: &plan.decls[step],
+                frame: &host.frame,
+                scene: None,
+                timer: &host.timer,
+                setup: &setup,
+            };
+            passes::record(passes[index], &mut ctx);
+        }
+        let output = plan.resolve(FINAL_AO).ok_or_else(|| Error::Plan("nothing provides the final AO".into()))?;
+        host.frame_index += 1;
+        host.previous_views = eyes;
+        host.last_plan = Some(plan);
+        let target = host.targets.targets.get(&output).ok_or_else(|| Error::Plan(format!("{} was not allocated", output.name())))?;
+        Ok(AoOutput { texture: &target.texture, view: &target.array_view })
+    }
+}
+
+/// The renderer settings the engine's passes read: the host's AO settings, its size as
+/// the profile's, and its near plane. SSDO is refused (see the module's notes).
+fn host_settings(config: &AoConfig, near: f64) -> Result<Settings> {
+    if config.views == 0 || config.views > 2 {
+        return Err(Error::input(format!("the AO engine renders 1 or 2 views, not {}", config.views)));
+    }
+    if config.settings.technique.carries_light() {
+        return Err(Error::input(format!(
+            "technique {} gathers light from vrao's own direct-light buffer: the AO engine offers {}",
+            config.settings.technique.name(),
+            Technique::ALL.iter().filter(|t| !t.carries_light()).map(|t| t.name()).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    let settings = Settings {
+        profile: HeadsetProfile::with_size("host", config.width, config.height),
+        near,
+        ao: config.settings.clone(),
+        ..Settings::default()
+    };
+    settings.validate()?;
+    Ok(settings)
+}
+
+/// Each view as an [`Eye`] (pose from the view matrix, field of view from the
+/// projection) and the near distance of the first view's projection.
+fn eyes_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, f64)> {
+    if frame.views.len() != views as usize {
+        return Err(Error::input(format!("the frame gives {} views' matrices; the engine renders {views}", frame.views.len())));
+    }
+    let mut eyes = Vec::with_capacity(frame.views.len());
+    let mut near = 0.0;
+    for (index, m) in frame.views.iter().enumerate() {
+        let side = if index == 0 { EyeSide::Left } else { EyeSide::Right };
+        let projection = Projection::of(&m.projection, frame.depth_convention)
+            .map_err(|e| Error::input(format!("view {index}: projection: {e}")))?;
+        let pose = rigid_pose(&m.view).map_err(|e| Error::input(format!("view {index}: view matrix: {e}")))?;
+        if index == 0 {
+            near = projection.near;
+        }
+        eyes.push(Eye { side, pose, fov: projection.fov });
+    }
+    Ok((eyes, near))
+}
+
+/// The head pose whose view-from-world is `view`: refused unless it is a finite rigid
+/// transform (orthonormal rotation within 1e-3, no projection row).
+fn rigid_pose(view: &Mat4) -> std::result::Result<HeadPose, String> {
+    let view = view.as_dmat4();
+    if !view.is_finite() {
+        return Err("not finite".into());
+    }
+    let world_from_view = view.inverse();
+    let rotation = glam::DMat3::from_mat4(world_from_view);
+    let orthonormal = (rotation.transpose() * rotation - glam::DMat3::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 1e-3);
+    let last_row = view.row(3);
+    if !orthonormal || rotation.determinant() < 0.0 || (last_row - glam::DVec4::W).abs().max_element() > 1e-6 {
+        return Err("not a rigid transform (rotation and translation only, right-handed)".into());
+    }
+    let orientation = DQuat::from_mat3(&rotation).normalize();
+    Ok(HeadPose { position: world_from_view.w_axis.truncate(), orientation })
+}
+
+/// What the engine reads from a host's perspective projection.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Projection {
+    /// The frustum's angles.
+    pub fov: Fov,
+    /// Distance of the near plane (where depth is 1 reversed, 0 standard).
+    pub near: f64,
+    /// distance = `depth_numerator` / (depth + `depth_offset`).
+    pub depth_offset: f64,
+    /// See `depth_offset`.
+    pub depth_numerator: f64,
+}
+
+impl Projection {
+    /// Reads `projection` as a right-handed perspective of the stated convention.
+    pub fn of(projection: &Mat4, convention: DepthConvention) -> std::result::Result<Projection, String> {
+        let p: DMat4 = projection.as_dmat4();
+        if !p.is_finite() {
+            return Err("not finite".into());
+        }
+        let (p00, p11, p20, p21) = (p.x_axis.x, p.y_axis.y, p.z_axis.x, p.z_axis.y);
+        let (p22, p23, p32, p33) = (p.z_axis.z, p.z_axis.w, p.w_axis.z, p.w_axis.w);
+        let skew = [p.x_axis.y, p.x_axis.z, p.x_axis.w, p.y_axis.x, p.y_axis.z, p.y_axis.w, p.w_axis.x, p.w_axis.y];
+        if (p23 + 1.0).abs() > 1e-6 || p33.abs() > 1e-9 || skew.iter().any(|e| e.abs() > 1e-9) || p00 <= 0.0 || p11 <= 0.0
+        {
+            return Err("not a right-handed perspective projection (clip w = -z, no skew)".into());
+        }
+        // depth(distance) = p32 / distance - p22, so distance = p32 / (depth + p22).
+        let reversed = p32 > 0.0;
+        if reversed != convention.reversed_z {
+            return Err(format!(
+                "its depth {} with distance, but the depth convention says {}",
+                if reversed { "falls" } else { "rises" },
+                if convention.reversed_z { "reversed-Z" } else { "standard" }
+            ));
+        }
+        let far_depth = -p22; // depth at infinite distance
+        let infinite = (far_depth - if reversed { 0.0 } else { 1.0 }).abs() < 1e-6;
+        if infinite != convention.infinite_far {
+            return Err(format!(
+                "its far plane is {}, but the depth convention says {}",
+                if infinite { "at infinity" } else { "finite" },
+                if convention.infinite_far { "infinite" } else { "finite" }
+            ));
+        }
+        let near_depth = if reversed { 1.0 } else { 0.0 };
+        let near = p32 / (near_depth + p22);
+        if !(near.is_finite() && near > 0.0) {
+            return Err(format!("its near plane ({near} m) is not a positive distance"));
+        }
+        let angle = |t: f64| t.atan() as f32;
+        let fov = Fov {
+            left: angle((p20 - 1.0) / p00),
+            right: angle((p20 + 1.0) / p00),
+            up: angle((p21 + 1.0) / p11),
+            down: angle((p21 - 1.0) / p11),
+        };
+        fov.validate()?;
+        Ok(Projection { fov, near, depth_offset: p22, depth_numerator: p32 })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_engine_can_live_in_a_multithreaded_host() {
+        fn send_sync<T: Send + Sync>() {}
+        send_sync::<AoEngine>();
+    }
+    use crate::render::stereo::reversed_z_projection;
+
+    fn fov() -> Fov {
+        Fov { left: -0.8, right: 0.7, up: 0.75, down: -0.85 }
+    }
+
+    #[test]
+    fn vrao_s_own_projection_reads_back_its_field_of_view_and_near() {
+        let p = reversed_z_projection(&fov(), 0.05).as_mat4();
+        let read = Projection::of(&p, DepthConvention::REVERSED_INFINITE).unwrap();
+        for (a, b) in [(read.fov.left, -0.8), (read.fov.right, 0.7), (read.fov.up, 0.75), (read.fov.down, -0.85)] {
+            assert!((a - b).abs() < 1e-6, "{:?}", read.fov);
+        }
+        assert!((read.near - 0.05).abs() < 1e-9);
+        // Reversed-Z infinite: depth = near / distance.
+        assert!((read.depth_numerator / (0.01 + read.depth_offset) - 5.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_standard_finite_projection_maps_its_planes() {
+        let p = glam::camera::rh::proj::directx::perspective(1.2, 0.9, 0.1, 100.0);
+        let read = Projection::of(&p, DepthConvention::STANDARD_FINITE).unwrap();
+        assert!((read.near - 0.1).abs() < 1e-5, "{read:?}");
+        let distance = |depth: f64| read.depth_numerator / (depth + read.depth_offset);
+        assert!((distance(0.0) - 0.1).abs() < 1e-5);
+        assert!((distance(1.0) - 100.0).abs() < 1e-2);
+        assert!((read.fov.up - 0.6).abs() < 1e-5 && (read.fov.down + 0.6).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_convention_the_projection_contradicts_is_refused() {
+        let standard = glam::camera::rh::proj::directx::perspective(1.2, 0.9, 0.1, 100.0);
+        let e = Projection::of(&standard, DepthConvention::REVERSED_INFINITE).unwrap_err();
+        assert!(e.contains("reversed-Z"), "{e}");
+        let reversed_infinite = glam::camera::rh::proj::directx::perspective_infinite_reverse(1.2, 0.9, 0.1);
+        let e = Projection::of(&reversed_infinite, DepthConvention { reversed_z: true, infinite_far: false }).unwrap_err();
+        assert!(e.contains("infinity"), "{e}");
+        let orthographic = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0);
+        assert!(Projection::of(&orthographic, DepthConvention::STANDARD_FINITE).is_err());
+    }
+
+    #[test]
+    fn a_view_matrix_must_be_rigid() {
+        let view = glam::camera::rh::view::look_at_mat4(glam::Vec3::new(1.0, 2.0, 3.0), glam::Vec3::ZERO, glam::Vec3::Y);
+        let pose = rigid_pose(&view).unwrap();
+        assert!((pose.position - glam::DVec3::new(1.0, 2.0, 3.0)).length() < 1e-5);
+        let eye = Eye { side: EyeSide::Left, pose, fov: fov() };
+        let back = eye.view_from_world().as_mat4();
+        assert!(back.abs_diff_eq(view, 1e-5), "{back} vs {view}");
+        assert!(rigid_pose(&(view * Mat4::from_scale(glam::Vec3::splat(2.0)))).is_err());
+        assert!(rigid_pose(&Mat4::from_cols_array(&[f32::NAN; 16])).is_err());
+    }
+}

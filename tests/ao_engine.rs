@@ -1,0 +1,180 @@
+//! The AO engine driven by a host: the `embed` example's own geometry and depth prepass
+//! (no vrao scene, no vrao G-buffer) fed to `AoEngine`, against vrao's renderer drawing
+//! the same geometry from the same eyes. One implementation: they must agree.
+
+mod common;
+#[path = "../examples/embed/host.rs"]
+mod host;
+
+use glam::DVec3;
+use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
+use vrao::ao::{AoConfig, AoEngine, AoFrame, DepthConvention, HostNormals, NormalEncoding, NormalSpace, ViewMatrices};
+use vrao::render::graph::FINAL_AO;
+use vrao::render::scene::Mesh;
+use vrao::render::settings::{AoSettings, Technique};
+use vrao::render::stereo::{Eye, EyeSide, Fov, HeadPose};
+use vrao::{Error, HeadsetProfile, Renderer, Settings};
+
+const WIDTH: u32 = 96;
+const HEIGHT: u32 = 108;
+const NEAR: f64 = 0.05;
+
+/// The demo's eyes as vrao eyes (pose from the host's view matrix, an asymmetric frustum each).
+fn eyes() -> Vec<Eye> {
+    let fovs = [
+        Fov { left: -0.85, right: 0.7, up: 0.8, down: -0.8 },
+        Fov { left: -0.7, right: 0.85, up: 0.8, down: -0.8 },
+    ];
+    demo_eyes()
+        .iter()
+        .zip(fovs)
+        .enumerate()
+        .map(|(i, (view, fov))| {
+            let world_from_view = view.as_dmat4().inverse();
+            let (_, rotation, position) = world_from_view.to_scale_rotation_translation();
+            let side = if i == 0 { EyeSide::Left } else { EyeSide::Right };
+            Eye { side, pose: HeadPose { position, orientation: rotation }, fov }
+        })
+        .collect()
+}
+
+/// The host's matrices for `eyes` in its depth convention.
+fn host_views(eyes: &[Eye], depth: HostDepth) -> Vec<ViewMatrices> {
+    eyes.iter()
+        .map(|eye| {
+            let [l, r, u, d] = eye.fov.tangents().map(|t| t as f32);
+            ViewMatrices { view: eye.view_from_world().as_mat4(), projection: depth.projection([l, r, u, d], NEAR as f32) }
+        })
+        .collect()
+}
+
+/// The same geometry as a vrao scene, for the renderer.
+fn scene() -> vrao::Scene {
+    let meshes = demo_geometry()
+        .into_iter()
+        .enumerate()
+        .map(|(i, m)| Mesh {
+            name: format!("mesh{i}"),
+            origin: DVec3::ZERO,
+            uvs: vec![glam::Vec2::ZERO; m.positions.len()],
+            positions: m.positions,
+            normals: m.normals,
+            indices: m.indices,
+            material: 0,
+        })
+        .collect();
+    common::bare_scene(meshes)
+}
+
+fn settings(ao: &AoSettings) -> Settings {
+    Settings { profile: HeadsetProfile::with_size("test", WIDTH, HEIGHT), near: NEAR, ao: ao.clone(), ..Settings::default() }
+}
+
+/// Each eye's final AO from vrao's renderer.
+fn renderer_ao(gpu: &std::sync::Arc<vrao::Gpu>, ao: &AoSettings) -> Vec<Vec<f32>> {
+    let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(ao)).unwrap();
+    renderer.render_and_wait(&eyes(), &[FINAL_AO]).unwrap();
+    renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect()
+}
+
+/// Each eye's AO from the engine over the host's depth prepass.
+fn engine_ao(gpu: &vrao::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: bool) -> Vec<Vec<f32>> {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
+    let views = host_views(&eyes(), depth);
+    let config = AoConfig { settings: ao.clone(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let convention = match depth {
+        HostDepth::ReversedInfinite => DepthConvention::REVERSED_INFINITE,
+        HostDepth::StandardFinite { .. } => DepthConvention::STANDARD_FINITE,
+    };
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(device, &mut encoder, &views);
+    let frame = AoFrame { depth: &prepass.depth, depth_convention: convention, normals: with_normals.then_some(normals), views: &views };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    (0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect()
+}
+
+fn rmse(a: &[Vec<f32>], b: &[Vec<f32>]) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (x, y) in a.iter().zip(b) {
+        assert_eq!(x.len(), y.len());
+        for (p, q) in x.iter().zip(y) {
+            sum += f64::from(p - q).powi(2);
+            n += 1;
+        }
+    }
+    (sum / n as f64).sqrt()
+}
+
+#[test]
+fn the_engine_over_a_host_depth_buffer_matches_the_renderer() {
+    let (gpu, _lock) = common::gpu();
+    let ao = AoSettings::default();
+    let reference = renderer_ao(&gpu, &ao);
+    let mean = reference.iter().flatten().sum::<f32>() / (2 * WIDTH * HEIGHT) as f32;
+    assert!(mean < 0.97 && mean > 0.3, "the demo room shows occlusion (mean AO {mean})");
+
+    let host_normals = engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true);
+    let error = rmse(&host_normals, &reference);
+    eprintln!("engine (reversed-Z Depth32Float, host normals) against the renderer: RMSE {error:.2e}");
+    assert!(error <= 1e-3, "RMSE {error}");
+
+    let rebuilt = engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, false);
+    let error = rmse(&rebuilt, &reference);
+    eprintln!("engine (normals rebuilt from depth) against the renderer: RMSE {error:.4}");
+    assert!(error <= 0.03, "RMSE {error}");
+
+    let standard = engine_ao(&gpu, &ao, HostDepth::StandardFinite { far: 50.0 }, true);
+    let error = rmse(&standard, &reference);
+    eprintln!("engine (standard-Z Depth24Plus, far 50 m, host normals) against the renderer: RMSE {error:.4}");
+    assert!(error <= 0.01, "RMSE {error}");
+}
+
+#[test]
+fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
+    let (gpu, _lock) = common::gpu();
+    for technique in [Technique::Ssao, Technique::Hbao, Technique::Gtao] {
+        for half_res in [false, true] {
+            let ao = AoSettings { technique, half_res, ..AoSettings::default() };
+            let error = rmse(&engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true), &renderer_ao(&gpu, &ao));
+            assert!(error <= 1e-3, "{} half_res {half_res}: RMSE {error}", technique.name());
+        }
+    }
+}
+
+#[test]
+fn bad_host_input_is_a_typed_error_naming_it() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let ssdo = AoConfig {
+        settings: AoSettings { technique: Technique::Ssdo, ..AoSettings::default() },
+        width: WIDTH,
+        height: HEIGHT,
+        views: 2,
+    };
+    let e = AoEngine::new(device, queue, &ssdo).err().expect("SSDO is the renderer's");
+    assert!(matches!(e, Error::Input { .. }) && e.to_string().contains("ssdo"), "{e}");
+
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let small = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH / 2, HEIGHT));
+    let views = host_views(&eyes(), HostDepth::ReversedInfinite);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let frame = AoFrame { depth: &small.depth, depth_convention: DepthConvention::REVERSED_INFINITE, normals: None, views: &views };
+    let e = engine.record(&mut encoder, &frame).err().expect("a depth buffer of another size");
+    assert!(e.to_string().contains("depth") && e.to_string().contains("does not match"), "{e}");
+
+    let right = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT));
+    let frame = AoFrame { depth: &right.depth, depth_convention: DepthConvention::STANDARD_FINITE, normals: None, views: &views };
+    let e = engine.record(&mut encoder, &frame).err().expect("a convention the projection contradicts");
+    assert!(e.to_string().contains("view 0: projection"), "{e}");
+
+    let mut scaled = views.clone();
+    scaled[1].view *= glam::Mat4::from_scale(glam::Vec3::splat(2.0));
+    let frame = AoFrame { depth: &right.depth, depth_convention: DepthConvention::REVERSED_INFINITE, normals: None, views: &scaled };
+    let e = engine.record(&mut encoder, &frame).err().expect("a view matrix with scale");
+    assert!(e.to_string().contains("view 1: view matrix"), "{e}");
+}
