@@ -146,6 +146,38 @@ fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
 }
 
 #[test]
+fn a_mono_view_from_a_single_layer_depth_buffer_matches_the_renderer() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let ao = AoSettings::default();
+    let eye = eyes()[0];
+    let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(&ao)).unwrap();
+    renderer.render_and_wait(&[eye], &[FINAL_AO]).unwrap();
+    let reference: Vec<Vec<f32>> =
+        renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect();
+
+    // A plain 2D depth texture (one layer), drawn by the host's prepass into layer 0.
+    let prepass = DepthPrepass::with_layers(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1);
+    let views = host_views(&[eye], HostDepth::ReversedInfinite);
+    let config = AoConfig { settings: ao, width: WIDTH, height: HEIGHT, views: 1 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(device, &mut encoder, &views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: Some(normals),
+        views: &views,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    assert_eq!(texture.size().depth_or_array_layers, 1);
+    let error = rmse(&[host::read_alpha(device, queue, &texture, 0)], &reference[..1]);
+    assert!(error <= 1e-3, "mono: RMSE {error}");
+}
+
+#[test]
 fn bad_host_input_is_a_typed_error_naming_it() {
     let (gpu, _lock) = common::gpu();
     let (device, queue) = (&gpu.device, &gpu.queue);

@@ -152,8 +152,19 @@ pub struct DepthPrepass {
 }
 
 impl DepthPrepass {
-    /// Uploads `meshes` and makes the eyes' targets at `width` × `height`.
-    pub fn new(device: &wgpu::Device, meshes: &[HostMesh], depth_kind: HostDepth, (width, height): (u32, u32)) -> Self {
+    /// Uploads `meshes` and makes both eyes' targets (2-layer arrays) at `width` × `height`.
+    pub fn new(device: &wgpu::Device, meshes: &[HostMesh], depth_kind: HostDepth, size: (u32, u32)) -> Self {
+        Self::with_layers(device, meshes, depth_kind, size, 2)
+    }
+
+    /// [`DepthPrepass::new`] with `layers` layers (1: plain 2D textures for a mono view).
+    pub fn with_layers(
+        device: &wgpu::Device,
+        meshes: &[HostMesh],
+        depth_kind: HostDepth,
+        (width, height): (u32, u32),
+        layers: u32,
+    ) -> Self {
         let mut vertices: Vec<[f32; 6]> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
         for mesh in meshes {
@@ -227,7 +238,7 @@ impl DepthPrepass {
         let target = |label, format| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 2 },
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,

@@ -4,12 +4,14 @@
 //! both eyes and writes it as `OUT/embed_ao_left.png` and `OUT/embed_ao_right.png`.
 //!
 //! ```text
-//! cargo run --release --example embed [OUT] [--standard-depth] [--no-normals]
+//! cargo run --release --example embed [OUT] [--standard-depth] [--no-normals] [--time]
 //! ```
 //!
 //! `--standard-depth` stores depth as `Depth24Plus` with a finite far plane instead of
 //! reversed-Z `Depth32Float`; `--no-normals` lets the engine rebuild normals from depth.
 //! It exits non-zero when the AO is not finite, outside 0..1, or shows no occlusion.
+//! `--time` also times whole frames at 1080×1200 per eye, interleaved: the host's prepass
+//! alone, and with the engine (host normals, rebuilt normals), median wall-clock ms.
 
 mod host;
 
@@ -76,6 +78,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
     let ao = engine.record(&mut encoder, &frame)?.texture.clone();
     queue.submit([encoder.finish()]);
+    if args.iter().any(|a| a == "--time") {
+        time_frames(&device, &queue, depth_kind, convention)?;
+    }
     if let Some(plan) = engine.last_plan() {
         eprint!("{plan}");
     }
@@ -93,6 +98,57 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         let path = out.join(format!("embed_ao_{name}.png"));
         image::GrayImage::from_raw(WIDTH, HEIGHT, pixels).ok_or("image size")?.save(&path)?;
         eprintln!("{name} eye: mean AO {mean:.3} -> {}", path.display());
+    }
+    Ok(())
+}
+
+/// Frames of the host's prepass alone and with the engine after it, interleaved so that
+/// the machine's state affects each alike; prints each one's median wall-clock ms per eye.
+fn time_frames(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    depth_kind: HostDepth,
+    convention: DepthConvention,
+) -> Result<(), Box<dyn std::error::Error>> {
+    const SIZE: (u32, u32) = (1080, 1200);
+    const ROUNDS: usize = 9;
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth_kind, SIZE);
+    let tangents = [[-1.2, 0.9, 1.1, -1.1], [-0.9, 1.2, 1.1, -1.1]];
+    let views: Vec<ViewMatrices> = demo_eyes()
+        .iter()
+        .zip(tangents)
+        .map(|(view, t)| ViewMatrices { view: *view, projection: depth_kind.projection(t, 0.05) })
+        .collect();
+    let config = AoConfig { settings: AoSettings::default(), width: SIZE.0, height: SIZE.1, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config)?;
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let labels = ["host prepass alone", "prepass + engine, host normals", "prepass + engine, rebuilt normals"];
+    let mut times = vec![Vec::new(); labels.len()];
+    // One warm-up round, then ROUNDS measured ones.
+    for round in 0..=ROUNDS {
+        for (kind, samples) in times.iter_mut().enumerate() {
+            let started = std::time::Instant::now();
+            let mut encoder = device.create_command_encoder(&Default::default());
+            prepass.record(device, &mut encoder, &views);
+            if kind > 0 {
+                let frame = AoFrame {
+                    depth: &prepass.depth,
+                    depth_convention: convention,
+                    normals: (kind == 1).then_some(normals),
+                    views: &views,
+                };
+                engine.record(&mut encoder, &frame)?;
+            }
+            queue.submit([encoder.finish()]);
+            device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None })?;
+            if round > 0 {
+                samples.push(started.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    for (label, mut samples) in labels.iter().zip(times) {
+        samples.sort_by(f64::total_cmp);
+        eprintln!("{label}: {:.2} ms per eye (median of {ROUNDS})", samples[ROUNDS / 2] / 2.0);
     }
     Ok(())
 }

@@ -555,6 +555,17 @@ mod tests {
     }
 
     #[test]
+    fn an_imported_texture_needs_no_producer_and_is_not_allocated() {
+        // The AO engine's chain without a G-buffer pass: the depth comes from the host.
+        let chain = &ao_chain(true, true)[1..4];
+        assert!(plan(chain, &[FINAL_AO], &[]).unwrap_err().to_string().contains("nothing produces 'depth'"));
+        let plan = plan(chain, &[FINAL_AO], &[DEPTH]).unwrap();
+        assert_eq!(plan.names, vec!["ssao", "blur", "upsample"]);
+        assert!(!plan.resources.contains(&DEPTH), "the graph does not allocate an imported texture");
+        assert!(plan.resources.contains(&RAW) && plan.resources.contains(&FULL));
+    }
+
+    #[test]
     fn an_unbound_read_is_no_dependency() {
         let d = vec![
             PassDecl::new("gbuffer").write(DEPTH),

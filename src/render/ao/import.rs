@@ -93,8 +93,7 @@ impl ImportSource {
             params.world_normals = (normals.space == NormalSpace::World) as u32;
         }
         for (layer, m) in params.layers.iter_mut().zip(frame.views) {
-            let p = Projection::of(&m.projection, frame.depth_convention)
-                .map_err(|e| Error::input(format!("projection: {e}")))?;
+            let p = Projection::of(&m.projection, frame.depth_convention, "projection")?;
             let [l, r, u, d] = p.fov.tangents();
             *layer = ImportLayer {
                 view_from_world: m.view.to_cols_array_2d(),

@@ -309,9 +309,8 @@ fn eyes_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, f64)> {
     let mut near = 0.0;
     for (index, m) in frame.views.iter().enumerate() {
         let side = if index == 0 { EyeSide::Left } else { EyeSide::Right };
-        let projection = Projection::of(&m.projection, frame.depth_convention)
-            .map_err(|e| Error::input(format!("view {index}: projection: {e}")))?;
-        let pose = rigid_pose(&m.view).map_err(|e| Error::input(format!("view {index}: view matrix: {e}")))?;
+        let projection = Projection::of(&m.projection, frame.depth_convention, &format!("view {index}: projection"))?;
+        let pose = rigid_pose(&m.view, &format!("view {index}: view matrix"))?;
         if index == 0 {
             near = projection.near;
         }
@@ -321,18 +320,20 @@ fn eyes_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, f64)> {
 }
 
 /// The head pose whose view-from-world is `view`: refused unless it is a finite rigid
-/// transform (orthonormal rotation within 1e-3, no projection row).
-fn rigid_pose(view: &Mat4) -> std::result::Result<HeadPose, String> {
+/// transform (orthonormal rotation within 1e-3, no projection row); errors start with `what`.
+fn rigid_pose(view: &Mat4, what: &str) -> Result<HeadPose> {
     let view = view.as_dmat4();
     if !view.is_finite() {
-        return Err("not finite".into());
+        return Err(Error::input(format!("{what}: not finite")));
     }
     let world_from_view = view.inverse();
     let rotation = glam::DMat3::from_mat4(world_from_view);
     let orthonormal = (rotation.transpose() * rotation - glam::DMat3::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 1e-3);
     let last_row = view.row(3);
     if !orthonormal || rotation.determinant() < 0.0 || (last_row - glam::DVec4::W).abs().max_element() > 1e-6 {
-        return Err("not a rigid transform (rotation and translation only, right-handed)".into());
+        return Err(Error::input(format!(
+            "{what}: not a rigid transform (rotation and translation only, right-handed)"
+        )));
     }
     let orientation = DQuat::from_mat3(&rotation).normalize();
     Ok(HeadPose { position: world_from_view.w_axis.truncate(), orientation })
@@ -352,23 +353,25 @@ pub(crate) struct Projection {
 }
 
 impl Projection {
-    /// Reads `projection` as a right-handed perspective of the stated convention.
-    pub fn of(projection: &Mat4, convention: DepthConvention) -> std::result::Result<Projection, String> {
+    /// Reads `projection` as a right-handed perspective of the stated convention; errors
+    /// start with `what`.
+    pub fn of(projection: &Mat4, convention: DepthConvention, what: &str) -> Result<Projection> {
+        let refuse = |why: String| Err(Error::input(format!("{what}: {why}")));
         let p: DMat4 = projection.as_dmat4();
         if !p.is_finite() {
-            return Err("not finite".into());
+            return refuse("not finite".into());
         }
         let (p00, p11, p20, p21) = (p.x_axis.x, p.y_axis.y, p.z_axis.x, p.z_axis.y);
         let (p22, p23, p32, p33) = (p.z_axis.z, p.z_axis.w, p.w_axis.z, p.w_axis.w);
         let skew = [p.x_axis.y, p.x_axis.z, p.x_axis.w, p.y_axis.x, p.y_axis.z, p.y_axis.w, p.w_axis.x, p.w_axis.y];
         if (p23 + 1.0).abs() > 1e-6 || p33.abs() > 1e-9 || skew.iter().any(|e| e.abs() > 1e-9) || p00 <= 0.0 || p11 <= 0.0
         {
-            return Err("not a right-handed perspective projection (clip w = -z, no skew)".into());
+            return refuse("not a right-handed perspective projection (clip w = -z, no skew)".into());
         }
         // depth(distance) = p32 / distance - p22, so distance = p32 / (depth + p22).
         let reversed = p32 > 0.0;
         if reversed != convention.reversed_z {
-            return Err(format!(
+            return refuse(format!(
                 "its depth {} with distance, but the depth convention says {}",
                 if reversed { "falls" } else { "rises" },
                 if convention.reversed_z { "reversed-Z" } else { "standard" }
@@ -377,7 +380,7 @@ impl Projection {
         let far_depth = -p22; // depth at infinite distance
         let infinite = (far_depth - if reversed { 0.0 } else { 1.0 }).abs() < 1e-6;
         if infinite != convention.infinite_far {
-            return Err(format!(
+            return refuse(format!(
                 "its far plane is {}, but the depth convention says {}",
                 if infinite { "at infinity" } else { "finite" },
                 if convention.infinite_far { "infinite" } else { "finite" }
@@ -386,7 +389,7 @@ impl Projection {
         let near_depth = if reversed { 1.0 } else { 0.0 };
         let near = p32 / (near_depth + p22);
         if !(near.is_finite() && near > 0.0) {
-            return Err(format!("its near plane ({near} m) is not a positive distance"));
+            return refuse(format!("its near plane ({near} m) is not a positive distance"));
         }
         let angle = |t: f64| t.atan() as f32;
         let fov = Fov {
@@ -395,7 +398,9 @@ impl Projection {
             up: angle((p21 + 1.0) / p11),
             down: angle((p21 - 1.0) / p11),
         };
-        fov.validate()?;
+        if let Err(why) = fov.validate() {
+            return refuse(why.to_string());
+        }
         Ok(Projection { fov, near, depth_offset: p22, depth_numerator: p32 })
     }
 }
@@ -418,7 +423,7 @@ mod tests {
     #[test]
     fn vrao_s_own_projection_reads_back_its_field_of_view_and_near() {
         let p = reversed_z_projection(&fov(), 0.05).as_mat4();
-        let read = Projection::of(&p, DepthConvention::REVERSED_INFINITE).unwrap();
+        let read = Projection::of(&p, DepthConvention::REVERSED_INFINITE, "p").unwrap();
         for (a, b) in [(read.fov.left, -0.8), (read.fov.right, 0.7), (read.fov.up, 0.75), (read.fov.down, -0.85)] {
             assert!((a - b).abs() < 1e-6, "{:?}", read.fov);
         }
@@ -430,7 +435,7 @@ mod tests {
     #[test]
     fn a_standard_finite_projection_maps_its_planes() {
         let p = glam::camera::rh::proj::directx::perspective(1.2, 0.9, 0.1, 100.0);
-        let read = Projection::of(&p, DepthConvention::STANDARD_FINITE).unwrap();
+        let read = Projection::of(&p, DepthConvention::STANDARD_FINITE, "p").unwrap();
         assert!((read.near - 0.1).abs() < 1e-5, "{read:?}");
         let distance = |depth: f64| read.depth_numerator / (depth + read.depth_offset);
         assert!((distance(0.0) - 0.1).abs() < 1e-5);
@@ -441,24 +446,26 @@ mod tests {
     #[test]
     fn a_convention_the_projection_contradicts_is_refused() {
         let standard = glam::camera::rh::proj::directx::perspective(1.2, 0.9, 0.1, 100.0);
-        let e = Projection::of(&standard, DepthConvention::REVERSED_INFINITE).unwrap_err();
+        let e = Projection::of(&standard, DepthConvention::REVERSED_INFINITE, "p").unwrap_err().to_string();
         assert!(e.contains("reversed-Z"), "{e}");
         let reversed_infinite = glam::camera::rh::proj::directx::perspective_infinite_reverse(1.2, 0.9, 0.1);
-        let e = Projection::of(&reversed_infinite, DepthConvention { reversed_z: true, infinite_far: false }).unwrap_err();
+        let e = Projection::of(&reversed_infinite, DepthConvention { reversed_z: true, infinite_far: false }, "p")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("infinity"), "{e}");
         let orthographic = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0);
-        assert!(Projection::of(&orthographic, DepthConvention::STANDARD_FINITE).is_err());
+        assert!(Projection::of(&orthographic, DepthConvention::STANDARD_FINITE, "p").is_err());
     }
 
     #[test]
     fn a_view_matrix_must_be_rigid() {
         let view = glam::camera::rh::view::look_at_mat4(glam::Vec3::new(1.0, 2.0, 3.0), glam::Vec3::ZERO, glam::Vec3::Y);
-        let pose = rigid_pose(&view).unwrap();
+        let pose = rigid_pose(&view, "v").unwrap();
         assert!((pose.position - glam::DVec3::new(1.0, 2.0, 3.0)).length() < 1e-5);
         let eye = Eye { side: EyeSide::Left, pose, fov: fov() };
         let back = eye.view_from_world().as_mat4();
         assert!(back.abs_diff_eq(view, 1e-5), "{back} vs {view}");
-        assert!(rigid_pose(&(view * Mat4::from_scale(glam::Vec3::splat(2.0)))).is_err());
-        assert!(rigid_pose(&Mat4::from_cols_array(&[f32::NAN; 16])).is_err());
+        assert!(rigid_pose(&(view * Mat4::from_scale(glam::Vec3::splat(2.0))), "v").is_err());
+        assert!(rigid_pose(&Mat4::from_cols_array(&[f32::NAN; 16]), "v").is_err());
     }
 }
