@@ -39,6 +39,22 @@ enum Command {
     Budget(cli::budget::BudgetArgs),
 }
 
+/// The library tells the user what it does (which headset, the bench's progress) at the
+/// info level and warns at the warn level: both go to stderr, vrao's own info lines as
+/// plain text, everything else with its level and source. `RUST_LOG` overrides the filter.
+fn init_log() {
+    use std::io::Write;
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,vrao=info"))
+        .format(|out, record| {
+            if record.level() == log::Level::Info && record.target().starts_with("vrao") {
+                writeln!(out, "{}", record.args())
+            } else {
+                writeln!(out, "[{} {}] {}", record.level(), record.target(), record.args())
+            }
+        })
+        .init();
+}
+
 fn main() -> ExitCode {
     // Mesa's Vulkan drivers probe for a Wayland display and print "error: XDG_RUNTIME_DIR
     // is invalid" on headless machines although nothing is wrong; give the probe a
@@ -46,7 +62,7 @@ fn main() -> ExitCode {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    init_log();
     // clap's own usage errors print themselves and exit 2.
     let cli = Cli::parse();
     let backend = cli.backend;

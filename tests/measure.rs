@@ -266,3 +266,26 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     let expected = format!("fit: {} N={}", best["technique"].as_str().unwrap(), best["samples"]);
     assert!(t.contains(&expected), "expected '{expected}' in:\n{t}");
 }
+
+/// Measures the reference tracer's throughput on Sibenik (run with `--ignored
+/// --nocapture`; needs the shared scenes).
+#[test]
+#[ignore]
+fn sibenik_throughput() {
+    use vrao::measure::reference::{trace, ProgressBar, ReferenceSettings};
+    if vrao::render::scene::shared_scenes_dir().is_none() {
+        return;
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/sibenik.toml");
+    let started = std::time::Instant::now();
+    let scene = vrao::Scene::load(path.to_str().unwrap()).unwrap();
+    eprintln!("loaded {} triangles in {:.2} s", scene.triangle_count(), started.elapsed().as_secs_f64());
+    let size = (270, 300);
+    let near = vrao::render::stereo::DEFAULT_NEAR;
+    let s = ReferenceSettings { radius: scene.suggested_ao_radius() as f64, rays_per_pixel: 64, stride: 1, near };
+    let eyes = vrao::HeadsetProfile::with_size("test", size.0, size.1).eyes(&scene.head.pose_at(0.0), near);
+    let mut bar = ProgressBar::new("sibenik");
+    let image = trace(&scene, &eyes.eyes, size, &s, &mut |p| bar.update(p)).unwrap();
+    bar.finish();
+    eprintln!("{} ({:?}, r = {})", bar.summary(), image.stats, s.radius);
+}

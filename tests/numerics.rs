@@ -386,7 +386,7 @@ fn a_reprojection_history_without_usable_depth_falls_back_to_the_rotational_warp
         orientation: DQuat::from_rotation_y(0.05) * head.orientation,
     };
     let target = s.profile.eyes(&moved, s.near);
-    let mut reprojector = Reprojector::new(&gpu);
+    let mut reprojector = Reprojector::new(&gpu).unwrap();
     let mut warp = |depth: &LayeredTarget, mode| {
         let output = output_target(&gpu, color.extent());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());

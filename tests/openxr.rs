@@ -118,10 +118,12 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
     let err =
         vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), None, BackendChoice::Auto)
             .err()
-            .expect("--headset openxr without a runtime is an error");
+            .expect("OpenXR alone without a runtime is an error");
+    assert!(matches!(err, vrao::app::HeadsetError::OpenXrUnavailable(_)), "{err}");
+    let err = vrao::Error::from(err);
     assert_eq!(err.exit_code(), 2, "{err}");
     let text = err.to_string();
-    assert!(text.contains("--headset openxr") && text.contains("no OpenXR"), "{text}");
+    assert!(text.starts_with("no usable GPU: OpenXR headset: ") && text.contains("no OpenXR"), "{text}");
 }
 
 /// Depth32Float cannot be written by copies: a full-screen pass writes a different

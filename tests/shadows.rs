@@ -242,12 +242,12 @@ fn only_directional_lights_get_a_shadow_pass_and_explain_says_why() {
     let p = plan(&boxed, &settings(32, 32), &[COLOR]);
     let at = |name: &str| p.names.iter().position(|n| *n == name).unwrap();
     assert!(at("shadow") < at("direct"), "{p}");
-    assert!(reason(&p, "rsm").unwrap().contains("--rsm on"));
+    assert!(reason(&p, "rsm").unwrap().contains("reflective shadow maps are off"));
     // ... not with --shadows off ...
     let mut off = settings(32, 32);
     off.shadows.enabled = false;
     let p = plan(&boxed, &off, &[COLOR]);
-    assert!(!p.runs("shadow") && reason(&p, "shadow").unwrap().contains("--shadows off"), "{p}");
+    assert!(!p.runs("shadow") && reason(&p, "shadow").unwrap().contains("shadows are off"), "{p}");
     // ... except for the reflective shadow maps, which need the light-space pass anyway;
     // the direct pass then reads no shadow map.
     off.shadows.rsm = true;

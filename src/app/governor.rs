@@ -25,9 +25,11 @@
 //! not try that raise again.
 
 use crate::render::bench_file::{BenchFile, BenchRecord};
+use crate::render::error::{Error, Result};
 use crate::render::settings::{AoSettings, Technique};
 use serde::Serialize;
 use std::collections::VecDeque;
+use std::path::Path;
 
 /// The bench committed with vrao: the furnished room, gtao/ssao/hbao × 12–64 samples ×
 /// full/half × temporal at r = 0.3 m, 540x600 per eye on lavapipe.
@@ -80,8 +82,8 @@ impl Frontier {
     /// The Pareto-optimal rows of `file` at its radius nearest to `radius` (errors only
     /// compare within one radius). Rows without a finite error or a positive cost, depth-
     /// peeled rows (a [`Level`] cannot express peeling) and non-occlusion techniques
-    /// (none, fetch-only, rsm) are left out.
-    pub fn from_bench(file: &BenchFile, radius: f32) -> Result<Frontier, String> {
+    /// (none, fetch-only, rsm) are left out. A bench without such rows is `Error::Input`.
+    pub fn from_bench(file: &BenchFile, radius: f32) -> Result<Frontier> {
         let usable: Vec<(&BenchRecord, Technique)> = file
             .records
             .iter()
@@ -94,13 +96,13 @@ impl Frontier {
         let Some(nearest) =
             usable.iter().map(|(r, _)| r.radius_m).min_by(|a, b| (a - radius).abs().total_cmp(&(b - radius).abs()))
         else {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "the bench of '{}' on '{}' ({} rows; {}) has no occlusion rows with an AO error and a positive time to govern with (measure with a reference)",
                 file.scene,
                 file.adapter,
                 file.records.len(),
                 if file.command.is_empty() { "no command recorded" } else { file.command.as_str() }
-            ));
+            )));
         };
         let mut rows: Vec<_> = usable.into_iter().filter(|(r, _)| r.radius_m == nearest).collect();
         rows.sort_by(|(a, _), (b, _)| {
@@ -120,7 +122,7 @@ impl Frontier {
                 setting: r.setting(),
                 technique,
                 samples: r.samples,
-                half_res: r.resolution == "half",
+                half_res: r.resolution.is_half(),
                 temporal: r.temporal,
                 ao_rmse: rmse,
                 ms_per_eye: ms,
@@ -129,16 +131,18 @@ impl Frontier {
         Ok(Frontier { levels, radius_m: nearest })
     }
 
-    /// A bench JSON's frontier; `origin` names the file in errors.
-    pub fn from_json(text: &str, origin: &str, radius: f32) -> Result<Frontier, String> {
-        let file: BenchFile =
-            serde_json::from_str(text).map_err(|e| format!("{origin}: not a vrao bench file: {e}"))?;
-        Frontier::from_bench(&file, radius).map_err(|e| format!("{origin}: {e}"))
+    /// A bench JSON's frontier; `origin`, the file, is named in errors (with the line
+    /// where the JSON is malformed).
+    pub fn from_json(text: &str, origin: &Path, radius: f32) -> Result<Frontier> {
+        let file: BenchFile = serde_json::from_str(text)
+            .map_err(|e| Error::at_line(origin, e.line(), format!("not a vrao bench file: {e}")))?;
+        Frontier::from_bench(&file, radius).map_err(|e| Error::in_file(origin, e.to_string()))
     }
 
     /// The frontier of the bench committed at `assets/governor/frontier.json`.
     pub fn builtin() -> Frontier {
-        Frontier::from_json(BUILTIN_JSON, BUILTIN_PATH, BUILTIN_RADIUS_M).expect("the built-in frontier parses")
+        Frontier::from_json(BUILTIN_JSON, Path::new(BUILTIN_PATH), BUILTIN_RADIUS_M)
+            .expect("the built-in frontier parses")
     }
 
     /// Every level, cheapest (most error) first.
@@ -214,30 +218,33 @@ impl GovernorConfig {
         }
     }
 
-    /// Checks every value; the error names the field and the value.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks every value; the error (`Error::Input`) names the field and the value.
+    pub fn validate(&self) -> Result<()> {
         let c = self;
         if !(c.period_ms.is_finite() && c.period_ms > 0.0) {
-            return Err(format!("governor period {} ms must be a positive finite number", c.period_ms));
+            return Err(Error::input(format!("governor period {} ms must be a positive finite number", c.period_ms)));
         }
         if !(c.raise_below.is_finite()
             && c.drop_above.is_finite()
             && 0.0 < c.raise_below
             && c.raise_below < c.drop_above)
         {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "governor thresholds raise below {} and drop above {} must satisfy 0 < raise < drop",
                 c.raise_below, c.drop_above
-            ));
+            )));
         }
         if c.calm_frames_to_raise == 0 || c.drop_step == 0 || c.raise_step == 0 {
-            return Err(format!(
+            return Err(Error::input(format!(
                 "governor calm frames {}, drop step {} and raise step {} must be at least 1",
                 c.calm_frames_to_raise, c.drop_step, c.raise_step
-            ));
+            )));
         }
         if !(c.frontier_scale.is_finite() && c.frontier_scale > 0.0) {
-            return Err(format!("governor frontier scale {} must be a positive finite number", c.frontier_scale));
+            return Err(Error::input(format!(
+                "governor frontier scale {} must be a positive finite number",
+                c.frontier_scale
+            )));
         }
         Ok(())
     }
@@ -286,11 +293,12 @@ pub struct Governor {
 }
 
 impl Governor {
-    /// Starts at `start_level` (clamped to the top).
-    pub fn new(frontier: Frontier, config: GovernorConfig, start_level: usize) -> Result<Governor, String> {
+    /// Starts at `start_level` (clamped to the top); a bad configuration or an empty
+    /// frontier is `Error::Input`.
+    pub fn new(frontier: Frontier, config: GovernorConfig, start_level: usize) -> Result<Governor> {
         config.validate()?;
         if frontier.is_empty() {
-            return Err("the governor needs a frontier with at least one level".into());
+            return Err(Error::input("the governor needs a frontier with at least one level"));
         }
         let level = start_level.min(frontier.top());
         let correction = vec![1.0; frontier.len()];

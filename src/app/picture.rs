@@ -3,7 +3,8 @@
 //! (mirror.wgsl).
 
 use crate::app::BufferView;
-use crate::render::gpu::kernel::{shader_module, wgsl};
+use crate::render::error::Result;
+use crate::render::gpu::kernel::{try_shader_module, wgsl};
 use crate::render::gpu::raster::fullscreen_pipeline;
 use crate::render::gpu::Gpu;
 
@@ -40,7 +41,7 @@ fn texture_binding(sample_type: wgpu::TextureSampleType) -> wgpu::BindingType {
 }
 
 impl Blit {
-    pub(super) fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> Blit {
+    pub(super) fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> Result<Blit> {
         let device = &gpu.device;
         let eye_layout = fragment_layout(
             gpu,
@@ -56,7 +57,7 @@ impl Blit {
             &[(2, texture_binding(wgpu::TextureSampleType::Float { filterable: false }))],
         );
         let depth_layout = fragment_layout(gpu, "depth view", &[(3, texture_binding(wgpu::TextureSampleType::Depth))]);
-        let module = shader_module(device, "mirror", &[wgsl!("src/app/mirror.wgsl")]);
+        let module = try_shader_module(device, "mirror", &[wgsl!("src/app/mirror.wgsl")])?;
         let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(entry_point),
@@ -71,7 +72,7 @@ impl Blit {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        Blit {
+        Ok(Blit {
             eye: pipeline(&eye_layout, "fs_main"),
             occlusion: pipeline(&float_layout, "fs_occlusion"),
             normals: pipeline(&float_layout, "fs_normals"),
@@ -80,7 +81,7 @@ impl Blit {
             float_layout,
             depth_layout,
             sampler,
-        }
+        })
     }
 
     pub(super) fn pipeline(&self, shown: BufferView) -> &wgpu::RenderPipeline {

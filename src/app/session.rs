@@ -1,9 +1,10 @@
 //! `vrao run` as one call: the headset profile and size, the budget governor, the headset
-//! (OpenXR or simulated), Ctrl-C, and the frame loop with or without a window.
+//! (OpenXR or simulated), and the frame loop with or without a window until it ends or
+//! the caller's interrupt flag is set.
 
 use crate::app::governor::{Frontier, Governor, GovernorConfig};
 use crate::app::window::{run_window, WindowOptions};
-use crate::app::{open_headset, BufferView, FrameLoop, HeadsetChoice, RunSummary};
+use crate::app::{open_headset, BufferView, FrameLoop, HeadsetChoice, HeadsetError, RunSummary};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::BackendChoice;
 use crate::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
@@ -13,6 +14,8 @@ use crate::xr::simulated::motion::HeadMotion;
 use crate::xr::simulated::reproject::ReprojectionMode;
 use crate::xr::simulated::{SimulatedOptions, TimeMode};
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// How [`run_session`] runs; `Default` is a simulated-or-OpenXR Vive session with no
 /// window, the governor on, until 600 frames.
@@ -80,31 +83,50 @@ impl Default for RunOptions {
     }
 }
 
+/// Why a session could not start, by the setting at fault (the command line names its
+/// option from the variant); anything else is [`SessionError::Other`].
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    /// [`RunOptions::profile`] names no headset profile.
+    #[error("{0}")]
+    Profile(Error),
+    /// [`RunOptions::refresh`] is not a rate the profile supports.
+    #[error("{0}")]
+    Refresh(Error),
+    /// [`RunOptions::show`] asks for a buffer view without a window to show it in.
+    #[error("the {} buffer view needs a window (a mirror or single-pass display)", .0.name())]
+    ViewNeedsWindow(BufferView),
+    /// The headset (OpenXR asked for and unavailable, or the simulated one).
+    #[error(transparent)]
+    Headset(#[from] HeadsetError),
+    /// Any other failure.
+    #[error(transparent)]
+    Other(#[from] Error),
+}
+
+impl From<SessionError> for Error {
+    fn from(error: SessionError) -> Error {
+        match error {
+            SessionError::Profile(e) | SessionError::Refresh(e) | SessionError::Other(e) => e,
+            SessionError::ViewNeedsWindow(_) => Error::input(error.to_string()),
+            SessionError::Headset(e) => e.into(),
+        }
+    }
+}
+
 /// Runs a headset session on `scene` with `settings` (their profile is replaced by the
-/// one `options` names) and returns its summary. Prints which headset and governor it
-/// uses. The first Ctrl-C ends the session cleanly (the summary is still returned), a
-/// second one stops the process.
-pub fn run_session(scene: &Scene, settings: &Settings, options: &RunOptions) -> Result<RunSummary> {
-    let mut profile =
-        crate::xr::profiles::by_name(&options.profile).map_err(|e| Error::input(format!("--profile: {e}")))?;
-    if let Some(hz) = options.refresh {
-        profile = profile.with_refresh(hz).map_err(|e| Error::input(format!("--refresh: {e}")))?;
-    }
-    let size = match (options.width, options.height) {
-        (None, None) => None,
-        (w, h) => Some((w.unwrap_or(profile.width), h.unwrap_or(profile.height))),
-    };
-    if let Some((w, h)) = size {
-        profile = profile.with_render_size(w, h);
-    }
-    let mut settings = settings.clone();
-    settings.profile = profile;
-    settings.validate()?;
+/// one `options` names) and returns its summary. Which headset and governor it uses
+/// goes to the log (info). Setting `interrupt` (a Ctrl-C handler of the caller's, say)
+/// ends the session cleanly after the current frame; the summary is still returned.
+pub fn run_session(
+    scene: &Scene,
+    settings: &Settings,
+    options: &RunOptions,
+    interrupt: Arc<AtomicBool>,
+) -> std::result::Result<RunSummary, SessionError> {
+    let (settings, size) = session_settings(settings, options)?;
     if options.display == DisplayMode::None && options.show != BufferView::Eyes {
-        return Err(Error::input(format!(
-            "--show {} needs a window (--display mirror or single-pass)",
-            clap::ValueEnum::to_possible_value(&options.show).map_or_else(String::new, |v| v.get_name().to_string())
-        )));
+        return Err(SessionError::ViewNeedsWindow(options.show));
     }
     let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };
     let frames = options.frames.or((options.display == DisplayMode::None).then_some(600));
@@ -123,13 +145,14 @@ pub fn run_session(scene: &Scene, settings: &Settings, options: &RunOptions) -> 
         frames,
     };
     let (headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend)?;
-    println!("headset: {message}");
-    let mut frame_loop = FrameLoop::new(gpu.clone(), scene, &settings, headset)?;
+    log::info!("headset: {message}");
+    let mut frame_loop = FrameLoop::new(gpu, scene, &settings, headset)?;
     frame_loop.frame_limit = frames;
+    frame_loop.exit_requested = interrupt;
     frame_loop.renderer.set_frames_in_flight(options.frames_in_flight);
     if let Some(governor) = governor {
         let frontier = governor.frontier();
-        println!(
+        log::info!(
             "governor: on, {} levels from {} to {}; starting at {}",
             frontier.len(),
             frontier.levels()[0].setting,
@@ -138,15 +161,6 @@ pub fn run_session(scene: &Scene, settings: &Settings, options: &RunOptions) -> 
         );
         frame_loop.set_governor(governor)?;
     }
-    // Ctrl-C ends the session cleanly (OpenXR walks to EXITING) and the report is still
-    // written; a second Ctrl-C while it ends is the default: the process stops.
-    let exit = frame_loop.exit_requested.clone();
-    let _ = ctrlc::set_handler(move || {
-        if exit.swap(true, std::sync::atomic::Ordering::Relaxed) {
-            std::process::exit(130);
-        }
-        eprintln!("Ctrl-C: ending the session");
-    });
     if options.display == DisplayMode::None {
         while frame_loop.step()?.is_some() {}
         frame_loop.end()?;
@@ -158,8 +172,32 @@ pub fn run_session(scene: &Scene, settings: &Settings, options: &RunOptions) -> 
             screenshot: options.screenshot.clone(),
             show: options.show,
         };
-        run_window(frame_loop, scene, window)
+        Ok(run_window(frame_loop, scene, window)?)
     }
+}
+
+/// `settings` with the headset profile `options` names, at its refresh rate and size,
+/// and the per-eye size asked for instead of the headset's own, if any (a side not
+/// given is the profile's).
+fn session_settings(
+    settings: &Settings,
+    options: &RunOptions,
+) -> std::result::Result<(Settings, Option<(u32, u32)>), SessionError> {
+    let mut profile = crate::xr::profiles::by_name(&options.profile).map_err(SessionError::Profile)?;
+    if let Some(hz) = options.refresh {
+        profile = profile.with_refresh(hz).map_err(SessionError::Refresh)?;
+    }
+    let size = match (options.width, options.height) {
+        (None, None) => None,
+        (w, h) => Some((w.unwrap_or(profile.width), h.unwrap_or(profile.height))),
+    };
+    if let Some((w, h)) = size {
+        profile = profile.with_render_size(w, h);
+    }
+    let mut settings = settings.clone();
+    settings.profile = profile;
+    settings.validate()?;
+    Ok((settings, size))
 }
 
 /// The governor of a session: its frontier (the bench file given, or the built-in one)
@@ -168,7 +206,7 @@ fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
     let frontier = match &options.governor_frontier {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
-            Frontier::from_json(&text, &path.display().to_string(), settings.ao.radius).map_err(Error::input)?
+            Frontier::from_json(&text, path, settings.ao.radius)?
         }
         None => Frontier::builtin(),
     };
@@ -184,5 +222,5 @@ fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
         })
         .unwrap_or(frontier.top());
     let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
-    Governor::new(frontier, config, start).map_err(Error::input)
+    Governor::new(frontier, config, start)
 }

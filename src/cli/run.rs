@@ -3,12 +3,14 @@
 use super::{AoArgs, OnOff, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
-use vrao::app::{run_session, BufferView, HeadsetChoice, RunOptions};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use vrao::app::{run_session, BufferView, HeadsetChoice, HeadsetError, RunOptions, SessionError};
 use vrao::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
 use vrao::render::settings::DisplayMode;
 use vrao::xr::simulated::motion::HeadMotion;
 use vrao::xr::simulated::reproject::ReprojectionMode;
-use vrao::{BackendChoice, Result, Scene, Settings};
+use vrao::{BackendChoice, Error, Result, Scene, Settings};
 
 #[derive(Args)]
 pub struct RunArgs {
@@ -99,11 +101,53 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         screenshot: args.screenshot,
         show: args.show,
     };
-    let summary = run_session(&scene, &settings, &options)?;
+    let summary = run_session(&scene, &settings, &options, interrupt_on_ctrl_c()).map_err(name_the_option)?;
     println!("{}", summary.to_text());
     match &args.report {
         Some(path) => vrao::render::output::write_json(path, &summary),
         None => Ok(()),
+    }
+}
+
+/// A flag that the first Ctrl-C sets, which ends the session cleanly (the summary and
+/// report are still written); a second Ctrl-C while it ends stops the process (130, as a
+/// shell reports an interrupted command).
+fn interrupt_on_ctrl_c() -> Arc<AtomicBool> {
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let flag = interrupt.clone();
+    let installed = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        eprintln!("Ctrl-C: ending the session");
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: Ctrl-C will stop vrao at once, without a summary: {e}");
+    }
+    interrupt
+}
+
+/// The session's error with the command-line option that caused it named.
+fn name_the_option(error: SessionError) -> Error {
+    match error {
+        SessionError::Profile(e) => with_option("--profile", e),
+        SessionError::Refresh(e) => with_option("--refresh", e),
+        SessionError::ViewNeedsWindow(view) => {
+            Error::input(format!("--show {} needs a window (--display mirror or single-pass)", view.name()))
+        }
+        SessionError::Headset(HeadsetError::OpenXrUnavailable(why)) => {
+            Error::Device(format!("--headset openxr: {why}"))
+        }
+        other => other.into(),
+    }
+}
+
+/// `error` with its message led by `option`, its kind (and exit code) kept.
+fn with_option(option: &str, error: Error) -> Error {
+    match error {
+        Error::Input { file, line, message } => Error::Input { file, line, message: format!("{option}: {message}") },
+        Error::Device(message) => Error::Device(format!("{option}: {message}")),
+        other => other,
     }
 }
 

@@ -8,7 +8,7 @@ use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{ReferenceImage, ReferencePixel};
 use crate::measure::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency, BORDER_PX};
-pub use crate::render::bench_file::{BenchFile, BenchRecord, LimitInfo, ReferenceInfo};
+pub use crate::render::bench_file::{BenchFile, BenchRecord, LimitInfo, ReferenceInfo, Resolution};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::timing::{is_per_eye, summarize, SpanSummary};
 use crate::render::gpu::Gpu;
@@ -16,7 +16,8 @@ use crate::render::graph::FINAL_AO;
 pub use crate::render::output::significant;
 use crate::render::passes::composite::HDR;
 use crate::render::passes::gbuffer::{DEPTH, NORMALS};
-use crate::render::passes::rsm::RSM_INDIRECT;
+use crate::render::passes::rsm::{self, RSM_INDIRECT};
+use crate::render::passes::shadow;
 use crate::render::renderer::{Renderer, Timing};
 use crate::render::scene::Scene;
 use crate::render::settings::{Settings, Technique};
@@ -95,7 +96,9 @@ pub struct BenchRow {
 }
 
 impl BenchRow {
-    /// Median ms of one pass for both eyes together (0 when it did not run).
+    /// Median ms of one pass for both eyes together, 0 when it did not run: a row is
+    /// only made when every pass that ran has a span under its name (`check_timed`), so
+    /// look passes up by their `NAME` constants.
     pub fn median_ms(&self, span: &str) -> f64 {
         self.spans.iter().find(|s| s.label == span).map_or(0.0, |s| s.median_ms)
     }
@@ -174,7 +177,7 @@ impl CaseRun {
         if timing == Timing::Pipelined && !gpu.caps.timestamps {
             return Err(Error::Device(format!(
                 "{} has no timestamp queries; use serial timing",
-                gpu.adapter.get_info().name
+                gpu.info.name.clone()
             )));
         }
         let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
@@ -222,6 +225,10 @@ impl CaseRun {
     /// with a reference its error (against the screen-space `limit` too when given).
     fn finish(mut self, reference: Option<&ReferenceImage>, limit: Option<&ScreenLimit>) -> Result<BenchRow> {
         let (settings, output) = (&self.settings, self.output);
+        // The measured frames' plan, before the bounce below renders a frame of another.
+        let plan = self.renderer.last_plan().cloned().ok_or_else(|| Error::Gpu("no frame was measured".into()))?;
+        let spans = summarize(&self.timings);
+        check_timed(&plan.names, &spans)?;
         let occlusion = self.renderer.read_f32(output)?;
         let error = reference
             .map(|reference| score(self.case.technique, &occlusion, reference, limit, self.pixels_per_degree()));
@@ -256,12 +263,11 @@ impl CaseRun {
             }
             _ => None,
         };
-        let occlusion_passes = self.renderer.last_plan().map_or_else(Vec::new, |plan| plan.occlusion_passes());
         Ok(BenchRow {
-            spans: summarize(&self.timings),
+            spans,
             views: 2,
             pass: settings.ao.pass_name(),
-            occlusion_passes,
+            occlusion_passes: plan.occlusion_passes(),
             error,
             bounce,
             stereo,
@@ -270,8 +276,18 @@ impl CaseRun {
     }
 }
 
-/// The graph pass of reflective shadow maps' gather (bench rows of technique "rsm").
-pub const RSM_PASS: &str = "rsm";
+/// The graph pass of reflective shadow maps' gather, whose name bench rows of it also
+/// carry as their technique ("rsm").
+pub const RSM_PASS: &str = rsm::NAME;
+
+/// Fails when a pass of `ran` has no span in `spans`: a pass's cost is looked up by its
+/// name, and one timed under another name would otherwise read as 0 ms.
+fn check_timed(ran: &[&'static str], spans: &[SpanSummary]) -> Result<()> {
+    match ran.iter().find(|pass| !spans.iter().any(|s| s.label == **pass)) {
+        Some(pass) => Err(Error::Gpu(format!("pass '{pass}' ran but no GPU time was measured under its name"))),
+        None => Ok(()),
+    }
+}
 
 /// Reflective shadow maps with `samples` VPLs per pixel within `radius` (the reference's
 /// radius, so both gather the bounce from about the same neighbourhood): per-pass medians
@@ -302,12 +318,16 @@ pub fn measure_rsm(
     renderer.set_timing(timing);
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let mut timings = Vec::new();
+    let mut ran = Vec::new();
     for frame in 0..warmup + frames {
         let report = renderer.render_and_wait(&eyes.eyes, &[RSM_INDIRECT])?;
+        ran = report.plan.names;
         if frame >= warmup {
             timings.push(if timing == Timing::Serial { report.wall_ms } else { report.gpu_ms });
         }
     }
+    let spans = summarize(&timings);
+    check_timed(&ran, &spans)?;
     let bounce = match reference {
         Some(reference) => {
             let irradiance = renderer.read_f32(RSM_INDIRECT)?;
@@ -325,10 +345,10 @@ pub fn measure_rsm(
     };
     Ok(BenchRow {
         case,
-        spans: summarize(&timings),
+        spans,
         views: 2,
         pass: RSM_PASS,
-        occlusion_passes: vec![RSM_PASS, "shadow"],
+        occlusion_passes: vec![RSM_PASS, shadow::NAME],
         error: None,
         bounce,
         stereo: None,

@@ -9,7 +9,7 @@
 //! half the budget; the stereo frame passes when the sum of its passes fits the budget.
 
 use crate::render::error::Result;
-use crate::render::gpu::timing::{summarize, SpanSummary};
+use crate::render::gpu::timing::{is_per_eye, summarize, SpanSummary};
 use crate::render::graph::Resource;
 use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::{FrameReport, Renderer, Timing};
@@ -32,11 +32,36 @@ pub struct PassTimes {
     pub right: Option<SpanSummary>,
 }
 
+/// What a verdict is about; reports write `left eye`, `right eye` or `stereo frame`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Scope {
+    /// The left eye rendered alone.
+    #[serde(rename = "left eye")]
+    LeftEye,
+    /// The right eye rendered alone.
+    #[serde(rename = "right eye")]
+    RightEye,
+    /// Both eyes in one frame.
+    #[serde(rename = "stereo frame")]
+    StereoFrame,
+}
+
+impl Scope {
+    /// `left eye`, `right eye` or `stereo frame`, as reports write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scope::LeftEye => "left eye",
+            Scope::RightEye => "right eye",
+            Scope::StereoFrame => "stereo frame",
+        }
+    }
+}
+
 /// The verdict for one eye or for the whole stereo frame.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Verdict {
-    /// `left eye`, `right eye` or `stereo frame`.
-    pub what: String,
+    /// One eye alone or the stereo frame.
+    pub what: Scope,
     /// Sum of the per-pass medians.
     pub ms: f64,
     /// Half the stereo budget for an eye, the whole budget for the stereo frame (ms).
@@ -82,7 +107,7 @@ impl BudgetReport {
 
     /// `None` within budget; otherwise what is over it, as the error `vrao budget` exits 3 with.
     pub fn over_budget(&self) -> Option<crate::render::error::Error> {
-        let over: Vec<&str> = self.verdicts.iter().filter(|v| !v.pass).map(|v| v.what.as_str()).collect();
+        let over: Vec<&str> = self.verdicts.iter().filter(|v| !v.pass).map(|v| v.what.name()).collect();
         (!over.is_empty()).then(|| {
             crate::render::error::Error::OverBudget(format!(
                 "{} over the {:.3} ms stereo frame budget",
@@ -129,7 +154,7 @@ impl BudgetReport {
             let _ = writeln!(
                 s,
                 "{:<13} {:>10.3} ms of {:>8.3} ms  {}",
-                v.what,
+                v.what.name(),
                 v.ms,
                 v.budget_ms,
                 if v.pass { "PASS".to_string() } else { format!("FAIL ({:.1}× over)", v.ms / v.budget_ms) }
@@ -158,7 +183,7 @@ pub struct BudgetRun {
 fn pass_times(report: &FrameReport, timing: Timing) -> Vec<(String, f64)> {
     let source = if timing == Timing::Serial { &report.wall_ms } else { &report.gpu_ms };
     // Per-eye sub-spans inside a pass ("gbuffer left") are not passes of their own.
-    source.iter().filter(|(name, _)| !name.ends_with(" left") && !name.ends_with(" right")).cloned().collect()
+    source.iter().filter(|(name, _)| !is_per_eye(name)).cloned().collect()
 }
 
 /// Renders `warmup + frames` rounds of (stereo frame, left eye alone, right eye alone)
@@ -193,23 +218,22 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         .collect();
     let total = |k: usize| summaries[k].iter().map(|s| s.median_ms).sum::<f64>();
     let per_eye_budget = how.budget_ms / 2.0;
-    let verdict =
-        |what: &str, ms: f64, budget_ms: f64| Verdict { what: what.into(), ms, budget_ms, pass: ms <= budget_ms };
+    let verdict = |what: Scope, ms: f64, budget_ms: f64| Verdict { what, ms, budget_ms, pass: ms <= budget_ms };
     let verdicts = vec![
-        verdict("left eye", total(1), per_eye_budget),
-        verdict("right eye", total(2), per_eye_budget),
-        verdict("stereo frame", total(0), how.budget_ms),
+        verdict(Scope::LeftEye, total(1), per_eye_budget),
+        verdict(Scope::RightEye, total(2), per_eye_budget),
+        verdict(Scope::StereoFrame, total(0), how.budget_ms),
     ];
-    let cpu_encode = ["stereo frame", "left eye", "right eye"]
+    let cpu_encode = [Scope::StereoFrame, Scope::LeftEye, Scope::RightEye]
         .iter()
         .zip(&encode)
-        .map(|(label, e)| {
+        .map(|(scope, e)| {
             let mut s = summarize(e).pop().expect("at least one measured frame");
-            s.label = label.to_string();
+            s.label = scope.name().to_string();
             s
         })
         .collect();
-    let info = renderer.gpu().adapter.get_info();
+    let info = renderer.gpu().info.clone();
     let p = &renderer.settings().profile;
     Ok(BudgetReport {
         adapter: info.name.clone(),
@@ -225,4 +249,20 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         cpu_encode,
         verdicts,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn verdict_scopes_keep_their_names_in_reports() {
+        for (scope, name) in
+            [(Scope::LeftEye, "left eye"), (Scope::RightEye, "right eye"), (Scope::StereoFrame, "stereo frame")]
+        {
+            assert_eq!(scope.name(), name);
+            assert_eq!(serde_json::to_string(&scope).unwrap(), format!("\"{name}\""));
+            assert_eq!(serde_json::from_str::<Scope>(&format!("\"{name}\"")).unwrap(), scope);
+        }
+    }
 }

@@ -121,9 +121,7 @@ impl ScatterPlot {
             )));
         }
         let mut buffer = vec![255u8; width as usize * height as usize * 3];
-        let drawn = self
-            .draw(&mut buffer, width, height)
-            .map_err(|e| Error::Output { path: "plot".into(), message: format!("drawing the plot: {e}") })?;
+        let drawn = self.draw(&mut buffer, width, height)?;
         let image = RgbImage::from_raw(width, height, buffer).expect("the buffer has width × height RGB pixels");
         Ok((image, drawn))
     }
@@ -136,8 +134,8 @@ impl ScatterPlot {
             .map_err(|e| Error::Output { path: path.to_path_buf(), message: format!("writing the plot: {e}") })
     }
 
-    fn draw(&self, buffer: &mut [u8], width: u32, height: u32) -> std::result::Result<Drawn, String> {
-        let err = |e: &dyn std::fmt::Display| e.to_string();
+    fn draw(&self, buffer: &mut [u8], width: u32, height: u32) -> Result<Drawn> {
+        let err = drawing_failed;
         let root = Backend::new(buffer, (width, height)).into_drawing_area();
         // Sizes follow the image: 1280×800 gets 14 px tick labels and 12 px point labels.
         let unit = (width.min(height) as f64 / 800.0).max(0.5);
@@ -192,51 +190,21 @@ impl ScatterPlot {
             // The label sits at the foot of the line: errors near 0 are rare, so the data
             // stays clear, and point labels avoid its box (`budget_box`).
             let style = font(14.0).color(&rgb(BUDGET_COLOR));
-            let lines: Vec<&str> = label.lines().collect();
-            let line_h = px(17.0) as i32;
-            let (x0, y0) = (lx + px(6.0) as i32, ay.end - px(6.0) as i32 - line_h * lines.len() as i32);
-            let mut w = 0;
-            for (i, line) in lines.iter().enumerate() {
-                root.draw_text(line, &style, (x0, y0 + i as i32 * line_h)).map_err(|e| err(&e))?;
-                w = w.max(root.estimate_text_size(line, &style).map_or(0, |(w, _)| w as i32));
-            }
-            budget_box = Some((x0, y0, x0 + w, ay.end));
+            let foot = (lx + px(6.0) as i32, ay.end - px(6.0) as i32);
+            let (x0, y0, x1, _) = draw_lines_above(&root, label, &style, foot, px(17.0) as i32)?;
+            budget_box = Some((x0, y0, x1, ay.end));
         }
-
-        let mut front: Vec<(f64, f64)> =
-            self.pareto.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
-        front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let style = ShapeStyle::from(rgb(PARETO_COLOR)).stroke_width(px(2.0));
-        chart.draw_series(LineSeries::new(front, style)).map_err(|e| err(&e))?;
 
         let radius = px(5.0) as i32;
-        for s in &self.series {
-            let colour = rgb(s.color);
-            let points = s.points.iter().filter(|p| p.x.is_finite() && p.y.is_finite());
-            chart
-                .draw_series(points.clone().map(|p| Circle::new((p.x, p.y), radius, colour.filled())))
-                .map_err(|e| err(&e))?;
-            drawn.points.extend(points.map(|p| chart.backend_coord(&(p.x, p.y))));
-        }
+        drawn.points = self.draw_front_and_points(&mut chart, px(2.0), radius)?;
 
         // Labels after every point, so a label avoids the points drawn after its own.
         let texts = self.series.iter().flat_map(|s| &s.points).filter(|p| p.x.is_finite() && p.y.is_finite());
-        let mut taken: Vec<(i32, i32, i32, i32)> =
+        let labelled: Vec<(&str, (i32, i32))> = texts.map(|p| p.label.as_str()).zip(drawn.points.clone()).collect();
+        let mut taken: Vec<LabelBox> =
             drawn.points.iter().map(|&(x, y)| (x - radius, y - radius, x + radius, y + radius)).collect();
         taken.extend(budget_box);
-        for (p, &(x, y)) in texts.zip(&drawn.points) {
-            let (w, h) = root.estimate_text_size(&p.label, &label_style).map_err(|e| err(&e))?;
-            let (w, h) = (w as i32, h as i32);
-            let (b, beside) = place_label((x, y), (w, h), radius + 3, &taken, drawn.area);
-            if !beside {
-                // A label pushed away from its point gets a thin leader line back to it.
-                let to = (x.clamp(b.0, b.2), y.clamp(b.1, b.3));
-                root.draw(&PathElement::new([(x, y), to], rgb(PARETO_COLOR).mix(0.4))).map_err(|e| err(&e))?;
-            }
-            root.draw_text(&p.label, &label_style, (b.0, b.1)).map_err(|e| err(&e))?;
-            taken.push(b);
-            drawn.labels.push(b);
-        }
+        drawn.labels = draw_point_labels(&root, &labelled, &label_style, radius, taken, drawn.area)?;
 
         // Legend: a dot and the series name per row.
         let row = px(22.0) as i32;
@@ -248,6 +216,89 @@ impl ScatterPlot {
         root.present().map_err(|e| err(&e))?;
         Ok(drawn)
     }
+
+    /// Draws the Pareto front (a line `stroke` px wide) and every series' points as dots
+    /// of `radius` px; returns the points' pixel positions, series by series.
+    fn draw_front_and_points(&self, chart: &mut Chart<'_, '_>, stroke: u32, radius: i32) -> Result<Vec<(i32, i32)>> {
+        let mut front: Vec<(f64, f64)> =
+            self.pareto.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let style = ShapeStyle::from(rgb(PARETO_COLOR)).stroke_width(stroke);
+        chart.draw_series(LineSeries::new(front, style)).map_err(|e| drawing_failed(&e))?;
+        let mut drawn = Vec::new();
+        for s in &self.series {
+            let colour = rgb(s.color);
+            let points = s.points.iter().filter(|p| p.x.is_finite() && p.y.is_finite());
+            chart
+                .draw_series(points.clone().map(|p| Circle::new((p.x, p.y), radius, colour.filled())))
+                .map_err(|e| drawing_failed(&e))?;
+            drawn.extend(points.map(|p| chart.backend_coord(&(p.x, p.y))));
+        }
+        Ok(drawn)
+    }
+}
+
+/// The plot's chart: f64 axes on vrao's text-drawing backend.
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    Backend<'b>,
+    plotters::coord::cartesian::Cartesian2d<
+        plotters::coord::types::RangedCoordf64,
+        plotters::coord::types::RangedCoordf64,
+    >,
+>;
+
+/// A text's box in pixels: left, top, right, bottom.
+type LabelBox = (i32, i32, i32, i32);
+
+/// Why plotters could not draw, as vrao's error.
+fn drawing_failed(e: &dyn std::fmt::Display) -> Error {
+    Error::Output { path: "plot".into(), message: format!("drawing the plot: {e}") }
+}
+
+/// Draws the lines of `text` `line_h` apart so that the last one ends at `foot` (its
+/// left and bottom); returns the box they cover.
+fn draw_lines_above(
+    root: &DrawingArea<Backend<'_>, plotters::coord::Shift>,
+    text: &str,
+    style: &TextStyle,
+    (x0, bottom): (i32, i32),
+    line_h: i32,
+) -> Result<LabelBox> {
+    let lines: Vec<&str> = text.lines().collect();
+    let y0 = bottom - line_h * lines.len() as i32;
+    let mut w = 0;
+    for (i, line) in lines.iter().enumerate() {
+        root.draw_text(line, style, (x0, y0 + i as i32 * line_h)).map_err(|e| drawing_failed(&e))?;
+        w = w.max(root.estimate_text_size(line, style).map_or(0, |(w, _)| w as i32));
+    }
+    Ok((x0, y0, x0 + w, bottom))
+}
+
+/// Draws each (label, point) where it overlaps nothing in `taken` (the points, the
+/// budget label, the labels placed before it) inside `area`; a label pushed away from
+/// its point gets a thin leader line back to it. Returns the labels' boxes.
+fn draw_point_labels(
+    root: &DrawingArea<Backend<'_>, plotters::coord::Shift>,
+    labelled: &[(&str, (i32, i32))],
+    style: &TextStyle,
+    radius: i32,
+    mut taken: Vec<LabelBox>,
+    area: LabelBox,
+) -> Result<Vec<LabelBox>> {
+    let mut boxes = Vec::with_capacity(labelled.len());
+    for &(label, (x, y)) in labelled {
+        let (w, h) = root.estimate_text_size(label, style).map_err(|e| drawing_failed(&e))?;
+        let (b, beside) = place_label((x, y), (w as i32, h as i32), radius + 3, &taken, area);
+        if !beside {
+            let to = (x.clamp(b.0, b.2), y.clamp(b.1, b.3));
+            root.draw(&PathElement::new([(x, y), to], rgb(PARETO_COLOR).mix(0.4))).map_err(|e| drawing_failed(&e))?;
+        }
+        root.draw_text(label, style, (b.0, b.1)).map_err(|e| drawing_failed(&e))?;
+        taken.push(b);
+        boxes.push(b);
+    }
+    Ok(boxes)
 }
 
 /// The label box of `size` for the point at `at`: the first spot (right, left, then

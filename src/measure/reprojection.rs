@@ -98,7 +98,7 @@ pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove])
     }
     gpu.queue.submit([encoder.finish()]);
     let output = output_target(&gpu, extent);
-    let mut reprojector = Reprojector::new(&gpu);
+    let mut reprojector = Reprojector::new(&gpu)?;
     let mut rows = Vec::new();
     for &movement in movements {
         let target_eyes = settings.profile.eyes(&movement.apply(head), settings.near);
@@ -144,7 +144,7 @@ pub fn study(
     let gpu = std::sync::Arc::new(crate::render::gpu::Gpu::new(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     let rows = measure(&mut renderer, &scene.head.pose_at(0.0), &default_movements())?;
-    Ok((rows, gpu.adapter.get_info().name))
+    Ok((rows, gpu.info.name.clone()))
 }
 
 /// The benchmark's movements: rotations of 1–10° and translations of 1–10 cm.

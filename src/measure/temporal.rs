@@ -4,12 +4,14 @@
 
 use crate::measure::bench::error_figures;
 use crate::measure::reference::{trace_cached, ReferenceImage, ReferenceSettings};
-use crate::render::error::Result;
+use crate::render::error::{Error, Result};
+use crate::render::gpu::timing::passes_ms;
 use crate::render::gpu::Gpu;
 use crate::render::graph::FINAL_AO;
 use crate::render::renderer::Renderer;
 use crate::render::scene::Scene;
 use crate::render::settings::Settings;
+use crate::render::stats;
 use crate::xr::simulated::motion::HeadMotion;
 use serde::Serialize;
 use std::path::Path;
@@ -63,12 +65,8 @@ pub fn convergence(
             let head = motion.pose_at(&scene.head, frame as f64 * dt);
             let eyes = settings.profile.eyes(&head, settings.near);
             let report = renderer.render_and_wait(&eyes.eyes, &[FINAL_AO])?;
-            let ms: f64 = report
-                .wall_ms
-                .iter()
-                .filter(|(pass, _)| !matches!(pass.as_str(), "gbuffer" | "direct" | "depth-peel"))
-                .map(|(_, ms)| ms)
-                .sum();
+            let ms = passes_ms(&report.wall_ms, &report.plan.occlusion_passes())
+                .map_err(|pass| Error::Gpu(format!("pass '{pass}' ran but no time was measured under its name")))?;
             times.push(ms / eyes.eyes.len() as f64);
             if !CHECKPOINTS.contains(&frame) {
                 continue;
@@ -87,15 +85,13 @@ pub fn convergence(
                 layers.iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>()
             };
             let noise_rmse = crate::measure::metrics::rmse(&ao(&image), &ao(&target), None).unwrap_or(f64::NAN);
-            let mut sorted = times.clone();
-            sorted.sort_by(f64::total_cmp);
             points.push(ConvergencePoint {
                 configuration: name.clone(),
                 motion: motion.name().to_string(),
                 frame,
                 ao_rmse: e.ao_rmse,
                 noise_rmse,
-                occlusion_ms_per_eye: crate::render::gpu::timing::quantile(&sorted, 0.5),
+                occlusion_ms_per_eye: stats::median(&times).expect("a frame was timed before each checkpoint"),
             });
         }
     }
@@ -156,10 +152,10 @@ pub fn study(
         ReferenceSettings { radius: base.ao.radius as f64, rays_per_pixel: rays, stride: 2, near: base.near };
     let mut points = Vec::new();
     for motion in [HeadMotion::Static, HeadMotion::YawSweep] {
-        eprintln!("temporal: {} ({} configurations × 16 frames)", motion.name(), configurations.len());
+        log::info!("temporal: {} ({} configurations × 16 frames)", motion.name(), configurations.len());
         points.extend(convergence(&gpu, scene, &configurations, motion, &reference, cache)?);
     }
-    Ok(TemporalStudy { points, adapter: gpu.adapter.get_info().name })
+    Ok(TemporalStudy { points, adapter: gpu.info.name.clone() })
 }
 
 /// A Markdown table: one row per configuration, one column per checkpoint, each cell

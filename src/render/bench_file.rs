@@ -3,6 +3,47 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The resolution the occlusion runs at. Reports and bench files write it as `full` or
+/// `half` ([`Resolution::name`]), as they always have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Resolution {
+    /// The eye's own size.
+    Full,
+    /// Half the size per axis, then upsampled (`AoSettings::half_res`).
+    Half,
+}
+
+impl Resolution {
+    /// `Half` when the occlusion runs at half resolution (`AoSettings::half_res`).
+    pub fn from_half_res(half_res: bool) -> Resolution {
+        if half_res {
+            Resolution::Half
+        } else {
+            Resolution::Full
+        }
+    }
+
+    /// Whether this is half resolution (the value of `AoSettings::half_res`).
+    pub fn is_half(self) -> bool {
+        self == Resolution::Half
+    }
+
+    /// `full` or `half`: the name reports, tables and bench files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Resolution::Full => "full",
+            Resolution::Half => "half",
+        }
+    }
+}
+
+impl std::fmt::Display for Resolution {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One row as written to CSV, JSON and Markdown.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BenchRecord {
@@ -12,8 +53,8 @@ pub struct BenchRecord {
     pub samples: u32,
     /// Occlusion radius in metres.
     pub radius_m: f32,
-    /// `full` or `half`: the resolution the occlusion ran at.
-    pub resolution: String,
+    /// The resolution the occlusion ran at (`full` or `half` in the file).
+    pub resolution: Resolution,
     /// Median GPU ms per eye of the technique's own pass.
     pub technique_ms_per_eye: f64,
     /// Median GPU ms per eye of the bilateral blur (0 when off).
@@ -177,7 +218,20 @@ pub struct ReferenceInfo {
 
 #[cfg(test)]
 mod tests {
+    use super::Resolution;
     use crate::render::output::significant;
+
+    #[test]
+    fn resolutions_keep_their_names_in_files() {
+        for (r, name) in [(Resolution::Full, "full"), (Resolution::Half, "half")] {
+            assert_eq!(r.name(), name);
+            assert_eq!(r.to_string(), name);
+            assert_eq!(serde_json::to_string(&r).unwrap(), format!("\"{name}\""));
+            assert_eq!(serde_json::from_str::<Resolution>(&format!("\"{name}\"")).unwrap(), r);
+        }
+        assert!(serde_json::from_str::<Resolution>("\"quarter\"").is_err());
+        assert!(Resolution::from_half_res(true).is_half() && !Resolution::from_half_res(false).is_half());
+    }
 
     #[test]
     fn significant_digits_without_float_noise() {

@@ -91,11 +91,11 @@ impl Technique {
 /// Bench files name their techniques, and the governor and `vrao budget --fit` read them
 /// back; the names are the command line's (clap's `ValueEnum`).
 impl std::str::FromStr for Technique {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
         <Technique as clap::ValueEnum>::from_str(s, false).map_err(|_| {
             let names: Vec<&str> = Technique::all().iter().map(|t| t.name()).collect();
-            format!("unknown technique '{s}' (expected one of {})", names.join(", "))
+            Error::input(format!("unknown technique '{s}' (expected one of {})", names.join(", ")))
         })
     }
 }

@@ -2,6 +2,7 @@
 //! reversed-Z infinite-far projection. `view_position_from_depth` is the one place that
 //! turns a depth sample back into a view-space position; `shaders/common.wgsl` mirrors it.
 
+use crate::render::error::{Error, Result};
 use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
 
 /// Default interpupillary distance in metres.
@@ -74,17 +75,35 @@ impl Fov {
     }
 
     /// Checks that every angle is finite and within ±90° and that the view is not empty.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidFov> {
         let half = std::f32::consts::FRAC_PI_2;
         for (name, a) in [("left", self.left), ("right", self.right), ("up", self.up), ("down", self.down)] {
             if !a.is_finite() || a.abs() >= half - 1e-4 {
-                return Err(format!("fov angle {name} = {a} rad is not in (-90°, 90°)"));
+                return Err(InvalidFov(format!("fov angle {name} = {a} rad is not in (-90°, 90°)")));
             }
         }
         if self.right <= self.left || self.up <= self.down {
-            return Err(format!("fov {self:?} is empty (right must exceed left, up must exceed down)"));
+            return Err(InvalidFov(format!("fov {self:?} is empty (right must exceed left, up must exceed down)")));
         }
         Ok(())
+    }
+}
+
+/// A field of view that cannot be rendered ([`Fov::validate`]), in one line for the user.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct InvalidFov(pub String);
+
+impl From<InvalidFov> for Error {
+    /// A field of view is input (a profile, a scene, a runtime's views): `Error::Input`.
+    fn from(error: InvalidFov) -> Error {
+        Error::input(error.0)
+    }
+}
+
+impl From<InvalidFov> for String {
+    fn from(error: InvalidFov) -> String {
+        error.0
     }
 }
 
@@ -267,18 +286,19 @@ impl HeadsetProfile {
         HeadsetProfile { width, height, ..self }
     }
 
-    /// The same headset at another of its supported refresh rates.
-    pub fn with_refresh(self, hz: f64) -> Result<HeadsetProfile, String> {
+    /// The same headset at another of its supported refresh rates; another rate is
+    /// `Error::Input` listing the supported ones.
+    pub fn with_refresh(self, hz: f64) -> Result<HeadsetProfile> {
         // A tolerance so that a rate parsed from text (e.g. "72.0") still matches.
         match self.refresh_rates_hz.iter().find(|&&r| (r - hz).abs() < 1e-6) {
             Some(&rate) => Ok(HeadsetProfile { refresh_hz: rate, ..self }),
             None => {
                 let rates: Vec<String> = self.refresh_rates_hz.iter().map(|r| r.to_string()).collect();
-                Err(format!(
+                Err(Error::input(format!(
                     "refresh rate {hz} Hz is not supported by headset profile '{}' (supported: {} Hz)",
                     self.name,
                     rates.join(", ")
-                ))
+                )))
             }
         }
     }

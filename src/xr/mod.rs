@@ -60,6 +60,18 @@ pub struct FrameCounters {
     pub latency_p95_ms: f64,
 }
 
+impl FrameCounters {
+    /// Sets the latency median and 95th percentile from the latency samples (ms), by
+    /// [`crate::render::stats`]'s one definition whichever headset measured them; with
+    /// no samples both stay as they are (0 before any frame was shown).
+    pub fn set_latency(&mut self, samples_ms: &[f64]) {
+        let sorted = crate::render::stats::Sorted::new(samples_ms.iter().copied());
+        if let (Some(median), Some(p95)) = (sorted.median(), sorted.quantile(0.95)) {
+            (self.latency_median_ms, self.latency_p95_ms) = (median, p95);
+        }
+    }
+}
+
 /// The headset interface `vrao run` drives; the OpenXR and simulated headsets both
 /// implement it.
 pub trait Headset {
@@ -102,4 +114,20 @@ pub trait Headset {
     }
     /// Ends the session cleanly.
     fn end(&mut self, gpu: &Gpu) -> Result<()>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn latency_percentiles_interpolate_between_ranks() {
+        let mut counters = FrameCounters::default();
+        counters.set_latency(&[]);
+        assert_eq!((counters.latency_median_ms, counters.latency_p95_ms), (0.0, 0.0));
+        // 1..=5 ms: the median 3, the 95th percentile 4 + 0.8 × (5 − 4) (nearest rank said 5).
+        counters.set_latency(&[5.0, 1.0, 4.0, 2.0, 3.0]);
+        assert_eq!(counters.latency_median_ms, 3.0);
+        assert!((counters.latency_p95_ms - 4.8).abs() < 1e-12);
+    }
 }

@@ -50,6 +50,32 @@ pub enum Unavailable {
     Busy,
 }
 
+/// An OpenXR or Vulkan call that failed while a session was set up or ran, in one line:
+/// the call and what it returned. Setting up, it makes the headset
+/// [`Unavailable::Failed`]; running, it ends the session (the state machine's loss).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct RuntimeFailure(pub String);
+
+impl From<String> for RuntimeFailure {
+    fn from(why: String) -> RuntimeFailure {
+        RuntimeFailure(why)
+    }
+}
+
+impl From<RuntimeFailure> for Unavailable {
+    fn from(failure: RuntimeFailure) -> Unavailable {
+        Unavailable::Failed(failure.0)
+    }
+}
+
+impl From<RuntimeFailure> for crate::render::error::Error {
+    /// The runtime's device could not be used: `Error::Device`.
+    fn from(failure: RuntimeFailure) -> crate::render::error::Error {
+        crate::render::error::Error::Device(failure.0)
+    }
+}
+
 impl std::fmt::Display for Unavailable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -148,7 +174,8 @@ pub struct OpenXrOptions {
     /// xrRequestExitSession, then STOPPING → xrEndSession → EXITING, and `wait_frame`
     /// returns `None`.
     pub frames: Option<u64>,
-    /// Print session state changes and a lost session's fall back to stderr.
+    /// Log session state changes at the info level (debug otherwise); a lost session's
+    /// fall back is a warning either way.
     pub report: bool,
     /// Force one swapchain layout (`None`: a 2-layer array when the runtime accepts
     /// one, otherwise one swapchain per eye).

@@ -6,13 +6,15 @@
 //! an app gets from the runtime (OpenVR's GetProjectionRaw, OpenXR's xrLocateViews). The right
 //! eye is the left eye mirrored: each dump's right eye matches that to within 0.3°.
 
+use crate::render::error::{Error, Result};
 use crate::render::stereo::{Fov, HeadsetProfile, DEFAULT_IPD};
 
 /// The names [`by_name`] knows, as the CLI spells them.
 pub const PROFILE_NAMES: [&str; 6] = ["vive", "vive-pro-2", "index", "quest-2", "quest-3", "pico-4"];
 
-/// The profile of a named headset at its default refresh rate.
-pub fn by_name(name: &str) -> Result<HeadsetProfile, String> {
+/// The profile of a named headset at its default refresh rate; an unknown name is
+/// `Error::Input` listing the known ones.
+pub fn by_name(name: &str) -> Result<HeadsetProfile> {
     match name {
         "vive" => Ok(HeadsetProfile::vive()),
         "vive-pro-2" => Ok(vive_pro_2()),
@@ -20,7 +22,7 @@ pub fn by_name(name: &str) -> Result<HeadsetProfile, String> {
         "quest-2" => Ok(quest_2()),
         "quest-3" => Ok(quest_3()),
         "pico-4" => Ok(pico_4()),
-        _ => Err(format!("unknown headset profile '{name}' (known: {})", PROFILE_NAMES.join(", "))),
+        _ => Err(Error::input(format!("unknown headset profile '{name}' (known: {})", PROFILE_NAMES.join(", ")))),
     }
 }
 
@@ -231,6 +233,8 @@ mod tests {
     #[test]
     fn unknown_name_is_one_line_naming_it_and_every_known_name() {
         let err = by_name("rift-cv1").unwrap_err();
+        assert_eq!(err.exit_code(), crate::render::error::EXIT_INPUT);
+        let err = err.to_string();
         assert!(!err.contains('\n'), "{err}");
         assert!(err.contains("'rift-cv1'"), "{err}");
         for name in PROFILE_NAMES {
@@ -255,7 +259,7 @@ mod tests {
     fn with_refresh_takes_supported_rates_and_rejects_others_in_one_line() {
         let p = by_name("pico-4").unwrap();
         assert_eq!(p.with_refresh(72.0).unwrap().refresh_hz, 72.0);
-        let err = p.with_refresh(120.0).unwrap_err();
+        let err = p.with_refresh(120.0).unwrap_err().to_string();
         assert!(!err.contains('\n'), "{err}");
         assert!(err.contains("120") && err.contains("pico-4") && err.contains("72, 90"), "{err}");
         assert!(by_name("vive").unwrap().with_refresh(144.0).is_err());

@@ -378,10 +378,12 @@ fn the_frontier_keeps_the_strictly_pareto_optimal_rows_of_the_nearest_radius() {
     assert_eq!(Frontier::from_bench(&file, 0.2).unwrap().levels().len(), 1);
 
     let no_errors = bench(&[("ssao", 12, true, false, 0.5, 0.5, None)]);
-    let e = Frontier::from_bench(&no_errors, 0.5).unwrap_err();
+    let e = Frontier::from_bench(&no_errors, 0.5).unwrap_err().to_string();
     assert!(e.contains("'synthetic'") && e.contains("AO error"), "{e}");
-    let e = Frontier::from_json("{}", "my.json", 0.5).unwrap_err();
-    assert!(e.starts_with("my.json: not a vrao bench file"), "{e}");
+    let e = Frontier::from_json("{}", std::path::Path::new("my.json"), 0.5).unwrap_err();
+    assert_eq!(e.exit_code(), crate::render::error::EXIT_INPUT);
+    let e = e.to_string();
+    assert!(e.starts_with("my.json:1: not a vrao bench file"), "{e}");
 }
 
 #[test]
@@ -415,9 +417,9 @@ fn a_level_sets_technique_samples_resolution_and_temporal_only() {
 fn bad_configurations_name_the_value() {
     let frontier = synthetic();
     let bad = GovernorConfig { raise_below: 0.95, ..GovernorConfig::default() };
-    let e = Governor::new(frontier.clone(), bad, 0).unwrap_err();
+    let e = Governor::new(frontier.clone(), bad, 0).unwrap_err().to_string();
     assert!(e.contains("0.95"), "{e}");
     let bad = GovernorConfig { period_ms: 0.0, ..GovernorConfig::default() };
-    assert!(Governor::new(frontier.clone(), bad, 0).unwrap_err().contains("0 ms"));
+    assert!(Governor::new(frontier.clone(), bad, 0).unwrap_err().to_string().contains("0 ms"));
     assert_eq!(Governor::new(frontier, GovernorConfig::default(), 99).unwrap().level(), 4);
 }

@@ -98,120 +98,187 @@ pub fn score(
     limit: Option<&ScreenLimit>,
     pixels_per_degree: f64,
 ) -> ErrorFigures {
-    let (w, h) = (reference.width as usize, reference.height as usize);
-    let (gw, gh) = reference.grid_size();
-    let (gw, gh) = (gw as usize, gh as usize);
     let limit = limit.filter(|l| l.grid_size() == reference.grid_size() && l.layers.len() >= reference.layers.len());
-    let (mut gpu_ao, mut ref_ao, mut falloff, mut noise2, mut mask) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut limit_ao, mut limit_mask) = (Vec::new(), Vec::new());
-    let (mut gpu_ambient, mut ref_ambient) = (Vec::new(), Vec::new());
+    let (gw, gh) = reference.grid_size();
+    let grid_ppd = pixels_per_degree / reference.stride.max(1) as f64;
+    let mut cells = Vec::new();
     let (mut ssim_sum, mut flip_sum, mut flip_pixels) = (0.0, 0.0, 0usize);
-    let (mut outer_border, mut beside_edge) = (Vec::new(), Vec::new());
-    for (layer, pixels) in reference.layers.iter().enumerate() {
-        let image = &occlusion[layer];
-        let first = gpu_ao.len();
-        for gy in 0..gh {
-            for gx in 0..gw {
-                let r = &pixels[gy * gw + gx];
-                let (x, y) = reference.pixel_of(gx as u32, gy as u32);
-                let (x, y) = ((x as usize).min(w - 1), (y as usize).min(h - 1));
-                let texel = &image[(y * w + x) * 4..(y * w + x) * 4 + 4];
-                // Layer 0 is the left eye: its outer border is on the left.
-                let outer = if layer == 0 { x } else { w - 1 - x };
-                outer_border.push(r.hit && outer.min(y).min(h - 1 - y) < BORDER_PX as usize);
-                beside_edge.push(r.hit && near_depth_edge(pixels, (gw, gh), gx, gy));
-                gpu_ao.push(texel[3]);
-                ref_ao.push(r.ao);
-                falloff.push(r.ao_falloff);
-                mask.push(r.hit);
-                noise2.push(if r.hit { (r.ao_std_error as f64).powi(2) } else { 0.0 });
-                let l = limit.map(|l| *l.get(layer, gx as u32, gy as u32));
-                limit_ao.push(l.map_or(1.0, |l| l.ao));
-                limit_mask.push(r.hit && l.is_some_and(|l| l.hit));
-                let ambient = if technique.carries_light() {
-                    [texel[0], texel[1], texel[2]]
-                } else {
-                    r.unoccluded.map(|c| c * texel[3])
-                };
-                let truth = [0, 1, 2].map(|c| r.environment_visible[c] + r.bounce[c]);
-                gpu_ambient.push(luminance(ambient) as f32);
-                ref_ambient.push(luminance(truth) as f32);
-            }
-        }
-        let range = first..gpu_ao.len();
-        ssim_sum +=
-            metrics::ssim(&gpu_ao[range.clone()], &ref_ao[range.clone()], gw, gh, Some(&mask[range.clone()]), 1.0)
-                .unwrap_or(0.0);
-        // FLIP on this eye's grid, the sky 1 in both; pooled over both eyes' hit pixels.
-        let sky_is_one = |values: &[f32]| -> Vec<f32> {
-            values.iter().zip(&mask[range.clone()]).map(|(&v, &hit)| if hit { v } else { 1.0 }).collect()
-        };
-        let grid_ppd = pixels_per_degree / reference.stride.max(1) as f64;
-        let (test, truth) = (sky_is_one(&gpu_ao[range.clone()]), sky_is_one(&ref_ao[range.clone()]));
-        let hits = mask[range.clone()].iter().filter(|&&m| m).count();
-        if let Some(mean) = metrics::flip_mean(&test, &truth, gw, gh, Some(&mask[range]), grid_ppd) {
+    for (layer, image) in occlusion.iter().enumerate().take(reference.layers.len()) {
+        let eye = eye_cells(technique, image, reference, layer, limit);
+        let (ssim, flip) = eye_similarity(&eye, (gw as usize, gh as usize), grid_ppd);
+        ssim_sum += ssim;
+        // FLIP is pooled over both eyes' hit pixels.
+        if let Some((mean, hits)) = flip {
             flip_sum += mean * hits as f64;
             flip_pixels += hits;
         }
+        cells.extend(eye);
     }
-    let hit_count = mask.iter().filter(|&&m| m).count();
-    let hits = hit_count.max(1) as f64;
-    let noise = (noise2.iter().sum::<f64>() / hits).sqrt();
-    let corrected = |a: &[f32], b: &[f32], mask: &[bool], noise: f64| {
-        metrics::noise_corrected_rmse(metrics::rmse(a, b, Some(mask)).unwrap_or(f64::NAN), noise)
-    };
-    let mean_difference = |a: &[f32], b: &[f32], keep: &dyn Fn(usize) -> bool| {
-        let (mut n, mut sum) = (0usize, 0f64);
-        for i in (0..a.len()).filter(|&i| keep(i)) {
-            n += 1;
-            sum += a[i] as f64 - b[i] as f64;
-        }
-        (n > 0).then(|| sum / n as f64)
-    };
-    let ao_bias = mean_difference(&gpu_ao, &ref_ao, &|i| mask[i]).unwrap_or(f64::NAN);
-    let ao_bias_dark = mean_difference(&gpu_ao, &ref_ao, &|i| mask[i] && ref_ao[i] < DARK_REFERENCE);
-    let mean_ambient = ref_ambient.iter().zip(&mask).filter(|(_, &m)| m).map(|(&a, _)| a as f64).sum::<f64>() / hits;
-    let ambient_rel_rmse = (mean_ambient > 1e-12)
-        .then(|| metrics::rmse(&gpu_ambient, &ref_ambient, Some(&mask)).map(|e| e / mean_ambient))
-        .flatten();
-    // The limit against the reference with the reference's noise taken out, as `ao_rmse`
-    // (so the two compare directly). The limit's own noise is not subtracted: its
-    // binomial bound ignores the stratification of its rays and is several times what
-    // they leave (on the crease the limit and a 64-ray reference differ by an RMSE of
-    // 0.011 while each one's bound is ~0.03), so subtracting it would zero real error.
-    let (ao_rmse_vs_limit, limit_rmse, limit_bias) = match limit {
-        Some(_) if limit_mask.iter().any(|&m| m) => {
-            let n = limit_mask.iter().filter(|&&m| m).count() as f64;
-            let ref_noise2 = noise2.iter().zip(&limit_mask).filter(|(_, &m)| m).map(|(v, _)| v).sum::<f64>() / n;
-            (
-                metrics::rmse(&gpu_ao, &limit_ao, Some(&limit_mask)),
-                Some(corrected(&limit_ao, &ref_ao, &limit_mask, ref_noise2.sqrt())),
-                mean_difference(&limit_ao, &ref_ao, &|i| limit_mask[i]),
-            )
-        }
-        _ => (None, None, None),
-    };
-    let edge_pixels = beside_edge.iter().filter(|&&e| e).count();
-    let halos = (0..gpu_ao.len()).filter(|&i| beside_edge[i] && gpu_ao[i] < ref_ao[i] - HALO_DARKER).count();
+    let hits = cells.iter().filter(|c| c.hit).count().max(1) as f64;
+    let noise = (cells.iter().map(|c| c.noise2).sum::<f64>() / hits).sqrt();
+    let (ao_rmse_vs_limit, limit_rmse, limit_bias) = limit_figures(&cells);
     ErrorFigures {
-        ao_rmse_outer_border: outer_border
+        ao_rmse_outer_border: cells
             .iter()
-            .any(|&b| b)
-            .then(|| metrics::rmse(&gpu_ao, &ref_ao, Some(&outer_border)))
+            .any(|c| c.outer_border)
+            .then(|| rmse(&cells, |c| c.ao, |c| c.ref_ao, |c| c.outer_border))
             .flatten(),
-        halo_share: (edge_pixels > 0).then(|| halos as f64 / edge_pixels as f64),
-        ao_rmse: corrected(&gpu_ao, &ref_ao, &mask, noise),
-        ao_bias,
-        ao_bias_dark,
-        ao_rmse_falloff: corrected(&gpu_ao, &falloff, &mask, noise),
+        halo_share: halo_share(&cells),
+        ao_rmse: corrected_rmse(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit, noise),
+        ao_bias: mean_difference(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit).unwrap_or(f64::NAN),
+        ao_bias_dark: mean_difference(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit && c.ref_ao < DARK_REFERENCE),
+        ao_rmse_falloff: corrected_rmse(&cells, |c| c.ao, |c| c.ref_falloff, |c| c.hit, noise),
         ao_ssim: ssim_sum / reference.layers.len().max(1) as f64,
-        ambient_rel_rmse,
+        ambient_rel_rmse: ambient_rel_rmse(&cells, hits),
         flip_mean: (flip_pixels > 0).then(|| flip_sum / flip_pixels as f64),
         ao_rmse_vs_limit,
         limit_rmse,
         limit_bias,
     }
+}
+
+/// One traced cell of the reference grid beside what the frame (and the screen-space
+/// limit) put at its pixel.
+struct Cell {
+    /// The reference traced a surface here (not the sky).
+    hit: bool,
+    /// The frame's AO (alpha), the reference's hard cut-off AO and its linear-falloff AO.
+    ao: f32,
+    ref_ao: f32,
+    ref_falloff: f32,
+    /// The reference AO's variance (its standard error squared; 0 on the sky).
+    noise2: f64,
+    /// The screen-space limit's AO (1 without a limit) and whether both it and the
+    /// reference hit a surface.
+    limit_ao: f32,
+    limit_hit: bool,
+    /// The luminance of the frame's ambient light and of the reference's.
+    ambient: f32,
+    ref_ambient: f32,
+    /// A hit within [`BORDER_PX`] of the eye's outer, top or bottom border.
+    outer_border: bool,
+    /// A hit beside a depth edge ([`near_depth_edge`]).
+    beside_edge: bool,
+}
+
+/// The cells of eye `layer`, row by row, from its occlusion `image` (RGBA at the full
+/// image size).
+fn eye_cells(
+    technique: Technique,
+    image: &[f32],
+    reference: &ReferenceImage,
+    layer: usize,
+    limit: Option<&ScreenLimit>,
+) -> Vec<Cell> {
+    let (w, h) = (reference.width as usize, reference.height as usize);
+    let (gw, gh) = reference.grid_size();
+    let pixels = &reference.layers[layer];
+    let mut cells = Vec::with_capacity(pixels.len());
+    for gy in 0..gh {
+        for gx in 0..gw {
+            let r = &pixels[(gy * gw + gx) as usize];
+            let (x, y) = reference.pixel_of(gx, gy);
+            let (x, y) = ((x as usize).min(w - 1), (y as usize).min(h - 1));
+            let texel = &image[(y * w + x) * 4..(y * w + x) * 4 + 4];
+            // Layer 0 is the left eye: its outer border is on the left.
+            let outer = if layer == 0 { x } else { w - 1 - x };
+            let l = limit.map(|l| *l.get(layer, gx, gy));
+            let ambient = if technique.carries_light() {
+                [texel[0], texel[1], texel[2]]
+            } else {
+                r.unoccluded.map(|c| c * texel[3])
+            };
+            let truth = [0, 1, 2].map(|c| r.environment_visible[c] + r.bounce[c]);
+            cells.push(Cell {
+                hit: r.hit,
+                ao: texel[3],
+                ref_ao: r.ao,
+                ref_falloff: r.ao_falloff,
+                noise2: if r.hit { (r.ao_std_error as f64).powi(2) } else { 0.0 },
+                limit_ao: l.map_or(1.0, |l| l.ao),
+                limit_hit: r.hit && l.is_some_and(|l| l.hit),
+                ambient: luminance(ambient) as f32,
+                ref_ambient: luminance(truth) as f32,
+                outer_border: r.hit && outer.min(y).min(h - 1 - y) < BORDER_PX as usize,
+                beside_edge: r.hit && near_depth_edge(pixels, (gw as usize, gh as usize), gx as usize, gy as usize),
+            });
+        }
+    }
+    cells
+}
+
+/// One eye's SSIM of the AO against the reference on its grid (`gw × gh` cells), and its
+/// mean FLIP at `grid_ppd` pixels per degree with the hit cells it covers (both images
+/// with the sky as 1), if FLIP could be taken.
+fn eye_similarity(cells: &[Cell], (gw, gh): (usize, usize), grid_ppd: f64) -> (f64, Option<(f64, usize)>) {
+    let mask: Vec<bool> = cells.iter().map(|c| c.hit).collect();
+    let ao: Vec<f32> = cells.iter().map(|c| c.ao).collect();
+    let ref_ao: Vec<f32> = cells.iter().map(|c| c.ref_ao).collect();
+    let ssim = metrics::ssim(&ao, &ref_ao, gw, gh, Some(&mask), 1.0).unwrap_or(0.0);
+    let sky_is_one =
+        |values: &[f32]| -> Vec<f32> { values.iter().zip(&mask).map(|(&v, &hit)| if hit { v } else { 1.0 }).collect() };
+    let hits = mask.iter().filter(|&&m| m).count();
+    let flip = metrics::flip_mean(&sky_is_one(&ao), &sky_is_one(&ref_ao), gw, gh, Some(&mask), grid_ppd);
+    (ssim, flip.map(|mean| (mean, hits)))
+}
+
+/// A value of a cell (its AO, its reference's, …), and whether a cell counts.
+type Value = fn(&Cell) -> f32;
+type Keep = fn(&Cell) -> bool;
+
+/// RMSE of `a` against `b` over the cells `keep` keeps (`None` when it keeps none).
+fn rmse(cells: &[Cell], a: Value, b: Value, keep: Keep) -> Option<f64> {
+    let (a, b): (Vec<f32>, Vec<f32>) = cells.iter().map(|c| (a(c), b(c))).unzip();
+    let mask: Vec<bool> = cells.iter().map(keep).collect();
+    metrics::rmse(&a, &b, Some(&mask))
+}
+
+/// [`rmse`] with the reference's own noise (RMS `noise`) taken out in quadrature.
+fn corrected_rmse(cells: &[Cell], a: Value, b: Value, keep: Keep, noise: f64) -> f64 {
+    metrics::noise_corrected_rmse(rmse(cells, a, b, keep).unwrap_or(f64::NAN), noise)
+}
+
+/// Mean of `a − b` over the cells `keep` keeps (`None` when it keeps none).
+fn mean_difference(cells: &[Cell], a: Value, b: Value, keep: Keep) -> Option<f64> {
+    let kept: Vec<&Cell> = cells.iter().filter(|c| keep(c)).collect();
+    let sum: f64 = kept.iter().map(|c| a(c) as f64 - b(c) as f64).sum();
+    (!kept.is_empty()).then(|| sum / kept.len() as f64)
+}
+
+/// The ambient light's luminance RMSE relative to the reference's mean over the `hits`
+/// hit cells; `None` where the reference has no ambient light.
+fn ambient_rel_rmse(cells: &[Cell], hits: f64) -> Option<f64> {
+    let mean = cells.iter().filter(|c| c.hit).map(|c| c.ref_ambient as f64).sum::<f64>() / hits;
+    (mean > 1e-12).then(|| rmse(cells, |c| c.ambient, |c| c.ref_ambient, |c| c.hit).map(|e| e / mean)).flatten()
+}
+
+/// (the frame against the screen-space limit, the limit's noise-corrected RMSE and its
+/// bias against the reference), over the cells both hit; all `None` without a limit.
+///
+/// The limit against the reference has the reference's noise taken out, as `ao_rmse`
+/// (so the two compare directly). The limit's own noise is not subtracted: its binomial
+/// bound ignores the stratification of its rays and is several times what they leave
+/// (on the crease the limit and a 64-ray reference differ by an RMSE of 0.011 while each
+/// one's bound is ~0.03), so subtracting it would zero real error.
+fn limit_figures(cells: &[Cell]) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let both = cells.iter().filter(|c| c.limit_hit).count();
+    if both == 0 {
+        return (None, None, None);
+    }
+    let ref_noise2 = cells.iter().filter(|c| c.limit_hit).map(|c| c.noise2).sum::<f64>() / both as f64;
+    (
+        rmse(cells, |c| c.ao, |c| c.limit_ao, |c| c.limit_hit),
+        Some(corrected_rmse(cells, |c| c.limit_ao, |c| c.ref_ao, |c| c.limit_hit, ref_noise2.sqrt())),
+        mean_difference(cells, |c| c.limit_ao, |c| c.ref_ao, |c| c.limit_hit),
+    )
+}
+
+/// The share of the cells beside a depth edge that are darker than the reference by
+/// more than [`HALO_DARKER`]; `None` without an edge.
+fn halo_share(cells: &[Cell]) -> Option<f64> {
+    let edge = cells.iter().filter(|c| c.beside_edge).count();
+    let halos = cells.iter().filter(|c| c.beside_edge && c.ao < c.ref_ao - HALO_DARKER).count();
+    (edge > 0).then(|| halos as f64 / edge as f64)
 }
 
 impl LimitInfo {

@@ -3,6 +3,7 @@
 
 // The bench's types and imports (this file is a part of bench.rs split out for size).
 use super::*;
+use crate::render::passes::{blur, composite, peel, upsample};
 
 /// The records of measured rows, with the Pareto front marked.
 pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
@@ -17,10 +18,10 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 technique: if name == RSM_PASS { RSM_PASS.to_string() } else { c.technique.name().to_string() },
                 samples: c.samples,
                 radius_m: c.radius,
-                resolution: if c.half_res { "half" } else { "full" }.to_string(),
+                resolution: Resolution::from_half_res(c.half_res),
                 technique_ms_per_eye: per_eye(name),
-                blur_ms_per_eye: per_eye("blur"),
-                upsample_ms_per_eye: per_eye("upsample"),
+                blur_ms_per_eye: per_eye(blur::NAME),
+                upsample_ms_per_eye: per_eye(upsample::NAME),
                 occlusion_ms_per_eye: row.occlusion_ms_per_eye(),
                 p75_over_p25: spread,
                 ao_rmse: row.error.as_ref().map(|e| e.ao_rmse),
@@ -40,11 +41,11 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
                 pareto: false,
                 depth_peeling: c.depth_peeling,
-                peel_ms_per_eye: per_eye("depth-peel"),
+                peel_ms_per_eye: per_eye(peel::NAME),
                 bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
                 bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
                 temporal: c.temporal,
-                composite_ms_per_eye: per_eye("composite"),
+                composite_ms_per_eye: per_eye(composite::NAME),
                 frame_upsample_ms_per_eye: None,
                 other_ms_per_eye: Some(row.other_ms_per_eye()),
             }
@@ -52,7 +53,7 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
         .collect();
     for i in 0..out.len() {
         let half = &out[i];
-        if half.resolution != "half" || half.composite_ms_per_eye <= 0.0 {
+        if !half.resolution.is_half() || half.composite_ms_per_eye <= 0.0 {
             continue;
         }
         let full = full_resolution_partner(&out, half).filter(|f| f.composite_ms_per_eye > 0.0);
@@ -66,7 +67,7 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
 fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -> Option<&'a BenchRecord> {
     let h = half;
     records.iter().find(|f| {
-        f.resolution == "full"
+        f.resolution == Resolution::Full
             && (f.technique.as_str(), f.samples, f.radius_m, f.depth_peeling, f.temporal)
                 == (h.technique.as_str(), h.samples, h.radius_m, h.depth_peeling, h.temporal)
     })
@@ -165,8 +166,8 @@ const COLUMNS: &[Column] = &[
     Column {
         name: "resolution",
         header: "res",
-        csv: |r| r.resolution.clone(),
-        markdown: |r| r.resolution.clone(),
+        csv: |r| r.resolution.name().to_string(),
+        markdown: |r| r.resolution.name().to_string(),
         optional: false,
     },
     Column {
@@ -209,7 +210,7 @@ const COLUMNS: &[Column] = &[
         name: "upsample_ms_per_eye",
         header: "upsample ms",
         csv: |r| format!("{:.3}", r.upsample_ms_per_eye),
-        markdown: |r| if r.resolution == "half" { format!("{:.1}", r.upsample_ms_per_eye) } else { String::new() },
+        markdown: |r| if r.resolution.is_half() { format!("{:.1}", r.upsample_ms_per_eye) } else { String::new() },
         optional: true,
     },
     Column {
@@ -378,7 +379,7 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
     let mut s = String::new();
     let plain = |r: &&BenchRecord| !r.depth_peeling && !r.temporal;
     let mut half_full = String::new();
-    for half in records.iter().filter(|r| r.resolution == "half") {
+    for half in records.iter().filter(|r| r.resolution.is_half()) {
         let Some(full) = full_resolution_partner(records, half) else {
             continue;
         };
@@ -400,14 +401,13 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
         s += &half_full;
     }
     for (against, title) in [
-        ("ssao", "Technique pass against SSAO's at the same setting and resolution"),
-        ("fetch-only", "Technique pass against fetch-only's (same depth taps, no arithmetic)"),
+        (Technique::Ssao.name(), "Technique pass against SSAO's at the same setting and resolution"),
+        (Technique::FetchOnly.name(), "Technique pass against fetch-only's (same depth taps, no arithmetic)"),
     ] {
         let mut table = String::new();
-        for r in records.iter().filter(plain).filter(|r| r.technique != against && r.technique != "rsm") {
+        for r in records.iter().filter(plain).filter(|r| r.technique != against && r.technique != RSM_PASS) {
             let partner = records.iter().filter(plain).find(|b| {
-                b.technique == against
-                    && (b.samples, b.radius_m, &b.resolution) == (r.samples, r.radius_m, &r.resolution)
+                b.technique == against && (b.samples, b.radius_m, b.resolution) == (r.samples, r.radius_m, r.resolution)
             });
             if let Some(b) = partner {
                 let ratio = r.technique_ms_per_eye / b.technique_ms_per_eye;
@@ -487,7 +487,7 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
             Some(s) => s.points.push(point),
             None => {
                 let hue = HUES[variants.iter().position(|v| v == &technique).unwrap_or(0) % HUES.len()];
-                let color = if r.resolution == "half" { hue.1 } else { hue.0 };
+                let color = if r.resolution.is_half() { hue.1 } else { hue.0 };
                 series.push(Series { label, color, points: vec![point] });
             }
         }

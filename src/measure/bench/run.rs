@@ -3,7 +3,7 @@
 
 use super::{
     estimate_seconds, mark_pareto, markdown_report, measure_rsm, pixels_per_degree, plot, read_json, records, sweep,
-    to_csv, to_json, BenchCase, BenchFile, BenchRecord, LimitInfo, Measurement, ReferenceInfo,
+    to_csv, to_json, BenchCase, BenchFile, BenchRecord, BenchRow, LimitInfo, Measurement, ReferenceInfo, Resolution,
 };
 use crate::measure::reference::{trace_cached, ProgressBar, ReferenceImage, ReferenceSettings};
 use crate::render::error::{Error, Result};
@@ -98,7 +98,7 @@ pub fn cases(options: &BenchOptions, radii: &[f32]) -> Vec<BenchCase> {
 }
 
 /// Sweeps `options` over `scene`; `base` gives everything the cases do not vary (the
-/// per-eye size, denoise, bounce form, GTAO parameters). Prints progress to stderr.
+/// per-eye size, denoise, bounce form, GTAO parameters). Logs its progress (info).
 pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Result<BenchRun> {
     let radii = if options.radii.is_empty() {
         let r = scene.suggested_ao_radius();
@@ -107,23 +107,9 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
         options.radii.clone()
     };
     let cases = cases(options, &radii);
-    for case in &cases {
-        let mut s = base.clone();
-        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res, s.ao.depth_peeling) =
-            (case.technique, case.samples, case.radius, case.half_res, case.depth_peeling);
-        s.validate()?;
-        if case.technique == Technique::None {
-            return Err(Error::input("--techniques: none has no occlusion to measure"));
-        }
-    }
-    if !options.rsm_samples.is_empty() && crate::render::passes::shadow::shadow_casters(scene).is_empty() {
-        return Err(Error::input(format!("--rsm-samples: '{}' has no directional light to bounce", scene.name)));
-    }
-    if let Some(n) = options.rsm_samples.iter().find(|n| !(1..=1024).contains(*n)) {
-        return Err(Error::input(format!("--rsm-samples {n} is not within 1..=1024")));
-    }
+    check_options(scene, base, options, &cases)?;
     let gpu = Arc::new(Gpu::new(options.backend)?);
-    let info = gpu.adapter.get_info();
+    let info = gpu.info.clone();
     let timing = options.timing.resolve(&gpu);
     let (width, height) = (base.profile.width, base.profile.height);
     let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near);
@@ -134,7 +120,7 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
         }
         None => (Vec::new(), None),
     };
-    eprintln!(
+    log::info!(
         "bench: {} cases on '{}' ({}), {width}x{height} per eye, {} frames each, {timing:?} timing",
         cases.len(),
         scene.name,
@@ -148,51 +134,12 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
         whole_frame: options.whole_frame,
         interleave: options.interleave,
     };
-    let (estimate, frame_seconds) = estimate_seconds(&gpu, scene, base, &cases, how)?;
-    eprintln!(
-        "bench: estimated {} ({} cases × ({} + {} frames) at ~{:.0} ms a frame of the first case, plus set-up; other cases may differ)",
-        format_duration(estimate),
-        cases.len(),
-        options.warmup,
-        options.frames,
-        frame_seconds * 1000.0
-    );
+    log_estimate(&gpu, scene, base, &cases, how)?;
     let started = std::time::Instant::now();
     let mut rows = sweep(&gpu, scene, base, &cases, how, &references, |done, total, row| {
-        let elapsed = started.elapsed().as_secs_f64();
-        let eta = elapsed / done as f64 * (total - done) as f64;
-        let mut error = row.error.as_ref().map_or(String::new(), |e| {
-            let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-            format!(
-                "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}) FLIP {}",
-                e.ao_rmse,
-                e.ao_bias,
-                opt(e.ao_rmse_vs_limit),
-                opt(e.limit_rmse),
-                opt(e.flip_mean)
-            )
-        });
-        if let Some(share) = row.stereo.and_then(|s| s.inconsistent) {
-            error += &format!("  stereo ≠ {:.1} %", share * 100.0);
-        }
-        eprintln!(
-            "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
-            format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
-            row.case.samples,
-            row.case.radius,
-            if row.case.half_res { "half" } else { "full" },
-            row.occlusion_ms_per_eye()
-        );
+        log::info!("{}", progress_line(done, total, row, started.elapsed().as_secs_f64()));
     })?;
-    for &samples in &options.rsm_samples {
-        for &radius in &radii {
-            let reference = references.iter().find(|(r, _)| *r == radius).map(|(_, image)| image);
-            let row = measure_rsm(&gpu, scene, base, samples, radius, how, reference)?;
-            let error = row.bounce.map_or(String::new(), |b| format!("  bounce rel RMSE {:.4}", b.rel_rmse));
-            eprintln!("[rsm] N={samples:<3} r={radius:<7} half {:>9.3} ms/eye{error}", row.occlusion_ms_per_eye());
-            rows.push(row);
-        }
-    }
+    rows.extend(rsm_rows(&gpu, scene, base, options, &radii, how, &references)?);
     let file = BenchFile {
         scene: scene.name.clone(),
         adapter: info.name.clone(),
@@ -214,6 +161,96 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
     Ok(BenchRun { file, radii, adapter })
 }
 
+/// Refuses a sweep before any GPU work: every case's settings must be valid and have an
+/// occlusion technique, and reflective-shadow-map rows need a directional light and a
+/// VPL count within 1..=1024.
+fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: &[BenchCase]) -> Result<()> {
+    for case in cases {
+        let mut s = base.clone();
+        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res, s.ao.depth_peeling) =
+            (case.technique, case.samples, case.radius, case.half_res, case.depth_peeling);
+        s.validate()?;
+        if case.technique == Technique::None {
+            return Err(Error::input("the bench's techniques include none, which has no occlusion to measure"));
+        }
+    }
+    if !options.rsm_samples.is_empty() && crate::render::passes::shadow::shadow_casters(scene).is_empty() {
+        return Err(Error::input(format!(
+            "reflective shadow map rows: '{}' has no directional light to bounce",
+            scene.name
+        )));
+    }
+    if let Some(n) = options.rsm_samples.iter().find(|n| !(1..=1024).contains(*n)) {
+        return Err(Error::input(format!("reflective shadow map rows: {n} VPLs is not within 1..=1024")));
+    }
+    Ok(())
+}
+
+/// Logs how long the sweep is likely to take ([`estimate_seconds`]).
+fn log_estimate(gpu: &Arc<Gpu>, scene: &Scene, base: &Settings, cases: &[BenchCase], how: Measurement) -> Result<()> {
+    let (estimate, frame_seconds) = estimate_seconds(gpu, scene, base, cases, how)?;
+    log::info!(
+        "bench: estimated {} ({} cases × ({} + {} frames) at ~{:.0} ms a frame of the first case, plus set-up; other cases may differ)",
+        format_duration(estimate),
+        cases.len(),
+        how.warmup,
+        how.frames,
+        frame_seconds * 1000.0
+    );
+    Ok(())
+}
+
+/// One measured row as a progress line: the case, its cost, its error figures when it
+/// has them, and the time so far and to go (after `elapsed` seconds).
+fn progress_line(done: usize, total: usize, row: &BenchRow, elapsed: f64) -> String {
+    let eta = elapsed / done as f64 * (total - done) as f64;
+    let mut error = row.error.as_ref().map_or(String::new(), |e| {
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+        format!(
+            "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}) FLIP {}",
+            e.ao_rmse,
+            e.ao_bias,
+            opt(e.ao_rmse_vs_limit),
+            opt(e.limit_rmse),
+            opt(e.flip_mean)
+        )
+    });
+    if let Some(share) = row.stereo.and_then(|s| s.inconsistent) {
+        error += &format!("  stereo ≠ {:.1} %", share * 100.0);
+    }
+    format!(
+        "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
+        format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
+        row.case.samples,
+        row.case.radius,
+        Resolution::from_half_res(row.case.half_res).name(),
+        row.occlusion_ms_per_eye()
+    )
+}
+
+/// The reflective-shadow-map rows: every VPL count of `options` at every radius.
+fn rsm_rows(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    base: &Settings,
+    options: &BenchOptions,
+    radii: &[f32],
+    how: Measurement,
+    references: &[(f32, ReferenceImage)],
+) -> Result<Vec<BenchRow>> {
+    let mut rows = Vec::new();
+    for &samples in &options.rsm_samples {
+        for &radius in radii {
+            let reference = references.iter().find(|(r, _)| *r == radius).map(|(_, image)| image);
+            let row = measure_rsm(gpu, scene, base, samples, radius, how, reference)?;
+            let error = row.bounce.map_or(String::new(), |b| format!("  bounce rel RMSE {:.4}", b.rel_rmse));
+            log::info!("[rsm] N={samples:<3} r={radius:<7} half {:>9.3} ms/eye{error}", row.occlusion_ms_per_eye());
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
 /// Traces (or reads from the cache) the reference of every radius, with a progress bar.
 fn trace_references(
     scene: &Scene,
@@ -231,9 +268,10 @@ fn trace_references(
             stride: options.stride,
             near: base.near,
         };
-        eprintln!(
+        log::info!(
             "reference: r = {radius} m, {} rays per pixel, every {} pixels",
-            options.rays_per_pixel, options.stride
+            options.rays_per_pixel,
+            options.stride
         );
         let mut bar = ProgressBar::new("reference");
         let size = (base.profile.width, base.profile.height);
@@ -271,7 +309,7 @@ pub fn replot(path: &Path) -> Result<BenchRun> {
 /// report to print (the Markdown, the reference, the Pareto fronts, what was written).
 pub fn write_outputs(out: &Path, run: &BenchRun, budget_ms: f64) -> Result<String> {
     if !(budget_ms.is_finite() && budget_ms > 0.0) {
-        return Err(Error::input(format!("--budget-ms {budget_ms} must be a positive number of milliseconds")));
+        return Err(Error::input(format!("the plots' frame budget {budget_ms} ms must be a positive number")));
     }
     let file = &run.file;
     std::fs::create_dir_all(out).map_err(|e| Error::Output {

@@ -2,6 +2,7 @@
 
 use super::errors::near_depth_edge;
 use super::*;
+use crate::render::passes::{blur, gbuffer};
 
 fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
     let span = |label: &str, median_ms| SpanSummary {
@@ -15,10 +16,10 @@ fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
     };
     BenchRow {
         case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false, depth_peeling: false, temporal: false },
-        spans: vec![span(technique.name(), ms), span("blur", 2.0), span("gbuffer", 50.0)],
+        spans: vec![span(technique.name(), ms), span(blur::NAME, 2.0), span(gbuffer::NAME, 50.0)],
         views: 2,
         pass: technique.name(),
-        occlusion_passes: vec![technique.name(), "blur"],
+        occlusion_passes: vec![technique.name(), blur::NAME],
         error: Some(ErrorFigures {
             ao_rmse,
             ao_bias: -0.05,
@@ -124,6 +125,18 @@ fn csv_markdown_and_json_hold_every_row() {
     let json = to_json(&file(recs.clone()));
     let back: BenchFile = serde_json::from_str(&json).unwrap();
     assert_eq!(back.records, recs);
+    // The resolution keeps its name in files written before it was an enum.
+    assert!(json.contains("\"resolution\": \"full\""), "{json}");
+}
+
+#[test]
+fn a_pass_that_ran_without_a_span_is_an_error_not_zero_ms() {
+    let spans = row(Technique::Ssao, 10.0, 0.1).spans;
+    assert!(check_timed(&[Technique::Ssao.name(), blur::NAME, gbuffer::NAME], &spans).is_ok());
+    let error = check_timed(&[Technique::Ssao.name(), crate::render::passes::upsample::NAME], &spans).unwrap_err();
+    assert!(error.to_string().contains("'upsample'"), "{error}");
+    // A pass that did not run reads 0 ms.
+    assert_eq!(row(Technique::Ssao, 10.0, 0.1).median_ms(crate::render::passes::upsample::NAME), 0.0);
 }
 
 #[test]

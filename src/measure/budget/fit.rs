@@ -1,8 +1,8 @@
 //! `vrao budget` as one call: open the device, optionally pick the setting from a bench
 //! file (the least AO error that fits the budget), and measure it.
 
-use super::{run, BudgetReport, BudgetRun};
-use crate::measure::bench::BenchFile;
+use super::{run, BudgetReport, BudgetRun, Scope};
+use crate::measure::bench::{BenchFile, BenchRecord};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::{BackendChoice, Gpu};
 use crate::render::passes::tonemap::COLOR;
@@ -56,7 +56,7 @@ pub struct BudgetOutcome {
 pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOptions) -> Result<BudgetOutcome> {
     let budget_ms = options.budget_ms.unwrap_or(settings.profile.budget_ms());
     if !(budget_ms.is_finite() && budget_ms > 0.0) {
-        return Err(Error::input(format!("--budget-ms {budget_ms} must be a positive number of milliseconds")));
+        return Err(Error::input(format!("the frame budget {budget_ms} ms must be a positive number")));
     }
     settings.validate()?;
     let fit_file = match &options.fit {
@@ -69,7 +69,7 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
     let measure = |settings: &Settings, frames: u32| -> Result<BudgetReport> {
         let output = if options.occlusion_only {
             if settings.ao.technique == crate::render::settings::Technique::None {
-                return Err(Error::input("--measure occlusion needs an occlusion technique"));
+                return Err(Error::input("measuring the occlusion alone needs an occlusion technique, not none"));
             }
             crate::render::graph::FINAL_AO
         } else {
@@ -103,7 +103,7 @@ pub fn fit_setting(
     occlusion_only: bool,
     measure: impl Fn(&Settings, u32) -> Result<BudgetReport>,
 ) -> Result<Fit> {
-    let adapter = gpu.adapter.get_info().name;
+    let adapter = gpu.info.name.clone();
     if file.adapter != adapter {
         return Err(Error::in_file(
             path,
@@ -128,23 +128,45 @@ pub fn fit_setting(
         let mut base = settings.clone();
         base.ao.technique = Technique::None;
         let report = measure(&base, 5)?;
-        report.verdicts.iter().filter(|v| v.what != "stereo frame").map(|v| v.ms).fold(0.0, f64::max)
+        report.verdicts.iter().filter(|v| v.what != Scope::StereoFrame).map(|v| v.ms).fold(0.0, f64::max)
     };
     let left_per_eye = budget_ms / 2.0 - base_ms;
+    let chosen = choose_row(file, path, settings.ao.radius, left_per_eye, base_ms, &mut notes)?;
+    let mut ao = settings.ao.clone();
+    ao.technique = chosen.technique.parse().map_err(|e: Error| Error::in_file(path, e.to_string()))?;
+    ao.samples = chosen.samples;
+    ao.radius = chosen.radius_m;
+    ao.half_res = chosen.resolution.is_half();
+    ao.depth_peeling = chosen.depth_peeling;
+    Ok(Fit { ao, warnings, notes })
+}
+
+/// The bench row with the least AO error among those at the bench radius nearest to
+/// `radius_asked` whose occlusion fits `left_per_eye` ms per eye (what the budget leaves
+/// after `base_ms` of the other passes), or the cheapest when none fits; `notes` say
+/// which and why.
+fn choose_row<'a>(
+    file: &'a BenchFile,
+    path: &Path,
+    radius_asked: f32,
+    left_per_eye: f64,
+    base_ms: f64,
+    notes: &mut Vec<String>,
+) -> Result<&'a BenchRecord> {
     // Errors compare only within one radius (each radius is its own target quantity):
     // take the rows of the radius asked for, or of the bench radius nearest to it.
     let measured: Vec<_> = file.records.iter().filter(|r| r.ao_rmse.is_some_and(f64::is_finite)).collect();
     let Some(radius) = measured
         .iter()
         .map(|r| r.radius_m)
-        .min_by(|a, b| (a - settings.ao.radius).abs().total_cmp(&(b - settings.ao.radius).abs()))
+        .min_by(|a, b| (a - radius_asked).abs().total_cmp(&(b - radius_asked).abs()))
     else {
         return Err(Error::in_file(path, "has no rows with an error against the reference"));
     };
-    if radius != settings.ao.radius {
+    if radius != radius_asked {
         notes.push(format!(
             "fit: the bench has no rows at r = {} m; using its nearest radius, {radius} m",
-            settings.ao.radius
+            radius_asked
         ));
     }
     let with_error: Vec<_> = measured.into_iter().filter(|r| r.radius_m == radius).collect();
@@ -173,11 +195,5 @@ pub fn fit_setting(
             cheapest
         }
     };
-    let mut ao = settings.ao.clone();
-    ao.technique = chosen.technique.parse().map_err(|e: String| Error::in_file(path, e))?;
-    ao.samples = chosen.samples;
-    ao.radius = chosen.radius_m;
-    ao.half_res = chosen.resolution == "half";
-    ao.depth_peeling = chosen.depth_peeling;
-    Ok(Fit { ao, warnings, notes })
+    Ok(chosen)
 }

@@ -168,14 +168,14 @@ pub fn trace_cached(
     let key = cache_key(scene, eyes, size, settings);
     let path = cache_file(cache_dir, key);
     if path.exists() {
-        match std::fs::read(&path).map_err(|e| e.to_string()).and_then(|bytes| decode(&bytes, key)) {
+        match read_cache(&path, key) {
             Ok(image) if image.layers.len() == eyes.len() && (image.width, image.height) == size => {
                 let total: usize = image.layers.iter().map(Vec::len).sum();
                 progress(Progress { done: total, total, rays: 0, elapsed: std::time::Duration::ZERO });
                 return Ok(image);
             }
             Ok(_) => log::warn!("{}: reference cache file does not match its key; tracing again", path.display()),
-            Err(message) => log::warn!("{}: unusable reference cache file ({message}); tracing again", path.display()),
+            Err(why) => log::warn!("{}: unusable reference cache file ({why}); tracing again", path.display()),
         }
     }
     let image = trace(scene, eyes, size, settings, progress)?;
@@ -199,9 +199,26 @@ pub fn write_cache(path: &Path, key: u64, image: &ReferenceImage) -> Result<()> 
     })
 }
 
-/// Reads the image stored under `key` at `path`; the message says why it is unusable.
-pub fn read_cache(path: &Path, key: u64) -> std::result::Result<ReferenceImage, String> {
-    decode(&std::fs::read(path).map_err(|e| e.to_string())?, key)
+/// Reads the image stored under `key` at `path`; the error says why it is unusable.
+pub fn read_cache(path: &Path, key: u64) -> std::result::Result<ReferenceImage, UnusableCache> {
+    decode(&std::fs::read(path).map_err(|e| UnusableCache(e.to_string()))?, key)
+}
+
+/// Why a reference cache file cannot be used (whoever wanted it traces again).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct UnusableCache(pub String);
+
+impl From<&str> for UnusableCache {
+    fn from(why: &str) -> UnusableCache {
+        UnusableCache(why.to_string())
+    }
+}
+
+impl From<String> for UnusableCache {
+    fn from(why: String) -> UnusableCache {
+        UnusableCache(why)
+    }
 }
 
 fn encode(key: u64, image: &ReferenceImage) -> Vec<u8> {
@@ -239,7 +256,7 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
-    fn take<const N: usize>(&mut self) -> std::result::Result<[u8; N], String> {
+    fn take<const N: usize>(&mut self) -> std::result::Result<[u8; N], UnusableCache> {
         if self.bytes.len() < N {
             return Err("truncated".into());
         }
@@ -247,26 +264,26 @@ impl Reader<'_> {
         self.bytes = rest;
         Ok(head.try_into().expect("split at N"))
     }
-    fn u32(&mut self) -> std::result::Result<u32, String> {
+    fn u32(&mut self) -> std::result::Result<u32, UnusableCache> {
         self.take().map(u32::from_le_bytes)
     }
-    fn u64(&mut self) -> std::result::Result<u64, String> {
+    fn u64(&mut self) -> std::result::Result<u64, UnusableCache> {
         self.take().map(u64::from_le_bytes)
     }
-    fn f32(&mut self) -> std::result::Result<f32, String> {
+    fn f32(&mut self) -> std::result::Result<f32, UnusableCache> {
         self.take().map(f32::from_le_bytes)
     }
-    fn f64(&mut self) -> std::result::Result<f64, String> {
+    fn f64(&mut self) -> std::result::Result<f64, UnusableCache> {
         self.take().map(f64::from_le_bytes)
     }
-    fn f32x3(&mut self) -> std::result::Result<[f32; 3], String> {
+    fn f32x3(&mut self) -> std::result::Result<[f32; 3], UnusableCache> {
         Ok([self.f32()?, self.f32()?, self.f32()?])
     }
 }
 
-fn decode(bytes: &[u8], key: u64) -> std::result::Result<ReferenceImage, String> {
+fn decode(bytes: &[u8], key: u64) -> std::result::Result<ReferenceImage, UnusableCache> {
     if bytes.len() < HEADER_BYTES + 8 {
-        return Err(format!("truncated ({} bytes)", bytes.len()));
+        return Err(format!("truncated ({} bytes)", bytes.len()).into());
     }
     let (body, checksum) = bytes.split_at(bytes.len() - 8);
     let mut h = Fnv64::default();
@@ -280,19 +297,19 @@ fn decode(bytes: &[u8], key: u64) -> std::result::Result<ReferenceImage, String>
     }
     let version = r.u32()?;
     if version != FORMAT_VERSION {
-        return Err(format!("format version {version}, expected {FORMAT_VERSION}"));
+        return Err(format!("format version {version}, expected {FORMAT_VERSION}").into());
     }
     if r.u64()? != key {
         return Err("written for other inputs".into());
     }
     let (width, height, stride, layer_count, gw, gh) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?, r.u32()?, r.u32()?);
     if width == 0 || height == 0 || stride == 0 || grid_size((width, height), stride) != (gw, gh) {
-        return Err(format!("inconsistent size {width}×{height} / {stride} with grid {gw}×{gh}"));
+        return Err(format!("inconsistent size {width}×{height} / {stride} with grid {gw}×{gh}").into());
     }
     let cells = gw as u64 * gh as u64;
     let expected = HEADER_BYTES as u64 + layer_count as u64 * cells * PIXEL_BYTES as u64;
     if body.len() as u64 != expected {
-        return Err(format!("{} bytes where {expected} were expected", body.len()));
+        return Err(format!("{} bytes where {expected} were expected", body.len()).into());
     }
     let rays = r.u64()?;
     let (seconds, build_seconds, rays_per_second, noise) = (r.f64()?, r.f64()?, r.f64()?, r.f64()?);
@@ -304,7 +321,7 @@ fn decode(bytes: &[u8], key: u64) -> std::result::Result<ReferenceImage, String>
             let hit = match r.take::<1>()?[0] {
                 0 => false,
                 1 => true,
-                other => return Err(format!("bad hit flag {other}")),
+                other => return Err(format!("bad hit flag {other}").into()),
             };
             layer.push(ReferencePixel {
                 hit,
@@ -389,12 +406,12 @@ mod tests {
         // -0.0 and 0.0 compare equal; the bits must survive too.
         assert_eq!(back.layers[0][0].bounce[2].to_bits(), (-0.0f32).to_bits());
 
-        assert!(decode(&bytes, 43).unwrap_err().contains("other inputs"));
+        assert!(decode(&bytes, 43).unwrap_err().0.contains("other inputs"));
         for cut in [0, 7, HEADER_BYTES, bytes.len() - 1] {
             assert!(decode(&bytes[..cut], 42).is_err(), "cut at {cut}");
         }
         let mut flipped = bytes.clone();
         flipped[HEADER_BYTES + 3] ^= 1;
-        assert!(decode(&flipped, 42).unwrap_err().contains("checksum"));
+        assert!(decode(&flipped, 42).unwrap_err().0.contains("checksum"));
     }
 }

@@ -240,19 +240,7 @@ pub fn trace(
     settings: &ReferenceSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ReferenceImage> {
-    settings.validate()?;
-    if size.0 == 0 || size.1 == 0 {
-        return Err(Error::input(format!("reference image size {}×{} is empty", size.0, size.1)));
-    }
-    if eyes.is_empty() {
-        return Err(Error::input("reference needs at least one eye"));
-    }
-    for eye in eyes {
-        eye.fov.validate().map_err(Error::input)?;
-        if !eye.pose.position.is_finite() || !eye.pose.orientation.is_finite() {
-            return Err(Error::input(format!("eye pose {:?} is not finite", eye.pose)));
-        }
-    }
+    check_trace(eyes, size, settings)?;
     let start = Instant::now();
     let anchor = eyes.iter().map(|e| e.pose.position).sum::<DVec3>() / eyes.len() as f64;
     let geometry = SceneGeometry::build(scene, anchor)?;
@@ -264,73 +252,72 @@ pub fn trace(
         radius: settings.radius,
         rays_per_pixel: settings.rays_per_pixel,
     };
-    let (gw, gh) = grid_size(size, settings.stride);
+    let tracer =
+        RowTracer { eyes, anchor, size, settings, estimator: &estimator, grid: grid_size(size, settings.stride) };
+    let (gw, gh) = tracer.grid;
     let rows_total = eyes.len() * gh as usize;
-    let pixels_total = rows_total * gw as usize;
     let rows_done = AtomicUsize::new(0);
     let rays = AtomicU64::new(0);
-
-    let trace_row = |row: usize| -> Vec<ReferencePixel> {
-        let (layer, j) = (row / gh as usize, (row % gh as usize) as u32);
-        let eye = eyes[layer].pose.sanitized();
-        let eye = Eye { pose: eye, ..eyes[layer] };
-        let origin = (eye.pose.position - anchor).as_vec3();
-        let forward = eye.pose.orientation * DVec3::NEG_Z;
-        let mut points = Vec::with_capacity(settings.rays_per_pixel as usize);
-        let mut row_rays = 0u64;
-        let pixels = (0..gw)
-            .map(|i| {
-                let (x, y) = pixel_of(size, settings.stride, i, j);
-                let dir = crate::render::stereo::pixel_ray(&eye, size, (x as f64 + 0.5, y as f64 + 0.5));
-                let along = dir.dot(forward);
-                let dir32 = dir.as_vec3();
-                row_rays += 1;
-                let tmin = (settings.near / along) as f32;
-                let Some(hit) = geometry.closest(origin, dir32, tmin, f32::INFINITY, u32::MAX) else {
-                    return ReferencePixel::SKY;
-                };
-                let surface = geometry.surface(&hit);
-                let mut rng = Rng::new(pixel_seed(layer as u32, x, y));
-                let e = estimator.estimate(&surface, dir32, &mut rng, &mut points);
-                row_rays += e.rays;
-                let rgb = |c: [f64; 3]| c.map(|v| if v.is_finite() { v as f32 } else { 0.0 });
-                ReferencePixel {
-                    hit: true,
-                    depth: (hit.t as f64 * along) as f32,
-                    ao: e.ao as f32,
-                    ao_falloff: e.ao_falloff as f32,
-                    ao_std_error: e.ao_std_error as f32,
-                    environment_visible: rgb(e.environment_visible),
-                    bounce: rgb(e.bounce),
-                    unoccluded: rgb(e.unoccluded),
-                }
-            })
-            .collect();
+    let trace_row = |row: usize| {
+        let (pixels, row_rays) = tracer.row(row);
         rays.fetch_add(row_rays, Ordering::Relaxed);
         rows_done.fetch_add(1, Ordering::Relaxed);
         pixels
     };
-
-    let report = |progress: &mut dyn FnMut(Progress)| {
-        progress(Progress {
-            done: rows_done.load(Ordering::Relaxed) * gw as usize,
-            total: pixels_total,
-            rays: rays.load(Ordering::Relaxed),
-            elapsed: start.elapsed(),
-        })
+    let report = || Progress {
+        done: rows_done.load(Ordering::Relaxed) * gw as usize,
+        total: rows_total * gw as usize,
+        rays: rays.load(Ordering::Relaxed),
+        elapsed: start.elapsed(),
     };
-    // rayon's threads trace while this thread reports progress until the rows arrive.
-    let rows: Vec<Vec<ReferencePixel>> = std::thread::scope(|s| {
+    let rows = in_parallel_reporting(rows_total, trace_row, || progress(report()));
+    progress(report());
+
+    let mut layers: Vec<Vec<ReferencePixel>> = vec![Vec::with_capacity((gw * gh) as usize); eyes.len()];
+    for (row, pixels) in rows.into_iter().enumerate() {
+        layers[row / gh as usize].extend(pixels);
+    }
+    let stats = ReferenceStats::of(&layers, rays.into_inner(), start.elapsed().as_secs_f64(), build_seconds);
+    Ok(ReferenceImage { width: size.0, height: size.1, stride: settings.stride, layers, stats })
+}
+
+/// Refuses what cannot be traced: bad settings, an empty image, no eye, an eye with an
+/// invalid field of view or a pose that is not finite.
+fn check_trace(eyes: &[Eye], size: (u32, u32), settings: &ReferenceSettings) -> Result<()> {
+    settings.validate()?;
+    if size.0 == 0 || size.1 == 0 {
+        return Err(Error::input(format!("reference image size {}×{} is empty", size.0, size.1)));
+    }
+    if eyes.is_empty() {
+        return Err(Error::input("reference needs at least one eye"));
+    }
+    for eye in eyes {
+        eye.fov.validate()?;
+        if !eye.pose.position.is_finite() || !eye.pose.orientation.is_finite() {
+            return Err(Error::input(format!("eye pose {:?} is not finite", eye.pose)));
+        }
+    }
+    Ok(())
+}
+
+/// `work(0..count)` on rayon's threads, in order, while this thread calls `report` a few
+/// times a second until the results arrive. A panic in `work` is raised here.
+fn in_parallel_reporting<T: Send>(
+    count: usize,
+    work: impl Fn(usize) -> T + Sync + Send,
+    mut report: impl FnMut(),
+) -> Vec<T> {
+    std::thread::scope(|s| {
         let (sender, receiver) = std::sync::mpsc::channel();
         let worker = s.spawn(move || {
-            let rows = (0..rows_total).into_par_iter().map(trace_row).collect::<Vec<_>>();
+            let results = (0..count).into_par_iter().map(work).collect::<Vec<_>>();
             // The receiver outlives this thread (it joins it below).
-            let _ = sender.send(rows);
+            let _ = sender.send(results);
         });
         loop {
-            report(progress);
+            report();
             match receiver.recv_timeout(Duration::from_millis(100)) {
-                Ok(rows) => break rows,
+                Ok(results) => break results,
                 Err(std::sync::mpsc::RecvTimeoutError::Timeout) => continue,
                 // The worker panicked before sending: re-raise its panic here.
                 Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => match worker.join() {
@@ -339,30 +326,97 @@ pub fn trace(
                 },
             }
         }
-    });
-    report(progress);
+    })
+}
 
-    let mut layers: Vec<Vec<ReferencePixel>> = vec![Vec::with_capacity((gw * gh) as usize); eyes.len()];
-    for (row, pixels) in rows.into_iter().enumerate() {
-        layers[row / gh as usize].extend(pixels);
+/// Traces rows of the reference grid: row `r` is grid row `r % gh` of eye `r / gh`.
+struct RowTracer<'a> {
+    eyes: &'a [Eye],
+    /// The f64 origin the geometry is stored relative to.
+    anchor: DVec3,
+    size: (u32, u32),
+    settings: &'a ReferenceSettings,
+    estimator: &'a Estimator<'a>,
+    /// Grid cells across and down.
+    grid: (u32, u32),
+}
+
+impl RowTracer<'_> {
+    /// The pixels of one row and the rays traced for them.
+    fn row(&self, row: usize) -> (Vec<ReferencePixel>, u64) {
+        let (gw, gh) = self.grid;
+        let (layer, j) = (row / gh as usize, (row % gh as usize) as u32);
+        let eye = Eye { pose: self.eyes[layer].pose.sanitized(), ..self.eyes[layer] };
+        let mut points = Vec::with_capacity(self.settings.rays_per_pixel as usize);
+        let mut rays = 0u64;
+        let pixels = (0..gw)
+            .map(|i| {
+                let (pixel, pixel_rays) =
+                    self.pixel(&eye, layer, pixel_of(self.size, self.settings.stride, i, j), &mut points);
+                rays += pixel_rays;
+                pixel
+            })
+            .collect();
+        (pixels, rays)
     }
-    let (mut hit_pixels, mut variance) = (0u64, 0f64);
-    for p in layers.iter().flatten().filter(|p| p.hit) {
-        hit_pixels += 1;
-        variance += (p.ao_std_error as f64).powi(2);
+
+    /// The reference at pixel (x, y) of `eye` (layer `layer`) and the rays it took;
+    /// `points` is scratch space for the estimator.
+    fn pixel(
+        &self,
+        eye: &Eye,
+        layer: usize,
+        (x, y): (u32, u32),
+        points: &mut Vec<(f64, f64)>,
+    ) -> (ReferencePixel, u64) {
+        let geometry = self.estimator.geometry;
+        let origin = (eye.pose.position - self.anchor).as_vec3();
+        let forward = eye.pose.orientation * DVec3::NEG_Z;
+        let dir = crate::render::stereo::pixel_ray(eye, self.size, (x as f64 + 0.5, y as f64 + 0.5));
+        let along = dir.dot(forward);
+        let dir32 = dir.as_vec3();
+        let tmin = (self.settings.near / along) as f32;
+        let Some(hit) = geometry.closest(origin, dir32, tmin, f32::INFINITY, u32::MAX) else {
+            return (ReferencePixel::SKY, 1);
+        };
+        let surface = geometry.surface(&hit);
+        let mut rng = Rng::new(pixel_seed(layer as u32, x, y));
+        let e = self.estimator.estimate(&surface, dir32, &mut rng, points);
+        let rgb = |c: [f64; 3]| c.map(|v| if v.is_finite() { v as f32 } else { 0.0 });
+        let pixel = ReferencePixel {
+            hit: true,
+            depth: (hit.t as f64 * along) as f32,
+            ao: e.ao as f32,
+            ao_falloff: e.ao_falloff as f32,
+            ao_std_error: e.ao_std_error as f32,
+            environment_visible: rgb(e.environment_visible),
+            bounce: rgb(e.bounce),
+            unoccluded: rgb(e.unoccluded),
+        };
+        // The primary ray and the estimator's.
+        (pixel, 1 + e.rays)
     }
-    let seconds = start.elapsed().as_secs_f64();
-    let rays = rays.into_inner();
-    let stats = ReferenceStats {
-        rays,
-        seconds,
-        build_seconds,
-        rays_per_second: if seconds > 0.0 { rays as f64 / seconds } else { 0.0 },
-        noise: if hit_pixels > 0 { (variance / hit_pixels as f64).sqrt() } else { 0.0 },
-        hit_pixels,
-        from_cache: false,
-    };
-    Ok(ReferenceImage { width: size.0, height: size.1, stride: settings.stride, layers, stats })
+}
+
+impl ReferenceStats {
+    /// The statistics of a finished trace of `layers`: `rays` traced in `seconds`, of
+    /// which `build_seconds` built the BVH.
+    fn of(layers: &[Vec<ReferencePixel>], rays: u64, seconds: f64, build_seconds: f64) -> ReferenceStats {
+        let (mut hit_pixels, mut variance) = (0u64, 0f64);
+        for p in layers.iter().flatten().filter(|p| p.hit) {
+            hit_pixels += 1;
+            variance += (p.ao_std_error as f64).powi(2);
+        }
+        ReferenceStats {
+            rays,
+            seconds,
+            build_seconds,
+            rays_per_second: if seconds > 0.0 { rays as f64 / seconds } else { 0.0 },
+            noise: if hit_pixels > 0 { (variance / hit_pixels as f64).sqrt() } else { 0.0 },
+            hit_pixels,
+            from_cache: false,
+        }
+    }
 }
 
 /// The world-space point a hit pixel of `image` sees: along the pixel's centre ray to its

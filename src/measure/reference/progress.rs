@@ -1,6 +1,6 @@
 //! The reference tracer's [`Progress`] shown with indicatif: a bar on a terminal
 //! (`reference [#####.....]  42% 1.2 Mrays/s ETA 35s`), nothing otherwise, and one
-//! summary line at the end either way (logs keep how fast the trace ran).
+//! summary line in the log (info) at the end either way (logs keep how fast the trace ran).
 
 use super::Progress;
 use std::io::IsTerminal;
@@ -46,13 +46,13 @@ impl ProgressBar {
         self.bar.set_position(p.done as u64);
     }
 
-    /// Clears the bar and prints one summary line. Does nothing the second time.
+    /// Clears the bar and logs one summary line (info). Does nothing the second time.
     pub fn finish(&mut self) {
         if std::mem::replace(&mut self.finished, true) {
             return;
         }
         self.bar.finish_and_clear();
-        eprintln!("{}", self.summary());
+        log::info!("{}", self.summary());
     }
 
     /// "reference: 12.3 Mrays in 0:04 (3.1 Mrays/s)".

@@ -174,7 +174,7 @@ pub fn screen_space_limit(eyes: &[EyeBuffers], size: (u32, u32), settings: &Limi
                 size.1
             )));
         }
-        eye.fov.validate().map_err(Error::input)?;
+        eye.fov.validate()?;
     }
     let (gw, gh) = grid_size(size, settings.stride);
     let rows: Vec<Vec<LimitPixel>> = (0..eyes.len() * gh as usize)

@@ -483,27 +483,3 @@ fn extreme_radii_stay_finite_and_in_range() {
         }
     }
 }
-
-/// Measures throughput on Sibenik (run with `--ignored --nocapture`).
-#[test]
-#[ignore]
-fn sibenik_throughput() {
-    let Some(dir) = crate::render::scene::shared_scenes_dir() else { return };
-    let _ = dir;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/sibenik.toml");
-    let started = Instant::now();
-    let scene = Scene::load(path.to_str().unwrap()).unwrap();
-    eprintln!("loaded {} triangles in {:.2} s", scene.triangle_count(), started.elapsed().as_secs_f64());
-    let size = (270, 300);
-    let s = ReferenceSettings {
-        radius: scene.suggested_ao_radius() as f64,
-        rays_per_pixel: 64,
-        stride: 1,
-        near: DEFAULT_NEAR,
-    };
-    let eyes = eyes_for(&scene, size);
-    let mut bar = ProgressBar::new("sibenik");
-    let image = trace(&scene, &eyes, size, &s, &mut |p| bar.update(p)).unwrap();
-    bar.finish();
-    eprintln!("{:?} (r = {})", image.stats, s.radius);
-}

@@ -3,9 +3,11 @@
 //! ([`Bind`]); binding `i` is entry `i`.
 
 use super::Gpu;
+use crate::render::error::{Error, Result};
 use crate::render::graph::Resource;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
@@ -55,26 +57,93 @@ pub const COMMON: Shader = wgsl!("shaders/common.wgsl");
 /// `irradiance.wgsl`: the environment's irradiance and radiance quadratics.
 pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");
 
-/// A shader module made of the given files, concatenated in order (common first), so
-/// passes share `common.wgsl` without string formatting.
-pub fn shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
-    // Shader development: `VRAO_SHADER_DIR=.` (the repository root) reads the files from
-    // disk, so an edited shader runs without rebuilding the binary.
-    let shader_dir = std::env::var_os("VRAO_SHADER_DIR").map(std::path::PathBuf::from);
+/// The environment variable that makes shaders load from disk: `VRAO_SHADER_DIR=.` (the
+/// repository root) runs an edited shader without rebuilding the binary.
+pub const SHADER_DIR_VAR: &str = "VRAO_SHADER_DIR";
+
+/// The text of `files`, concatenated in order (common first) so passes share
+/// `common.wgsl` without string formatting: as compiled in, or read from the directory
+/// [`SHADER_DIR_VAR`] names when it is set. A file that cannot be read there is
+/// `Error::Input` naming it.
+pub fn shader_source(files: &[Shader]) -> Result<String> {
+    let dir = std::env::var_os(SHADER_DIR_VAR).map(PathBuf::from);
+    source_from(dir.as_deref(), files)
+}
+
+/// [`shader_source`] with the shader directory given (`None`: the compiled-in text).
+fn source_from(dir: Option<&Path>, files: &[Shader]) -> Result<String> {
     let mut source = String::new();
     for file in files {
-        match &shader_dir {
-            Some(dir) => match std::fs::read_to_string(dir.join(file.path)) {
-                Ok(text) => source.push_str(&text),
-                Err(error) => {
-                    eprintln!("error: VRAO_SHADER_DIR: cannot read {}: {error}", dir.join(file.path).display());
-                    std::process::exit(2);
-                }
-            },
+        match dir {
+            Some(dir) => {
+                let path = dir.join(file.path);
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|e| Error::in_file(&path, format!("cannot read this shader ({SHADER_DIR_VAR}): {e}")))?;
+                source.push_str(&text);
+            }
             None => source.push_str(file.source),
         }
         source.push('\n');
     }
+    Ok(source)
+}
+
+/// The first error kept until someone takes it.
+struct ErrorSlot(Mutex<Option<Error>>);
+
+impl ErrorSlot {
+    const fn new() -> ErrorSlot {
+        ErrorSlot(Mutex::new(None))
+    }
+
+    /// Keeps `error` unless an earlier one is waiting (then it is only logged, at debug:
+    /// one missing directory fails every shader).
+    fn record(&self, error: Error) {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if slot.is_some() {
+            log::debug!("{error}");
+        } else {
+            log::error!("{error}");
+            *slot = Some(error);
+        }
+    }
+
+    fn take(&self) -> Result<()> {
+        match self.0.lock().unwrap_or_else(|p| p.into_inner()).take() {
+            Some(error) => Err(error),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The first shader that [`shader_module`] could not read since the last
+/// [`take_shader_error`]. Process-wide like the environment variable it comes from.
+static SHADER_ERROR: ErrorSlot = ErrorSlot::new();
+
+/// The first shader file that could not be read from [`SHADER_DIR_VAR`] since the last
+/// call, as the `Error::Input` naming it (then cleared). Whoever makes passes through
+/// the infallible [`shader_module`] or [`Kernel::new`] checks this before using them.
+pub fn take_shader_error() -> Result<()> {
+    SHADER_ERROR.take()
+}
+
+/// A shader module of `files` ([`shader_source`]); an unreadable file is the error.
+pub fn try_shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> Result<wgpu::ShaderModule> {
+    Ok(module_of(device, label, shader_source(files)?))
+}
+
+/// A shader module of `files` ([`shader_source`]) that always succeeds, for the passes'
+/// constructors: a file that cannot be read is recorded for [`take_shader_error`] and
+/// the compiled-in text stands in, so the module is valid until the error is returned.
+pub fn shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
+    let source = shader_source(files).unwrap_or_else(|error| {
+        SHADER_ERROR.record(error);
+        source_from(None, files).expect("the compiled-in text needs no file")
+    });
+    module_of(device, label, source)
+}
+
+fn module_of(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -223,16 +292,33 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding `binds`.
+    /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding
+    /// `binds`. A shader file that cannot be read is recorded for [`take_shader_error`]
+    /// ([`shader_module`]).
     pub fn new(gpu: &Gpu, label: &str, files: &[Shader], entry: &str, binds: &[Bind]) -> Kernel {
         Self::with_constants(gpu, label, files, entry, binds, &[])
     }
 
-    /// A kernel whose WGSL `override` constants take the given values.
+    /// A kernel whose WGSL `override` constants take the given values (a file that
+    /// cannot be read is recorded as by [`Kernel::new`]).
     pub fn with_constants(
         gpu: &Gpu,
         label: &str,
         files: &[Shader],
+        entry: &str,
+        binds: &[Bind],
+        constants: &[(&str, f64)],
+    ) -> Kernel {
+        let module = shader_module(&gpu.device, label, files);
+        Self::from_module(gpu, label, &module, entry, binds, constants)
+    }
+
+    /// A kernel of `entry` in a module made already (say by [`try_shader_module`], which
+    /// returns a shader file it cannot read as the error), its `override` constants set.
+    pub fn from_module(
+        gpu: &Gpu,
+        label: &str,
+        module: &wgpu::ShaderModule,
         entry: &str,
         binds: &[Bind],
         constants: &[(&str, f64)],
@@ -258,11 +344,10 @@ impl Kernel {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, label, files);
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(label),
             layout: Some(&pipeline_layout),
-            module: &module,
+            module,
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,
@@ -364,4 +449,40 @@ fn identity(resources: &[wgpu::BindingResource]) -> Option<u64> {
         }
     }
     Some(hasher.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const COMMON_AND_MISSING: [Shader; 2] = [COMMON, Shader { path: "shaders/no-such-file.wgsl", source: "" }];
+
+    #[test]
+    fn compiled_in_sources_are_concatenated_in_order() {
+        let text = source_from(None, &[COMMON, IRRADIANCE]).unwrap();
+        assert_eq!(text, format!("{}\n{}\n", COMMON.source, IRRADIANCE.source));
+    }
+
+    #[test]
+    fn a_shader_directory_is_read_from_and_a_missing_file_is_an_input_error_naming_it() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+        assert_eq!(source_from(Some(dir), &[COMMON]).unwrap(), format!("{}\n", COMMON.source));
+        let error = source_from(Some(dir), &COMMON_AND_MISSING).unwrap_err();
+        assert_eq!(error.exit_code(), crate::render::error::EXIT_INPUT);
+        match &error {
+            Error::Input { file: Some(file), .. } => assert_eq!(file, &dir.join("shaders/no-such-file.wgsl")),
+            other => panic!("not an input error naming the file: {other:?}"),
+        }
+        assert!(error.to_string().contains("no-such-file.wgsl") && error.to_string().contains(SHADER_DIR_VAR));
+    }
+
+    #[test]
+    fn the_first_recorded_error_is_returned_once() {
+        let slot = ErrorSlot::new();
+        assert!(slot.take().is_ok());
+        slot.record(Error::input("first"));
+        slot.record(Error::input("second"));
+        assert_eq!(slot.take().unwrap_err().to_string(), "first");
+        assert!(slot.take().is_ok());
+    }
 }

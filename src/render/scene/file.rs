@@ -153,9 +153,10 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
 
     let lights = match &file.light {
         None => obj::default_lights(&meshes, &materials),
-        Some(entries) => {
-            entries.iter().map(|e| light(e.get_ref()).map_err(|m| at(e.span(), m))).collect::<Result<_>>()?
-        }
+        Some(entries) => entries
+            .iter()
+            .map(|e| light(e.get_ref()).map_err(|f| f.place(|m| at(e.span(), m))))
+            .collect::<Result<_>>()?,
     };
 
     let environment = match &file.environment {
@@ -177,7 +178,7 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
     };
     scene.head = match &file.head {
         None => HeadPath::fixed(scene.bounds().framing_pose()),
-        Some(entry) => head_path(entry.get_ref()).map_err(|m| at(entry.span(), m))?,
+        Some(entry) => head_path(entry.get_ref()).map_err(|f| f.place(|m| at(entry.span(), m)))?,
     };
     Ok(scene)
 }
@@ -210,14 +211,14 @@ pub const SCENES_PREFIX: &str = "$VRAO_SCENES/";
 
 /// Where the path `value` of a `what` entry points: under `$VRAO_SCENES` for a path with
 /// [`SCENES_PREFIX`], otherwise relative to the scene file's `directory`.
-fn resolve(directory: &Path, what: &str, value: &str) -> std::result::Result<PathBuf, String> {
+fn resolve(directory: &Path, what: &str, value: &str) -> std::result::Result<PathBuf, Failure> {
     let Some(rest) = value.strip_prefix(SCENES_PREFIX) else { return Ok(directory.join(value)) };
     match std::env::var_os("VRAO_SCENES").filter(|v| !v.is_empty()) {
         Some(scenes) => Ok(PathBuf::from(scenes).join(rest)),
-        None => Err(format!(
+        None => Err(Failure::Here(format!(
             "{what} '{value}' is among the public scenes: set VRAO_SCENES to the folder that holds them \
              (cornell_box/, sibenik/, envmaps/)"
-        )),
+        ))),
     }
 }
 
@@ -253,20 +254,20 @@ fn load_mesh_entry(
     Ok((meshes, materials))
 }
 
-fn finite3(what: &str, v: [f64; 3]) -> std::result::Result<DVec3, String> {
+fn finite3(what: &str, v: [f64; 3]) -> std::result::Result<DVec3, Failure> {
     let v = DVec3::from_array(v);
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(format!("{what} {:?} is not finite", v.to_array()))
+        Err(Failure::Here(format!("{what} {:?} is not finite", v.to_array())))
     }
 }
 
-fn non_negative(what: &str, x: f64) -> std::result::Result<f32, String> {
+fn non_negative(what: &str, x: f64) -> std::result::Result<f32, Failure> {
     if x.is_finite() && x >= 0.0 && x <= f32::MAX as f64 {
         Ok(x as f32)
     } else {
-        Err(format!("{what} {x:?} must be finite and ≥ 0"))
+        Err(Failure::Here(format!("{what} {x:?} must be finite and ≥ 0")))
     }
 }
 
@@ -278,7 +279,7 @@ struct Transform {
 
 impl MeshEntry {
     /// The entry's placement, or `None` when it has none (so unplaced meshes stay exact).
-    fn transform(&self) -> std::result::Result<Option<Transform>, String> {
+    fn transform(&self) -> std::result::Result<Option<Transform>, Failure> {
         if self.translate.is_none() && self.rotate_deg.is_none() && self.scale.is_none() {
             return Ok(None);
         }
@@ -291,7 +292,7 @@ impl MeshEntry {
         };
         // Offsets are scaled in f32, so the scale must be representable there too.
         if !scale.as_vec3().is_finite() || scale.abs().min_element() == 0.0 {
-            return Err(format!("scale {:?} must be finite and nonzero", scale.to_array()));
+            return Err(Failure::Here(format!("scale {:?} must be finite and nonzero", scale.to_array())));
         }
         let rotation =
             DMat3::from_euler(EulerRot::XYZEx, degrees.x.to_radians(), degrees.y.to_radians(), degrees.z.to_radians());
@@ -312,11 +313,11 @@ impl Transform {
     }
 }
 
-fn light(entry: &LightEntry) -> std::result::Result<Light, String> {
-    let colour = |c: &Option<[f64; 3]>| -> std::result::Result<glam::Vec3, String> {
+fn light(entry: &LightEntry) -> std::result::Result<Light, Failure> {
+    let colour = |c: &Option<[f64; 3]>| -> std::result::Result<glam::Vec3, Failure> {
         let c = finite3("light color", c.unwrap_or([1.0; 3]))?;
         if c.min_element() < 0.0 {
-            return Err(format!("light color {:?} is negative", c.to_array()));
+            return Err(Failure::Here(format!("light color {:?} is negative", c.to_array())));
         }
         Ok(c.as_vec3())
     };
@@ -358,13 +359,13 @@ fn load_environment(entry: &EnvironmentEntry, directory: &Path) -> std::result::
     }
 }
 
-fn head_pose(eye: [f64; 3], look_at: [f64; 3]) -> std::result::Result<HeadPose, String> {
+fn head_pose(eye: [f64; 3], look_at: [f64; 3]) -> std::result::Result<HeadPose, Failure> {
     let (eye, target) = (finite3("eye", eye)?, finite3("look_at", look_at)?);
     HeadPose::look_at(eye, target)
-        .ok_or_else(|| format!("eye {:?} and look_at {:?} coincide", eye.to_array(), target.to_array()))
+        .ok_or_else(|| Failure::Here(format!("eye {:?} and look_at {:?} coincide", eye.to_array(), target.to_array())))
 }
 
-fn head_path(entry: &HeadEntry) -> std::result::Result<HeadPath, String> {
+fn head_path(entry: &HeadEntry) -> std::result::Result<HeadPath, Failure> {
     match (entry.eye, entry.look_at, &entry.path) {
         (Some(eye), Some(look_at), None) => Ok(HeadPath::fixed(head_pose(eye, look_at)?)),
         (None, None, Some(path)) if !path.is_empty() => {
@@ -372,13 +373,16 @@ fn head_path(entry: &HeadEntry) -> std::result::Result<HeadPath, String> {
             for key in path {
                 let previous = keys.last().map(|k| k.0);
                 if !key.t.is_finite() || previous.is_some_and(|p| key.t <= p) {
-                    return Err(format!("head path time t = {:?} must be finite and later than the key before", key.t));
+                    return Err(Failure::Here(format!(
+                        "head path time t = {:?} must be finite and later than the key before",
+                        key.t
+                    )));
                 }
                 keys.push((key.t, head_pose(key.eye, key.look_at)?));
             }
             Ok(HeadPath { keys })
         }
-        _ => Err("[head] needs eye and look_at, or a non-empty path of { t, eye, look_at } keys".into()),
+        _ => Err(Failure::Here("[head] needs eye and look_at, or a non-empty path of { t, eye, look_at } keys".into())),
     }
 }
 

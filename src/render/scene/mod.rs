@@ -283,15 +283,15 @@ pub fn shared_scenes_dir() -> Option<PathBuf> {
     dir.is_dir().then_some(dir)
 }
 
-/// For tests: the shared scene file `relative`, or `None` after printing why the test is
-/// skipped. Panics when the file is missing and `CI` is set, because CI must run every test.
+/// For tests: the shared scene file `relative`, or `None` after a warning (log) that the
+/// test is skipped. Panics when the file is missing and `CI` is set, because CI must run every test.
 #[doc(hidden)]
 pub fn shared_scene_for_test(relative: &str) -> Option<PathBuf> {
     let path = shared_scenes_dir().map(|dir| dir.join(relative)).filter(|p| p.is_file());
     if path.is_none() {
         let message = format!("shared scene file {relative} not found (set VRAO_SCENES)");
         assert!(std::env::var_os("CI").is_none(), "{message}");
-        eprintln!("skipped: {message}");
+        log::warn!("skipped: {message}");
     }
     path
 }

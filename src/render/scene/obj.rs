@@ -256,7 +256,7 @@ fn scan_obj(path: &Path, text: &str) -> Result<ObjScan> {
                     return Err(Error::at_line(path, line, message));
                 }
                 for word in &words {
-                    check_face_vertex(word, &defined).map_err(|message| Error::at_line(path, line, message))?;
+                    check_face_vertex(word, &defined).map_err(|problem| Error::at_line(path, line, problem.0))?;
                 }
                 out.push_str(&format!("f {rest}\n"));
             }
@@ -285,11 +285,11 @@ fn scan_obj(path: &Path, text: &str) -> Result<ObjScan> {
 
 /// Checks one face vertex `v`, `v/vt`, `v//vn` or `v/vt/vn`: every index must be an
 /// integer naming an element defined above (positive from the start of the file, 1-based;
-/// negative counting back from the latest).
-fn check_face_vertex(word: &str, defined: &Defined) -> std::result::Result<(), String> {
+/// negative counting back from the latest). The problem is placed at its line by the caller.
+fn check_face_vertex(word: &str, defined: &Defined) -> std::result::Result<(), BadFaceVertex> {
     let parts: Vec<&str> = word.split('/').collect();
     if parts.len() > 3 || parts[0].is_empty() {
-        return Err(format!("face vertex '{word}' is not of the form v, v/vt, v//vn or v/vt/vn"));
+        return Err(BadFaceVertex(format!("face vertex '{word}' is not of the form v, v/vt, v//vn or v/vt/vn")));
     }
     let kinds = [
         ("face index", "vertices", defined.vertices),
@@ -300,17 +300,21 @@ fn check_face_vertex(word: &str, defined: &Defined) -> std::result::Result<(), S
         if part.is_empty() {
             continue;
         }
-        let index: i64 =
-            part.parse().map_err(|_| format!("{what} '{part}' in face vertex '{word}' is not an integer"))?;
+        let index: i64 = part
+            .parse()
+            .map_err(|_| BadFaceVertex(format!("{what} '{part}' in face vertex '{word}' is not an integer")))?;
         if index == 0 {
-            return Err(format!("{what} 0 is invalid (OBJ indices start at 1)"));
+            return Err(BadFaceVertex(format!("{what} 0 is invalid (OBJ indices start at 1)")));
         }
         if index.unsigned_abs() > count as u64 {
-            return Err(format!("{what} {index} is out of range ({count} {plural} defined so far)"));
+            return Err(BadFaceVertex(format!("{what} {index} is out of range ({count} {plural} defined so far)")));
         }
     }
     Ok(())
 }
+
+/// What is wrong with one face vertex, for the caller to place at its line.
+struct BadFaceVertex(String);
 
 /// One `newmtl` block, as far as rendering uses it.
 #[derive(Clone, Debug)]
@@ -414,11 +418,9 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
 
 /// Decodes an image file into RGBA8 (PNG, JPEG, TGA or BMP, by content).
 fn load_texture(path: &Path) -> Result<Texture> {
-    let decode = || -> std::result::Result<image::DynamicImage, String> {
-        let reader = image::ImageReader::open(path).map_err(|e| e.to_string())?;
-        reader.with_guessed_format().map_err(|e| e.to_string())?.decode().map_err(|e| e.to_string())
-    };
-    let image = decode().map_err(|e| Error::in_file(path, format!("cannot decode texture: {e}")))?.into_rgba8();
+    let cannot = |e: &dyn std::fmt::Display| Error::in_file(path, format!("cannot decode texture: {e}"));
+    let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
+    let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?.into_rgba8();
     Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw() })
 }
 

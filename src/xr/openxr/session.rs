@@ -20,7 +20,8 @@
 use super::state::{Action, Event, FrameBudget, SessionMachine, Turn};
 use super::swapchain::{EyeSwapchains, FillError, SubImage};
 use super::{
-    application_info, load_entry, vulkan, InstanceSlot, OpenXrOptions, OpenXrReport, SessionPhase, Unavailable,
+    application_info, load_entry, vulkan, InstanceSlot, OpenXrOptions, OpenXrReport, RuntimeFailure, SessionPhase,
+    Unavailable,
 };
 use crate::render::error::{Error, Result};
 use crate::render::gpu::Gpu;
@@ -166,11 +167,10 @@ impl OpenXrHeadset {
         }
     }
 
+    /// A session event: at the info level when the options ask for reports, debug otherwise.
     fn note(&self, what: &str) {
-        log::info!("OpenXR: {what}");
-        if self.options.report {
-            eprintln!("openxr: {what}");
-        }
+        let level = if self.options.report { log::Level::Info } else { log::Level::Debug };
+        log::log!(level, "OpenXR: {what}");
     }
 
     /// Feeds the state machine and makes the runtime calls it answers. A failing call
@@ -179,19 +179,20 @@ impl OpenXrHeadset {
         let at = self.opened.elapsed();
         for action in self.machine.feed(event, at) {
             if let Err(why) = self.execute(action) {
-                self.machine.feed(Event::Failed(why), at);
+                self.machine.feed(Event::Failed(why.0), at);
                 return;
             }
         }
     }
 
-    fn execute(&mut self, action: Action) -> std::result::Result<(), String> {
+    fn execute(&mut self, action: Action) -> std::result::Result<(), RuntimeFailure> {
         let Some(xr) = self.xr.as_ref() else { return Ok(()) };
-        match action {
-            Action::BeginSession => xr.session.begin(VIEW_TYPE).map(drop).map_err(|e| format!("xrBeginSession: {e}")),
-            Action::EndSession => xr.session.end().map(drop).map_err(|e| format!("xrEndSession: {e}")),
-            Action::RequestExit => xr.session.request_exit().map_err(|e| format!("xrRequestExitSession: {e}")),
-        }
+        let (call, result) = match action {
+            Action::BeginSession => ("xrBeginSession", xr.session.begin(VIEW_TYPE).map(drop)),
+            Action::EndSession => ("xrEndSession", xr.session.end().map(drop)),
+            Action::RequestExit => ("xrRequestExitSession", xr.session.request_exit()),
+        };
+        result.map_err(|e| RuntimeFailure(format!("{call}: {e}")))
     }
 
     /// Once the machine has its verdict: tears the session down and, after a loss,
@@ -284,9 +285,6 @@ impl OpenXrHeadset {
         let (views, warning) = self.tracking.merge(flags, &views);
         if let Some(warning) = warning {
             log::warn!("OpenXR: {warning}");
-            if self.options.report {
-                eprintln!("openxr: {warning}");
-            }
         }
         if let Some(now) = sampled_at {
             let ms = (state.predicted_display_time.as_nanos() - now.as_nanos()) as f64 / 1e6;
@@ -326,7 +324,7 @@ impl OpenXrHeadset {
     }
 
     /// Ends the session's frame with the projection layer for `frame`.
-    fn present(&mut self, pending: &Pending, frame: &SubmittedFrame) -> std::result::Result<(), String> {
+    fn present(&mut self, pending: &Pending, frame: &SubmittedFrame) -> std::result::Result<(), RuntimeFailure> {
         let near = frame.near;
         let Some(xr) = self.xr.as_mut() else { return Ok(()) };
         let sub_images = match xr.swapchains.fill(&self.gpu, frame.color, frame.depth) {
@@ -334,9 +332,9 @@ impl OpenXrHeadset {
             Err(FillError::Gpu(e)) => {
                 // A GPU error in vrao's own copy: end the frame empty, report the error.
                 end_frame(xr, pending.display_time, None).map_err(|e| format!("xrEndFrame: {e}"))?;
-                return Err(format!("copying the eyes into the swapchains: {e}"));
+                return Err(RuntimeFailure(format!("copying the eyes into the swapchains: {e}")));
             }
-            Err(e @ FillError::Xr(_)) => return Err(e.to_string()),
+            Err(e @ FillError::Xr(_)) => return Err(RuntimeFailure(e.to_string())),
         };
         let layer = Layer { views: pending.views, sub_images, near };
         end_frame(xr, pending.display_time, Some(&layer)).map_err(|e| format!("xrEndFrame: {e}"))?;
@@ -370,9 +368,8 @@ impl OpenXrHeadset {
             }
             _ => format!("OpenXR session lost ({why}): the run ends"),
         };
-        // Always said, whatever `report` is: the user must know the headset went away.
-        log::warn!("{message}");
-        eprintln!("headset: {message}");
+        // A warning whatever `report` is: the user must know the headset went away.
+        log::warn!("headset: {message}");
     }
 
     /// Destroys the session: waits for the GPU, destroys the wgpu side of the swapchain
@@ -428,14 +425,6 @@ fn phase_of(state: xr::SessionState) -> Option<SessionPhase> {
         xr::SessionState::EXITING => SessionPhase::Exiting,
         _ => return None,
     })
-}
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let i = ((sorted.len() - 1) as f64 * p).round() as usize;
-    sorted[i.min(sorted.len() - 1)]
 }
 
 impl Headset for OpenXrHeadset {
@@ -519,7 +508,7 @@ impl Headset for OpenXrHeadset {
             Some(frame) if request.should_render => {
                 self.budget.submitted(true);
                 if let Err(why) = self.present(&pending, &frame) {
-                    self.feed(Event::Failed(why));
+                    self.feed(Event::Failed(why.0));
                 }
             }
             _ => {
@@ -534,10 +523,7 @@ impl Headset for OpenXrHeadset {
 
     fn counters(&self) -> FrameCounters {
         let mut counters = self.counters;
-        let mut sorted = self.latencies_ms.clone();
-        sorted.sort_by(f64::total_cmp);
-        counters.latency_median_ms = percentile(&sorted, 0.5);
-        counters.latency_p95_ms = percentile(&sorted, 0.95);
+        counters.set_latency(&self.latencies_ms);
         if let Some(simulated) = &self.fallback {
             let after = simulated.counters();
             counters.presented += after.presented;

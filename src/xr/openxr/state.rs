@@ -522,7 +522,7 @@ mod tests {
         budget.submitted(true);
         assert!(budget.reached());
         assert_eq!(budget.remaining(), Some(0));
-        assert!(FrameBudget::new(Some(0)).reached(), "--frames 0 is reached at once");
+        assert!(FrameBudget::new(Some(0)).reached(), "a frame limit of 0 is reached at once");
         let mut unlimited = FrameBudget::new(None);
         unlimited.submitted(true);
         assert!(!unlimited.reached());

@@ -15,6 +15,7 @@
 //! channel without banding), then float16, then UNORM. Depth goes through the same pass
 //! (frag_depth), which also leaves it in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
 
+use super::RuntimeFailure;
 use crate::render::gpu::raster::fullscreen_pipeline;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
@@ -341,7 +342,7 @@ impl EyeSwapchains {
         size: (u32, u32),
         with_depth: bool,
         layout: Option<SwapchainLayout>,
-    ) -> Result<EyeSwapchains, String> {
+    ) -> Result<EyeSwapchains, RuntimeFailure> {
         let offered = session.enumerate_swapchain_formats().map_err(|e| format!("xrEnumerateSwapchainFormats: {e}"))?;
         let color_format = pick(&offered, &COLOR_FORMATS).ok_or_else(|| {
             format!("the runtime offers no colour swapchain format vrao can fill (offered Vulkan formats {offered:?})")
@@ -368,7 +369,7 @@ impl EyeSwapchains {
                 }
             }
         }
-        Err(format!("xrCreateSwapchain: {}", last_error.expect("at least one layout was tried")))
+        Err(RuntimeFailure(format!("xrCreateSwapchain: {}", last_error.expect("at least one layout was tried"))))
     }
 
     pub fn has_depth(&self) -> bool {

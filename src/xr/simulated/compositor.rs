@@ -9,7 +9,6 @@
 //! any vsync shows it is *dropped*. Latency is the time from sampling the pose a shown
 //! frame was rendered with to the vsync that shows it.
 
-use crate::render::gpu::timing::quantile;
 use crate::xr::FrameCounters;
 use std::time::{Duration, Instant};
 
@@ -180,12 +179,7 @@ impl Compositor {
     /// The counters so far, with the latency median and p95 over the displayed vsyncs.
     pub fn counters(&self) -> FrameCounters {
         let mut c = self.counters;
-        if !self.latencies_ms.is_empty() {
-            let mut sorted = self.latencies_ms.clone();
-            sorted.sort_by(f64::total_cmp);
-            c.latency_median_ms = quantile(&sorted, 0.5);
-            c.latency_p95_ms = quantile(&sorted, 0.95);
-        }
+        c.set_latency(&self.latencies_ms);
         c
     }
 }

@@ -214,7 +214,10 @@ impl SimulatedHeadset {
             ),
             _ => {
                 let target = self.eyes_at(self.compositor.vsync_time(vsync));
-                let reprojector = self.reprojector.get_or_insert_with(|| Reprojector::new(gpu));
+                let reprojector = match &mut self.reprojector {
+                    Some(reprojector) => reprojector,
+                    none => none.insert(Reprojector::new(gpu)?),
+                };
                 reprojector.record(
                     gpu,
                     &mut encoder,

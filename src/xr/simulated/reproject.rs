@@ -2,7 +2,8 @@
 //! re-presented at a newer head pose, rotationally (orientation only, a homography per
 //! eye) or positionally (the submitted depth forward-splatted into the new view).
 
-use crate::render::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::render::error::Result;
+use crate::render::gpu::kernel::{try_shader_module, wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::passes::tonemap::COLOR;
@@ -68,13 +69,14 @@ const BINDINGS: [Bind; 6] = [
 ];
 
 impl Reprojector {
-    /// Compiles the warp's kernels (splat, positional, rotational).
-    pub fn new(gpu: &Gpu) -> Reprojector {
-        let files = [COMMON, wgsl!("src/xr/simulated/reproject.wgsl")];
+    /// Compiles the warp's kernels (splat, positional, rotational); a shader file that
+    /// cannot be read (`VRAO_SHADER_DIR`) is the error.
+    pub fn new(gpu: &Gpu) -> Result<Reprojector> {
+        let module = try_shader_module(&gpu.device, "reproject", &[COMMON, wgsl!("src/xr/simulated/reproject.wgsl")])?;
         let variant = |label, entry, positional: bool| {
-            Kernel::with_constants(gpu, label, &files, entry, &BINDINGS, &[("POSITIONAL", f64::from(positional))])
+            Kernel::from_module(gpu, label, &module, entry, &BINDINGS, &[("POSITIONAL", f64::from(positional))])
         };
-        Reprojector {
+        Ok(Reprojector {
             splat: variant("reproject splat", "splat", true),
             positional: variant("reproject depth", "resolve", true),
             rotational: variant("reproject rotational", "resolve", false),
@@ -91,7 +93,7 @@ impl Reprojector {
                 ..Default::default()
             }),
             splatted: None,
-        }
+        })
     }
 
     /// Records the warp of `color` + `depth` (rendered for `source` eyes) to the `target`

@@ -12,6 +12,10 @@ use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::render::settings::{Denoise, Technique};
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "blur";
+
 /// Horizontally denoised occlusion (first half of the separable filter).
 pub const AO_BLUR_H: Resource = Resource::storage("ao-blur-h", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
 
@@ -99,7 +103,7 @@ impl BlurPass {
 impl Pass for BlurPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
-        PassDecl::new("blur")
+        PassDecl::new(NAME)
             .bindings(&HORIZONTAL)
             .bindings(&VERTICAL)
             .provide(OCCLUSION, AO_BLURRED)

@@ -6,6 +6,10 @@ use crate::render::gpu::kernel::{wgsl, Bind, Kernel, COMMON};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "tonemap";
+
 /// Tone-mapped, sRGB-encoded eye colour.
 pub const COLOR: Resource = Resource::storage("color", Size::Full, wgpu::TextureFormat::Rgba8Unorm);
 
@@ -26,7 +30,7 @@ impl TonemapPass {
 
 impl Pass for TonemapPass {
     fn declare(&self, _: &FrameSetup) -> PassDecl {
-        PassDecl::new("tonemap").bindings(&BINDINGS)
+        PassDecl::new(NAME).bindings(&BINDINGS)
     }
 
     fn record(&self, ctx: &mut FrameContext) {

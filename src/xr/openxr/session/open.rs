@@ -58,7 +58,7 @@ impl OpenXrHeadset {
             .and_then(|modes| modes.first().copied())
             .unwrap_or(xr::EnvironmentBlendMode::OPAQUE);
 
-        let (gpu, binding) = vulkan::create_gpu(&instance, system).map_err(Unavailable::Failed)?;
+        let (gpu, binding) = vulkan::create_gpu(&instance, system)?;
         let gpu = Arc::new(gpu);
         // SAFETY: the binding names the instance, physical device and device the runtime
         // created for this system, and one queue of the family the device was made with;
@@ -70,8 +70,7 @@ impl OpenXrHeadset {
             .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
             .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
         let swapchains =
-            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)
-                .map_err(Unavailable::Failed)?;
+            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)?;
         let swapchain_text = swapchains.describe();
         let depth = swapchains.has_depth();
         let xr = Xr {

@@ -103,11 +103,3 @@ fn tracking_before_any_valid_pose_uses_the_default_views() {
     let (views, _) = tracking.merge(xr::ViewStateFlags::ORIENTATION_VALID, &[view(0.0, [9.0; 3]), view(0.0, [9.0; 3])]);
     assert!((position(&views[1]) - Vec3::new(0.032, 0.0, 0.0)).length() < 1e-6);
 }
-
-#[test]
-fn percentiles_of_latency_samples() {
-    let sorted = [1.0, 2.0, 3.0, 4.0, 5.0];
-    assert_eq!(percentile(&sorted, 0.5), 3.0);
-    assert_eq!(percentile(&sorted, 0.95), 5.0);
-    assert_eq!(percentile(&[], 0.5), 0.0);
-}

@@ -1,0 +1,155 @@
+//! What a run did (`vrao run --report`), summarized from the frame loop once it ended.
+
+use crate::app::governor::GovernorChange;
+use crate::app::{FrameLoop, SERIAL_EVERY};
+use crate::render::bench_file::Resolution;
+use crate::render::gpu::timing::summarize;
+use crate::render::output::significant;
+use crate::render::settings::AoSettings;
+use crate::render::stats;
+use std::sync::atomic::Ordering;
+
+/// What a run did (`vrao run --report`): frames rendered and in flight, the frame budget
+/// and how often it was missed, the headset's counters and per-pass medians.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RunSummary {
+    /// The headset's name (simulated profile or OpenXR runtime and system).
+    pub headset: String,
+    /// The GPU adapter's name.
+    pub adapter: String,
+    /// Frames rendered and handed to the headset.
+    pub frames_rendered: u64,
+    /// The most frames the GPU worked on at once, and the limit.
+    pub frames_in_flight_max: usize,
+    /// The renderer's limit on frames in flight.
+    pub frames_in_flight_limit: usize,
+    /// The display period (ms) and the frames whose GPU time exceeded it (of those timed).
+    pub budget_ms: f64,
+    /// Timed frames whose GPU time exceeded `budget_ms`.
+    pub over_budget_frames: u64,
+    /// Frames whose GPU time came back.
+    pub timed_frames: u64,
+    /// Medians over the run ([`crate::render::stats`]; 0 when no frame was timed): GPU
+    /// time per frame (both eyes), CPU encode time per frame, and their ratio.
+    pub gpu_frame_ms_median: f64,
+    /// Median CPU encode time per frame (ms).
+    pub cpu_encode_ms_median: f64,
+    /// `cpu_encode_ms_median` / `gpu_frame_ms_median`.
+    pub cpu_encode_share_of_gpu: f64,
+    /// How the passes were timed: pipelined, and on a CPU adapter every
+    /// [`SERIAL_EVERY`]th frame serial (one submission per pass).
+    pub timing: String,
+    /// The headset's frame counters: submitted, presented, reprojected, dropped, latency.
+    pub counters: crate::xr::FrameCounters,
+    /// (pass, median GPU ms for both eyes) over the recent frames.
+    pub pass_medians_ms: Vec<(String, f64)>,
+    /// Whether Ctrl-C (the session's interrupt flag) ended the run.
+    pub interrupted: bool,
+    /// The budget governor: on or off, every change it made, and the AO setting the run
+    /// ended with.
+    pub governor: String,
+    /// Every change the governor made, in order.
+    pub governor_changes: Vec<GovernorChange>,
+    /// The AO setting of the last frame, e.g. `gtao N=24 r=0.3 m half`.
+    pub final_ao_setting: String,
+    /// The OpenXR session's states, layers and loss reason (OpenXR headsets only).
+    pub openxr: Option<crate::xr::openxr::OpenXrReport>,
+}
+
+impl RunSummary {
+    /// Summarizes the loop as it stands (call it when the loop has ended).
+    pub fn of(frame_loop: &FrameLoop) -> RunSummary {
+        let gpu_frame_ms_median = stats::median(&frame_loop.gpu_frame_ms).unwrap_or(0.0);
+        let cpu_encode_ms_median = stats::median(&frame_loop.cpu_encode_ms).unwrap_or(0.0);
+        RunSummary {
+            headset: frame_loop.headset.describe(),
+            adapter: frame_loop.gpu.info.name.clone(),
+            frames_rendered: frame_loop.frames,
+            frames_in_flight_max: frame_loop.renderer.frames_in_flight_max(),
+            frames_in_flight_limit: frame_loop.renderer.frames_in_flight_limit(),
+            budget_ms: frame_loop.budget_ms,
+            over_budget_frames: frame_loop.over_budget_frames,
+            timed_frames: frame_loop.timed_frames,
+            gpu_frame_ms_median,
+            cpu_encode_ms_median,
+            cpu_encode_share_of_gpu: if gpu_frame_ms_median > 0.0 {
+                cpu_encode_ms_median / gpu_frame_ms_median
+            } else {
+                0.0
+            },
+            timing: if frame_loop.cpu_adapter() {
+                format!("pipelined; every {SERIAL_EVERY}th frame serial for the per-pass medians (CPU adapter)")
+            } else {
+                "pipelined".into()
+            },
+            counters: frame_loop.headset.counters(),
+            pass_medians_ms: pass_medians(frame_loop),
+            interrupted: frame_loop.exit_requested.load(Ordering::Relaxed),
+            governor: if frame_loop.governor.is_some() { "on" } else { "off" }.into(),
+            governor_changes: frame_loop.governor.as_ref().map(|g| g.changes().to_vec()).unwrap_or_default(),
+            final_ao_setting: ao_setting(&frame_loop.renderer.settings().ao),
+            openxr: frame_loop.headset.openxr_report(),
+        }
+    }
+
+    /// The summary as the few lines `vrao run` prints.
+    pub fn to_text(&self) -> String {
+        let c = &self.counters;
+        let passes: Vec<String> = self.pass_medians_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect();
+        format!(
+            "governor {}: {} changes, AO setting at the end: {}\nframes: {} rendered (up to {} in flight), {} submitted; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms\nGPU per frame: median {:.2} ms against a {:.2} ms budget, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}",
+            self.governor,
+            self.governor_changes.len(),
+            self.final_ao_setting,
+            self.frames_rendered,
+            self.frames_in_flight_max,
+            c.submitted,
+            c.presented,
+            c.reprojected,
+            c.dropped,
+            c.latency_median_ms,
+            c.latency_p95_ms,
+            self.gpu_frame_ms_median,
+            self.budget_ms,
+            self.over_budget_frames,
+            self.timed_frames,
+            self.cpu_encode_ms_median,
+            100.0 * self.cpu_encode_share_of_gpu,
+            self.timing,
+            passes.join(", ")
+        )
+    }
+}
+
+/// (pass, median GPU ms) over the recent frames; on a CPU adapter over the frames timed
+/// pass by pass, whose per-pass times are the true ones there.
+fn pass_medians(frame_loop: &FrameLoop) -> Vec<(String, f64)> {
+    let frames = &frame_loop.history.frames;
+    let serial_only = frames.iter().any(|f| f.serial);
+    let spans: Vec<Vec<(String, f64)>> =
+        frames.iter().filter(|f| !serial_only || f.serial).map(|f| f.spans.clone()).collect();
+    summarize(&spans).into_iter().map(|s| (s.label, s.median_ms)).collect()
+}
+
+/// The AO setting in one line, as bench files write theirs: `gtao temporal N=24 r=0.3 m half`.
+fn ao_setting(ao: &AoSettings) -> String {
+    let temporal = if ao.temporal.enabled { " temporal" } else { "" };
+    let r = significant(ao.radius as f64, 3);
+    let resolution = Resolution::from_half_res(ao.half_res);
+    format!("{}{temporal} N={} r={r} m {resolution}", ao.technique.name(), ao.samples)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ao_setting_names_technique_samples_radius_and_resolution() {
+        let mut ao = AoSettings { samples: 24, radius: 0.3, half_res: true, ..AoSettings::default() };
+        ao.temporal.enabled = true;
+        assert_eq!(ao_setting(&ao), format!("{} temporal N=24 r=0.3 m half", ao.technique.name()));
+        ao.half_res = false;
+        ao.temporal.enabled = false;
+        assert!(ao_setting(&ao).ends_with("N=24 r=0.3 m full"), "{}", ao_setting(&ao));
+    }
+}
