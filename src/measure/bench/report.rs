@@ -494,10 +494,9 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
     }
     let pareto: Vec<(f64, f64)> =
         rows.iter().filter(|r| r.pareto).map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
-    let mut other: Vec<f64> = rows.iter().filter_map(|r| r.other_ms_per_eye).collect();
-    other.sort_by(f64::total_cmp);
-    let line = match other.get(other.len() / 2) {
-        Some(&other) => {
+    let other: Vec<f64> = rows.iter().filter_map(|r| r.other_ms_per_eye).collect();
+    let line = match crate::render::stats::median(&other) {
+        Some(other) => {
             let share = (budget_ms_per_eye - other).max(0.0);
             let label = format!(
                 "occlusion budget {share:.2} ms/eye\n({budget_ms_per_eye:.2} per eye \u{2212} {other:.2} other passes)"
