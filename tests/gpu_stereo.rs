@@ -160,7 +160,7 @@ fn unclipped_scene() -> Scene {
 fn multiview_and_multipass_give_the_same_pixels() {
     let (gpu, _guard) = common::gpu();
     if !gpu.caps.multiview {
-        eprintln!("skipped: adapter '{}' has no multiview", gpu.info.name.clone());
+        eprintln!("skipped: adapter '{}' has no multiview", gpu.info.name);
         return;
     }
     // Geometry no driver has to clip: both paths must agree byte for byte on every adapter.
@@ -177,7 +177,7 @@ fn multiview_and_multipass_give_the_same_pixels() {
 fn the_multiview_probe_predicts_clipped_geometry() {
     let (gpu, _guard) = common::gpu();
     if !gpu.caps.multiview {
-        eprintln!("skipped: adapter '{}' has no multiview", gpu.info.name.clone());
+        eprintln!("skipped: adapter '{}' has no multiview", gpu.info.name);
         return;
     }
     // The room's walls reach past every edge of the view, so the driver must clip them.
@@ -199,7 +199,11 @@ fn the_multiview_probe_predicts_clipped_geometry() {
 fn the_graph_runs_only_what_the_requested_outputs_need() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:room").unwrap();
-    let s = settings(64, 72, StereoMode::Auto);
+    let mut s = settings(64, 72, StereoMode::Auto);
+    // GTAO at full resolution, denoised, without temporal accumulation.
+    s.ao.technique = vrao::render::settings::Technique::Gtao;
+    s.ao.half_res = false;
+    s.ao.temporal.enabled = false;
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     let report = renderer.render_and_wait(&eyes.eyes, &[NORMALS]).unwrap();
@@ -229,7 +233,8 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
         assert!(report.gpu_ms_of("gbuffer").is_some() && report.gpu_ms_of("composite").is_none());
     }
     let report = renderer.render(&eyes.eyes, &[COLOR]).unwrap();
-    assert_eq!(report.plan.names, vec!["gbuffer", "direct", "ssao", "blur", "composite", "tonemap"]);
+    // At full resolution the composite reads the occlusion as the denoise left it.
+    assert_eq!(report.plan.names, vec!["gbuffer", "direct", "gtao", "blur", "composite", "tonemap"]);
 }
 
 #[test]
@@ -277,7 +282,7 @@ fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
     }
     // A frame of a CPU adapter takes milliseconds: the next one is encoded and handed
     // over while it is still on the GPU.
-    if gpu.info.clone().device_type == wgpu::DeviceType::Cpu {
+    if gpu.info.device_type == wgpu::DeviceType::Cpu {
         assert_eq!(renderer.frames_in_flight_max(), 2);
     }
     // With one frame in flight, each frame waits for the one before.

@@ -87,7 +87,7 @@ impl TimingChoice {
         match self {
             TimingChoice::Pipelined => Timing::Pipelined,
             TimingChoice::Serial => Timing::Serial,
-            TimingChoice::Auto if gpu.info.clone().device_type == wgpu::DeviceType::Cpu => Timing::Serial,
+            TimingChoice::Auto if gpu.info.device_type == wgpu::DeviceType::Cpu => Timing::Serial,
             TimingChoice::Auto => Timing::Pipelined,
         }
     }
@@ -169,7 +169,7 @@ impl Renderer {
             StereoMode::Multiview => {
                 return Err(Error::input(format!(
                     "--stereo multiview: adapter '{}' has no multiview; use --stereo multipass",
-                    gpu.info.name.clone()
+                    gpu.info.name
                 )))
             }
         };

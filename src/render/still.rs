@@ -69,7 +69,7 @@ pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) 
     }
     let report = report.expect("at least one frame");
     let written = crate::render::output::write_images(&renderer, &options.out, 2, options.debug)?;
-    let adapter = gpu.info.clone();
+    let adapter = &gpu.info;
     let summary = format!(
         "rendered '{}' ({} triangles) on {}: {}x{} per eye, {} G-buffer, {} N={} r={} m{}",
         scene.name,
