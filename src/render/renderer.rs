@@ -178,6 +178,8 @@ impl Renderer {
         let scene_passes = passes::scene_passes(&gpu, scene, &gpu_scene, &frame);
         let ao = AoEngine::with_light_gathering(gpu.clone(), vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]);
         let output_passes = passes::output_passes(&gpu);
+        // A shader file VRAO_SHADER_DIR names but that cannot be read is the error here.
+        crate::render::gpu::kernel::take_shader_error()?;
         let timer = PassTimer::new(&gpu)?;
         gpu.take_error()?;
         Ok(Renderer {

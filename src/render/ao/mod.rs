@@ -167,6 +167,7 @@ impl AoEngine {
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
         }
+        crate::render::gpu::kernel::take_shader_error()?;
         Ok(AoEngine { gpu, chain, host: Some(host) })
     }
 
