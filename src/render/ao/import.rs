@@ -7,6 +7,7 @@
 use super::{AoConfig, AoFrame, NormalEncoding, NormalSpace, Projection};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, Slot};
+use crate::render::gpu::raster;
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
@@ -266,23 +267,9 @@ impl Pass for ImportPass {
         });
         let (depth, normals) = (ctx.target(DEPTH), ctx.target(NORMALS));
         for layer in 0..source.views {
-            let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(NAME),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &normals.layer_views[layer as usize],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth.layer_views[layer as usize],
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let normals = (&normals.layer_views[layer as usize], wgpu::Color::TRANSPARENT);
+            let depth = &depth.layer_views[layer as usize];
+            let mut pass = raster::colour_and_depth_pass(ctx.encoder, NAME, normals, Some(depth));
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.draw(0..3, layer..layer + 1);

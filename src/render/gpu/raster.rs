@@ -128,3 +128,31 @@ pub fn layer_views(texture: &wgpu::Texture, label: &str, layers: u32) -> Vec<wgp
         })
         .collect()
 }
+
+/// A render pass that clears one colour target to `clear` and, when given, a reversed-Z
+/// depth target to 0 (infinitely far): the fullscreen passes that write both (the AO
+/// engine's import, the OpenXR blit).
+pub fn colour_and_depth_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    (colour, clear): (&wgpu::TextureView, wgpu::Color),
+    depth: Option<&wgpu::TextureView>,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: colour,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

@@ -288,24 +288,12 @@ impl EyeBlit {
                 },
             ],
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("openxr swapchain blit"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: depth_view.map(|view| wgpu::RenderPassDepthStencilAttachment {
-                view,
-                // Reversed-Z: 0 is infinitely far.
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = crate::render::gpu::raster::colour_and_depth_pass(
+            encoder,
+            "openxr swapchain blit",
+            (color_view, wgpu::Color::BLACK),
+            depth_view,
+        );
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.set_viewport(0.0, 0.0, width as f32, height as f32, 0.0, 1.0);
