@@ -287,7 +287,12 @@ fn main_rs_is_a_thin_dispatcher() {
 fn command_line_names_are_the_names_reports_print() {
     use clap::ValueEnum;
     use vrao::render::settings::{BounceForm, Denoise, DisplayMode, Quality, Technique};
-    fn check<T: ValueEnum + Copy + std::fmt::Debug>(all: &[T], name: impl Fn(T) -> &'static str) {
+    fn check<T: ValueEnum + Copy + PartialEq + std::fmt::Debug>(all: &[T], name: impl Fn(T) -> &'static str) {
+        // The plain-Rust lists (the library has them without clap) miss no variant.
+        for v in T::value_variants() {
+            assert!(all.contains(v), "{v:?} is missing from the list");
+        }
+        assert_eq!(all.len(), T::value_variants().len());
         for &v in all {
             let typed = v.to_possible_value().expect("no hidden variants");
             assert_eq!(typed.get_name(), name(v), "{v:?}");

@@ -5,7 +5,8 @@ pub use crate::render::passes::gtao::GtaoSettings;
 use crate::render::stereo::{HeadsetProfile, DEFAULT_NEAR};
 
 /// How the G-buffer reaches both eye layers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum StereoMode {
     /// Multiview when the adapter has it, one pass per eye otherwise.
     #[default]
@@ -17,7 +18,8 @@ pub enum StereoMode {
 }
 
 /// What the desktop window shows (Belonogov 2018 §5.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum DisplayMode {
     /// No window: the headset alone.
     #[default]
@@ -42,7 +44,8 @@ impl DisplayMode {
 }
 
 /// The occlusion technique.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum Technique {
     /// No occlusion pass: the ambient term is unoccluded.
     None,
@@ -83,17 +86,40 @@ impl Technique {
     }
 
     /// Every technique, in the order the CLI and the bench list them (declaration order).
+    pub const ALL: [Technique; 7] = [
+        Technique::None,
+        Technique::Ssao,
+        Technique::Hbao,
+        Technique::Gtao,
+        Technique::Ssdo,
+        Technique::SsdoBounce,
+        Technique::FetchOnly,
+    ];
+
+    /// Every technique, in the order the CLI and the bench list them ([`Technique::ALL`]).
     pub fn all() -> &'static [Technique] {
-        <Technique as clap::ValueEnum>::value_variants()
+        &Technique::ALL
+    }
+
+    /// The techniques that estimate occlusion (neither `none` nor the fetch-only
+    /// baseline), the default first, then in [`Technique::all`]'s order: what `vrao bench`
+    /// sweeps unless told otherwise.
+    pub fn estimators() -> Vec<Technique> {
+        let default = Technique::default();
+        let others = Technique::all()
+            .iter()
+            .copied()
+            .filter(|&t| ![default, Technique::None, Technique::FetchOnly].contains(&t));
+        std::iter::once(default).chain(others).collect()
     }
 }
 
 /// Bench files name their techniques, and the governor and `vrao budget --fit` read them
-/// back; the names are the command line's (clap's `ValueEnum`).
+/// back; the names are the command line's ([`Technique::name`]).
 impl std::str::FromStr for Technique {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        <Technique as clap::ValueEnum>::from_str(s, false).map_err(|_| {
+        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
             let names: Vec<&str> = Technique::all().iter().map(|t| t.name()).collect();
             Error::input(format!("unknown technique '{s}' (expected one of {})", names.join(", ")))
         })
@@ -101,7 +127,8 @@ impl std::str::FromStr for Technique {
 }
 
 /// Sampling quality presets: Belonogov 2018's kernel sizes N = 12, 24, 36, 64.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum Quality {
     /// N = 12.
     Low,
@@ -138,10 +165,11 @@ impl Quality {
 }
 
 /// Where each pixel's kernel rotation comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum Noise {
     /// A 5×5 tile of rotations repeated over the screen (Belonogov 2018).
-    #[value(name = "tiled", alias = "tiled5x5")]
+    #[cfg_attr(feature = "app", value(name = "tiled", alias = "tiled5x5"))]
     Tiled5x5,
     /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (the Czech SSDO thesis).
     #[default]
@@ -149,7 +177,8 @@ pub enum Noise {
 }
 
 /// How SSDO's bounce weighs a blocking sample's sender.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum BounceForm {
     /// Ritschel et al. 2009 eq. 2: a patch of area π r²/N × strength at the sender pixel,
     /// weighted by the sender and receiver cosines over d² (as a disc's solid angle, so a
@@ -178,7 +207,8 @@ impl BounceForm {
 }
 
 /// The spatial denoise of the occlusion.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum Denoise {
     /// Edge-aware box over the 4×4 noise tile, 5 taps per axis in two passes
     /// (src/render/passes/blur/denoise.wgsl).
@@ -250,7 +280,8 @@ pub struct AoSettings {
 }
 
 /// How the temporal pass blends the new frame into the history.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum TemporalBlend {
     /// The running mean of the last `max_frames` frames: each frame's rotated pattern
     /// counts equally, so N frames of n samples approach one frame of N·n.

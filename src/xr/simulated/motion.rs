@@ -7,7 +7,8 @@ use glam::{DQuat, DVec3};
 use std::f64::consts::TAU;
 
 /// Head motion the simulated headset adds to the scene's pose, for testing stereo and reprojection under movement.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum HeadMotion {
     /// The scene's head pose (or its scripted path) as is.
     #[default]

@@ -12,14 +12,15 @@ use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
 /// How the simulated compositor warps a frame to a newer head pose.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum ReprojectionMode {
     /// Orientation only: every pixel is treated as infinitely far.
     Rotational,
     /// Orientation and position, using the frame's depth; disocclusions take the
     /// background beside them.
     #[default]
-    #[value(alias = "positional")]
+    #[cfg_attr(feature = "app", value(alias = "positional"))]
     Depth,
 }
 
