@@ -168,7 +168,7 @@ impl Renderer {
             }
             StereoMode::Multiview => {
                 return Err(Error::input(format!(
-                    "--stereo multiview: adapter '{}' has no multiview; use --stereo multipass",
+                    "stereo mode multiview: adapter '{}' has no multiview; use the multipass mode",
                     gpu.info.name
                 )))
             }

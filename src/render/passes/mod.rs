@@ -2,7 +2,8 @@
 //! builder chain, the textures it creates (constants with their size class and format),
 //! what it reads and writes (its kernels' binding lists), what it provides under the
 //! graph's named outputs, and whether it runs this frame; the graph decides which passes
-//! run, and each records its GPU work when it does. [`all`] lists them in execution order.
+//! run, and each records its GPU work when it does. [`scene_passes`], [`ao_chain`] and
+//! [`output_passes`] list them in execution order.
 
 pub mod blur;
 pub mod composite;
