@@ -238,9 +238,16 @@ fn left_eye_value(
     return result;
 }
 
-// Clamps to [0, 1] and maps NaN to 1 (unoccluded): AO never leaves its range.
+// The least AO of a surface: 1/256, one ray of the reference tracer's 256 per pixel
+// (measure::reference, `vrao bench --rays`) getting out, the smallest visibility above 0
+// it reports. A pixel the eye sees has the direction to the eye open, so no estimate
+// may call it fully occluded; and 0 would tone-map to pure black wherever no direct
+// light falls (an estimate of exactly 0 was GTAO's bug: gtao.wgsl `visible_sectors`).
+const AO_FLOOR: f32 = 1.0 / 256.0;
+
+// Clamps to [AO_FLOOR, 1] and maps NaN to 1 (unoccluded): AO never leaves its range.
 fn saturate_ao(a: f32) -> f32 {
-    return select(1.0, clamp(a, 0.0, 1.0), a == a);
+    return select(1.0, clamp(a, AO_FLOOR, 1.0), a == a);
 }
 
 // Equirectangular lookup; the layout matches `scene::Environment::direction`

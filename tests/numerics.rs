@@ -182,7 +182,13 @@ fn radius_1e_minus_6_and_1e6_and_one_or_256_samples() {
         }
     }
     // Continuity in the radius: 0.5 m and 0.5005 m give nearly the same AO.
-    let a = render_checked(&gpu, "r 0.5", &scene, &settings(SMALL, AoSettings::default()), &room_head());
+    let a = render_checked(
+        &gpu,
+        "r 0.5",
+        &scene,
+        &settings(SMALL, AoSettings { radius: 0.5, ..AoSettings::default() }),
+        &room_head(),
+    );
     let b = render_checked(
         &gpu,
         "r 0.5005",

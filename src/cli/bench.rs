@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
 use vrao::measure::reference::default_cache_dir;
 use vrao::render::renderer::TimingChoice;
-use vrao::render::settings::{BounceForm, Denoise, Technique};
+use vrao::render::scene::RENDER_DEFAULT;
+use vrao::render::settings::{AoSettings, BounceForm, Denoise, Quality, Technique};
 use vrao::{BackendChoice, HeadsetProfile, Result, Scene, Settings};
 
 /// A sweep over a switch: off, on or both.
@@ -38,13 +39,14 @@ enum Resolution {
 
 #[derive(Args)]
 pub struct BenchArgs {
-    #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
+    #[arg(long, default_value = RENDER_DEFAULT, help = SCENE_HELP)]
     scene: String,
-    /// Techniques to sweep, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "ssao,hbao,ssdo,ssdo-bounce", hide_possible_values = true)]
+    /// Techniques to sweep, comma-separated (by default every estimator, gtao first).
+    #[arg(long, value_delimiter = ',', value_enum, default_values_t = Technique::estimators(), hide_possible_values = true)]
     techniques: Vec<Technique>,
-    /// Sample counts, comma-separated (by default the grid of Belonogov 2018).
-    #[arg(long, value_delimiter = ',', default_value = "12,24,36,64")]
+    /// Sample counts, comma-separated (by default the presets' counts, the grid of
+    /// Belonogov 2018).
+    #[arg(long, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
     samples: Vec<u32>,
     /// Radii in metres, comma-separated (default: the scene's radius × 0.5, 1, 2).
     #[arg(long, value_delimiter = ',')]
@@ -74,16 +76,16 @@ pub struct BenchArgs {
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
     /// eq. 2).
-    #[arg(long, default_value = "direction", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
     bounce_form: BounceForm,
     #[command(flatten)]
     gtao: GtaoArgs,
     /// Spatial denoise of every row: tile (edge-aware, 5 taps per axis over the 4×4 noise
     /// tile) or bilateral (11×11 at --blur 5).
-    #[arg(long, default_value = "tile", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
     denoise: Denoise,
     /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = AoSettings::default().blur_radius)]
     blur: u32,
     /// Measure this many cases at a time, round-robin one frame each, so that the
     /// machine's drift during a long sweep falls on all of them alike (fair ratios
@@ -97,10 +99,10 @@ pub struct BenchArgs {
     #[arg(long)]
     frame: bool,
     /// Per-eye width in pixels.
-    #[arg(long, default_value_t = 1080)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels.
-    #[arg(long, default_value_t = 1200)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one
     /// submission per pass, wall clock) or auto (serial on CPU adapters such as lavapipe,
@@ -123,7 +125,7 @@ pub struct BenchArgs {
     #[arg(long)]
     cache: Option<PathBuf>,
     /// Budget per stereo frame in ms for the plot's budget line (each eye gets half).
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_budget_ms, default_value_t = 1000.0 / 90.0)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_budget_ms, default_value_t = 1000.0 / HeadsetProfile::vive().refresh_hz)]
     budget_ms: f64,
     /// Measure nothing: rewrite the table, CSV, Markdown and plots of this bench.json
     /// (Pareto fronts recomputed) into --out.
@@ -185,4 +187,27 @@ fn command_line() -> String {
         })
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Bench {
+        #[command(flatten)]
+        args: BenchArgs,
+    }
+
+    #[test]
+    fn bench_with_no_options_sweeps_every_estimator_on_the_default_scene() {
+        let args = Bench::try_parse_from(["bench"]).unwrap().args;
+        assert_eq!(args.scene, RENDER_DEFAULT);
+        use Technique::*;
+        assert_eq!(args.techniques, [Gtao, Ssao, Hbao, Ssdo, SsdoBounce]);
+        assert_eq!(args.samples, [12, 24, 36, 64]);
+        assert_eq!((args.denoise, args.blur), (AoSettings::default().denoise, AoSettings::default().blur_radius));
+        assert_eq!((args.width, args.height), (1080, 1200));
+    }
 }

@@ -5,7 +5,7 @@ use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::budget::{measure_budget, BudgetOptions};
 use vrao::render::renderer::TimingChoice;
-use vrao::{BackendChoice, Result, Scene};
+use vrao::{BackendChoice, HeadsetProfile, Result, Scene};
 
 /// What each measured frame produces.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -19,10 +19,10 @@ pub struct BudgetArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Per-eye width in pixels.
-    #[arg(long, default_value_t = 1080)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels.
-    #[arg(long, default_value_t = 1200)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Measured frames (each: the stereo frame, then each eye alone), after warm-up.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]

@@ -14,6 +14,7 @@ use glam::DVec3;
 use vrao::render::passes::shadow::suggested_rsm_radius;
 use vrao::render::settings::{
     AoSettings, BounceForm, Denoise, GtaoSettings, Noise, Quality, ShadowSettings, Technique, Temporal, TemporalBlend,
+    AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL,
 };
 use vrao::{HeadsetProfile, Scene, Settings};
 
@@ -33,21 +34,31 @@ impl OnOff {
     }
 }
 
+impl From<bool> for OnOff {
+    fn from(on: bool) -> OnOff {
+        if on {
+            OnOff::On
+        } else {
+            OnOff::Off
+        }
+    }
+}
+
 /// Shadow options for directional lights.
 #[derive(Args, Clone)]
 pub struct LightArgs {
     /// Shadow maps with 3×3 PCF for the directional lights: on or off (a scene with no
     /// directional light has none either way).
-    #[arg(long, help_heading = SHADOW_HEADING, default_value = "on")]
+    #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().enabled))]
     shadows: OnOff,
     /// Texels along each side of the square light-space maps.
-    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = 2048)]
+    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().size)]
     shadow_size: u32,
     /// One bounce of the directional lights from reflective shadow maps: on or off.
-    #[arg(long, help_heading = SHADOW_HEADING, default_value = "off")]
+    #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().rsm))]
     rsm: OnOff,
     /// Virtual point lights gathered per pixel and light by the reflective shadow maps.
-    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = 64)]
+    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().rsm_samples)]
     rsm_samples: u32,
     /// RSM gather radius in metres (default: a quarter of the scene's diagonal, within 0.1..=4 m).
     #[arg(long, help_heading = SHADOW_HEADING, allow_negative_numbers = true)]
@@ -94,30 +105,29 @@ pub struct AoArgs {
     /// Occlusion technique: none, ssao, hbao, gtao (the default: the most accurate per
     /// millisecond), ssdo, ssdo-bounce or fetch-only (the benchmark baseline with SSAO's
     /// depth taps and no occlusion arithmetic).
-    #[arg(long, default_value = "gtao", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = AoSettings::default().technique, hide_possible_values = true)]
     technique: Technique,
     /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
-    #[arg(long, default_value = "medium", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = Quality::default(), hide_possible_values = true)]
     quality: Quality,
     /// Depth taps per pixel, 1..=256 (overrides --quality).
     #[arg(long)]
     samples: Option<u32>,
-    /// Occlusion radius in metres (default: 8 % of the scene's diagonal, within 0.01..=1 m).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, help = radius_help())]
     radius: Option<f32>,
     /// Occlusion weight, 0..=4 (1 = full occlusion).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().strength)]
     strength: f32,
     /// Depth bias as a fraction of the radius.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().bias)]
     bias: f32,
     /// SSDO bounce strength (ssdo-bounce); 0 leaves the bounce out.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().bounce)]
     bounce: f32,
     /// How the bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
     /// the receiver cosine) or patch (Ritschel et al. 2009 eq. 2: area π r²/N, both
     /// cosines, 1/d²).
-    #[arg(long, default_value = "direction", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
     bounce_form: BounceForm,
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
@@ -129,16 +139,16 @@ pub struct AoArgs {
     depth_peeling: bool,
     /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
     /// bilateral (separable, --blur px either side).
-    #[arg(long, default_value = "tile", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
     denoise: Denoise,
     /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns any denoise off.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = AoSettings::default().blur_radius)]
     blur: u32,
     /// Blur depth-edge width as a fraction of the pixel's distance (smaller keeps sharper edges).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().blur_plane_sigma)]
     blur_sigma: f32,
     /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
-    #[arg(long, default_value = "halton", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = AoSettings::default().noise, hide_possible_values = true)]
     noise: Noise,
     #[command(flatten)]
     gtao: GtaoArgs,
@@ -151,19 +161,29 @@ pub struct AoArgs {
     #[arg(long)]
     temporal: bool,
     /// Temporal disocclusion threshold in metres (plus two pixel footprints).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.02)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Temporal::default().epsilon_m)]
     temporal_epsilon: f32,
     /// Temporal blend: average (running mean) or confidence (the history weighed by how
     /// well it agrees with the new frame).
-    #[arg(long, default_value = "average", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = Temporal::default().blend, hide_possible_values = true)]
     temporal_blend: TemporalBlend,
     /// Frames after which a pixel counts as converged.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = Temporal::default().max_frames)]
     temporal_frames: u32,
     /// Motion-adaptive temporal window: a pixel that moved m pixels since the last frame
     /// averages at most frames / (1 + m / this) frames (at least 4); 0 turns it off.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Temporal::default().motion_px)]
     temporal_motion_px: f32,
+}
+
+/// `--radius`'s help, with the library's figures for the default.
+fn radius_help() -> String {
+    format!(
+        "Occlusion radius in metres (default: {} % of the scene's diagonal, within {}..={} m)",
+        AO_RADIUS_OF_DIAGONAL * 100.0,
+        AO_RADIUS_MIN,
+        AO_RADIUS_MAX
+    )
 }
 
 impl AoArgs {

@@ -6,7 +6,7 @@ use glam::DVec3;
 use std::path::PathBuf;
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::HeadPath;
-use vrao::render::stereo::DEFAULT_IPD;
+use vrao::render::settings::{DEFAULT_EXPOSURE, DEFAULT_WHITE_POINT};
 use vrao::render::still::{render_still, StillOptions};
 use vrao::{BackendChoice, Error, HeadPose, HeadsetProfile, Result, Scene, Settings, StereoMode};
 
@@ -31,19 +31,19 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, requires = "eye", allow_hyphen_values = true)]
     look_at: Option<DVec3>,
     /// Stereo G-buffer path: auto, multiview or multipass.
-    #[arg(long, default_value = "auto", hide_possible_values = true)]
+    #[arg(long, value_enum, default_value_t = StereoMode::default(), hide_possible_values = true)]
     stereo: StereoMode,
     /// Per-eye width in pixels (Vive-class default).
-    #[arg(long, default_value_t = 1080)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels (Vive-class default).
-    #[arg(long, default_value_t = 1200)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Interpupillary distance in metres.
-    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_IPD)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().ipd)]
     ipd: f64,
     /// Linear exposure before tone mapping.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_EXPOSURE)]
     exposure: f32,
     /// Timing with --frames: pipelined (GPU timestamps), serial (also wall clock per
     /// pass) or auto (serial on CPU adapters, pipelined on GPUs).
@@ -54,10 +54,27 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Reinhard white point (smallest exposed luminance shown as white).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 4.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_WHITE_POINT)]
     white_point: f32,
     #[command(flatten)]
     ao: AoArgs,
+}
+
+impl RenderArgs {
+    /// The settings these options give for `scene`.
+    fn settings(&self, scene: &Scene) -> Settings {
+        let mut profile = HeadsetProfile::with_size("vive", self.width, self.height);
+        profile.ipd = self.ipd;
+        Settings {
+            profile,
+            stereo: self.stereo,
+            exposure: self.exposure,
+            white_point: self.white_point,
+            ao: self.ao.settings(scene),
+            shadows: self.ao.lights.settings(scene),
+            ..Settings::default()
+        }
+    }
 }
 
 pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
@@ -67,17 +84,7 @@ pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
             .ok_or_else(|| Error::input(format!("--eye and --look-at are the same point {eye}")))?;
         scene.head = HeadPath::fixed(pose);
     }
-    let mut profile = HeadsetProfile::with_size("vive", args.width, args.height);
-    profile.ipd = args.ipd;
-    let settings = Settings {
-        profile,
-        stereo: args.stereo,
-        exposure: args.exposure,
-        white_point: args.white_point,
-        ao: args.ao.settings(&scene),
-        shadows: args.ao.lights.settings(&scene),
-        ..Settings::default()
-    };
+    let settings = args.settings(&scene);
     let options = StillOptions { backend, timing: args.timing, frames: args.frames, debug: args.debug, out: args.out };
     let still = render_still(&scene, &settings, &options)?;
     println!("{}", still.summary);
@@ -88,4 +95,40 @@ pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    /// `vrao render`'s options alone, parsed as the subcommand parses them.
+    #[derive(Parser)]
+    struct Render {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
+
+    #[test]
+    fn render_with_no_options_uses_the_library_defaults() {
+        let args = Render::try_parse_from(["render"]).unwrap().args;
+        assert_eq!(args.scene, vrao::render::scene::RENDER_DEFAULT);
+        let scene = Scene::load(&args.scene).unwrap();
+        assert_eq!(args.settings(&scene), Settings::default());
+        assert_eq!(Settings::default().ao.technique, vrao::render::settings::Technique::Gtao);
+    }
+
+    #[test]
+    fn render_options_reach_the_settings() {
+        let line = "render --quality ultra --half-res --radius 0.25 --technique hbao --temporal";
+        let args = Render::try_parse_from(line.split(' ')).unwrap().args;
+        let settings = args.settings(&Scene::load(&args.scene).unwrap());
+        let ao = &settings.ao;
+        assert_eq!(
+            (ao.samples, ao.half_res, ao.radius, ao.technique),
+            (64, true, 0.25, vrao::render::settings::Technique::Hbao)
+        );
+        assert!(ao.temporal.enabled);
+        assert_ne!(settings, Settings::default());
+    }
 }

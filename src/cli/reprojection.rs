@@ -4,17 +4,17 @@ use super::{AoArgs, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::reprojection::{study, to_markdown};
-use vrao::{BackendChoice, Result, Scene};
+use vrao::{BackendChoice, HeadsetProfile, Result, Scene};
 
 #[derive(Args)]
 pub struct ReprojectionArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Per-eye width in pixels.
-    #[arg(long, default_value_t = 1080)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels.
-    #[arg(long, default_value_t = 1200)]
+    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Write the rows as JSON here.
     #[arg(long)]

@@ -2,7 +2,33 @@
 
 use crate::render::error::{Error, Result};
 pub use crate::render::passes::gtao::GtaoSettings;
+use crate::render::passes::shadow::suggested_rsm_radius;
+use crate::render::scene::{Scene, RENDER_DEFAULT};
 use crate::render::stereo::{HeadsetProfile, DEFAULT_NEAR};
+use std::sync::OnceLock;
+
+/// A scene's default occlusion radius is this fraction of its bounding-box diagonal
+/// ([`Scene::suggested_ao_radius`]), kept within [`AO_RADIUS_MIN`]..=[`AO_RADIUS_MAX`].
+pub const AO_RADIUS_OF_DIAGONAL: f64 = 0.08;
+/// The smallest default occlusion radius, metres (a scene of a few centimetres).
+pub const AO_RADIUS_MIN: f32 = 0.01;
+/// The largest default occlusion radius, metres: room-scale detail, even in a cathedral.
+pub const AO_RADIUS_MAX: f32 = 1.0;
+/// Linear exposure applied before tone mapping, by default.
+pub const DEFAULT_EXPOSURE: f32 = 1.0;
+/// Reinhard's white point, by default.
+pub const DEFAULT_WHITE_POINT: f32 = 4.0;
+
+/// The occlusion and RSM radii that the default scene ([`RENDER_DEFAULT`], what `vrao
+/// render` draws when no scene is named) suggests: [`Settings::default`] is that
+/// command's setting with no options, so its radii are the default scene's. Built once.
+fn default_scene_radii() -> (f32, f32) {
+    static RADII: OnceLock<(f32, f32)> = OnceLock::new();
+    *RADII.get_or_init(|| {
+        let scene = Scene::load(RENDER_DEFAULT).expect("the default scene is built in");
+        (scene.suggested_ao_radius(), suggested_rsm_radius(&scene))
+    })
+}
 
 /// How the G-buffer reaches both eye layers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -50,12 +76,13 @@ pub enum Technique {
     /// No occlusion pass: the ambient term is unoccluded.
     None,
     /// Normal-oriented hemisphere SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3).
-    #[default]
     Ssao,
     /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
     Hbao,
     /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
-    /// (Jimenez et al. 2016, Therrien et al. 2023).
+    /// (Jimenez et al. 2016, Therrien et al. 2023). The default: the most accurate per
+    /// millisecond.
+    #[default]
     Gtao,
     /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
     Ssdo,
@@ -329,12 +356,15 @@ impl Default for Temporal {
     }
 }
 
+/// What `vrao render` uses with no options: GTAO at the medium preset (N = 24) and full
+/// resolution, the tile denoise, no temporal accumulation, and the default scene's radius
+/// (8 % of the furnished room's diagonal; [`AoSettings::fitted_to`] fits another scene).
 impl Default for AoSettings {
     fn default() -> Self {
         AoSettings {
-            technique: Technique::Ssao,
-            samples: Quality::Medium.samples(),
-            radius: 0.5,
+            technique: Technique::default(),
+            samples: Quality::default().samples(),
+            radius: default_scene_radii().0,
             strength: 1.0,
             bias: 0.02,
             range_check: true,
@@ -354,6 +384,12 @@ impl Default for AoSettings {
 }
 
 impl AoSettings {
+    /// The defaults with `scene`'s own occlusion radius ([`Scene::suggested_ao_radius`]),
+    /// as `vrao render` sets them up for a scene when no radius is given.
+    pub fn fitted_to(scene: &Scene) -> AoSettings {
+        AoSettings { radius: scene.suggested_ao_radius(), ..AoSettings::default() }
+    }
+
     /// Checks every value's range; the error names the value and its range.
     pub fn validate(&self) -> Result<()> {
         if !(1..=256).contains(&self.samples) {
@@ -449,9 +485,11 @@ pub struct ShadowSettings {
     pub rsm_radius: f32,
 }
 
+/// Shadows on (2048² maps), no RSM; the RSM radius is the default scene's
+/// ([`suggested_rsm_radius`]), as `vrao render` sets it with no options.
 impl Default for ShadowSettings {
     fn default() -> Self {
-        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: 1.0 }
+        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: default_scene_radii().1 }
     }
 }
 
@@ -471,14 +509,18 @@ impl ShadowSettings {
     }
 }
 
+/// Exactly what `vrao render` uses with no options (the one place its defaults come
+/// from): a Vive-class headset (1080×1200 per eye, IPD 64 mm), the G-buffer path the
+/// adapter supports best, exposure 1 and white point 4, [`AoSettings::default`] and
+/// [`ShadowSettings::default`].
 impl Default for Settings {
     fn default() -> Self {
         Settings {
             profile: HeadsetProfile::vive(),
             stereo: StereoMode::Auto,
             near: DEFAULT_NEAR,
-            exposure: 1.0,
-            white_point: 4.0,
+            exposure: DEFAULT_EXPOSURE,
+            white_point: DEFAULT_WHITE_POINT,
             ao: AoSettings::default(),
             shadows: ShadowSettings::default(),
         }

@@ -234,11 +234,13 @@ impl Scene {
     }
 
     /// A default occlusion radius for this scene: 8 % of its bounding-box diagonal,
-    /// kept within 1 cm and 1 m (room-scale detail; a cathedral still gets 1 m).
+    /// kept within 1 cm and 1 m (room-scale detail; a cathedral still gets 1 m); the
+    /// figures are `settings::AO_RADIUS_*`.
     pub fn suggested_ao_radius(&self) -> f32 {
+        use crate::render::settings::{AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL};
         let b = self.bounds();
         let diagonal = if b.is_empty() { 0.0 } else { b.size().length() };
-        ((0.08 * diagonal) as f32).clamp(0.01, 1.0)
+        ((AO_RADIUS_OF_DIAGONAL * diagonal) as f32).clamp(AO_RADIUS_MIN, AO_RADIUS_MAX)
     }
 
     /// Triangles over all meshes.

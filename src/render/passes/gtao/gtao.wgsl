@@ -164,6 +164,28 @@ fn sector_bits(lo: f32, hi: f32, offset: f32) -> u32 {
     return ones << start;
 }
 
+// The slice's visible share in sectors (0..=32). Every interval a sample blocks lies on
+// its own half, beyond the one nearest V on that half, so the gap between those two,
+// around V, is open: exactly, and never empty while no slab reaches V itself (the eye
+// sees the pixel, so the direction to it is clear). Rounded like the rest, that gap
+// was counted as the whole sectors it crosses (`sector_bits` leaves the sectors from
+// floor(a·32 + offset) up to floor(b·32 + offset) clear): as often none as one, when it
+// is narrower than a sector. With a receiver seen through a narrow opening (a window
+// behind a slatted blind), every slice's gap rounded away at once and AO read exactly
+// 0 (black after tone mapping); more steps per slice (ultra) find fronts nearer V and
+// narrow the gap further. The rounded count has the exact width as its mean over the
+// per-pixel offsets, so counting the gap at its width instead keeps the mean.
+fn visible_sectors(march: March, offset: f32) -> f32 {
+    let a = clamp(march.near_minus, 0.0, 1.0);
+    let b = clamp(march.near_plus, 0.0, 1.0);
+    let clear = SECTORS - f32(countOneBits(march.occluded));
+    if (!(b > a)) {
+        return clear;
+    }
+    let rounded_gap = floor(b * SECTORS + offset) - floor(a * SECTORS + offset);
+    return clear - rounded_gap + (b - a) * SECTORS;
+}
+
 // 4×4 interleaved noise: a Bayer order (every 2×2 and 4×4 block holds evenly spread
 // values), so the 4×4 denoise window sees each of the 16 patterns once.
 fn bayer4(p: vec2<u32>) -> f32 {
@@ -174,12 +196,17 @@ fn bayer4(p: vec2<u32>) -> f32 {
     return (f32(index) + 0.5) / 16.0;
 }
 
-// One half-slice's march so far: the slice's occluded sectors, and the previous
-// sample (its sector coordinate, −1 when none, and its distance) for `connect`.
+// One slice's march so far: its occluded sectors, the previous sample of the current
+// half (its sector coordinate, −1 when none, and its distance) for `connect`, and the
+// ends of the occluded intervals nearest V on each half (`near_plus` the least u
+// blocked on the + half, `near_minus` the greatest on the − half; 2 and −1 while none):
+// the directions between them, around V, are exactly open (`visible_sectors`).
 struct March {
     occluded: u32,
     previous_u: f32,
     previous_distance: f32,
+    near_plus: f32,
+    near_minus: f32,
 };
 
 struct SampleLimits {
@@ -245,6 +272,11 @@ fn add_sample(march: ptr<function, March>, slice: Slice, side: f32, p: vec3<f32>
         hi = max(hi, (*march).previous_u);
     }
     (*march).occluded |= sector_bits(lo, hi, limits.sector_offset);
+    if (side > 0.0) {
+        (*march).near_plus = min((*march).near_plus, lo);
+    } else {
+        (*march).near_minus = max((*march).near_minus, hi);
+    }
     (*march).previous_u = u_front;
     (*march).previous_distance = sample_distance;
 }
@@ -340,6 +372,8 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
         slice.horizon_minus = -slice.horizon_plus;
         var march: March;
         march.occluded = 0u;
+        march.near_plus = 2.0;
+        march.near_minus = -1.0;
         for (var half = 0u; half < 2u; half++) {
             let sign = select(-1.0, 1.0, half == 0u);
             march.previous_u = -1.0;
@@ -368,9 +402,8 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
                 add_sample(&march, slice, sign, p, surface_at(q, r.layer, r.eye, march.previous_distance), limits);
             }
         }
-        let occluded = march.occluded;
         let weight = projected_len * slice_total;
-        visible += weight * (1.0 - f32(countOneBits(occluded)) / SECTORS);
+        visible += weight * visible_sectors(march, limits.sector_offset) / SECTORS;
         total += weight;
     }
     var visibility = 1.0;
