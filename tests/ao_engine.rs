@@ -21,10 +21,8 @@ const NEAR: f64 = 0.05;
 
 /// The demo's eyes as vrao eyes (pose from the host's view matrix, an asymmetric frustum each).
 fn eyes() -> Vec<Eye> {
-    let fovs = [
-        Fov { left: -0.85, right: 0.7, up: 0.8, down: -0.8 },
-        Fov { left: -0.7, right: 0.85, up: 0.8, down: -0.8 },
-    ];
+    let fovs =
+        [Fov { left: -0.85, right: 0.7, up: 0.8, down: -0.8 }, Fov { left: -0.7, right: 0.85, up: 0.8, down: -0.8 }];
     demo_eyes()
         .iter()
         .zip(fovs)
@@ -43,7 +41,10 @@ fn host_views(eyes: &[Eye], depth: HostDepth) -> Vec<ViewMatrices> {
     eyes.iter()
         .map(|eye| {
             let [l, r, u, d] = eye.fov.tangents().map(|t| t as f32);
-            ViewMatrices { view: eye.view_from_world().as_mat4(), projection: depth.projection([l, r, u, d], NEAR as f32) }
+            ViewMatrices {
+                view: eye.view_from_world().as_mat4(),
+                projection: depth.projection([l, r, u, d], NEAR as f32),
+            }
         })
         .collect()
 }
@@ -67,7 +68,12 @@ fn scene() -> vrao::Scene {
 }
 
 fn settings(ao: &AoSettings) -> Settings {
-    Settings { profile: HeadsetProfile::with_size("test", WIDTH, HEIGHT), near: NEAR, ao: ao.clone(), ..Settings::default() }
+    Settings {
+        profile: HeadsetProfile::with_size("test", WIDTH, HEIGHT),
+        near: NEAR,
+        ao: ao.clone(),
+        ..Settings::default()
+    }
 }
 
 /// Each eye's final AO from vrao's renderer.
@@ -91,7 +97,12 @@ fn engine_ao(gpu: &vrao::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: b
     let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
     let mut encoder = device.create_command_encoder(&Default::default());
     prepass.record(device, &mut encoder, &views);
-    let frame = AoFrame { depth: &prepass.depth, depth_convention: convention, normals: with_normals.then_some(normals), views: &views };
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: convention,
+        normals: with_normals.then_some(normals),
+        views: &views,
+    };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
     (0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect()
@@ -195,18 +206,33 @@ fn bad_host_input_is_a_typed_error_naming_it() {
     let small = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH / 2, HEIGHT));
     let views = host_views(&eyes(), HostDepth::ReversedInfinite);
     let mut encoder = device.create_command_encoder(&Default::default());
-    let frame = AoFrame { depth: &small.depth, depth_convention: DepthConvention::REVERSED_INFINITE, normals: None, views: &views };
+    let frame = AoFrame {
+        depth: &small.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views: &views,
+    };
     let e = engine.record(&mut encoder, &frame).err().expect("a depth buffer of another size");
     assert!(e.to_string().contains("depth") && e.to_string().contains("does not match"), "{e}");
 
     let right = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT));
-    let frame = AoFrame { depth: &right.depth, depth_convention: DepthConvention::STANDARD_FINITE, normals: None, views: &views };
+    let frame = AoFrame {
+        depth: &right.depth,
+        depth_convention: DepthConvention::STANDARD_FINITE,
+        normals: None,
+        views: &views,
+    };
     let e = engine.record(&mut encoder, &frame).err().expect("a convention the projection contradicts");
     assert!(e.to_string().contains("view 0: projection"), "{e}");
 
     let mut scaled = views.clone();
     scaled[1].view *= glam::Mat4::from_scale(glam::Vec3::splat(2.0));
-    let frame = AoFrame { depth: &right.depth, depth_convention: DepthConvention::REVERSED_INFINITE, normals: None, views: &scaled };
+    let frame = AoFrame {
+        depth: &right.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views: &scaled,
+    };
     let e = engine.record(&mut encoder, &frame).err().expect("a view matrix with scale");
     assert!(e.to_string().contains("view 1: view matrix"), "{e}");
 }

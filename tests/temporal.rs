@@ -202,7 +202,10 @@ fn the_graph_leaves_the_temporal_pass_out_when_it_is_off() {
     let off = Renderer::new(gpu.clone(), &scene, &settings(false, 8)).unwrap();
     let plan = off.plan(2, &[COLOR]).unwrap();
     assert!(!plan.names.contains(&"temporal"));
-    assert!(plan.left_out.iter().any(|(name, why)| *name == "temporal" && why.contains("temporal accumulation is off")), "{plan}");
+    assert!(
+        plan.left_out.iter().any(|(name, why)| *name == "temporal" && why.contains("temporal accumulation is off")),
+        "{plan}"
+    );
     let on = Renderer::new(gpu, &scene, &settings(true, 8)).unwrap();
     assert!(on.plan(2, &[COLOR]).unwrap().names.contains(&"temporal"));
 }

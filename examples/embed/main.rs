@@ -35,8 +35,11 @@ fn main() -> std::process::ExitCode {
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let out = std::path::PathBuf::from(args.iter().find(|a| !a.starts_with("--")).map_or("out", |s| s.as_str()));
-    let depth_kind =
-        if args.iter().any(|a| a == "--standard-depth") { HostDepth::StandardFinite { far: 50.0 } } else { HostDepth::ReversedInfinite };
+    let depth_kind = if args.iter().any(|a| a == "--standard-depth") {
+        HostDepth::StandardFinite { far: 50.0 }
+    } else {
+        HostDepth::ReversedInfinite
+    };
     let with_normals = !args.iter().any(|a| a == "--no-normals");
     std::fs::create_dir_all(&out)?;
 

@@ -159,10 +159,13 @@ impl WindowState {
             .map_err(|e| Error::Device(format!("cannot draw into the window: {e}")))?;
         let caps = surface.get_capabilities(adapter);
         // The eye images hold sRGB-encoded values: a non-sRGB surface shows them as they are.
-        let format =
-            caps.formats.iter().copied().find(|f| !f.is_srgb()).or_else(|| caps.formats.first().copied()).ok_or_else(
-                || Error::Device(format!("{} cannot present to this window", gpu.info.name)),
-            )?;
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .or_else(|| caps.formats.first().copied())
+            .ok_or_else(|| Error::Device(format!("{} cannot present to this window", gpu.info.name)))?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,

@@ -440,8 +440,7 @@ impl Renderer {
             let last = step + 1 == plan.run.len();
             cpu_encode_ms += encode_start.elapsed().as_secs_f64() * 1e3;
             if self.timing == Timing::Serial && !last {
-                let finished =
-                    std::mem::replace(encoder, self.gpu.device.create_command_encoder(&Default::default()));
+                let finished = std::mem::replace(encoder, self.gpu.device.create_command_encoder(&Default::default()));
                 let submitted = Instant::now();
                 self.gpu.queue.submit([finished.finish()]);
                 if wait_each_pass {

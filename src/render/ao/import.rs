@@ -190,7 +190,8 @@ impl ImportPass {
             Slot::Depth.layout_entry(1, wgpu::ShaderStages::FRAGMENT),
             Slot::Layers.layout_entry(2, wgpu::ShaderStages::FRAGMENT),
         ];
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(NAME), entries: &entries });
+        let layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(NAME), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(NAME),
             bind_group_layouts: &[Some(&layout)],

@@ -225,7 +225,8 @@ impl AoEngine {
     /// anything is recorded.
     pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder, frame: &AoFrame) -> Result<AoOutput<'_>> {
         let gpu = self.gpu.clone();
-        let host = self.host.as_mut().ok_or_else(|| Error::input("the renderer's AO engine is driven by the renderer"))?;
+        let host =
+            self.host.as_mut().ok_or_else(|| Error::input("the renderer's AO engine is driven by the renderer"))?;
         let config = &host.config;
         let (eyes, near) = eyes_of(frame, config.views)?;
         let source = ImportSource::check(frame, config)?;
@@ -247,7 +248,8 @@ impl AoEngine {
             current_views: &eyes,
             previous_views: previous,
         };
-        let passes: Vec<&dyn Pass> = std::iter::once(&host.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();
+        let passes: Vec<&dyn Pass> =
+            std::iter::once(&host.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();
         let decls: Vec<_> = passes.iter().map(|p| p.declare(&setup)).collect();
         let imported = if frame.normals.is_some() { vec![HOST_DEPTH, HOST_NORMALS] } else { vec![HOST_DEPTH] };
         let plan = graph::plan(&decls, &[FINAL_AO], &imported)?;
@@ -272,7 +274,11 @@ impl AoEngine {
         host.frame_index += 1;
         host.previous_views = eyes;
         host.last_plan = Some(plan);
-        let target = host.targets.targets.get(&output).ok_or_else(|| Error::Plan(format!("{} was not allocated", output.name())))?;
+        let target = host
+            .targets
+            .targets
+            .get(&output)
+            .ok_or_else(|| Error::Plan(format!("{} was not allocated", output.name())))?;
         Ok(AoOutput { texture: &target.texture, view: &target.array_view })
     }
 }
@@ -304,7 +310,10 @@ fn host_settings(config: &AoConfig, near: f64) -> Result<Settings> {
 /// projection) and the near distance of the first view's projection.
 fn eyes_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, f64)> {
     if frame.views.len() != views as usize {
-        return Err(Error::input(format!("the frame gives {} views' matrices; the engine renders {views}", frame.views.len())));
+        return Err(Error::input(format!(
+            "the frame gives {} views' matrices; the engine renders {views}",
+            frame.views.len()
+        )));
     }
     let mut eyes = Vec::with_capacity(frame.views.len());
     let mut near = 0.0;
@@ -329,7 +338,8 @@ fn rigid_pose(view: &Mat4, what: &str) -> Result<HeadPose> {
     }
     let world_from_view = view.inverse();
     let rotation = glam::DMat3::from_mat4(world_from_view);
-    let orthonormal = (rotation.transpose() * rotation - glam::DMat3::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 1e-3);
+    let orthonormal =
+        (rotation.transpose() * rotation - glam::DMat3::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 1e-3);
     let last_row = view.row(3);
     if !orthonormal || rotation.determinant() < 0.0 || (last_row - glam::DVec4::W).abs().max_element() > 1e-6 {
         return Err(Error::input(format!(
@@ -365,7 +375,11 @@ impl Projection {
         let (p00, p11, p20, p21) = (p.x_axis.x, p.y_axis.y, p.z_axis.x, p.z_axis.y);
         let (p22, p23, p32, p33) = (p.z_axis.z, p.z_axis.w, p.w_axis.z, p.w_axis.w);
         let skew = [p.x_axis.y, p.x_axis.z, p.x_axis.w, p.y_axis.x, p.y_axis.z, p.y_axis.w, p.w_axis.x, p.w_axis.y];
-        if (p23 + 1.0).abs() > 1e-6 || p33.abs() > 1e-9 || skew.iter().any(|e| e.abs() > 1e-9) || p00 <= 0.0 || p11 <= 0.0
+        if (p23 + 1.0).abs() > 1e-6
+            || p33.abs() > 1e-9
+            || skew.iter().any(|e| e.abs() > 1e-9)
+            || p00 <= 0.0
+            || p11 <= 0.0
         {
             return refuse("not a right-handed perspective projection (clip w = -z, no skew)".into());
         }
@@ -460,7 +474,8 @@ mod tests {
 
     #[test]
     fn a_view_matrix_must_be_rigid() {
-        let view = glam::camera::rh::view::look_at_mat4(glam::Vec3::new(1.0, 2.0, 3.0), glam::Vec3::ZERO, glam::Vec3::Y);
+        let view =
+            glam::camera::rh::view::look_at_mat4(glam::Vec3::new(1.0, 2.0, 3.0), glam::Vec3::ZERO, glam::Vec3::Y);
         let pose = rigid_pose(&view, "v").unwrap();
         assert!((pose.position - glam::DVec3::new(1.0, 2.0, 3.0)).length() < 1e-5);
         let eye = Eye { side: EyeSide::Left, pose, fov: fov() };

@@ -129,7 +129,8 @@ mod tests {
     fn a_host_device_is_checked_by_its_limits_and_backend() {
         let vulkan = DeviceSupport { backend: wgpu::Backend::Vulkan, limits: wgpu::Limits::default() };
         assert!(missing_device_capabilities(&vulkan).is_empty());
-        let no_compute = DeviceSupport { backend: wgpu::Backend::Vulkan, limits: wgpu::Limits::downlevel_webgl2_defaults() };
+        let no_compute =
+            DeviceSupport { backend: wgpu::Backend::Vulkan, limits: wgpu::Limits::downlevel_webgl2_defaults() };
         let missing = missing_device_capabilities(&no_compute);
         assert!(missing.iter().any(|m| m.contains("compute")), "{missing:?}");
         let gl = DeviceSupport { backend: wgpu::Backend::Gl, limits: wgpu::Limits::default() };

@@ -171,7 +171,9 @@ impl<'a> FrameContext<'a> {
         'a: 'b,
     {
         debug_assert!(
-            overrides.iter().all(|(r, _)| binds.iter().any(|b| matches!(*b, Bind::Read(x) | Bind::Write(x) if x == *r))),
+            overrides
+                .iter()
+                .all(|(r, _)| binds.iter().any(|b| matches!(*b, Bind::Read(x) | Bind::Write(x) if x == *r))),
             "{}: an override names a resource the binding list does not",
             self.decl.name
         );
