@@ -58,7 +58,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         "'{}' ({} triangles) on {}, {}x{} per eye, {}:",
         scene.name,
         scene.triangle_count(),
-        gpu.adapter.get_info().name,
+        gpu.info.name,
         settings.profile.width,
         settings.profile.height,
         settings.ao.technique.name(),
