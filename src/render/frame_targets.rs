@@ -20,13 +20,14 @@ pub struct FrameTargets {
 }
 
 impl FrameTargets {
-    /// Binds `target` as the imported resource `r` for the next frames. Bind groups that
-    /// held the previous texture are dropped only when the texture changed.
-    pub fn import(&mut self, r: Resource, target: LayeredTarget) {
+    /// Binds `texture` (`layers` layers of its `aspect`) as the imported resource `r` for
+    /// the next frames. Its views and the bind groups that hold them are made anew only
+    /// when the texture changed.
+    pub fn import(&mut self, r: Resource, texture: &wgpu::Texture, aspect: wgpu::TextureAspect, layers: u32) {
         debug_assert!(matches!(r.kind(), Kind::Imported), "{} is not an imported resource", r.name());
-        let same = self.targets.get(&r).is_some_and(|t| t.texture == target.texture && t.layers == target.layers);
+        let same = self.targets.get(&r).is_some_and(|t| t.texture == *texture && t.layers == layers);
         if !same {
-            self.targets.insert(r, target);
+            self.targets.insert(r, LayeredTarget::wrap(texture, r.name(), aspect, layers));
             invalidate_bind_groups();
         }
     }

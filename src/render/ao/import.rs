@@ -8,7 +8,6 @@ use super::{AoConfig, AoFrame, NormalEncoding, NormalSpace, Projection};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, Slot};
 use crate::render::gpu::raster;
-use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource};
 use crate::render::passes::gbuffer::{DEPTH, NORMALS};
@@ -71,7 +70,8 @@ pub struct ImportSource {
 impl ImportSource {
     /// Checks the host's textures and matrices against the engine's configuration; the
     /// error names the input and what is wrong with it.
-    pub fn check(frame: &AoFrame, config: &AoConfig) -> Result<ImportSource> {
+    /// `projections` are the views' projections as [`Projection::of`] read them.
+    pub(crate) fn check(frame: &AoFrame, config: &AoConfig, projections: &[Projection]) -> Result<ImportSource> {
         check_texture("depth", frame.depth, config)?;
         if !DEPTH_FORMATS.contains(&frame.depth.format()) {
             return Err(Error::input(format!(
@@ -93,8 +93,7 @@ impl ImportSource {
             params.unsigned_normals = (normals.encoding == NormalEncoding::Unsigned) as u32;
             params.world_normals = (normals.space == NormalSpace::World) as u32;
         }
-        for (layer, m) in params.layers.iter_mut().zip(frame.views) {
-            let p = Projection::of(&m.projection, frame.depth_convention, "projection")?;
+        for ((layer, m), p) in params.layers.iter_mut().zip(frame.views).zip(projections) {
             let [l, r, u, d] = p.fov.tangents();
             *layer = ImportLayer {
                 view_from_world: m.view.to_cols_array_2d(),
@@ -107,16 +106,6 @@ impl ImportSource {
         params.size = [config.width, config.height];
         params.reversed = frame.depth_convention.reversed_z as u32;
         Ok(ImportSource { params, views: config.views })
-    }
-
-    /// The host's depth as a layered target (its depth aspect, one layer per view).
-    pub fn depth_target(&self, texture: &wgpu::Texture, layers: u32) -> LayeredTarget {
-        wrap(texture, "host depth", wgpu::TextureAspect::DepthOnly, layers)
-    }
-
-    /// The host's normals as a layered target.
-    pub fn normals_target(&self, texture: &wgpu::Texture, layers: u32) -> LayeredTarget {
-        wrap(texture, "host normals", wgpu::TextureAspect::All, layers)
     }
 
     /// The engine's near plane (vrao depth = near / distance).
@@ -148,27 +137,6 @@ fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Resu
         return Err(Error::input(format!("{what}: the texture lacks TEXTURE_BINDING usage")));
     }
     Ok(())
-}
-
-fn wrap(texture: &wgpu::Texture, label: &str, aspect: wgpu::TextureAspect, layers: u32) -> LayeredTarget {
-    let size = texture.size();
-    let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
-        label: Some(label),
-        dimension: Some(wgpu::TextureViewDimension::D2Array),
-        aspect,
-        base_array_layer: 0,
-        array_layer_count: Some(layers),
-        ..Default::default()
-    });
-    LayeredTarget {
-        texture: texture.clone(),
-        array_view,
-        layer_views: Vec::new(),
-        format: texture.format(),
-        width: size.width,
-        height: size.height,
-        layers,
-    }
 }
 
 /// The import pass of a host's engine.

@@ -215,7 +215,7 @@ impl AoEngine {
     }
 
     fn host_mut(&mut self) -> Result<&mut HostState> {
-        self.host.as_mut().ok_or_else(|| Error::input("the renderer's AO engine is driven by the renderer"))
+        self.host.as_mut().ok_or_else(renderer_driven)
     }
 
     /// Records one frame of AO into `encoder` from the host's depth (and normals) and
@@ -225,16 +225,16 @@ impl AoEngine {
     /// anything is recorded.
     pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder, frame: &AoFrame) -> Result<AoOutput<'_>> {
         let gpu = self.gpu.clone();
-        let host =
-            self.host.as_mut().ok_or_else(|| Error::input("the renderer's AO engine is driven by the renderer"))?;
+        // Not host_mut: the chain stays borrowed beside the host state below.
+        let host = self.host.as_mut().ok_or_else(renderer_driven)?;
         let config = &host.config;
-        let (eyes, near) = eyes_of(frame, config.views)?;
-        let source = ImportSource::check(frame, config)?;
-        let settings = host_settings(config, near)?;
+        let (eyes, projections) = views_of(frame, config.views)?;
+        let source = ImportSource::check(frame, config, &projections)?;
+        let settings = host_settings(config, projections[0].near)?;
         let layers = config.views;
-        host.targets.import(HOST_DEPTH, source.depth_target(frame.depth, layers));
+        host.targets.import(HOST_DEPTH, frame.depth, wgpu::TextureAspect::DepthOnly, layers);
         if let Some(normals) = &frame.normals {
-            host.targets.import(HOST_NORMALS, source.normals_target(normals.texture, layers));
+            host.targets.import(HOST_NORMALS, normals.texture, wgpu::TextureAspect::All, layers);
         }
         host.import.set_source(source);
         let previous = (host.previous_views.len() == eyes.len()).then_some(&host.previous_views[..]);
@@ -283,6 +283,11 @@ impl AoEngine {
     }
 }
 
+/// The refusal of a host call on the renderer's own engine.
+fn renderer_driven() -> Error {
+    Error::input("the renderer's AO engine is driven by the renderer")
+}
+
 /// The renderer settings the engine's passes read: the host's AO settings, its size as
 /// the profile's, and its near plane. SSDO is refused (see the module's notes).
 fn host_settings(config: &AoConfig, near: f64) -> Result<Settings> {
@@ -307,8 +312,9 @@ fn host_settings(config: &AoConfig, near: f64) -> Result<Settings> {
 }
 
 /// Each view as an [`Eye`] (pose from the view matrix, field of view from the
-/// projection) and the near distance of the first view's projection.
-fn eyes_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, f64)> {
+/// projection), and each view's projection as read (the engine's near plane is the
+/// first one's).
+fn views_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, Vec<Projection>)> {
     if frame.views.len() != views as usize {
         return Err(Error::input(format!(
             "the frame gives {} views' matrices; the engine renders {views}",
@@ -316,17 +322,15 @@ fn eyes_of(frame: &AoFrame, views: u32) -> Result<(Vec<Eye>, f64)> {
         )));
     }
     let mut eyes = Vec::with_capacity(frame.views.len());
-    let mut near = 0.0;
+    let mut projections = Vec::with_capacity(frame.views.len());
     for (index, m) in frame.views.iter().enumerate() {
         let side = if index == 0 { EyeSide::Left } else { EyeSide::Right };
         let projection = Projection::of(&m.projection, frame.depth_convention, &format!("view {index}: projection"))?;
         let pose = rigid_pose(&m.view, &format!("view {index}: view matrix"))?;
-        if index == 0 {
-            near = projection.near;
-        }
         eyes.push(Eye { side, pose, fov: projection.fov });
+        projections.push(projection);
     }
-    Ok((eyes, near))
+    Ok((eyes, projections))
 }
 
 /// The head pose whose view-from-world is `view`: refused unless it is a finite rigid

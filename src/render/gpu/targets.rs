@@ -57,6 +57,28 @@ impl LayeredTarget {
         LayeredTarget::new(device, label, format, (1, 1, 2), wgpu::TextureUsages::TEXTURE_BINDING)
     }
 
+    /// A texture someone else made (a host's depth buffer), seen as `layers` layers of its
+    /// `aspect`; no per-layer views.
+    pub fn wrap(texture: &wgpu::Texture, label: &str, aspect: wgpu::TextureAspect, layers: u32) -> LayeredTarget {
+        let size = texture.size();
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(label),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            aspect,
+            array_layer_count: Some(layers),
+            ..Default::default()
+        });
+        LayeredTarget {
+            texture: texture.clone(),
+            array_view,
+            layer_views: Vec::new(),
+            format: texture.format(),
+            width: size.width,
+            height: size.height,
+            layers,
+        }
+    }
+
     /// (width, height, layers).
     pub fn extent(&self) -> (u32, u32, u32) {
         (self.width, self.height, self.layers)
