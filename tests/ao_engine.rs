@@ -62,6 +62,7 @@ fn scene() -> vrao::Scene {
             normals: m.normals,
             indices: m.indices,
             material: 0,
+            node: None,
         })
         .collect();
     common::bare_scene(meshes)

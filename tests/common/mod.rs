@@ -41,6 +41,7 @@ pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Me
     Mesh {
         name: name.into(),
         origin: center,
+        node: None,
         positions: vec![
             glam::Vec3::new(-h, -h, 0.0),
             glam::Vec3::new(h, -h, 0.0),
@@ -68,6 +69,7 @@ pub fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Me
     Mesh {
         name: name.into(),
         origin: center,
+        node: None,
         positions,
         normals: vec![glam::Vec3::Z; n],
         uvs: vec![glam::Vec2::ZERO; n],
@@ -86,6 +88,7 @@ pub fn bare_scene(meshes: Vec<Mesh>) -> Scene {
         lights: Vec::new(),
         environment: None,
         head: HeadPath::fixed(vrao::HeadPose::IDENTITY),
+        nodes: Vec::new(),
     }
 }
 
@@ -113,7 +116,7 @@ pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize
         }
     }
     let uvs = vec![glam::Vec2::ZERO; positions.len()];
-    Mesh { name: name.into(), origin: center, positions, normals, uvs, indices, material }
+    Mesh { name: name.into(), origin: center, positions, normals, uvs, indices, material, node: None }
 }
 
 /// The world position of every pixel of a depth readback (reversed-Z, one layer per eye,

@@ -320,11 +320,13 @@ mod tests {
                 positions,
                 indices: vec![0, 1, 2, 0, 2, 3],
                 material: 0,
+                node: None,
             }],
             materials: vec![Material::plain("white", Vec3::ONE)],
             lights: vec![],
             environment: None,
             head: HeadPath::fixed(HeadPose::IDENTITY),
+            nodes: Vec::new(),
         }
     }
 

@@ -138,7 +138,7 @@ fn sphere_mesh(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
         }
     }
     let uvs = vec![Vec2::ZERO; positions.len()];
-    Mesh { name: "ball".into(), origin: centre, positions, normals, uvs, indices, material: 0 }
+    Mesh { name: "ball".into(), origin: centre, positions, normals, uvs, indices, material: 0, node: None }
 }
 
 fn floor_mesh(half: f32) -> Mesh {
@@ -156,6 +156,7 @@ fn floor_mesh(half: f32) -> Mesh {
         positions,
         indices: vec![0, 1, 2, 0, 2, 3],
         material: 0,
+        node: None,
     }
 }
 
@@ -167,6 +168,7 @@ fn custom_scene(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light>,
         lights,
         environment: env,
         head: HeadPath::fixed(HeadPose::look_at(DVec3::new(0.0, 1.0, 3.0), DVec3::ZERO).unwrap()),
+        nodes: Vec::new(),
     }
 }
 

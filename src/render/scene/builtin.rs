@@ -91,6 +91,7 @@ pub fn load(name: &str) -> Result<Scene> {
 /// An outdoor scene: white materials, the default sun and the default sky.
 pub(super) fn open_scene(name: &str, meshes: Vec<Mesh>, head: HeadPose) -> Scene {
     Scene {
+        nodes: Vec::new(),
         name: name.into(),
         meshes,
         materials: vec![Material::plain("white", Vec3::splat(WHITE))],
@@ -141,6 +142,7 @@ fn room() -> Scene {
     let box_centre = (ROOM_BOX_MIN + ROOM_BOX_MAX) * 0.5;
     Scene {
         name: "room".into(),
+        nodes: Vec::new(),
         meshes,
         materials: vec![
             Material::plain("white", Vec3::splat(ROOM_WHITE)),
@@ -295,6 +297,7 @@ impl Builder {
         Mesh {
             name: name.into(),
             origin,
+            node: None,
             uvs: vec![glam::Vec2::ZERO; positions.len()],
             positions,
             normals: self.normals,

@@ -167,6 +167,7 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
     };
 
     let mut scene = Scene {
+        nodes: Vec::new(),
         name: file
             .name
             .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()),

@@ -101,6 +101,7 @@ pub(super) fn furnished() -> Scene {
     meshes.extend(shelves());
     meshes.push(blind());
     Scene {
+        nodes: Vec::new(),
         name: "furnished".into(),
         meshes,
         materials: materials(),

@@ -4,6 +4,7 @@
 //! (`builtin.rs`, addressed as `builtin:NAME`). Every loader validates what it reads and
 //! returns [`crate::render::error::Error::Input`] naming the file and line for anything malformed.
 
+pub mod animation;
 pub mod builtin;
 pub mod edge_cases;
 pub mod environment;
@@ -15,9 +16,10 @@ pub mod obj;
 
 use crate::render::error::{Error, Result};
 use crate::render::stereo::HeadPose;
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::path::{Path, PathBuf};
 
+pub use animation::{Interpolation, Node, NodeTracks, Track, Trs};
 pub use environment::Environment;
 
 /// A triangle mesh. Positions are stored relative to `origin` (f64) so that a scene
@@ -39,6 +41,10 @@ pub struct Mesh {
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// The animated node this mesh moves with ([`Scene::nodes`]); `None` for static
+    /// geometry, which is in world space. With a node, `origin` and `positions` are in the
+    /// node's local frame.
+    pub node: Option<usize>,
 }
 
 impl Mesh {
@@ -63,6 +69,37 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
+/// What a material's alpha (its `alpha` factor times the texture's alpha) does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is solid.
+    Opaque,
+    /// Alpha-tested: where alpha is below `cutoff` the surface is a hole for every pass
+    /// (G-buffer, shadow maps, depth peel) and for the reference tracer's rays.
+    Mask {
+        /// The threshold, in [0, 1].
+        cutoff: f32,
+    },
+    /// Blended (glTF `BLEND`, OBJ `d` < 1 without `map_d`): AO has no transparency, so vrao
+    /// draws it alpha-tested at [`BLEND_CUTOFF`]: mostly opaque texels occlude and
+    /// receive AO, mostly transparent ones (glass) are holes.
+    Blend,
+}
+
+/// The alpha below which a [`AlphaMode::Blend`] texel is a hole.
+pub const BLEND_CUTOFF: f32 = 0.5;
+
+impl AlphaMode {
+    /// The alpha below which a texel is a hole, or `None` for a solid material.
+    pub fn cutoff(&self) -> Option<f32> {
+        match *self {
+            AlphaMode::Opaque => None,
+            AlphaMode::Mask { cutoff } => Some(cutoff),
+            AlphaMode::Blend => Some(BLEND_CUTOFF),
+        }
+    }
+}
+
 /// A diffuse material, as an MTL entry describes it.
 #[derive(Clone, Debug)]
 pub struct Material {
@@ -72,14 +109,36 @@ pub struct Material {
     pub diffuse: Vec3,
     /// Emitted radiance (MTL `Ke`), linear, unbounded.
     pub emissive: Vec3,
-    /// Diffuse texture (MTL `map_Kd`), multiplied with `diffuse`.
+    /// Diffuse texture (MTL `map_Kd`), multiplied with `diffuse`; its alpha channel
+    /// multiplies `alpha`.
     pub diffuse_texture: Option<Texture>,
+    /// Alpha factor (MTL `d`, glTF `baseColorFactor.a`), in [0, 1].
+    pub alpha: f32,
+    /// What alpha does (opaque, alpha-tested or blended).
+    pub alpha_mode: AlphaMode,
 }
 
 impl Material {
     /// A material of one diffuse colour, neither emissive nor textured.
     pub fn plain(name: &str, diffuse: Vec3) -> Self {
-        Material { name: name.into(), diffuse, emissive: Vec3::ZERO, diffuse_texture: None }
+        Material {
+            name: name.into(),
+            diffuse,
+            emissive: Vec3::ZERO,
+            diffuse_texture: None,
+            alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
+        }
+    }
+
+    /// The alpha below which this material is a hole, or `None` when it is solid
+    /// everywhere (opaque, or an alpha test that nothing can fail).
+    pub fn alpha_cutoff(&self) -> Option<f32> {
+        let cutoff = self.alpha_mode.cutoff()?;
+        let texture_alpha_min =
+            self.diffuse_texture.as_ref().map_or(255, |t| t.rgba8.chunks_exact(4).map(|c| c[3]).min().unwrap_or(255));
+        let lowest = self.alpha * texture_alpha_min as f32 / 255.0;
+        (lowest < cutoff).then_some(cutoff)
     }
 }
 
@@ -219,18 +278,81 @@ pub struct Scene {
     pub environment: Option<Environment>,
     /// The head pose over time (one key for a still head).
     pub head: HeadPath,
+    /// The motion hierarchy that moving meshes hang from ([`Mesh::node`]); empty for a
+    /// still scene (`animation.rs`).
+    pub nodes: Vec<Node>,
 }
 
 impl Scene {
-    /// World-space bounds of every mesh.
+    /// World-space bounds of every mesh (moving ones where they are at time 0).
     pub fn bounds(&self) -> Aabb {
+        let transforms = self.node_transforms(0.0);
         let mut b = Aabb::EMPTY;
         for m in &self.meshes {
-            for p in &m.positions {
-                b.extend(m.origin + p.as_dvec3());
+            match m.node.and_then(|n| transforms.get(n)) {
+                Some(world) => {
+                    for p in &m.positions {
+                        b.extend(world.transform_point3(m.origin + p.as_dvec3()));
+                    }
+                }
+                None => {
+                    for p in &m.positions {
+                        b.extend(m.origin + p.as_dvec3());
+                    }
+                }
             }
         }
         b
+    }
+
+    /// Whether some mesh moves (hangs from an animated node).
+    pub fn is_animated(&self) -> bool {
+        self.meshes.iter().any(|m| m.node.is_some()) && self.animation_period() > 0.0
+    }
+
+    /// Whether some material is alpha-tested (or blended) and can actually fail the test.
+    pub fn has_alpha_test(&self) -> bool {
+        self.materials.iter().any(|m| m.alpha_cutoff().is_some())
+    }
+
+    /// The loop period of the animation: the last key time over every track (0 when
+    /// nothing is animated).
+    pub fn animation_period(&self) -> f64 {
+        self.nodes.iter().map(|n| n.tracks.end()).fold(0.0, f64::max)
+    }
+
+    /// `t` wrapped into the animation's loop period (0 when nothing moves; non-finite `t`
+    /// gives 0).
+    pub fn animation_time(&self, t: f64) -> f64 {
+        let period = self.animation_period();
+        if period > 0.0 && t.is_finite() {
+            t.rem_euclid(period)
+        } else {
+            0.0
+        }
+    }
+
+    /// World-from-local transforms of every node at scene time `t` (wrapped into the loop).
+    pub fn node_transforms(&self, t: f64) -> Vec<DMat4> {
+        animation::world_transforms(&self.nodes, self.animation_time(t))
+    }
+
+    /// The scene frozen at time `t`: every moving mesh baked into world space, no nodes
+    /// (what the reference tracer renders for a frame at that time).
+    pub fn at_time(&self, t: f64) -> Scene {
+        if self.nodes.is_empty() {
+            return self.clone();
+        }
+        let transforms = self.node_transforms(t);
+        let meshes = self
+            .meshes
+            .iter()
+            .map(|m| match m.node.and_then(|n| transforms.get(n)) {
+                Some(world) => bake(m, world),
+                None => m.clone(),
+            })
+            .collect();
+        Scene { meshes, nodes: Vec::new(), ..self.clone() }
     }
 
     /// A default occlusion radius for this scene: 8 % of its bounding-box diagonal,
@@ -267,6 +389,30 @@ impl Scene {
             Some(ext) if ext == "obj" => obj::load_bare(path),
             _ => Err(Error::in_file(path, "unknown scene type: expected builtin:NAME, a .toml scene file or an .obj")),
         }
+    }
+}
+
+/// `mesh` moved into world space by `world` (positions and normals; a mirroring transform
+/// reverses the winding).
+fn bake(mesh: &Mesh, world: &DMat4) -> Mesh {
+    let points: Vec<DVec3> =
+        mesh.positions.iter().map(|p| world.transform_point3(mesh.origin + p.as_dvec3())).collect();
+    let (origin, positions) = Mesh::recentre(&points);
+    let normal_matrix = glam::DMat3::from_mat4(*world).inverse().transpose();
+    let normals = mesh.normals.iter().map(|n| (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()).collect();
+    let mut indices = mesh.indices.clone();
+    if glam::DMat3::from_mat4(*world).determinant() < 0.0 {
+        indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
+    }
+    Mesh {
+        name: mesh.name.clone(),
+        origin,
+        positions,
+        normals,
+        uvs: mesh.uvs.clone(),
+        indices,
+        material: mesh.material,
+        node: None,
     }
 }
 

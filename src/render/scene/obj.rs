@@ -103,6 +103,7 @@ pub fn load_bare(path: &Path) -> Result<Scene> {
         materials,
         environment: Some(Environment::default_sky()),
         head: HeadPath::fixed(crate::render::stereo::HeadPose::IDENTITY),
+        nodes: Vec::new(),
     };
     scene.head = HeadPath::fixed(scene.bounds().framing_pose());
     Ok(scene)
@@ -339,6 +340,8 @@ impl MtlMaterial {
             diffuse: self.diffuse.unwrap_or(Vec3::splat(DEFAULT_DIFFUSE)).clamp(Vec3::ZERO, Vec3::ONE),
             emissive: self.emissive,
             diffuse_texture,
+            alpha: 1.0,
+            alpha_mode: super::AlphaMode::Opaque,
         })
     }
 }
@@ -452,6 +455,7 @@ fn convert(model: tobj::Model, material: usize) -> Option<Mesh> {
     Some(Mesh {
         name: model.name,
         origin,
+        node: None,
         positions: geometry.positions,
         normals: geometry.normals,
         uvs: geometry.uvs,
@@ -516,6 +520,7 @@ mod tests {
             uvs: vec![Vec2::ZERO; 4],
             indices: vec![0, 2, 1, 0, 3, 2],
             material: 0,
+            node: None,
         };
         let mut lamp = Material::plain("lamp", Vec3::ONE);
         lamp.emissive = Vec3::new(4.0, 2.0, 0.0);
