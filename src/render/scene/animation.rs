@@ -195,15 +195,19 @@ pub struct Node {
     /// Index of the parent in [`super::Scene::nodes`] (always smaller than this node's), or
     /// `None` for a node placed in the world.
     pub parent: Option<usize>,
-    /// The transform when no track overrides it. For a root node this includes every
-    /// static ancestor's transform (world from local).
+    /// A fixed transform outside the animated one: the node's local transform is
+    /// `base · TRS(t)`. For a root node it is the world transform of its static ancestors
+    /// (identity when it sits in the world); for a static node given as a matrix (glTF
+    /// `matrix`, which cannot be animated) it is that matrix with `rest` the identity.
+    pub base: DMat4,
+    /// The TRS when no track overrides it.
     pub rest: Trs,
     /// The animated properties.
     pub tracks: NodeTracks,
 }
 
 impl Node {
-    /// The local transform at `t` seconds (already wrapped into the loop period).
+    /// The local transform (`base · TRS`) at `t` seconds (already wrapped into the loop period).
     pub fn local_at(&self, t: f64) -> DMat4 {
         let mut trs = self.rest;
         if let Some(track) = &self.tracks.translation {
@@ -215,7 +219,7 @@ impl Node {
         if let Some(track) = &self.tracks.scale {
             trs.scale = track.sample(t);
         }
-        trs.matrix()
+        self.base * trs.matrix()
     }
 }
 
@@ -287,12 +291,14 @@ mod tests {
             Node {
                 name: "hinge".into(),
                 parent: None,
+                base: DMat4::IDENTITY,
                 rest: Trs { translation: DVec3::new(1.0, 0.0, 0.0), ..Trs::IDENTITY },
                 tracks: NodeTracks { rotation: Some(spin), ..Default::default() },
             },
             Node {
                 name: "door".into(),
                 parent: Some(0),
+                base: DMat4::IDENTITY,
                 rest: Trs { translation: DVec3::new(0.5, 0.0, 0.0), ..Trs::IDENTITY },
                 tracks: NodeTracks::default(),
             },
