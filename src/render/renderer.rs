@@ -18,10 +18,11 @@ use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::timing::{FrameTiming, PassTimer};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{self, Plan, Resource};
-use crate::render::passes::{self, FrameContext, FrameSetup, Pass};
+use crate::render::passes::{self, FrameContext, FrameMotion, FrameSetup, Pass};
 use crate::render::scene::Scene;
 use crate::render::settings::{Settings, StereoMode};
 use crate::render::stereo::Eye;
+use glam::DVec3;
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -124,6 +125,13 @@ pub struct Renderer {
     /// Frames rendered so far, and the views of the last one (temporal reuse).
     frame_index: u64,
     previous_views: Vec<Eye>,
+    /// The scene time of the next frame (animation) and of the previous one.
+    scene_time: f64,
+    previous_scene_time: Option<f64>,
+    /// Each moving object's node and local bounding sphere (centre, radius).
+    mover_bounds: Vec<(usize, DVec3, f64)>,
+    /// What moves in the frame being rendered.
+    motion: FrameMotion,
     /// The last plan and what it was made for: kept while nothing it depends on changes.
     plan_cache: Option<(PlanKey, Plan)>,
     /// Submitted frames the GPU has not been seen to finish, oldest first.
@@ -182,6 +190,8 @@ impl Renderer {
         crate::render::gpu::kernel::take_shader_error()?;
         let timer = PassTimer::new(&gpu)?;
         gpu.take_error()?;
+        let mover_bounds = mover_bounds(scene, &gpu_scene);
+        let motion = FrameMotion { vectors: gpu_scene.has_moving_objects(), movers: Vec::new() };
         Ok(Renderer {
             gpu,
             scene: scene.clone(),
@@ -197,6 +207,10 @@ impl Renderer {
             timing: Timing::Pipelined,
             frame_index: 0,
             previous_views: Vec::new(),
+            scene_time: 0.0,
+            previous_scene_time: None,
+            mover_bounds,
+            motion,
             plan_cache: None,
             in_flight: VecDeque::new(),
             frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
@@ -250,6 +264,17 @@ impl Renderer {
         Ok(())
     }
 
+    /// The scene time (seconds) of the next frame: where animated objects are. The frame
+    /// after it moves them from there (motion vectors), unless the history is reset.
+    pub fn set_scene_time(&mut self, seconds: f64) {
+        self.scene_time = if seconds.is_finite() { seconds } else { 0.0 };
+    }
+
+    /// The scene time of the next frame.
+    pub fn scene_time(&self) -> f64 {
+        self.scene_time
+    }
+
     /// How the next frames are submitted and timed.
     pub fn set_timing(&mut self, timing: Timing) {
         self.timing = timing;
@@ -277,6 +302,7 @@ impl Renderer {
             frame_index: self.frame_index,
             current_views: &[],
             previous_views: (self.previous_views.len() == views as usize).then_some(&self.previous_views[..]),
+            motion: &self.motion,
         }
     }
 
@@ -385,6 +411,7 @@ impl Renderer {
         }
         self.frame_index += 1;
         self.previous_views = views.to_vec();
+        self.previous_scene_time = Some(self.scene_time);
         let finished = self.timer.finished();
         self.gpu.take_error()?;
         let frame = self.frame_index - 1;
@@ -403,6 +430,7 @@ impl Renderer {
         let mut targets = std::mem::take(&mut self.targets);
         targets.allocate(&self.gpu.device, &plan, &self.setup(layers));
         self.targets = targets;
+        self.update_motion(layers);
         let lighting = FrameLighting::of(&self.scene, &self.gpu_scene);
         self.frame.update(&self.gpu.queue, &lighting, views, &self.settings);
         self.frame.update_ao(&self.gpu.queue, &self.settings, self.frame_index);
@@ -483,6 +511,32 @@ impl Renderer {
         Ok((frames_in_flight, last_wall_ms))
     }
 
+    /// Moves the animated objects to this frame's scene time (from the previous frame's,
+    /// when there is a history of as many views) and finds the spheres around them.
+    fn update_motion(&mut self, layers: u32) {
+        if self.mover_bounds.is_empty() {
+            return;
+        }
+        let has_history = self.previous_views.len() == layers as usize;
+        let previous = self.previous_scene_time.filter(|_| has_history);
+        self.gpu_scene.set_time(&self.gpu.queue, &self.scene, self.scene_time, previous);
+        let anchor = self.gpu_scene.anchor;
+        let now = self.scene.node_transforms(self.scene_time);
+        let before = previous.map(|t| self.scene.node_transforms(t));
+        let mut movers = Vec::new();
+        for &(node, centre, radius) in &self.mover_bounds {
+            for transforms in std::iter::once(&now).chain(before.as_ref()) {
+                let world = transforms[node];
+                let c = world.transform_point3(centre) - anchor;
+                // The longest column: the largest stretch of a rotation-and-scale.
+                let m = glam::DMat3::from_mat4(world);
+                let scale = m.x_axis.length().max(m.y_axis.length()).max(m.z_axis.length());
+                movers.push([c.x as f32, c.y as f32, c.z as f32, (radius * scale) as f32]);
+            }
+        }
+        self.motion.movers = movers;
+    }
+
     /// The plan of the last frame, if one was rendered.
     pub fn last_plan(&self) -> Option<&Plan> {
         self.plan_cache.as_ref().map(|(_, plan)| plan)
@@ -516,4 +570,22 @@ impl Renderer {
         }
         readback::read_layers_f32(&self.gpu, &target)
     }
+}
+
+/// Each moving object's node with the sphere (centre and radius, in the node's local
+/// frame) around its meshes.
+fn mover_bounds(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, DVec3, f64)> {
+    gpu_scene
+        .object_nodes
+        .iter()
+        .map(|&node| {
+            let mut bounds = crate::render::scene::Aabb::EMPTY;
+            for mesh in scene.meshes.iter().filter(|m| m.node == Some(node)) {
+                mesh.positions.iter().for_each(|p| bounds.extend(mesh.origin + p.as_dvec3()));
+            }
+            let radius = if bounds.is_empty() { 0.0 } else { 0.5 * bounds.size().length() };
+            let centre = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
+            (node, centre, radius)
+        })
+        .collect()
 }

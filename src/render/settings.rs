@@ -341,6 +341,11 @@ pub struct Temporal {
     /// frames (at least 4). Screen-space occlusion changes with the view, so a long
     /// mean lags a turning head (ghosting); a still head keeps the whole window. 0 = off.
     pub motion_px: f32,
+    /// In a scene that moves: reproject each pixel by its motion vector (its object's
+    /// motion and the eye's) and keep only a short history, clamped to this frame's
+    /// neighbourhood, within the AO radius of a moving object. Off: the eyes alone, as
+    /// in a still scene (what `vrao temporal --motion` compares against).
+    pub object_motion: bool,
 }
 
 impl Default for Temporal {
@@ -352,6 +357,7 @@ impl Default for Temporal {
             max_frames: 16,
             confidence_bias: 0.1,
             motion_px: 0.5,
+            object_motion: true,
         }
     }
 }

@@ -105,6 +105,11 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
             }
             None => h.u32(0),
         }
+        // Only alpha-tested materials hash their alpha, so keys of solid scenes stay as they were.
+        if let Some(cutoff) = m.alpha_cutoff() {
+            h.u32(2);
+            h.f32s(&[m.alpha, cutoff]);
+        }
     }
     h.u64(scene.lights.len() as u64);
     for light in &scene.lights {

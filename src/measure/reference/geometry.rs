@@ -34,6 +34,19 @@ pub(crate) struct SurfaceMaterial {
     pub diffuse: Vec3,
     pub emissive: Vec3,
     pub texture: Option<Texture>,
+    /// Alpha factor and alpha-test cutoff: rays pass through texels whose alpha (factor
+    /// × the texture's, filtered as the GPU filters it) is below the cutoff.
+    pub alpha: f32,
+    pub cutoff: Option<f32>,
+}
+
+impl SurfaceMaterial {
+    /// Whether a ray passes through this material at `uv` (an alpha-tested hole).
+    fn is_hole(&self, uv: Vec2) -> bool {
+        let Some(cutoff) = self.cutoff else { return false };
+        let alpha = self.alpha * self.texture.as_ref().map_or(1.0, |t| sample_alpha(t, uv));
+        alpha < cutoff
+    }
 }
 
 /// The closest hit along a ray: distance and barycentric weights of v1 and v2.
@@ -67,6 +80,8 @@ pub(crate) struct SceneGeometry {
     tris: Vec<Tri>,
     attributes: Vec<TriAttributes>,
     pub materials: Vec<SurfaceMaterial>,
+    /// Whether some material is alpha-tested (rays then test each hit's alpha).
+    has_holes: bool,
 }
 
 impl SceneGeometry {
@@ -74,6 +89,15 @@ impl SceneGeometry {
     /// non-finite vertex or no area are left out (they rasterise to nothing); an index or
     /// material out of range is an input error.
     pub fn build(scene: &Scene, anchor: DVec3) -> Result<SceneGeometry> {
+        // A scene that moves is traced frozen: callers pass `Scene::at_time` of the
+        // frame's time; one that is not frozen is traced at time 0.
+        let frozen;
+        let scene = if scene.nodes.is_empty() {
+            scene
+        } else {
+            frozen = scene.at_time(0.0);
+            &frozen
+        };
         let mut tris = Vec::with_capacity(scene.triangle_count());
         let mut attributes = Vec::with_capacity(scene.triangle_count());
         for mesh in &scene.meshes {
@@ -127,7 +151,7 @@ impl SceneGeometry {
             attributes = bvh.primitive_indices.iter().map(|&i| attributes[i as usize]).collect();
             Some(bvh)
         };
-        let materials = scene
+        let materials: Vec<SurfaceMaterial> = scene
             .materials
             .iter()
             .map(|m| SurfaceMaterial {
@@ -136,9 +160,12 @@ impl SceneGeometry {
                 texture: m.diffuse_texture.clone().filter(|t| {
                     t.width > 0 && t.height > 0 && t.rgba8.len() as u64 == 4 * t.width as u64 * t.height as u64
                 }),
+                alpha: m.alpha,
+                cutoff: m.alpha_cutoff(),
             })
             .collect();
-        Ok(SceneGeometry { bvh, tris, attributes, materials })
+        let has_holes = materials.iter().any(|m| m.cutoff.is_some());
+        Ok(SceneGeometry { bvh, tris, attributes, materials, has_holes })
     }
 
     #[cfg(test)]
@@ -146,8 +173,14 @@ impl SceneGeometry {
         self.tris.len()
     }
 
+    /// The uv at barycentrics (b1, b2) of leaf-order triangle `prim`.
+    fn uv_at(&self, prim: usize, b1: f32, b2: f32) -> Vec2 {
+        let a = &self.attributes[prim];
+        a.uvs[0] * (1.0 - b1 - b2) + a.uvs[1] * b1 + a.uvs[2] * b2
+    }
+
     /// The closest hit with t in (`tmin`, `tmax`) along unit `dir` from `origin`, ignoring
-    /// triangle `skip` (`u32::MAX` for none).
+    /// triangle `skip` (`u32::MAX` for none) and alpha-tested holes.
     pub fn closest(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         // obvhs's box test takes the sign of a zero component from its bits but selects the
@@ -163,6 +196,7 @@ impl SceneGeometry {
             }
             // The traversal keeps a hit only when it is strictly closer than its tmax.
             match pre.intersect(&self.tris[id], ray.tmin, ray.tmax) {
+                Some((_, b1, b2)) if self.has_holes && self.is_hole(id, b1, b2) => f32::INFINITY,
                 Some((t, b1, b2)) if t < ray.tmax => {
                     best = Some(Hit { t, prim: id as u32, b1, b2 });
                     t
@@ -173,6 +207,12 @@ impl SceneGeometry {
         // The traversal accepted exactly the hits recorded, each closer than the last.
         debug_assert!(best.is_none_or(|b| hit.t == b.t && hit.primitive_id == b.prim));
         best
+    }
+
+    /// Whether the hit at (b1, b2) of `prim` falls in an alpha-tested hole.
+    fn is_hole(&self, prim: usize, b1: f32, b2: f32) -> bool {
+        let material = &self.materials[self.attributes[prim].material as usize];
+        material.cutoff.is_some() && material.is_hole(self.uv_at(prim, b1, b2))
     }
 
     /// The attributes at `hit`.
@@ -299,6 +339,23 @@ pub(crate) fn sample_texture(texture: &Texture, uv: Vec2) -> Vec3 {
     let top = texel(x0, y0).lerp(texel(x0 + 1, y0), fx);
     let bottom = texel(x0, y0 + 1).lerp(texel(x0 + 1, y0 + 1), fx);
     top.lerp(bottom, fy)
+}
+
+/// Bilinear lookup of a texture's alpha (linear bytes, as the GPU filters them), with
+/// the addressing of [`sample_texture`].
+pub(crate) fn sample_alpha(texture: &Texture, uv: Vec2) -> f32 {
+    let (w, h) = (texture.width as i64, texture.height as i64);
+    let uv = if uv.is_finite() { uv } else { Vec2::ZERO };
+    let x = uv.x as f64 * w as f64 - 0.5;
+    let y = (uv.y as f64 * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let texel =
+        |x: i64, y: i64| texture.rgba8[4 * (y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize + 3] as f32 / 255.0;
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let top = texel(x0, y0) + (texel(x0 + 1, y0) - texel(x0, y0)) * fx;
+    let bottom = texel(x0, y0 + 1) + (texel(x0 + 1, y0 + 1) - texel(x0, y0 + 1)) * fx;
+    top + (bottom - top) * fy
 }
 
 #[cfg(test)]

@@ -141,6 +141,8 @@ struct HostState {
     frame_index: u64,
     previous_views: Vec<Eye>,
     last_plan: Option<Plan>,
+    /// Whether this frame has the host's motion vectors.
+    motion: passes::FrameMotion,
 }
 
 impl AoEngine {
@@ -163,6 +165,7 @@ impl AoEngine {
             frame_index: 0,
             previous_views: Vec::new(),
             last_plan: None,
+            motion: passes::FrameMotion::default(),
         };
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
@@ -247,6 +250,7 @@ impl AoEngine {
             frame_index: host.frame_index,
             current_views: &eyes,
             previous_views: previous,
+            motion: &host.motion,
         };
         let passes: Vec<&dyn Pass> =
             std::iter::once(&host.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();

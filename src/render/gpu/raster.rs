@@ -41,6 +41,9 @@ pub struct MeshPipeline<'a> {
     pub fragment: Option<(&'a str, &'a [Option<wgpu::ColorTargetState>])>,
     /// Multiview's view mask, if the pipeline draws every layer at once.
     pub multiview_mask: Option<std::num::NonZeroU32>,
+    /// Whether the fragment stage discards alpha-tested holes (mesh.wgsl's `ALPHA_TEST`
+    /// override; the module must include mesh.wgsl and have a fragment stage).
+    pub alpha_test: bool,
 }
 
 /// A pipeline that draws the scene's meshes two-sided, writing depth (OBJ windings are
@@ -48,6 +51,11 @@ pub struct MeshPipeline<'a> {
 /// faces, and both faces of a surface cast shadows).
 pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipeline {
     let (format, compare) = p.depth;
+    let alpha_constants = [("ALPHA_TEST", 1.0)];
+    let fragment_options = wgpu::PipelineCompilationOptions {
+        constants: if p.alpha_test { &alpha_constants } else { &[] },
+        ..Default::default()
+    };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(p.label),
         layout: Some(p.layout),
@@ -69,7 +77,7 @@ pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipe
         fragment: p.fragment.map(|(entry, targets)| wgpu::FragmentState {
             module: p.module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: fragment_options,
             targets,
         }),
         multiview_mask: p.multiview_mask,

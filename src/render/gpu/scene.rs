@@ -1,11 +1,18 @@
 //! The scene on the GPU: one vertex and one index buffer for all meshes, positions
-//! relative to an f64 anchor, and one uniform + texture per material.
+//! relative to an f64 anchor, one uniform + texture per material, and one transform slot
+//! per moving object.
+//!
+//! Static meshes are uploaded in the anchored world frame and drawn with object 0, whose
+//! transform is the identity (exact in f32: the multiply changes no bit). A moving mesh
+//! ([`crate::render::scene::Mesh::node`]) is uploaded once in its node's local frame and
+//! moved by its object's transform, which [`GpuScene::set_time`] writes each frame with the
+//! previous frame's beside it (the G-buffer's motion vectors), so nothing is re-uploaded.
 
 use super::kernel::{wgsl, Shader};
 use super::Gpu;
 use crate::render::scene::{Environment, Scene};
 use bytemuck::{Pod, Zeroable};
-use glam::DVec3;
+use glam::{DMat4, DVec3, Mat4};
 use wgpu::util::DeviceExt;
 
 /// mesh.wgsl: the material bind group, `VertexIn` and the material's albedo, shared by
@@ -32,6 +39,36 @@ pub struct MaterialUniform {
     pub diffuse: [f32; 4],
     /// Emitted radiance in rgb; w unused.
     pub emission: [f32; 4],
+    /// x: alpha factor; y: the alpha-test cutoff (−1 for a solid material); zw unused.
+    pub alpha: [f32; 4],
+}
+
+/// One object's transforms (`Object` of mesh.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct ObjectUniform {
+    /// This frame's anchored-from-local transform.
+    pub anchored_from_local: [[f32; 4]; 4],
+    /// The previous frame's (motion vectors).
+    pub previous_anchored_from_local: [[f32; 4]; 4],
+    /// The inverse transpose of this frame's, for normals.
+    pub normal_from_local: [[f32; 4]; 4],
+}
+
+/// Bytes between objects' slots in the object buffer: the largest uniform-offset
+/// alignment a device may ask for.
+const OBJECT_STRIDE: u64 = 256;
+
+/// Which draws [`GpuScene::draw`] records: passes with an alpha-tested pipeline draw the
+/// solid materials with their plain pipeline and the alpha-tested ones with the other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawSet {
+    /// Every draw (a scene without alpha-tested materials, or a pass that ignores alpha).
+    All,
+    /// Draws of materials without an alpha test.
+    Solid,
+    /// Draws of alpha-tested materials.
+    AlphaTested,
 }
 
 /// One material on the GPU: its uniform and diffuse texture.
@@ -44,12 +81,18 @@ pub struct GpuMaterial {
     pub has_texture: bool,
 }
 
-/// A contiguous range of indices drawn with one material.
+/// A contiguous range of indices drawn with one material and one object transform.
 pub struct Draw {
     /// Indices into [`GpuScene::indices`] to draw.
     pub indices: std::ops::Range<u32>,
-    /// Index into [`GpuScene::materials`] and `material_groups`.
+    /// Index into [`GpuScene::materials`].
     pub material: usize,
+    /// The object slot that moves it (0: static geometry).
+    pub object: usize,
+    /// Whether its material is alpha-tested.
+    pub alpha_tested: bool,
+    /// Its material and object (layout: [`GpuScene::material_layout`]).
+    pub group: wgpu::BindGroup,
 }
 
 /// The scene's meshes, materials and environment uploaded once, shared by every pass.
@@ -65,12 +108,17 @@ pub struct GpuScene {
     pub draws: Vec<Draw>,
     /// The scene's materials, in scene order.
     pub materials: Vec<GpuMaterial>,
-    /// Layout of a material's bind group (uniform, diffuse texture, sampler; fragment
-    /// stage), and one bind group per material: the G-buffer and the light-space pass
-    /// both draw the scene with them.
+    /// Layout of a draw's bind group (material uniform, diffuse texture, sampler, object
+    /// transforms): the G-buffer, the light-space pass and the depth peel draw the scene
+    /// with it, at group 1.
     pub material_layout: wgpu::BindGroupLayout,
-    /// One bind group per material, in `materials` order (layout: `material_layout`).
-    pub material_groups: Vec<wgpu::BindGroup>,
+    /// One [`ObjectUniform`] slot per object, [`OBJECT_STRIDE`] bytes apart; slot 0 is the
+    /// static geometry's identity.
+    pub objects: wgpu::Buffer,
+    /// The scene node each object slot after 0 follows.
+    pub object_nodes: Vec<usize>,
+    /// Whether some draw is alpha-tested (passes then build their alpha-tested pipelines).
+    pub alpha_tested: bool,
     /// The environment as a filterable equirectangular texture (1×1 black without one).
     pub environment: wgpu::TextureView,
     /// Sampler of the materials' diffuse textures.
@@ -78,16 +126,40 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
-    /// Records every draw of the scene into `pass`, binding each draw's material at
-    /// `material_group` (or none, for passes that read positions only).
-    pub fn draw(&self, pass: &mut wgpu::RenderPass, material_group: Option<u32>) {
+    /// Records the draws of `set` into `pass`, binding each draw's material and object at
+    /// group 1.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, set: DrawSet) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for draw in self.draws.iter().filter(|d| !d.indices.is_empty()) {
-            if let Some(group) = material_group {
-                pass.set_bind_group(group, &self.material_groups[draw.material], &[]);
-            }
+        let wanted = |d: &&Draw| match set {
+            DrawSet::All => true,
+            DrawSet::Solid => !d.alpha_tested,
+            DrawSet::AlphaTested => d.alpha_tested,
+        };
+        for draw in self.draws.iter().filter(|d| !d.indices.is_empty()).filter(wanted) {
+            pass.set_bind_group(1, &draw.group, &[]);
             pass.draw_indexed(draw.indices.clone(), 0, 0..1);
+        }
+    }
+
+    /// Whether some object moves (the scene has animated meshes).
+    pub fn has_moving_objects(&self) -> bool {
+        !self.object_nodes.is_empty()
+    }
+
+    /// Writes every moving object's transform at scene time `time`, with `previous` (the
+    /// previous frame's time; `None` on a first frame or after a cut: no motion) beside it.
+    pub fn set_time(&self, queue: &wgpu::Queue, scene: &Scene, time: f64, previous: Option<f64>) {
+        if self.object_nodes.is_empty() {
+            return;
+        }
+        let now = scene.node_transforms(time);
+        let before = previous.map(|t| scene.node_transforms(t));
+        for (i, &node) in self.object_nodes.iter().enumerate() {
+            let current = now.get(node).copied().unwrap_or(DMat4::IDENTITY);
+            let last = before.as_ref().and_then(|b| b.get(node).copied()).unwrap_or(current);
+            let uniform = object_uniform(self.anchor, current, last);
+            queue.write_buffer(&self.objects, (i as u64 + 1) * OBJECT_STRIDE, bytemuck::bytes_of(&uniform));
         }
     }
 
@@ -97,10 +169,23 @@ impl GpuScene {
         let anchor = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
-        let mut draws = Vec::new();
+        // (indices, material, object) of each draw; bind groups are made below.
+        let mut runs = Vec::new();
+        // Object slot 0 is static geometry; each animated node a mesh hangs from gets one.
+        let mut object_nodes: Vec<usize> = Vec::new();
         for mesh in &scene.meshes {
             let base = vertices.len() as u32;
-            let offset = (mesh.origin - anchor).as_vec3();
+            let (offset, object) = match mesh.node {
+                // In the node's local frame; the object transform adds the anchor.
+                Some(node) => {
+                    let slot = object_nodes.iter().position(|&n| n == node).unwrap_or_else(|| {
+                        object_nodes.push(node);
+                        object_nodes.len() - 1
+                    });
+                    (mesh.origin.as_vec3(), slot + 1)
+                }
+                None => ((mesh.origin - anchor).as_vec3(), 0),
+            };
             for i in 0..mesh.positions.len() {
                 vertices.push(Vertex {
                     position: (mesh.positions[i] + offset).to_array(),
@@ -110,7 +195,7 @@ impl GpuScene {
             }
             let start = indices.len() as u32;
             indices.extend(mesh.indices.iter().map(|i| i + base));
-            draws.push(Draw { indices: start..indices.len() as u32, material: mesh.material });
+            runs.push((start..indices.len() as u32, mesh.material, object));
         }
         // wgpu rejects empty buffers; an empty scene draws nothing from a dummy vertex.
         if vertices.is_empty() {
@@ -139,6 +224,7 @@ impl GpuScene {
                 let uniform = MaterialUniform {
                     diffuse: [m.diffuse.x, m.diffuse.y, m.diffuse.z, if has_texture { 1.0 } else { 0.0 }],
                     emission: [m.emissive.x, m.emissive.y, m.emissive.z, 0.0],
+                    alpha: [m.alpha, m.alpha_cutoff().unwrap_or(-1.0), 0.0, 0.0],
                 };
                 GpuMaterial {
                     uniform: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -161,20 +247,47 @@ impl GpuScene {
             ..Default::default()
         });
         let material_layout = material_layout(device);
-        let material_groups = materials
-            .iter()
-            .map(|m| {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("material"),
+        // Every slot starts at the identity (static geometry, and moving objects until
+        // the first `set_time`) with no motion.
+        let identity = object_uniform(anchor, DMat4::from_translation(anchor), DMat4::from_translation(anchor));
+        let slots: Vec<u8> = (0..=object_nodes.len())
+            .flat_map(|_| {
+                let mut slot = bytemuck::bytes_of(&identity).to_vec();
+                slot.resize(OBJECT_STRIDE as usize, 0);
+                slot
+            })
+            .collect();
+        let objects = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene objects"),
+            contents: &slots,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let alpha_cutoffs: Vec<bool> = scene.materials.iter().map(|m| m.alpha_cutoff().is_some()).collect();
+        let draws = runs
+            .into_iter()
+            .map(|(range, material, object)| {
+                let m = &materials[material];
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("material and object"),
                     layout: &material_layout,
                     entries: &[
                         wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
                         wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&sampler) },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer: &objects,
+                                offset: object as u64 * OBJECT_STRIDE,
+                                size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
+                            }),
+                        },
                     ],
-                })
+                });
+                Draw { indices: range, material, object, alpha_tested: alpha_cutoffs[material], group }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let alpha_tested = draws.iter().any(|d| d.alpha_tested);
         GpuScene {
             anchor,
             vertices: vertex_buffer,
@@ -182,10 +295,26 @@ impl GpuScene {
             draws,
             materials,
             material_layout,
-            material_groups,
+            objects,
+            object_nodes,
+            alpha_tested,
             environment: environment_texture(gpu, scene.environment.as_ref()),
             sampler,
         }
+    }
+}
+
+/// An object's uniform: `world_from_local` now and in the previous frame, made relative
+/// to the anchor in f64 before rounding to f32.
+fn object_uniform(anchor: DVec3, world_from_local: DMat4, previous_world_from_local: DMat4) -> ObjectUniform {
+    let anchored = DMat4::from_translation(-anchor);
+    let now = anchored * world_from_local;
+    let normal = glam::DMat3::from_mat4(now).inverse().transpose();
+    let normal = if normal.is_finite() { DMat4::from_mat3(normal) } else { DMat4::IDENTITY };
+    ObjectUniform {
+        anchored_from_local: now.as_mat4().to_cols_array_2d(),
+        previous_anchored_from_local: (anchored * previous_world_from_local).as_mat4().to_cols_array_2d(),
+        normal_from_local: Mat4::from(normal.as_mat4()).to_cols_array_2d(),
     }
 }
 
@@ -241,7 +370,8 @@ fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureVie
     texture.create_view(&Default::default())
 }
 
-/// The bind-group layout of one material: its uniform, diffuse texture and sampler.
+/// The bind-group layout of one draw: its material's uniform, diffuse texture and
+/// sampler, and its object's transforms.
 fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let fragment = wgpu::ShaderStages::FRAGMENT;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -271,6 +401,16 @@ fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 binding: 2,
                 visibility: fragment,
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
+                },
                 count: None,
             },
         ],

@@ -48,7 +48,7 @@ pub fn scene_passes(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &Fram
         Box::new(shadow::ShadowPass::new(gpu, gpu_scene, light_space.clone())),
         Box::new(direct::DirectLightPass::new(gpu, light_space.clone())),
         Box::new(rsm::RsmPass::new(gpu, light_space)),
-        Box::new(peel::DepthPeelPass::new(gpu, frame)),
+        Box::new(peel::DepthPeelPass::new(gpu, gpu_scene, frame)),
     ]
 }
 
@@ -93,6 +93,25 @@ pub struct FrameSetup<'a> {
     pub current_views: &'a [crate::render::stereo::Eye],
     /// The previous frame's views, when it had as many as this one (temporal reuse).
     pub previous_views: Option<&'a [crate::render::stereo::Eye]>,
+    /// What moves this frame ([`FrameMotion::STILL`] in a still scene).
+    pub motion: &'a FrameMotion,
+}
+
+/// What moved since the previous frame, for temporal accumulation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameMotion {
+    /// Whether [`gbuffer::MOTION`] holds each pixel's motion this frame (the scene
+    /// moves, or a host handed its motion vectors to the AO engine).
+    pub vectors: bool,
+    /// Bounding spheres (anchored centre, radius) of every moving object, where it is and
+    /// where it was in the previous frame: the AO of what lies within the AO radius of
+    /// them changes although the surface itself does not move.
+    pub movers: Vec<[f32; 4]>,
+}
+
+impl FrameMotion {
+    /// Nothing moves but the eyes.
+    pub const STILL: FrameMotion = FrameMotion { vectors: false, movers: Vec::new() };
 }
 
 /// Everything a pass records with.

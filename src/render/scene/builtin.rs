@@ -15,7 +15,8 @@ use glam::{DVec3, Vec3};
 use std::f64::consts::{PI, TAU};
 
 /// The built-in scene names, as `builtin:NAME` or `builtin = "NAME"` in a scene file.
-pub const NAMES: [&str; 8] = ["plane", "crease", "room", "sphere", "box", "furnished", "columns", "flipped-normals"];
+pub const NAMES: [&str; 10] =
+    ["plane", "crease", "room", "sphere", "box", "furnished", "columns", "flipped-normals", "grille", "moving"];
 
 /// Half the side of the square floor of "plane", "sphere" and "box" (x, z in ±20 m).
 pub const FLOOR_HALF_SIZE: f64 = 20.0;
@@ -81,6 +82,8 @@ pub fn load(name: &str) -> Result<Scene> {
         "furnished" => super::furnished::furnished(),
         "columns" => super::edge_cases::columns(),
         "flipped-normals" => super::edge_cases::flipped_normals(),
+        "grille" => super::content::grille(),
+        "moving" => super::content::moving(),
         _ => {
             return Err(Error::input(format!("unknown builtin scene '{name}'; available: {}", NAMES.join(", "))));
         }

@@ -6,6 +6,7 @@
 
 pub mod animation;
 pub mod builtin;
+pub mod content;
 pub mod edge_cases;
 pub mod environment;
 pub mod file;

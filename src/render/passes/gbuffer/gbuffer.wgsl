@@ -1,10 +1,18 @@
-// G-buffer: depth, view-space normals, albedo and emission for each eye layer.
-// The vertex entry point lives in gbuffer_multiview.wgsl (one pass, `view_index` picks
-// the eye) or gbuffer_multipass.wgsl (one pass per eye, a uniform picks it).
+// G-buffer: depth, view-space normals, albedo and emission for each eye layer, and in a
+// scene that moves, each pixel's motion. The vertex entry points live in
+// gbuffer_multiview.wgsl (one pass, `view_index` picks the eye) or gbuffer_multipass.wgsl
+// (one pass per eye, a uniform picks it).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 
-// Material bindings, `VertexIn` and `material_albedo`: shaders/mesh.wgsl.
+// The previous frame's eyes, for motion vectors (written only in a scene that moves).
+struct PreviousEyes {
+    clip_from_anchored: array<mat4x4<f32>, 2>,
+    view_from_anchored: array<mat4x4<f32>, 2>,
+};
+@group(0) @binding(1) var<uniform> previous: PreviousEyes;
+
+// Material and object bindings, `VertexIn`, `material_albedo`, `alpha_test`: shaders/mesh.wgsl.
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -13,13 +21,38 @@ struct VertexOut {
     @location(2) uv: vec2<f32>,
 };
 
+// VertexOut and where the point was in the previous frame.
+struct MotionVertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) view_position: vec3<f32>,
+    @location(1) view_normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) previous_clip: vec4<f32>,
+    // Distance along the previous view's −z.
+    @location(4) previous_distance: f32,
+};
+
 fn transform_vertex(v: VertexIn, eye: u32) -> VertexOut {
     let e = frame.eyes[eye];
+    let anchored = anchored_position(v);
     var out: VertexOut;
-    out.clip = e.clip_from_anchored * vec4<f32>(v.position, 1.0);
-    out.view_position = (e.view_from_anchored * vec4<f32>(v.position, 1.0)).xyz;
-    out.view_normal = (e.view_from_anchored * vec4<f32>(v.normal, 0.0)).xyz;
+    out.clip = e.clip_from_anchored * anchored;
+    out.view_position = (e.view_from_anchored * anchored).xyz;
+    out.view_normal = (e.view_from_anchored * vec4<f32>(anchored_normal(v), 0.0)).xyz;
     out.uv = v.uv;
+    return out;
+}
+
+fn transform_vertex_with_motion(v: VertexIn, eye: u32) -> MotionVertexOut {
+    let now = transform_vertex(v, eye);
+    let before = previous_anchored_position(v);
+    var out: MotionVertexOut;
+    out.clip = now.clip;
+    out.view_position = now.view_position;
+    out.view_normal = now.view_normal;
+    out.uv = now.uv;
+    out.previous_clip = previous.clip_from_anchored[eye] * before;
+    out.previous_distance = -(previous.view_from_anchored[eye] * before).z;
     return out;
 }
 
@@ -29,22 +62,54 @@ struct GBufferOut {
     @location(2) emission: vec4<f32>,
 };
 
-@fragment
-fn fs_main(in: VertexOut) -> GBufferOut {
-    var n = in.view_normal;
+struct GBufferMotionOut {
+    @location(0) normal: vec4<f32>,
+    @location(1) albedo: vec4<f32>,
+    @location(2) emission: vec4<f32>,
+    // xy: previous uv − this uv (uv: 0..1 from the top left); z: the previous distance
+    // along −z minus this one; w: 1, or 0 where the point was behind the previous eye.
+    @location(3) motion: vec4<f32>,
+};
+
+fn shade(view_position: vec3<f32>, view_normal: vec3<f32>, uv: vec2<f32>) -> GBufferOut {
+    alpha_test(uv);
+    var n = view_normal;
     let len2 = dot(n, n);
     // A zero or NaN interpolated normal falls back to the geometric one.
-    let geometric = normalize(cross(dpdx(in.view_position), dpdy(in.view_position)));
+    let geometric = normalize(cross(dpdx(view_position), dpdy(view_position)));
     n = select(geometric, n * inverseSqrt(len2), len2 > 1e-20 && len2 == len2);
     // Surfaces are seen from the front: flip normals that face away from the eye, so
     // OBJ files with inconsistent winding still shade correctly.
-    if (dot(n, -in.view_position) < 0.0) {
+    if (dot(n, -view_position) < 0.0) {
         n = -n;
     }
-    let albedo = material_albedo(in.uv);
+    let albedo = material_albedo(uv);
     var out: GBufferOut;
     out.normal = vec4<f32>(finite_or_zero3(n), 0.0);
     out.albedo = vec4<f32>(albedo, 1.0);
     out.emission = vec4<f32>(finite_or_zero3(material.emission.rgb), 0.0);
+    return out;
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> GBufferOut {
+    return shade(in.view_position, in.view_normal, in.uv);
+}
+
+@fragment
+fn fs_motion(in: MotionVertexOut) -> GBufferMotionOut {
+    let g = shade(in.view_position, in.view_normal, in.uv);
+    var out: GBufferMotionOut;
+    out.normal = g.normal;
+    out.albedo = g.albedo;
+    out.emission = g.emission;
+    let uv = in.clip.xy / vec2<f32>(frame.size);
+    var motion = vec4<f32>(0.0);
+    if (in.previous_clip.w > 0.0) {
+        let ndc = in.previous_clip.xy / in.previous_clip.w;
+        let previous_uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+        motion = vec4<f32>(previous_uv - uv, in.previous_distance + in.view_position.z, 1.0);
+    }
+    out.motion = select(vec4<f32>(0.0), motion, all(motion == motion) && all(abs(motion) < vec4<f32>(6.0e4)));
     return out;
 }

@@ -11,6 +11,7 @@ use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::{shader_module, wgsl, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
+use crate::render::gpu::scene::{DrawSet, GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::passes::gbuffer::DEPTH;
@@ -29,6 +30,8 @@ pub const DEPTH_LAYER_2: Resource =
 /// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
     pipeline: wgpu::RenderPipeline,
+    /// The alpha-tested materials' (a scene with some only).
+    alpha_tested: Option<wgpu::RenderPipeline>,
     frame_group: wgpu::BindGroup,
     eye_layout: wgpu::BindGroupLayout,
     /// The eye index (0 left, 1 right) each per-eye pass binds.
@@ -37,7 +40,7 @@ pub struct DepthPeelPass {
 
 impl DepthPeelPass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu, frame: &FrameBuffers) -> Self {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
         let device = &gpu.device;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth peel frame"),
@@ -61,23 +64,29 @@ impl DepthPeelPass {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("depth peel"),
-            bind_group_layouts: &[Some(&frame_layout), Some(&eye_layout)],
+            bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, "depth peel", &[COMMON, wgsl!("src/render/passes/peel/peel.wgsl")]);
-        let pipeline = mesh_pipeline(
-            device,
-            MeshPipeline {
-                label: "depth peel",
-                layout: &layout,
-                module: &module,
-                vertex: ("vs_peel", &MESH_ATTRIBUTES[..1]),
-                // Reversed Z; two-sided: the back faces are what this pass is for.
-                depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
-                fragment: Some(("fs_peel", &[])),
-                multiview_mask: None,
-            },
-        );
+        let module =
+            shader_module(device, "depth peel", &[COMMON, MESH_WGSL, wgsl!("src/render/passes/peel/peel.wgsl")]);
+        let make = |alpha_test: bool| {
+            mesh_pipeline(
+                device,
+                MeshPipeline {
+                    label: "depth peel",
+                    layout: &layout,
+                    module: &module,
+                    vertex: ("vs_peel", &MESH_ATTRIBUTES),
+                    // Reversed Z; two-sided: the back faces are what this pass is for.
+                    depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
+                    fragment: Some(("fs_peel", &[])),
+                    multiview_mask: None,
+                    alpha_test,
+                },
+            )
+        };
+        let pipeline = make(false);
+        let alpha_tested = scene.alpha_tested.then(|| make(true));
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("depth peel frame"),
             layout: &frame_layout,
@@ -90,7 +99,7 @@ impl DepthPeelPass {
                 usage: wgpu::BufferUsages::UNIFORM,
             })
         });
-        DepthPeelPass { pipeline, frame_group, eye_layout, eye_index }
+        DepthPeelPass { pipeline, alpha_tested, frame_group, eye_layout, eye_index }
     }
 }
 
@@ -144,8 +153,15 @@ impl Pass for DepthPeelPass {
                 });
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.frame_group, &[]);
-                pass.set_bind_group(1, &eye_group, &[]);
-                gpu_scene.draw(&mut pass, None);
+                pass.set_bind_group(2, &eye_group, &[]);
+                match &self.alpha_tested {
+                    Some(alpha_tested) => {
+                        gpu_scene.draw(&mut pass, DrawSet::Solid);
+                        pass.set_pipeline(alpha_tested);
+                        gpu_scene.draw(&mut pass, DrawSet::AlphaTested);
+                    }
+                    None => gpu_scene.draw(&mut pass, DrawSet::All),
+                }
             }
             ctx.timer.end(ctx.encoder, span);
         }

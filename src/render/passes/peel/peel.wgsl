@@ -7,25 +7,37 @@
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 
+// Group 1, the draw's material and object: shaders/mesh.wgsl.
+
 struct PeelEye {
     index: u32,
 };
-@group(1) @binding(0) var<uniform> peel_eye: PeelEye;
-@group(1) @binding(1) var first_layer: texture_depth_2d_array;
+@group(2) @binding(0) var<uniform> peel_eye: PeelEye;
+@group(2) @binding(1) var first_layer: texture_depth_2d_array;
 
 // How much farther than the first layer (as a fraction of its distance) a surface must
 // be to count as the next layer: absorbs coincident duplicates and rounding between the
 // two rasterisations (1 mm at 1 m), far below any thickness SSDO's bias can resolve.
 override PEEL_GAP: f32 = 1e-3;
 
-// The G-buffer's transform (gbuffer.wgsl `transform_vertex`), position only.
+struct PeelVertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+};
+
+// The G-buffer's transform (gbuffer.wgsl `transform_vertex`), position and uv.
 @vertex
-fn vs_peel(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return frame.eyes[peel_eye.index].clip_from_anchored * vec4<f32>(position, 1.0);
+fn vs_peel(v: VertexIn) -> PeelVertexOut {
+    var out: PeelVertexOut;
+    out.clip = frame.eyes[peel_eye.index].clip_from_anchored * anchored_position(v);
+    out.uv = v.uv;
+    return out;
 }
 
 @fragment
-fn fs_peel(@builtin(position) p: vec4<f32>) {
+fn fs_peel(in: PeelVertexOut) {
+    alpha_test(in.uv);
+    let p = in.clip;
     // Reversed Z with an infinite far plane: distance = near / depth, so "farther than
     // the first layer by the gap" is depth × (1 + gap) < first depth. On the sky (first
     // depth 0) nothing is behind.

@@ -20,7 +20,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
-use crate::render::gpu::scene::{GpuScene, MESH_WGSL};
+use crate::render::gpu::scene::{DrawSet, GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::scene::{Light, Scene};
@@ -286,8 +286,9 @@ impl LightSpace {
 /// The light-space pass: per shadowed light, depth (and with RSM normal and flux).
 pub struct ShadowPass {
     light_space: Arc<LightSpace>,
-    depth_only: wgpu::RenderPipeline,
-    reflective: wgpu::RenderPipeline,
+    /// [solid, alpha-tested] (the second only in a scene with alpha-tested materials).
+    depth_only: [Option<wgpu::RenderPipeline>; 2],
+    reflective: [Option<wgpu::RenderPipeline>; 2],
     /// One uniform (`ShadowLight`) and bind group per fitted light.
     light_buffers: Vec<wgpu::Buffer>,
     light_groups: Vec<wgpu::BindGroup>,
@@ -311,8 +312,13 @@ impl ShadowPass {
             "shadow map",
             &[COMMON, SHADOW_WGSL, MESH_WGSL, wgsl!("src/render/passes/shadow/shadow_map.wgsl")],
         );
-        let depth_only = pipeline(device, &layout, &module, false);
-        let reflective = pipeline(device, &layout, &module, true);
+        let variants = |reflective: bool| {
+            [false, true].map(|alpha_test| {
+                (!alpha_test || scene.alpha_tested).then(|| pipeline(device, &layout, &module, reflective, alpha_test))
+            })
+        };
+        let depth_only = variants(false);
+        let reflective = variants(true);
         let light_buffers: Vec<wgpu::Buffer> = light_space
             .fits
             .iter()
@@ -344,8 +350,15 @@ fn pipeline(
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     reflective: bool,
+    alpha_test: bool,
 ) -> wgpu::RenderPipeline {
     let targets = [RSM_NORMAL, RSM_FLUX].map(|r| Some(wgpu::ColorTargetState::from(r.format())));
+    // The depth-only map has no fragment stage unless it must discard holes.
+    let fragment = match (reflective, alpha_test) {
+        (true, _) => Some(("fs_rsm", &targets[..])),
+        (false, true) => Some(("fs_alpha", &[][..])),
+        (false, false) => None,
+    };
     mesh_pipeline(
         device,
         MeshPipeline {
@@ -355,8 +368,9 @@ fn pipeline(
             vertex: ("vs_main", &MESH_ATTRIBUTES),
             // 0 nearest the light.
             depth: (SHADOW_MAP.format(), wgpu::CompareFunction::Less),
-            fragment: reflective.then_some(("fs_rsm", &targets[..])),
+            fragment,
             multiview_mask: None,
+            alpha_test,
         },
     )
 }
@@ -419,9 +433,17 @@ impl Pass for ShadowPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(if reflective { &self.reflective } else { &self.depth_only });
+            let [solid, alpha_tested] = if reflective { &self.reflective } else { &self.depth_only };
             pass.set_bind_group(0, group, &[]);
-            gpu_scene.draw(&mut pass, Some(1));
+            pass.set_pipeline(solid.as_ref().expect("the solid pipelines always exist"));
+            match alpha_tested {
+                Some(alpha_tested) => {
+                    gpu_scene.draw(&mut pass, DrawSet::Solid);
+                    pass.set_pipeline(alpha_tested);
+                    gpu_scene.draw(&mut pass, DrawSet::AlphaTested);
+                }
+                None => gpu_scene.draw(&mut pass, DrawSet::All),
+            }
         }
     }
 }

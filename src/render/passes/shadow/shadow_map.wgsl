@@ -5,7 +5,7 @@
 
 @group(0) @binding(0) var<uniform> light: ShadowLight;
 
-// Material bindings, `VertexIn` and `material_albedo`: shaders/mesh.wgsl.
+// Material and object bindings, `VertexIn`, `material_albedo`, `alpha_test`: shaders/mesh.wgsl.
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -17,8 +17,8 @@ struct VertexOut {
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
     var out: VertexOut;
-    out.clip = light.clip_from_anchored * vec4<f32>(v.position, 1.0);
-    out.normal = (light.view_from_anchored * vec4<f32>(v.normal, 0.0)).xyz;
+    out.clip = light.clip_from_anchored * anchored_position(v);
+    out.normal = (light.view_from_anchored * vec4<f32>(anchored_normal(v), 0.0)).xyz;
     out.uv = v.uv;
     return out;
 }
@@ -32,8 +32,15 @@ struct RsmOut {
 // turns normals towards the eye (surfaces are two-sided), and the flux density
 // ρ · E: an orthographic texel covers p² of the light's cross-section whatever the
 // surface's slope, so its flux is ρ · E · p² (the gather multiplies by the area).
+// The depth-only map of alpha-tested materials: holes let the light through.
+@fragment
+fn fs_alpha(in: VertexOut) {
+    alpha_test(in.uv);
+}
+
 @fragment
 fn fs_rsm(in: VertexOut) -> RsmOut {
+    alpha_test(in.uv);
     var n = in.normal;
     let len2 = dot(n, n);
     n = select(vec3<f32>(0.0, 0.0, 1.0), n * inverseSqrt(len2), len2 > 1e-20 && len2 == len2);

@@ -4,6 +4,7 @@
 //! frame; the pass owns them, so they persist from frame to frame whatever the graph
 //! allocates, and makes them again only when the occlusion's size changes.
 
+use super::gbuffer::MOTION;
 use super::occlusion::AO_GEOMETRY;
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{invalidate_bind_groups, wgsl, Bind, Kernel, Slot, COMMON};
@@ -37,10 +38,14 @@ pub const HISTORY_POSITION: [Resource; 2] = [
     Resource::storage("history-position-b", Size::Occlusion, wgpu::TextureFormat::Rgba32Float),
 ];
 
+/// The most moving objects whose surroundings get a short history (temporal.wgsl
+/// `MAX_MOVERS`, two spheres each: now and before); more are left to the motion vectors.
+const MAX_MOVERS: usize = 16;
+
 /// temporal.wgsl's bindings: frame, AO parameters, the pass's uniform, the occlusion
-/// and its geometry, last frame's history (value, position), the accumulation out and
-/// this frame's history out (value, position).
-const BINDINGS: [Bind; 10] = [
+/// and its geometry, last frame's history (value, position), the accumulation out,
+/// this frame's history out (value, position) and the pixels' motion.
+const BINDINGS: [Bind; 11] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::Own(Slot::Uniform),
@@ -51,6 +56,7 @@ const BINDINGS: [Bind; 10] = [
     Bind::Write(AO_ACCUMULATED),
     Bind::Own(Slot::Output(HISTORY_VALUE[0].format())),
     Bind::Own(Slot::Output(HISTORY_POSITION[0].format())),
+    Bind::Read(MOTION),
 ];
 
 /// Mirrors `Temporal` in temporal.wgsl.
@@ -66,7 +72,12 @@ struct TemporalUniform {
     history_valid: u32,
     pixel_tangent: f32,
     motion_px: f32,
-    _pad: u32,
+    has_motion: u32,
+    previous_anchored_from_view: [[[f32; 4]; 4]; 2],
+    previous_tangents: [[f32; 4]; 2],
+    movers: [[f32; 4]; MAX_MOVERS],
+    mover_count: u32,
+    _pad: [u32; 3],
 }
 
 /// Temporal accumulation of the occlusion by reverse reprojection (module docs).
@@ -117,9 +128,13 @@ impl TemporalPass {
 impl Pass for TemporalPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let ao = &setup.settings.ao;
-        PassDecl::new(NAME)
-            .bindings(&BINDINGS)
-            .provide(OCCLUSION, AO_ACCUMULATED)
+        let decl = PassDecl::new(NAME).bindings(&BINDINGS);
+        let decl = if uses_motion(setup) {
+            decl.note("reprojects by the pixels' motion vectors; short history near moving objects")
+        } else {
+            decl.unbind(MOTION)
+        };
+        decl.provide(OCCLUSION, AO_ACCUMULATED)
             .occlusion_cost()
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to accumulate")
             .disabled_if(!ao.temporal.enabled, "temporal accumulation is off")
@@ -138,14 +153,27 @@ impl Pass for TemporalPass {
             let anchored_from_view = DMat4::from_translation(-anchor) * world_from_view;
             u.anchored_from_view[layer] = anchored_from_view.as_mat4().to_cols_array_2d();
             if let Some(previous) = setup.previous_views {
-                u.previous_clip_from_anchored[layer] =
-                    previous[layer].clip_from_anchored(anchor, near).to_cols_array_2d();
+                let eye = &previous[layer];
+                u.previous_clip_from_anchored[layer] = eye.clip_from_anchored(anchor, near).to_cols_array_2d();
+                let anchored_from_view = DMat4::from_translation(-anchor) * eye.view_from_world().inverse();
+                u.previous_anchored_from_view[layer] = anchored_from_view.as_mat4().to_cols_array_2d();
+                u.previous_tangents[layer] = eye.fov.tangents().map(|t| t as f32);
             }
         }
         u.epsilon = t.epsilon_m;
         u.confidence_bias = t.confidence_bias;
         u.max_frames = t.max_frames as f32;
         u.motion_px = t.motion_px;
+        if uses_motion(setup) {
+            u.has_motion = 1;
+            // Each sphere grows by the AO radius: what lies that close sees the object.
+            let radius = setup.settings.ao.radius;
+            let movers = setup.motion.movers.iter().take(MAX_MOVERS);
+            for (slot, m) in u.movers.iter_mut().zip(movers) {
+                *slot = [m[0], m[1], m[2], m[3] + radius];
+            }
+            u.mover_count = setup.motion.movers.len().min(MAX_MOVERS) as u32;
+        }
         u.blend = match t.blend {
             TemporalBlend::Average => 0,
             TemporalBlend::Confidence => 1,
@@ -181,4 +209,10 @@ impl Pass for TemporalPass {
         let index = HISTORY_VALUE.iter().chain(&HISTORY_POSITION).position(|h| *h == r)?;
         self.history.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).get(index).cloned()
     }
+}
+
+/// Whether this frame reprojects by motion vectors (the scene moves or the host gave
+/// them, and the settings ask for it).
+fn uses_motion(setup: &FrameSetup) -> bool {
+    setup.motion.vectors && setup.settings.ao.temporal.object_motion
 }

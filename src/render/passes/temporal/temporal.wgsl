@@ -5,6 +5,13 @@
 // distance), and blended with this frame's value. The technique turns its sampling
 // pattern each frame, so the blend averages different patterns. Disoccluded,
 // off-screen or non-finite history is discarded: the pixel starts again from this frame.
+//
+// In a scene that moves, each pixel is carried back by its motion vector instead (the
+// G-buffer's, or a host's): its surface point's previous position is rebuilt from the
+// previous uv and distance, so a moving object keeps its own history. A surface near a
+// moving object keeps its place but not its occlusion: within the AO radius of a moving
+// object (where it is or was) the history is clamped to this frame's 3×3 neighbourhood
+// and kept short, so the occlusion the object cast where it was does not linger.
 
 struct Temporal {
     // Current frame, per layer: view space → the scene's anchored world frame.
@@ -22,8 +29,22 @@ struct Temporal {
     pixel_tangent: f32,
     // Motion-adaptive window (settings.rs `Temporal::motion_px`); 0 = off.
     motion_px: f32,
-    _pad: u32,
+    // 1 when `motion` holds per-pixel motion this frame.
+    has_motion: u32,
+    // Previous frame, per layer: view space → anchored world frame, and its tangents.
+    previous_anchored_from_view: array<mat4x4<f32>, 2>,
+    previous_tangents: array<vec4<f32>, 2>,
+    // Moving objects' spheres (anchored centre, radius plus the AO radius), now and before.
+    movers: array<vec4<f32>, MAX_MOVERS>,
+    mover_count: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
+
+const MAX_MOVERS: u32 = 16u;
+// The longest history near a moving object.
+const NEAR_MOVER_WINDOW: f32 = 3.0;
 
 // The shortest window motion may impose: below it the mean barely removes noise.
 const MIN_MOTION_WINDOW: f32 = 4.0;
@@ -38,6 +59,18 @@ const MIN_MOTION_WINDOW: f32 = 4.0;
 @group(0) @binding(7) var accumulated_out: texture_storage_2d_array<rgba16float, write>;
 @group(0) @binding(8) var history_value_out: texture_storage_2d_array<rgba16float, write>;
 @group(0) @binding(9) var history_position_out: texture_storage_2d_array<rgba32float, write>;
+@group(0) @binding(10) var motion: texture_2d_array<f32>;
+
+// Whether `world` lies within a moving object's reach (its sphere plus the AO radius).
+fn near_mover(world: vec3<f32>) -> bool {
+    for (var i = 0u; i < min(temporal.mover_count, MAX_MOVERS); i++) {
+        let m = temporal.movers[i];
+        if (distance(world, m.xyz) <= m.w) {
+            return true;
+        }
+    }
+    return false;
+}
 
 fn all_finite4(v: vec4<f32>) -> bool {
     return all(v == v) && all(abs(v) <= vec4<f32>(3.0e38));
@@ -67,25 +100,56 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var count = 0.0;
     var previous = vec4<f32>(0.0);
     var window = temporal.max_frames;
+    let near_moving = near_mover(world);
     if (temporal.history_valid != 0u) {
-        let clip = temporal.previous_clip_from_anchored[id.z] * vec4<f32>(world, 1.0);
-        if (clip.w > 0.0) {
-            let ndc = clip.xy / clip.w;
-            let previous_uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
-            if (all(previous_uv >= vec2<f32>(0.0)) && all(previous_uv < vec2<f32>(1.0))) {
-                let q = min(vec2<i32>(previous_uv * vec2<f32>(ao.ao_size)), vec2<i32>(ao.ao_size) - vec2<i32>(1));
-                let stored = textureLoad(history_position, q, layer, 0);
-                let value = textureLoad(history_value, q, layer, 0);
-                let footprint = geometry.w * temporal.pixel_tangent;
-                let same_point = distance(stored.xyz, world) <= temporal.epsilon + 2.0 * footprint;
-                if (stored.w >= 1.0 && same_point && all_finite4(stored) && all_finite4(value)) {
-                    count = stored.w;
-                    previous = value;
-                    if (temporal.motion_px > 0.0) {
-                        let moved = length((previous_uv - uv) * vec2<f32>(ao.ao_size));
-                        let shortened = temporal.max_frames / (1.0 + moved / temporal.motion_px);
-                        window = clamp(shortened, min(MIN_MOTION_WINDOW, temporal.max_frames), temporal.max_frames);
+        // Where the point was: by the eye's motion alone in a still scene, by the pixel's
+        // motion vector in one that moves.
+        var previous_uv = vec2<f32>(-1.0);
+        var previous_world = world;
+        if (temporal.has_motion != 0u) {
+            let full = full_res_pixel(id.xy, ao.scale, frame.size);
+            let m = textureLoad(motion, vec2<i32>(full), layer, 0);
+            if (m.w > 0.0) {
+                previous_uv = uv + m.xy;
+                let before = view_position_from_distance(previous_uv, geometry.w + m.z, temporal.previous_tangents[id.z]);
+                previous_world = (temporal.previous_anchored_from_view[id.z] * vec4<f32>(before, 1.0)).xyz;
+            }
+        } else {
+            let clip = temporal.previous_clip_from_anchored[id.z] * vec4<f32>(world, 1.0);
+            if (clip.w > 0.0) {
+                let ndc = clip.xy / clip.w;
+                previous_uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+            }
+        }
+        if (all(previous_uv >= vec2<f32>(0.0)) && all(previous_uv < vec2<f32>(1.0))) {
+            let q = min(vec2<i32>(previous_uv * vec2<f32>(ao.ao_size)), vec2<i32>(ao.ao_size) - vec2<i32>(1));
+            let stored = textureLoad(history_position, q, layer, 0);
+            let value = textureLoad(history_value, q, layer, 0);
+            let footprint = geometry.w * temporal.pixel_tangent;
+            let same_point = distance(stored.xyz, previous_world) <= temporal.epsilon + 2.0 * footprint;
+            if (stored.w >= 1.0 && same_point && all_finite4(stored) && all_finite4(value)) {
+                count = stored.w;
+                previous = value;
+                if (temporal.motion_px > 0.0) {
+                    let moved = length((previous_uv - uv) * vec2<f32>(ao.ao_size));
+                    let shortened = temporal.max_frames / (1.0 + moved / temporal.motion_px);
+                    window = clamp(shortened, min(MIN_MOTION_WINDOW, temporal.max_frames), temporal.max_frames);
+                }
+                if (near_moving) {
+                    // The occlusion here changes as the object moves: keep the history
+                    // only within this frame's neighbourhood, and short.
+                    var low = current;
+                    var high = current;
+                    for (var dy = -1; dy <= 1; dy++) {
+                        for (var dx = -1; dx <= 1; dx++) {
+                            let n = clamp(p + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(ao.ao_size) - vec2<i32>(1));
+                            let v = textureLoad(current_layers, n, layer, 0);
+                            low = min(low, v);
+                            high = max(high, v);
+                        }
                     }
+                    previous = clamp(previous, low, high);
+                    window = min(window, NEAR_MOVER_WINDOW);
                 }
             }
         }
