@@ -61,6 +61,8 @@ pub struct FrameLoop {
     /// whose time the governor's AO setting changes (the rest of the frame does not
     /// depend on it), as each frame's plan names them.
     in_flight: VecDeque<InFlight>,
+    /// The first frame's display time: the scene's animation plays from there.
+    scene_time_origin: Option<f64>,
     /// An AO pass whose span was missing has been reported (once per run).
     missing_span_reported: bool,
     /// Chooses the AO setting from the measured GPU times (`None`: settings fixed).
@@ -98,6 +100,7 @@ impl FrameLoop {
         Ok(FrameLoop {
             cpu_adapter,
             in_flight: VecDeque::new(),
+            scene_time_origin: None,
             missing_span_reported: false,
             governor: None,
             buffer_view: BufferView::Eyes,
@@ -168,6 +171,9 @@ impl FrameLoop {
     fn render(&mut self, request: &FrameRequest) -> Result<FrameReport> {
         let mut outputs = vec![COLOR, DEPTH];
         outputs.extend(self.buffer_view.resource(self.renderer.settings()));
+        // Animated objects are where they are at the frame's display time.
+        let origin = *self.scene_time_origin.get_or_insert(request.display_time);
+        self.renderer.set_scene_time(request.display_time - origin);
         let (headset, gpu) = (&mut self.headset, &self.gpu);
         self.renderer.render_with(&request.eyes.eyes, &outputs, |encoder, targets| {
             if let (Some(color), Some(depth)) = (targets.get(&COLOR), targets.get(&DEPTH)) {

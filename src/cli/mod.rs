@@ -229,6 +229,18 @@ impl AoArgs {
 }
 
 /// `X,Y,Z` in metres, each finite.
+/// The largest scene time the options take (seconds: about 11.6 days).
+pub const MAX_SCENE_TIME_S: f64 = 1e6;
+
+/// A scene time in seconds: finite, within 0..=[`MAX_SCENE_TIME_S`].
+pub fn parse_scene_time(s: &str) -> Result<f64, String> {
+    let t: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number of seconds"))?;
+    if !(0.0..=MAX_SCENE_TIME_S).contains(&t) {
+        return Err(format!("{t} s is not within 0..={MAX_SCENE_TIME_S} s"));
+    }
+    Ok(t)
+}
+
 pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
@@ -253,4 +265,4 @@ pub fn parse_budget_ms(s: &str) -> Result<f64, String> {
 }
 
 /// The `--scene` help every command shares.
-pub const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals)";
+pub const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, a glTF (.gltf, .glb), or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals, grille, moving)";

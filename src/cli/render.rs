@@ -53,6 +53,9 @@ pub struct RenderArgs {
     /// first frames are warm-up and not counted.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
+    /// Scene time in seconds (0 to 1e6): where animated objects and a scripted head are.
+    #[arg(long, default_value_t = 0.0, value_parser = super::parse_scene_time)]
+    time: f64,
     /// Reinhard white point (smallest exposed luminance shown as white).
     #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_WHITE_POINT)]
     white_point: f32,
@@ -85,7 +88,14 @@ pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         scene.head = HeadPath::fixed(pose);
     }
     let settings = args.settings(&scene);
-    let options = StillOptions { backend, timing: args.timing, frames: args.frames, debug: args.debug, out: args.out };
+    let options = StillOptions {
+        backend,
+        timing: args.timing,
+        frames: args.frames,
+        debug: args.debug,
+        out: args.out,
+        time: args.time,
+    };
     let still = render_still(&scene, &settings, &options)?;
     println!("{}", still.summary);
     if args.explain {

@@ -1,16 +1,34 @@
-//! `vrao temporal`: how temporal accumulation converges next to spatial-only settings.
+//! `vrao temporal`: how temporal accumulation converges next to spatial-only settings;
+//! with `--motion`, how it copes with moving objects (ghosts, error during motion).
 
-use super::{AoArgs, SCENE_HELP};
+use super::AoArgs;
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::reference::default_cache_dir;
+use vrao::measure::temporal::motion::{self, motion_study, Sequence};
 use vrao::measure::temporal::{study, to_markdown};
 use vrao::{BackendChoice, Result, Scene};
 
 #[derive(Args)]
 pub struct TemporalArgs {
-    #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
-    scene: String,
+    /// Scene: builtin:NAME, a .toml scene file, an .obj or a glTF (default: builtin:room,
+    /// or builtin:moving with --motion).
+    #[arg(long)]
+    scene: Option<String>,
+    /// Score a motion sequence of a scene that moves instead: every scored frame against
+    /// the reference at its time, for temporal accumulation off, by the eyes alone and
+    /// by motion vectors, next to the scene frozen at that time.
+    #[arg(long)]
+    motion: bool,
+    /// With --motion: scene time of the sequence's first frame, 0 to 1e6 s.
+    #[arg(long, default_value_t = 0.5, value_parser = super::parse_scene_time)]
+    start: f64,
+    /// With --motion: frames scored (each traces a reference), 1 to 64.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
+    scored: u32,
+    /// With --motion: frames (at 90 Hz) between scored frames, 1 to 90.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=90))]
+    every: u32,
     /// Per-eye width in pixels.
     #[arg(long, default_value_t = 270)]
     width: u32,
@@ -28,8 +46,34 @@ pub struct TemporalArgs {
 }
 
 pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
-    let scene = Scene::load(&args.scene)?;
+    if let Some(out) = &args.out {
+        vrao::render::output::check_output_file(out)?;
+    }
+    let default_scene = if args.motion { "builtin:moving" } else { "builtin:room" };
+    let scene = Scene::load(args.scene.as_deref().unwrap_or(default_scene))?;
     let base = args.ao.eye_settings(&scene, args.width, args.height);
+    if args.motion {
+        let sequence = Sequence { start: args.start, scored: args.scored, every: args.every };
+        let study = motion_study(backend, &scene, &base, sequence, args.rays, &default_cache_dir())?;
+        println!(
+            "'{}' moving from t = {} s, {} frames scored every {} at 90 Hz, {}x{} per eye, {} N={} r = {} m, on {}",
+            scene.name,
+            args.start,
+            args.scored,
+            args.every,
+            args.width,
+            args.height,
+            base.ao.technique.name(),
+            base.ao.samples,
+            vrao::render::output::significant(base.ao.radius as f64, 3),
+            study.adapter
+        );
+        print!("{}", motion::to_markdown(&study.points));
+        return match &args.out {
+            Some(path) => vrao::render::output::write_json(path, &study.points),
+            None => Ok(()),
+        };
+    }
     let study = study(backend, &scene, &base, args.rays, &default_cache_dir())?;
     println!(
         "AO RMSE against the reference ({} rays, every 2nd pixel) after k frames; '{}' at {}x{} per eye, {} r = {} m, on {}",

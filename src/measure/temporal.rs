@@ -2,6 +2,8 @@
 //! and 16 frames, with a static head and with the head moving, next to the same
 //! per-frame settings without temporal reuse.
 
+pub mod motion;
+
 use crate::measure::bench::error_figures;
 use crate::measure::reference::{trace_cached, ReferenceImage, ReferenceSettings};
 use crate::render::error::{Error, Result};

@@ -125,6 +125,30 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
     Ok(written)
 }
 
+/// Checks, before any work, that a file can be written at `path`: not a directory, and
+/// its folder exists and takes a new file (tried by creating and removing a probe).
+pub fn check_output_file(path: &Path) -> Result<()> {
+    let fail = |message: String| Err(Error::Output { path: path.into(), message });
+    if path.is_dir() {
+        return fail("is a directory, not a file".into());
+    }
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !folder.is_dir() {
+        return fail(format!("its folder {} does not exist", folder.display()));
+    }
+    let probe = folder.join(format!(".vrao-write-probe-{}", std::process::id()));
+    match std::fs::write(&probe, b"") {
+        Ok(()) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => fail(format!("cannot write in {}: {e}", folder.display())),
+    }
+}
+
 /// Writes `value` as pretty JSON to `path`; a failure names the path.
 pub fn write_json<T: serde::Serialize + ?Sized>(path: &Path, value: &T) -> Result<()> {
     let json =

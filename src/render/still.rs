@@ -24,6 +24,9 @@ pub struct StillOptions {
     pub debug: bool,
     /// Directory for the PNG files (created if missing).
     pub out: PathBuf,
+    /// Scene time in seconds: where the head (on a scripted path) and the animated
+    /// objects are.
+    pub time: f64,
 }
 
 /// What [`render_still`] did.
@@ -37,7 +40,7 @@ pub struct Still {
     pub written: Vec<PathBuf>,
 }
 
-/// Renders `scene` from its head pose at time 0 and writes `left.png` and `right.png`
+/// Renders `scene` from its head pose at `options.time` and writes `left.png` and `right.png`
 /// (and with `debug` the buffers behind them) into `options.out`.
 pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) -> Result<Still> {
     settings.validate()?;
@@ -50,7 +53,8 @@ pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) 
     })?;
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     renderer.set_timing(options.timing.resolve(&gpu));
-    let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+    renderer.set_scene_time(options.time);
+    let eyes = settings.profile.eyes(&scene.head.pose_at(options.time), settings.near);
     let outputs = crate::render::output::outputs(settings, options.debug);
     // Warm-up frames (pipeline compilation, first-touch allocation) are not measured.
     let frames = options.frames.max(1);

@@ -81,7 +81,7 @@ pub fn grille() -> Scene {
         materials: vec![Material::plain("white", Vec3::splat(0.8)), mask],
         lights: vec![Light::default_sun()],
         environment: Some(Environment::default_sky()),
-        head: HeadPath::fixed(eye_at(DVec3::new(0.0, 1.9, 1.9), DVec3::new(0.0, 0.0, 0.1))),
+        head: HeadPath::fixed(eye_at(DVec3::new(0.0, 1.3, 1.5), DVec3::new(0.0, 0.0, 0.0))),
         nodes: Vec::new(),
     }
 }

@@ -1,0 +1,265 @@
+//! Temporal accumulation in a scene that moves (`vrao temporal --motion`): every scored
+//! frame of a motion sequence against the reference traced at that frame's time, for
+//! temporal accumulation off, reprojecting by the eyes alone, and by the G-buffer's motion
+//! vectors, next to the same scene frozen at that time (what the static-scene error is).
+
+use crate::measure::bench::error_figures;
+use crate::measure::reference::{trace_cached, world_position, ReferenceImage, ReferenceSettings};
+use crate::render::error::{Error, Result};
+use crate::render::gpu::Gpu;
+use crate::render::graph::FINAL_AO;
+use crate::render::renderer::Renderer;
+use crate::render::scene::Scene;
+use crate::render::settings::Settings;
+use crate::render::stereo::Eye;
+use glam::DVec3;
+use serde::Serialize;
+use std::path::Path;
+use std::sync::Arc;
+
+/// An AO value further than this from the reference, near a moving object, is a ghost.
+pub const GHOST_THRESHOLD: f32 = 0.1;
+
+/// Frame rate of the sequence (a 90 Hz headset).
+pub const SEQUENCE_HZ: f64 = 90.0;
+
+/// Frames rendered before the first scored one, so the history is full.
+pub const WARMUP_FRAMES: u32 = 16;
+
+/// The most frames a sequence may score (each needs a traced reference).
+pub const MAX_SCORED_FRAMES: u32 = 64;
+
+/// One scored frame of one configuration.
+#[derive(Clone, Debug, Serialize)]
+pub struct MotionPoint {
+    /// `temporal off`, `temporal, eyes only`, `temporal, motion vectors`, or
+    /// `frozen scene, temporal` (the static-scene figure at the same time).
+    pub configuration: String,
+    /// The frame's number in the sequence (0 = its first).
+    pub frame: u32,
+    /// The frame's scene time in seconds.
+    pub time: f64,
+    /// AO RMSE against the reference at that time (noise of the reference removed).
+    pub ao_rmse: f64,
+    /// Mean AO minus the reference's.
+    pub ao_bias: f64,
+    /// Share of the image's pixels near a moving object's recent path whose AO is off
+    /// by more than [`GHOST_THRESHOLD`].
+    pub ghost_share: f64,
+    /// Share of the image's pixels near a moving object's recent path.
+    pub near_motion_share: f64,
+}
+
+/// What `vrao temporal --motion` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct MotionStudy {
+    /// Every configuration's scored frames.
+    pub points: Vec<MotionPoint>,
+    /// The adapter that rendered them.
+    pub adapter: String,
+}
+
+/// The sequence: `scored` frames scored every `every` frames after [`WARMUP_FRAMES`],
+/// starting at scene time `start`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sequence {
+    /// Scene time of the first frame (s).
+    pub start: f64,
+    /// Frames scored.
+    pub scored: u32,
+    /// Frames between scored ones.
+    pub every: u32,
+}
+
+impl Sequence {
+    fn frames(&self) -> u32 {
+        WARMUP_FRAMES + self.scored * self.every
+    }
+    fn time_of(&self, frame: u32) -> f64 {
+        self.start + frame as f64 / SEQUENCE_HZ
+    }
+    fn is_scored(&self, frame: u32) -> bool {
+        frame >= WARMUP_FRAMES && (frame - WARMUP_FRAMES + 1).is_multiple_of(self.every)
+    }
+}
+
+/// The configurations compared, from `base` (its technique, quality and radius).
+pub fn configurations(base: &Settings) -> Vec<(String, Settings)> {
+    let with = |enabled: bool, object_motion: bool| {
+        let mut s = base.clone();
+        s.ao.temporal.enabled = enabled;
+        s.ao.temporal.object_motion = object_motion;
+        s
+    };
+    vec![
+        ("temporal off".into(), with(false, true)),
+        ("temporal, eyes only".into(), with(true, false)),
+        ("temporal, motion vectors".into(), with(true, true)),
+    ]
+}
+
+/// Renders the sequence of `scene` (which should move) for each configuration and
+/// scores the scored frames against references traced at their times (cached in
+/// `cache`); then the frozen scene at each scored time, with temporal accumulation
+/// converged over [`WARMUP_FRAMES`] frames, as the static-scene figure.
+pub fn motion_study(
+    backend: crate::render::gpu::BackendChoice,
+    scene: &Scene,
+    base: &Settings,
+    sequence: Sequence,
+    rays: u32,
+    cache: &Path,
+) -> Result<MotionStudy> {
+    base.validate()?;
+    if !scene.is_animated() {
+        return Err(Error::input(format!("scene '{}' has no moving object: nothing to measure", scene.name)));
+    }
+    if sequence.scored == 0 || sequence.scored > MAX_SCORED_FRAMES || sequence.every == 0 || sequence.every > 90 {
+        return Err(Error::input(format!(
+            "a motion sequence scores 1..={MAX_SCORED_FRAMES} frames, every 1..=90 frames (asked: {} every {})",
+            sequence.scored, sequence.every
+        )));
+    }
+    let gpu = Arc::new(Gpu::new(backend)?);
+    let reference =
+        ReferenceSettings { radius: base.ao.radius as f64, rays_per_pixel: rays, stride: 2, near: base.near };
+    let size = (base.profile.width, base.profile.height);
+    let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near).eyes;
+    let mut references: Vec<(u32, ReferenceImage)> = Vec::new();
+    let mut reference_at = |frame: u32| -> Result<ReferenceImage> {
+        if let Some((_, r)) = references.iter().find(|(f, _)| *f == frame) {
+            return Ok(r.clone());
+        }
+        let frozen = scene.at_time(sequence.time_of(frame));
+        let traced = trace_cached(cache, &frozen, &eyes, size, &reference, &mut |_| {})?;
+        references.push((frame, traced.clone()));
+        Ok(traced)
+    };
+    let mut points = Vec::new();
+    for (name, settings) in configurations(base) {
+        log::info!("temporal --motion: {name}, {} frames", sequence.frames());
+        let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
+        for frame in 0..sequence.frames() {
+            renderer.set_scene_time(sequence.time_of(frame));
+            renderer.render_and_wait(&eyes, &[FINAL_AO])?;
+            if sequence.is_scored(frame) {
+                let image = renderer.read_f32(FINAL_AO)?;
+                let r = reference_at(frame)?;
+                points.push(score(&name, frame, sequence.time_of(frame), scene, &settings, &eyes, &image, &r));
+            }
+        }
+    }
+    // The static-scene figure: the same frame of the scene frozen, converged.
+    let mut converged = base.clone();
+    converged.ao.temporal.enabled = true;
+    for frame in (0..sequence.frames()).filter(|&f| sequence.is_scored(f)) {
+        let time = sequence.time_of(frame);
+        let mut renderer = Renderer::new(gpu.clone(), &scene.at_time(time), &converged)?;
+        for _ in 0..WARMUP_FRAMES {
+            renderer.render_and_wait(&eyes, &[FINAL_AO])?;
+        }
+        let image = renderer.read_f32(FINAL_AO)?;
+        let r = reference_at(frame)?;
+        points.push(score("frozen scene, temporal", frame, time, scene, &converged, &eyes, &image, &r));
+    }
+    Ok(MotionStudy { points, adapter: gpu.info.name.clone() })
+}
+
+/// Scores one frame: error figures, and the ghosts near the moving objects' recent path
+/// (where each object was over the temporal window, grown by the AO radius).
+#[allow(clippy::too_many_arguments)]
+fn score(
+    configuration: &str,
+    frame: u32,
+    time: f64,
+    scene: &Scene,
+    settings: &Settings,
+    eyes: &[Eye],
+    image: &[Vec<f32>],
+    reference: &ReferenceImage,
+) -> MotionPoint {
+    let e = error_figures(settings.ao.technique, image, reference);
+    let window = settings.ao.temporal.max_frames.max(1);
+    let path: Vec<(DVec3, f64)> = (0..window)
+        .flat_map(|k| moving_spheres(scene, time - k as f64 / SEQUENCE_HZ))
+        .map(|(c, r)| (c, r + settings.ao.radius as f64))
+        .collect();
+    let (gw, gh) = reference.grid_size();
+    let (mut cells, mut near, mut ghosts) = (0usize, 0usize, 0usize);
+    for (layer, eye) in eyes.iter().enumerate().take(image.len()) {
+        for j in 0..gh {
+            for i in 0..gw {
+                cells += 1;
+                let Some(world) = world_position(reference, eye, layer, i, j) else { continue };
+                if !path.iter().any(|(c, r)| world.distance(*c) <= *r) {
+                    continue;
+                }
+                near += 1;
+                let (x, y) = reference.pixel_of(i, j);
+                let ao = image[layer][4 * (y * reference.width + x) as usize + 3];
+                if (ao - reference.get(layer, i, j).ao).abs() > GHOST_THRESHOLD {
+                    ghosts += 1;
+                }
+            }
+        }
+    }
+    let share = |n: usize| n as f64 / cells.max(1) as f64;
+    MotionPoint {
+        configuration: configuration.into(),
+        frame,
+        time,
+        ao_rmse: e.ao_rmse,
+        ao_bias: e.ao_bias,
+        ghost_share: share(ghosts),
+        near_motion_share: share(near),
+    }
+}
+
+/// World-space spheres (centre, radius) around each moving mesh at time `t`.
+fn moving_spheres(scene: &Scene, t: f64) -> Vec<(DVec3, f64)> {
+    let transforms = scene.node_transforms(t);
+    scene
+        .meshes
+        .iter()
+        .filter_map(|m| {
+            let world = transforms.get(m.node?)?;
+            let mut bounds = crate::render::scene::Aabb::EMPTY;
+            m.positions.iter().for_each(|p| bounds.extend(world.transform_point3(m.origin + p.as_dvec3())));
+            (!bounds.is_empty()).then(|| (bounds.center(), 0.5 * bounds.size().length()))
+        })
+        .collect()
+}
+
+/// A Markdown table: per configuration, the worst and mean ghost share, the mean RMSE and
+/// bias over the scored frames, and the RMSE's worst ratio to the frozen scene's.
+pub fn to_markdown(points: &[MotionPoint]) -> String {
+    let frozen: Vec<&MotionPoint> = points.iter().filter(|p| p.configuration.starts_with("frozen")).collect();
+    let mut s = String::from(
+        "| configuration | ghost share, worst frame | ghost share, mean | near-motion share | AO RMSE, mean | RMSE / frozen RMSE, worst | bias, mean |\n|---|---|---|---|---|---|---|\n",
+    );
+    let mut names: Vec<&str> = Vec::new();
+    for p in points {
+        if !names.contains(&p.configuration.as_str()) {
+            names.push(&p.configuration);
+        }
+    }
+    for name in names {
+        let rows: Vec<&MotionPoint> = points.iter().filter(|p| p.configuration == name).collect();
+        let n = rows.len().max(1) as f64;
+        let worst_ghosts = rows.iter().map(|r| r.ghost_share).fold(0.0, f64::max);
+        let mean = |f: fn(&MotionPoint) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+        let worst_ratio = rows
+            .iter()
+            .filter_map(|r| frozen.iter().find(|f| f.frame == r.frame).map(|f| r.ao_rmse / f.ao_rmse))
+            .fold(0.0, f64::max);
+        s += &format!(
+            "| {name} | {:.3} % | {:.3} % | {:.2} % | {:.4} | {worst_ratio:.3} | {:+.4} |\n",
+            100.0 * worst_ghosts,
+            100.0 * mean(|r| r.ghost_share),
+            100.0 * mean(|r| r.near_motion_share),
+            mean(|r| r.ao_rmse),
+            mean(|r| r.ao_bias),
+        );
+    }
+    s
+}
