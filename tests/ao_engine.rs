@@ -8,7 +8,9 @@ mod host;
 
 use glam::DVec3;
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
-use vrao::ao::{AoConfig, AoEngine, AoFrame, DepthConvention, HostNormals, NormalEncoding, NormalSpace, ViewMatrices};
+use vrao::ao::{
+    AoConfig, AoEngine, AoFrame, DepthConvention, HostMotion, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
+};
 use vrao::render::graph::FINAL_AO;
 use vrao::render::scene::Mesh;
 use vrao::render::settings::{AoSettings, Technique};
@@ -103,6 +105,7 @@ fn engine_ao(gpu: &vrao::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: b
         depth_convention: convention,
         normals: with_normals.then_some(normals),
         views: &views,
+        motion: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
@@ -181,6 +184,7 @@ fn a_mono_view_from_a_single_layer_depth_buffer_matches_the_renderer() {
         depth_convention: DepthConvention::REVERSED_INFINITE,
         normals: Some(normals),
         views: &views,
+        motion: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
@@ -212,6 +216,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         depth_convention: DepthConvention::REVERSED_INFINITE,
         normals: None,
         views: &views,
+        motion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a depth buffer of another size");
     assert!(e.to_string().contains("depth") && e.to_string().contains("does not match"), "{e}");
@@ -222,6 +227,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         depth_convention: DepthConvention::STANDARD_FINITE,
         normals: None,
         views: &views,
+        motion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a convention the projection contradicts");
     assert!(e.to_string().contains("view 0: projection"), "{e}");
@@ -233,7 +239,90 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         depth_convention: DepthConvention::REVERSED_INFINITE,
         normals: None,
         views: &scaled,
+        motion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a view matrix with scale");
     assert!(e.to_string().contains("view 1: view matrix"), "{e}");
+}
+
+/// A host's motion vectors, `Rg32Float`, every texel `value`, one layer per eye.
+fn motion_texture(device: &wgpu::Device, queue: &wgpu::Queue, size: (u32, u32), value: [f32; 2]) -> wgpu::Texture {
+    use wgpu::util::DeviceExt;
+    let texels: Vec<f32> = (0..2 * size.0 * size.1).flat_map(|_| value).collect();
+    device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("host motion"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 2 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rg32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&texels),
+    )
+}
+
+/// Temporal accumulation over a host's depth reads the host's motion vectors: with zero
+/// motion and still views it keeps the same history as reprojecting by the views alone;
+/// vectors pointing far away lose it; a texture of another size is refused.
+#[test]
+fn host_motion_vectors_reach_temporal_accumulation() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let mut ao = AoSettings::default();
+    ao.temporal.enabled = true;
+    let config = AoConfig { settings: ao, width: WIDTH, height: HEIGHT, views: 2 };
+    let prepass = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT));
+    let views = host_views(&eyes(), HostDepth::ReversedInfinite);
+    let still = motion_texture(device, queue, (WIDTH, HEIGHT), [0.0, 0.0]);
+    let away = motion_texture(device, queue, (WIDTH, HEIGHT), [0.5, 0.0]);
+    let run = |motion: Option<HostMotion>| {
+        let mut engine = AoEngine::new(device, queue, &config).unwrap();
+        let mut texture = None;
+        for _ in 0..6 {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            prepass.record(device, &mut encoder, &views);
+            let frame = AoFrame {
+                depth: &prepass.depth,
+                depth_convention: DepthConvention::REVERSED_INFINITE,
+                normals: None,
+                views: &views,
+                motion,
+            };
+            texture = Some(engine.record(&mut encoder, &frame).unwrap().texture.clone());
+            queue.submit([encoder.finish()]);
+        }
+        let plan = engine.last_plan().unwrap();
+        let reads_host_motion =
+            plan.resolve(vrao::render::graph::PIXEL_MOTION).map(|r| r.name()) == Some("host-motion");
+        let texture = texture.unwrap();
+        ((0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect::<Vec<_>>(), reads_host_motion)
+    };
+    let (by_views, reads) = run(None);
+    assert!(!reads);
+    let (by_zero_motion, reads) = run(Some(HostMotion { texture: &still, to_previous_uv: [1.0, 1.0] }));
+    assert!(reads, "temporal accumulation reads the host's motion");
+    let (by_wrong_motion, _) = run(Some(HostMotion { texture: &away, to_previous_uv: [1.0, 1.0] }));
+    let same = rmse(&by_views, &by_zero_motion);
+    let lost = rmse(&by_views, &by_wrong_motion);
+    println!("zero motion vs the views alone: RMSE {same:.2e}; vectors half an image away: {lost:.2e}");
+    assert!(same < 1e-3, "zero motion keeps the views' history: {same}");
+    assert!(lost > 10.0 * same.max(1e-5), "vectors half an image away lose the history: {lost} vs {same}");
+
+    let small = motion_texture(device, queue, (WIDTH / 2, HEIGHT), [0.0, 0.0]);
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views: &views,
+        motion: Some(HostMotion { texture: &small, to_previous_uv: [1.0, 1.0] }),
+    };
+    let e = engine.record(&mut encoder, &frame).err().expect("motion of another size");
+    assert!(e.to_string().contains("motion") && e.to_string().contains("does not match"), "{e}");
 }

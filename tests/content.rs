@@ -183,5 +183,6 @@ fn a_still_opaque_scene_adds_no_motion_or_alpha_work() {
     let gbuffer = plan.decls.iter().find(|d| d.name == "gbuffer").unwrap();
     assert!(gbuffer.writes.contains(&MOTION));
     let temporal = plan.decls.iter().find(|d| d.name == "temporal").unwrap();
-    assert!(!temporal.unbound.contains(&MOTION) && temporal.reads.contains(&MOTION));
+    assert!(!temporal.unbound.contains(&vrao::render::graph::PIXEL_MOTION));
+    assert_eq!(plan.resolve(vrao::render::graph::PIXEL_MOTION), Some(MOTION));
 }

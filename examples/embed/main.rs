@@ -78,6 +78,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         depth_convention: convention,
         normals: with_normals.then_some(normals),
         views: &views,
+        // The example's geometry stands still.
+        motion: None,
     };
     let ao = engine.record(&mut encoder, &frame)?.texture.clone();
     queue.submit([encoder.finish()]);
@@ -139,6 +141,7 @@ fn time_frames(
                     depth_convention: convention,
                     normals: (kind == 1).then_some(normals),
                     views: &views,
+                    motion: None,
                 };
                 engine.record(&mut encoder, &frame)?;
             }

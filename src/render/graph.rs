@@ -148,6 +148,11 @@ impl Ord for Resource {
 /// the techniques write it: rgb = SSDO's gathered irradiance, a = AO.
 pub const OCCLUSION: Resource = Resource::alias("occlusion", wgpu::TextureFormat::Rgba16Float, None);
 
+/// Each pixel's motion since the previous frame, as [`crate::render::passes::gbuffer::MOTION`]
+/// lays it out: the G-buffer's in a scene that moves, or the motion vectors a host hands
+/// the AO engine. Temporal accumulation reads it.
+pub const PIXEL_MOTION: Resource = Resource::alias("pixel-motion", wgpu::TextureFormat::Rgba16Float, None);
+
 /// The final AO at full resolution: the upsampled occlusion, or [`OCCLUSION`] itself
 /// when the occlusion runs at full resolution. What the outputs, the bench and the
 /// window's buffer view read.

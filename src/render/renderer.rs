@@ -191,7 +191,7 @@ impl Renderer {
         let timer = PassTimer::new(&gpu)?;
         gpu.take_error()?;
         let mover_bounds = mover_bounds(scene, &gpu_scene);
-        let motion = FrameMotion { vectors: gpu_scene.has_moving_objects(), movers: Vec::new() };
+        let motion = FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL };
         Ok(Renderer {
             gpu,
             scene: scene.clone(),

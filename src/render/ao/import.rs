@@ -9,7 +9,7 @@ use crate::render::error::{Error, Result};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, Slot};
 use crate::render::gpu::raster;
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource};
+use crate::render::graph::{PassDecl, Resource, PIXEL_MOTION};
 use crate::render::passes::gbuffer::{DEPTH, NORMALS};
 use crate::render::passes::{FrameContext, FrameSetup, Pass};
 use bytemuck::{Pod, Zeroable};
@@ -23,6 +23,9 @@ pub const HOST_DEPTH: Resource = Resource::imported("host-depth", wgpu::TextureF
 
 /// The host's normals (any float-sampled format).
 pub const HOST_NORMALS: Resource = Resource::imported("host-normals", wgpu::TextureFormat::Rgba16Float);
+/// The host's motion vectors (any float format): temporal accumulation reads them
+/// directly as [`crate::render::graph::PIXEL_MOTION`].
+pub const HOST_MOTION: Resource = Resource::imported("host-motion", wgpu::TextureFormat::Rgba16Float);
 
 const IMPORT_WGSL: Shader = wgsl!("src/render/ao/import.wgsl");
 
@@ -65,6 +68,8 @@ struct ImportParams {
 pub struct ImportSource {
     params: ImportParams,
     views: u32,
+    /// Whether the host gave motion vectors.
+    motion: bool,
 }
 
 impl ImportSource {
@@ -93,6 +98,17 @@ impl ImportSource {
             params.unsigned_normals = (normals.encoding == NormalEncoding::Unsigned) as u32;
             params.world_normals = (normals.space == NormalSpace::World) as u32;
         }
+        if let Some(motion) = &frame.motion {
+            check_texture("motion", motion.texture, config)?;
+            let sample = motion.texture.format().sample_type(None, None);
+            if !matches!(sample, Some(wgpu::TextureSampleType::Float { .. })) {
+                return Err(Error::input(format!("motion: format {:?} is not read as float", motion.texture.format())));
+            }
+            let [x, y] = motion.to_previous_uv;
+            if !(x.is_finite() && y.is_finite()) {
+                return Err(Error::input(format!("motion: to_previous_uv {:?} is not finite", motion.to_previous_uv)));
+            }
+        }
         for ((layer, m), p) in params.layers.iter_mut().zip(frame.views).zip(projections) {
             let [l, r, u, d] = p.fov.tangents();
             *layer = ImportLayer {
@@ -105,7 +121,7 @@ impl ImportSource {
         }
         params.size = [config.width, config.height];
         params.reversed = frame.depth_convention.reversed_z as u32;
-        Ok(ImportSource { params, views: config.views })
+        Ok(ImportSource { params, views: config.views, motion: frame.motion.is_some() })
     }
 
     /// The engine's near plane (vrao depth = near / distance).
@@ -215,6 +231,11 @@ impl ImportPass {
 impl Pass for ImportPass {
     fn declare(&self, _setup: &FrameSetup) -> PassDecl {
         let decl = PassDecl::new(NAME).read(HOST_DEPTH).read(HOST_NORMALS).write(DEPTH).write(NORMALS);
+        // The host's motion goes to temporal accumulation as it is.
+        let decl = match self.source() {
+            Some(source) if source.motion => decl.read(HOST_MOTION).provide(PIXEL_MOTION, HOST_MOTION),
+            _ => decl,
+        };
         match self.source() {
             Some(source) if source.params.host_normals == 1 => decl,
             _ => decl.unbind(HOST_NORMALS).note("no host normals: rebuilt from the depth"),

@@ -29,7 +29,7 @@ use crate::render::passes::{self, FrameContext, FrameSetup, Pass};
 use crate::render::settings::{AoSettings, Settings, Technique};
 use crate::render::stereo::{Eye, EyeSide, Fov, HeadPose, HeadsetProfile};
 use glam::{DMat4, DQuat, Mat4};
-use import::{ImportPass, ImportSource, HOST_DEPTH, HOST_NORMALS};
+use import::{ImportPass, ImportSource, HOST_DEPTH, HOST_MOTION, HOST_NORMALS};
 use std::sync::Arc;
 
 /// How the host's depth buffer maps distance to depth.
@@ -77,6 +77,21 @@ pub struct HostNormals<'a> {
     pub encoding: NormalEncoding,
 }
 
+/// The host's motion vectors: where each pixel's surface point was in the previous frame,
+/// as a float-sampled texture (`Rg16Float`, `Rgba16Float`, `Rg32Float`, …) with one
+/// layer per view, xy read. Temporal accumulation then carries moving objects' history
+/// with them instead of rejecting it (`AoSettings::temporal`).
+#[derive(Clone, Copy, Debug)]
+pub struct HostMotion<'a> {
+    /// The texture (`TEXTURE_BINDING`), the engine's size.
+    pub texture: &'a wgpu::Texture,
+    /// Multiplies a texel's xy into the uv offset to the previous frame (uv 0..1 from the
+    /// top-left): `[1/width, 1/height]` for pixels pointing from this frame to the
+    /// previous, `[0.5, -0.5]` for NDC offsets, negated when the vectors point from the
+    /// previous frame to this one.
+    pub to_previous_uv: [f32; 2],
+}
+
 /// One view's matrices, as the host rendered its depth with them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewMatrices {
@@ -99,6 +114,9 @@ pub struct AoFrame<'a> {
     pub normals: Option<HostNormals<'a>>,
     /// Each view's matrices, one per view (left eye first).
     pub views: &'a [ViewMatrices],
+    /// The host's motion vectors, or `None`: temporal accumulation then reprojects by the
+    /// views' motion alone (right for a still scene).
+    pub motion: Option<HostMotion<'a>>,
 }
 
 /// What the engine is made for: the AO settings, the size of each view and their number.
@@ -239,6 +257,18 @@ impl AoEngine {
         if let Some(normals) = &frame.normals {
             host.targets.import(HOST_NORMALS, normals.texture, wgpu::TextureAspect::All, layers);
         }
+        host.motion = match &frame.motion {
+            Some(motion) => {
+                host.targets.import(HOST_MOTION, motion.texture, wgpu::TextureAspect::All, layers);
+                passes::FrameMotion {
+                    vectors: true,
+                    uv_scale: motion.to_previous_uv,
+                    with_distance: false,
+                    ..passes::FrameMotion::STILL
+                }
+            }
+            None => passes::FrameMotion::STILL,
+        };
         host.import.set_source(source);
         let previous = (host.previous_views.len() == eyes.len()).then_some(&host.previous_views[..]);
         let setup = FrameSetup {
@@ -255,7 +285,9 @@ impl AoEngine {
         let passes: Vec<&dyn Pass> =
             std::iter::once(&host.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();
         let decls: Vec<_> = passes.iter().map(|p| p.declare(&setup)).collect();
-        let imported = if frame.normals.is_some() { vec![HOST_DEPTH, HOST_NORMALS] } else { vec![HOST_DEPTH] };
+        let mut imported = vec![HOST_DEPTH];
+        imported.extend(frame.normals.is_some().then_some(HOST_NORMALS));
+        imported.extend(frame.motion.is_some().then_some(HOST_MOTION));
         let plan = graph::plan(&decls, &[FINAL_AO], &imported)?;
         host.targets.allocate(&gpu.device, &plan, &setup);
         host.frame.update(&gpu.queue, &FrameLighting::NONE, &eyes, &settings);

@@ -98,7 +98,7 @@ pub struct FrameSetup<'a> {
 }
 
 /// What moved since the previous frame, for temporal accumulation.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct FrameMotion {
     /// Whether [`gbuffer::MOTION`] holds each pixel's motion this frame (the scene
     /// moves, or a host handed its motion vectors to the AO engine).
@@ -107,11 +107,24 @@ pub struct FrameMotion {
     /// where it was in the previous frame: the AO of what lies within the AO radius of
     /// them changes although the surface itself does not move.
     pub movers: Vec<[f32; 4]>,
+    /// What turns a motion texel's xy into the uv offset to the previous frame
+    /// (1, 1 for the G-buffer's).
+    pub uv_scale: [f32; 2],
+    /// Whether the motion's z holds the change in distance and w its validity (the
+    /// G-buffer's); a host's 2D vectors leave the distance to the eyes' motion.
+    pub with_distance: bool,
 }
 
 impl FrameMotion {
     /// Nothing moves but the eyes.
-    pub const STILL: FrameMotion = FrameMotion { vectors: false, movers: Vec::new() };
+    pub const STILL: FrameMotion =
+        FrameMotion { vectors: false, movers: Vec::new(), uv_scale: [1.0; 2], with_distance: true };
+}
+
+impl Default for FrameMotion {
+    fn default() -> Self {
+        FrameMotion::STILL
+    }
 }
 
 /// Everything a pass records with.

@@ -285,25 +285,54 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// World-space bounds of every mesh (moving ones where they are at time 0).
+    /// World-space bounds of every mesh, moving ones over their whole animation.
     pub fn bounds(&self) -> Aabb {
-        let transforms = self.node_transforms(0.0);
         let mut b = Aabb::EMPTY;
+        for m in self.meshes.iter().filter(|m| m.node.is_none()) {
+            for p in &m.positions {
+                b.extend(m.origin + p.as_dvec3());
+            }
+        }
+        self.swept_corners().into_iter().for_each(|p| b.extend(p));
+        b
+    }
+
+    /// Key times at which a moving object's bounds are sampled over the loop.
+    const SWEEP_SAMPLES: usize = 64;
+
+    /// World-space corners of every moving mesh's local bounding box, at
+    /// [`Self::SWEEP_SAMPLES`] times over the animation loop (and at its end): what the
+    /// bounds and the shadow maps' fits must contain. Empty for a still scene.
+    pub fn swept_corners(&self) -> Vec<DVec3> {
+        if !self.meshes.iter().any(|m| m.node.is_some()) {
+            return Vec::new();
+        }
+        let period = self.animation_period();
+        let times: Vec<DMat4Set> = (0..=Self::SWEEP_SAMPLES)
+            .map(|k| animation::world_transforms(&self.nodes, period * k as f64 / Self::SWEEP_SAMPLES as f64))
+            .collect();
+        let mut corners = Vec::new();
         for m in &self.meshes {
-            match m.node.and_then(|n| transforms.get(n)) {
-                Some(world) => {
-                    for p in &m.positions {
-                        b.extend(world.transform_point3(m.origin + p.as_dvec3()));
-                    }
-                }
-                None => {
-                    for p in &m.positions {
-                        b.extend(m.origin + p.as_dvec3());
-                    }
+            let Some(node) = m.node else { continue };
+            let mut local = Aabb::EMPTY;
+            m.positions.iter().filter(|p| p.is_finite()).for_each(|p| local.extend(m.origin + p.as_dvec3()));
+            if local.is_empty() {
+                continue;
+            }
+            for transforms in &times {
+                let Some(world) = transforms.get(node) else { continue };
+                for i in 0..8 {
+                    let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
+                    let c = DVec3::new(
+                        pick(1, local.min.x, local.max.x),
+                        pick(2, local.min.y, local.max.y),
+                        pick(4, local.min.z, local.max.z),
+                    );
+                    corners.push(world.transform_point3(c));
                 }
             }
         }
-        b
+        corners
     }
 
     /// Whether some mesh moves (hangs from an animated node).
@@ -392,6 +421,9 @@ impl Scene {
         }
     }
 }
+
+/// Every node's world transform at one time.
+type DMat4Set = Vec<DMat4>;
 
 /// `mesh` moved into world space by `world` (positions and normals; a mirroring transform
 /// reverses the winding).

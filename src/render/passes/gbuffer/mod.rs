@@ -11,7 +11,7 @@ use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::render::gpu::scene::{DrawSet, GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource, Size};
+use crate::render::graph::{PassDecl, Resource, Size, PIXEL_MOTION};
 use bytemuck::{Pod, Zeroable};
 use std::num::NonZeroU32;
 use wgpu::util::DeviceExt;
@@ -211,7 +211,7 @@ impl Pass for GBufferPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
         let mut decl = PassDecl::new(NAME).write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION);
         decl = if self.motion {
-            decl.write(MOTION)
+            decl.write(MOTION).provide(PIXEL_MOTION, MOTION)
         } else {
             decl.note("motion vectors left out: nothing in the scene moves")
         };

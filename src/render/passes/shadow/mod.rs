@@ -158,7 +158,8 @@ pub struct LightFit {
 }
 
 impl LightFit {
-    /// The box around every finite vertex of `scene` as seen along `direction`.
+    /// The box around every finite vertex of `scene` (moving meshes wherever their
+    /// animation takes them) as seen along `direction`.
     pub fn new(scene: &Scene, anchor: DVec3, light: usize, direction: DVec3, radiance: Vec3) -> LightFit {
         let forward = direction.normalize();
         let helper = if forward.cross(DVec3::Y).length_squared() < 1e-6 { DVec3::Z } else { DVec3::Y };
@@ -167,14 +168,18 @@ impl LightFit {
         let back = -forward;
         let rotation = DMat3::from_cols(right, up, back).transpose();
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for mesh in &scene.meshes {
-            let offset = mesh.origin - anchor;
-            for p in &mesh.positions {
-                let v = rotation * (offset + p.as_dvec3());
-                if v.is_finite() {
-                    lo = lo.min(v);
-                    hi = hi.max(v);
-                }
+        // Static meshes' vertices, and the corners moving meshes sweep over their animation.
+        let swept = scene.swept_corners();
+        let static_points = scene
+            .meshes
+            .iter()
+            .filter(|m| m.node.is_none())
+            .flat_map(|m| m.positions.iter().map(move |p| (m.origin - anchor) + p.as_dvec3()));
+        for anchored in static_points.chain(swept.into_iter().map(|c| c - anchor)) {
+            let v = rotation * anchored;
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
             }
         }
         // No finite vertex: the bounds are still (+∞, −∞).

@@ -4,13 +4,12 @@
 //! frame; the pass owns them, so they persist from frame to frame whatever the graph
 //! allocates, and makes them again only when the occlusion's size changes.
 
-use super::gbuffer::MOTION;
 use super::occlusion::AO_GEOMETRY;
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{invalidate_bind_groups, wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
-use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION};
+use crate::render::graph::{PassDecl, Resource, Size, OCCLUSION, PIXEL_MOTION};
 use crate::render::settings::{Technique, TemporalBlend};
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
@@ -56,7 +55,7 @@ const BINDINGS: [Bind; 11] = [
     Bind::Write(AO_ACCUMULATED),
     Bind::Own(Slot::Output(HISTORY_VALUE[0].format())),
     Bind::Own(Slot::Output(HISTORY_POSITION[0].format())),
-    Bind::Read(MOTION),
+    Bind::Read(PIXEL_MOTION),
 ];
 
 /// Mirrors `Temporal` in temporal.wgsl.
@@ -75,9 +74,11 @@ struct TemporalUniform {
     has_motion: u32,
     previous_anchored_from_view: [[[f32; 4]; 4]; 2],
     previous_tangents: [[f32; 4]; 2],
+    previous_view_from_anchored: [[[f32; 4]; 4]; 2],
     movers: [[f32; 4]; MAX_MOVERS],
     mover_count: u32,
-    _pad: [u32; 3],
+    motion_with_distance: u32,
+    motion_uv_scale: [f32; 2],
 }
 
 /// Temporal accumulation of the occlusion by reverse reprojection (module docs).
@@ -132,7 +133,7 @@ impl Pass for TemporalPass {
         let decl = if uses_motion(setup) {
             decl.note("reprojects by the pixels' motion vectors; short history near moving objects")
         } else {
-            decl.unbind(MOTION)
+            decl.unbind(PIXEL_MOTION)
         };
         decl.provide(OCCLUSION, AO_ACCUMULATED)
             .occlusion_cost()
@@ -157,6 +158,8 @@ impl Pass for TemporalPass {
                 u.previous_clip_from_anchored[layer] = eye.clip_from_anchored(anchor, near).to_cols_array_2d();
                 let anchored_from_view = DMat4::from_translation(-anchor) * eye.view_from_world().inverse();
                 u.previous_anchored_from_view[layer] = anchored_from_view.as_mat4().to_cols_array_2d();
+                let view_from_anchored = eye.view_from_world() * DMat4::from_translation(anchor);
+                u.previous_view_from_anchored[layer] = view_from_anchored.as_mat4().to_cols_array_2d();
                 u.previous_tangents[layer] = eye.fov.tangents().map(|t| t as f32);
             }
         }
@@ -173,6 +176,8 @@ impl Pass for TemporalPass {
                 *slot = [m[0], m[1], m[2], m[3] + radius];
             }
             u.mover_count = setup.motion.movers.len().min(MAX_MOVERS) as u32;
+            u.motion_with_distance = setup.motion.with_distance as u32;
+            u.motion_uv_scale = setup.motion.uv_scale;
         }
         u.blend = match t.blend {
             TemporalBlend::Average => 0,

@@ -34,12 +34,16 @@ struct Temporal {
     // Previous frame, per layer: view space → anchored world frame, and its tangents.
     previous_anchored_from_view: array<mat4x4<f32>, 2>,
     previous_tangents: array<vec4<f32>, 2>,
+    // Previous frame, per layer: anchored world frame → view space.
+    previous_view_from_anchored: array<mat4x4<f32>, 2>,
     // Moving objects' spheres (anchored centre, radius plus the AO radius), now and before.
     movers: array<vec4<f32>, MAX_MOVERS>,
     mover_count: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: the motion's z is the change in distance and w its validity (the G-buffer's);
+    // 0: a host's 2D vectors, the distance follows the eyes' motion.
+    motion_with_distance: u32,
+    // Turns a motion texel's xy into the uv offset to the previous frame.
+    motion_uv_scale: vec2<f32>,
 };
 
 const MAX_MOVERS: u32 = 16u;
@@ -109,9 +113,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (temporal.has_motion != 0u) {
             let full = full_res_pixel(id.xy, ao.scale, frame.size);
             let m = textureLoad(motion, vec2<i32>(full), layer, 0);
-            if (m.w > 0.0) {
-                previous_uv = uv + m.xy;
-                let before = view_position_from_distance(previous_uv, geometry.w + m.z, temporal.previous_tangents[id.z]);
+            let with_distance = temporal.motion_with_distance != 0u;
+            let valid = select(all(m.xy == m.xy) && all(abs(m.xy) < vec2<f32>(3.0e38)), m.w > 0.0, with_distance);
+            if (valid) {
+                previous_uv = uv + m.xy * temporal.motion_uv_scale;
+                var previous_distance = geometry.w + m.z;
+                if (!with_distance) {
+                    previous_distance = -(temporal.previous_view_from_anchored[id.z] * vec4<f32>(world, 1.0)).z;
+                }
+                let before = view_position_from_distance(previous_uv, previous_distance, temporal.previous_tangents[id.z]);
                 previous_world = (temporal.previous_anchored_from_view[id.z] * vec4<f32>(before, 1.0)).xyz;
             }
         } else {
