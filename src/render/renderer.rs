@@ -18,8 +18,8 @@ use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::timing::{FrameTiming, PassTimer};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{self, Plan, Resource};
-use crate::render::passes::{self, FrameContext, FrameMotion, FrameSetup, Pass};
-use crate::render::scene::Scene;
+use crate::render::passes::{self, FrameContext, FrameMotion, FrameSetup, MoverBox, Pass};
+use crate::render::scene::{Aabb, Scene};
 use crate::render::settings::{Settings, StereoMode};
 use crate::render::stereo::Eye;
 use glam::DVec3;
@@ -128,8 +128,8 @@ pub struct Renderer {
     /// The scene time of the next frame (animation) and of the previous one.
     scene_time: f64,
     previous_scene_time: Option<f64>,
-    /// Each moving object's node and local bounding sphere (centre, radius).
-    mover_bounds: Vec<(usize, DVec3, f64)>,
+    /// Each moving object's node and its meshes' bounds in the node's frame.
+    mover_bounds: Vec<(usize, Aabb)>,
     /// What moves in the frame being rendered.
     motion: FrameMotion,
     /// The last plan and what it was made for: kept while nothing it depends on changes.
@@ -524,14 +524,9 @@ impl Renderer {
         let now = self.scene.node_transforms(self.scene_time);
         let before = previous.map(|t| self.scene.node_transforms(t));
         let mut movers = Vec::new();
-        for &(node, centre, radius) in &self.mover_bounds {
+        for (node, local) in &self.mover_bounds {
             for transforms in std::iter::once(&now).chain(before.as_ref()) {
-                let world = transforms[node];
-                let c = world.transform_point3(centre) - anchor;
-                // The longest column: the largest stretch of a rotation-and-scale.
-                let m = glam::DMat3::from_mat4(world);
-                let scale = m.x_axis.length().max(m.y_axis.length()).max(m.z_axis.length());
-                movers.push([c.x as f32, c.y as f32, c.z as f32, (radius * scale) as f32]);
+                movers.push(MoverBox::of(local, &transforms[*node], anchor));
             }
         }
         self.motion.movers = movers;
@@ -572,20 +567,20 @@ impl Renderer {
     }
 }
 
-/// Each moving object's node with the sphere (centre and radius, in the node's local
-/// frame) around its meshes.
-fn mover_bounds(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, DVec3, f64)> {
+/// Each moving object's node with the bounds of its meshes in the node's frame.
+fn mover_bounds(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, Aabb)> {
     gpu_scene
         .object_nodes
         .iter()
         .map(|&node| {
-            let mut bounds = crate::render::scene::Aabb::EMPTY;
+            let mut bounds = Aabb::EMPTY;
             for mesh in scene.meshes.iter().filter(|m| m.node == Some(node)) {
-                mesh.positions.iter().for_each(|p| bounds.extend(mesh.origin + p.as_dvec3()));
+                mesh.positions.iter().filter(|p| p.is_finite()).for_each(|p| bounds.extend(mesh.origin + p.as_dvec3()));
             }
-            let radius = if bounds.is_empty() { 0.0 } else { 0.5 * bounds.size().length() };
-            let centre = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
-            (node, centre, radius)
+            if bounds.is_empty() {
+                bounds.extend(DVec3::ZERO);
+            }
+            (node, bounds)
         })
         .collect()
 }

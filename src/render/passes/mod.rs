@@ -103,16 +103,48 @@ pub struct FrameMotion {
     /// Whether [`gbuffer::MOTION`] holds each pixel's motion this frame (the scene
     /// moves, or a host handed its motion vectors to the AO engine).
     pub vectors: bool,
-    /// Bounding spheres (anchored centre, radius) of every moving object, where it is and
-    /// where it was in the previous frame: the AO of what lies within the AO radius of
-    /// them changes although the surface itself does not move.
-    pub movers: Vec<[f32; 4]>,
+    /// Boxes around every moving object, where it is and where it was in the previous
+    /// frame: the AO of what lies within the AO radius of them changes although the
+    /// surface itself does not move.
+    pub movers: Vec<MoverBox>,
     /// What turns a motion texel's xy into the uv offset to the previous frame
     /// (1, 1 for the G-buffer's).
     pub uv_scale: [f32; 2],
     /// Whether the motion's z holds the change in distance and w its validity (the
     /// G-buffer's); a host's 2D vectors leave the distance to the eyes' motion.
     pub with_distance: bool,
+}
+
+/// An oriented box around a moving object (`MoverBox` of temporal.wgsl): a point p of
+/// the anchored frame lies inside when |rows · (p, 1)| ≤ half_extents on each axis.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MoverBox {
+    /// The box's frame from the anchored world frame: three rows of an affine map whose
+    /// rotation is orthonormal, so distances stay in metres.
+    pub box_from_anchored: [[f32; 4]; 3],
+    /// Half the box's size along its axes (metres); w unused.
+    pub half_extents: [f32; 4],
+}
+
+impl MoverBox {
+    /// The box `local` (bounds in a node's frame) placed by `world` (world from local,
+    /// rotation and scale without shear), relative to `anchor`.
+    pub fn of(local: &crate::render::scene::Aabb, world: &glam::DMat4, anchor: glam::DVec3) -> MoverBox {
+        let m = glam::DMat3::from_mat4(*world);
+        let axes = [m.x_axis, m.y_axis, m.z_axis];
+        let half = local.size() * 0.5;
+        let centre = world.transform_point3(local.center()) - anchor;
+        let mut rows = [[0.0f32; 4]; 3];
+        let mut half_extents = [0.0f32; 4];
+        for (i, axis) in axes.iter().enumerate() {
+            let length = axis.length();
+            let unit = if length > 0.0 && length.is_finite() { *axis / length } else { glam::DVec3::ZERO };
+            rows[i] = [unit.x as f32, unit.y as f32, unit.z as f32, -unit.dot(centre) as f32];
+            half_extents[i] = (half[i] * length) as f32;
+        }
+        MoverBox { box_from_anchored: rows, half_extents }
+    }
 }
 
 impl FrameMotion {

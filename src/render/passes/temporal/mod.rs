@@ -5,7 +5,7 @@
 //! allocates, and makes them again only when the occlusion's size changes.
 
 use super::occlusion::AO_GEOMETRY;
-use super::{FrameContext, FrameSetup, Pass};
+use super::{FrameContext, FrameSetup, MoverBox, Pass};
 use crate::render::gpu::kernel::{invalidate_bind_groups, wgsl, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
@@ -37,8 +37,9 @@ pub const HISTORY_POSITION: [Resource; 2] = [
     Resource::storage("history-position-b", Size::Occlusion, wgpu::TextureFormat::Rgba32Float),
 ];
 
-/// The most moving objects whose surroundings get a short history (temporal.wgsl
-/// `MAX_MOVERS`, two spheres each: now and before); more are left to the motion vectors.
+/// The most boxes around moving objects (two per object: now and before) whose
+/// surroundings get a short history (temporal.wgsl `MAX_MOVERS`); more are left to the
+/// motion vectors alone.
 const MAX_MOVERS: usize = 16;
 
 /// temporal.wgsl's bindings: frame, AO parameters, the pass's uniform, the occlusion
@@ -75,7 +76,7 @@ struct TemporalUniform {
     previous_anchored_from_view: [[[f32; 4]; 4]; 2],
     previous_tangents: [[f32; 4]; 2],
     previous_view_from_anchored: [[[f32; 4]; 4]; 2],
-    movers: [[f32; 4]; MAX_MOVERS],
+    movers: [MoverBox; MAX_MOVERS],
     mover_count: u32,
     motion_with_distance: u32,
     motion_uv_scale: [f32; 2],
@@ -169,11 +170,11 @@ impl Pass for TemporalPass {
         u.motion_px = t.motion_px;
         if uses_motion(setup) {
             u.has_motion = 1;
-            // Each sphere grows by the AO radius: what lies that close sees the object.
+            // Each box reaches by the AO radius: what lies that close sees the object.
             let radius = setup.settings.ao.radius;
-            let movers = setup.motion.movers.iter().take(MAX_MOVERS);
-            for (slot, m) in u.movers.iter_mut().zip(movers) {
-                *slot = [m[0], m[1], m[2], m[3] + radius];
+            for (slot, m) in u.movers.iter_mut().zip(setup.motion.movers.iter().take(MAX_MOVERS)) {
+                *slot = *m;
+                slot.half_extents[3] = radius;
             }
             u.mover_count = setup.motion.movers.len().min(MAX_MOVERS) as u32;
             u.motion_with_distance = setup.motion.with_distance as u32;

@@ -36,8 +36,8 @@ struct Temporal {
     previous_tangents: array<vec4<f32>, 2>,
     // Previous frame, per layer: anchored world frame → view space.
     previous_view_from_anchored: array<mat4x4<f32>, 2>,
-    // Moving objects' spheres (anchored centre, radius plus the AO radius), now and before.
-    movers: array<vec4<f32>, MAX_MOVERS>,
+    // Boxes around the moving objects, now and before.
+    movers: array<MoverBox, MAX_MOVERS>,
     mover_count: u32,
     // 1: the motion's z is the change in distance and w its validity (the G-buffer's);
     // 0: a host's 2D vectors, the distance follows the eyes' motion.
@@ -46,9 +46,16 @@ struct Temporal {
     motion_uv_scale: vec2<f32>,
 };
 
+// A box around a moving object: rows map the anchored frame to the box's (orthonormal),
+// half_extents.xyz its half size, half_extents.w the AO radius it reaches by.
+struct MoverBox {
+    rows: array<vec4<f32>, 3>,
+    half_extents: vec4<f32>,
+};
+
 const MAX_MOVERS: u32 = 16u;
 // The longest history near a moving object.
-const NEAR_MOVER_WINDOW: f32 = 3.0;
+const NEAR_MOVER_WINDOW: f32 = 2.0;
 
 // The shortest window motion may impose: below it the mean barely removes noise.
 const MIN_MOTION_WINDOW: f32 = 4.0;
@@ -65,11 +72,14 @@ const MIN_MOTION_WINDOW: f32 = 4.0;
 @group(0) @binding(9) var history_position_out: texture_storage_2d_array<rgba32float, write>;
 @group(0) @binding(10) var motion: texture_2d_array<f32>;
 
-// Whether `world` lies within a moving object's reach (its sphere plus the AO radius).
+// Whether `world` lies within a moving object's reach (the AO radius around its box).
 fn near_mover(world: vec3<f32>) -> bool {
+    let p = vec4<f32>(world, 1.0);
     for (var i = 0u; i < min(temporal.mover_count, MAX_MOVERS); i++) {
         let m = temporal.movers[i];
-        if (distance(world, m.xyz) <= m.w) {
+        let local = vec3<f32>(dot(m.rows[0], p), dot(m.rows[1], p), dot(m.rows[2], p));
+        let outside = max(abs(local) - m.half_extents.xyz, vec3<f32>(0.0));
+        if (length(outside) <= m.half_extents.w) {
             return true;
         }
     }
