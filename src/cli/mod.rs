@@ -174,6 +174,10 @@ pub struct AoArgs {
     /// averages at most frames / (1 + m / this) frames (at least 4); 0 turns it off.
     #[arg(long, allow_negative_numbers = true, default_value_t = Temporal::default().motion_px)]
     temporal_motion_px: f32,
+    /// In a scene that moves, reproject by the eyes alone, ignoring the motion vectors
+    /// (moving objects then leave their old AO behind: for comparison).
+    #[arg(long)]
+    temporal_eyes_only: bool,
 }
 
 /// `--radius`'s help, with the library's figures for the default.
@@ -220,6 +224,7 @@ impl AoArgs {
                 blend: self.temporal_blend,
                 max_frames: self.temporal_frames,
                 motion_px: self.temporal_motion_px,
+                object_motion: !self.temporal_eyes_only,
                 ..Default::default()
             },
             gtao: self.gtao.gtao.clone(),
