@@ -105,7 +105,7 @@ fn depth_based_reprojection_beats_rotational_under_translation_and_both_beat_no_
     let mut renderer = vrao::Renderer::new(gpu, &scene, &settings).unwrap();
     let head = scene.head.pose_at(0.0);
     let moves = [HeadMove::RotateDegrees(5.0), HeadMove::TranslateCm(5.0), HeadMove::TranslateCm(10.0)];
-    let rows = measure(&mut renderer, &head, &moves).unwrap();
+    let rows = measure(&mut renderer, &head, &moves, 0.0).unwrap();
     for r in &rows {
         assert!(r.rotational_rmse.is_finite() && r.depth_rmse.is_finite(), "{r:?}");
         assert!(r.depth_rmse < r.stale_rmse, "{r:?}");

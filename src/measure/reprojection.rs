@@ -73,8 +73,19 @@ fn rmse(a: &[Vec<u8>], b: &[Vec<u8>]) -> f64 {
 
 /// Renders at `head`, then for each movement warps that frame in both modes and compares
 /// with a fresh render at the moved pose.
-pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove]) -> Result<Vec<ReprojectionError>> {
+///
+/// In a scene that moves, the fresh frames are rendered `late_s` seconds of scene time
+/// after the source frame (a frame shown that late): the warp moves the eyes, not the
+/// objects (the compositor does not extrapolate objects by their motion vectors), so
+/// what they moved meanwhile is part of the error.
+pub fn measure(
+    renderer: &mut Renderer,
+    head: &HeadPose,
+    movements: &[HeadMove],
+    late_s: f64,
+) -> Result<Vec<ReprojectionError>> {
     let gpu = renderer.gpu().clone();
+    let source_time = renderer.scene_time();
     let settings = renderer.settings().clone();
     let outputs = [COLOR, DEPTH];
     let source_eyes = settings.profile.eyes(head, settings.near);
@@ -100,6 +111,7 @@ pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove])
     let output = output_target(&gpu, extent);
     let mut reprojector = Reprojector::new(&gpu)?;
     let mut rows = Vec::new();
+    renderer.set_scene_time(source_time + late_s);
     for &movement in movements {
         let target_eyes = settings.profile.eyes(&movement.apply(head), settings.near);
         renderer.render(&target_eyes.eyes, &outputs)?;
@@ -130,11 +142,13 @@ pub fn measure(renderer: &mut Renderer, head: &HeadPose, movements: &[HeadMove])
             depth_rmse: rmse(&depth_based, &fresh),
         });
     }
+    renderer.set_scene_time(source_time);
     Ok(rows)
 }
 
 /// `vrao reprojection`: [`measure`] the [`default_movements`] from `scene`'s head pose
-/// at time 0 on a new device; also returns the adapter's name.
+/// at time 0 on a new device, fresh frames one frame period later in a scene that moves;
+/// also returns the adapter's name.
 pub fn study(
     backend: crate::render::gpu::BackendChoice,
     scene: &crate::render::scene::Scene,
@@ -143,7 +157,8 @@ pub fn study(
     settings.validate()?;
     let gpu = std::sync::Arc::new(crate::render::gpu::Gpu::new(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
-    let rows = measure(&mut renderer, &scene.head.pose_at(0.0), &default_movements())?;
+    let late_s = if scene.is_animated() { 1.0 / settings.profile.refresh_hz } else { 0.0 };
+    let rows = measure(&mut renderer, &scene.head.pose_at(0.0), &default_movements(), late_s)?;
     Ok((rows, gpu.info.name.clone()))
 }
 
