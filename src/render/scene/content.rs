@@ -110,8 +110,9 @@ pub fn moving() -> Scene {
     let mut ball = Builder::default();
     ball.sphere(DVec3::ZERO, BALL_RADIUS, 24, 48);
     let mut door = Builder::default();
-    // In the hinge's frame: 0.9 m wide along +z, 2 m tall, 4 cm thick.
-    cuboid_faces(DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.04, 2.0, 0.9)).iter().for_each(|f| door.face(f, 1));
+    // In the hinge frame: 0.9 m wide along +z, 2 m tall, 4 cm thick on the −x side (it
+    // swings towards +x, so nothing turns behind the hinge into the wall).
+    cuboid_faces(DVec3::new(-0.04, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.9)).iter().for_each(|f| door.face(f, 1));
     let mut ball = ball.finish("ball", 1);
     ball.node = Some(0);
     let mut door = door.finish("door", 2);
@@ -146,7 +147,7 @@ pub fn moving() -> Scene {
         },
     };
     // The door: shut, open, shut, with zero tangents (ease in and out).
-    let open = DQuat::from_rotation_y(-DOOR_SWING_DEG.to_radians());
+    let open = DQuat::from_rotation_y(DOOR_SWING_DEG.to_radians());
     let zero = DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0);
     let door_node = Node {
         name: "door".into(),

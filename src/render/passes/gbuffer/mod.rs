@@ -208,15 +208,14 @@ fn pipeline(
 }
 
 impl Pass for GBufferPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, _: &FrameSetup) -> PassDecl {
         let mut decl = PassDecl::new(NAME).write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION);
         decl = if self.motion {
             decl.write(MOTION).provide(PIXEL_MOTION, MOTION)
         } else {
             decl.note("motion vectors left out: nothing in the scene moves")
         };
-        let alpha_tested = setup.scene.is_some_and(|s| s.has_alpha_test());
-        if !alpha_tested {
+        if self.multipass.alpha_tested.is_none() {
             decl = decl.note("alpha test left out: no material has holes");
         }
         decl
