@@ -6,6 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
 use vrao::measure::reference::default_cache_dir;
+use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::RENDER_DEFAULT;
 use vrao::render::settings::{AoSettings, BounceForm, Denoise, Quality, Technique};
@@ -68,11 +69,11 @@ pub struct BenchArgs {
     /// given for ssdo-bounce rows.
     #[arg(long, value_delimiter = ',')]
     rsm_samples: Vec<u32>,
-    /// Measured frames per case, after warm-up.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    /// Measured frames per case, after warm-up; 1..=100000.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
-    /// Warm-up frames per case (not measured).
-    #[arg(long, default_value_t = 3)]
+    /// Warm-up frames per case (not measured), 0..=1000.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
     /// eq. 2).
@@ -89,7 +90,7 @@ pub struct BenchArgs {
     blur: u32,
     /// Measure this many cases at a time, round-robin one frame each, so that the
     /// machine's drift during a long sweep falls on all of them alike (fair ratios
-    /// between techniques); each needs its own targets in memory at once.
+    /// between techniques); each needs its own targets in memory at once. 1..=64.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     interleave: u32,
     /// Render whole frames (direct light and composite too), not only the occlusion: the
@@ -112,10 +113,10 @@ pub struct BenchArgs {
     /// Output directory for bench.csv, bench.json, bench.md and bench.png.
     #[arg(long, default_value = "bench")]
     out: PathBuf,
-    /// Reference rays per traced pixel (cosine-weighted, stratified).
+    /// Reference rays per traced pixel (cosine-weighted, stratified), 1..=65536.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
-    /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there).
+    /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there), 1..=64.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     stride: u32,
     /// Skip the reference: time only, no error columns.
@@ -134,6 +135,8 @@ pub struct BenchArgs {
 }
 
 pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
+    // An output folder that cannot be written fails now, not after the sweep.
+    vrao::render::output::check_output_folder(&args.out)?;
     let run = match &args.replot {
         Some(path) => replot(path)?,
         None => {

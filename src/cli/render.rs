@@ -50,7 +50,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "pipelined", hide_possible_values = true)]
     timing: TimingChoice,
     /// Render this many frames and report per-pass GPU medians (with --explain); the
-    /// first frames are warm-up and not counted.
+    /// first frames are warm-up and not counted. 1..=100000.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Reinhard white point (smallest exposed luminance shown as white).

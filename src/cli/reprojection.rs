@@ -24,6 +24,9 @@ pub struct ReprojectionArgs {
 }
 
 pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        vrao::render::output::check_output_file(out)?;
+    }
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
     let (rows, adapter) = study(backend, &scene, &settings)?;

@@ -17,8 +17,8 @@ pub struct TemporalArgs {
     /// Per-eye height in pixels.
     #[arg(long, default_value_t = 300)]
     height: u32,
-    /// Reference rays per traced pixel.
-    #[arg(long, default_value_t = 256)]
+    /// Reference rays per traced pixel, 1..=65536.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
     /// Write the points as JSON here.
     #[arg(long)]
@@ -28,6 +28,9 @@ pub struct TemporalArgs {
 }
 
 pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        vrao::render::output::check_output_file(out)?;
+    }
     let scene = Scene::load(&args.scene)?;
     let base = args.ao.eye_settings(&scene, args.width, args.height);
     let study = study(backend, &scene, &base, args.rays, &default_cache_dir())?;

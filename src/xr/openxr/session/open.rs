@@ -12,7 +12,9 @@ impl OpenXrHeadset {
     pub fn open(options: OpenXrOptions) -> std::result::Result<(OpenXrHeadset, Arc<Gpu>), Unavailable> {
         let entry = load_entry()?;
         let slot = InstanceSlot::take()?;
-        let available = entry.enumerate_extensions().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        let available = entry.enumerate_extensions().map_err(|e| {
+            super::super::no_runtime(&super::super::xr_call_failed("xrEnumerateInstanceExtensionProperties", e))
+        })?;
         if !available.khr_vulkan_enable2 {
             return Err(Unavailable::Unsupported("no XR_KHR_vulkan_enable2".into()));
         }
@@ -22,7 +24,7 @@ impl OpenXrHeadset {
         extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
         let instance = entry
             .create_instance(&application_info(), &extensions, &[], &())
-            .map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+            .map_err(|e| super::super::no_runtime(&super::super::xr_call_failed("xrCreateInstance", e)))?;
         let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
         let runtime = format!("{} {}", props.runtime_name, props.runtime_version);
         let system = instance
@@ -105,6 +107,8 @@ impl OpenXrHeadset {
             tracking: Tracking::default(),
             opened: Instant::now(),
             fallback: None,
+            last_display_time: None,
+            display_period_ms: 0.0,
         };
         Ok((headset, gpu))
     }
