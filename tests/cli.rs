@@ -483,6 +483,9 @@ fn a_screenshot_without_a_window_is_refused() {
     );
 }
 
+/// A change made to a bench file's JSON.
+type BenchChange = dyn Fn(&mut serde_json::Value);
+
 /// A copy of the built-in frontier (a real bench file) with `change` applied to its JSON.
 fn bench_file(dir: &std::path::Path, name: &str, change: impl Fn(&mut serde_json::Value)) -> String {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/governor/frontier.json")).unwrap();
@@ -496,7 +499,7 @@ fn bench_and_frontier_files_are_validated_on_load_naming_file_record_and_value()
     // Problem 11: empty files, unknown techniques, negative times and N = 100000 were
     // plotted, fitted and governed with.
     let dir = temp_dir("bench-files");
-    let cases: [(&str, &dyn Fn(&mut serde_json::Value), &[&str]); 5] = [
+    let cases: [(&str, &BenchChange, &[&str]); 5] = [
         ("empty.json", &|j| j["records"] = serde_json::json!([]), &["empty.json", "no bench records"]),
         ("unknown.json", &|j| j["records"][2]["technique"] = "raytrace9000".into(), &["record 3", "raytrace9000"]),
         ("negative.json", &|j| j["records"][0]["occlusion_ms_per_eye"] = (-0.891).into(), &["record 1", "-0.891"]),
