@@ -334,7 +334,9 @@ fn light(entry: &LightEntry) -> std::result::Result<Light, Failure> {
     // Colour × intensity is what the shading multiplies in; beyond the HDR buffer's range
     // every pixel the light reaches would overflow (black after tone mapping).
     let (LightEntry::Directional { color, intensity, .. } | LightEntry::Point { color, intensity, .. }) = entry;
-    let brightest = colour(color)?.max_element() as f64 * non_negative("light intensity", *intensity)? as f64;
+    // Each checked first (finite, not negative); the product from the file's own values.
+    let _checked = (colour(color)?, non_negative("light intensity", *intensity)?);
+    let brightest = color.unwrap_or([1.0; 3]).into_iter().fold(0.0, f64::max) * intensity;
     if let Some(trouble) = limits::radiance_trouble("light color × intensity", brightest) {
         return Err(Failure::Here(trouble));
     }
