@@ -45,8 +45,8 @@ pub struct BenchArgs {
     /// Techniques to sweep, comma-separated (by default every estimator, gtao first).
     #[arg(long, value_delimiter = ',', value_enum, default_values_t = Technique::estimators(), hide_possible_values = true)]
     techniques: Vec<Technique>,
-    /// Sample counts, comma-separated (by default the presets' counts, the grid of
-    /// Belonogov 2018).
+    /// Sample counts, comma-separated, each 1..=256 (by default the presets' counts, the
+    /// grid of Belonogov 2018).
     #[arg(long, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
     samples: Vec<u32>,
     /// Radii in metres, comma-separated (default: the scene's radius × 0.5, 1, 2).
@@ -64,7 +64,7 @@ pub struct BenchArgs {
     #[arg(long, default_value = "off", hide_possible_values = true)]
     temporal: Sweep,
     /// Also measure reflective shadow maps (one bounce of the directional lights) with
-    /// these VPL counts, comma-separated, gathering within each radius: rows "rsm", whose
+    /// these VPL counts (each 1..=1024), comma-separated, gathering within each radius: rows "rsm", whose
     /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
     /// given for ssdo-bounce rows.
     #[arg(long, value_delimiter = ',')]
@@ -99,10 +99,10 @@ pub struct BenchArgs {
     /// row's; sweep --resolution both, ideally interleaved).
     #[arg(long)]
     frame: bool,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one

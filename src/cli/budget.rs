@@ -19,10 +19,10 @@ enum Measure {
 pub struct BudgetArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Measured frames (each: the stereo frame, then each eye alone), after warm-up; 1..=100000.

@@ -33,10 +33,10 @@ pub struct RenderArgs {
     /// Stereo G-buffer path: auto, multiview or multipass.
     #[arg(long, value_enum, default_value_t = StereoMode::default(), hide_possible_values = true)]
     stereo: StereoMode,
-    /// Per-eye width in pixels (Vive-class default).
+    /// Per-eye width in pixels, 1..=8192 (Vive-class default).
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels (Vive-class default).
+    /// Per-eye height in pixels, 1..=8192 (Vive-class default).
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Interpupillary distance in metres.

@@ -45,10 +45,12 @@ pub struct RunArgs {
     /// With OpenXR the runtime's display period sets the frame budget, frame by frame.
     #[arg(long)]
     refresh: Option<f64>,
-    /// Per-eye width to render at (default: the profile's; with OpenXR, the runtime's).
+    /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
+    /// runtime's).
     #[arg(long)]
     width: Option<u32>,
-    /// Per-eye height to render at (default: the profile's; with OpenXR, the runtime's).
+    /// Per-eye height to render at, 1..=8192 (default: the profile's; with OpenXR, the
+    /// runtime's).
     #[arg(long)]
     height: Option<u32>,
     /// Budget governor: on (choose the AO setting by error per millisecond so that each
@@ -59,10 +61,10 @@ pub struct RunArgs {
     /// one, measured on the furnished room; see assets/governor/README.md).
     #[arg(long)]
     governor_frontier: Option<PathBuf>,
-    /// Frames the GPU may work on at once.
+    /// Frames the GPU may work on at once, 1..=8.
     #[arg(long, default_value_t = DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
     frames_in_flight: u64,
-    /// Window size WIDTHxHEIGHT.
+    /// Window size WIDTHxHEIGHT, each 1..=16384.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     window: (u32, u32),
     /// Save a screenshot of the window to this PNG after the last frame.

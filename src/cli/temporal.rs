@@ -11,10 +11,10 @@ use vrao::{BackendChoice, Result, Scene};
 pub struct TemporalArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = 270)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = 300)]
     height: u32,
     /// Reference rays per traced pixel, 1..=65536.
