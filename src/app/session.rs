@@ -131,8 +131,11 @@ impl From<SessionError> for Error {
 
 /// Runs a headset session on `scene` with `settings` (their profile is replaced by the
 /// one `options` names) and returns its summary. Which headset and governor it uses
-/// goes to the log (info). Setting `interrupt` (a Ctrl-C handler of the caller's, say)
-/// ends the session cleanly after the current frame; the summary is still returned.
+/// goes to the log (info). `interrupt` is the caller's cancellation token (its Ctrl-C
+/// handler sets it; the library installs none): setting it at any time, from start-up
+/// on, ends the session cleanly from whatever state it is in (an OpenXR session before
+/// READY or stopped by the runtime included); the summary is still returned, with
+/// `interrupted` and the state it was in.
 pub fn run_session(
     scene: &Scene,
     settings: &Settings,
