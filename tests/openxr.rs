@@ -427,6 +427,11 @@ fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
     assert!(report.display_period_ms > 0.0, "{report:?}");
     assert!(report.missed_display_periods < stats.frames, "{report:?}");
     assert_eq!(report.interrupted_in, None);
+    // XR_FB_display_refresh_rate, where offered: the rate is one the runtime lists.
+    if !report.display_refresh_rates_hz.is_empty() {
+        let rate = report.display_refresh_rate_hz.expect("a rate is reported with the extension");
+        assert!(report.display_refresh_rates_hz.contains(&rate), "{report:?}");
+    }
     assert_eq!(report.states_seen, phases.iter().map(|p| p.name()).collect::<Vec<_>>());
     assert_eq!((report.loss_reason, report.ending.as_deref(), report.fell_back), (None, Some("EXITING"), false));
     assert_eq!(report.runtime, runtime);

@@ -168,6 +168,12 @@ pub struct OpenXrReport {
     pub display_period_ms: f64,
     /// The session state the run was interrupted in (Ctrl-C), if it was.
     pub interrupted_in: Option<String>,
+    /// The display refresh rates the runtime offers (XR_FB_display_refresh_rate; empty
+    /// when it does not have the extension).
+    pub display_refresh_rates_hz: Vec<f32>,
+    /// The display refresh rate the runtime last reported through the extension (after
+    /// vrao asked for the profile's, when offered), following its change events.
+    pub display_refresh_rate_hz: Option<f32>,
     /// Why the session was lost or a runtime call failed, if so.
     pub loss_reason: Option<String>,
     /// How the session ended (`EXITING`, a timeout, a loss), once it has.
@@ -202,6 +208,9 @@ pub struct OpenXrOptions {
     /// What to continue with when the session is lost (LOSS_PENDING, a lost instance or
     /// a failing runtime); `None` ends the run instead.
     pub fallback: Option<SimulatedOptions>,
+    /// The refresh rate to ask the runtime for (XR_FB_display_refresh_rate), when it
+    /// offers that rate; the runtime's predicted display period sets the budget either way.
+    pub preferred_refresh_hz: Option<f64>,
     /// The caller's cancellation token (its Ctrl-C handler sets it): checked in every
     /// wait, so the session ends from whatever state it is in. `None`: not interruptible.
     pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
@@ -222,6 +231,7 @@ impl OpenXrOptions {
             #[cfg(feature = "xr")]
             layout: None,
             fallback: Some(simulated.clone()),
+            preferred_refresh_hz: Some(simulated.profile.refresh_hz),
             interrupt: None,
         }
     }

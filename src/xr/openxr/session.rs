@@ -115,6 +115,9 @@ pub struct OpenXrHeadset {
     last_display_time: Option<xr::Time>,
     /// The runtime's latest predicted display period (ms), 0 before the first frame.
     display_period_ms: f64,
+    /// XR_FB_display_refresh_rate: the rates offered and the latest one reported.
+    refresh_rates_hz: Vec<f32>,
+    refresh_hz: Option<f32>,
 }
 
 fn failed(what: &str) -> impl Fn(xr::sys::Result) -> Unavailable + '_ {
@@ -167,6 +170,8 @@ impl OpenXrHeadset {
             missed_display_periods: self.stats.missed_display_periods,
             display_period_ms: self.display_period_ms,
             interrupted_in: self.machine.interrupted_in(),
+            display_refresh_rates_hz: self.refresh_rates_hz.clone(),
+            display_refresh_rate_hz: self.refresh_hz,
             loss_reason: self.machine.loss_reason().map(str::to_string),
             ending: self.machine.ending().map(str::to_string),
             fell_back: self.fallback.is_some(),
@@ -248,6 +253,7 @@ impl OpenXrHeadset {
     fn poll_events(&mut self) {
         let Some(xr) = self.xr.as_ref() else { return };
         let mut events = Vec::new();
+        let mut refresh_changes = Vec::new();
         let mut buffer = xr::EventDataBuffer::new();
         loop {
             match xr.instance.poll_event(&mut buffer) {
@@ -256,6 +262,11 @@ impl OpenXrHeadset {
                     None => log::warn!("OpenXR: unknown session state {:?}", change.state()),
                 },
                 Ok(Some(xr::Event::InstanceLossPending(_))) => events.push(Event::InstanceLossPending),
+                Ok(Some(xr::Event::DisplayRefreshRateChangedFB(change))) => {
+                    // The budget follows the predicted display period anyway; this says why.
+                    let (from, to) = (change.from_display_refresh_rate(), change.to_display_refresh_rate());
+                    refresh_changes.push((from, to));
+                }
                 Ok(Some(xr::Event::EventsLost(lost))) => {
                     log::warn!("OpenXR: {} events lost", lost.lost_event_count())
                 }
@@ -266,6 +277,10 @@ impl OpenXrHeadset {
                     break;
                 }
             }
+        }
+        for (from, to) in refresh_changes {
+            self.note(&format!("display refresh rate {from} Hz -> {to} Hz"));
+            self.refresh_hz = Some(to);
         }
         for event in events {
             if let Event::State(phase) = &event {

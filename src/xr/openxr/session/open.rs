@@ -22,6 +22,7 @@ impl OpenXrHeadset {
         extensions.khr_vulkan_enable2 = true;
         extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
         extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
+        extensions.fb_display_refresh_rate = available.fb_display_refresh_rate;
         let instance = entry
             .create_instance(&application_info(), &extensions, &[], &())
             .map_err(|e| super::super::no_runtime(&super::super::xr_call_failed("xrCreateInstance", e)))?;
@@ -71,6 +72,11 @@ impl OpenXrHeadset {
         let space = session
             .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
             .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
+        let (refresh_rates_hz, refresh_hz) = if extensions.fb_display_refresh_rate {
+            display_refresh_rate(&session, options.preferred_refresh_hz)
+        } else {
+            (Vec::new(), None)
+        };
         let swapchains =
             EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)?;
         let swapchain_text = swapchains.describe();
@@ -108,8 +114,29 @@ impl OpenXrHeadset {
             opened: Instant::now(),
             fallback: None,
             last_display_time: None,
+            refresh_rates_hz,
+            refresh_hz,
             display_period_ms: 0.0,
         };
         Ok((headset, gpu))
+    }
+}
+
+/// XR_FB_display_refresh_rate: the rates the runtime offers, and the rate it runs at
+/// after asking for `preferred` when offered (within 0.5 Hz). A failing call only loses
+/// the information: the budget comes from the predicted display period regardless.
+fn display_refresh_rate(session: &xr::Session<xr::Vulkan>, preferred: Option<f64>) -> (Vec<f32>, Option<f32>) {
+    let offered = session.enumerate_display_refresh_rates().unwrap_or_default();
+    let current = session.get_display_refresh_rate().ok();
+    let wanted = preferred.and_then(|hz| offered.iter().copied().find(|&r| (r as f64 - hz).abs() < 0.5));
+    match wanted {
+        Some(rate) if current != Some(rate) => match session.request_display_refresh_rate(rate) {
+            Ok(()) => (offered, Some(rate)),
+            Err(e) => {
+                log::warn!("OpenXR: {}", super::super::xr_call_failed("xrRequestDisplayRefreshRateFB", e));
+                (offered, current)
+            }
+        },
+        _ => (offered, current),
     }
 }
