@@ -335,7 +335,8 @@ fn light(entry: &LightEntry) -> std::result::Result<Light, Failure> {
     // every pixel the light reaches would overflow (black after tone mapping).
     let (LightEntry::Directional { color, intensity, .. } | LightEntry::Point { color, intensity, .. }) = entry;
     // Each checked first (finite, not negative); the product from the file's own values.
-    let _checked = (colour(color)?, non_negative("light intensity", *intensity)?);
+    colour(color)?;
+    non_negative("light intensity", *intensity)?;
     let brightest = color.unwrap_or([1.0; 3]).into_iter().fold(0.0, f64::max) * intensity;
     if let Some(trouble) = limits::radiance_trouble("light color × intensity", brightest) {
         return Err(Failure::Here(trouble));
