@@ -14,7 +14,7 @@ use crate::xr::simulated::motion::HeadMotion;
 use crate::xr::simulated::reproject::ReprojectionMode;
 use crate::xr::simulated::{SimulatedOptions, TimeMode};
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// The most frames a session renders when asked for a count (a day at 90 Hz is 7.8 M).
@@ -171,8 +171,17 @@ pub fn run_session(
         compose: options.display == DisplayMode::Mirror,
         frames,
     };
-    let (headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
+    let (mut headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
     log::info!("headset: {message}");
+    // Interrupted while the headset opened: end its session now rather than after
+    // compiling the renderer's pipelines (a second on a CPU adapter).
+    if interrupt.load(Ordering::Relaxed) {
+        let state = headset.session_state();
+        headset.request_exit();
+        while headset.wait_frame(&gpu)?.is_some_and(|request| headset.submit(&gpu, &request, None).is_ok()) {}
+        headset.end(&gpu)?;
+        return Ok(RunSummary::before_frames(headset.as_ref(), &gpu, &settings, state, options.frames_in_flight));
+    }
     let mut frame_loop = FrameLoop::new(gpu, scene, &settings, headset)?;
     frame_loop.frame_limit = frames;
     frame_loop.exit_requested = interrupt;

@@ -123,6 +123,46 @@ impl RunSummary {
         }
     }
 
+    /// The summary of a session interrupted (in `state`) before its first frame: the
+    /// headset opened and was ended, nothing was rendered.
+    pub fn before_frames(
+        headset: &dyn crate::xr::Headset,
+        gpu: &crate::render::gpu::Gpu,
+        settings: &crate::render::settings::Settings,
+        state: String,
+        frames_in_flight: usize,
+    ) -> RunSummary {
+        let openxr = headset.openxr_report();
+        let budget_ms = openxr.as_ref().map_or(0.0, |r| r.display_period_ms);
+        let budget_ms = if budget_ms > 0.0 { budget_ms } else { settings.profile.budget_ms() };
+        RunSummary {
+            headset: headset.describe(),
+            adapter: gpu.info.name.clone(),
+            frames_rendered: 0,
+            frames_in_flight_max: 0,
+            frames_in_flight_limit: frames_in_flight,
+            budget_ms,
+            budget_source: headset.display_rate_source(),
+            budget_ms_min: budget_ms,
+            budget_ms_max: budget_ms,
+            budget_changes: 0,
+            over_budget_frames: 0,
+            timed_frames: 0,
+            gpu_frame_ms_median: 0.0,
+            cpu_encode_ms_median: 0.0,
+            cpu_encode_share_of_gpu: 0.0,
+            timing: "no frame was rendered".into(),
+            counters: openxr.as_ref().is_none_or(|r| r.fell_back).then(|| headset.counters()),
+            pass_medians_ms: Vec::new(),
+            interrupted: true,
+            interrupted_in: Some(state),
+            governor: "not started".into(),
+            governor_changes: Vec::new(),
+            final_ao_setting: ao_setting(&settings.ao),
+            openxr,
+        }
+    }
+
     /// The summary as the few lines `vrao run` prints.
     pub fn to_text(&self) -> String {
         let passes: Vec<String> = self.pass_medians_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect();
