@@ -310,3 +310,314 @@ fn command_line_names_are_the_names_reports_print() {
         assert_eq!(t.name().parse::<Technique>().ok(), Some(t));
     }
 }
+
+/// Runs vrao and asserts the bad-input contract: exit 2, an `error:` line containing
+/// every one of `names`, no panic and no path into the cargo registry. Returns the text.
+fn refused(args: &[&str], names: &[&str]) -> String {
+    let out = vrao(args);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {t}");
+    assert!(!t.contains("panicked") && !t.contains(".cargo/registry"), "{args:?}: {t}");
+    let errors: Vec<String> =
+        String::from_utf8_lossy(&out.stderr).lines().filter(|l| l.starts_with("error:")).map(str::to_string).collect();
+    assert_eq!(errors.len(), 1, "{args:?}: one error line: {t}");
+    for name in names {
+        assert!(errors[0].contains(name), "{args:?}: the error names '{name}': {t}");
+    }
+    t
+}
+
+#[test]
+fn count_and_time_options_are_bounded_and_say_so_in_help() {
+    // Problem 6: warm-up + frames wrapped a u32 and panicked; problem 7: --warmup and
+    // --virtual-time had no upper bound and ran on.
+    let budget = ["budget", "--scene", "builtin:box", "--width", "96", "--height", "96", "--frames", "1"];
+    refused(&[&budget[..], &["--warmup", "4294967295"]].concat(), &["--warmup", "0..=1000"]);
+    refused(&["bench", "--warmup", "4294967295", "--no-reference"], &["--warmup", "0..=1000"]);
+    refused(&["bench", "--frames", "0"], &["--frames", "1..=100000"]);
+    refused(&["temporal", "--rays", "0"], &["--rays", "1..=65536"]);
+    refused(&["run", "--frames", "10000001"], &["--frames", "1..=10000000"]);
+    let run = ["run", "--headset", "simulated", "--display", "none", "--frames", "3"];
+    refused(&[&run[..], &["--virtual-time", "1e300"]].concat(), &["--virtual-time", "1e300", "0..=10000"]);
+    refused(&[&run[..], &["--virtual-time", "5,NaN"]].concat(), &["--virtual-time", "NaN"]);
+    refused(&[&run[..], &["--refresh", "5"]].concat(), &["--refresh", "10..=500 Hz"]);
+    refused(&[&run[..], &["--refresh", "1e300"]].concat(), &["--refresh", "10..=500 Hz"]);
+    for (command, bounds) in [
+        ("budget", &["0..=1000", "1..=100000"][..]),
+        ("bench", &["0..=1000", "1..=100000", "1..=65536", "1..=64"]),
+        ("run", &["1..=10000000", "0..=10000", "10..=500"]),
+        ("render", &["1..=100000"]),
+        ("temporal", &["1..=65536"]),
+    ] {
+        let help = text(&vrao(&[command, "--help"]));
+        for bound in bounds {
+            assert!(help.contains(bound), "`vrao {command} --help` states {bound}:\n{help}");
+        }
+    }
+}
+
+#[test]
+fn a_simulated_headset_takes_a_runtime_rate_such_as_20_hz() {
+    let dir = temp_dir("refresh-20");
+    let report = dir.join("r.json");
+    let out = vrao(&[
+        "run",
+        "--headset",
+        "simulated",
+        "--display",
+        "none",
+        "--frames",
+        "2",
+        "--refresh",
+        "20",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--governor",
+        "off",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["budget_ms"], 50.0, "{json}");
+}
+
+/// Writes `name` under `dir` with `text`; returns its path as a string.
+fn write(dir: &std::path::Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn light_that_would_overflow_the_shading_is_refused_naming_file_and_line() {
+    // Problem 8: finite values whose product overflowed: black frames with exit 0.
+    let dir = temp_dir("bright");
+    let sun = write(
+        &dir,
+        "sun.toml",
+        "[[mesh]]\nbuiltin = \"box\"\n\n[[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]\ncolor = [1e30, 1e30, 1e30]\nintensity = 1e30\n",
+    );
+    refused(&["render", "--scene", &sun], &["sun.toml:4:", "light color × intensity", "65504"]);
+    let sky =
+        write(&dir, "sky.toml", "[[mesh]]\nbuiltin = \"box\"\n\n[environment]\nsky = \"default\"\nintensity = 3e38\n");
+    refused(&["render", "--scene", &sky], &["sky.toml:4:", "environment intensity"]);
+    write(&dir, "lamp.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe 3e38 3e38 3e38\n");
+    let lamp = write(&dir, "lamp.obj", "mtllib lamp.mtl\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    refused(&["render", "--scene", &lamp], &["lamp.mtl:3:", "Ke"]);
+    // Ordinary bright values still load.
+    let fine = write(
+        &dir,
+        "fine.toml",
+        "[[mesh]]\nbuiltin = \"box\"\n\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 500\n",
+    );
+    let out = vrao(&[
+        "render",
+        "--scene",
+        &fine,
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+}
+
+#[test]
+fn geometry_that_would_vanish_is_refused_naming_file_and_line() {
+    // Problem 12: far vertices, a scale that is 0 in f32, a far translation: a frame
+    // of sky (or black) with exit 0.
+    let dir = temp_dir("vanish");
+    let far = write(&dir, "far.obj", "v 0 0 0\nv 1 0 0\nv 3e38 1 0\nf 1 2 3\n");
+    refused(&["render", "--scene", &far], &["far.obj:3:", "3e38"]);
+    let mesh = "[[mesh]]\nbuiltin = \"box\"\n";
+    let tiny = write(&dir, "tiny.toml", &format!("{mesh}scale = 1e-300\n"));
+    refused(&["render", "--scene", &tiny], &["tiny.toml:1:", "scale"]);
+    let away = write(&dir, "away.toml", &format!("{mesh}translate = [1e300, 0, 0]\n"));
+    refused(&["render", "--scene", &away], &["away.toml:1:", "translate 1e300"]);
+    let huge = write(&dir, "huge.toml", &format!("{mesh}translate = [9e5, 0, 0]\nscale = 1e5\n"));
+    refused(&["render", "--scene", &huge], &["huge.toml:1:", "vertex"]);
+}
+
+#[test]
+fn a_texture_larger_than_the_device_takes_is_refused_naming_file_and_limit() {
+    // Problem 9: 30 lines of wgpu log, exit 1, an empty --out folder.
+    let dir = temp_dir("wide-texture");
+    let limit: u32 = text(&vrao(&["info"]))
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("max_texture_dimension_2d")?.trim().parse().ok())
+        .expect("info prints max_texture_dimension_2d");
+    image::RgbaImage::new(limit + 1, 1).save(dir.join("wide.png")).unwrap();
+    write(&dir, "wide.mtl", "newmtl wide\nmap_Kd wide.png\n");
+    let obj = write(&dir, "wide.obj", "mtllib wide.mtl\nusemtl wide\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let out_dir = dir.join("out");
+    refused(
+        &["render", "--scene", &obj, "--width", "16", "--height", "16", "--out", out_dir.to_str().unwrap()],
+        &["wide.png", &format!("{}x1", limit + 1), &format!("at most {limit}")],
+    );
+    assert!(!out_dir.exists(), "a refused scene leaves no empty --out folder");
+}
+
+#[test]
+fn a_screenshot_without_a_window_is_refused() {
+    // Problem 10: silently ignored, exit 0, no file.
+    let dir = temp_dir("screenshot");
+    let shot = dir.join("s.png");
+    refused(
+        &[
+            "run",
+            "--headset",
+            "simulated",
+            "--display",
+            "none",
+            "--frames",
+            "2",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        &["--screenshot", "window"],
+    );
+}
+
+/// A change made to a bench file's JSON.
+type BenchChange = dyn Fn(&mut serde_json::Value);
+
+/// A copy of the built-in frontier (a real bench file) with `change` applied to its JSON.
+fn bench_file(dir: &std::path::Path, name: &str, change: impl Fn(&mut serde_json::Value)) -> String {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/governor/frontier.json")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    change(&mut json);
+    write(dir, name, &serde_json::to_string_pretty(&json).unwrap())
+}
+
+#[test]
+fn bench_and_frontier_files_are_validated_on_load_naming_file_record_and_value() {
+    // Problem 11: empty files, unknown techniques, negative times and N = 100000 were
+    // plotted, fitted and governed with.
+    let dir = temp_dir("bench-files");
+    let cases: [(&str, &BenchChange, &[&str]); 5] = [
+        ("empty.json", &|j| j["records"] = serde_json::json!([]), &["empty.json", "no bench records"]),
+        ("unknown.json", &|j| j["records"][2]["technique"] = "raytrace9000".into(), &["record 3", "raytrace9000"]),
+        ("negative.json", &|j| j["records"][0]["occlusion_ms_per_eye"] = (-0.891).into(), &["record 1", "-0.891"]),
+        ("samples.json", &|j| j["records"][1]["samples"] = 100000.into(), &["record 2", "samples 100000"]),
+        ("radius.json", &|j| j["records"][0]["radius_m"] = 0.0.into(), &["record 1", "radius 0 m"]),
+    ];
+    for (name, change, names) in cases {
+        let file = bench_file(&dir, name, change);
+        let names: Vec<&str> = [&[name][..], names].concat();
+        refused(&["bench", "--replot", &file, "--out", dir.join("replot").to_str().unwrap()], &names);
+        refused(
+            &["budget", "--fit", &file, "--width", "8", "--height", "8", "--out", dir.join("b.json").to_str().unwrap()],
+            &names,
+        );
+        let run =
+            ["run", "--headset", "simulated", "--display", "none", "--frames", "2", "--width", "8", "--height", "8"];
+        let t = refused(&[&run[..], &["--governor-frontier", &file]].concat(), &names);
+        assert!(!t.contains("governor: on"), "refused before the levels are printed as valid: {t}");
+    }
+}
+
+#[test]
+fn output_paths_are_checked_before_the_work() {
+    // Problem 13: bench, temporal, budget and run failed at the end of their work.
+    let dir = temp_dir("outputs");
+    let file = write(&dir, "a-file", "not a folder");
+    refused(&["bench", "--out", &file], &[&file, "is a file"]);
+    let unwritable = "/proc/nope/r.json";
+    refused(&["temporal", "--out", unwritable], &[unwritable]);
+    refused(&["reprojection", "--out", unwritable], &[unwritable]);
+    refused(&["budget", "--out", dir.to_str().unwrap()], &[dir.to_str().unwrap(), "folder"]);
+    refused(&["run", "--headset", "simulated", "--display", "none", "--report", unwritable], &[unwritable]);
+    // A check leaves nothing behind.
+    let entries: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(entries, [std::ffi::OsString::from("a-file")]);
+}
+
+#[test]
+fn messages_name_the_real_cause() {
+    // Problem 14.
+    let dir = temp_dir("messages");
+    let big = write(&dir, "big.toml", "[[mesh]]\nbuiltin = \"box\"\nscale = \"big\"\n");
+    refused(&["render", "--scene", &big], &["big.toml:3:", "scale must be a number or [x, y, z]"]);
+    let looped = dir.join("loop.toml");
+    std::os::unix::fs::symlink(&looped, &looped).unwrap();
+    let t = refused(&["render", "--scene", looped.to_str().unwrap()], &["loop.toml"]);
+    assert!(!t.contains("no such file"), "a symlink loop is not a missing file: {t}");
+    // No display: a window problem, not a GPU one, and no build path.
+    let out = Command::new(env!("CARGO_BIN_EXE_vrao"))
+        .args([
+            "run",
+            "--headset",
+            "simulated",
+            "--display",
+            "mirror",
+            "--frames",
+            "2",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .unwrap();
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{t}");
+    assert!(t.contains("cannot open a desktop window") && t.contains("--display none"), "{t}");
+    assert!(!t.contains("no usable GPU") && !t.contains(".cargo") && !t.contains("winit-0"), "{t}");
+}
+
+#[test]
+fn sigterm_and_sigint_end_a_session_with_its_report() {
+    // Problem 10: SIGTERM lost the report. The handler is in place before the session.
+    let dir = temp_dir("signals");
+    for signal in ["TERM", "INT"] {
+        let report = dir.join(format!("{signal}.json"));
+        let mut child = Command::new(env!("CARGO_BIN_EXE_vrao"))
+            .args(["run", "--headset", "simulated", "--display", "none", "--width", "16", "--height", "16"])
+            .args(["--frames", "10000000", "--report", report.to_str().unwrap()])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Whenever the signal lands (start-up or running), the run ends with its report.
+        std::thread::sleep(std::time::Duration::from_secs(3));
+        let sent = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+        assert!(sent.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(0), "SIG{signal} ends the run cleanly");
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert_eq!(json["interrupted"], true, "SIG{signal}: {json}");
+        assert!(json["interrupted_in"].is_string(), "SIG{signal}: the report says in which state: {json}");
+    }
+}
+
+#[test]
+fn an_unusable_openxr_runtime_names_its_manifest_not_the_gpu() {
+    // Before: every case read "no usable GPU: --headset openxr: no OpenXR runtime (…)".
+    let dir = temp_dir("manifest");
+    let missing = dir.join("missing.json").to_str().unwrap().to_string();
+    let broken = write(&dir, "broken.json", "{ not json");
+    let gone = write(&dir, "gone.json", r#"{"runtime": {"library_path": "./libgone.so"}}"#);
+    for (manifest, cause) in [(&missing, "cannot be read"), (&broken, "does not parse"), (&gone, "does not exist")] {
+        let out = Command::new(env!("CARGO_BIN_EXE_vrao"))
+            .args(["run", "--headset", "openxr", "--display", "none", "--frames", "1"])
+            .env("XR_RUNTIME_JSON", manifest)
+            .output()
+            .unwrap();
+        let t = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{t}");
+        assert!(!t.contains("no usable GPU") && !t.contains("panicked"), "{t}");
+        assert_eq!(error_lines(&out).len(), 1, "{t}");
+        // Without the OpenXR loader installed, that is the cause named instead.
+        if !t.contains("no OpenXR loader") {
+            assert!(t.contains(manifest.as_str()) && t.contains(cause), "{manifest}: {t}");
+        }
+    }
+}

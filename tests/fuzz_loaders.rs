@@ -99,8 +99,67 @@ fn every_saved_regression_input_loads_or_errs_without_a_panic() {
         };
         let input = std::fs::read(&path).unwrap();
         let result = catch_unwind(AssertUnwindSafe(|| load_bytes(target, &input, &scratch)));
-        assert!(result.is_ok(), "{} panics", path.display());
+        let Ok(result) = result else { panic!("{} panics", path.display()) };
+        // Inputs a loader once let through (finite values the renderer cannot draw: black
+        // frames, vanished geometry) must now be refused, naming the file and line.
+        let name = path.file_name().unwrap().to_string_lossy();
+        if name.starts_with("refused-") {
+            let error = result.err().unwrap_or_else(|| panic!("{name} loads; it must be refused")).to_string();
+            let place = format!("fuzz.{}:", target.extension());
+            assert!(error.contains(&place), "{name}: the error names the file and line: {error}");
+        }
         checked += 1;
     }
     assert!(checked > 0, "no regression inputs in {}", dir.display());
+}
+
+/// Bench files feed `vrao bench --replot`, `vrao budget --fit` and the governor's
+/// frontier: mutated copies of the built-in frontier are refused naming the file, or load
+/// with every record in range and give a frontier (or a refusal) without a panic.
+#[cfg(feature = "app")]
+#[test]
+fn mutated_bench_files_are_refused_or_load_in_range_without_a_panic() {
+    use vrao::app::governor::Frontier;
+    use vrao::render::bench_file::BenchFile;
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let seed = include_bytes!("../assets/governor/frontier.json").to_vec();
+    let origin = std::path::Path::new("fuzz.json");
+    let mut rng = Mutator::new(0xbe4c);
+    let (started, mut runs, mut accepted) = (Instant::now(), 0u64, 0u64);
+    let mut crashes = Vec::new();
+    while started.elapsed() < budget() {
+        let mut input = seed.clone();
+        for _ in 0..1 + runs % 4 {
+            rng.mutate(&mut input);
+        }
+        let text = String::from_utf8_lossy(&input).into_owned();
+        let outcome = catch_unwind(AssertUnwindSafe(|| match BenchFile::from_json(&text, origin) {
+            Ok(file) => {
+                for r in &file.records {
+                    assert!((1..=1024).contains(&r.samples), "{r:?}");
+                    assert!(r.radius_m.is_finite() && r.radius_m > 0.0, "{r:?}");
+                    assert!(r.occlusion_ms_per_eye.is_finite() && r.occlusion_ms_per_eye >= 0.0, "{r:?}");
+                }
+                if let Ok(frontier) = Frontier::from_bench(&file, 0.3) {
+                    assert!(frontier.levels().iter().all(|l| l.ms_per_eye.is_finite() && l.ms_per_eye > 0.0));
+                }
+                true
+            }
+            Err(e) => {
+                assert!(e.to_string().starts_with("fuzz.json"), "an error that names no file: {e}");
+                false
+            }
+        }));
+        match outcome {
+            Ok(true) => accepted += 1,
+            Ok(false) => {}
+            Err(_) => crashes.push(text),
+        }
+        runs += 1;
+    }
+    std::panic::set_hook(default_hook);
+    eprintln!("bench files: {runs} inputs, {accepted} accepted, {} panics", crashes.len());
+    assert!(crashes.is_empty(), "bench files that panicked: {:?}", &crashes[..crashes.len().min(2)]);
+    assert!(runs > 50 && accepted > 0, "{runs} inputs, {accepted} accepted: the mutations reach the records");
 }

@@ -161,7 +161,15 @@ fn profiles_set_the_budget_and_an_unknown_profile_or_rate_is_refused() {
     let index = run_report(&dir, "index.json", &["--profile", "index", "--refresh", "144", "--governor", "off"]);
     assert!((index["budget_ms"].as_f64().unwrap() - 1000.0 / 144.0).abs() < 1e-9, "{index}");
     assert!(index["headset"].as_str().unwrap().contains("index"), "{index}");
-    for bad in [&["--profile", "no-such-headset"][..], &["--profile", "pico-4", "--refresh", "120"][..]] {
+    assert!(
+        index["budget_source"].as_str().unwrap().contains("144 Hz"),
+        "the report says which rate governed: {index}"
+    );
+    // A rate the product does not list but a runtime may run at (the simulated headset
+    // takes any sane rate); an insane one is refused.
+    let pico = run_report(&dir, "pico.json", &["--profile", "pico-4", "--refresh", "120", "--governor", "off"]);
+    assert!((pico["budget_ms"].as_f64().unwrap() - 1000.0 / 120.0).abs() < 1e-9, "{pico}");
+    for bad in [&["--profile", "no-such-headset"][..], &["--profile", "pico-4", "--refresh", "1000"][..]] {
         let mut args = vec!["run", "--headset", "simulated", "--display", "none", "--frames", "2"];
         args.extend(bad);
         let out = vrao(&args);

@@ -100,9 +100,14 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
         Err(why) => expect_no_runtime("open", &why),
     }
 
-    let (mut headset, gpu, message) =
-        vrao::app::open_headset(vrao::app::HeadsetChoice::Auto, small_simulated(Some(3)), None, BackendChoice::Auto)
-            .expect("the fall back opens");
+    let (mut headset, gpu, message) = vrao::app::open_headset(
+        vrao::app::HeadsetChoice::Auto,
+        small_simulated(Some(3)),
+        None,
+        BackendChoice::Auto,
+        &Default::default(),
+    )
+    .expect("the fall back opens");
     assert!(message.contains("using the simulated headset"), "{message}");
     assert!(message.contains(if ci { "no OpenXR runtime" } else { "no OpenXR" }), "{message}");
     assert_eq!(message.lines().count(), 1, "one line: {message}");
@@ -115,15 +120,21 @@ fn without_a_runtime_the_library_reports_it_and_falls_back_to_the_simulated_head
     assert_eq!(frames, 3);
     headset.end(&gpu).unwrap();
 
-    let err =
-        vrao::app::open_headset(vrao::app::HeadsetChoice::OpenXr, small_simulated(Some(3)), None, BackendChoice::Auto)
-            .err()
-            .expect("OpenXR alone without a runtime is an error");
+    let err = vrao::app::open_headset(
+        vrao::app::HeadsetChoice::OpenXr,
+        small_simulated(Some(3)),
+        None,
+        BackendChoice::Auto,
+        &Default::default(),
+    )
+    .err()
+    .expect("OpenXR alone without a runtime is an error");
     assert!(matches!(err, vrao::app::HeadsetError::OpenXrUnavailable(_)), "{err}");
     let err = vrao::Error::from(err);
     assert_eq!(err.exit_code(), 2, "{err}");
     let text = err.to_string();
-    assert!(text.starts_with("no usable GPU: OpenXR headset: ") && text.contains("no OpenXR"), "{text}");
+    assert!(text.starts_with("OpenXR headset: ") && text.contains("no OpenXR"), "{text}");
+    assert!(!text.contains("no usable GPU"), "an absent runtime is not a GPU problem: {text}");
 }
 
 /// Depth32Float cannot be written by copies: a full-screen pass writes a different
@@ -399,7 +410,7 @@ fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
     eprintln!("states {phases:?}\nstats {stats:?}\ncounters {counters:?}");
     assert_eq!(counters.submitted, rendered);
     assert_eq!(stats.layers, rendered, "every rendered frame ends with the projection layer");
-    assert_eq!(counters.presented, stats.layers);
+    assert_eq!(counters.presented, 0, "OpenXR does not say what the compositor presented");
     assert!(headset.submits_depth(), "Monado has XR_KHR_composition_layer_depth: {}", headset.swapchains());
     assert_eq!(stats.layers_with_depth, stats.layers, "every layer carries depth");
     assert_eq!(counters.reprojected, 0, "reprojection is the runtime's and not counted");
@@ -409,6 +420,18 @@ fn a_real_session_reaches_focused_submits_depth_and_ends_cleanly() {
     assert_eq!(report.layers_submitted, rendered);
     assert_eq!(report.depth_layers_submitted, rendered);
     assert_eq!(report.empty_frames, stats.empty_frames);
+    // What the runtime said: frames it asked not to render, and its display period (the
+    // budget); missed periods are the gaps between predicted display times.
+    assert_eq!(report.not_rendered, stats.not_rendered);
+    assert_eq!(report.missed_display_periods, stats.missed_display_periods);
+    assert!(report.display_period_ms > 0.0, "{report:?}");
+    assert!(report.missed_display_periods < stats.frames, "{report:?}");
+    assert_eq!(report.interrupted_in, None);
+    // XR_FB_display_refresh_rate, where offered: the rate is one the runtime lists.
+    if !report.display_refresh_rates_hz.is_empty() {
+        let rate = report.display_refresh_rate_hz.expect("a rate is reported with the extension");
+        assert!(report.display_refresh_rates_hz.contains(&rate), "{report:?}");
+    }
     assert_eq!(report.states_seen, phases.iter().map(|p| p.name()).collect::<Vec<_>>());
     assert_eq!((report.loss_reason, report.ending.as_deref(), report.fell_back), (None, Some("EXITING"), false));
     assert_eq!(report.runtime, runtime);
@@ -460,6 +483,10 @@ fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
     assert_eq!(report.loss_reason.as_deref(), Some("test: LOSS_PENDING"));
     assert!(report.fell_back);
     assert_eq!(report.frames_rendered, before);
+    assert_eq!(
+        report.frames_rendered, report.layers_submitted,
+        "a frame counts as rendered once its layer is submitted"
+    );
     // The fall back takes the exit request.
     headset.request_exit();
     assert!(headset.wait_frame(&gpu).unwrap().is_none());
@@ -481,4 +508,37 @@ fn one_swapchain_per_eye_works_too() {
     assert!(headset.phases().contains(&SessionPhase::Exiting), "end() walks to EXITING: {:?}", headset.phases());
     assert_eq!(headset.stats().layers_with_depth, rendered);
     assert!(headset.lost().is_none());
+}
+
+#[test]
+#[ignore = "needs an OpenXR runtime (e.g. Monado); run with --ignored"]
+fn an_interrupt_ends_the_session_in_whatever_state_it_is() {
+    let _one_at_a_time = common::gpu_lock();
+    require_runtime();
+    // Before any frame (the session not yet READY or just begun) and while FOCUSED.
+    for frames_first in [0, 10] {
+        let interrupt = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let options = OpenXrOptions { interrupt: Some(interrupt.clone()), ..session_options(None) };
+        let (mut headset, gpu) = OpenXrHeadset::open(options).expect("session");
+        let mut renderer = renderer_for(&headset, &gpu);
+        run_frames(&mut headset, &gpu, &mut renderer, frames_first);
+        interrupt.store(true, std::sync::atomic::Ordering::Relaxed);
+        let mut after = 0;
+        while let Some(request) = headset.wait_frame(&gpu).unwrap() {
+            headset.submit(&gpu, &request, None).unwrap();
+            after += 1;
+            assert!(after < 1000, "the interrupt did not end the session");
+        }
+        headset.end(&gpu).unwrap();
+        let report = headset.openxr_report().unwrap();
+        eprintln!("interrupted after {frames_first} frames: {report:?}");
+        assert!(report.interrupted_in.is_some(), "{report:?}");
+        assert_eq!(report.loss_reason, None, "{report:?}");
+        if frames_first > 0 {
+            assert_eq!(report.ending.as_deref(), Some("EXITING"), "a running session walks to EXITING: {report:?}");
+        }
+        drop(renderer);
+        drop(headset);
+        probe_runtime().expect("the session and instance were destroyed");
+    }
 }

@@ -41,8 +41,17 @@ pub struct FrameLoop {
     pub frames: u64,
     /// Stop after this many rendered frames.
     pub frame_limit: Option<u64>,
-    /// The display period the frame must fit (ms).
+    /// The display period the frame must fit (ms): the headset's latest
+    /// ([`FrameRequest::display_period_ms`]), the profile's until it says.
     pub budget_ms: f64,
+    /// The shortest and longest display period seen (ms).
+    pub budget_range_ms: (f64, f64),
+    /// How often the display period changed during the run.
+    pub budget_changes: u64,
+    /// The session state the run was interrupted in (Ctrl-C), once the loop saw it.
+    pub interrupted_in: Option<String>,
+    /// Whether the headset has given a display period yet.
+    display_period_seen: bool,
     /// Frames whose GPU time exceeded `budget_ms`, and all frames whose time came back.
     pub over_budget_frames: u64,
     /// Frames whose GPU time has come back (the denominator of `over_budget_frames`).
@@ -75,6 +84,8 @@ pub struct FrameLoop {
 /// What the loop keeps of a submitted frame until its GPU times come back.
 struct InFlight {
     frame: u64,
+    /// The display period the frame was rendered for: its GPU time is judged against it.
+    budget_ms: f64,
     serial: bool,
     occlusion_passes: Vec<&'static str>,
 }
@@ -111,6 +122,10 @@ impl FrameLoop {
             frames: 0,
             frame_limit: None,
             budget_ms: settings.profile.budget_ms(),
+            budget_range_ms: (settings.profile.budget_ms(), settings.profile.budget_ms()),
+            budget_changes: 0,
+            interrupted_in: None,
+            display_period_seen: false,
             over_budget_frames: 0,
             timed_frames: 0,
             gpu_frame_ms: Vec::new(),
@@ -136,9 +151,13 @@ impl FrameLoop {
         // through STOPPING to EXITING over the next calls.
         if self.exit_requested.load(Ordering::Relaxed) && !self.exit_sent {
             self.exit_sent = true;
+            self.interrupted_in = Some(self.headset.session_state());
             self.headset.request_exit();
         }
         let Some(request) = self.headset.wait_frame(&self.gpu)? else { return Ok(None) };
+        if let Some(period_ms) = request.display_period_ms {
+            self.follow_display_period(period_ms);
+        }
         if !request.should_render {
             self.headset.submit(&self.gpu, &request, None)?;
             return Ok(Some(Step { request, report: None }));
@@ -160,6 +179,7 @@ impl FrameLoop {
         }
         self.in_flight.push_back(InFlight {
             frame: report.frame,
+            budget_ms: self.budget_ms,
             serial,
             occlusion_passes: report.plan.occlusion_passes(),
         });
@@ -182,6 +202,26 @@ impl FrameLoop {
         })
     }
 
+    /// Takes the display period the headset gives this frame as the budget, and hands it
+    /// to the governor, so that both follow the display from this frame on.
+    pub fn follow_display_period(&mut self, period_ms: f64) {
+        if !(period_ms.is_finite() && period_ms > 0.0) {
+            return;
+        }
+        // The first period the headset gives replaces the profile's outright.
+        if !std::mem::replace(&mut self.display_period_seen, true) {
+            self.budget_range_ms = (period_ms, period_ms);
+        } else if period_ms != self.budget_ms {
+            log::info!("display period {:.2} ms -> {period_ms:.2} ms: the budget follows", self.budget_ms);
+            self.budget_changes += 1;
+        }
+        self.budget_ms = period_ms;
+        self.budget_range_ms = (self.budget_range_ms.0.min(period_ms), self.budget_range_ms.1.max(period_ms));
+        if let Some(governor) = &mut self.governor {
+            governor.set_period_ms(period_ms);
+        }
+    }
+
     /// Books the GPU times of frames that came back.
     fn take_timings(&mut self, finished: Vec<FrameTiming>) {
         for mut timing in finished {
@@ -190,10 +230,11 @@ impl FrameLoop {
             }
             let sent = self.in_flight.front().filter(|f| f.frame == timing.frame);
             timing.serial = sent.is_some_and(|f| f.serial);
+            let budget_ms = sent.map_or(self.budget_ms, |f| f.budget_ms);
             let passes = sent.map(|f| f.occlusion_passes.clone());
             let ao_ms = passes.and_then(|passes| self.occlusion_ms(&timing, &passes));
             self.timed_frames += 1;
-            if timing.total_ms > self.budget_ms {
+            if timing.total_ms > budget_ms {
                 self.over_budget_frames += 1;
             }
             self.gpu_frame_ms.push(timing.total_ms);
@@ -234,7 +275,8 @@ impl FrameLoop {
     }
 
     /// Lets `governor` choose the AO setting from now on, starting at its current level.
-    pub fn set_governor(&mut self, governor: Governor) -> Result<()> {
+    pub fn set_governor(&mut self, mut governor: Governor) -> Result<()> {
+        governor.set_period_ms(self.budget_ms);
         let mut settings = self.renderer.settings().clone();
         settings.ao = governor.current().apply(&settings.ao);
         self.renderer.set_settings(&settings)?;

@@ -134,8 +134,7 @@ impl Frontier {
     /// A bench JSON's frontier; `origin`, the file, is named in errors (with the line
     /// where the JSON is malformed).
     pub fn from_json(text: &str, origin: &Path, radius: f32) -> Result<Frontier> {
-        let file: BenchFile = serde_json::from_str(text)
-            .map_err(|e| Error::at_line(origin, e.line(), format!("not a vrao bench file: {e}")))?;
+        let file = BenchFile::from_json(text, origin)?;
         Frontier::from_bench(&file, radius).map_err(|e| Error::in_file(origin, e.to_string()))
     }
 
@@ -338,6 +337,20 @@ impl Governor {
     /// The thresholds it runs with.
     pub fn config(&self) -> &GovernorConfig {
         &self.config
+    }
+
+    /// Follows the display: from now on frames are judged against `period_ms` (the
+    /// runtime's predicted display period, which may change at any frame: a Quest
+    /// switching between 72, 90 and 120 Hz, a runtime lowering the rate under load).
+    /// The frames measured so far stay: a shorter period drops on the next frame over
+    /// it, a longer one raises as soon as the calm frames fit. A non-positive or
+    /// non-finite period is ignored (returns false); returns whether the period changed.
+    pub fn set_period_ms(&mut self, period_ms: f64) -> bool {
+        if !(period_ms.is_finite() && period_ms > 0.0) || period_ms == self.config.period_ms {
+            return false;
+        }
+        self.config.period_ms = period_ms;
+        true
     }
 
     /// Feeds the whole frame's GPU time (both eyes) of frame `frame`; returns the change

@@ -6,6 +6,7 @@ use crate::render::gpu::{BackendChoice, Gpu};
 use crate::xr::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::xr::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::xr::Headset as _;
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 /// Which headset `vrao run` drives.
@@ -33,10 +34,10 @@ pub enum HeadsetError {
 }
 
 impl From<HeadsetError> for Error {
-    /// An unavailable OpenXR headset is the device's fault (`Error::Device`, exit 2).
+    /// An unavailable OpenXR headset is no GPU's fault (`Error::Unavailable`, exit 2).
     fn from(error: HeadsetError) -> Error {
         match error {
-            HeadsetError::OpenXrUnavailable(_) => Error::Device(error.to_string()),
+            HeadsetError::OpenXrUnavailable(_) => Error::Unavailable(error.to_string()),
             HeadsetError::Other(error) => error,
         }
     }
@@ -48,12 +49,15 @@ impl From<HeadsetError> for Error {
 ///
 /// The OpenXR headset renders at the runtime's recommended per-eye size (and with its
 /// views) unless `size` asks for another; the profile is the simulated headset's only.
-/// It falls back to the simulated headset if its session is lost.
+/// It falls back to the simulated headset if its session is lost. Setting `interrupt`
+/// (the caller's cancellation token) ends an OpenXR session from whatever state it is in,
+/// within one poll of the runtime's events.
 pub fn open_headset(
     choice: HeadsetChoice,
     simulated: SimulatedOptions,
     size: Option<(u32, u32)>,
     backend: BackendChoice,
+    interrupt: &Arc<AtomicBool>,
 ) -> Result<OpenedHeadset, HeadsetError> {
     // `why`: the reason the simulated headset stands in for OpenXR, if it does.
     let simulated_headset = |why: Option<String>| -> Result<OpenedHeadset, HeadsetError> {
@@ -70,7 +74,9 @@ pub fn open_headset(
         if backend == BackendChoice::Gl {
             return Err(Unavailable::Unsupported("OpenXR sessions need the Vulkan backend, not GL".into()));
         }
-        openxr::open_headset(OpenXrOptions::from_simulated(&simulated, size))
+        let options =
+            OpenXrOptions { interrupt: Some(interrupt.clone()), ..OpenXrOptions::from_simulated(&simulated, size) };
+        openxr::open_headset(options)
     };
     match choice {
         HeadsetChoice::Simulated => simulated_headset(None),

@@ -49,6 +49,9 @@ pub(super) struct PanelInfo<'a> {
     pub(super) history: &'a PassHistory,
     pub(super) budget_ms: f64,
     pub(super) governor: Option<&'a Governor>,
+    /// What an OpenXR session said so far (`None` for the simulated headset, and after a
+    /// lost session, whose simulated counters then apply).
+    pub(super) openxr: Option<crate::xr::openxr::OpenXrReport>,
 }
 
 /// Colour of pass `i` in the profiler graph.
@@ -124,11 +127,20 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
             ui.small("no AO buffer: the technique is none");
         }
         ui.separator();
-        let [presented, reprojected, dropped] = panel.rates;
-        ui.label(format!(
-            "per second: {presented:.0} presented, {reprojected:.0} reprojected, {dropped:.1} dropped\nlatency: median {:.1} ms, p95 {:.1} ms",
-            counters.latency_median_ms, counters.latency_p95_ms
-        ));
+        match &info.openxr {
+            // OpenXR does not say what its compositor presented or reprojected.
+            Some(x) => ui.label(format!(
+                "OpenXR: {} layers submitted, {} not to render, {} display periods missed; period {:.2} ms",
+                x.layers_submitted, x.not_rendered, x.missed_display_periods, x.display_period_ms
+            )),
+            None => {
+                let [presented, reprojected, dropped] = panel.rates;
+                ui.label(format!(
+                    "per second: {presented:.0} presented, {reprojected:.0} reprojected, {dropped:.1} dropped\nlatency: median {:.1} ms, p95 {:.1} ms",
+                    counters.latency_median_ms, counters.latency_p95_ms
+                ))
+            }
+        };
         ui.separator();
         match info.governor {
             Some(governor) => {

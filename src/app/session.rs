@@ -14,8 +14,11 @@ use crate::xr::simulated::motion::HeadMotion;
 use crate::xr::simulated::reproject::ReprojectionMode;
 use crate::xr::simulated::{SimulatedOptions, TimeMode};
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+
+/// The most frames a session renders when asked for a count (a day at 90 Hz is 7.8 M).
+pub const RUN_FRAMES_MAX: u64 = 10_000_000;
 
 /// How [`run_session`] runs; `Default` is a simulated-or-OpenXR Vive session with no
 /// window, the governor on, until 600 frames.
@@ -96,6 +99,15 @@ pub enum SessionError {
     /// [`RunOptions::show`] asks for a buffer view without a window to show it in.
     #[error("the {} buffer view needs a window (a mirror or single-pass display)", .0.name())]
     ViewNeedsWindow(BufferView),
+    /// [`RunOptions::screenshot`] asks for the window's picture without a window.
+    #[error("a screenshot needs a window (a mirror or single-pass display)")]
+    ScreenshotNeedsWindow,
+    /// [`RunOptions::frames`] is 0 or above [`RUN_FRAMES_MAX`].
+    #[error("{0} frames is not within 1..={RUN_FRAMES_MAX}")]
+    Frames(u64),
+    /// [`RunOptions::virtual_time`] has a render time out of range.
+    #[error("{0}")]
+    VirtualTime(Error),
     /// The headset (OpenXR asked for and unavailable, or the simulated one).
     #[error(transparent)]
     Headset(#[from] HeadsetError),
@@ -108,7 +120,10 @@ impl From<SessionError> for Error {
     fn from(error: SessionError) -> Error {
         match error {
             SessionError::Profile(e) | SessionError::Refresh(e) | SessionError::Other(e) => e,
-            SessionError::ViewNeedsWindow(_) => Error::input(error.to_string()),
+            SessionError::ViewNeedsWindow(_) | SessionError::ScreenshotNeedsWindow | SessionError::Frames(_) => {
+                Error::input(error.to_string())
+            }
+            SessionError::VirtualTime(e) => e,
             SessionError::Headset(e) => e.into(),
         }
     }
@@ -116,8 +131,11 @@ impl From<SessionError> for Error {
 
 /// Runs a headset session on `scene` with `settings` (their profile is replaced by the
 /// one `options` names) and returns its summary. Which headset and governor it uses
-/// goes to the log (info). Setting `interrupt` (a Ctrl-C handler of the caller's, say)
-/// ends the session cleanly after the current frame; the summary is still returned.
+/// goes to the log (info). `interrupt` is the caller's cancellation token (its Ctrl-C
+/// handler sets it; the library installs none): setting it at any time, from start-up
+/// on, ends the session cleanly from whatever state it is in (an OpenXR session before
+/// READY or stopped by the runtime included); the summary is still returned, with
+/// `interrupted` and the state it was in.
 pub fn run_session(
     scene: &Scene,
     settings: &Settings,
@@ -127,6 +145,15 @@ pub fn run_session(
     let (settings, size) = session_settings(settings, options)?;
     if options.display == DisplayMode::None && options.show != BufferView::Eyes {
         return Err(SessionError::ViewNeedsWindow(options.show));
+    }
+    if options.display == DisplayMode::None && options.screenshot.is_some() {
+        return Err(SessionError::ScreenshotNeedsWindow);
+    }
+    if let Some(frames) = options.frames.filter(|n| !(1..=RUN_FRAMES_MAX).contains(n)) {
+        return Err(SessionError::Frames(frames));
+    }
+    if !options.virtual_time.is_empty() {
+        crate::xr::simulated::check_virtual_render_ms(&options.virtual_time).map_err(SessionError::VirtualTime)?;
     }
     let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };
     let frames = options.frames.or((options.display == DisplayMode::None).then_some(600));
@@ -144,8 +171,17 @@ pub fn run_session(
         compose: options.display == DisplayMode::Mirror,
         frames,
     };
-    let (headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend)?;
+    let (mut headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
     log::info!("headset: {message}");
+    // Interrupted while the headset opened: end its session now rather than after
+    // compiling the renderer's pipelines (a second on a CPU adapter).
+    if interrupt.load(Ordering::Relaxed) {
+        let state = headset.session_state();
+        headset.request_exit();
+        while headset.wait_frame(&gpu)?.is_some_and(|request| headset.submit(&gpu, &request, None).is_ok()) {}
+        headset.end(&gpu)?;
+        return Ok(RunSummary::before_frames(headset.as_ref(), &gpu, &settings, state, options.frames_in_flight));
+    }
     let mut frame_loop = FrameLoop::new(gpu, scene, &settings, headset)?;
     frame_loop.frame_limit = frames;
     frame_loop.exit_requested = interrupt;

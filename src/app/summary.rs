@@ -23,8 +23,18 @@ pub struct RunSummary {
     pub frames_in_flight_max: usize,
     /// The renderer's limit on frames in flight.
     pub frames_in_flight_limit: usize,
-    /// The display period (ms) and the frames whose GPU time exceeded it (of those timed).
+    /// The display period (ms) at the end of the run: the frame budget each frame's GPU
+    /// time is judged against (the period the frame was rendered for).
     pub budget_ms: f64,
+    /// Which rate governed the budget and where it came from: the OpenXR runtime's
+    /// predicted display period, or the simulated headset's refresh rate.
+    pub budget_source: String,
+    /// The shortest and longest display period of the run (ms).
+    pub budget_ms_min: f64,
+    /// The longest display period of the run (ms).
+    pub budget_ms_max: f64,
+    /// How often the display period changed during the run.
+    pub budget_changes: u64,
     /// Timed frames whose GPU time exceeded `budget_ms`.
     pub over_budget_frames: u64,
     /// Frames whose GPU time came back.
@@ -39,12 +49,18 @@ pub struct RunSummary {
     /// How the passes were timed: pipelined, and on a CPU adapter every
     /// [`SERIAL_EVERY`]th frame serial (one submission per pass).
     pub timing: String,
-    /// The headset's frame counters: submitted, presented, reprojected, dropped, latency.
-    pub counters: crate::xr::FrameCounters,
+    /// The simulated compositor's frame counters (submitted, presented, reprojected,
+    /// dropped, latency); `None` for an OpenXR session, whose runtime does not say what it
+    /// presented or reprojected (see `openxr` for what it does say). After a lost OpenXR
+    /// session, the simulated headset's counters from then on.
+    pub counters: Option<crate::xr::FrameCounters>,
     /// (pass, median GPU ms for both eyes) over the recent frames.
     pub pass_medians_ms: Vec<(String, f64)>,
-    /// Whether Ctrl-C (the session's interrupt flag) ended the run.
+    /// Whether Ctrl-C or SIGTERM (the session's interrupt flag) ended the run.
     pub interrupted: bool,
+    /// The session state the run was in when it was interrupted (OpenXR: the
+    /// XrSessionState, e.g. `FOCUSED`, `IDLE`; the simulated headset: `running`).
+    pub interrupted_in: Option<String>,
     /// The budget governor: on or off, every change it made, and the AO setting the run
     /// ended with.
     pub governor: String,
@@ -60,6 +76,16 @@ impl RunSummary {
     /// Summarizes the loop as it stands (call it when the loop has ended).
     pub fn of(frame_loop: &FrameLoop) -> RunSummary {
         let gpu_frame_ms_median = stats::median(&frame_loop.gpu_frame_ms).unwrap_or(0.0);
+        let openxr = frame_loop.headset.openxr_report();
+        let interrupted = frame_loop.exit_requested.load(Ordering::Relaxed);
+        // The loop saw the interrupt before a frame, or the OpenXR headset saw it while
+        // it waited for the runtime.
+        let interrupted_in = frame_loop
+            .interrupted_in
+            .clone()
+            .or_else(|| openxr.as_ref().and_then(|r| r.interrupted_in.clone()))
+            .or_else(|| interrupted.then(|| frame_loop.headset.session_state()));
+        let simulated_counters = openxr.as_ref().is_none_or(|r| r.fell_back);
         let cpu_encode_ms_median = stats::median(&frame_loop.cpu_encode_ms).unwrap_or(0.0);
         RunSummary {
             headset: frame_loop.headset.describe(),
@@ -68,6 +94,10 @@ impl RunSummary {
             frames_in_flight_max: frame_loop.renderer.frames_in_flight_max(),
             frames_in_flight_limit: frame_loop.renderer.frames_in_flight_limit(),
             budget_ms: frame_loop.budget_ms,
+            budget_source: frame_loop.headset.display_rate_source(),
+            budget_ms_min: frame_loop.budget_range_ms.0,
+            budget_ms_max: frame_loop.budget_range_ms.1,
+            budget_changes: frame_loop.budget_changes,
             over_budget_frames: frame_loop.over_budget_frames,
             timed_frames: frame_loop.timed_frames,
             gpu_frame_ms_median,
@@ -82,35 +112,94 @@ impl RunSummary {
             } else {
                 "pipelined".into()
             },
-            counters: frame_loop.headset.counters(),
+            counters: simulated_counters.then(|| frame_loop.headset.counters()),
             pass_medians_ms: pass_medians(frame_loop),
-            interrupted: frame_loop.exit_requested.load(Ordering::Relaxed),
+            interrupted,
+            interrupted_in,
             governor: if frame_loop.governor.is_some() { "on" } else { "off" }.into(),
             governor_changes: frame_loop.governor.as_ref().map(|g| g.changes().to_vec()).unwrap_or_default(),
             final_ao_setting: ao_setting(&frame_loop.renderer.settings().ao),
-            openxr: frame_loop.headset.openxr_report(),
+            openxr,
+        }
+    }
+
+    /// The summary of a session interrupted (in `state`) before its first frame: the
+    /// headset opened and was ended, nothing was rendered.
+    pub fn before_frames(
+        headset: &dyn crate::xr::Headset,
+        gpu: &crate::render::gpu::Gpu,
+        settings: &crate::render::settings::Settings,
+        state: String,
+        frames_in_flight: usize,
+    ) -> RunSummary {
+        let openxr = headset.openxr_report();
+        let budget_ms = openxr.as_ref().map_or(0.0, |r| r.display_period_ms);
+        let budget_ms = if budget_ms > 0.0 { budget_ms } else { settings.profile.budget_ms() };
+        RunSummary {
+            headset: headset.describe(),
+            adapter: gpu.info.name.clone(),
+            frames_rendered: 0,
+            frames_in_flight_max: 0,
+            frames_in_flight_limit: frames_in_flight,
+            budget_ms,
+            budget_source: headset.display_rate_source(),
+            budget_ms_min: budget_ms,
+            budget_ms_max: budget_ms,
+            budget_changes: 0,
+            over_budget_frames: 0,
+            timed_frames: 0,
+            gpu_frame_ms_median: 0.0,
+            cpu_encode_ms_median: 0.0,
+            cpu_encode_share_of_gpu: 0.0,
+            timing: "no frame was rendered".into(),
+            counters: openxr.as_ref().is_none_or(|r| r.fell_back).then(|| headset.counters()),
+            pass_medians_ms: Vec::new(),
+            interrupted: true,
+            interrupted_in: Some(state),
+            governor: "not started".into(),
+            governor_changes: Vec::new(),
+            final_ao_setting: ao_setting(&settings.ao),
+            openxr,
         }
     }
 
     /// The summary as the few lines `vrao run` prints.
     pub fn to_text(&self) -> String {
-        let c = &self.counters;
         let passes: Vec<String> = self.pass_medians_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect();
+        let mut frames =
+            format!("frames: {} rendered (up to {} in flight)", self.frames_rendered, self.frames_in_flight_max);
+        if let Some(x) = &self.openxr {
+            // Only what OpenXR says: nothing here is "presented" or "reprojected".
+            frames += &format!(
+                "; OpenXR: {} layers submitted, {} frames the runtime said not to render, {} display periods missed (from predicted display times)",
+                x.layers_submitted, x.not_rendered, x.missed_display_periods
+            );
+        }
+        if let Some(c) = &self.counters {
+            let after = if self.openxr.is_some() { " (simulated headset, after the loss)" } else { "" };
+            frames += &format!(
+                "; {} submitted{after}; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms",
+                c.submitted, c.presented, c.reprojected, c.dropped, c.latency_median_ms, c.latency_p95_ms
+            );
+        }
+        let budget = if self.budget_changes > 0 {
+            format!(
+                "a {:.2} ms budget ({:.2}..{:.2} ms, {} changes) from {}",
+                self.budget_ms, self.budget_ms_min, self.budget_ms_max, self.budget_changes, self.budget_source
+            )
+        } else {
+            format!("a {:.2} ms budget from {}", self.budget_ms, self.budget_source)
+        };
+        let interrupted = match &self.interrupted_in {
+            Some(state) if self.interrupted => format!("\ninterrupted in {state}"),
+            _ => String::new(),
+        };
         format!(
-            "governor {}: {} changes, AO setting at the end: {}\nframes: {} rendered (up to {} in flight), {} submitted; vsyncs: {} presented, {} reprojected; {} dropped; latency median {:.1} ms, p95 {:.1} ms\nGPU per frame: median {:.2} ms against a {:.2} ms budget, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}",
+            "governor {}: {} changes, AO setting at the end: {}\n{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
             self.governor_changes.len(),
             self.final_ao_setting,
-            self.frames_rendered,
-            self.frames_in_flight_max,
-            c.submitted,
-            c.presented,
-            c.reprojected,
-            c.dropped,
-            c.latency_median_ms,
-            c.latency_p95_ms,
             self.gpu_frame_ms_median,
-            self.budget_ms,
             self.over_budget_frames,
             self.timed_frames,
             self.cpu_encode_ms_median,

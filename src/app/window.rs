@@ -36,12 +36,29 @@ pub struct WindowOptions {
     pub show: BufferView,
 }
 
+/// winit's OS errors lead with a place in winit's own source ("os error at
+/// …/winit-0.30.13/src/platform_impl/linux/mod.rs:765: "), a build path that means
+/// nothing to the user: keep the system's reason alone.
+fn without_source_location(message: String) -> String {
+    match message.strip_prefix("os error at ").and_then(|rest| rest.split_once(": ")) {
+        Some((_, reason)) => reason.to_string(),
+        None => message,
+    }
+}
+
 /// Opens the window and runs the session until the headset ends it or the window closes.
 pub fn run_window(mut frame_loop: FrameLoop, scene: &Scene, options: WindowOptions) -> Result<RunSummary> {
     frame_loop.buffer_view = options.show;
-    let event_loop = EventLoop::new().map_err(|e| Error::Device(format!("cannot open a desktop window: {e}")))?;
+    let event_loop = EventLoop::new().map_err(|e| {
+        Error::Unavailable(format!(
+            "cannot open a desktop window ({}); without a display, run with --display none",
+            without_source_location(e.to_string())
+        ))
+    })?;
     let mut app = WindowApp { frame_loop, scene: scene.clone(), options, window: None, error: None, finished: false };
-    event_loop.run_app(&mut app).map_err(|e| Error::Device(format!("the window's event loop failed: {e}")))?;
+    event_loop.run_app(&mut app).map_err(|e| {
+        Error::Unavailable(format!("the window's event loop failed: {}", without_source_location(e.to_string())))
+    })?;
     app.frame_loop.end()?;
     if let Some(e) = app.error {
         return Err(e);
@@ -150,9 +167,9 @@ impl WindowState {
         let attributes = Window::default_attributes()
             .with_title(format!("vrao — {}", frame_loop.headset.describe()))
             .with_inner_size(winit::dpi::PhysicalSize::new(options.size.0, options.size.1));
-        let window = Arc::new(
-            event_loop.create_window(attributes).map_err(|e| Error::Device(format!("cannot create a window: {e}")))?,
-        );
+        let window = Arc::new(event_loop.create_window(attributes).map_err(|e| {
+            Error::Unavailable(format!("cannot create a window: {}", without_source_location(e.to_string())))
+        })?);
         let (instance, adapter) = gpu_instance_adapter(gpu)?;
         let surface = instance
             .create_surface(window.clone())
@@ -287,6 +304,7 @@ impl WindowState {
             history: &frame_loop.history,
             budget_ms: frame_loop.budget_ms,
             governor: frame_loop.governor.as_ref(),
+            openxr: frame_loop.headset.openxr_report().filter(|r| !r.fell_back),
         };
         let full_output = self.egui_ctx.run_ui(raw_input, |ui| {
             changed = panel_ui(ui, panel, &info, &counters);
@@ -472,5 +490,17 @@ fn gpu_instance_adapter(gpu: &Gpu) -> Result<(&wgpu::Instance, &wgpu::Adapter)> 
     match (&gpu.instance, &gpu.adapter) {
         (Some(instance), Some(adapter)) => Ok((instance, adapter)),
         _ => Err(Error::Device("a window needs the wgpu instance and adapter vrao opened itself".into())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::without_source_location;
+
+    #[test]
+    fn window_errors_drop_winits_source_path() {
+        let winit = "os error at /home/u/.cargo/registry/src/index/winit-0.30.13/src/platform_impl/linux/mod.rs:765: neither WAYLAND_DISPLAY nor DISPLAY is set";
+        assert_eq!(without_source_location(winit.into()), "neither WAYLAND_DISPLAY nor DISPLAY is set");
+        assert_eq!(without_source_location("the event loop exited".into()), "the event loop exited");
     }
 }

@@ -6,6 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
 use vrao::measure::reference::default_cache_dir;
+use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::RENDER_DEFAULT;
 use vrao::render::settings::{AoSettings, BounceForm, Denoise, Quality, Technique};
@@ -44,8 +45,8 @@ pub struct BenchArgs {
     /// Techniques to sweep, comma-separated (by default every estimator, gtao first).
     #[arg(long, value_delimiter = ',', value_enum, default_values_t = Technique::estimators(), hide_possible_values = true)]
     techniques: Vec<Technique>,
-    /// Sample counts, comma-separated (by default the presets' counts, the grid of
-    /// Belonogov 2018).
+    /// Sample counts, comma-separated, each 1..=256 (by default the presets' counts, the
+    /// grid of Belonogov 2018).
     #[arg(long, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
     samples: Vec<u32>,
     /// Radii in metres, comma-separated (default: the scene's radius × 0.5, 1, 2).
@@ -63,16 +64,16 @@ pub struct BenchArgs {
     #[arg(long, default_value = "off", hide_possible_values = true)]
     temporal: Sweep,
     /// Also measure reflective shadow maps (one bounce of the directional lights) with
-    /// these VPL counts, comma-separated, gathering within each radius: rows "rsm", whose
+    /// these VPL counts (each 1..=1024), comma-separated, gathering within each radius: rows "rsm", whose
     /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
     /// given for ssdo-bounce rows.
     #[arg(long, value_delimiter = ',')]
     rsm_samples: Vec<u32>,
-    /// Measured frames per case, after warm-up.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    /// Measured frames per case, after warm-up; 1..=100000.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
-    /// Warm-up frames per case (not measured).
-    #[arg(long, default_value_t = 3)]
+    /// Warm-up frames per case (not measured), 0..=1000.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
     /// eq. 2).
@@ -89,7 +90,7 @@ pub struct BenchArgs {
     blur: u32,
     /// Measure this many cases at a time, round-robin one frame each, so that the
     /// machine's drift during a long sweep falls on all of them alike (fair ratios
-    /// between techniques); each needs its own targets in memory at once.
+    /// between techniques); each needs its own targets in memory at once. 1..=64.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     interleave: u32,
     /// Render whole frames (direct light and composite too), not only the occlusion: the
@@ -98,10 +99,10 @@ pub struct BenchArgs {
     /// row's; sweep --resolution both, ideally interleaved).
     #[arg(long)]
     frame: bool,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one
@@ -112,10 +113,10 @@ pub struct BenchArgs {
     /// Output directory for bench.csv, bench.json, bench.md and bench.png.
     #[arg(long, default_value = "bench")]
     out: PathBuf,
-    /// Reference rays per traced pixel (cosine-weighted, stratified).
+    /// Reference rays per traced pixel (cosine-weighted, stratified), 1..=65536.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
-    /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there).
+    /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there), 1..=64.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     stride: u32,
     /// Skip the reference: time only, no error columns.
@@ -134,6 +135,8 @@ pub struct BenchArgs {
 }
 
 pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
+    // An output folder that cannot be written fails now, not after the sweep.
+    vrao::render::output::check_output_folder(&args.out)?;
     let run = match &args.replot {
         Some(path) => replot(path)?,
         None => {

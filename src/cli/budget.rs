@@ -4,6 +4,7 @@ use super::{parse_budget_ms, AoArgs, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::budget::{measure_budget, BudgetOptions};
+use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
 use vrao::{BackendChoice, HeadsetProfile, Result, Scene};
 
@@ -18,17 +19,17 @@ enum Measure {
 pub struct BudgetArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
-    /// Measured frames (each: the stereo frame, then each eye alone), after warm-up.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    /// Measured frames (each: the stereo frame, then each eye alone), after warm-up; 1..=100000.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
-    /// Warm-up frames (not measured).
-    #[arg(long, default_value_t = 3)]
+    /// Warm-up frames (not measured), 0..=1000.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// Budget of one stereo frame in ms (default: the headset's refresh interval, 11.1 ms
     /// at 90 Hz); each eye gets half.
@@ -53,6 +54,8 @@ pub struct BudgetArgs {
 }
 
 pub fn run(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
+    // A report that cannot be written fails now, not after the measurement.
+    vrao::render::output::check_output_file(&args.out)?;
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
     let options = BudgetOptions {

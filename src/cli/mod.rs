@@ -51,13 +51,14 @@ pub struct LightArgs {
     /// directional light has none either way).
     #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().enabled))]
     shadows: OnOff,
-    /// Texels along each side of the square light-space maps.
+    /// Texels along each side of the square light-space maps, 16..=8192.
     #[arg(long, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().size)]
     shadow_size: u32,
     /// One bounce of the directional lights from reflective shadow maps: on or off.
     #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().rsm))]
     rsm: OnOff,
-    /// Virtual point lights gathered per pixel and light by the reflective shadow maps.
+    /// Virtual point lights gathered per pixel and light by the reflective shadow maps,
+    /// 1..=1024.
     #[arg(long, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().rsm_samples)]
     rsm_samples: u32,
     /// RSM gather radius in metres (default: a quarter of the scene's diagonal, within 0.1..=4 m).
@@ -141,7 +142,8 @@ pub struct AoArgs {
     /// bilateral (separable, --blur px either side).
     #[arg(long, value_enum, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
     denoise: Denoise,
-    /// Bilateral blur radius in full-resolution pixels (5 = 11×11); 0 turns any denoise off.
+    /// Bilateral blur radius in full-resolution pixels, 0..=16 (5 = 11×11); 0 turns any
+    /// denoise off.
     #[arg(long, default_value_t = AoSettings::default().blur_radius)]
     blur: u32,
     /// Blur depth-edge width as a fraction of the pixel's distance (smaller keeps sharper edges).
@@ -167,7 +169,7 @@ pub struct AoArgs {
     /// well it agrees with the new frame).
     #[arg(long, value_enum, default_value_t = Temporal::default().blend, hide_possible_values = true)]
     temporal_blend: TemporalBlend,
-    /// Frames after which a pixel counts as converged.
+    /// Frames after which a pixel counts as converged, 1..=1024.
     #[arg(long, default_value_t = Temporal::default().max_frames)]
     temporal_frames: u32,
     /// Motion-adaptive temporal window: a pixel that moved m pixels since the last frame

@@ -33,10 +33,10 @@ pub struct RenderArgs {
     /// Stereo G-buffer path: auto, multiview or multipass.
     #[arg(long, value_enum, default_value_t = StereoMode::default(), hide_possible_values = true)]
     stereo: StereoMode,
-    /// Per-eye width in pixels (Vive-class default).
+    /// Per-eye width in pixels, 1..=8192 (Vive-class default).
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels (Vive-class default).
+    /// Per-eye height in pixels, 1..=8192 (Vive-class default).
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Interpupillary distance in metres.
@@ -50,7 +50,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "pipelined", hide_possible_values = true)]
     timing: TimingChoice,
     /// Render this many frames and report per-pass GPU medians (with --explain); the
-    /// first frames are warm-up and not counted.
+    /// first frames are warm-up and not counted. 1..=100000.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Scene time in seconds (0 to 1e6): where animated objects and a scripted head are.

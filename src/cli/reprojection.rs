@@ -10,10 +10,10 @@ use vrao::{BackendChoice, HeadsetProfile, Result, Scene};
 pub struct ReprojectionArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Write the rows as JSON here.
@@ -24,6 +24,9 @@ pub struct ReprojectionArgs {
 }
 
 pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        vrao::render::output::check_output_file(out)?;
+    }
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
     let (rows, adapter) = study(backend, &scene, &settings)?;

@@ -5,7 +5,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use vrao::app::{run_session, BufferView, HeadsetChoice, HeadsetError, RunOptions, SessionError};
+use vrao::app::{run_session, BufferView, HeadsetChoice, HeadsetError, RunOptions, SessionError, RUN_FRAMES_MAX};
 use vrao::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
 use vrao::render::settings::DisplayMode;
 use vrao::xr::simulated::motion::HeadMotion;
@@ -22,8 +22,9 @@ pub struct RunArgs {
     /// Desktop window: none, mirror (both eyes side by side) or single-pass (mono view).
     #[arg(long, default_value = "mirror", hide_possible_values = true)]
     display: DisplayMode,
-    /// Stop after this many frames (default: until the window is closed; 600 without one).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Stop after this many frames, 1..=10000000 (default: until the window is closed;
+    /// 600 without one).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=RUN_FRAMES_MAX))]
     frames: Option<u64>,
     /// Simulated head motion: static, yaw-sweep, figure-eight or head-roll.
     #[arg(long, default_value = "static", hide_possible_values = true)]
@@ -32,7 +33,7 @@ pub struct RunArgs {
     #[arg(long, default_value = "depth", hide_possible_values = true)]
     reprojection: ReprojectionMode,
     /// Run the simulated headset in virtual time, each frame taking these render times
-    /// in ms (cycled): deterministic counters.
+    /// in ms (cycled), each within 0..=10000: deterministic counters.
     #[arg(long, value_delimiter = ',')]
     virtual_time: Vec<f64>,
     /// Headset profile of the simulated headset: vive, vive-pro-2, index, quest-2,
@@ -40,13 +41,16 @@ pub struct RunArgs {
     /// follows the rate). An OpenXR runtime's recommended size and views win over it.
     #[arg(long, default_value = "vive")]
     profile: String,
-    /// Refresh rate in Hz, one the profile supports (default: the profile's).
+    /// Refresh rate in Hz of the simulated headset, 10..=500 (default: the profile's).
+    /// With OpenXR the runtime's display period sets the frame budget, frame by frame.
     #[arg(long)]
     refresh: Option<f64>,
-    /// Per-eye width to render at (default: the profile's; with OpenXR, the runtime's).
+    /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
+    /// runtime's).
     #[arg(long)]
     width: Option<u32>,
-    /// Per-eye height to render at (default: the profile's; with OpenXR, the runtime's).
+    /// Per-eye height to render at, 1..=8192 (default: the profile's; with OpenXR, the
+    /// runtime's).
     #[arg(long)]
     height: Option<u32>,
     /// Budget governor: on (choose the AO setting by error per millisecond so that each
@@ -57,10 +61,10 @@ pub struct RunArgs {
     /// one, measured on the furnished room; see assets/governor/README.md).
     #[arg(long)]
     governor_frontier: Option<PathBuf>,
-    /// Frames the GPU may work on at once.
+    /// Frames the GPU may work on at once, 1..=8.
     #[arg(long, default_value_t = DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
     frames_in_flight: u64,
-    /// Window size WIDTHxHEIGHT.
+    /// Window size WIDTHxHEIGHT, each 1..=16384.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     window: (u32, u32),
     /// Save a screenshot of the window to this PNG after the last frame.
@@ -78,6 +82,12 @@ pub struct RunArgs {
 }
 
 pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
+    // Before anything that takes time or opens a session: a Ctrl-C (or SIGTERM) from
+    // here on ends the run cleanly, with its report.
+    let interrupt = interrupt_on_ctrl_c();
+    for output in [&args.report, &args.screenshot].into_iter().flatten() {
+        vrao::render::output::check_output_file(output)?;
+    }
     let scene = Scene::load(&args.scene)?;
     // The session replaces the profile with the one --profile names.
     let settings =
@@ -101,7 +111,7 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         screenshot: args.screenshot,
         show: args.show,
     };
-    let summary = run_session(&scene, &settings, &options, interrupt_on_ctrl_c()).map_err(name_the_option)?;
+    let summary = run_session(&scene, &settings, &options, interrupt).map_err(name_the_option)?;
     println!("{}", summary.to_text());
     match &args.report {
         Some(path) => vrao::render::output::write_json(path, &summary),
@@ -109,9 +119,9 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     }
 }
 
-/// A flag that the first Ctrl-C sets, which ends the session cleanly (the summary and
-/// report are still written); a second Ctrl-C while it ends stops the process (130, as a
-/// shell reports an interrupted command).
+/// A flag that the first Ctrl-C (SIGINT) or SIGTERM sets, which ends the session cleanly
+/// in whatever state it is (the summary and report are still written); a second one
+/// while it ends stops the process (130, as a shell reports an interrupted command).
 fn interrupt_on_ctrl_c() -> Arc<AtomicBool> {
     let interrupt = Arc::new(AtomicBool::new(false));
     let flag = interrupt.clone();
@@ -119,7 +129,7 @@ fn interrupt_on_ctrl_c() -> Arc<AtomicBool> {
         if flag.swap(true, Ordering::Relaxed) {
             std::process::exit(130);
         }
-        eprintln!("Ctrl-C: ending the session");
+        eprintln!("interrupted: ending the session (again to stop at once)");
     });
     if let Err(e) = installed {
         eprintln!("warning: Ctrl-C will stop vrao at once, without a summary: {e}");
@@ -135,8 +145,13 @@ fn name_the_option(error: SessionError) -> Error {
         SessionError::ViewNeedsWindow(view) => {
             Error::input(format!("--show {} needs a window (--display mirror or single-pass)", view.name()))
         }
+        SessionError::ScreenshotNeedsWindow => {
+            Error::input("--screenshot needs a window (--display mirror or single-pass)")
+        }
+        SessionError::Frames(n) => Error::input(format!("--frames {n} is not within 1..={RUN_FRAMES_MAX}")),
+        SessionError::VirtualTime(e) => with_option("--virtual-time", e),
         SessionError::Headset(HeadsetError::OpenXrUnavailable(why)) => {
-            Error::Device(format!("--headset openxr: {why}"))
+            Error::Unavailable(format!("--headset openxr: {why}"))
         }
         other => other.into(),
     }
@@ -147,6 +162,7 @@ fn with_option(option: &str, error: Error) -> Error {
     match error {
         Error::Input { file, line, message } => Error::Input { file, line, message: format!("{option}: {message}") },
         Error::Device(message) => Error::Device(format!("{option}: {message}")),
+        Error::Unavailable(message) => Error::Unavailable(format!("{option}: {message}")),
         other => other,
     }
 }

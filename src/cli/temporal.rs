@@ -29,14 +29,14 @@ pub struct TemporalArgs {
     /// With --motion: frames (at 90 Hz) between scored frames, 1 to 90.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=90))]
     every: u32,
-    /// Per-eye width in pixels.
+    /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = 270)]
     width: u32,
-    /// Per-eye height in pixels.
+    /// Per-eye height in pixels, 1..=8192.
     #[arg(long, default_value_t = 300)]
     height: u32,
-    /// Reference rays per traced pixel.
-    #[arg(long, default_value_t = 256)]
+    /// Reference rays per traced pixel, 1..=65536.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
     /// Write the points as JSON here.
     #[arg(long)]

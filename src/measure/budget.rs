@@ -189,6 +189,8 @@ fn pass_times(report: &FrameReport, timing: Timing) -> Vec<(String, f64)> {
 /// Renders `warmup + frames` rounds of (stereo frame, left eye alone, right eye alone)
 /// and compares the medians with the budget.
 pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<BudgetReport> {
+    // Bounded counts: `warmup + frames` never wraps, and there is a measured frame.
+    crate::measure::check_frames(how.warmup, how.frames)?;
     renderer.set_timing(how.timing);
     let views: [&[crate::render::stereo::Eye]; 3] = [&eyes.eyes, &eyes.eyes[..1], &eyes.eyes[1..]];
     let mut times: [Vec<Vec<(String, f64)>>; 3] = Default::default();

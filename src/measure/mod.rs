@@ -15,3 +15,36 @@ pub mod reference;
 pub mod reprojection;
 pub mod stereo_consistency;
 pub mod temporal;
+
+use crate::render::error::{Error, Result};
+
+/// The most warm-up frames a measurement takes (`--warmup` of bench and budget): a few
+/// suffice for pipeline compilation and first-touch allocation.
+pub const WARMUP_MAX: u32 = 1000;
+/// The most measured frames per case (`--frames` of bench and budget).
+pub const MEASURED_FRAMES_MAX: u32 = 100_000;
+
+/// Refuses warm-up and measured frame counts out of 0..=[`WARMUP_MAX`] and
+/// 1..=[`MEASURED_FRAMES_MAX`] (no measurement without a measured frame, none that runs
+/// for days).
+pub fn check_frames(warmup: u32, frames: u32) -> Result<()> {
+    if warmup > WARMUP_MAX {
+        return Err(Error::input(format!("warm-up of {warmup} frames is not within 0..={WARMUP_MAX}")));
+    }
+    if !(1..=MEASURED_FRAMES_MAX).contains(&frames) {
+        return Err(Error::input(format!("{frames} measured frames is not within 1..={MEASURED_FRAMES_MAX}")));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn frame_counts_are_bounded_both_ways() {
+        assert!(super::check_frames(0, 1).is_ok());
+        assert!(super::check_frames(super::WARMUP_MAX, super::MEASURED_FRAMES_MAX).is_ok());
+        let e = super::check_frames(u32::MAX, 1).unwrap_err().to_string();
+        assert!(e.contains("4294967295") && e.contains("0..=1000"), "{e}");
+        assert!(super::check_frames(3, 0).is_err());
+    }
+}

@@ -1,7 +1,10 @@
 //! The bench's file format (`vrao bench --out`, JSON): plain data that `measure` writes
 //! and the governor in `app` reads its frontier from, so it lives below both.
 
+use crate::render::error::{Error, Result};
+use crate::render::settings::{Technique, RSM_SAMPLES_MAX, SAMPLES_MAX};
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// The resolution the occlusion runs at. Reports and bench files write it as `full` or
 /// `half` ([`Resolution::name`]), as they always have.
@@ -190,6 +193,69 @@ pub struct BenchFile {
     pub command: String,
     /// One row per measured case, in sweep order.
     pub records: Vec<BenchRecord>,
+}
+
+impl BenchFile {
+    /// Parses a bench JSON and checks every record ([`BenchFile::validate`]); errors name
+    /// `origin` (and the line where the JSON is malformed).
+    pub fn from_json(text: &str, origin: &Path) -> Result<BenchFile> {
+        let file: BenchFile = serde_json::from_str(text)
+            .map_err(|e| Error::at_line(origin, e.line(), format!("not a vrao bench file: {e}")))?;
+        file.validate(origin)?;
+        Ok(file)
+    }
+
+    /// Checks what a bench run could have written: at least one record, and in each a
+    /// known technique, samples in range, a positive radius, and finite non-negative times
+    /// and errors. The error names `origin`, the record (1-based, with its setting) and
+    /// the value.
+    pub fn validate(&self, origin: &Path) -> Result<()> {
+        if self.records.is_empty() {
+            return Err(Error::in_file(origin, "holds no bench records"));
+        }
+        for (i, record) in self.records.iter().enumerate() {
+            if let Err(trouble) = record.check() {
+                let message = format!("record {} ({}): {trouble}", i + 1, record.setting());
+                return Err(Error::in_file(origin, message));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl BenchRecord {
+    /// What is wrong with this record, if anything (see [`BenchFile::validate`]).
+    fn check(&self) -> std::result::Result<(), String> {
+        // Rows of reflective shadow maps carry "rsm" and their VPL count as samples.
+        let rsm = self.technique == crate::render::passes::rsm::NAME;
+        if !rsm && self.technique.parse::<Technique>().is_err() {
+            return Err(format!("unknown technique '{}'", self.technique));
+        }
+        let samples_max = if rsm { RSM_SAMPLES_MAX } else { SAMPLES_MAX };
+        if !(1..=samples_max).contains(&self.samples) {
+            return Err(format!("samples {} is not within 1..={samples_max}", self.samples));
+        }
+        if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
+            return Err(format!("radius {} m is not a positive number", self.radius_m));
+        }
+        let times = [
+            ("technique_ms_per_eye", self.technique_ms_per_eye),
+            ("blur_ms_per_eye", self.blur_ms_per_eye),
+            ("upsample_ms_per_eye", self.upsample_ms_per_eye),
+            ("occlusion_ms_per_eye", self.occlusion_ms_per_eye),
+            ("p75_over_p25", self.p75_over_p25),
+        ];
+        let errors = [("ao_rmse", self.ao_rmse), ("ao_bias", self.ao_bias)];
+        let present = errors.iter().filter_map(|(name, v)| v.map(|v| (*name, v)));
+        for (name, value) in times.into_iter().chain(present) {
+            // A bias may be negative; nothing else a bench writes is.
+            let negative_allowed = name == "ao_bias";
+            if !value.is_finite() || (!negative_allowed && value < 0.0) {
+                return Err(format!("{name} {value} is not a finite, non-negative number"));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The screen-space limit's march (the reference tracer's `LimitSettings`).

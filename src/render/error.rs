@@ -23,6 +23,11 @@ pub enum Error {
     /// No usable GPU adapter or device.
     #[error("no usable GPU: {0}")]
     Device(String),
+    /// Something other than the GPU that a run needs cannot be used: a desktop window
+    /// (no display), an OpenXR runtime (none installed, a broken manifest). Not the GPU's
+    /// fault, so never called "no usable GPU"; the message names the cause.
+    #[error("{0}")]
+    Unavailable(String),
     /// A GPU operation failed while running (validation, lost device, readback).
     #[error("GPU error: {0}")]
     Gpu(String),
@@ -70,7 +75,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self {
             // An output that cannot be written is the path the user gave (or its disk).
-            Error::Input { .. } | Error::Device(_) | Error::Output { .. } => EXIT_INPUT,
+            Error::Input { .. } | Error::Device(_) | Error::Unavailable(_) | Error::Output { .. } => EXIT_INPUT,
             Error::Gpu(_) | Error::Plan(_) => 1,
             Error::OverBudget(_) => EXIT_OVER_BUDGET,
         }
@@ -91,6 +96,8 @@ mod tests {
         assert_eq!(Error::in_file(f, "missing").to_string(), "a/scene.toml: missing");
         assert_eq!(Error::input("plain").to_string(), "plain");
         assert_eq!(Error::Device("none".into()).to_string(), "no usable GPU: none");
+        assert_eq!(Error::Unavailable("no display".into()).to_string(), "no display");
+        assert_eq!(Error::Unavailable("no display".into()).exit_code(), EXIT_INPUT);
         assert_eq!(Error::Gpu("lost".into()).to_string(), "GPU error: lost");
         let out = Error::Output { path: PathBuf::from("o.png"), message: "denied".into() };
         assert_eq!(out.to_string(), "o.png: denied");

@@ -125,28 +125,57 @@ pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) 
     Ok(written)
 }
 
-/// Checks, before any work, that a file can be written at `path`: not a directory, and
-/// its folder exists and takes a new file (tried by creating and removing a probe).
+/// Checks, before any work, that a file can be written at `path` (its folder exists and
+/// takes new files, and `path` is no folder), so that a long run does not fail at its
+/// end. Leaves nothing behind.
 pub fn check_output_file(path: &Path) -> Result<()> {
-    let fail = |message: String| Err(Error::Output { path: path.into(), message });
+    let refuse = |message: String| Err(Error::Output { path: path.into(), message });
     if path.is_dir() {
-        return fail("is a directory, not a file".into());
+        return refuse("is a folder, not a file".into());
     }
     let folder = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    if !folder.is_dir() {
-        return fail(format!("its folder {} does not exist", folder.display()));
-    }
-    let probe = folder.join(format!(".vrao-write-probe-{}", std::process::id()));
-    match std::fs::write(&probe, b"") {
-        Ok(()) => {
-            let _ = std::fs::remove_file(&probe);
-            Ok(())
+    match std::fs::metadata(folder) {
+        Ok(meta) if meta.is_dir() => {
+            probe_folder(folder).or_else(|e| refuse(format!("cannot write in {}: {e}", folder.display())))
         }
-        Err(e) => fail(format!("cannot write in {}: {e}", folder.display())),
+        Ok(_) => refuse(format!("{} is not a folder", folder.display())),
+        Err(e) => refuse(format!("cannot write there: {}: {e}", folder.display())),
     }
+}
+
+/// Checks, before any work, that `path` is a folder that takes new files or can be
+/// created as one (its nearest existing ancestor is a writable folder). Creates nothing.
+pub fn check_output_folder(path: &Path) -> Result<()> {
+    let refuse = |message: String| Err(Error::Output { path: path.into(), message });
+    let mut existing = path;
+    loop {
+        match std::fs::metadata(existing) {
+            Ok(meta) if meta.is_dir() => break,
+            Ok(_) if existing == path => return refuse("is a file, not a folder".into()),
+            Ok(_) => return refuse(format!("cannot create this folder: {} is a file", existing.display())),
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return refuse(format!("cannot use this folder: {e}"))
+            }
+            Err(_) => match existing.parent() {
+                Some(parent) if !parent.as_os_str().is_empty() => existing = parent,
+                _ => {
+                    existing = Path::new(".");
+                    break;
+                }
+            },
+        }
+    }
+    probe_folder(existing).or_else(|e| refuse(format!("cannot write in {}: {e}", existing.display())))
+}
+
+/// Creates and removes a file in `folder`: the one sure test that it takes new files.
+fn probe_folder(folder: &Path) -> std::io::Result<()> {
+    let probe = folder.join(format!(".vrao-write-probe-{}", std::process::id()));
+    std::fs::OpenOptions::new().write(true).create_new(true).open(&probe)?;
+    std::fs::remove_file(&probe)
 }
 
 /// Writes `value` as pretty JSON to `path`; a failure names the path.

@@ -163,6 +163,9 @@ impl Renderer {
     /// [`StereoMode::Auto`] allows it.
     pub fn new(gpu: Arc<Gpu>, scene: &Scene, settings: &Settings) -> Result<Renderer> {
         settings.validate()?;
+        // Refused here, naming the file, rather than as a wgpu validation error at upload.
+        let max_side = gpu.device.limits().max_texture_dimension_2d;
+        crate::render::scene::limits::check_texture_sizes(scene, max_side, &gpu.info.name)?;
         let multiview = match settings.stereo {
             StereoMode::Auto => gpu.caps.multiview_reliable,
             StereoMode::Multipass => false,

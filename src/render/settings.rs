@@ -14,6 +14,10 @@ pub const AO_RADIUS_OF_DIAGONAL: f64 = 0.08;
 pub const AO_RADIUS_MIN: f32 = 0.01;
 /// The largest default occlusion radius, metres: room-scale detail, even in a cathedral.
 pub const AO_RADIUS_MAX: f32 = 1.0;
+/// The most depth taps per pixel an occlusion technique takes (`--samples`).
+pub const SAMPLES_MAX: u32 = 256;
+/// The most virtual point lights the reflective shadow maps gather per pixel.
+pub const RSM_SAMPLES_MAX: u32 = 1024;
 /// Linear exposure applied before tone mapping, by default.
 pub const DEFAULT_EXPOSURE: f32 = 1.0;
 /// Reinhard's white point, by default.
@@ -398,8 +402,8 @@ impl AoSettings {
 
     /// Checks every value's range; the error names the value and its range.
     pub fn validate(&self) -> Result<()> {
-        if !(1..=256).contains(&self.samples) {
-            return Err(Error::input(format!("samples {} is not within 1..=256", self.samples)));
+        if !(1..=SAMPLES_MAX).contains(&self.samples) {
+            return Err(Error::input(format!("samples {} is not within 1..={SAMPLES_MAX}", self.samples)));
         }
         if !(self.radius.is_finite() && self.radius > 0.0 && self.radius <= 1e6) {
             return Err(Error::input(format!("radius {} m must be a finite number in (0, 1e6]", self.radius)));
@@ -505,8 +509,8 @@ impl ShadowSettings {
         if !(16..=8192).contains(&self.size) {
             return Err(Error::input(format!("shadow map size {} is not within 16..=8192", self.size)));
         }
-        if !(1..=1024).contains(&self.rsm_samples) {
-            return Err(Error::input(format!("RSM samples {} is not within 1..=1024", self.rsm_samples)));
+        if !(1..=RSM_SAMPLES_MAX).contains(&self.rsm_samples) {
+            return Err(Error::input(format!("RSM samples {} is not within 1..={RSM_SAMPLES_MAX}", self.rsm_samples)));
         }
         if !(self.rsm_radius.is_finite() && self.rsm_radius > 0.0 && self.rsm_radius <= 1e6) {
             return Err(Error::input(format!("RSM radius {} m must be a finite number in (0, 1e6]", self.rsm_radius)));

@@ -9,6 +9,11 @@ use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
 pub const DEFAULT_IPD: f64 = 0.064;
 /// Default near plane in metres (the far plane is at infinity).
 pub const DEFAULT_NEAR: f64 = 0.05;
+/// The slowest display rate a headset session takes (Hz): Monado's simulated headset
+/// runs at 20 Hz; below 10 Hz nothing is a headset any more.
+pub const REFRESH_HZ_MIN: f64 = 10.0;
+/// The fastest display rate a headset session takes (Hz), well above any headset's 144.
+pub const REFRESH_HZ_MAX: f64 = 500.0;
 
 /// Head (or eye) pose in world space: where it is and which way it faces.
 /// The pose looks down its local −Z with +Y up.
@@ -286,21 +291,25 @@ impl HeadsetProfile {
         HeadsetProfile { width, height, ..self }
     }
 
-    /// The same headset at another of its supported refresh rates; another rate is
-    /// `Error::Input` listing the supported ones.
+    /// The same headset at another refresh rate: any rate within
+    /// [`REFRESH_HZ_MIN`]..=[`REFRESH_HZ_MAX`] (a runtime may run a headset at a rate its
+    /// product sheet does not list, such as Monado's simulated 20 Hz; the simulated
+    /// headset takes any of them). A rate outside is `Error::Input` naming the range and
+    /// the rates the real headset lists.
     pub fn with_refresh(self, hz: f64) -> Result<HeadsetProfile> {
-        // A tolerance so that a rate parsed from text (e.g. "72.0") still matches.
-        match self.refresh_rates_hz.iter().find(|&&r| (r - hz).abs() < 1e-6) {
-            Some(&rate) => Ok(HeadsetProfile { refresh_hz: rate, ..self }),
-            None => {
-                let rates: Vec<String> = self.refresh_rates_hz.iter().map(|r| r.to_string()).collect();
-                Err(Error::input(format!(
-                    "refresh rate {hz} Hz is not supported by headset profile '{}' (supported: {} Hz)",
-                    self.name,
-                    rates.join(", ")
-                )))
-            }
+        // A listed rate parsed from text (e.g. "72.0") is taken exactly as listed.
+        if let Some(&rate) = self.refresh_rates_hz.iter().find(|&&r| (r - hz).abs() < 1e-6) {
+            return Ok(HeadsetProfile { refresh_hz: rate, ..self });
         }
+        if hz.is_finite() && (REFRESH_HZ_MIN..=REFRESH_HZ_MAX).contains(&hz) {
+            return Ok(HeadsetProfile { refresh_hz: hz, ..self });
+        }
+        let rates: Vec<String> = self.refresh_rates_hz.iter().map(|r| r.to_string()).collect();
+        Err(Error::input(format!(
+            "refresh rate {hz:?} Hz is not within {REFRESH_HZ_MIN}..={REFRESH_HZ_MAX} Hz (headset profile '{}' lists {} Hz)",
+            self.name,
+            rates.join(", ")
+        )))
     }
 
     /// The frame budget in milliseconds (one refresh period).

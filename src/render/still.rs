@@ -44,14 +44,15 @@ pub struct Still {
 /// (and with `debug` the buffers behind them) into `options.out`.
 pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) -> Result<Still> {
     settings.validate()?;
-    // A refused adapter leaves nothing behind; an unwritable directory fails before
-    // the frames, not after.
+    // An unwritable directory fails before the GPU starts; a refused adapter or scene
+    // (a texture too large for it) leaves no empty folder behind.
+    crate::render::output::check_output_folder(&options.out)?;
     let gpu = Arc::new(Gpu::new(options.backend)?);
+    let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     std::fs::create_dir_all(&options.out).map_err(|e| Error::Output {
         path: options.out.clone(),
         message: format!("cannot create this directory: {e}"),
     })?;
-    let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     renderer.set_timing(options.timing.resolve(&gpu));
     renderer.set_scene_time(options.time);
     let eyes = settings.profile.eyes(&scene.head.pose_at(options.time), settings.near);

@@ -27,6 +27,10 @@ pub struct FrameRequest {
     /// False when the headset will not show this frame (OpenXR's shouldRender): the
     /// application submits without rendering.
     pub should_render: bool,
+    /// The display period this frame must fit (ms): OpenXR's predicted display period,
+    /// the simulated headset's refresh interval. The frame budget follows it frame by
+    /// frame; `None` while the headset has not said (the profile's rate stands).
+    pub display_period_ms: Option<f64>,
 }
 
 /// What the application hands to the headset: both eyes' colour and depth (2-layer
@@ -107,6 +111,14 @@ pub trait Headset {
     /// `None` once the headset has wound down (OpenXR: xrRequestExitSession, then
     /// STOPPING → xrEndSession → EXITING; at once when the session is not running).
     fn request_exit(&mut self);
+    /// The state the session is in, in words (OpenXR: the XrSessionState name), for the
+    /// report of an interrupted run.
+    fn session_state(&self) -> String {
+        "running".into()
+    }
+    /// Where the display period of [`FrameRequest::display_period_ms`] comes from, for
+    /// the report (which rate governed the budget).
+    fn display_rate_source(&self) -> String;
     /// What the OpenXR session did (`None` for headsets that are not OpenXR). An
     /// OpenXR headset that fell back to the simulated one still reports, with the loss.
     fn openxr_report(&self) -> Option<crate::xr::openxr::OpenXrReport> {

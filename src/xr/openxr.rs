@@ -81,13 +81,21 @@ impl std::fmt::Display for Unavailable {
         match self {
             Unavailable::NotBuilt => write!(f, "vrao was built without the `xr` feature"),
             Unavailable::NoLoader(why) => write!(f, "no OpenXR loader ({why})"),
-            Unavailable::NoRuntime(why) => write!(f, "no OpenXR runtime ({why})"),
+            Unavailable::NoRuntime(why) => write!(f, "no OpenXR runtime: {why}"),
             Unavailable::NoHeadset(why) => write!(f, "no OpenXR headset ({why})"),
             Unavailable::Unsupported(why) => write!(f, "the OpenXR runtime cannot be used ({why})"),
             Unavailable::Failed(why) => write!(f, "the OpenXR session could not be set up ({why})"),
             Unavailable::Busy => write!(f, "another OpenXR instance is live in this process"),
         }
     }
+}
+
+/// A failed OpenXR call in one line naming the call and its XrResult, with the
+/// runtime-independent meaning: `xrReleaseSwapchainImage: XR_ERROR_INSTANCE_LOST (the
+/// XrInstance was lost or could not be found)`.
+#[cfg(feature = "xr")]
+pub fn xr_call_failed(call: &str, result: openxr::sys::Result) -> String {
+    format!("{call}: XR_{result:?} ({result})")
 }
 
 /// A step of OpenXR's session life cycle (XrSessionState), as the headset saw it.
@@ -134,7 +142,7 @@ impl std::fmt::Display for SessionPhase {
 }
 
 /// What an OpenXR session did, for reports and tests (`Headset::openxr_report`).
-#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct OpenXrReport {
     /// The runtime's name and version.
     pub runtime: String,
@@ -150,6 +158,22 @@ pub struct OpenXrReport {
     pub depth_layers_submitted: u64,
     /// Frames ended without a layer (not rendered, or run while leaving).
     pub empty_frames: u64,
+    /// Frames the runtime told vrao not to render (shouldRender false).
+    pub not_rendered: u64,
+    /// Display periods the runtime skipped between the frames it handed out, from the
+    /// gaps between successive predicted display times (OpenXR says nothing more about
+    /// late or dropped frames: the compositor's own counts are not visible to vrao).
+    pub missed_display_periods: u64,
+    /// The runtime's latest predicted display period (ms): the frame budget.
+    pub display_period_ms: f64,
+    /// The session state the run was interrupted in (Ctrl-C), if it was.
+    pub interrupted_in: Option<String>,
+    /// The display refresh rates the runtime offers (XR_FB_display_refresh_rate; empty
+    /// when it does not have the extension).
+    pub display_refresh_rates_hz: Vec<f32>,
+    /// The display refresh rate the runtime last reported through the extension (after
+    /// vrao asked for the profile's, when offered), following its change events.
+    pub display_refresh_rate_hz: Option<f32>,
     /// Why the session was lost or a runtime call failed, if so.
     pub loss_reason: Option<String>,
     /// How the session ended (`EXITING`, a timeout, a loss), once it has.
@@ -184,6 +208,12 @@ pub struct OpenXrOptions {
     /// What to continue with when the session is lost (LOSS_PENDING, a lost instance or
     /// a failing runtime); `None` ends the run instead.
     pub fallback: Option<SimulatedOptions>,
+    /// The refresh rate to ask the runtime for (XR_FB_display_refresh_rate), when it
+    /// offers that rate; the runtime's predicted display period sets the budget either way.
+    pub preferred_refresh_hz: Option<f64>,
+    /// The caller's cancellation token (its Ctrl-C handler sets it): checked in every
+    /// wait, so the session ends from whatever state it is in. `None`: not interruptible.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl OpenXrOptions {
@@ -201,6 +231,8 @@ impl OpenXrOptions {
             #[cfg(feature = "xr")]
             layout: None,
             fallback: Some(simulated.clone()),
+            preferred_refresh_hz: Some(simulated.profile.refresh_hz),
+            interrupt: None,
         }
     }
 }
@@ -280,6 +312,66 @@ fn application_info() -> openxr::ApplicationInfo<'static> {
     }
 }
 
+/// Why xrCreateInstance found no runtime, in one line naming the manifest: the one
+/// `XR_RUNTIME_JSON` names (missing, unparsable, naming a library that is not there or
+/// does not load) or, without it, the active_runtime.json files the loader reads.
+/// `result` is what the loader said.
+pub fn no_runtime(result: &str) -> Unavailable {
+    let manifest = std::env::var_os("XR_RUNTIME_JSON").filter(|v| !v.is_empty()).map(std::path::PathBuf::from);
+    Unavailable::NoRuntime(runtime_trouble(manifest.as_deref(), &active_runtime_paths(), result))
+}
+
+/// Where the loader looks for the active runtime on Linux without `XR_RUNTIME_JSON`.
+fn active_runtime_paths() -> Vec<std::path::PathBuf> {
+    let config = std::env::var_os("XDG_CONFIG_HOME")
+        .filter(|v| !v.is_empty())
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".config")));
+    let system = std::env::var("XDG_CONFIG_DIRS").unwrap_or_else(|_| "/etc/xdg".into());
+    let dirs = config.into_iter().chain(system.split(':').filter(|d| !d.is_empty()).map(Into::into));
+    dirs.chain(["/etc".into()]).map(|d: std::path::PathBuf| d.join("openxr/1/active_runtime.json")).collect()
+}
+
+/// [`no_runtime`]'s message for `manifest` (from `XR_RUNTIME_JSON`) or, without one,
+/// the first of `active` that exists.
+pub fn runtime_trouble(manifest: Option<&std::path::Path>, active: &[std::path::PathBuf], result: &str) -> String {
+    let (manifest, named_by) = match manifest {
+        Some(path) => (path.to_path_buf(), "XR_RUNTIME_JSON"),
+        None => match active.iter().find(|p| p.exists()) {
+            Some(path) => (path.clone(), "the active runtime"),
+            None => {
+                let looked: Vec<String> = active.iter().map(|p| p.display().to_string()).collect();
+                return format!(
+                    "none is installed: XR_RUNTIME_JSON is not set and there is no {} ({result})",
+                    looked.join(" or ")
+                );
+            }
+        },
+    };
+    let shown = manifest.display();
+    let text = match std::fs::read_to_string(&manifest) {
+        Ok(text) => text,
+        Err(e) => return format!("{named_by} manifest {shown} cannot be read: {e}"),
+    };
+    let json: serde_json::Value = match serde_json::from_str(&text) {
+        Ok(json) => json,
+        Err(e) => return format!("{named_by} manifest {shown} does not parse as JSON: {e}"),
+    };
+    let Some(library) = json["runtime"]["library_path"].as_str() else {
+        return format!("{named_by} manifest {shown} names no runtime.library_path");
+    };
+    // A relative library path is relative to the manifest's folder.
+    let library_path = manifest.parent().unwrap_or(std::path::Path::new("")).join(library);
+    let bare_name = !library.contains('/');
+    if !bare_name && !library_path.exists() {
+        return format!(
+            "the runtime library {} that {named_by} manifest {shown} names does not exist",
+            library_path.display()
+        );
+    }
+    format!("the runtime library {library} that {named_by} manifest {shown} names did not load or start ({result})")
+}
+
 /// Whether an OpenXR runtime answers: creates (and drops) an instance. Returns the
 /// runtime's name and version.
 #[cfg(feature = "xr")]
@@ -288,7 +380,7 @@ pub fn probe_runtime() -> Result<String, Unavailable> {
     let _slot = InstanceSlot::take()?;
     let instance = entry
         .create_instance(&application_info(), &openxr::ExtensionSet::default(), &[], &())
-        .map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        .map_err(|e| no_runtime(&xr_call_failed("xrCreateInstance", e)))?;
     let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
     Ok(format!("{} {}", props.runtime_name, props.runtime_version))
 }
@@ -330,6 +422,45 @@ mod tests {
         assert!((forward - expected).length() < 1e-9, "{forward:?}");
         let up = flat.orientation * DVec3::Y;
         assert!((up - DVec3::Y).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_missing_runtime_is_explained_by_its_manifest() {
+        let dir = std::env::temp_dir().join(format!("vrao-manifest-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let result = "xrCreateInstance: XR_ERROR_RUNTIME_UNAVAILABLE";
+        let trouble = |manifest: &std::path::Path| runtime_trouble(Some(manifest), &[], result);
+        // Named by XR_RUNTIME_JSON but not there.
+        let missing = dir.join("missing.json");
+        let t = trouble(&missing);
+        assert!(
+            t.contains("XR_RUNTIME_JSON manifest") && t.contains("missing.json") && t.contains("cannot be read"),
+            "{t}"
+        );
+        // Not JSON.
+        let broken = dir.join("broken.json");
+        std::fs::write(&broken, "{ not json").unwrap();
+        let t = trouble(&broken);
+        assert!(t.contains("broken.json") && t.contains("does not parse as JSON"), "{t}");
+        // JSON naming a library that is not there (relative to the manifest's folder).
+        let gone = dir.join("gone.json");
+        std::fs::write(&gone, r#"{"file_format_version": "1.0.0", "runtime": {"library_path": "./libgone.so"}}"#)
+            .unwrap();
+        let t = trouble(&gone);
+        assert!(t.contains("libgone.so") && t.contains("does not exist") && t.contains("gone.json"), "{t}");
+        // A library that is there but did not start: the loader's result is kept.
+        let present = dir.join("present.json");
+        std::fs::write(dir.join("libpresent.so"), "not a library").unwrap();
+        std::fs::write(&present, r#"{"runtime": {"library_path": "libpresent.so"}}"#).unwrap();
+        let t = trouble(&present);
+        assert!(t.contains("did not load or start") && t.contains("XR_ERROR_RUNTIME_UNAVAILABLE"), "{t}");
+        // No manifest at all: where the loader looked.
+        let t = runtime_trouble(None, &[dir.join("active_runtime.json")], result);
+        assert!(t.contains("XR_RUNTIME_JSON is not set") && t.contains("active_runtime.json"), "{t}");
+        for t in [trouble(&missing), trouble(&broken), trouble(&gone)] {
+            assert!(!t.contains('\n') && !t.contains("GPU"), "{t}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

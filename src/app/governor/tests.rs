@@ -423,3 +423,46 @@ fn bad_configurations_name_the_value() {
     assert!(Governor::new(frontier.clone(), bad, 0).unwrap_err().to_string().contains("0 ms"));
     assert_eq!(Governor::new(frontier, GovernorConfig::default(), 99).unwrap().level(), 4);
 }
+
+#[test]
+fn the_budget_and_the_level_follow_a_changing_display_period_within_one_frame() {
+    // A runtime at 90 Hz, then 72 Hz from frame 40, then 120 Hz from frame 80 (a Quest
+    // switching rates, a runtime lowering its rate under load). Frames cost 6 ms besides
+    // the AO: 7.0, 7.6, 8.4, 9.6 and 12.0 ms at the five levels.
+    let frontier = synthetic();
+    let top = frontier.top();
+    let mut governor = Governor::new(frontier.clone(), GovernorConfig::for_refresh_hz(90.0), top).unwrap();
+    let script = Script { other_ms: 6.0, device_scale: 1.0, load: &|_| 1.0, ao_factor: &|_| 1.0 };
+    let hz = |frame: u64| match frame {
+        0..40 => 90.0,
+        40..80 => 72.0,
+        _ => 120.0,
+    };
+    let mut levels = Vec::new();
+    for frame in 0..120 {
+        let period_ms = 1000.0 / hz(frame);
+        let changed = governor.set_period_ms(period_ms);
+        assert_eq!(changed, frame == 40 || frame == 80, "frame {frame}: the period changes only with the rate");
+        assert_eq!(governor.config().period_ms, period_ms, "frame {frame}: the budget is this frame's period");
+        let (ms, ao) = script.cost(&frontier, governor.level(), 1.0);
+        governor.observe_with_ao(frame, ms, ao);
+        levels.push(governor.level());
+    }
+    let change_at = |frame: u64| governor.changes().iter().find(|c| c.frame == frame).cloned();
+    // 90 Hz: the top level (12 ms) is over 90 % of 11.1 ms; the governor settles at 8.4 ms.
+    assert_eq!(levels[39], 2, "{levels:?}");
+    // 72 Hz: the first frame at the new period is calm against it and raises at once.
+    let raise = change_at(40).expect("a raise on the first 72 Hz frame");
+    assert!(raise.reason.contains("13.89 ms"), "judged against 72 Hz: {}", raise.reason);
+    assert_eq!(levels[40], 3, "{levels:?}");
+    assert_eq!(levels[79], top, "72 Hz has room for the top level: {levels:?}");
+    // 120 Hz: the first frame at the new period is over it and drops at once.
+    let drop = change_at(80).expect("a drop on the first 120 Hz frame");
+    assert!(drop.reason.contains("8.33 ms"), "judged against 120 Hz: {}", drop.reason);
+    assert!(levels[80] < top, "{levels:?}");
+    let (last_ms, _) = script.cost(&frontier, levels[119], 1.0);
+    assert!(last_ms <= 0.9 * 1000.0 / 120.0, "the level fits 120 Hz at the end: {last_ms} ms, {levels:?}");
+    // A period a runtime cannot mean is ignored.
+    assert!(!governor.set_period_ms(0.0) && !governor.set_period_ms(f64::NAN));
+    assert_eq!(governor.config().period_ms, 1000.0 / 120.0);
+}

@@ -437,7 +437,7 @@ pub fn to_json(file: &BenchFile) -> String {
 /// Reads a bench JSON file (for `vrao budget --fit`).
 pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
-    serde_json::from_str(&text).map_err(|e| Error::at_line(path, e.line(), format!("not a vrao bench file: {e}")))
+    BenchFile::from_json(&text, path)
 }
 
 /// The plot's file name for one radius, rounded so that it carries no float noise:

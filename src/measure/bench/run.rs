@@ -165,6 +165,7 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
 /// occlusion technique, and reflective-shadow-map rows need a directional light and a
 /// VPL count within 1..=1024.
 fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: &[BenchCase]) -> Result<()> {
+    crate::measure::check_frames(options.warmup, options.frames)?;
     for case in cases {
         let mut s = base.clone();
         (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res, s.ao.depth_peeling) =

@@ -59,6 +59,7 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
         return Err(Error::input(format!("the frame budget {budget_ms} ms must be a positive number")));
     }
     settings.validate()?;
+    crate::measure::check_frames(options.warmup, options.frames)?;
     let fit_file = match &options.fit {
         Some(path) => Some((crate::measure::bench::read_json(path)?, path)),
         None => None,

@@ -49,7 +49,7 @@
 //! normals use the inverse transpose, and a mirroring scale reverses the winding so that
 //! triangles stay counter-clockwise around their normals.
 
-use super::{builtin, obj, Environment, HeadPath, Light, Material, Mesh, Scene};
+use super::{builtin, limits, obj, Environment, HeadPath, Light, Material, Mesh, Scene};
 use crate::render::error::{Error, Result};
 use crate::render::stereo::HeadPose;
 use glam::{DMat3, DVec3, EulerRot};
@@ -80,7 +80,7 @@ struct MeshEntry {
 }
 
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "scale must be a number or [x, y, z]")]
 enum Scale {
     Uniform(f64),
     PerAxis([f64; 3]),
@@ -252,6 +252,10 @@ fn load_mesh_entry(
     if let Some(transform) = transform {
         meshes.iter_mut().for_each(|m| transform.apply(m));
     }
+    // Each part may be in range and their product not (a large scale of a distant mesh).
+    if let Some(trouble) = meshes.iter().find_map(limits::mesh_trouble) {
+        return Err(Failure::Here(trouble));
+    }
     Ok((meshes, materials))
 }
 
@@ -295,6 +299,11 @@ impl MeshEntry {
         if !scale.as_vec3().is_finite() || scale.abs().min_element() == 0.0 {
             return Err(Failure::Here(format!("scale {:?} must be finite and nonzero", scale.to_array())));
         }
+        let troubles = scale.to_array().into_iter().map(limits::scale_trouble);
+        let far = translate.to_array().into_iter().map(|t| limits::coordinate_trouble("translate", t));
+        if let Some(trouble) = troubles.chain(far).flatten().next() {
+            return Err(Failure::Here(trouble));
+        }
         let rotation =
             DMat3::from_euler(EulerRot::XYZEx, degrees.x.to_radians(), degrees.y.to_radians(), degrees.z.to_radians());
         Ok(Some(Transform { linear: rotation * DMat3::from_diagonal(scale), translate }))
@@ -322,6 +331,16 @@ fn light(entry: &LightEntry) -> std::result::Result<Light, Failure> {
         }
         Ok(c.as_vec3())
     };
+    // Colour × intensity is what the shading multiplies in; beyond the HDR buffer's range
+    // every pixel the light reaches would overflow (black after tone mapping).
+    let (LightEntry::Directional { color, intensity, .. } | LightEntry::Point { color, intensity, .. }) = entry;
+    // Each checked first (finite, not negative); the product from the file's own values.
+    colour(color)?;
+    non_negative("light intensity", *intensity)?;
+    let brightest = color.unwrap_or([1.0; 3]).into_iter().fold(0.0, f64::max) * intensity;
+    if let Some(trouble) = limits::radiance_trouble("light color × intensity", brightest) {
+        return Err(Failure::Here(trouble));
+    }
     Ok(match entry {
         LightEntry::Directional { direction, color, intensity } => {
             let d = finite3("light direction", *direction)?;
@@ -342,6 +361,18 @@ fn light(entry: &LightEntry) -> std::result::Result<Light, Failure> {
 }
 
 fn load_environment(entry: &EnvironmentEntry, directory: &Path) -> std::result::Result<Environment, Failure> {
+    let environment = environment_unchecked(entry, directory)?;
+    // The sky's brightest texel times its intensity is what the shading reads.
+    let brightest = environment.texels.iter().flatten().fold(0.0f32, |m, &c| m.max(c)) as f64;
+    let trouble =
+        limits::radiance_trouble("environment intensity × brightest texel", environment.intensity as f64 * brightest);
+    match trouble {
+        Some(trouble) => Err(Failure::Here(trouble)),
+        None => Ok(environment),
+    }
+}
+
+fn environment_unchecked(entry: &EnvironmentEntry, directory: &Path) -> std::result::Result<Environment, Failure> {
     let intensity = non_negative("environment intensity", entry.intensity.unwrap_or(1.0))?;
     match (&entry.hdr, entry.sky.as_deref()) {
         (Some(hdr), None) => {

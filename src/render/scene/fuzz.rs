@@ -70,9 +70,15 @@ fn check_finite(scene: &Scene) {
             mesh.name
         );
         assert!(mesh.material < scene.materials.len(), "mesh {} material out of range", mesh.name);
+        // Finite is not enough: nothing beyond what the renderer can draw (limits.rs).
+        if mesh.node.is_none() {
+            assert_eq!(super::limits::mesh_trouble(mesh), None, "mesh {} is out of range", mesh.name);
+        }
     }
     for m in &scene.materials {
         assert!(m.diffuse.is_finite() && m.emissive.is_finite(), "material {} is not finite", m.name);
+        let brightest = m.emissive.max_element() as f64;
+        assert!(brightest <= super::limits::RADIANCE_MAX, "material {} emits {brightest}", m.name);
     }
 }
 
@@ -83,6 +89,9 @@ const TOKENS: &[&[u8]] = &[
     b"-inf",
     b"1e39",
     b"-1e39",
+    b"3e38",
+    b"1e300",
+    b"1e-300",
     b"1e-45",
     b"0",
     b"-1",

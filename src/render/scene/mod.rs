@@ -12,6 +12,7 @@ pub mod environment;
 pub mod file;
 pub mod furnished;
 pub mod fuzz;
+pub mod limits;
 pub mod normals;
 pub mod obj;
 
@@ -68,6 +69,9 @@ pub struct Texture {
     pub height: u32,
     /// `width × height` texels, four bytes each.
     pub rgba8: Vec<u8>,
+    /// The image file it was decoded from (`None` when it came from no file of its own),
+    /// named when the device cannot take the texture.
+    pub source: Option<PathBuf>,
 }
 
 /// What a material's alpha (its `alpha` factor times the texture's alpha) does.
@@ -411,8 +415,10 @@ impl Scene {
             return builtin::load(name);
         }
         let path = Path::new(spec);
-        if !path.exists() {
-            return Err(Error::in_file(path, "no such file"));
+        // `exists()` says false for a symlink loop or an unreadable directory too: say why.
+        if let Err(e) = std::fs::metadata(path) {
+            let why = if e.kind() == std::io::ErrorKind::NotFound { "no such file".into() } else { e.to_string() };
+            return Err(Error::in_file(path, why));
         }
         match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
             Some(ext) if ext == "toml" => file::load(path),

@@ -232,6 +232,10 @@ fn scan_obj(path: &Path, text: &str) -> Result<ObjScan> {
                         return Err(Error::at_line(path, line, message));
                     }
                 };
+                let farthest = xyz.iter().fold(0.0f32, |m, c| m.max(c.abs())) as f64;
+                if let Some(trouble) = super::limits::coordinate_trouble("vertex coordinate", farthest) {
+                    return Err(Error::at_line(path, line, trouble));
+                }
                 out.push_str(&format!("v {} {} {}\n", xyz[0], xyz[1], xyz[2]));
                 defined.vertices += 1;
             }
@@ -381,6 +385,12 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
                 if (key == "Kd" || key == "Ke") && colour.min_element() < 0.0 {
                     return Err(at(format!("{key} {rest} is negative")));
                 }
+                // An emitter brighter than the HDR buffer holds would turn to infinity (black).
+                if key == "Ke" {
+                    if let Some(trouble) = super::limits::radiance_trouble("Ke", colour.max_element() as f64) {
+                        return Err(at(trouble));
+                    }
+                }
                 // Values before the first newmtl belong to no material (as in tobj).
                 if let Some(m) = materials.last_mut() {
                     match key {
@@ -424,7 +434,7 @@ fn load_texture(path: &Path) -> Result<Texture> {
     let cannot = |e: &dyn std::fmt::Display| Error::in_file(path, format!("cannot decode texture: {e}"));
     let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
     let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?.into_rgba8();
-    Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw() })
+    Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw(), source: Some(path.into()) })
 }
 
 /// A tobj model as a mesh: positions recentred on their bounds, v flipped, normals

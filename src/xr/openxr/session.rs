@@ -31,6 +31,7 @@ use crate::xr::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use glam::{DQuat, DVec3, Quat, Vec3};
 use layer::{end_frame, Layer};
 use openxr as xr;
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracking::{fov_from_xr, pose_from_xr, Tracking};
@@ -54,6 +55,11 @@ pub struct OpenXrStats {
     pub layers_with_depth: u64,
     /// Frames ended without a layer (not rendered, or run while the session stopped).
     pub empty_frames: u64,
+    /// Display periods the runtime skipped between frames it handed out: each gap
+    /// between successive predicted display times beyond one predicted display period
+    /// (rounded to whole periods). A missed frame of the application, as far as OpenXR
+    /// shows it; the compositor's own late or dropped frames are not visible.
+    pub missed_display_periods: u64,
 }
 
 /// The OpenXR session objects. Fields drop in order: swapchains before the session,
@@ -74,6 +80,8 @@ struct Xr {
 /// A frame between `wait_frame` and `submit`.
 struct Pending {
     index: u64,
+    /// Whether the runtime said to render this frame (shouldRender).
+    should_render: bool,
     display_time: xr::Time,
     views: [xr::View; 2],
 }
@@ -103,6 +111,13 @@ pub struct OpenXrHeadset {
     tracking: Tracking,
     opened: Instant,
     fallback: Option<SimulatedHeadset>,
+    /// The previous frame's predicted display time, for the missed display periods.
+    last_display_time: Option<xr::Time>,
+    /// The runtime's latest predicted display period (ms), 0 before the first frame.
+    display_period_ms: f64,
+    /// XR_FB_display_refresh_rate: the rates offered and the latest one reported.
+    refresh_rates_hz: Vec<f32>,
+    refresh_hz: Option<f32>,
 }
 
 fn failed(what: &str) -> impl Fn(xr::sys::Result) -> Unavailable + '_ {
@@ -151,6 +166,12 @@ impl OpenXrHeadset {
             layers_submitted: self.stats.layers,
             depth_layers_submitted: self.stats.layers_with_depth,
             empty_frames: self.stats.empty_frames,
+            not_rendered: self.stats.not_rendered,
+            missed_display_periods: self.stats.missed_display_periods,
+            display_period_ms: self.display_period_ms,
+            interrupted_in: self.machine.interrupted_in(),
+            display_refresh_rates_hz: self.refresh_rates_hz.clone(),
+            display_refresh_rate_hz: self.refresh_hz,
             loss_reason: self.machine.loss_reason().map(str::to_string),
             ending: self.machine.ending().map(str::to_string),
             fell_back: self.fallback.is_some(),
@@ -164,6 +185,19 @@ impl OpenXrHeadset {
         if self.xr.is_some() && self.fallback.is_none() {
             self.feed(Event::Failed(why.to_string()));
             self.conclude();
+        }
+    }
+
+    /// Feeds the caller's interrupt (Ctrl-C) to the machine the first time it is seen,
+    /// in whatever state the session is: checked on every turn of the wait loops, so an
+    /// interrupt before READY or while the runtime has the session stopped ends the run
+    /// within one poll, not after the machine's timeouts.
+    fn check_interrupt(&mut self) {
+        let set = self.options.interrupt.as_ref().is_some_and(|flag| flag.load(Ordering::Relaxed));
+        if set && self.machine.interrupted_in().is_none() && !self.machine.is_over() {
+            let state = self.machine.states().last().map_or("before the first session state", |p| p.name());
+            self.note(&format!("interrupted in {state}: ending the session"));
+            self.feed(Event::Interrupted);
         }
     }
 
@@ -192,7 +226,7 @@ impl OpenXrHeadset {
             Action::EndSession => ("xrEndSession", xr.session.end().map(drop)),
             Action::RequestExit => ("xrRequestExitSession", xr.session.request_exit()),
         };
-        result.map_err(|e| RuntimeFailure(format!("{call}: {e}")))
+        result.map_err(|e| RuntimeFailure(super::xr_call_failed(call, e)))
     }
 
     /// Once the machine has its verdict: tears the session down and, after a loss,
@@ -219,6 +253,7 @@ impl OpenXrHeadset {
     fn poll_events(&mut self) {
         let Some(xr) = self.xr.as_ref() else { return };
         let mut events = Vec::new();
+        let mut refresh_changes = Vec::new();
         let mut buffer = xr::EventDataBuffer::new();
         loop {
             match xr.instance.poll_event(&mut buffer) {
@@ -227,16 +262,25 @@ impl OpenXrHeadset {
                     None => log::warn!("OpenXR: unknown session state {:?}", change.state()),
                 },
                 Ok(Some(xr::Event::InstanceLossPending(_))) => events.push(Event::InstanceLossPending),
+                Ok(Some(xr::Event::DisplayRefreshRateChangedFB(change))) => {
+                    // The budget follows the predicted display period anyway; this says why.
+                    let (from, to) = (change.from_display_refresh_rate(), change.to_display_refresh_rate());
+                    refresh_changes.push((from, to));
+                }
                 Ok(Some(xr::Event::EventsLost(lost))) => {
                     log::warn!("OpenXR: {} events lost", lost.lost_event_count())
                 }
                 Ok(Some(_)) => {}
                 Ok(None) => break,
                 Err(e) => {
-                    events.push(Event::Failed(format!("xrPollEvent: {e}")));
+                    events.push(Event::Failed(super::xr_call_failed("xrPollEvent", e)));
                     break;
                 }
             }
+        }
+        for (from, to) in refresh_changes {
+            self.note(&format!("display refresh rate {from} Hz -> {to} Hz"));
+            self.refresh_hz = Some(to);
         }
         for event in events {
             if let Event::State(phase) = &event {
@@ -251,7 +295,7 @@ impl OpenXrHeadset {
         let Some(xr) = self.xr.as_mut() else { return };
         match end_frame(xr, display_time, None) {
             Ok(()) => self.stats.empty_frames += 1,
-            Err(e) => self.feed(Event::Failed(format!("xrEndFrame: {e}"))),
+            Err(e) => self.feed(Event::Failed(super::xr_call_failed("xrEndFrame", e))),
         }
     }
 
@@ -270,18 +314,27 @@ impl OpenXrHeadset {
 
     fn try_frame(&mut self, render: bool) -> std::result::Result<Option<FrameRequest>, String> {
         let xr = self.xr.as_mut().expect("frames need a session");
-        let state = xr.frame_waiter.wait().map_err(|e| format!("xrWaitFrame: {e}"))?;
-        xr.frame_stream.begin().map_err(|e| format!("xrBeginFrame: {e}"))?;
+        let state = xr.frame_waiter.wait().map_err(|e| super::xr_call_failed("xrWaitFrame", e))?;
+        xr.frame_stream.begin().map_err(|e| super::xr_call_failed("xrBeginFrame", e))?;
+        let period_ns = state.predicted_display_period.as_nanos();
+        if period_ns > 0 {
+            self.display_period_ms = period_ns as f64 / 1e6;
+            if let Some(last) = self.last_display_time {
+                let gap_ns = state.predicted_display_time.as_nanos() - last.as_nanos();
+                self.stats.missed_display_periods += missed_periods(gap_ns, period_ns);
+            }
+        }
+        self.last_display_time = Some(state.predicted_display_time);
         if !render {
             // Leaving: until the runtime says STOPPING the session still runs frames;
             // they show nothing new.
-            end_frame(xr, state.predicted_display_time, None).map_err(|e| format!("xrEndFrame: {e}"))?;
+            end_frame(xr, state.predicted_display_time, None).map_err(|e| super::xr_call_failed("xrEndFrame", e))?;
             self.stats.empty_frames += 1;
             return Ok(None);
         }
         let located = xr.session.locate_views(VIEW_TYPE, state.predicted_display_time, &xr.space);
         let sampled_at = if xr.clock { xr.instance.now().ok() } else { None };
-        let (flags, views) = located.map_err(|e| format!("xrLocateViews: {e}"))?;
+        let (flags, views) = located.map_err(|e| super::xr_call_failed("xrLocateViews", e))?;
         let (views, warning) = self.tracking.merge(flags, &views);
         if let Some(warning) = warning {
             log::warn!("OpenXR: {warning}");
@@ -299,10 +352,17 @@ impl OpenXrHeadset {
         if !state.should_render {
             self.stats.not_rendered += 1;
         }
-        self.pending = Some(Pending { index, display_time: state.predicted_display_time, views });
+        self.pending = Some(Pending {
+            index,
+            should_render: state.should_render,
+            display_time: state.predicted_display_time,
+            views,
+        });
         Ok(Some(FrameRequest {
             index,
             display_time: state.predicted_display_time.as_nanos() as f64 / 1e9,
+            // The runtime's period is the budget; before it gives one, the profile's.
+            display_period_ms: (self.display_period_ms > 0.0).then_some(self.display_period_ms),
             eyes: self.eye_pair(&views),
             size: self.recommended_size(),
             should_render: state.should_render,
@@ -331,18 +391,18 @@ impl OpenXrHeadset {
             Ok(sub_images) => sub_images,
             Err(FillError::Gpu(e)) => {
                 // A GPU error in vrao's own copy: end the frame empty, report the error.
-                end_frame(xr, pending.display_time, None).map_err(|e| format!("xrEndFrame: {e}"))?;
+                end_frame(xr, pending.display_time, None).map_err(|e| super::xr_call_failed("xrEndFrame", e))?;
                 return Err(RuntimeFailure(format!("copying the eyes into the swapchains: {e}")));
             }
-            Err(e @ FillError::Xr(_)) => return Err(RuntimeFailure(e.to_string())),
+            Err(e @ FillError::Xr(..)) => return Err(RuntimeFailure(e.to_string())),
         };
         let layer = Layer { views: pending.views, sub_images, near };
-        end_frame(xr, pending.display_time, Some(&layer)).map_err(|e| format!("xrEndFrame: {e}"))?;
+        end_frame(xr, pending.display_time, Some(&layer)).map_err(|e| super::xr_call_failed("xrEndFrame", e))?;
         self.stats.layers += 1;
         if xr.swapchains.has_depth() {
             self.stats.layers_with_depth += 1;
         }
-        self.counters.presented += 1;
+        // Not "presented": OpenXR does not say whether the compositor showed the layer.
         Ok(())
     }
 
@@ -412,6 +472,17 @@ impl OpenXrHeadset {
     }
 }
 
+/// Display periods skipped between two successive frames whose predicted display times
+/// are `gap_ns` apart, at a predicted display period of `period_ns`: the whole periods
+/// beyond the first (a gap of 1.4 periods rounds to none missed, 2.6 to two).
+pub(crate) fn missed_periods(gap_ns: i64, period_ns: i64) -> u64 {
+    if gap_ns <= 0 || period_ns <= 0 {
+        return 0;
+    }
+    let periods = (gap_ns as f64 / period_ns as f64).round() as u64;
+    periods.saturating_sub(1)
+}
+
 /// The session state an XrSessionState names (`None`: one OpenXR 1.0 does not define).
 fn phase_of(state: xr::SessionState) -> Option<SessionPhase> {
     Some(match state {
@@ -465,6 +536,7 @@ impl Headset for OpenXrHeadset {
             self.feed(Event::FramesReached);
         }
         loop {
+            self.check_interrupt();
             if self.conclude() {
                 // Left (the session is gone) or lost (the fall back, if any, goes on).
                 return self.wait_frame(gpu);
@@ -505,12 +577,12 @@ impl Headset for OpenXrHeadset {
             )));
         }
         match frame {
-            Some(frame) if request.should_render => {
-                self.budget.submitted(true);
-                if let Err(why) = self.present(&pending, &frame) {
-                    self.feed(Event::Failed(why.0));
-                }
-            }
+            Some(frame) if pending.should_render => match self.present(&pending, &frame) {
+                // A frame counts as rendered once its layer reached the runtime: a frame
+                // lost on the way is not (frames rendered = layers submitted).
+                Ok(()) => self.budget.submitted(true),
+                Err(why) => self.feed(Event::Failed(why.0)),
+            },
             _ => {
                 self.budget.submitted(false);
                 self.end_empty(pending.display_time);
@@ -536,6 +608,21 @@ impl Headset for OpenXrHeadset {
 
     fn openxr_report(&self) -> Option<OpenXrReport> {
         Some(self.report())
+    }
+
+    fn display_rate_source(&self) -> String {
+        match &self.fallback {
+            Some(simulated) => format!("{} (after the OpenXR session was lost)", simulated.display_rate_source()),
+            None => "the OpenXR runtime's predicted display period (xrWaitFrame), frame by frame".into(),
+        }
+    }
+
+    fn session_state(&self) -> String {
+        match (&self.fallback, self.machine.states().last()) {
+            (Some(simulated), _) => format!("{} (after the OpenXR session was lost)", simulated.session_state()),
+            (None, Some(phase)) => phase.name().to_string(),
+            (None, None) => "before the first session state".to_string(),
+        }
     }
 
     /// xrRequestExitSession when the session runs (the following `wait_frame` calls

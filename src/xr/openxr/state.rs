@@ -23,8 +23,11 @@ pub enum Event {
     State(SessionPhase),
     /// XrEventDataInstanceLossPending.
     InstanceLossPending,
-    /// The user quit (window closed, Ctrl-C, `Headset::request_exit`, `end`).
+    /// The user quit (window closed, `Headset::request_exit`, `end`).
     ExitRequested,
+    /// The caller's cancellation token was set (Ctrl-C, SIGTERM): an exit request that
+    /// also records the state the session was in.
+    Interrupted,
     /// `--frames N` frames were rendered.
     FramesReached,
     /// A runtime call failed (the text says which and why).
@@ -73,6 +76,9 @@ pub struct SessionMachine {
     exit_asked_at: Option<Duration>,
     /// When the runtime stopped the session without being asked to.
     stopped_at: Option<Duration>,
+    /// The state the session was in when the run was interrupted (`Some(None)`: before
+    /// any state was reported).
+    interrupted_in: Option<Option<SessionPhase>>,
     /// The verdict once the run is over (`Leave` or `Lose`).
     over: Option<Turn>,
     /// How the run ended, in words.
@@ -104,6 +110,10 @@ impl SessionMachine {
                 Vec::new()
             }
             Event::ExitRequested | Event::FramesReached => self.exit(at),
+            Event::Interrupted => {
+                self.interrupted_in.get_or_insert(self.states.last().copied());
+                self.exit(at)
+            }
             Event::Failed(why) => {
                 self.fail(why);
                 Vec::new()
@@ -245,6 +255,15 @@ impl SessionMachine {
     /// How the run ended, once it has.
     pub fn ending(&self) -> Option<&str> {
         self.ending.as_deref()
+    }
+
+    /// The state the session was in when [`Event::Interrupted`] came, in words (`None`:
+    /// not interrupted).
+    pub fn interrupted_in(&self) -> Option<String> {
+        self.interrupted_in.map(|phase| match phase {
+            Some(phase) => phase.name().to_string(),
+            None => "before the first session state".to_string(),
+        })
     }
 }
 
@@ -499,6 +518,61 @@ mod tests {
         assert_eq!(m.feed(Event::Failed("xrRequestExitSession: XR_ERROR_SESSION_LOST".into()), s(3.0)), []);
         assert_eq!(m.turn(s(3.0)), Turn::Leave);
         assert_eq!(m.loss_reason(), Some("xrRequestExitSession: XR_ERROR_SESSION_LOST"));
+    }
+
+    /// Every place a session can be in, reached by the runtime's events from a fresh
+    /// machine, with whether xrBeginSession made it run.
+    fn in_each_state() -> Vec<(&'static str, SessionMachine, bool)> {
+        let at = |phases: &[SessionPhase]| {
+            let mut m = SessionMachine::new();
+            states(&mut m, phases, 1.0);
+            m
+        };
+        vec![
+            ("before the first session state", SessionMachine::new(), false),
+            ("IDLE", at(&[Idle]), false),
+            ("READY", at(&[Idle, Ready]), true),
+            ("SYNCHRONIZED", at(&[Idle, Ready, Synchronized]), true),
+            ("VISIBLE", at(&[Idle, Ready, Synchronized, Visible]), true),
+            ("FOCUSED", at(&[Idle, Ready, Synchronized, Visible, Focused]), true),
+            ("STOPPING", at(&[Idle, Ready, Synchronized, Focused, Stopping]), false),
+            ("IDLE", at(&[Idle, Ready, Synchronized, Focused, Stopping, Idle]), false),
+        ]
+    }
+
+    #[test]
+    fn an_interrupt_ends_the_run_from_every_state_and_records_it() {
+        for (state, mut m, running) in in_each_state() {
+            let actions = m.feed(Event::Interrupted, s(2.0));
+            assert_eq!(m.interrupted_in().as_deref(), Some(state));
+            if running {
+                // A running session is asked to exit; frames run empty until the runtime
+                // stops it, then xrEndSession, then EXITING.
+                assert_eq!(actions, [RequestExit], "{state}");
+                assert_eq!(m.turn(s(2.0)), Turn::EmptyFrame, "{state}");
+                assert_eq!(states(&mut m, &[Stopping], 2.05), [EndSession], "{state}");
+                assert_eq!(states(&mut m, &[Idle, Exiting], 2.1), [], "{state}");
+            } else {
+                // Not running (before READY, stopped, idle): no wait for the runtime.
+                assert_eq!(actions, [], "{state}");
+            }
+            assert_eq!(m.turn(s(2.1)), Turn::Leave, "{state}: the run ends");
+            assert_eq!(m.loss_reason(), None, "{state}");
+            // A second interrupt keeps the first state.
+            m.feed(Event::Interrupted, s(2.2));
+            assert_eq!(m.interrupted_in().as_deref(), Some(state));
+        }
+    }
+
+    #[test]
+    fn an_interrupt_the_runtime_never_answers_still_ends_within_the_exit_timeout() {
+        for (state, mut m, running) in in_each_state() {
+            m.feed(Event::Interrupted, s(2.0));
+            let expected = if running { Turn::EmptyFrame } else { Turn::Leave };
+            assert_eq!(m.turn(s(2.0) + EXIT_TIMEOUT - s(0.01)), expected, "{state}");
+            assert_eq!(m.turn(s(2.0) + EXIT_TIMEOUT), Turn::Leave, "{state}");
+        }
+        assert_eq!(SessionMachine::new().interrupted_in(), None, "not interrupted");
     }
 
     #[test]

@@ -126,19 +126,19 @@ impl Chain {
 
     /// xrAcquireSwapchainImage + xrWaitSwapchainImage on every swapchain; the image
     /// index of each.
-    fn acquire(&mut self) -> xr::Result<Vec<usize>> {
+    fn acquire(&mut self) -> Result<Vec<usize>, FillError> {
         let mut indices = Vec::with_capacity(self.swapchains.len());
         for swapchain in &mut self.swapchains {
-            let index = swapchain.acquire_image()?;
-            swapchain.wait_image(xr::Duration::INFINITE)?;
+            let index = swapchain.acquire_image().map_err(|e| FillError::Xr("xrAcquireSwapchainImage", e))?;
+            swapchain.wait_image(xr::Duration::INFINITE).map_err(|e| FillError::Xr("xrWaitSwapchainImage", e))?;
             indices.push(index as usize);
         }
         Ok(indices)
     }
 
-    fn release(&mut self) -> xr::Result<()> {
+    fn release(&mut self) -> Result<(), FillError> {
         for swapchain in &mut self.swapchains {
-            swapchain.release_image()?;
+            swapchain.release_image().map_err(|e| FillError::Xr("xrReleaseSwapchainImage", e))?;
         }
         Ok(())
     }
@@ -395,12 +395,12 @@ impl EyeSwapchains {
         color: &LayeredTarget,
         depth: &LayeredTarget,
     ) -> Result<[SubImage; 2], FillError> {
-        let color_indices = self.color.acquire().map_err(FillError::Xr)?;
+        let color_indices = self.color.acquire()?;
         let depth_indices = match self.depth.as_mut().map(Chain::acquire).transpose() {
             Ok(indices) => indices,
             Err(e) => {
                 let _ = self.color.release();
-                return Err(FillError::Xr(e));
+                return Err(e);
             }
         };
         let width = color.width.min(self.size.0);
@@ -422,7 +422,7 @@ impl EyeSwapchains {
         let gpu_error = gpu.take_error();
         let released = self.color.release().and_then(|()| self.depth.as_mut().map(Chain::release).unwrap_or(Ok(())));
         gpu_error.map_err(FillError::Gpu)?;
-        released.map_err(FillError::Xr)?;
+        released?;
         Ok(sub_images)
     }
 
@@ -441,14 +441,15 @@ impl EyeSwapchains {
 /// Why a frame could not be copied into the swapchains.
 #[derive(Debug)]
 pub enum FillError {
-    Xr(xr::sys::Result),
+    /// The OpenXR call that failed and its result.
+    Xr(&'static str, xr::sys::Result),
     Gpu(crate::render::error::Error),
 }
 
 impl std::fmt::Display for FillError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            FillError::Xr(e) => write!(f, "swapchain image: {e}"),
+            FillError::Xr(call, e) => write!(f, "{}", super::xr_call_failed(call, *e)),
             FillError::Gpu(e) => write!(f, "{e}"),
         }
     }

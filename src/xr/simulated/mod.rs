@@ -80,6 +80,24 @@ struct Rendering {
     finished_at: Arc<Mutex<Option<f64>>>,
 }
 
+/// The longest virtual render time of a frame (ms): a frame that late already misses
+/// hundreds of vsyncs; a longer one would keep the compositor counting vsyncs for hours.
+pub const VIRTUAL_RENDER_MS_MAX: f64 = 10_000.0;
+
+/// Refuses a virtual render-time script that is empty or has a time outside
+/// 0..=[`VIRTUAL_RENDER_MS_MAX`] ms (NaN included).
+pub fn check_virtual_render_ms(render_ms: &[f64]) -> Result<()> {
+    if render_ms.is_empty() {
+        return Err(Error::input("virtual render times: give one or more milliseconds"));
+    }
+    match render_ms.iter().find(|ms| !(0.0..=VIRTUAL_RENDER_MS_MAX).contains(*ms)) {
+        Some(ms) => {
+            Err(Error::input(format!("virtual render time {ms:?} ms is not within 0..={VIRTUAL_RENDER_MS_MAX} ms")))
+        }
+        None => Ok(()),
+    }
+}
+
 /// A headset without hardware: vsyncs on a real or virtual clock, a compositor that reprojects late frames, frame counters as SteamVR reports them.
 pub struct SimulatedHeadset {
     options: SimulatedOptions,
@@ -102,14 +120,11 @@ pub struct SimulatedHeadset {
 }
 
 impl SimulatedHeadset {
-    /// A headset with `options`; fails on an empty or non-finite virtual render-time script.
+    /// A headset with `options`; fails on an empty virtual render-time script or one with
+    /// a time outside 0..=[`VIRTUAL_RENDER_MS_MAX`].
     pub fn new(options: SimulatedOptions) -> Result<SimulatedHeadset> {
         if let TimeMode::Virtual { render_ms } = &options.time {
-            if render_ms.is_empty() || render_ms.iter().any(|ms| !(ms.is_finite() && *ms >= 0.0)) {
-                return Err(Error::input(format!(
-                    "virtual render times {render_ms:?} must be one or more finite, non-negative milliseconds"
-                )));
-            }
+            check_virtual_render_ms(render_ms)?;
         }
         let clock = match options.time {
             TimeMode::Real => Clock::real(),
@@ -335,6 +350,7 @@ impl Headset for SimulatedHeadset {
             eyes: self.eyes_at(display_time),
             size: self.recommended_size(),
             should_render: true,
+            display_period_ms: Some(self.options.profile.budget_ms()),
         };
         self.next_frame += 1;
         Ok(Some(request))
@@ -393,6 +409,15 @@ impl Headset for SimulatedHeadset {
 
     fn counters(&self) -> FrameCounters {
         self.compositor.counters()
+    }
+
+    fn session_state(&self) -> String {
+        if self.ended || self.exit_requested { "ending" } else { "running" }.into()
+    }
+
+    fn display_rate_source(&self) -> String {
+        let p = &self.options.profile;
+        format!("the simulated headset's refresh rate ({} Hz, profile '{}' or --refresh)", p.refresh_hz, p.name)
     }
 
     fn request_exit(&mut self) {

@@ -12,7 +12,9 @@ impl OpenXrHeadset {
     pub fn open(options: OpenXrOptions) -> std::result::Result<(OpenXrHeadset, Arc<Gpu>), Unavailable> {
         let entry = load_entry()?;
         let slot = InstanceSlot::take()?;
-        let available = entry.enumerate_extensions().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        let available = entry.enumerate_extensions().map_err(|e| {
+            super::super::no_runtime(&super::super::xr_call_failed("xrEnumerateInstanceExtensionProperties", e))
+        })?;
         if !available.khr_vulkan_enable2 {
             return Err(Unavailable::Unsupported("no XR_KHR_vulkan_enable2".into()));
         }
@@ -20,9 +22,10 @@ impl OpenXrHeadset {
         extensions.khr_vulkan_enable2 = true;
         extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
         extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
+        extensions.fb_display_refresh_rate = available.fb_display_refresh_rate;
         let instance = entry
             .create_instance(&application_info(), &extensions, &[], &())
-            .map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+            .map_err(|e| super::super::no_runtime(&super::super::xr_call_failed("xrCreateInstance", e)))?;
         let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
         let runtime = format!("{} {}", props.runtime_name, props.runtime_version);
         let system = instance
@@ -69,6 +72,11 @@ impl OpenXrHeadset {
         let space = session
             .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
             .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
+        let (refresh_rates_hz, refresh_hz) = if extensions.fb_display_refresh_rate {
+            display_refresh_rate(&session, options.preferred_refresh_hz)
+        } else {
+            (Vec::new(), None)
+        };
         let swapchains =
             EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)?;
         let swapchain_text = swapchains.describe();
@@ -105,7 +113,30 @@ impl OpenXrHeadset {
             tracking: Tracking::default(),
             opened: Instant::now(),
             fallback: None,
+            last_display_time: None,
+            refresh_rates_hz,
+            refresh_hz,
+            display_period_ms: 0.0,
         };
         Ok((headset, gpu))
+    }
+}
+
+/// XR_FB_display_refresh_rate: the rates the runtime offers, and the rate it runs at
+/// after asking for `preferred` when offered (within 0.5 Hz). A failing call only loses
+/// the information: the budget comes from the predicted display period regardless.
+fn display_refresh_rate(session: &xr::Session<xr::Vulkan>, preferred: Option<f64>) -> (Vec<f32>, Option<f32>) {
+    let offered = session.enumerate_display_refresh_rates().unwrap_or_default();
+    let current = session.get_display_refresh_rate().ok();
+    let wanted = preferred.and_then(|hz| offered.iter().copied().find(|&r| (r as f64 - hz).abs() < 0.5));
+    match wanted {
+        Some(rate) if current != Some(rate) => match session.request_display_refresh_rate(rate) {
+            Ok(()) => (offered, Some(rate)),
+            Err(e) => {
+                log::warn!("OpenXR: {}", super::super::xr_call_failed("xrRequestDisplayRefreshRateFB", e));
+                (offered, current)
+            }
+        },
+        _ => (offered, current),
     }
 }
