@@ -30,8 +30,15 @@ pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
     let (rows, adapter) = study(backend, &scene, &settings)?;
+    // In a scene that moves the fresh frames are one frame period later (`study`): the
+    // warp moves the eyes, not the objects.
+    let late = if scene.is_animated() {
+        format!(", {:.1} ms of scene time later (objects moved meanwhile)", 1e3 / settings.profile.refresh_hz)
+    } else {
+        String::new()
+    };
     println!(
-        "reprojection of '{}' at {}x{} per eye on {adapter}: RMSE of colour (0..1, both eyes) against a fresh render",
+        "reprojection of '{}' at {}x{} per eye on {adapter}: RMSE of colour (0..1, both eyes) against a fresh render{late}",
         scene.name, args.width, args.height
     );
     print!("{}", to_markdown(&rows));
