@@ -134,8 +134,7 @@ pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
     if root.nodes.len() > MAX_NODES {
         return Err(Error::in_file(path, format!("{} nodes, more than vrao's limit of {MAX_NODES}", root.nodes.len())));
     }
-    let document = ::gltf::Document::from_json(root)
-        .map_err(|e| Error::in_file(path, format!("invalid glTF: {}", first_line(&e.to_string()))))?;
+    let document = ::gltf::Document::from_json(root).map_err(|e| Error::in_file(path, first_line(&e.to_string())))?;
 
     let buffers = load_buffers(path, &document, bin)?;
     let mut loader = Loader {
@@ -561,7 +560,7 @@ impl Loader<'_> {
                     let mut normals: Vec<Vec3> =
                         self.read_vectors::<3>(&accessor, &label)?.into_iter().map(Vec3::from).collect();
                     self.same_count(normals.len(), count, &label)?;
-                    normals::repair_normals(&positions, &mut normals, &indices);
+                    keep_unit_repair_others(&positions, &mut normals, &indices);
                     let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
                     Geometry { positions, normals, uvs, indices }
                 }
@@ -948,6 +947,23 @@ fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, String> {
     }
     let image = image::load_from_memory(bytes).map_err(|e| format!("cannot decode: {e}"))?.into_rgba8();
     Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw() })
+}
+
+/// Normals as [`normals::repair_normals`] leaves them, except that a normal already of
+/// unit length keeps its exact bits (normalising again may move the last bit, and a file
+/// written from a loaded OBJ should give that OBJ's normals exactly).
+fn keep_unit_repair_others(positions: &[Vec3], normals: &mut [Vec3], indices: &[u32]) {
+    let is_unit = |n: &Vec3| (n.length_squared() - 1.0).abs() < 1e-6;
+    if normals.iter().all(is_unit) {
+        return;
+    }
+    let mut repaired = normals.to_vec();
+    normals::repair_normals(positions, &mut repaired, indices);
+    for (n, r) in normals.iter_mut().zip(repaired) {
+        if !is_unit(n) {
+            *n = r;
+        }
+    }
 }
 
 /// A static primitive in world space: positions through `world` in f64 and recentred as

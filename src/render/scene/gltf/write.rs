@@ -224,7 +224,7 @@ pub fn write(scene: &Scene, path: &Path, options: &WriteOptions) -> Result<()> {
     for mesh in &scene.meshes {
         let material = &scene.materials.get(mesh.material);
         let textured = material.is_some_and(|m| m.diffuse_texture.is_some());
-        let mut positions: Vec<Vec3> = mesh.positions.iter().map(|p| (mesh.origin + p.as_dvec3()).as_vec3()).collect();
+        let mut positions = world_f32(mesh.origin, &mesh.positions);
         let mut normals = mesh.normals.clone();
         let mut uvs = mesh.uvs.clone();
         let mut indices = mesh.indices.clone();
@@ -444,6 +444,41 @@ pub fn write(scene: &Scene, path: &Path, options: &WriteOptions) -> Result<()> {
         text
     };
     std::fs::write(path, bytes).map_err(|e| output(path, &e))
+}
+
+/// World positions as f32 that the loaders' recentring (on the centre of their bounds)
+/// turns back into exactly `origin` and `offsets`, so that a loaded OBJ written as glTF
+/// loads bit for bit as the OBJ did. Each coordinate is the nearest f32 to origin + offset
+/// or a neighbour of it (the OBJ's own f32 is one of these); the extremes are chosen as a
+/// pair whose centre is `origin`.
+fn world_f32(origin: DVec3, offsets: &[Vec3]) -> Vec<Vec3> {
+    let mut out = vec![Vec3::ZERO; offsets.len()];
+    for k in 0..3 {
+        let o = origin[k];
+        let (lo, hi) = offsets.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| (a.min(p[k]), b.max(p[k])));
+        let pair = candidates(o, lo)
+            .into_iter()
+            .flat_map(|a| candidates(o, hi).into_iter().map(move |b| (a, b)))
+            .find(|&(a, b)| (a as f64 + b as f64) * 0.5 == o);
+        for (w, p) in out.iter_mut().zip(offsets) {
+            w[k] = match pair {
+                Some((a, _)) if p[k] == lo => a,
+                Some((_, b)) if p[k] == hi => b,
+                _ => candidates(o, p[k]).first().copied().unwrap_or((o + p[k] as f64) as f32),
+            };
+        }
+    }
+    out
+}
+
+/// The f32 values within one step of origin + offset whose offset from `origin`, rounded
+/// to f32, is `offset` again (nearest first).
+fn candidates(origin: f64, offset: f32) -> Vec<f32> {
+    let nearest = (origin + offset as f64) as f32;
+    [nearest, nearest.next_down(), nearest.next_up()]
+        .into_iter()
+        .filter(|&w| ((w as f64 - origin) as f32).to_bits() == offset.to_bits())
+        .collect()
 }
 
 /// A sampler's JSON with its input (times) and output (values) accessors.
