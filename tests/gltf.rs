@@ -620,3 +620,47 @@ fn sibenik_as_glb_gives_the_objs_g_buffer() {
     assert!(normals <= 1e-5, "normals differ by {normals}");
     assert_eq!(ao, 0.0, "AO differs by {ao}");
 }
+
+#[test]
+fn obj_map_d_and_d_become_alpha() {
+    let dir = common::temp_dir("obj-alpha");
+    // A 2×2 alpha map (grey, no alpha channel) and a 4×4 diffuse texture: resampled nearest.
+    image::GrayImage::from_raw(2, 2, vec![0, 255, 255, 0]).unwrap().save(dir.join("mask.png")).unwrap();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([10, 20, 30, 255])).save(dir.join("colour.png")).unwrap();
+    std::fs::write(
+        dir.join("a.mtl"),
+        "newmtl cut\nmap_Kd colour.png\nmap_d mask.png\nnewmtl bare\nmap_d -clamp on mask.png\n\
+         newmtl glass\nd 0.25\nnewmtl tr\nTr 0.5\nnewmtl solid\nd 1\n",
+    )
+    .unwrap();
+    let mut obj = String::from("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for m in ["cut", "bare", "glass", "tr", "solid"] {
+        obj.push_str(&format!("usemtl {m}\nf 1 2 3\n"));
+    }
+    let scene = Scene::load(write_file(&dir, "a.obj", obj).to_str().unwrap()).unwrap();
+    let cut = material(&scene, "cut");
+    assert_eq!(cut.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
+    let t = cut.diffuse_texture.as_ref().unwrap();
+    assert_eq!((t.width, t.height), (4, 4));
+    let alphas: Vec<u8> = t.rgba8.chunks(4).map(|c| c[3]).collect();
+    assert_eq!(alphas, [0, 0, 255, 255, 0, 0, 255, 255, 255, 255, 0, 0, 255, 255, 0, 0]);
+    assert_eq!(&t.rgba8[..3], &[10, 20, 30], "colour kept");
+    let bare = material(&scene, "bare").diffuse_texture.as_ref().unwrap();
+    assert_eq!((bare.width, bare.height, &bare.rgba8[..8]), (2, 2, &[255, 255, 255, 0, 255, 255, 255, 255][..]));
+    assert_eq!((material(&scene, "glass").alpha, material(&scene, "glass").alpha_mode), (0.25, AlphaMode::Blend));
+    assert_eq!((material(&scene, "tr").alpha, material(&scene, "tr").alpha_mode), (0.5, AlphaMode::Blend));
+    assert_eq!((material(&scene, "solid").alpha, material(&scene, "solid").alpha_mode), (1.0, AlphaMode::Opaque));
+    assert!(scene.has_alpha_test());
+
+    for (mtl, expected) in [
+        ("newmtl x\nd 1.5\n", "bad.mtl:2: d 1.5 is not in [0, 1]"),
+        ("newmtl x\nTr -0.5\n", "bad.mtl:2: Tr -0.5 is not in [0, 1]"),
+        ("newmtl x\nmap_d gone.png\n", "bad.mtl:2: texture file 'gone.png' not found"),
+        ("newmtl x\nmap_d\n", "bad.mtl:2: map_d needs a texture file name"),
+    ] {
+        std::fs::write(dir.join("bad.mtl"), mtl).unwrap();
+        let path = write_file(&dir, "bad.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n");
+        let e = Scene::load(path.to_str().unwrap()).unwrap_err().to_string();
+        assert!(e.contains(expected), "{e}");
+    }
+}
