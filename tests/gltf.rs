@@ -664,3 +664,66 @@ fn obj_map_d_and_d_become_alpha() {
         assert!(e.contains(expected), "{e}");
     }
 }
+
+#[test]
+fn scene_files_place_gltf_and_animate_meshes() {
+    let dir = common::temp_dir("gltf-scene-file");
+    let source = source_scene();
+    write(&source, &dir.join("thing.glb"), &WriteOptions::default()).unwrap();
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let toml = r#"
+[[mesh]]
+gltf = "thing.glb"
+translate = [10, 0, 0]
+
+[[mesh]]
+obj = "tri.obj"
+translate = [0, 0, -5]
+animation = { interpolation = "linear", keys = [
+    { t = 0.0, translate = [0, 0, 0], rotate_deg = [0, 0, 0] },
+    { t = 4.0, translate = [2, 0, 0], rotate_deg = [0, 0, 90] } ] }
+"#;
+    let path = write_file(&dir, "s.toml", toml);
+    let scene = Scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.meshes.len(), source.meshes.len() + 1);
+    // The glTF's meshes, static and moving, 10 m along x at every time.
+    for t in [0.0, 0.7, 1.9] {
+        let placed = corners(&scene, t);
+        for (name, expected) in corners(&source, t) {
+            let got = &placed.iter().find(|(n, _)| *n == name).unwrap().1;
+            for (a, b) in expected.iter().zip(got) {
+                assert!((a.0 + DVec3::new(10.0, 0.0, 0.0) - b.0).length() < 1e-5, "{name} t={t}: {} vs {}", a.0, b.0);
+            }
+        }
+    }
+    // The OBJ triangle at t = 2 (half way): turned 45° about z, moved 1 m, then placed.
+    let tri = corners(&scene, 2.0).into_iter().find(|(n, _)| n == "unnamed_object" || n.is_empty() || n == "tri");
+    let (_, corners_at_2) =
+        tri.unwrap_or_else(|| panic!("{:?}", scene.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()));
+    let turn = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_4);
+    let expected = [DVec3::ZERO, DVec3::X, DVec3::Y].map(|p| turn * p + DVec3::new(1.0, 0.0, -5.0));
+    for (c, e) in corners_at_2.iter().zip(expected) {
+        assert!((c.0 - e).length() < 1e-6, "{} vs {e}", c.0);
+    }
+    assert!(scene.is_animated());
+    assert_eq!(scene.animation_period(), 4.0);
+
+    for (animation, expected) in [
+        ("{ keys = [] }", "needs 1 to 10000 keys, found 0"),
+        (
+            "{ keys = [{ t = 1.0, translate = [0, 0, 0] }, { t = 1.0, translate = [1, 0, 0] }] }",
+            "1 then 1 are not strictly increasing",
+        ),
+        ("{ keys = [{ t = -1.0, translate = [0, 0, 0] }] }", "key time -1 must be finite"),
+        ("{ keys = [{ t = 0.0, translate = [0, 0, 0] }, { t = 1.0 }] }", "translate is given in 1 of 2 keys"),
+        ("{ keys = [{ t = 0.0 }] }", "give none of translate"),
+        ("{ interpolation = \"cubic\", keys = [{ t = 0.0, scale = 1 }] }", "interpolation 'cubic'"),
+        ("{ keys = [{ t = 0.0, scale = 1 }], speed = 2 }", "unknown field `speed`"),
+    ] {
+        let text = format!("\n[[mesh]]\nobj = \"tri.obj\"\nanimation = {animation}\n");
+        let e = Scene::load(write_file(&dir, "bad.toml", text).to_str().unwrap()).unwrap_err().to_string();
+        assert!(e.contains("bad.toml:") && e.contains(expected), "{animation}: {e}");
+    }
+    let e = Scene::load(write_file(&dir, "nog.toml", "[[mesh]]\ngltf = \"none.glb\"\n").to_str().unwrap()).unwrap_err();
+    assert!(e.to_string().contains("nog.toml:1: mesh gltf 'none.glb' not found"), "{e}");
+}
