@@ -134,6 +134,7 @@ pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
     if root.nodes.len() > MAX_NODES {
         return Err(Error::in_file(path, format!("{} nodes, more than vrao's limit of {MAX_NODES}", root.nodes.len())));
     }
+    precheck(&root).map_err(|m| Error::in_file(path, m))?;
     let document = ::gltf::Document::from_json(root).map_err(|e| Error::in_file(path, first_line(&e.to_string())))?;
 
     let buffers = load_buffers(path, &document, bin)?;
@@ -153,6 +154,35 @@ pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
     let content = loader.build()?;
     loader.warnings.emit(path);
     Ok(content)
+}
+
+/// What the crate's validation leaves out and its accessors would panic on (found by
+/// fuzzing, gltf-json 1.4.1): animation channel targets (node index and path) and a spot
+/// light without its cone.
+fn precheck(root: &json::Root) -> std::result::Result<(), String> {
+    use json::validation::Checked;
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let node = channel.target.node.value();
+            if node >= root.nodes.len() {
+                return Err(format!("animation {a} channel {c}: target node {node} does not exist"));
+            }
+            if !matches!(channel.target.path, Checked::Valid(_)) {
+                return Err(format!("animation {a} channel {c}: target path is not one of the glTF properties"));
+            }
+            if channel.sampler.value() >= animation.samplers.len() {
+                return Err(format!("animation {a} channel {c}: sampler does not exist"));
+            }
+        }
+    }
+    let lights = root.extensions.as_ref().and_then(|e| e.khr_lights_punctual.as_ref());
+    for (i, light) in lights.map_or(&[][..], |l| &l.lights[..]).iter().enumerate() {
+        use json::extensions::scene::khr_lights_punctual::Type;
+        if matches!(light.type_, Checked::Valid(Type::Spot)) && light.spot.is_none() {
+            return Err(format!("light {i}: a spot light needs its \"spot\" cone angles"));
+        }
+    }
+    Ok(())
 }
 
 /// The first line of a (possibly multi-line) message.
