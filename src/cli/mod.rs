@@ -253,4 +253,4 @@ pub fn parse_budget_ms(s: &str) -> Result<f64, String> {
 }
 
 /// The `--scene` help every command shares.
-pub const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals)";
+pub const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, a .gltf or .glb, or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals)";

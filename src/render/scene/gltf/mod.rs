@@ -516,6 +516,10 @@ impl Loader<'_> {
         }
         for primitive in &self.primitives[&mesh.index()] {
             let g = &primitive.geometry;
+            // Nothing to draw (an OBJ object without faces is dropped the same way).
+            if g.indices.is_empty() {
+                continue;
+            }
             self.triangles += g.indices.len() / 3;
             self.vertices += g.positions.len();
             if self.triangles > MAX_TRIANGLES || self.vertices > MAX_VERTICES {
