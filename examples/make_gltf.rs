@@ -122,7 +122,7 @@ fn quad(name: &str, y: f64, size: f32, material: usize) -> Mesh {
 
 /// The checker's coverage: solid cells 255, holes 0.
 fn checker_alpha(x: u32, y: u32) -> u8 {
-    if (x + y) % 2 == 0 {
+    if (x + y).is_multiple_of(2) {
         255
     } else {
         0

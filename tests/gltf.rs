@@ -17,9 +17,9 @@ use vrao::HeadPose;
 /// A 4×4 checker whose dark cells are transparent.
 fn checker() -> Texture {
     let mut rgba8 = Vec::new();
-    for y in 0..4 {
+    for y in 0..4u32 {
         for x in 0..4 {
-            let solid = (x + y) % 2 == 0;
+            let solid = (x + y).is_multiple_of(2);
             rgba8.extend(if solid { [200, 150, 100, 255] } else { [20, 30, 40, 0] });
         }
     }
@@ -122,7 +122,10 @@ fn camera_pose() -> HeadPose {
 }
 
 /// Each mesh's triangle corners in world space at `t`: (position, normal, uv), by name.
-fn corners(scene: &Scene, t: f64) -> Vec<(String, Vec<(DVec3, Vec3, Vec2)>)> {
+/// A triangle corner in world space: position, normal, uv.
+type Corner = (DVec3, Vec3, Vec2);
+
+fn corners(scene: &Scene, t: f64) -> Vec<(String, Vec<Corner>)> {
     let transforms = scene.node_transforms(t);
     let mut out: Vec<_> = scene
         .meshes

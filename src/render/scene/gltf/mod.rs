@@ -491,7 +491,7 @@ impl Loader<'_> {
             ::gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
                 let [x, y, z, w] = rotation.map(f64::from);
                 let q = DQuat::from_xyzw(x, y, z, w);
-                if !(q.length() > 1e-6) {
+                if q.length().is_nan() || q.length() <= 1e-6 {
                     return Err(self.error(format!("node {}: rotation {rotation:?} is not a quaternion", node.index())));
                 }
                 Local::Trs(Trs {
@@ -573,7 +573,7 @@ impl Loader<'_> {
                 Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
                 None => (0..count as u32).collect(),
             };
-            if indices.len() % 3 != 0 {
+            if !indices.len().is_multiple_of(3) {
                 return Err(self.error(format!("{what}: {} indices, not a whole number of triangles", indices.len())));
             }
             let uvs: Vec<Vec2> = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
