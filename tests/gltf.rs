@@ -730,3 +730,58 @@ animation = { interpolation = "linear", keys = [
     let e = Scene::load(write_file(&dir, "nog.toml", "[[mesh]]\ngltf = \"none.glb\"\n").to_str().unwrap()).unwrap_err();
     assert!(e.to_string().contains("nog.toml:1: mesh gltf 'none.glb' not found"), "{e}");
 }
+
+#[test]
+fn a_spot_light_lights_its_cone_with_gltfs_falloff_on_the_gpu() {
+    use vrao::render::passes::composite::HDR;
+    use vrao::render::stereo::HeadsetProfile;
+    use vrao::{Renderer, Settings};
+    let (intensity, inner, outer) = (8.0f32, 0.1f32, 0.7f32);
+    let mut floor = common::square("floor", DVec3::ZERO, 8.0, 0);
+    // Turn the square (facing +Z) to face up.
+    floor.positions.iter_mut().for_each(|p| *p = Vec3::new(p.x, 0.0, -p.y));
+    floor.normals = vec![Vec3::Y; 4];
+    let mut scene = common::bare_scene(vec![floor]);
+    scene.lights = vec![Light::Spot {
+        position: DVec3::new(0.0, 2.0, 0.0),
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity,
+        inner_cone: inner,
+        outer_cone: outer,
+    }];
+    let (gpu, _guard) = common::gpu();
+    let (w, h) = (96, 108);
+    let settings = Settings { profile: HeadsetProfile::with_size("test", w, h), ..Settings::default() };
+    let head = HeadPose::look_at(DVec3::new(0.0, 3.0, 2.0), DVec3::ZERO).unwrap();
+    let eyes = settings.profile.eyes(&head, settings.near);
+    let mut renderer = Renderer::new(gpu.clone(), &scene, &settings).unwrap();
+    renderer.render_and_wait(&eyes.eyes, &[HDR]).unwrap();
+    let hdr = renderer.read_f32(HDR).unwrap();
+    let radiance_at = |p: DVec3| {
+        let (uv, _) = eyes.eyes[0].project(p, settings.near).unwrap();
+        let (x, y) = ((uv[0] * w as f64) as usize, (uv[1] * h as f64) as usize);
+        hdr[0][4 * (y * w as usize + x)]
+    };
+    // albedo/π × I × falloff × cos / d² at a floor point `angle` off the spot's axis.
+    let expected = |angle: f32| {
+        let (cos_outer, scale) = vrao::render::scene::spot_ramp(inner, outer);
+        let ramp = ((angle.cos() - cos_outer) * scale).clamp(0.0, 1.0);
+        let d = 2.0 / angle.cos();
+        0.5 / std::f32::consts::PI * intensity * ramp * ramp * angle.cos() / (d * d)
+    };
+    for angle in [0.0f32, 0.3, 0.45] {
+        let got = radiance_at(DVec3::new((2.0 * angle.tan()) as f64, 0.0, 0.0));
+        let want = expected(angle);
+        assert!((got - want).abs() <= 0.08 * want, "{angle} rad off the axis: {got}, expected {want}");
+    }
+    assert_eq!(radiance_at(DVec3::new(2.0 * 0.8f64.tan(), 0.0, 0.0)), 0.0, "outside the outer cone");
+    assert!(
+        (vrao::render::scene::spot_falloff(0.3f32.cos(), inner, outer) - {
+            let r: f32 = (0.3f32.cos() - outer.cos()) / (inner.cos() - outer.cos());
+            r * r
+        })
+        .abs()
+            < 1e-6
+    );
+}
