@@ -59,7 +59,7 @@ pub enum TexcoordType {
     U16Normalized,
 }
 
-/// Choices for [`write`].
+/// Choices for [`write()`].
 #[derive(Clone, Debug)]
 pub struct WriteOptions {
     /// Where the geometry buffer goes.
