@@ -38,6 +38,9 @@ struct Light {
     pos_or_dir: vec4<f32>,
     radiance: vec4<f32>,
     kind: vec4<u32>,
+    // Spot lights (kind.x == 2): the cone's view-space axis, and (cos outer, ramp scale).
+    spot_direction: vec4<f32>,
+    cone: vec4<f32>,
 };
 
 const PI: f32 = 3.14159265358979;

@@ -621,3 +621,32 @@ fn an_unusable_openxr_runtime_names_its_manifest_not_the_gpu() {
         }
     }
 }
+
+#[test]
+fn a_bad_gltf_exits_2_with_one_line_and_writes_nothing() {
+    let dir = temp_dir("bad-gltf");
+    let truncated = dir.join("cut.glb");
+    std::fs::write(&truncated, b"glTF\x02\0\0\0\xff\xff\0\0JSON").unwrap();
+    let json = dir.join("lines.gltf");
+    std::fs::write(&json, r#"{"asset":{"version":"2.0"},"nodes":[{"mesh":7}],"scenes":[{"nodes":[0]}]}"#).unwrap();
+    for scene in [&truncated, &json] {
+        let out_dir = dir.join("out");
+        let out = vrao(&[
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        let t = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{}: {t}", scene.display());
+        let errors = error_lines(&out);
+        assert_eq!(errors.len(), 1, "{t}");
+        assert!(errors[0].contains(scene.to_str().unwrap()), "the error names the file: {t}");
+        assert!(!out_dir.exists() || std::fs::read_dir(&out_dir).unwrap().next().is_none(), "nothing written: {t}");
+    }
+}

@@ -1,4 +1,4 @@
-//! Bounded fuzzing of the OBJ, MTL and scene-file loaders on stable Rust: seeded
+//! Bounded fuzzing of the OBJ, MTL, scene-file and glTF loaders on stable Rust: seeded
 //! mutations of valid files (and of the shared scenes' own OBJ and MTL when present),
 //! each loaded through `Scene::load`. Any `Ok` or `Err` is fine; a panic fails the test
 //! and the input is saved under `target/fuzz-crashes/` to become a regression file in
@@ -7,7 +7,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
-use vrao::render::scene::fuzz::{load_bytes, Mutator, Target, VALID_MTL, VALID_OBJ, VALID_SCENE};
+use vrao::render::scene::fuzz::{load_bytes, Mutator, Target, VALID_GLTF, VALID_MTL, VALID_OBJ, VALID_SCENE};
 
 /// Time per target; `VRAO_FUZZ_SECONDS` overrides it for longer runs.
 fn budget() -> Duration {
@@ -26,6 +26,7 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
         Target::Obj => VALID_OBJ.as_bytes().to_vec(),
         Target::Mtl => VALID_MTL.as_bytes().to_vec(),
         Target::SceneFile => VALID_SCENE.as_bytes().to_vec(),
+        Target::Gltf => VALID_GLTF.as_bytes().to_vec(),
     }];
     let cornell =
         |ext: &str| vrao::render::scene::shared_scene_for_test(&format!("cornell_box/CornellBox-Original.{ext}"));
@@ -33,6 +34,13 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
         Target::Obj => seeds.extend(cornell("obj").and_then(|p| std::fs::read(p).ok())),
         Target::Mtl => seeds.extend(cornell("mtl").and_then(|p| std::fs::read(p).ok())),
         Target::SceneFile => seeds.push(include_bytes!("../assets/scenes/cornell.toml").to_vec()),
+        Target::Gltf => {
+            // The same content as a .glb container, as vrao's writer makes it.
+            let glb = scratch("glb-seed").join("seed.glb");
+            let scene = vrao::render::scene::Scene::load("builtin:furnished").unwrap();
+            vrao::render::scene::gltf::write::write(&scene, &glb, &Default::default()).unwrap();
+            seeds.push(std::fs::read(glb).unwrap());
+        }
     }
     seeds
 }
@@ -95,6 +103,7 @@ fn every_saved_regression_input_loads_or_errs_without_a_panic() {
             Some("obj") => Target::Obj,
             Some("mtl") => Target::Mtl,
             Some("toml") => Target::SceneFile,
+            Some("gltf") => Target::Gltf,
             _ => continue,
         };
         let input = std::fs::read(&path).unwrap();

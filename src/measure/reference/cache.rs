@@ -126,6 +126,13 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
                 h.f32s(&color.to_array());
                 h.f32s(&[intensity]);
             }
+            Light::Spot { position, direction, color, intensity, inner_cone, outer_cone } => {
+                h.u32(2);
+                h.f64s(&position.to_array());
+                h.f32s(&direction.to_array());
+                h.f32s(&color.to_array());
+                h.f32s(&[intensity, inner_cone, outer_cone]);
+            }
         }
     }
     match &scene.environment {

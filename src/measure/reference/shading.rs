@@ -112,14 +112,10 @@ pub(crate) fn stratified_points(count: u32, rng: &mut Rng, out: &mut Vec<(f64, f
 /// The scene's lights in anchored coordinates, as the direct pass reads them.
 pub(crate) enum AnchoredLight {
     /// `towards` is the unit direction towards the light (−direction).
-    Directional {
-        towards: Vec3,
-        radiance: Vec3,
-    },
-    Point {
-        position: Vec3,
-        radiance: Vec3,
-    },
+    Directional { towards: Vec3, radiance: Vec3 },
+    /// Point and spot lights; a spot has `cone` = (unit axis, cos outer cone, ramp scale)
+    /// as [`crate::render::scene::spot_ramp`] gives them.
+    Point { position: Vec3, radiance: Vec3, cone: Option<(Vec3, f32, f32)> },
 }
 
 pub(crate) struct Lighting<'a> {
@@ -137,9 +133,19 @@ impl<'a> Lighting<'a> {
                     towards: -direction.as_dvec3().normalize_or_zero().as_vec3(),
                     radiance: color * intensity,
                 },
-                Light::Point { position, color, intensity } => {
-                    AnchoredLight::Point { position: (position - anchor).as_vec3(), radiance: color * intensity }
-                }
+                Light::Point { position, color, intensity } => AnchoredLight::Point {
+                    position: (position - anchor).as_vec3(),
+                    radiance: color * intensity,
+                    cone: None,
+                },
+                Light::Spot { position, direction, color, intensity, inner_cone, outer_cone } => AnchoredLight::Point {
+                    position: (position - anchor).as_vec3(),
+                    radiance: color * intensity,
+                    cone: {
+                        let (cos_outer, scale) = crate::render::scene::spot_ramp(inner_cone, outer_cone);
+                        Some((direction.normalize_or_zero(), cos_outer, scale))
+                    },
+                },
             })
             .collect();
         Lighting { lights, environment: scene.environment.as_ref() }
@@ -166,10 +172,16 @@ impl<'a> Lighting<'a> {
                         }
                     }
                 }
-                AnchoredLight::Point { position, radiance } => {
+                AnchoredLight::Point { position, radiance, cone } => {
                     let to_light = position - surface.position;
                     let d2 = to_light.length_squared().max(1e-4);
-                    e += radiance * n.dot(to_light / d2.sqrt()).max(0.0) / d2;
+                    let l = to_light / d2.sqrt();
+                    // glTF's spot falloff, as the direct pass computes it.
+                    let falloff = cone.map_or(1.0, |(axis, cos_outer, scale)| {
+                        let ramp = ((axis.dot(-l) - cos_outer) * scale).clamp(0.0, 1.0);
+                        ramp * ramp
+                    });
+                    e += radiance * falloff * n.dot(l).max(0.0) / d2;
                 }
             }
         }

@@ -323,6 +323,36 @@ fn a_sender_in_a_directional_lights_shadow_gets_none_of_it() {
 }
 
 #[test]
+fn a_spot_light_follows_gltfs_cone_falloff() {
+    // A spot 3 m above the box's floor pointing down: full on the axis, the squared ramp
+    // between the cones, nothing outside.
+    let mut scene = Scene::load("builtin:box").unwrap();
+    let (inner, outer) = (0.1f32, 0.7f32);
+    scene.lights = vec![Light::Spot {
+        position: DVec3::new(2.0, 3.0, 0.0),
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity: 9.0,
+        inner_cone: inner,
+        outer_cone: outer,
+    }];
+    let geometry = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    let lighting = Lighting::new(&scene, DVec3::ZERO);
+    let floor_at = |x: f32| {
+        let hit = geometry.closest(Vec3::new(x, 5.0, 0.0), Vec3::NEG_Y, 0.0, 10.0, u32::MAX).unwrap();
+        geometry.surface(&hit)
+    };
+    for angle in [0.0f32, 0.4, 0.9] {
+        let x = 2.0 + 3.0 * angle.tan();
+        let e = lighting.shadowed_irradiance(&geometry, &floor_at(x)).x;
+        let d2 = 9.0 / (angle.cos() * angle.cos());
+        let expected = 9.0 * crate::render::scene::spot_falloff(angle.cos(), inner, outer) * angle.cos() / d2;
+        assert!((e - expected).abs() < 1e-4, "{angle} rad: {e}, expected {expected}");
+    }
+    assert!(lighting.shadowed_irradiance(&geometry, &floor_at(2.0 + 3.0 * 0.4f32.tan())).x > 0.1);
+}
+
+#[test]
 fn back_faces_send_no_bounce() {
     // Seen from behind the wall (z < wall), the wall's back faces the floor behind it.
     let (mut scene, _) = red_wall_crease();

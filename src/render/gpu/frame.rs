@@ -61,8 +61,12 @@ pub struct LightUniform {
     pub pos_or_dir: [f32; 4],
     /// Colour × intensity in rgb.
     pub radiance: [f32; 4],
-    /// x: 0 directional, 1 point.
+    /// x: 0 directional, 1 point, 2 spot.
     pub kind: [u32; 4],
+    /// Spot: the view-space unit direction of the cone's axis in xyz.
+    pub spot_direction: [f32; 4],
+    /// Spot: cos(outer cone) and the falloff ramp's scale ([`crate::render::scene::spot_ramp`]).
+    pub cone: [f32; 4],
 }
 
 /// The occlusion passes' parameters (`AoParams` of common.wgsl; layout must match).
@@ -277,12 +281,25 @@ impl FrameBuffers {
                             .to_array(),
                         radiance: (color * intensity).extend(0.0).to_array(),
                         kind: [0; 4],
+                        ..LightUniform::zeroed()
                     },
                     Light::Point { position, color, intensity } => LightUniform {
                         pos_or_dir: view_from_world.transform_point3(position).as_vec3().extend(1.0).to_array(),
                         radiance: (color * intensity).extend(0.0).to_array(),
                         kind: [1, 0, 0, 0],
+                        ..LightUniform::zeroed()
                     },
+                    Light::Spot { position, direction, color, intensity, inner_cone, outer_cone } => {
+                        let (cos_outer, scale) = crate::render::scene::spot_ramp(inner_cone, outer_cone);
+                        let axis = view_from_world.transform_vector3(direction.as_dvec3()).normalize_or_zero();
+                        LightUniform {
+                            pos_or_dir: view_from_world.transform_point3(position).as_vec3().extend(1.0).to_array(),
+                            radiance: (color * intensity).extend(0.0).to_array(),
+                            kind: [2, 0, 0, 0],
+                            spot_direction: axis.as_vec3().extend(0.0).to_array(),
+                            cone: [cos_outer, scale, 0.0, 0.0],
+                        }
+                    }
                 });
             }
         }

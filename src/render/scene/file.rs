@@ -14,13 +14,21 @@
 //! ```toml
 //! name = "cornell"                 # optional; default: the file name without extension
 //!
-//! [[mesh]]                         # any number; each is an OBJ or a built-in scene's meshes
+//! [[mesh]]                         # any number; each is an OBJ, a glTF or a built-in scene's meshes
 //! obj = "models/box.obj"           # or "$VRAO_SCENES/cornell_box/CornellBox-Original.obj"; or: builtin = "plane" | "crease" | "room" | "sphere" | "box"
 //!                                  #   | "furnished" | "columns" | "flipped-normals" (meshes and
 //!                                  #   materials only: lights and head come from this file)
+//!                                  # or: gltf = "models/robot.glb" (.gltf or .glb: meshes, materials
+//!                                  #   and its animation; its lights and camera are not used)
 //! translate = [0.0, 0.0, 0.0]      # metres (optional)
 //! rotate_deg = [0.0, 90.0, 0.0]    # about the world X, then Y, then Z axis (optional)
 //! scale = 1.0                      # or [sx, sy, sz]; finite and nonzero (optional)
+//! # optional: moves the entry's meshes by keyframes (world = placement · TRS(t) · mesh);
+//! # each key gives the same properties, t in seconds strictly increasing (at most 10000 keys);
+//! # the animation loops over the longest track of the scene
+//! animation = { interpolation = "linear", keys = [        # or "step"
+//!     { t = 0.0, translate = [0, 0, 0], rotate_deg = [0, 0, 0], scale = 1.0 },
+//!     { t = 2.0, translate = [1, 0, 0], rotate_deg = [0, 90, 0], scale = 1.0 } ] }
 //!
 //! [[light]]                        # no [[light]]: the rule of `obj::default_lights`
 //! type = "directional"             # (emissive meshes, else a sun); `light = []`: no lights
@@ -45,14 +53,20 @@
 //! #         { t = 4.0, eye = [2, 1.6, 2], look_at = [0, 1, 0] }]
 //! ```
 //!
+//! A glTF's static meshes are placed like an OBJ's; its moving nodes' roots take the
+//! placement into their `base` (so they move in the placed frame).
+//!
 //! Transforms are applied in f64 to each mesh's origin and in f32 to its (small) offsets;
 //! normals use the inverse transpose, and a mirroring scale reverses the winding so that
 //! triangles stay counter-clockwise around their normals.
 
-use super::{builtin, limits, obj, Environment, HeadPath, Light, Material, Mesh, Scene};
+use super::{
+    builtin, limits, obj, Environment, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene,
+};
+use super::{Track, Trs};
 use crate::render::error::{Error, Result};
 use crate::render::stereo::HeadPose;
-use glam::{DMat3, DVec3, EulerRot};
+use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
 use serde::Deserialize;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -73,11 +87,32 @@ struct SceneFile {
 #[serde(deny_unknown_fields)]
 struct MeshEntry {
     obj: Option<String>,
+    gltf: Option<String>,
     builtin: Option<String>,
+    animation: Option<AnimationEntry>,
     translate: Option<[f64; 3]>,
     rotate_deg: Option<[f64; 3]>,
     scale: Option<Scale>,
 }
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnimationEntry {
+    interpolation: Option<String>,
+    keys: Vec<AnimationKey>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnimationKey {
+    t: f64,
+    translate: Option<[f64; 3]>,
+    rotate_deg: Option<[f64; 3]>,
+    scale: Option<Scale>,
+}
+
+/// The most keys a `[mesh.animation]` may have.
+pub const MAX_ANIMATION_KEYS: usize = 10_000;
 
 #[derive(Deserialize)]
 #[serde(untagged, expecting = "scale must be a number or [x, y, z]")]
@@ -143,16 +178,38 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
     let directory = path.parent().unwrap_or(Path::new(""));
     let at = |span: Range<usize>, message: String| Error::at_line(path, line_of(text, span.start), message);
 
-    let (mut meshes, mut materials) = (Vec::new(), Vec::new());
+    let (mut meshes, mut materials, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
     for entry in &file.mesh {
-        let (new_meshes, new_materials) = load_mesh_entry(entry.get_ref(), directory, materials.len())
+        let placed = load_mesh_entry(entry.get_ref(), directory, materials.len())
             .map_err(|f| f.place(|m| at(entry.span(), m)))?;
-        meshes.extend(new_meshes);
-        materials.extend(new_materials);
+        // The entry's nodes count from 0; in the scene they follow those before them.
+        let offset = nodes.len();
+        meshes.extend(placed.meshes.into_iter().map(|mut m| {
+            m.node = m.node.map(|n| n + offset);
+            m
+        }));
+        nodes.extend(placed.nodes.into_iter().map(|mut n| {
+            n.parent = n.parent.map(|p| p + offset);
+            n
+        }));
+        materials.extend(placed.materials);
     }
 
     let lights = match &file.light {
-        None => obj::default_lights(&meshes, &materials),
+        None => {
+            // Emitters where they are at time 0 (a moving mesh's positions are local).
+            let still = Scene {
+                name: String::new(),
+                meshes: meshes.clone(),
+                materials: Vec::new(),
+                lights: Vec::new(),
+                environment: None,
+                head: HeadPath::fixed(HeadPose::IDENTITY),
+                nodes: nodes.clone(),
+            }
+            .at_time(0.0);
+            obj::default_lights(&still.meshes, &materials)
+        }
         Some(entries) => entries
             .iter()
             .map(|e| light(e.get_ref()).map_err(|f| f.place(|m| at(e.span(), m))))
@@ -167,7 +224,7 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
     };
 
     let mut scene = Scene {
-        nodes: Vec::new(),
+        nodes,
         name: file
             .name
             .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()),
@@ -223,40 +280,149 @@ fn resolve(directory: &Path, what: &str, value: &str) -> std::result::Result<Pat
     }
 }
 
+/// What one `[[mesh]]` entry adds: meshes, materials, and nodes (indices from 0).
+struct Placed {
+    meshes: Vec<Mesh>,
+    materials: Vec<Material>,
+    nodes: Vec<Node>,
+}
+
 fn load_mesh_entry(
     entry: &MeshEntry,
     directory: &Path,
     material_offset: usize,
-) -> std::result::Result<(Vec<Mesh>, Vec<Material>), Failure> {
+) -> std::result::Result<Placed, Failure> {
     let transform = entry.transform()?;
-    let (mut meshes, materials) = match (&entry.obj, &entry.builtin) {
-        (Some(obj), None) => {
+    let (mut meshes, materials, mut nodes) = match (&entry.obj, &entry.gltf, &entry.builtin) {
+        (Some(obj), None, None) => {
             let file = resolve(directory, "mesh obj", obj)?;
             if !file.is_file() {
                 return Err(Failure::Here(format!("mesh obj '{obj}' not found (looked for {})", file.display())));
             }
-            obj::load_obj(&file, material_offset).map_err(Failure::Elsewhere)?
+            let (meshes, materials) = obj::load_obj(&file, material_offset).map_err(Failure::Elsewhere)?;
+            (meshes, materials, Vec::new())
         }
-        (None, Some(name)) => {
+        (None, Some(gltf), None) => {
+            let file = resolve(directory, "mesh gltf", gltf)?;
+            if !file.is_file() {
+                return Err(Failure::Here(format!("mesh gltf '{gltf}' not found (looked for {})", file.display())));
+            }
+            let content = super::gltf::load_content(&file, material_offset).map_err(Failure::Elsewhere)?;
+            if !content.lights.is_empty() || content.camera.is_some() {
+                log::warn!(
+                    "{}: its lights and camera are not used when a scene file places it (the scene file gives them)",
+                    file.display()
+                );
+            }
+            (content.meshes, content.materials, content.nodes)
+        }
+        (None, None, Some(name)) => {
             let scene = builtin::load(name).map_err(|e| Failure::Here(e.to_string()))?;
             let mut meshes = scene.meshes;
             meshes.iter_mut().for_each(|m| m.material += material_offset);
-            (meshes, scene.materials)
+            (meshes, scene.materials, scene.nodes)
         }
         _ => {
             return Err(Failure::Here(
-                "a [[mesh]] needs exactly one of obj = \"file.obj\" or builtin = \"name\"".into(),
+                "a [[mesh]] needs exactly one of obj = \"file.obj\", gltf = \"file.glb\" or builtin = \"name\"".into(),
             ))
         }
     };
-    if let Some(transform) = transform {
-        meshes.iter_mut().for_each(|m| transform.apply(m));
+    let placement = transform.as_ref().map_or(DMat4::IDENTITY, Transform::matrix);
+    match &entry.animation {
+        Some(animation) => {
+            // A new root that the whole entry hangs from: world = placement · TRS(t) · local.
+            let tracks = animation_tracks(animation)?;
+            nodes.iter_mut().for_each(|n| n.parent = Some(n.parent.map_or(0, |p| p + 1)));
+            nodes.insert(
+                0,
+                Node { name: "animation".into(), parent: None, base: placement, rest: Trs::IDENTITY, tracks },
+            );
+            meshes.iter_mut().for_each(|m| m.node = Some(m.node.map_or(0, |n| n + 1)));
+        }
+        None => {
+            if let Some(transform) = transform {
+                meshes.iter_mut().filter(|m| m.node.is_none()).for_each(|m| transform.apply(m));
+                // Moving roots carry the placement in their base.
+                nodes.iter_mut().filter(|n| n.parent.is_none()).for_each(|n| n.base = placement * n.base);
+            }
+        }
     }
     // Each part may be in range and their product not (a large scale of a distant mesh).
     if let Some(trouble) = meshes.iter().find_map(limits::mesh_trouble) {
         return Err(Failure::Here(trouble));
     }
-    Ok((meshes, materials))
+    Ok(Placed { meshes, materials, nodes })
+}
+
+/// The tracks of a `[mesh.animation]`: one per property the keys give (every key must give
+/// the same properties), times finite, non-negative and strictly increasing.
+fn animation_tracks(animation: &AnimationEntry) -> std::result::Result<NodeTracks, Failure> {
+    let interpolation = match animation.interpolation.as_deref().unwrap_or("linear") {
+        "linear" => Interpolation::Linear,
+        "step" => Interpolation::Step,
+        other => {
+            return Err(Failure::Here(format!("animation interpolation '{other}': expected \"linear\" or \"step\"")))
+        }
+    };
+    let keys = &animation.keys;
+    if keys.is_empty() || keys.len() > MAX_ANIMATION_KEYS {
+        return Err(Failure::Here(format!("an animation needs 1 to {MAX_ANIMATION_KEYS} keys, found {}", keys.len())));
+    }
+    let times: Vec<f64> = keys.iter().map(|k| k.t).collect();
+    if let Some(t) = times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+        return Err(Failure::Here(format!("animation key time {t} must be finite and ≥ 0")));
+    }
+    if let Some(w) = times.windows(2).find(|w| w[1] <= w[0]) {
+        return Err(Failure::Here(format!("animation key times {} then {} are not strictly increasing", w[0], w[1])));
+    }
+    // Each property: present in every key or in none.
+    fn track<T>(
+        keys: &[AnimationKey],
+        times: &[f64],
+        interpolation: Interpolation,
+        name: &str,
+        value: impl Fn(&AnimationKey) -> Option<std::result::Result<T, Failure>>,
+    ) -> std::result::Result<Option<Track<T>>, Failure> {
+        let given = keys.iter().filter(|k| value(k).is_some()).count();
+        if given == 0 {
+            return Ok(None);
+        }
+        if given != keys.len() {
+            return Err(Failure::Here(format!(
+                "animation: {name} is given in {given} of {} keys (all or none)",
+                keys.len()
+            )));
+        }
+        let values = keys.iter().filter_map(&value).collect::<std::result::Result<Vec<T>, Failure>>()?;
+        Ok(Some(Track { interpolation, times: times.to_vec(), values }))
+    }
+    let translation =
+        track(keys, &times, interpolation, "translate", |k| k.translate.map(|v| finite3("translate", v)))?;
+    let rotation = track(keys, &times, interpolation, "rotate_deg", |k| {
+        k.rotate_deg.map(|v| {
+            finite3("rotate_deg", v)
+                .map(|d| DQuat::from_euler(EulerRot::XYZEx, d.x.to_radians(), d.y.to_radians(), d.z.to_radians()))
+        })
+    })?;
+    let scale = track(keys, &times, interpolation, "scale", |k| {
+        k.scale.as_ref().map(|s| {
+            let v = match *s {
+                Scale::Uniform(s) => DVec3::splat(s),
+                Scale::PerAxis(s) => DVec3::from_array(s),
+            };
+            if v.is_finite() && v.as_vec3().is_finite() {
+                Ok(v)
+            } else {
+                Err(Failure::Here(format!("animation scale {:?} is not finite", v.to_array())))
+            }
+        })
+    })?;
+    let tracks = NodeTracks { translation, rotation, scale };
+    if tracks.is_empty() {
+        return Err(Failure::Here("animation keys give none of translate, rotate_deg or scale".into()));
+    }
+    Ok(tracks)
 }
 
 fn finite3(what: &str, v: [f64; 3]) -> std::result::Result<DVec3, Failure> {
@@ -311,6 +477,11 @@ impl MeshEntry {
 }
 
 impl Transform {
+    /// As a matrix (for nodes: a moving root's base).
+    fn matrix(&self) -> DMat4 {
+        DMat4::from_mat3_translation(self.linear, self.translate)
+    }
+
     fn apply(&self, mesh: &mut Mesh) {
         let linear = self.linear.as_mat3();
         let normal_matrix = self.linear.inverse().transpose().as_mat3();

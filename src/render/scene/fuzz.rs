@@ -19,11 +19,14 @@ pub enum Target {
     Mtl,
     /// The bytes are a TOML scene file (`obj = "fuzz.obj"` finds a valid mesh).
     SceneFile,
+    /// The bytes are a glTF file (`.gltf` JSON, or a `.glb` container: the loader reads
+    /// the content, not the extension).
+    Gltf,
 }
 
 impl Target {
     /// Every target, for loops over all of them.
-    pub const ALL: [Target; 3] = [Target::Obj, Target::Mtl, Target::SceneFile];
+    pub const ALL: [Target; 4] = [Target::Obj, Target::Mtl, Target::SceneFile, Target::Gltf];
 
     /// The file extension the fuzzed bytes are written with.
     pub fn extension(self) -> &'static str {
@@ -31,6 +34,7 @@ impl Target {
             Target::Obj => "obj",
             Target::Mtl => "mtl",
             Target::SceneFile => "toml",
+            Target::Gltf => "gltf",
         }
     }
 }
@@ -42,6 +46,10 @@ pub const VALID_MTL: &str = "newmtl red\nKd 0.8 0.1 0.1\nKe 0 0 0\n";
 /// A valid scene file placing `fuzz.obj`.
 pub const VALID_SCENE: &str = "name = \"fuzz\"\n\n[[mesh]]\nobj = \"fuzz.obj\"\ntranslate = [0, 0, -1]\nscale = 2\n\n[[light]]\ntype = \"directional\"\ndirection = [0, -1, -1]\nintensity = 2\n\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 5\n\n[environment]\nsky = \"default\"\n\n[head]\npath = [{ t = 0, eye = [0, 1, 2], look_at = [0, 0, 0] }, { t = 1, eye = [1, 1, 2], look_at = [0, 0, 0] }]\n";
 
+/// A small valid `.gltf`: an indexed triangle under a moving parent, a masked material and
+/// a spot light, its buffer a data URI.
+pub const VALID_GLTF: &str = "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"spot\",\"intensity\":5,\"spot\":{\"innerConeAngle\":0.2,\"outerConeAngle\":0.5}}]}},\"scene\":0,\"scenes\":[{\"nodes\":[0,2]}],\"nodes\":[{\"translation\":[0,0,-1],\"children\":[1]},{\"mesh\":0,\"scale\":[2,2,2]},{\"translation\":[0,2,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],\"meshes\":[{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.8,0.1,0.1,0.5]},\"alphaMode\":\"MASK\",\"alphaCutoff\":0.4,\"emissiveFactor\":[0,0,0]}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},{\"buffer\":0,\"byteOffset\":44,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":52,\"byteLength\":24}],\"buffers\":[{\"byteLength\":76,\"uri\":\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAAAAAIA/AAAAAA==\"}],\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}],\"samplers\":[{\"input\":2,\"output\":3,\"interpolation\":\"LINEAR\"}]}]}";
+
 /// Writes `data` as the `target` file beside valid companions in `dir` and loads it.
 pub fn load_bytes(target: Target, data: &[u8], dir: &Path) -> Result<Scene> {
     let write = |name: &str, bytes: &[u8]| {
@@ -51,7 +59,14 @@ pub fn load_bytes(target: Target, data: &[u8], dir: &Path) -> Result<Scene> {
     write("fuzz.obj", if target == Target::Obj { data } else { VALID_OBJ.as_bytes() })?;
     write("fuzz.mtl", if target == Target::Mtl { data } else { VALID_MTL.as_bytes() })?;
     write("fuzz.toml", if target == Target::SceneFile { data } else { VALID_SCENE.as_bytes() })?;
-    let entry = if target == Target::SceneFile { "fuzz.toml" } else { "fuzz.obj" };
+    if target == Target::Gltf {
+        write("fuzz.gltf", data)?;
+    }
+    let entry = match target {
+        Target::SceneFile => "fuzz.toml",
+        Target::Gltf => "fuzz.gltf",
+        _ => "fuzz.obj",
+    };
     let scene = Scene::load(dir.join(entry).to_str().unwrap_or_default())?;
     check_finite(&scene);
     Ok(scene)
@@ -79,6 +94,9 @@ fn check_finite(scene: &Scene) {
         assert!(m.diffuse.is_finite() && m.emissive.is_finite(), "material {} is not finite", m.name);
         let brightest = m.emissive.max_element() as f64;
         assert!(brightest <= super::limits::RADIANCE_MAX, "material {} emits {brightest}", m.name);
+    }
+    for t in [0.0, 0.5, 1e6] {
+        assert!(scene.node_transforms(t).iter().all(|m| m.is_finite()), "a node transform is not finite at {t}");
     }
 }
 
@@ -127,6 +145,18 @@ const TOKENS: &[&[u8]] = &[
     b"Kd ",
     b"Ke ",
     b"map_Kd ",
+    b"map_d ",
+    b"d ",
+    b"Tr ",
+    b"\"mode\":",
+    b"\"count\":",
+    b"\"byteOffset\":",
+    b"\"byteStride\":",
+    b"\"children\":[0]",
+    b"\"matrix\":",
+    b"\"CUBICSPLINE\"",
+    b"4294967295",
+    b"1e300",
     b"[[mesh]]\n",
     b"[[light]]\n",
     b"[head]\n",

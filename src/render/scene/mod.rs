@@ -12,6 +12,7 @@ pub mod environment;
 pub mod file;
 pub mod furnished;
 pub mod fuzz;
+pub mod gltf;
 pub mod limits;
 pub mod normals;
 pub mod obj;
@@ -169,6 +170,41 @@ pub enum Light {
         /// Radiant intensity (irradiance at 1 m).
         intensity: f32,
     },
+    /// A spot light (glTF `KHR_lights_punctual` spot): a point light limited to a cone
+    /// around `direction`, full inside `inner_cone`, fading smoothly to nothing at
+    /// `outer_cone` (glTF's falloff: the square of a linear ramp in the cosine of the
+    /// angle). Like point lights it casts no shadow map.
+    Spot {
+        /// World position in metres.
+        position: DVec3,
+        /// Unit direction the cone points along.
+        direction: Vec3,
+        /// Linear RGB colour.
+        color: Vec3,
+        /// Radiant intensity on the axis (irradiance at 1 m).
+        intensity: f32,
+        /// Half-angle (radians) inside which the light is at full intensity.
+        inner_cone: f32,
+        /// Half-angle (radians) beyond which there is no light; greater than `inner_cone`, at most π/2.
+        outer_cone: f32,
+    },
+}
+
+/// glTF's smooth spot cone falloff: 1 inside the inner cone, 0 outside the outer one,
+/// between them the square of a linear ramp in the cosine of the angle off the axis
+/// (`KHR_lights_punctual`'s recommended form). `cos_angle` is the cosine between the spot
+/// direction and the direction from the light to the lit point.
+pub fn spot_falloff(cos_angle: f32, inner_cone: f32, outer_cone: f32) -> f32 {
+    let (cos_outer, scale) = spot_ramp(inner_cone, outer_cone);
+    let ramp = ((cos_angle - cos_outer) * scale).clamp(0.0, 1.0);
+    ramp * ramp
+}
+
+/// The cosine of the outer cone and the ramp's scale 1 / (cos inner − cos outer), kept
+/// finite when the cones (nearly) coincide; the shaders take these two numbers.
+pub fn spot_ramp(inner_cone: f32, outer_cone: f32) -> (f32, f32) {
+    let (cos_inner, cos_outer) = (inner_cone.cos(), outer_cone.cos());
+    (cos_outer, 1.0 / (cos_inner - cos_outer).max(1e-3))
 }
 
 impl Light {
@@ -409,7 +445,7 @@ impl Scene {
         self.materials.iter().any(|m| m.emissive.max_element() > 0.0)
     }
 
-    /// Loads `builtin:NAME`, a `.toml` scene file, or a bare `.obj`.
+    /// Loads `builtin:NAME`, a `.toml` scene file, a bare `.obj`, or a `.gltf`/`.glb`.
     pub fn load(spec: &str) -> Result<Scene> {
         if let Some(name) = spec.strip_prefix("builtin:") {
             return builtin::load(name);
@@ -423,7 +459,11 @@ impl Scene {
         match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
             Some(ext) if ext == "toml" => file::load(path),
             Some(ext) if ext == "obj" => obj::load_bare(path),
-            _ => Err(Error::in_file(path, "unknown scene type: expected builtin:NAME, a .toml scene file or an .obj")),
+            Some(ext) if ext == "gltf" || ext == "glb" => gltf::load(path),
+            _ => Err(Error::in_file(
+                path,
+                "unknown scene type: expected builtin:NAME, a .toml scene file, an .obj, a .gltf or a .glb",
+            )),
         }
     }
 }

@@ -11,6 +11,12 @@
 //! which the MTL spec allows). tobj still assigns each mesh its material, from the names
 //! this module hands it through its material loader.
 //!
+//! Alpha: `d` (or `Tr` = 1 − d) is the material's alpha factor; `map_d` is an alpha map
+//! (its alpha channel, or its grey level when it has none) merged into the diffuse
+//! texture's alpha (a white texture when there is no `map_Kd`; resampled by nearest texel
+//! when the sizes differ) and alpha-tested at 0.5 ([`super::AlphaMode::Mask`]); `d` < 1
+//! without `map_d` is [`super::AlphaMode::Blend`].
+//!
 //! Conventions: texture v is flipped so that v = 0 is the top row of the image. Missing
 //! normals are computed with [`normals::DEFAULT_CREASE_DEG`] creases. Zero-area triangles
 //! are kept (they rasterise to nothing and keep triangle counts equal to the file's) but
@@ -329,29 +335,45 @@ struct MtlMaterial {
     emissive: Vec3,
     /// `map_Kd`, resolved against the MTL file's directory; known to exist.
     diffuse_texture: Option<PathBuf>,
+    /// `d` (or 1 − `Tr`), in [0, 1].
+    alpha: Option<f32>,
+    /// `map_d`, resolved and known to exist: its alpha channel (or grey level when it has
+    /// none) becomes the diffuse texture's alpha, alpha-tested at 0.5.
+    alpha_texture: Option<PathBuf>,
 }
 
 impl MtlMaterial {
     /// The material with its texture decoded (once per file, via `cache`).
     fn into_material(self, cache: &mut HashMap<PathBuf, Texture>) -> Result<Material> {
-        let diffuse_texture = match self.diffuse_texture {
+        let mut diffuse_texture = match self.diffuse_texture {
             Some(path) if cache.contains_key(&path) => cache.get(&path).cloned(),
             Some(path) => Some(cache.entry(path.clone()).or_insert(load_texture(&path)?).clone()),
             None => None,
+        };
+        let alpha = self.alpha.unwrap_or(1.0);
+        let alpha_mode = match &self.alpha_texture {
+            Some(path) => {
+                let (width, height, coverage) = load_alpha(path)?;
+                diffuse_texture = Some(with_alpha(diffuse_texture, width, height, &coverage));
+                super::AlphaMode::Mask { cutoff: 0.5 }
+            }
+            // A uniformly see-through material (glass): blended, which vrao alpha-tests.
+            None if alpha < 1.0 => super::AlphaMode::Blend,
+            None => super::AlphaMode::Opaque,
         };
         Ok(Material {
             name: self.name,
             diffuse: self.diffuse.unwrap_or(Vec3::splat(DEFAULT_DIFFUSE)).clamp(Vec3::ZERO, Vec3::ONE),
             emissive: self.emissive,
             diffuse_texture,
-            alpha: 1.0,
-            alpha_mode: super::AlphaMode::Opaque,
+            alpha,
+            alpha_mode,
         })
     }
 }
 
-/// Parses and checks an MTL file. Keys used for rendering (Kd, Ke, map_Kd) are kept;
-/// the other numeric keys (Ka, Ks, Ns, Ni, d, illum) are checked but dropped; unknown
+/// Parses and checks an MTL file. Keys used for rendering (Kd, Ke, map_Kd, d, Tr, map_d)
+/// are kept; the other numeric keys (Ka, Ks, Ns, Ni, illum) are checked but dropped; unknown
 /// keys are ignored; `#` starts a comment anywhere on a line.
 fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
     let text = read_text(path)?;
@@ -375,6 +397,8 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
                 diffuse: None,
                 emissive: Vec3::ZERO,
                 diffuse_texture: None,
+                alpha: None,
+                alpha_texture: None,
             }),
             "Kd" | "Ka" | "Ks" | "Ke" => {
                 let colour = match numbers()?.as_slice() {
@@ -401,26 +425,40 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
                 }
             }
             "Ns" | "Ni" | "d" | "Tr" => {
-                let found = numbers()?.len();
-                if found != 1 {
-                    return Err(at(format!("{key} needs one number, found {found}")));
+                let values = numbers()?;
+                if values.len() != 1 {
+                    return Err(at(format!("{key} needs one number, found {}", values.len())));
+                }
+                if key == "d" || key == "Tr" {
+                    let value = values[0];
+                    if !(0.0..=1.0).contains(&value) {
+                        return Err(at(format!("{key} {value} is not in [0, 1]")));
+                    }
+                    if let Some(m) = materials.last_mut() {
+                        // Tr is transparency: 1 − d.
+                        m.alpha = Some(if key == "d" { value } else { 1.0 - value });
+                    }
                 }
             }
             "illum" if rest.parse::<u8>().is_err() => {
                 return Err(at(format!("illum value '{rest}' is not an illumination model number (0-10)")));
             }
-            "map_Kd" => {
+            "map_Kd" | "map_d" => {
                 // Options such as `-bm 1` come before the file name.
                 let name = if rest.starts_with('-') { rest.split_whitespace().last().unwrap_or("") } else { rest };
                 if name.is_empty() {
-                    return Err(at("map_Kd needs a texture file name".into()));
+                    return Err(at(format!("{key} needs a texture file name")));
                 }
                 let texture = directory.join(name);
                 if !texture.is_file() {
                     return Err(at(format!("texture file '{name}' not found (looked for {})", texture.display())));
                 }
                 if let Some(m) = materials.last_mut() {
-                    m.diffuse_texture = Some(texture);
+                    if key == "map_Kd" {
+                        m.diffuse_texture = Some(texture);
+                    } else {
+                        m.alpha_texture = Some(texture);
+                    }
                 }
             }
             _ => {}
@@ -435,6 +473,42 @@ fn load_texture(path: &Path) -> Result<Texture> {
     let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
     let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?.into_rgba8();
     Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw(), source: Some(path.into()) })
+}
+
+/// An alpha map (MTL `map_d`): its alpha channel when the image has one, else its grey
+/// level, as (width, height, one byte per texel).
+fn load_alpha(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+    let cannot = |e: &dyn std::fmt::Display| Error::in_file(path, format!("cannot decode alpha texture: {e}"));
+    let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
+    let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?;
+    let (width, height) = (image.width(), image.height());
+    let coverage = if image.color().has_alpha() {
+        image.into_rgba8().pixels().map(|p| p.0[3]).collect()
+    } else {
+        image.into_luma8().into_raw()
+    };
+    Ok((width, height, coverage))
+}
+
+/// `diffuse` (or a white texture of the alpha map's size) with its alpha channel replaced
+/// by `coverage` (`width` × `height`), resampled to the diffuse texture's size by nearest
+/// texel when the sizes differ.
+fn with_alpha(diffuse: Option<Texture>, width: u32, height: u32, coverage: &[u8]) -> Texture {
+    let mut texture = diffuse.unwrap_or_else(|| Texture {
+        width,
+        height,
+        rgba8: vec![255; 4 * width as usize * height as usize],
+        source: None,
+    });
+    let (tw, th) = (texture.width as u64, texture.height as u64);
+    for y in 0..th {
+        for x in 0..tw {
+            let (sx, sy) = (x * width as u64 / tw, y * height as u64 / th);
+            let alpha = coverage.get((sy * width as u64 + sx) as usize).copied().unwrap_or(255);
+            texture.rgba8[((y * tw + x) * 4 + 3) as usize] = alpha;
+        }
+    }
+    texture
 }
 
 /// A tobj model as a mesh: positions recentred on their bounds, v flipped, normals

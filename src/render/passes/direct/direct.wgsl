@@ -1,4 +1,4 @@
-// Direct light: the scene's point and directional lights on diffuse surfaces, plus
+// Direct light: the scene's point, spot and directional lights on diffuse surfaces, plus
 // emission, as outgoing radiance. The composite adds the ambient term on top, and
 // SSDO's bounce uses this as the sender radiance L_pixel (Ritschel et al. 2009 eq. 2); the view
 // distance rides along (`pack_direct`) so that the bounce's occluder probe reads
@@ -58,7 +58,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 let to_light = light.pos_or_dir.xyz - position;
                 // Clamp the distance so a light on a surface does not blow up to Inf.
                 let d2 = max(dot(to_light, to_light), 1e-4);
-                irradiance += light.radiance.rgb * max(dot(n, to_light * inverseSqrt(d2)), 0.0) / d2;
+                let l = to_light * inverseSqrt(d2);
+                var falloff = 1.0;
+                if (light.kind.x == 2u) {
+                    // glTF's spot falloff: the square of a ramp in the cosine off the axis.
+                    let ramp = clamp((dot(light.spot_direction.xyz, -l) - light.cone.x) * light.cone.y, 0.0, 1.0);
+                    falloff = ramp * ramp;
+                }
+                irradiance += light.radiance.rgb * falloff * max(dot(n, l), 0.0) / d2;
             }
         }
         let emission = textureLoad(emission_layers, p, i32(layer), 0).rgb;

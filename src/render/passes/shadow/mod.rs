@@ -110,11 +110,11 @@ pub fn rsm_active(scene: &Scene, settings: &Settings) -> bool {
 
 /// Why the light-space pass does not exist for this scene and these settings, if so.
 fn left_out_because(scene: &Scene, settings: &Settings) -> Option<String> {
-    let point_lights = scene.lights.iter().filter(|l| matches!(l, Light::Point { .. })).count();
+    let point_lights = scene.lights.iter().filter(|l| matches!(l, Light::Point { .. } | Light::Spot { .. })).count();
     if shadow_casters(scene).is_empty() {
         return Some(if point_lights > 0 {
             format!(
-                "no directional light casts shadows (the scene's {point_lights} point light(s) have no shadow maps)"
+                "no directional light casts shadows (the scene's {point_lights} point or spot light(s) have no shadow maps)"
             )
         } else {
             "the scene has no directional light: nothing casts shadows".to_string()
@@ -251,7 +251,7 @@ impl LightSpace {
                 Light::Directional { direction, color, intensity } => {
                     LightFit::new(scene, anchor, i, direction.as_dvec3(), color * intensity)
                 }
-                Light::Point { .. } => unreachable!("shadow casters are directional"),
+                Light::Point { .. } | Light::Spot { .. } => unreachable!("shadow casters are directional"),
             })
             .collect();
         let device = &gpu.device;
