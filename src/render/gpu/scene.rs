@@ -12,7 +12,7 @@ use super::kernel::{wgsl, Shader};
 use super::Gpu;
 use crate::render::scene::{Environment, Scene};
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, DVec3, Mat4};
+use glam::{DMat4, DVec3};
 use wgpu::util::DeviceExt;
 
 /// mesh.wgsl: the material bind group, `VertexIn` and the material's albedo, shared by
@@ -314,7 +314,7 @@ fn object_uniform(anchor: DVec3, world_from_local: DMat4, previous_world_from_lo
     ObjectUniform {
         anchored_from_local: now.as_mat4().to_cols_array_2d(),
         previous_anchored_from_local: (anchored * previous_world_from_local).as_mat4().to_cols_array_2d(),
-        normal_from_local: Mat4::from(normal.as_mat4()).to_cols_array_2d(),
+        normal_from_local: normal.as_mat4().to_cols_array_2d(),
     }
 }
 

@@ -39,7 +39,7 @@ fn checker_texture() -> Texture {
     let mut rgba8 = Vec::with_capacity((side * side * 4) as usize);
     for y in 0..side {
         for x in 0..side {
-            let solid = (x / TEXELS_PER_CELL + y / TEXELS_PER_CELL) % 2 == 0;
+            let solid = (x / TEXELS_PER_CELL + y / TEXELS_PER_CELL).is_multiple_of(2);
             rgba8.extend([200, 200, 200, if solid { 255 } else { 0 }]);
         }
     }
