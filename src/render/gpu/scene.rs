@@ -112,7 +112,7 @@ pub struct GpuScene {
     /// transforms): the G-buffer, the light-space pass and the depth peel draw the scene
     /// with it, at group 1.
     pub material_layout: wgpu::BindGroupLayout,
-    /// One [`ObjectUniform`] slot per object, [`OBJECT_STRIDE`] bytes apart; slot 0 is the
+    /// One [`ObjectUniform`] slot per object, 256 bytes apart (`OBJECT_STRIDE`); slot 0 is the
     /// static geometry's identity.
     pub objects: wgpu::Buffer,
     /// The scene node each object slot after 0 follows.

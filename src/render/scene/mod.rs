@@ -341,7 +341,7 @@ impl Scene {
     const SWEEP_SAMPLES: usize = 64;
 
     /// World-space corners of every moving mesh's local bounding box, at
-    /// [`Self::SWEEP_SAMPLES`] times over the animation loop (and at its end): what the
+    /// 64 times over the animation loop (and at its end): what the
     /// bounds and the shadow maps' fits must contain. Empty for a still scene.
     pub fn swept_corners(&self) -> Vec<DVec3> {
         if !self.meshes.iter().any(|m| m.node.is_some()) {
