@@ -152,15 +152,56 @@ pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
         vertices: 0,
     };
     let content = loader.build()?;
+    check_limits(path, &content)?;
     loader.warnings.emit(path);
     Ok(content)
 }
 
+/// Refuses, naming the file, what lies beyond what the renderer can draw (`limits.rs`,
+/// as for OBJ and scene files): static geometry beyond 10⁶ m, emission or lights
+/// brighter than the HDR buffer holds. (Moving meshes are in their node's frame.)
+fn check_limits(path: &Path, content: &Content) -> Result<()> {
+    use super::limits::{coordinate_trouble, mesh_trouble, radiance_trouble};
+    let meshes = content.meshes.iter().filter(|m| m.node.is_none()).find_map(mesh_trouble);
+    let emitters = content
+        .materials
+        .iter()
+        .find_map(|m| radiance_trouble(&format!("material '{}' emission", m.name), m.emissive.max_element() as f64));
+    let lights = content.lights.iter().find_map(|light| {
+        let (colour, intensity, position) = match *light {
+            Light::Directional { color, intensity, .. } => (color, intensity, None),
+            Light::Point { color, intensity, position } | Light::Spot { color, intensity, position, .. } => {
+                (color, intensity, Some(position))
+            }
+        };
+        let far = position.and_then(|p| coordinate_trouble("light position", p.abs().max_element()));
+        far.or_else(|| radiance_trouble("light colour × intensity", (colour * intensity).max_element() as f64))
+    });
+    match meshes.or(emitters).or(lights) {
+        Some(trouble) => Err(Error::in_file(path, trouble)),
+        None => Ok(()),
+    }
+}
+
 /// What the crate's validation leaves out and its accessors would panic on (found by
-/// fuzzing, gltf-json 1.4.1): animation channel targets (node index and path) and a spot
-/// light without its cone.
+/// fuzzing, gltf-json 1.4.1): animation channel targets (node index and path), a spot
+/// light without its cone, and a primitive's POSITION accessor that does not exist (the
+/// crate's own primitive check indexes the accessors with it before checking it).
 fn precheck(root: &json::Root) -> std::result::Result<(), String> {
     use json::validation::Checked;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "an attribute".into(),
+                    };
+                    return Err(format!("mesh {m} primitive {p}: {name} accessor {} does not exist", accessor.value()));
+                }
+            }
+        }
+    }
     for (a, animation) in root.animations.iter().enumerate() {
         for (c, channel) in animation.channels.iter().enumerate() {
             let node = channel.target.node.value();
