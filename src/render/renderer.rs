@@ -515,7 +515,7 @@ impl Renderer {
     }
 
     /// Moves the animated objects to this frame's scene time (from the previous frame's,
-    /// when there is a history of as many views) and finds the spheres around them.
+    /// when there is a history of as many views) and finds the boxes around them.
     fn update_motion(&mut self, layers: u32) {
         if self.mover_bounds.is_empty() {
             return;
