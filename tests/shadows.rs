@@ -233,7 +233,7 @@ fn only_directional_lights_get_a_shadow_pass_and_explain_says_why() {
     println!("{p}");
     assert!(!p.runs("shadow") && !p.runs("rsm"));
     assert!(!p.resources.contains(&SHADOW_MAP));
-    assert!(reason(&p, "shadow").unwrap().contains("point light"), "{p}");
+    assert!(reason(&p, "shadow").unwrap().contains("point or spot light"), "{p}");
     let mut rsm = settings(32, 32);
     rsm.shadows.rsm = true;
     assert!(reason(&plan(&room, &rsm, &[COLOR]), "rsm").unwrap().contains("no directional light"));
