@@ -214,7 +214,7 @@ impl BenchFile {
             return Err(Error::in_file(origin, "holds no bench records"));
         }
         for (i, record) in self.records.iter().enumerate() {
-            if let Err(trouble) = record.check() {
+            if let Err(Problem(trouble)) = record.check() {
                 let message = format!("record {} ({}): {trouble}", i + 1, record.setting());
                 return Err(Error::in_file(origin, message));
             }
@@ -223,20 +223,23 @@ impl BenchFile {
     }
 }
 
+/// What is wrong with a record, for the caller to name the file and the record with.
+struct Problem(String);
+
 impl BenchRecord {
     /// What is wrong with this record, if anything (see [`BenchFile::validate`]).
-    fn check(&self) -> std::result::Result<(), String> {
+    fn check(&self) -> std::result::Result<(), Problem> {
         // Rows of reflective shadow maps carry "rsm" and their VPL count as samples.
         let rsm = self.technique == crate::render::passes::rsm::NAME;
         if !rsm && self.technique.parse::<Technique>().is_err() {
-            return Err(format!("unknown technique '{}'", self.technique));
+            return Err(Problem(format!("unknown technique '{}'", self.technique)));
         }
         let samples_max = if rsm { RSM_SAMPLES_MAX } else { SAMPLES_MAX };
         if !(1..=samples_max).contains(&self.samples) {
-            return Err(format!("samples {} is not within 1..={samples_max}", self.samples));
+            return Err(Problem(format!("samples {} is not within 1..={samples_max}", self.samples)));
         }
         if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
-            return Err(format!("radius {} m is not a positive number", self.radius_m));
+            return Err(Problem(format!("radius {} m is not a positive number", self.radius_m)));
         }
         let times = [
             ("technique_ms_per_eye", self.technique_ms_per_eye),
@@ -251,7 +254,7 @@ impl BenchRecord {
             // A bias may be negative; nothing else a bench writes is.
             let negative_allowed = name == "ao_bias";
             if !value.is_finite() || (!negative_allowed && value < 0.0) {
-                return Err(format!("{name} {value} is not a finite, non-negative number"));
+                return Err(Problem(format!("{name} {value} is not a finite, non-negative number")));
             }
         }
         Ok(())

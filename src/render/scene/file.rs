@@ -307,14 +307,7 @@ fn load_mesh_entry(
             if !file.is_file() {
                 return Err(Failure::Here(format!("mesh gltf '{gltf}' not found (looked for {})", file.display())));
             }
-            let content = super::gltf::load_content(&file, material_offset).map_err(Failure::Elsewhere)?;
-            if !content.lights.is_empty() || content.camera.is_some() {
-                log::warn!(
-                    "{}: its lights and camera are not used when a scene file places it (the scene file gives them)",
-                    file.display()
-                );
-            }
-            (content.meshes, content.materials, content.nodes)
+            placed_gltf(&file, material_offset)?
         }
         (None, None, Some(name)) => {
             let scene = builtin::load(name).map_err(|e| Failure::Here(e.to_string()))?;
@@ -353,6 +346,28 @@ fn load_mesh_entry(
         return Err(Failure::Here(trouble));
     }
     Ok(Placed { meshes, materials, nodes })
+}
+
+/// A glTF's meshes, materials and moving nodes for a `[[mesh]] gltf = …` entry.
+#[cfg(feature = "gltf")]
+fn placed_gltf(
+    file: &Path,
+    material_offset: usize,
+) -> std::result::Result<(Vec<Mesh>, Vec<Material>, Vec<Node>), Failure> {
+    let content = super::gltf::load_content(file, material_offset).map_err(Failure::Elsewhere)?;
+    if !content.lights.is_empty() || content.camera.is_some() {
+        log::warn!(
+            "{}: its lights and camera are not used when a scene file places it (the scene file gives them)",
+            file.display()
+        );
+    }
+    Ok((content.meshes, content.materials, content.nodes))
+}
+
+/// Without the `gltf` feature a scene file cannot place a glTF.
+#[cfg(not(feature = "gltf"))]
+fn placed_gltf(file: &Path, _: usize) -> std::result::Result<(Vec<Mesh>, Vec<Material>, Vec<Node>), Failure> {
+    Err(Failure::Elsewhere(super::gltf_not_built(file)))
 }
 
 /// The tracks of a `[mesh.animation]`: one per property the keys give (every key must give

@@ -12,6 +12,7 @@ pub mod environment;
 pub mod file;
 pub mod furnished;
 pub mod fuzz;
+#[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod limits;
 pub mod normals;
@@ -459,7 +460,10 @@ impl Scene {
         match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
             Some(ext) if ext == "toml" => file::load(path),
             Some(ext) if ext == "obj" => obj::load_bare(path),
+            #[cfg(feature = "gltf")]
             Some(ext) if ext == "gltf" || ext == "glb" => gltf::load(path),
+            #[cfg(not(feature = "gltf"))]
+            Some(ext) if ext == "gltf" || ext == "glb" => Err(gltf_not_built(path)),
             _ => Err(Error::in_file(
                 path,
                 "unknown scene type: expected builtin:NAME, a .toml scene file, an .obj, a .gltf or a .glb",
@@ -493,6 +497,12 @@ fn bake(mesh: &Mesh, world: &DMat4) -> Mesh {
         material: mesh.material,
         node: None,
     }
+}
+
+/// The refusal of a glTF by a vrao built without the `gltf` feature.
+#[cfg(not(feature = "gltf"))]
+pub(crate) fn gltf_not_built(path: &Path) -> Error {
+    Error::in_file(path, "glTF needs vrao built with the `gltf` feature (on by default)")
 }
 
 /// The scene `vrao render` draws when none is named: the furnished room, whose table and

@@ -134,7 +134,7 @@ pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
     if root.nodes.len() > MAX_NODES {
         return Err(Error::in_file(path, format!("{} nodes, more than vrao's limit of {MAX_NODES}", root.nodes.len())));
     }
-    precheck(&root).map_err(|m| Error::in_file(path, m))?;
+    precheck(&root).map_err(|Problem(m)| Error::in_file(path, m))?;
     let document = ::gltf::Document::from_json(root).map_err(|e| Error::in_file(path, first_line(&e.to_string())))?;
 
     let buffers = load_buffers(path, &document, bin)?;
@@ -183,11 +183,20 @@ fn check_limits(path: &Path, content: &Content) -> Result<()> {
     }
 }
 
+/// What is wrong with a file, for the caller to name the file (and element) with.
+struct Problem(String);
+
+impl From<String> for Problem {
+    fn from(message: String) -> Problem {
+        Problem(message)
+    }
+}
+
 /// What the crate's validation leaves out and its accessors would panic on (found by
 /// fuzzing, gltf-json 1.4.1): animation channel targets (node index and path), a spot
 /// light without its cone, and a primitive's POSITION accessor that does not exist (the
 /// crate's own primitive check indexes the accessors with it before checking it).
-fn precheck(root: &json::Root) -> std::result::Result<(), String> {
+fn precheck(root: &json::Root) -> std::result::Result<(), Problem> {
     use json::validation::Checked;
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
@@ -197,7 +206,10 @@ fn precheck(root: &json::Root) -> std::result::Result<(), String> {
                         Checked::Valid(s) => s.to_string(),
                         Checked::Invalid => "an attribute".into(),
                     };
-                    return Err(format!("mesh {m} primitive {p}: {name} accessor {} does not exist", accessor.value()));
+                    return Err(Problem(format!(
+                        "mesh {m} primitive {p}: {name} accessor {} does not exist",
+                        accessor.value()
+                    )));
                 }
             }
         }
@@ -206,13 +218,15 @@ fn precheck(root: &json::Root) -> std::result::Result<(), String> {
         for (c, channel) in animation.channels.iter().enumerate() {
             let node = channel.target.node.value();
             if node >= root.nodes.len() {
-                return Err(format!("animation {a} channel {c}: target node {node} does not exist"));
+                return Err(Problem(format!("animation {a} channel {c}: target node {node} does not exist")));
             }
             if !matches!(channel.target.path, Checked::Valid(_)) {
-                return Err(format!("animation {a} channel {c}: target path is not one of the glTF properties"));
+                return Err(Problem(format!(
+                    "animation {a} channel {c}: target path is not one of the glTF properties"
+                )));
             }
             if channel.sampler.value() >= animation.samplers.len() {
-                return Err(format!("animation {a} channel {c}: sampler does not exist"));
+                return Err(Problem(format!("animation {a} channel {c}: sampler does not exist")));
             }
         }
     }
@@ -220,7 +234,7 @@ fn precheck(root: &json::Root) -> std::result::Result<(), String> {
     for (i, light) in lights.map_or(&[][..], |l| &l.lights[..]).iter().enumerate() {
         use json::extensions::scene::khr_lights_punctual::Type;
         if matches!(light.type_, Checked::Valid(Type::Spot)) && light.spot.is_none() {
-            return Err(format!("light {i}: a spot light needs its \"spot\" cone angles"));
+            return Err(Problem(format!("light {i}: a spot light needs its \"spot\" cone angles")));
         }
     }
     Ok(())
@@ -850,7 +864,7 @@ impl Loader<'_> {
                 resolve_uri(self.path, uri).map_err(|m| self.error(format!("{what}: {m}")))?
             }
         };
-        let texture = decode_image(&bytes).map_err(|m| self.error(format!("{what}: {m}")))?;
+        let texture = decode_image(&bytes).map_err(|Problem(m)| self.error(format!("{what}: {m}")))?;
         self.images.insert(index, texture.clone());
         Ok(texture)
     }
@@ -1012,13 +1026,13 @@ fn component(b: &[u8], data_type: DataType, normalized: bool) -> f32 {
 }
 
 /// Decodes an image to RGBA8, refusing sides over [`MAX_TEXTURE_SIDE`] before decoding.
-fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, String> {
+fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, Problem> {
     let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| format!("cannot decode: {e}"))?;
     let (width, height) = reader.into_dimensions().map_err(|e| format!("cannot decode: {e}"))?;
     if width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE || width == 0 || height == 0 {
-        return Err(format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}"));
+        return Err(Problem(format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}")));
     }
     let image = image::load_from_memory(bytes).map_err(|e| format!("cannot decode: {e}"))?.into_rgba8();
     Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw(), source: None })
