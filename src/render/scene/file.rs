@@ -307,7 +307,8 @@ fn load_mesh_entry(
             if !file.is_file() {
                 return Err(Failure::Here(format!("mesh gltf '{gltf}' not found (looked for {})", file.display())));
             }
-            placed_gltf(&file, material_offset)?
+            let placed = placed_gltf(&file, material_offset)?;
+            (placed.meshes, placed.materials, placed.nodes)
         }
         (None, None, Some(name)) => {
             let scene = builtin::load(name).map_err(|e| Failure::Here(e.to_string()))?;
@@ -350,10 +351,7 @@ fn load_mesh_entry(
 
 /// A glTF's meshes, materials and moving nodes for a `[[mesh]] gltf = …` entry.
 #[cfg(feature = "gltf")]
-fn placed_gltf(
-    file: &Path,
-    material_offset: usize,
-) -> std::result::Result<(Vec<Mesh>, Vec<Material>, Vec<Node>), Failure> {
+fn placed_gltf(file: &Path, material_offset: usize) -> std::result::Result<Placed, Failure> {
     let content = super::gltf::load_content(file, material_offset).map_err(Failure::Elsewhere)?;
     if !content.lights.is_empty() || content.camera.is_some() {
         log::warn!(
@@ -361,12 +359,12 @@ fn placed_gltf(
             file.display()
         );
     }
-    Ok((content.meshes, content.materials, content.nodes))
+    Ok(Placed { meshes: content.meshes, materials: content.materials, nodes: content.nodes })
 }
 
 /// Without the `gltf` feature a scene file cannot place a glTF.
 #[cfg(not(feature = "gltf"))]
-fn placed_gltf(file: &Path, _: usize) -> std::result::Result<(Vec<Mesh>, Vec<Material>, Vec<Node>), Failure> {
+fn placed_gltf(file: &Path, _: usize) -> std::result::Result<Placed, Failure> {
     Err(Failure::Elsewhere(super::gltf_not_built(file)))
 }
 
