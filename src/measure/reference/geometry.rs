@@ -320,42 +320,38 @@ fn srgb_to_linear(byte: u8) -> f32 {
     })[byte as usize]
 }
 
-/// Bilinear lookup of an sRGB texture (decoded to linear before filtering, as an sRGB
-/// texture format does), repeating in u and clamping in v; v = 0 is the top row
-/// ([`crate::render::scene::Mesh::uvs`]).
-pub(crate) fn sample_texture(texture: &Texture, uv: Vec2) -> Vec3 {
+/// Bilinear filtering of `texture` at `uv`, repeating in u and clamping in v; v = 0 is the
+/// top row ([`crate::render::scene::Mesh::uvs`]). `texel` reads the texel at a byte offset
+/// into `rgba8`; `lerp` blends two of them.
+fn bilinear<T: Copy>(texture: &Texture, uv: Vec2, texel: impl Fn(usize) -> T, lerp: impl Fn(T, T, f32) -> T) -> T {
     let (w, h) = (texture.width as i64, texture.height as i64);
     let uv = if uv.is_finite() { uv } else { Vec2::ZERO };
     let x = uv.x as f64 * w as f64 - 0.5;
     let y = (uv.y as f64 * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let texel = |x: i64, y: i64| {
-        let i = 4 * (y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize;
+    let at = |x: i64, y: i64| texel(4 * (y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let top = lerp(at(x0, y0), at(x0 + 1, y0), fx);
+    let bottom = lerp(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
+    lerp(top, bottom, fy)
+}
+
+/// Bilinear lookup of an sRGB texture (decoded to linear before filtering, as an sRGB
+/// texture format does), addressed as [`bilinear`] says.
+pub(crate) fn sample_texture(texture: &Texture, uv: Vec2) -> Vec3 {
+    let texel = |i: usize| {
         let b = &texture.rgba8[i..i + 3];
         Vec3::new(srgb_to_linear(b[0]), srgb_to_linear(b[1]), srgb_to_linear(b[2]))
     };
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let top = texel(x0, y0).lerp(texel(x0 + 1, y0), fx);
-    let bottom = texel(x0, y0 + 1).lerp(texel(x0 + 1, y0 + 1), fx);
-    top.lerp(bottom, fy)
+    bilinear(texture, uv, texel, Vec3::lerp)
 }
 
-/// Bilinear lookup of a texture's alpha (linear bytes, as the GPU filters them), with
-/// the addressing of [`sample_texture`].
+/// Bilinear lookup of a texture's alpha (linear bytes, as the GPU filters them),
+/// addressed as [`bilinear`] says.
 pub(crate) fn sample_alpha(texture: &Texture, uv: Vec2) -> f32 {
-    let (w, h) = (texture.width as i64, texture.height as i64);
-    let uv = if uv.is_finite() { uv } else { Vec2::ZERO };
-    let x = uv.x as f64 * w as f64 - 0.5;
-    let y = (uv.y as f64 * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let texel =
-        |x: i64, y: i64| texture.rgba8[4 * (y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize + 3] as f32 / 255.0;
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let top = texel(x0, y0) + (texel(x0 + 1, y0) - texel(x0, y0)) * fx;
-    let bottom = texel(x0, y0 + 1) + (texel(x0 + 1, y0 + 1) - texel(x0, y0 + 1)) * fx;
-    top + (bottom - top) * fy
+    let texel = |i: usize| texture.rgba8[i + 3] as f32 / 255.0;
+    bilinear(texture, uv, texel, |a, b, t| a + (b - a) * t)
 }
 
 #[cfg(test)]

@@ -213,10 +213,13 @@ impl GpuScene {
             contents: bytemuck::cast_slice(&indices),
             usage: wgpu::BufferUsages::INDEX,
         });
+        // Each material's alpha-test cutoff, found once (it scans the texture's alpha).
+        let cutoffs: Vec<Option<f32>> = scene.materials.iter().map(|m| m.alpha_cutoff()).collect();
         let materials: Vec<GpuMaterial> = scene
             .materials
             .iter()
-            .map(|m| {
+            .zip(&cutoffs)
+            .map(|(m, cutoff)| {
                 let (texture, has_texture) = match &m.diffuse_texture {
                     Some(t) => (rgba8_texture(gpu, &m.name, t.width, t.height, &t.rgba8), true),
                     None => (rgba8_texture(gpu, "white", 1, 1, &[255; 4]), false),
@@ -224,7 +227,7 @@ impl GpuScene {
                 let uniform = MaterialUniform {
                     diffuse: [m.diffuse.x, m.diffuse.y, m.diffuse.z, if has_texture { 1.0 } else { 0.0 }],
                     emission: [m.emissive.x, m.emissive.y, m.emissive.z, 0.0],
-                    alpha: [m.alpha, m.alpha_cutoff().unwrap_or(-1.0), 0.0, 0.0],
+                    alpha: [m.alpha, cutoff.unwrap_or(-1.0), 0.0, 0.0],
                 };
                 GpuMaterial {
                     uniform: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -262,7 +265,6 @@ impl GpuScene {
             contents: &slots,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        let alpha_cutoffs: Vec<bool> = scene.materials.iter().map(|m| m.alpha_cutoff().is_some()).collect();
         let draws = runs
             .into_iter()
             .map(|(range, material, object)| {
@@ -284,7 +286,7 @@ impl GpuScene {
                         },
                     ],
                 });
-                Draw { indices: range, material, object, alpha_tested: alpha_cutoffs[material], group }
+                Draw { indices: range, material, object, alpha_tested: cutoffs[material].is_some(), group }
             })
             .collect::<Vec<_>>();
         let alpha_tested = draws.iter().any(|d| d.alpha_tested);
