@@ -142,6 +142,25 @@ impl GpuScene {
         }
     }
 
+    /// Draws every mesh with `solid`, or, when the pass has an `alpha_tested` pipeline,
+    /// the solid materials first (early depth test) and the alpha-tested ones with it.
+    pub fn draw_with(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        solid: &wgpu::RenderPipeline,
+        alpha_tested: Option<&wgpu::RenderPipeline>,
+    ) {
+        pass.set_pipeline(solid);
+        match alpha_tested {
+            Some(alpha_tested) => {
+                self.draw(pass, DrawSet::Solid);
+                pass.set_pipeline(alpha_tested);
+                self.draw(pass, DrawSet::AlphaTested);
+            }
+            None => self.draw(pass, DrawSet::All),
+        }
+    }
+
     /// Whether some object moves (the scene has animated meshes).
     pub fn has_moving_objects(&self) -> bool {
         !self.object_nodes.is_empty()

@@ -9,7 +9,7 @@ use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
-use crate::render::gpu::scene::{DrawSet, GpuScene, MESH_WGSL};
+use crate::render::gpu::scene::{GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size, PIXEL_MOTION};
 use bytemuck::{Pod, Zeroable};
@@ -57,15 +57,7 @@ struct Pipelines {
 impl Pipelines {
     /// Draws the scene: solid materials first (early depth test), then the alpha-tested.
     fn draw(&self, pass: &mut wgpu::RenderPass, scene: &GpuScene) {
-        pass.set_pipeline(&self.solid);
-        match &self.alpha_tested {
-            Some(alpha_tested) => {
-                scene.draw(pass, DrawSet::Solid);
-                pass.set_pipeline(alpha_tested);
-                scene.draw(pass, DrawSet::AlphaTested);
-            }
-            None => scene.draw(pass, DrawSet::All),
-        }
+        scene.draw_with(pass, &self.solid, self.alpha_tested.as_ref());
     }
 }
 

@@ -11,7 +11,7 @@ use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::frame::FrameBuffers;
 use crate::render::gpu::kernel::{shader_module, wgsl, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
-use crate::render::gpu::scene::{DrawSet, GpuScene, MESH_WGSL};
+use crate::render::gpu::scene::{GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::passes::gbuffer::DEPTH;
@@ -151,17 +151,9 @@ impl Pass for DepthPeelPass {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.frame_group, &[]);
                 pass.set_bind_group(2, &eye_group, &[]);
-                match &self.alpha_tested {
-                    Some(alpha_tested) => {
-                        gpu_scene.draw(&mut pass, DrawSet::Solid);
-                        pass.set_pipeline(alpha_tested);
-                        gpu_scene.draw(&mut pass, DrawSet::AlphaTested);
-                    }
-                    None => gpu_scene.draw(&mut pass, DrawSet::All),
-                }
+                gpu_scene.draw_with(&mut pass, &self.pipeline, self.alpha_tested.as_ref());
             }
             ctx.timer.end(ctx.encoder, span);
         }

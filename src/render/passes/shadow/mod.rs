@@ -20,7 +20,7 @@
 use super::{FrameContext, FrameSetup, Pass};
 use crate::render::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::render::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
-use crate::render::gpu::scene::{DrawSet, GpuScene, MESH_WGSL};
+use crate::render::gpu::scene::{GpuScene, MESH_WGSL};
 use crate::render::gpu::Gpu;
 use crate::render::graph::{PassDecl, Resource, Size};
 use crate::render::scene::{Light, Scene};
@@ -440,15 +440,8 @@ impl Pass for ShadowPass {
             });
             let [solid, alpha_tested] = if reflective { &self.reflective } else { &self.depth_only };
             pass.set_bind_group(0, group, &[]);
-            pass.set_pipeline(solid.as_ref().expect("the solid pipelines always exist"));
-            match alpha_tested {
-                Some(alpha_tested) => {
-                    gpu_scene.draw(&mut pass, DrawSet::Solid);
-                    pass.set_pipeline(alpha_tested);
-                    gpu_scene.draw(&mut pass, DrawSet::AlphaTested);
-                }
-                None => gpu_scene.draw(&mut pass, DrawSet::All),
-            }
+            let solid = solid.as_ref().expect("the solid pipelines always exist");
+            gpu_scene.draw_with(&mut pass, solid, alpha_tested.as_ref());
         }
     }
 }
