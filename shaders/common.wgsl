@@ -106,6 +106,12 @@ struct AoParams {
     blur_plane_sigma: f32,
     // Sample-length scale this frame (temporal range jitter; 1 otherwise).
     range_scale: f32,
+    // Fixed foveation (settings::FoveationMap): the tangents of the angles off the view
+    // axis where the sample count starts to fall and where it reaches `foveation_edge_rate`
+    // of the full count (occlusion.wgsl `foveated_count`).
+    foveation_full_rate_tan: f32,
+    foveation_edge_tan: f32,
+    foveation_edge_rate: f32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left

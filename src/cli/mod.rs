@@ -13,8 +13,8 @@ use clap::Args;
 use glam::DVec3;
 use vrao::render::passes::shadow::suggested_rsm_radius;
 use vrao::render::settings::{
-    AoSettings, BounceForm, Denoise, GtaoSettings, Noise, Quality, ShadowSettings, Technique, Temporal, TemporalBlend,
-    AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL,
+    AoSettings, BounceForm, Denoise, Foveation, GtaoSettings, Noise, Quality, ShadowSettings, Technique, Temporal,
+    TemporalBlend, AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL,
 };
 use vrao::{HeadsetProfile, Scene, Settings};
 
@@ -133,6 +133,10 @@ pub struct AoArgs {
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
+    /// Fixed foveated occlusion: off, low (half the samples from 40° off each eye's view
+    /// axis) or high (a third of them from 30°); full rate near the axis either way.
+    #[arg(long, value_enum, default_value_t = AoSettings::default().foveation, hide_possible_values = true)]
+    foveation: Foveation,
     /// SSDO quality mode (Ritschel et al. 2009 §4): peel a second depth layer per eye; a
     /// sample then occludes only inside an object (between the layers), which removes the
     /// halos of thin objects in front of a background. Assumes closed geometry.
@@ -231,6 +235,7 @@ impl AoArgs {
             },
             gtao: self.gtao.gtao.clone(),
             stereo_reuse: !self.gtao.independent_eyes,
+            foveation: self.foveation,
         }
     }
 }

@@ -262,6 +262,77 @@ impl Denoise {
     }
 }
 
+/// Fixed foveated occlusion: every eye's AO at its full sample count near the eye's
+/// view axis and fewer samples towards the image's edges, where the flat projection
+/// spends more pixels per degree than at the centre, the lens squeezes them together
+/// and the eye, looking ahead through the lens, resolves less. The map is in degrees
+/// off each eye's own view axis, so it follows every headset profile's and every
+/// runtime's asymmetric field of view (its centre lies towards the nose, where the
+/// axis meets the image).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
+pub enum Foveation {
+    /// Every pixel at the full sample count.
+    #[default]
+    Off,
+    /// Full rate within 25° of the axis, down to half the samples at 40° and beyond.
+    Low,
+    /// Full rate within 15° of the axis, down to a third of the samples at 30° and beyond.
+    High,
+}
+
+/// Where a [`Foveation`] level lowers the sample count: the full count within
+/// `full_rate_deg` of an eye's view axis, then falling linearly in the tangent of the
+/// angle to `edge_rate` of it at `edge_deg` and beyond. Pixels take whole counts: one
+/// between two counts takes the higher one with the probability of its fraction (a 4×4
+/// ordered dither the denoise averages), so the map has no seam.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FoveationMap {
+    /// Angle off the view axis within which every pixel spends its full count (degrees).
+    pub full_rate_deg: f32,
+    /// Angle from which on pixels spend `edge_rate` of it (degrees).
+    pub edge_deg: f32,
+    /// The share of the full count spent at and beyond `edge_deg`, in (0, 1].
+    pub edge_rate: f32,
+}
+
+impl Foveation {
+    /// Every level, off first.
+    pub const ALL: [Foveation; 3] = [Foveation::Off, Foveation::Low, Foveation::High];
+
+    /// The level's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Foveation::Off => "off",
+            Foveation::Low => "low",
+            Foveation::High => "high",
+        }
+    }
+
+    /// The level's map (every level's numbers live here).
+    pub fn map(self) -> FoveationMap {
+        match self {
+            Foveation::Off => FoveationMap { full_rate_deg: 90.0, edge_deg: 90.0, edge_rate: 1.0 },
+            Foveation::Low => FoveationMap { full_rate_deg: 25.0, edge_deg: 40.0, edge_rate: 0.5 },
+            Foveation::High => FoveationMap { full_rate_deg: 15.0, edge_deg: 30.0, edge_rate: 1.0 / 3.0 },
+        }
+    }
+}
+
+impl FoveationMap {
+    /// The share of the full sample count a pixel `angle_deg` off its eye's view axis
+    /// spends (what the occlusion shaders' `foveation_rate` computes).
+    pub fn rate(&self, angle_deg: f32) -> f32 {
+        if self.edge_rate >= 1.0 || angle_deg <= self.full_rate_deg {
+            return 1.0;
+        }
+        let (inner, outer) = (self.full_rate_deg.to_radians().tan(), self.edge_deg.to_radians().tan());
+        let tan = angle_deg.min(89.0).to_radians().tan();
+        let t = ((tan - inner) / (outer - inner).max(1e-6)).clamp(0.0, 1.0);
+        1.0 + (self.edge_rate - 1.0) * t
+    }
+}
+
 /// Occlusion parameters shared by every technique.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AoSettings {
@@ -308,6 +379,8 @@ pub struct AoSettings {
     /// pass) and the AO-only techniques' upsample (`passes::upsample::reuses_left_eye_upsample`).
     /// Off: each eye computes everything alone.
     pub stereo_reuse: bool,
+    /// Fixed foveated occlusion: fewer samples towards each eye's image edges.
+    pub foveation: Foveation,
 }
 
 /// How the temporal pass blends the new frame into the history.
@@ -389,6 +462,7 @@ impl Default for AoSettings {
             temporal: Temporal::default(),
             gtao: GtaoSettings::default(),
             stereo_reuse: true,
+            foveation: Foveation::Off,
         }
     }
 }

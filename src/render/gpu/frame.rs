@@ -106,8 +106,15 @@ pub struct AoParamsUniform {
     pub blur_plane_sigma: f32,
     /// Scale of the sample lengths this frame (HBAO's temporal range jitter; 1 otherwise).
     pub range_scale: f32,
-    /// The WGSL struct's size is a multiple of its 8-byte alignment (`ao_size`).
-    pub padding: u32,
+    /// Fixed foveation (`settings::FoveationMap`): the tangent of the angle off the view
+    /// axis where the sample count starts to fall.
+    pub foveation_full_rate_tan: f32,
+    /// The tangent of the angle from which on pixels spend `foveation_edge_rate`.
+    pub foveation_edge_tan: f32,
+    /// The share of the full count spent at the edges (1: foveation off).
+    pub foveation_edge_rate: f32,
+    /// The WGSL struct's size is a multiple of 16 bytes.
+    pub padding: [u32; 3],
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).
@@ -213,6 +220,7 @@ impl FrameBuffers {
             matches!(ao.technique, Technique::Ssao | Technique::Ssdo | Technique::SsdoBounce | Technique::FetchOnly);
         let turns = ao.temporal.enabled && !hemisphere;
         let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
+        let foveation = ao.foveation.map();
         let params = AoParamsUniform {
             ao_size: [width, height],
             scale: if ao.half_res { 2 } else { 1 },
@@ -239,7 +247,10 @@ impl FrameBuffers {
             blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
             blur_plane_sigma: ao.blur_plane_sigma,
             range_scale: if turns { temporal_range_scale(frame_index) } else { 1.0 },
-            padding: 0,
+            foveation_full_rate_tan: foveation.full_rate_deg.to_radians().tan(),
+            foveation_edge_tan: foveation.edge_deg.to_radians().tan(),
+            foveation_edge_rate: foveation.edge_rate,
+            padding: [0; 3],
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
         queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));

@@ -186,16 +186,6 @@ fn visible_sectors(march: March, offset: f32) -> f32 {
     return clear - rounded_gap + (b - a) * SECTORS;
 }
 
-// 4×4 interleaved noise: a Bayer order (every 2×2 and 4×4 block holds evenly spread
-// values), so the 4×4 denoise window sees each of the 16 patterns once.
-fn bayer4(p: vec2<u32>) -> f32 {
-    let x = p.x & 3u;
-    let y = p.y & 3u;
-    let v = x ^ y;
-    let index = ((v & 1u) << 3u) | ((y & 1u) << 2u) | (v & 2u) | ((y & 2u) >> 1u);
-    return (f32(index) + 0.5) / 16.0;
-}
-
 // One slice's march so far: its occluded sectors, the previous sample of the current
 // half (its sector coordinate, −1 when none, and its distance) for `connect`, and the
 // ends of the occluded intervals nearest V on each half (`near_plus` the least u
@@ -318,8 +308,11 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     limits.connect = gtao.connect * radius;
     let size = vec2<f32>(frame.size);
     let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
-    let slices = max(gtao.slices, 1u);
-    let steps = max(gtao.steps, 1u);
+    // Fewer slices, then steps, towards the image's edges with fixed foveation
+    // (occlusion.wgsl).
+    let counts = foveated_march(max(gtao.slices, 1u), max(gtao.steps, 1u), foveation_rate(p), id.xy);
+    let slices = counts.x;
+    let steps = counts.y;
     // Whether any step can leave the image through the inner border, the only one the
     // other eye sees past (steps are at least a pixel apart, so the march reaches at most
     // max(march_px, steps) pixels out).

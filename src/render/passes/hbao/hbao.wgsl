@@ -18,8 +18,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // The radius R in pixels at this depth (tangent span per pixel × distance).
     let metres_per_pixel = (r.eye.tangents.y - r.eye.tangents.x) / f32(frame.size.x) * -r.position.z;
     let radius_px = ao.radius / max(metres_per_pixel, 1e-30);
-    let steps = max(ao.steps, 1u);
-    let directions = max(ao.directions, 1u);
+    // Fewer directions, then steps, towards the image's edges with fixed foveation
+    // (occlusion.wgsl).
+    let counts = foveated_march(max(ao.directions, 1u), max(ao.steps, 1u), foveation_rate(r.position), id.xy);
+    let directions = counts.x;
+    let steps = counts.y;
     // Never further than the image's diagonal.
     let march_px = min(radius_px * ao.range_scale, f32(frame.size.x + frame.size.y));
     let rotation = kernel_rotation(stereo_noise_pixel(r.pixel, frame.size, r.layer, r.eye, r.position), ao.noise) + ao.frame_angle;

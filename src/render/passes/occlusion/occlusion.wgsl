@@ -259,3 +259,54 @@ fn surface_at(q: vec2<f32>, layer: u32, eye: Eye, guess: f32) -> vec4<f32> {
     let surface = load_view_position(d, p, other, frame.size, frame.near);
     return vec4<f32>((other.other_from_view * vec4<f32>(surface, 1.0)).xyz, 1.0);
 }
+
+// 4×4 interleaved noise: a Bayer order (every 2×2 and 4×4 block holds evenly spread
+// values), so the 4×4 denoise window sees each of the 16 values once.
+fn bayer4(p: vec2<u32>) -> f32 {
+    let x = p.x & 3u;
+    let y = p.y & 3u;
+    let v = x ^ y;
+    let index = ((v & 1u) << 3u) | ((y & 1u) << 2u) | (v & 2u) | ((y & 2u) >> 1u);
+    return (f32(index) + 0.5) / 16.0;
+}
+
+// Fixed foveation (settings::Foveation): the share of its full sample count the receiver
+// at view-space `position` spends, from the tangent of its angle off the eye's view axis
+// (1 within `foveation_full_rate_tan`, falling linearly in the tangent to
+// `foveation_edge_rate` at `foveation_edge_tan`). Off, the rate is 1 everywhere.
+fn foveation_rate(position: vec3<f32>) -> f32 {
+    if (ao.foveation_edge_rate >= 1.0) {
+        return 1.0;
+    }
+    let tan_off_axis = length(position.xy) / max(-position.z, 1e-30);
+    let span = max(ao.foveation_edge_tan - ao.foveation_full_rate_tan, 1e-6);
+    let t = clamp((tan_off_axis - ao.foveation_full_rate_tan) / span, 0.0, 1.0);
+    return mix(1.0, ao.foveation_edge_rate, t);
+}
+
+// `full` samples (or steps, or slices) scaled by `rate` (a foveation rate), as a whole
+// count of at least 1: a fractional count rounds up with the probability of its
+// fraction, from a 4×4 ordered dither over occlusion pixel `p` (its own order,
+// decorrelated from the techniques' rotations), so the denoise averages the rate itself
+// and the map shows no step where the count changes.
+fn foveated_count(full: u32, rate: f32, p: vec2<u32>) -> u32 {
+    if (rate >= 1.0) {
+        return full;
+    }
+    let dither = fract(bayer4(p) * 13.0 + 0.40625);
+    return clamp(u32(floor(f32(full) * rate + dither)), 1u, full);
+}
+
+// A marching technique's slices (directions) and steps per slice under foveation `rate`:
+// slices go first, down to one, then steps. A pixel's slice directions turn with the
+// noise tile, so dropping slices leaves the estimate unbiased (the denoise averages the
+// directions of its window); fewer steps along a slice step over thin occluders and
+// lighten it.
+fn foveated_march(slices: u32, steps: u32, rate: f32, p: vec2<u32>) -> vec2<u32> {
+    if (rate >= 1.0) {
+        return vec2<u32>(slices, steps);
+    }
+    let kept_slices = foveated_count(slices, max(rate, 1.0 / f32(slices)), p);
+    let step_rate = rate * f32(slices) / f32(kept_slices);
+    return vec2<u32>(kept_slices, foveated_count(steps, step_rate, p));
+}

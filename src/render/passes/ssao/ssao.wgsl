@@ -14,8 +14,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let frame_rot = tangent_frame(r.normal, kernel_rotation(stereo_noise_pixel(r.pixel, frame.size, r.layer, r.eye, r.position), ao.noise) + ao.frame_angle);
     let bias = ao.bias * ao.radius;
     let origin = r.position + r.normal * bias;
+    // Fewer samples towards the image's edges with fixed foveation (occlusion.wgsl): a
+    // prefix of the low-discrepancy kernel.
+    let samples = foveated_count(max(ao.samples, 1u), foveation_rate(r.position), id.xy);
     var occlusion = 0.0;
-    for (var i = 0u; i < ao.samples; i++) {
+    for (var i = 0u; i < samples; i++) {
         let k = kernel[i];
         let s = origin + frame_rot * k.xyz * (k.w * ao.range_scale * ao.radius);
         let probe = probe_depth(depth_layers, r.layer, s, r.eye);
@@ -29,7 +32,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             occlusion += weight;
         }
     }
-    let visibility = 1.0 - occlusion / f32(max(ao.samples, 1u));
+    let visibility = 1.0 - occlusion / f32(samples);
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
     textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(0.0, 0.0, 0.0, result));
 }
