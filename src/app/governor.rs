@@ -26,7 +26,7 @@
 
 use crate::render::bench_file::{BenchFile, BenchRecord};
 use crate::render::error::{Error, Result};
-use crate::render::settings::{AoSettings, Technique};
+use crate::render::settings::{AoSettings, Foveation, Technique};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::path::Path;
@@ -51,6 +51,8 @@ pub struct Level {
     pub half_res: bool,
     /// Temporal accumulation on.
     pub temporal: bool,
+    /// Fixed foveation (a bench swept with `--foveation` offers foveated levels).
+    pub foveation: Foveation,
     /// AO RMSE against the reference.
     pub ao_rmse: f64,
     /// Occlusion cost per eye on the bench's device.
@@ -58,14 +60,15 @@ pub struct Level {
 }
 
 impl Level {
-    /// `ao` with this level's technique, samples, resolution and temporal accumulation;
-    /// everything else (radius, strength, …) is kept.
+    /// `ao` with this level's technique, samples, resolution, temporal accumulation and
+    /// foveation; everything else (radius, strength, …) is kept.
     pub fn apply(&self, ao: &AoSettings) -> AoSettings {
         let mut out = ao.clone();
         out.technique = self.technique;
         out.samples = self.samples;
         out.half_res = self.half_res;
         out.temporal.enabled = self.temporal;
+        out.foveation = self.foveation;
         out
     }
 }
@@ -124,6 +127,7 @@ impl Frontier {
                 samples: r.samples,
                 half_res: r.resolution.is_half(),
                 temporal: r.temporal,
+                foveation: r.foveation,
                 ao_rmse: rmse,
                 ms_per_eye: ms,
             });

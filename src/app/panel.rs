@@ -4,7 +4,7 @@
 
 use super::governor::Governor;
 use super::{BufferView, PassHistory};
-use crate::render::settings::{BounceForm, DisplayMode, Quality, Settings, Technique};
+use crate::render::settings::{BounceForm, DisplayMode, Foveation, Quality, Settings, Technique};
 use crate::xr::FrameCounters;
 
 /// Width of the egui side panel in points.
@@ -103,6 +103,11 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
             ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
             ui.checkbox(&mut ao.half_res, "half resolution");
             ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
+            egui::ComboBox::from_label("foveation").selected_text(ao.foveation.name()).show_ui(ui, |ui| {
+                for level in Foveation::ALL {
+                    ui.selectable_value(&mut ao.foveation, level, level.name());
+                }
+            });
         });
         ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
         let mut patch = ao.bounce_form == BounceForm::Patch;

@@ -9,7 +9,7 @@ use vrao::measure::reference::default_cache_dir;
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::RENDER_DEFAULT;
-use vrao::render::settings::{AoSettings, BounceForm, Denoise, Quality, Technique};
+use vrao::render::settings::{AoSettings, BounceForm, Denoise, Foveation, Quality, Technique};
 use vrao::{BackendChoice, HeadsetProfile, Result, Scene, Settings};
 
 /// A sweep over a switch: off, on or both.
@@ -63,6 +63,10 @@ pub struct BenchArgs {
     /// converged value after warm-up + frames with a static head).
     #[arg(long, default_value = "off", hide_possible_values = true)]
     temporal: Sweep,
+    /// Fixed foveation levels to sweep, comma-separated: off, low, high (each row also
+    /// gets its RMSE within 10° of each eye's view axis, where foveation keeps full rate).
+    #[arg(long, value_delimiter = ',', value_enum, default_values_t = [Foveation::Off], hide_possible_values = true)]
+    foveation: Vec<Foveation>,
     /// Also measure reflective shadow maps (one bounce of the directional lights) with
     /// these VPL counts (each 1..=1024), comma-separated, gathering within each radius: rows "rsm", whose
     /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
@@ -158,6 +162,7 @@ pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
                 },
                 depth_peeling: args.depth_peeling.values(),
                 temporal: args.temporal.values(),
+                foveation: args.foveation.clone(),
                 rsm_samples: args.rsm_samples.clone(),
                 timing: args.timing,
                 warmup: args.warmup,

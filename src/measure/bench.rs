@@ -20,7 +20,7 @@ use crate::render::passes::rsm::{self, RSM_INDIRECT};
 use crate::render::passes::shadow;
 use crate::render::renderer::{Renderer, Timing};
 use crate::render::scene::Scene;
-use crate::render::settings::{Settings, Technique};
+use crate::render::settings::{Foveation, Settings, Technique};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -53,6 +53,8 @@ pub struct BenchCase {
     /// Temporal accumulation (its pass counts as occlusion cost; the error is taken
     /// after the warm-up and measured frames, with a static head: converged).
     pub temporal: bool,
+    /// Fixed foveated occlusion.
+    pub foveation: Foveation,
 }
 
 /// How each case is run: frames (after warm-up) and the timing mode.
@@ -170,6 +172,7 @@ impl CaseRun {
         settings.ao.half_res = case.half_res;
         settings.ao.depth_peeling = case.depth_peeling;
         settings.ao.temporal.enabled = case.temporal;
+        settings.ao.foveation = case.foveation;
         if settings.ao.technique == Technique::None {
             return Err(Error::input("bench needs an occlusion technique"));
         }
@@ -230,8 +233,10 @@ impl CaseRun {
         let spans = summarize(&self.timings);
         check_timed(&plan.names, &spans)?;
         let occlusion = self.renderer.read_f32(output)?;
-        let error = reference
-            .map(|reference| score(self.case.technique, &occlusion, reference, limit, self.pixels_per_degree()));
+        let error = reference.map(|reference| {
+            let fovs: Vec<_> = self.eyes.eyes.iter().map(|e| e.fov).collect();
+            score(self.case.technique, &occlusion, reference, limit, self.pixels_per_degree(), &fovs)
+        });
         let stereo = {
             let depth = self.renderer.read_f32(DEPTH)?;
             let ao: Vec<Vec<f32>> = occlusion.iter().map(|l| l.iter().skip(3).step_by(4).copied().collect()).collect();
@@ -342,6 +347,7 @@ pub fn measure_rsm(
         half_res: true,
         depth_peeling: false,
         temporal: false,
+        foveation: Foveation::Off,
     };
     Ok(BenchRow {
         case,

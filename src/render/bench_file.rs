@@ -2,7 +2,7 @@
 //! and the governor in `app` reads its frontier from, so it lives below both.
 
 use crate::render::error::{Error, Result};
-use crate::render::settings::{Technique, RSM_SAMPLES_MAX, SAMPLES_MAX};
+use crate::render::settings::{Foveation, Technique, RSM_SAMPLES_MAX, SAMPLES_MAX};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -58,6 +58,9 @@ pub struct BenchRecord {
     pub radius_m: f32,
     /// The resolution the occlusion ran at (`full` or `half` in the file).
     pub resolution: Resolution,
+    /// Fixed foveation (`off`, `low` or `high`; `off` in files written before it existed).
+    #[serde(default)]
+    pub foveation: Foveation,
     /// Median GPU ms per eye of the technique's own pass.
     pub technique_ms_per_eye: f64,
     /// Median GPU ms per eye of the bilateral blur (0 when off).
@@ -70,6 +73,9 @@ pub struct BenchRecord {
     pub p75_over_p25: f64,
     /// RMSE against the reference's hard cut-off AO (`measure::bench::ErrorFigures::ao_rmse`).
     pub ao_rmse: Option<f64>,
+    /// The same within 10° of each eye's view axis (`measure::bench::ErrorFigures::ao_rmse_central`).
+    #[serde(default)]
+    pub ao_rmse_central: Option<f64>,
     /// Mean estimate − reference over hit pixels, both eyes.
     #[serde(default)]
     pub ao_bias: Option<f64>,
@@ -152,7 +158,11 @@ impl BenchRecord {
         let peel = if self.depth_peeling { " peeled" } else { "" };
         let temporal = if self.temporal { " temporal" } else { "" };
         let r = crate::render::output::significant(self.radius_m as f64, 2);
-        format!("{}{peel}{temporal} N={} r={r} m {}", self.technique, self.samples, self.resolution)
+        let foveation = match self.foveation {
+            Foveation::Off => String::new(),
+            level => format!(" foveation {}", level.name()),
+        };
+        format!("{}{peel}{temporal} N={} r={r} m {}{foveation}", self.technique, self.samples, self.resolution)
     }
 }
 

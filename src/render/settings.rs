@@ -269,7 +269,8 @@ impl Denoise {
 /// off each eye's own view axis, so it follows every headset profile's and every
 /// runtime's asymmetric field of view (its centre lies towards the nose, where the
 /// axis meets the image).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 #[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum Foveation {
     /// Every pixel at the full sample count.
@@ -635,5 +636,26 @@ impl Settings {
         }
         self.ao.validate()?;
         self.shadows.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn foveation_maps_keep_full_rate_near_the_axis_and_fall_monotonically_to_their_edge_rate() {
+        for level in Foveation::ALL {
+            let map = level.map();
+            assert_eq!(map.rate(0.0), 1.0);
+            assert_eq!(map.rate(map.full_rate_deg), 1.0);
+            assert!((map.rate(map.edge_deg + 10.0) - map.edge_rate).abs() < 1e-6, "{}", level.name());
+            let rates: Vec<f32> = (0..=90).map(|deg| map.rate(deg as f32)).collect();
+            assert!(rates.windows(2).all(|w| w[1] <= w[0]), "{}: not monotone", level.name());
+            assert!(rates.iter().all(|r| (map.edge_rate..=1.0).contains(r)));
+        }
+        assert!(Foveation::Off.map().rate(80.0) == 1.0);
+        // Each level spends less than the one before at the edges.
+        assert!(Foveation::High.map().edge_rate < Foveation::Low.map().edge_rate);
     }
 }

@@ -14,6 +14,10 @@ pub struct ErrorFigures {
     pub ao_rmse: f64,
     /// Mean of (estimate − reference): > 0 is too light, < 0 too dark.
     pub ao_bias: f64,
+    /// [`Self::ao_rmse`] over the pixels within [`CENTRAL_FIELD_DEG`] of each eye's view
+    /// axis: where the eye looks through the lens, and where fixed foveation keeps the
+    /// full rate. `None` when no traced pixel lies there.
+    pub ao_rmse_central: Option<f64>,
     /// The same over the pixels where the reference is below [`DARK_REFERENCE`]: how well
     /// the occluded places (creases, contacts) come out. `None` when there are none.
     pub ao_bias_dark: Option<f64>,
@@ -49,6 +53,10 @@ pub struct ErrorFigures {
     pub halo_share: Option<f64>,
 }
 
+/// Half the angle of the central field [`ErrorFigures::ao_rmse_central`] covers: the
+/// central 20° of each eye, where it looks ahead through the lens.
+pub const CENTRAL_FIELD_DEG: f64 = 10.0;
+
 /// How much darker than the reference a pixel beside a depth edge must be to count as
 /// part of a halo.
 pub const HALO_DARKER: f32 = 0.1;
@@ -81,22 +89,25 @@ pub fn pixels_per_degree(fov: &crate::render::stereo::Fov, width: u32) -> f64 {
 }
 
 /// Compares the occlusion a frame produced (per layer, RGBA at the full image size) with
-/// the reference on its grid of traced pixels; FLIP at the pixels per degree of the
-/// project's Vive-class headset profile at the reference's size (what [`score`] takes
-/// from the frame's eyes), no screen-space limit.
+/// the reference on its grid of traced pixels; FLIP at the pixels per degree and the
+/// central field of the project's Vive-class headset profile at the reference's size
+/// (what [`score`] takes from the frame's eyes), no screen-space limit.
 pub fn error_figures(technique: Technique, occlusion: &[Vec<f32>], reference: &ReferenceImage) -> ErrorFigures {
     let profile = crate::render::stereo::HeadsetProfile::with_size("vive", reference.width, reference.height);
-    score(technique, occlusion, reference, None, pixels_per_degree(&profile.fov_left, reference.width))
+    let fovs = [profile.fov_left, profile.fov_right];
+    score(technique, occlusion, reference, None, pixels_per_degree(&profile.fov_left, reference.width), &fovs)
 }
 
 /// [`error_figures`] with the screen-space limit of the same frame and radius (the limit
-/// columns are `None` without it) and FLIP at `pixels_per_degree` of the full image.
+/// columns are `None` without it), FLIP at `pixels_per_degree` of the full image and the
+/// central field of each layer's field of view in `fovs`.
 pub fn score(
     technique: Technique,
     occlusion: &[Vec<f32>],
     reference: &ReferenceImage,
     limit: Option<&ScreenLimit>,
     pixels_per_degree: f64,
+    fovs: &[crate::render::stereo::Fov],
 ) -> ErrorFigures {
     let limit = limit.filter(|l| l.grid_size() == reference.grid_size() && l.layers.len() >= reference.layers.len());
     let (gw, gh) = reference.grid_size();
@@ -104,7 +115,8 @@ pub fn score(
     let mut cells = Vec::new();
     let (mut ssim_sum, mut flip_sum, mut flip_pixels) = (0.0, 0.0, 0usize);
     for (layer, image) in occlusion.iter().enumerate().take(reference.layers.len()) {
-        let eye = eye_cells(technique, image, reference, layer, limit);
+        let fov = fovs.get(layer).copied();
+        let eye = eye_cells(technique, image, reference, layer, limit, fov);
         let (ssim, flip) = eye_similarity(&eye, (gw as usize, gh as usize), grid_ppd);
         ssim_sum += ssim;
         // FLIP is pooled over both eyes' hit pixels.
@@ -125,6 +137,10 @@ pub fn score(
             .flatten(),
         halo_share: halo_share(&cells),
         ao_rmse: corrected_rmse(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit, noise),
+        ao_rmse_central: cells
+            .iter()
+            .any(|c| c.central)
+            .then(|| corrected_rmse(&cells, |c| c.ao, |c| c.ref_ao, |c| c.central, noise)),
         ao_bias: mean_difference(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit).unwrap_or(f64::NAN),
         ao_bias_dark: mean_difference(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit && c.ref_ao < DARK_REFERENCE),
         ao_rmse_falloff: corrected_rmse(&cells, |c| c.ao, |c| c.ref_falloff, |c| c.hit, noise),
@@ -159,18 +175,31 @@ struct Cell {
     outer_border: bool,
     /// A hit beside a depth edge ([`near_depth_edge`]).
     beside_edge: bool,
+    /// A hit within [`CENTRAL_FIELD_DEG`] of the eye's view axis.
+    central: bool,
 }
 
 /// The cells of eye `layer`, row by row, from its occlusion `image` (RGBA at the full
-/// image size).
+/// image size); `fov`, the eye's field of view, places its central field (none without).
 fn eye_cells(
     technique: Technique,
     image: &[f32],
     reference: &ReferenceImage,
     layer: usize,
     limit: Option<&ScreenLimit>,
+    fov: Option<crate::render::stereo::Fov>,
 ) -> Vec<Cell> {
     let (w, h) = (reference.width as usize, reference.height as usize);
+    // A pixel centre's tangents off the view axis, as the projection lays them out.
+    let central_tan2 = CENTRAL_FIELD_DEG.to_radians().tan().powi(2);
+    let central = |x: usize, y: usize| {
+        fov.is_some_and(|fov| {
+            let [left, right, up, down] = fov.tangents();
+            let tan_x = left + (right - left) * (x as f64 + 0.5) / w as f64;
+            let tan_y = up + (down - up) * (y as f64 + 0.5) / h as f64;
+            tan_x * tan_x + tan_y * tan_y <= central_tan2
+        })
+    };
     let (gw, gh) = reference.grid_size();
     let pixels = &reference.layers[layer];
     let mut cells = Vec::with_capacity(pixels.len());
@@ -201,6 +230,7 @@ fn eye_cells(
                 ref_ambient: luminance(truth) as f32,
                 outer_border: r.hit && outer.min(y).min(h - 1 - y) < BORDER_PX as usize,
                 beside_edge: r.hit && near_depth_edge(pixels, (gw as usize, gh as usize), gx as usize, gy as usize),
+                central: r.hit && central(x, y),
             });
         }
     }

@@ -19,12 +19,14 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 samples: c.samples,
                 radius_m: c.radius,
                 resolution: Resolution::from_half_res(c.half_res),
+                foveation: c.foveation,
                 technique_ms_per_eye: per_eye(name),
                 blur_ms_per_eye: per_eye(blur::NAME),
                 upsample_ms_per_eye: per_eye(upsample::NAME),
                 occlusion_ms_per_eye: row.occlusion_ms_per_eye(),
                 p75_over_p25: spread,
                 ao_rmse: row.error.as_ref().map(|e| e.ao_rmse),
+                ao_rmse_central: row.error.as_ref().and_then(|e| e.ao_rmse_central),
                 ao_bias: row.error.as_ref().map(|e| e.ao_bias),
                 ao_bias_dark: row.error.as_ref().and_then(|e| e.ao_bias_dark),
                 ao_rmse_falloff: row.error.as_ref().map(|e| e.ao_rmse_falloff),
@@ -68,8 +70,8 @@ fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -
     let h = half;
     records.iter().find(|f| {
         f.resolution == Resolution::Full
-            && (f.technique.as_str(), f.samples, f.radius_m, f.depth_peeling, f.temporal)
-                == (h.technique.as_str(), h.samples, h.radius_m, h.depth_peeling, h.temporal)
+            && (f.technique.as_str(), f.samples, f.radius_m, f.depth_peeling, f.temporal, f.foveation)
+                == (h.technique.as_str(), h.samples, h.radius_m, h.depth_peeling, h.temporal, h.foveation)
     })
 }
 
@@ -171,6 +173,13 @@ const COLUMNS: &[Column] = &[
         optional: false,
     },
     Column {
+        name: "foveation",
+        header: "foveation",
+        csv: |r| r.foveation.name().to_string(),
+        markdown: |r| if r.foveation == Foveation::Off { String::new() } else { r.foveation.name().to_string() },
+        optional: true,
+    },
+    Column {
         name: "occlusion_ms_per_eye",
         header: "ms/eye",
         csv: |r| format!("{:.3}", r.occlusion_ms_per_eye),
@@ -178,6 +187,7 @@ const COLUMNS: &[Column] = &[
         optional: false,
     },
     figure_column!(ao_rmse, "RMSE", false),
+    figure_column!(ao_rmse_central, "RMSE central 20°", false),
     figure_column!(ao_bias, "bias", false),
     figure_column!(ao_bias_dark, "bias (ref < 0.8)", false),
     figure_column!(ao_rmse_vs_limit, "RMSE vs limit", false),
@@ -374,9 +384,12 @@ pub fn markdown_report(file: &BenchFile) -> String {
 ///   upsampling instead of the pass;
 /// - each technique's pass against SSAO's at the same setting and resolution;
 /// - each technique's pass against fetch-only's (the same depth taps, no arithmetic):
-///   how far it is from the memory limit.
+///   how far it is from the memory limit;
+/// - each foveated row against the same case without foveation: the chain's cost, the
+///   error where the eye looks and over the whole image.
 pub fn ratios_markdown(records: &[BenchRecord]) -> String {
     let mut s = String::new();
+    s += &foveation_markdown(records);
     let plain = |r: &&BenchRecord| !r.depth_peeling && !r.temporal;
     let mut half_full = String::new();
     for half in records.iter().filter(|r| r.resolution.is_half()) {
@@ -407,7 +420,9 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
         let mut table = String::new();
         for r in records.iter().filter(plain).filter(|r| r.technique != against && r.technique != RSM_PASS) {
             let partner = records.iter().filter(plain).find(|b| {
-                b.technique == against && (b.samples, b.radius_m, b.resolution) == (r.samples, r.radius_m, r.resolution)
+                b.technique == against
+                    && (b.samples, b.radius_m, b.resolution, b.foveation)
+                        == (r.samples, r.radius_m, r.resolution, r.foveation)
             });
             if let Some(b) = partner {
                 let ratio = r.technique_ms_per_eye / b.technique_ms_per_eye;
@@ -520,4 +535,56 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
         pareto,
         vertical_line: Some(line),
     }
+}
+
+/// The AO chain a frame pays per eye: the occlusion passes, with the frame's inline
+/// upsampling in place of the stand-alone upsample pass where `--frame` measured it.
+fn chain_ms_per_eye(r: &BenchRecord) -> f64 {
+    match r.frame_upsample_ms_per_eye {
+        Some(inline) => r.occlusion_ms_per_eye - r.upsample_ms_per_eye + inline,
+        None => r.occlusion_ms_per_eye,
+    }
+}
+
+/// Each foveated row against the same case with foveation off (empty without such
+/// pairs): the chain's cost ratio, the RMSE within the central 20° and over the whole
+/// image (the differences), and FLIP (the ratio).
+fn foveation_markdown(records: &[BenchRecord]) -> String {
+    let mut table = String::new();
+    for r in records.iter().filter(|r| r.foveation != Foveation::Off) {
+        let off = records.iter().find(|b| {
+            b.foveation == Foveation::Off
+                && (b.technique.as_str(), b.samples, b.radius_m, b.resolution, b.depth_peeling, b.temporal)
+                    == (r.technique.as_str(), r.samples, r.radius_m, r.resolution, r.depth_peeling, r.temporal)
+        });
+        let Some(off) = off else { continue };
+        let difference = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(a), Some(b)) => format!("{:+.4}", a - b),
+            _ => String::new(),
+        };
+        let flip = match (r.flip_mean, off.flip_mean) {
+            (Some(a), Some(b)) if b > 0.0 => format!("{:.3}", a / b),
+            _ => String::new(),
+        };
+        let _ = writeln!(
+            table,
+            "| {} | {} | {} | {} | {} | {:.3} | {} | {} | {flip} |",
+            r.technique,
+            r.samples,
+            significant(r.radius_m as f64, 2),
+            r.resolution,
+            r.foveation.name(),
+            chain_ms_per_eye(r) / chain_ms_per_eye(off),
+            difference(r.ao_rmse_central, off.ao_rmse_central),
+            difference(r.ao_rmse, off.ao_rmse),
+        );
+    }
+    if table.is_empty() {
+        return table;
+    }
+    format!(
+        "\nFoveated against off, same case (chain: the occlusion passes per eye, with the frame's inline upsampling under --frame):\n\n\
+         | technique | samples | radius_m | resolution | foveation | chain ms ratio | Δ RMSE central 20° | Δ RMSE whole | FLIP ratio |\n\
+         |---|---|---|---|---|---|---|---|---|\n{table}"
+    )
 }

@@ -10,6 +10,7 @@ use crate::render::error::{Error, Result};
 use crate::render::gpu::{BackendChoice, Gpu};
 use crate::render::renderer::TimingChoice;
 use crate::render::scene::Scene;
+use crate::render::settings::Foveation;
 use crate::render::settings::{Settings, Technique};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -33,6 +34,8 @@ pub struct BenchOptions {
     pub depth_peeling: Vec<bool>,
     /// Temporal accumulation off/on to sweep.
     pub temporal: Vec<bool>,
+    /// Foveation levels to sweep.
+    pub foveation: Vec<Foveation>,
     /// VPL counts of reflective-shadow-map rows (empty: none).
     pub rsm_samples: Vec<u32>,
     /// Serial, pipelined or auto (decided once the adapter is known).
@@ -75,7 +78,7 @@ pub struct BenchRun {
 }
 
 /// The cases of a sweep, in order: technique × samples × radius × resolution × depth
-/// peeling (SSDO only) × temporal.
+/// peeling (SSDO only) × temporal × foveation.
 pub fn cases(options: &BenchOptions, radii: &[f32]) -> Vec<BenchCase> {
     let mut cases = Vec::new();
     for &technique in &options.techniques {
@@ -87,7 +90,17 @@ pub fn cases(options: &BenchOptions, radii: &[f32]) -> Vec<BenchCase> {
                             continue;
                         }
                         for &temporal in &options.temporal {
-                            cases.push(BenchCase { technique, samples, radius, half_res, depth_peeling, temporal });
+                            for &foveation in &options.foveation {
+                                cases.push(BenchCase {
+                                    technique,
+                                    samples,
+                                    radius,
+                                    half_res,
+                                    depth_peeling,
+                                    temporal,
+                                    foveation,
+                                });
+                            }
                         }
                     }
                 }
@@ -224,7 +237,14 @@ fn progress_line(done: usize, total: usize, row: &BenchRow, elapsed: f64) -> Str
         format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
         row.case.samples,
         row.case.radius,
-        Resolution::from_half_res(row.case.half_res).name(),
+        format!(
+            "{}{}",
+            Resolution::from_half_res(row.case.half_res).name(),
+            match row.case.foveation {
+                Foveation::Off => String::new(),
+                level => format!(" fov-{}", level.name()),
+            }
+        ),
         row.occlusion_ms_per_eye()
     )
 }

@@ -15,13 +15,22 @@ fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
         max_ms: median_ms,
     };
     BenchRow {
-        case: BenchCase { technique, samples: 12, radius: 0.5, half_res: false, depth_peeling: false, temporal: false },
+        case: BenchCase {
+            technique,
+            samples: 12,
+            radius: 0.5,
+            half_res: false,
+            depth_peeling: false,
+            temporal: false,
+            foveation: Foveation::Off,
+        },
         spans: vec![span(technique.name(), ms), span(blur::NAME, 2.0), span(gbuffer::NAME, 50.0)],
         views: 2,
         pass: technique.name(),
         occlusion_passes: vec![technique.name(), blur::NAME],
         error: Some(ErrorFigures {
             ao_rmse,
+            ao_rmse_central: Some(ao_rmse),
             ao_bias: -0.05,
             ao_bias_dark: Some(-0.1),
             ao_rmse_falloff: 0.3,
@@ -100,12 +109,12 @@ fn csv_markdown_and_json_hold_every_row() {
     let recs = records(&rows);
     let csv = to_csv(&recs);
     assert_eq!(csv.lines().count(), 3);
-    // technique, N, r, resolution, ms/eye, RMSE, bias, bias (ref < 0.8), vs limit,
+    // technique, N, r, resolution, foveation, ms/eye, RMSE, central RMSE, bias, bias (ref < 0.8), vs limit,
     // limit RMSE, limit bias, outer border RMSE, halo, FLIP, stereo shares, falloff
     // RMSE, SSIM, ambient, …
     assert!(
         csv.lines().nth(2).unwrap().starts_with(
-            "hbao,12,0.5,full,7.000,0.2000,-0.0500,-0.1000,0.0600,0.0400,0.0100,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
+            "hbao,12,0.5,full,off,7.000,0.2000,0.2000,-0.0500,-0.1000,0.0600,0.0400,0.0100,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
         ),
         "{csv}"
     );
@@ -118,7 +127,7 @@ fn csv_markdown_and_json_hold_every_row() {
     assert_eq!(markdown.lines().count(), 4);
     let hbao = markdown.lines().nth(3).unwrap();
     assert!(
-        hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.070 | 6.2 % | 0.125 | 25.0 % | 50.0 % | 12.5 % |"),
+        hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.070 | 6.2 % | 0.125 | 25.0 % | 50.0 % | 12.5 % |"),
         "{hbao}"
     );
     assert!(!markdown.contains("peel") && !markdown.contains("bounce"), "{markdown}");

@@ -286,27 +286,30 @@ fn foveation_rate(position: vec3<f32>) -> f32 {
 
 // `full` samples (or steps, or slices) scaled by `rate` (a foveation rate), as a whole
 // count of at least 1: a fractional count rounds up with the probability of its
-// fraction, from a 4×4 ordered dither over occlusion pixel `p` (its own order,
-// decorrelated from the techniques' rotations), so the denoise averages the rate itself
-// and the map shows no step where the count changes.
-fn foveated_count(full: u32, rate: f32, p: vec2<u32>) -> u32 {
+// fraction, from a 4×4 ordered dither over `cell` (its own order, decorrelated from the
+// techniques' rotations), so the denoise averages the rate itself and the map shows no
+// step where the count changes. Per occlusion pixel, neighbouring invocations' loops
+// differ by at most one iteration (a SIMD group pays the longest).
+fn foveated_count(full: u32, rate: f32, cell: vec2<u32>) -> u32 {
     if (rate >= 1.0) {
         return full;
     }
-    let dither = fract(bayer4(p) * 13.0 + 0.40625);
+    let dither = fract(bayer4(cell) * 13.0 + 0.40625);
     return clamp(u32(floor(f32(full) * rate + dither)), 1u, full);
 }
 
-// A marching technique's slices (directions) and steps per slice under foveation `rate`:
-// slices go first, down to one, then steps. A pixel's slice directions turn with the
-// noise tile, so dropping slices leaves the estimate unbiased (the denoise averages the
-// directions of its window); fewer steps along a slice step over thin occluders and
-// lighten it.
+// A marching technique's slices (directions) and steps per slice under foveation `rate`
+// for occlusion pixel `p`: slices go first, down to one, then steps. A pixel's slice
+// directions turn with the noise tile, so dropping slices leaves the estimate unbiased
+// (the denoise averages the directions of its window); fewer steps along a slice step
+// over thin occluders and lighten it. The slice count is dithered per 8×8 block (a
+// workgroup), not per pixel: a SIMD group whose pixels marched one or two slices would
+// pay two for all of them.
 fn foveated_march(slices: u32, steps: u32, rate: f32, p: vec2<u32>) -> vec2<u32> {
     if (rate >= 1.0) {
         return vec2<u32>(slices, steps);
     }
-    let kept_slices = foveated_count(slices, max(rate, 1.0 / f32(slices)), p);
+    let kept_slices = foveated_count(slices, max(rate, 1.0 / f32(slices)), p / 8u);
     let step_rate = rate * f32(slices) / f32(kept_slices);
     return vec2<u32>(kept_slices, foveated_count(steps, step_rate, p));
 }
