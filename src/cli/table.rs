@@ -6,7 +6,7 @@ use super::parse_budget_ms;
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::{version, Resolution};
-use vrao::measure::table::{run_table, TableOptions, SCENES_MAX};
+use vrao::measure::table::{check_scene_count, run_table, TableOptions};
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::settings::{Foveation, Quality, Technique};
@@ -87,9 +87,7 @@ pub fn run(backend: BackendChoice, args: TableArgs) -> Result<()> {
         foveations: args.foveations,
     };
     options.validate()?;
-    if args.scenes.len() > SCENES_MAX {
-        return Err(Error::input(format!("{} scenes is more than {SCENES_MAX}", args.scenes.len())));
-    }
+    check_scene_count(args.scenes.len())?;
     let scenes = args.scenes.iter().map(|spec| Ok((spec.clone(), Scene::load(spec)?))).collect::<Result<Vec<_>>>()?;
     let table = run_table(&scenes, &options)?;
     let command = std::env::args().map(|a| shell_word(&a)).collect::<Vec<_>>().join(" ");

@@ -10,7 +10,6 @@
 use crate::measure::bench::Resolution;
 use crate::measure::budget::{self, BudgetReport, BudgetRun, PassTimes, Scope};
 use crate::render::error::{Error, Result};
-use crate::render::gpu::timing::SpanSummary;
 use crate::render::gpu::{BackendChoice, Gpu};
 use crate::render::passes::tonemap::COLOR;
 use crate::render::passes::{blur, composite, shadow};
@@ -167,14 +166,12 @@ impl TableRow {
 
     /// The AO chain's ms for `scope` (the left eye alone or the stereo frame).
     pub fn chain_ms(&self, scope: Scope) -> f64 {
-        let pick = |p: &PassTimes| -> Option<SpanSummary> {
-            match scope {
-                Scope::LeftEye => p.left.clone(),
-                Scope::RightEye => p.right.clone(),
-                Scope::StereoFrame => p.stereo.clone(),
-            }
+        let span = |p: &PassTimes| match scope {
+            Scope::LeftEye => p.left.as_ref().map(|s| s.median_ms),
+            Scope::RightEye => p.right.as_ref().map(|s| s.median_ms),
+            Scope::StereoFrame => p.stereo.as_ref().map(|s| s.median_ms),
         };
-        self.chain.iter().filter_map(|pass| self.times(pass).and_then(pick)).map(|s| s.median_ms).sum()
+        self.chain.iter().filter_map(|pass| self.times(pass).and_then(span)).sum()
     }
 
     /// The stereo AO chain over the left eye alone's: 1 + the right eye's marginal cost.
@@ -238,13 +235,19 @@ pub fn base_settings(scene: &Scene, options: &TableOptions) -> Settings {
     }
 }
 
+/// Refuses a table of no scenes or of more than [`SCENES_MAX`].
+pub fn check_scene_count(scenes: usize) -> Result<()> {
+    if !(1..=SCENES_MAX).contains(&scenes) {
+        return Err(Error::input(format!("{scenes} scenes is not within 1..={SCENES_MAX}")));
+    }
+    Ok(())
+}
+
 /// Measures every case of `options` on each of `scenes` (each with how it was asked for)
 /// and returns the table. Logs each row at the info level as it is done.
 pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<Table> {
     options.validate()?;
-    if !(1..=SCENES_MAX).contains(&scenes.len()) {
-        return Err(Error::input(format!("{} scenes is not within 1..={SCENES_MAX}", scenes.len())));
-    }
+    check_scene_count(scenes.len())?;
     let cases = options.cases();
     for (_, scene) in scenes {
         for case in &cases {
@@ -378,7 +381,8 @@ impl Table {
             seen
         };
         let notes = [
-            "Every figure is a median in ms of the whole frame (G-buffer, shadows, direct light, AO, composite, tone mapping).".to_string(),
+            "Frames are whole (G-buffer, shadows, direct light, AO, composite, tone mapping). Every figure is in ms: a pass's median over the measured rounds, or a sum of such medians (rest, the AO chain, the stereo frame).".to_string(),
+            "Timing serial: each pass submitted alone and timed by the wall clock (CPU adapters, whose timestamps misplace work); pipelined: GPU timestamps around each pass of one submission.".to_string(),
             format!(
                 "AO pass, denoise (`{}`), composite and rest are the left eye rendered alone; rest is every other pass of its frame, summed.",
                 blur::NAME
