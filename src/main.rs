@@ -37,6 +37,9 @@ enum Command {
     /// Headless per-eye budget test: per-pass medians against the frame budget; exit 0
     /// within budget, 3 over it.
     Budget(cli::budget::BudgetArgs),
+    /// The GPU table: per-pass ms per eye of every technique × preset × AO resolution ×
+    /// foveation and the stereo frame against the budget, per scene, in one Markdown file.
+    Table(cli::table::TableArgs),
 }
 
 /// The library tells the user what it does (which headset, the bench's progress) at the
@@ -71,6 +74,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => cli::render::run(backend, args),
         Some(Command::Bench(args)) => cli::bench::run(backend, args),
         Some(Command::Budget(args)) => cli::budget::run(backend, args),
+        Some(Command::Table(args)) => cli::table::run(backend, args),
         Some(Command::Run(args)) => cli::run::run(backend, args),
         Some(Command::Temporal(args)) => cli::temporal::run(backend, args),
         Some(Command::Reprojection(args)) => cli::reprojection::run(backend, args),

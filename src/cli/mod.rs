@@ -7,6 +7,7 @@ pub mod info;
 pub mod render;
 pub mod reprojection;
 pub mod run;
+pub mod table;
 pub mod temporal;
 
 use clap::Args;

@@ -1,6 +1,6 @@
 //! Measurement: the CPU reference tracer, image metrics, the bench and its budget fit,
-//! the temporal and reprojection studies, stereo consistency, reports and plots. Builds
-//! on `render` and `xr`, never on `app`.
+//! the temporal and reprojection studies, stereo consistency, the GPU table, reports and
+//! plots. Builds on `render` and `xr`, never on `app`.
 
 // Closed-form and quadrature expectations the tests compare the GPU against: a test
 // oracle, built for the crate's own tests and with the `testing` feature (which the
@@ -14,6 +14,7 @@ pub mod plot;
 pub mod reference;
 pub mod reprojection;
 pub mod stereo_consistency;
+pub mod table;
 pub mod temporal;
 
 use crate::render::error::{Error, Result};
