@@ -134,8 +134,8 @@ pub struct AoArgs {
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
-    /// Fixed foveated occlusion: off, low (half the samples from 40° off each eye's view
-    /// axis) or high (a third of them from 30°); full rate near the axis either way.
+    /// Fixed foveated occlusion: off, low (full rate within 25° of each eye's view axis,
+    /// half the samples from 40°) or high (full within 15°, half from 30°).
     #[arg(long, value_enum, default_value_t = AoSettings::default().foveation, hide_possible_values = true)]
     foveation: Foveation,
     /// SSDO quality mode (Ritschel et al. 2009 §4): peel a second depth layer per eye; a

@@ -146,6 +146,12 @@ pub struct TableRow {
     pub chain: Vec<&'static str>,
     /// Every pass's medians for the stereo frame and each eye alone, and the verdicts.
     pub report: BudgetReport,
+    /// At half resolution, when the same case ran at full resolution too: what the
+    /// composite's inline upsampling costs, the left eye alone and the stereo frame (this
+    /// row's composite minus the full-resolution row's, as `vrao bench --frame` takes
+    /// it). The chain then counts it instead of the whole composite, whose shading every
+    /// frame pays at any AO resolution.
+    pub inline_upsampling: Option<[f64; 2]>,
 }
 
 impl TableRow {
@@ -164,14 +170,30 @@ impl TableRow {
         rest.filter_map(|p| p.left.as_ref()).map(|s| s.median_ms).sum()
     }
 
-    /// The AO chain's ms for `scope` (the left eye alone or the stereo frame).
-    pub fn chain_ms(&self, scope: Scope) -> f64 {
-        let span = |p: &PassTimes| match scope {
-            Scope::LeftEye => p.left.as_ref().map(|s| s.median_ms),
-            Scope::RightEye => p.right.as_ref().map(|s| s.median_ms),
-            Scope::StereoFrame => p.stereo.as_ref().map(|s| s.median_ms),
+    /// Median ms of `pass` for `scope`; `None` when it did not run.
+    fn scope_ms(&self, pass: &str, scope: Scope) -> Option<f64> {
+        let p = self.times(pass)?;
+        let span = match scope {
+            Scope::LeftEye => &p.left,
+            Scope::RightEye => &p.right,
+            Scope::StereoFrame => &p.stereo,
         };
-        self.chain.iter().filter_map(|pass| self.times(pass).and_then(span)).sum()
+        span.as_ref().map(|s| s.median_ms)
+    }
+
+    /// The AO chain's ms for `scope` (the left eye alone or the stereo frame): its
+    /// passes, with the composite's inline upsampling in place of the whole composite
+    /// where it is known ([`TableRow::inline_upsampling`]).
+    pub fn chain_ms(&self, scope: Scope) -> f64 {
+        let inline =
+            self.inline_upsampling.map(|[left, stereo]| if scope == Scope::StereoFrame { stereo } else { left });
+        self.chain
+            .iter()
+            .filter_map(|&pass| match inline {
+                Some(ms) if pass == composite::NAME => Some(ms),
+                _ => self.scope_ms(pass, scope),
+            })
+            .sum()
     }
 
     /// The stereo AO chain over the left eye alone's: 1 + the right eye's marginal cost.
@@ -270,7 +292,13 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
             let settings = case.settings(&base);
             renderer.set_settings(&settings)?;
             let report = budget::run(&mut renderer, &eyes, how)?;
-            let row = TableRow { case: *case, pass: settings.ao.pass_name(), chain: chain(&renderer)?, report };
+            let row = TableRow {
+                case: *case,
+                pass: settings.ao.pass_name(),
+                chain: chain(&renderer)?,
+                report,
+                inline_upsampling: None,
+            };
             log::info!(
                 "table {}: {}/{} {} {} {} foveation {}: AO chain {:.3} ms left eye, stereo frame {:.3} ms",
                 scene.name,
@@ -284,6 +312,10 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
                 row.stereo_frame().ms
             );
             rows.push(row);
+        }
+        let upsampling: Vec<_> = rows.iter().map(|row| inline_upsampling(row, &rows)).collect();
+        for (row, inline) in rows.iter_mut().zip(upsampling) {
+            row.inline_upsampling = inline;
         }
         tables.push(SceneTable { spec: spec.clone(), name: scene.name.clone(), radius_m: base.ao.radius, rows });
     }
@@ -300,6 +332,23 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
         budget_ms,
         scenes: tables,
     })
+}
+
+/// A half-resolution row's inline upsampling ([`TableRow::inline_upsampling`]) from the
+/// full-resolution row of the same case among `rows`; `None` at full resolution or
+/// without that row.
+fn inline_upsampling(row: &TableRow, rows: &[TableRow]) -> Option<[f64; 2]> {
+    if row.case.resolution != Resolution::Half {
+        return None;
+    }
+    let full_case = TableCase { resolution: Resolution::Full, ..row.case };
+    let full = rows.iter().find(|f| f.case == full_case)?;
+    let excess = |scope: Scope| {
+        let (half, full) = (row.scope_ms(composite::NAME, scope)?, full.scope_ms(composite::NAME, scope)?);
+        // Timing noise can put a cheap upsampling below zero: it costs at least nothing.
+        Some((half - full).max(0.0))
+    };
+    Some([excess(Scope::LeftEye)?, excess(Scope::StereoFrame)?])
 }
 
 /// The AO chain of the renderer's current settings: the occlusion-cost passes of the
@@ -387,7 +436,7 @@ impl Table {
                 "AO pass, denoise (`{}`), composite and rest are the left eye rendered alone; rest is every other pass of its frame, summed.",
                 blur::NAME
             ),
-            "AO chain: the passes the frame graph marks as occlusion cost (the technique, temporal, denoise, upsample as they ran) plus, at half resolution, the composite, which upsamples the half-resolution AO inline. By row kind:".to_string(),
+            "AO chain: the passes the frame graph marks as occlusion cost (the technique, temporal, denoise, upsample as they ran) plus, at half resolution, the composite's inline upsampling of the half-resolution AO: the composite's excess over the same case's at full resolution (scope by scope, at least 0), or the whole composite, marked *, where no full-resolution row was measured. By row kind:".to_string(),
         ];
         for note in notes {
             let _ = writeln!(s, "- {note}");
@@ -414,6 +463,7 @@ fn row_cells(row: &TableRow) -> Vec<String> {
     let shown = [row.pass, blur::NAME, composite::NAME];
     let frame = row.stereo_frame();
     let ratio = frame.ms / frame.budget_ms;
+    let whole = if row.chain.contains(&composite::NAME) && row.inline_upsampling.is_none() { "*" } else { "" };
     vec![
         row.case.technique.name().to_string(),
         format!("{} ({})", row.case.quality.name(), row.case.quality.samples()),
@@ -423,8 +473,9 @@ fn row_cells(row: &TableRow) -> Vec<String> {
         ms(row.left_ms(blur::NAME)),
         ms(row.left_ms(composite::NAME)),
         ms(Some(row.left_rest_ms(&shown))),
-        ms(Some(row.chain_ms(Scope::LeftEye))),
-        ms(Some(row.chain_ms(Scope::StereoFrame))),
+        // * : the chain counts the whole composite (no full-resolution row to subtract).
+        format!("{}{whole}", ms(Some(row.chain_ms(Scope::LeftEye)))),
+        format!("{}{whole}", ms(Some(row.chain_ms(Scope::StereoFrame)))),
         format!("{:.2}×", row.stereo_over_left()),
         ms(Some(frame.ms)),
         format!("{} ({ratio:.2}×)", if frame.pass { "PASS" } else { "FAIL" }),

@@ -7,7 +7,7 @@
 @group(0) @binding(3) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(4) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var ao_out: texture_storage_2d_array<rgba16float, write>;
-@group(0) @binding(6) var geometry_out: texture_storage_2d_array<rgba32float, write>;
+@group(0) @binding(6) var geometry_out: texture_storage_2d_array<rgba16float, write>;
 
 // Whether the outputs are bound as one-layer views of the receiver's layer (GTAO's
 // right-eye dispatch, which reads the left eye's layer of the same targets meanwhile).
@@ -50,7 +50,8 @@ fn begin_receiver(id: vec3<u32>) -> Receiver {
     r.position = load_view_position(depth, r.pixel, r.eye, frame.size, frame.near);
     let stored = textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz;
     r.normal = repaired_normal(safe_normal(stored, r.position), r.pixel, r.layer, r.eye, r.position);
-    textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, -r.position.z));
+    // Clamped to the half float's range (AoGeometry's format): finite at any distance.
+    textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, min(-r.position.z, 65504.0)));
     r.valid = true;
     return r;
 }
