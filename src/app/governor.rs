@@ -60,15 +60,17 @@ pub struct Level {
 }
 
 impl Level {
-    /// `ao` with this level's technique, samples, resolution, temporal accumulation and
-    /// foveation; everything else (radius, strength, …) is kept.
+    /// `ao` with this level's technique, samples, resolution and temporal accumulation,
+    /// and the stronger of its foveation and `ao`'s (the user's choice is a floor: the
+    /// governor adds foveation where a level was measured with it, never takes it away);
+    /// everything else (radius, strength, …) is kept.
     pub fn apply(&self, ao: &AoSettings) -> AoSettings {
         let mut out = ao.clone();
         out.technique = self.technique;
         out.samples = self.samples;
         out.half_res = self.half_res;
         out.temporal.enabled = self.temporal;
-        out.foveation = self.foveation;
+        out.foveation = self.foveation.max(ao.foveation);
         out
     }
 }

@@ -269,7 +269,8 @@ impl Denoise {
 /// off each eye's own view axis, so it follows every headset profile's and every
 /// runtime's asymmetric field of view (its centre lies towards the nose, where the
 /// axis meets the image).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+/// Levels order by how much they save: `Off < Low < High`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 #[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 pub enum Foveation {

@@ -411,6 +411,12 @@ fn a_level_sets_technique_samples_resolution_and_temporal_only() {
     assert_eq!(AoSettings { technique: ao.technique, samples: ao.samples, half_res: true, ..out.clone() }, ao);
     let temporal = Level { temporal: true, ..level.clone() }.apply(&ao);
     assert!(temporal.temporal.enabled);
+    // The user's foveation is a floor: a level measured without foveation keeps it, one
+    // measured with more foveation raises it.
+    let foveated = AoSettings { foveation: Foveation::Low, ..ao.clone() };
+    assert_eq!(level.apply(&foveated).foveation, Foveation::Low);
+    assert_eq!(Level { foveation: Foveation::High, ..level.clone() }.apply(&foveated).foveation, Foveation::High);
+    assert_eq!(Level { foveation: Foveation::Low, ..level.clone() }.apply(&ao).foveation, Foveation::Low);
 }
 
 #[test]
