@@ -1,7 +1,8 @@
 //! `vrao table` as CI runs it: the whole GPU table's mechanism on lavapipe at a tiny size
 //! (the figures are for a GPU; this keeps the command from rotting).
 
-use std::path::PathBuf;
+mod common;
+
 use std::process::{Command, Output};
 
 fn vrao(args: &[&str]) -> Command {
@@ -14,13 +15,6 @@ fn text(out: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-table-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// A millisecond cell: a finite positive number.
 fn ms(cell: &str) -> f64 {
     let v: f64 = cell.parse().unwrap_or_else(|_| panic!("'{cell}' is not a number of ms"));
@@ -30,7 +24,7 @@ fn ms(cell: &str) -> f64 {
 
 #[test]
 fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
-    let dir = temp_dir("rows");
+    let dir = common::temp_dir("table-rows");
     let out_file = dir.join("table.md");
     let budget_ms = 25.0;
     let out = vrao(&[
@@ -120,7 +114,7 @@ fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
 
 #[test]
 fn bad_values_exit_2_with_one_line_naming_them_before_any_gpu_work() {
-    let dir = temp_dir("bad");
+    let dir = common::temp_dir("table-bad");
     let good_out = dir.join("t.md");
     let good_out = good_out.to_str().unwrap();
     let unwritable = "/proc/vrao-no/t.md";
@@ -149,7 +143,7 @@ fn bad_values_exit_2_with_one_line_naming_them_before_any_gpu_work() {
 
 #[test]
 fn the_gpu_script_writes_the_table_and_the_adapter_on_lavapipe() {
-    let dir = temp_dir("script");
+    let dir = common::temp_dir("table-script");
     let out_dir = dir.join("out");
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/gpu-table.sh");
     // A built-in scene needs no public scenes: any folder will do for SCENES.

@@ -396,9 +396,9 @@ pub fn ratios_markdown(records: &[BenchRecord]) -> String {
         let Some(full) = full_resolution_partner(records, half) else {
             continue;
         };
-        let in_frame = half.frame_upsample_ms_per_eye.map_or(String::new(), |up| {
-            format!("{:.3}", (half.occlusion_ms_per_eye - half.upsample_ms_per_eye + up) / full.occlusion_ms_per_eye)
-        });
+        let in_frame = half
+            .frame_upsample_ms_per_eye
+            .map_or(String::new(), |_| format!("{:.3}", chain_ms_per_eye(half) / full.occlusion_ms_per_eye));
         let _ = writeln!(
             half_full,
             "| {} | {} | {} | {:.3} | {in_frame} |",
