@@ -85,7 +85,9 @@ fn shade(view_position: vec3<f32>, view_normal: vec3<f32>, uv: vec2<f32>) -> GBu
     }
     let albedo = material_albedo(uv);
     var out: GBufferOut;
-    out.normal = vec4<f32>(finite_or_zero3(n), 0.0);
+    // w marks alpha-tested surfaces (cards: leaves, grilles, fences), which GTAO takes as
+    // thin occluders (gtao.wgsl `THIN_CARDS`).
+    out.normal = vec4<f32>(finite_or_zero3(n), select(0.0, 1.0, ALPHA_TEST));
     out.albedo = vec4<f32>(albedo, 1.0);
     out.emission = vec4<f32>(finite_or_zero3(material.emission.rgb), 0.0);
     return out;

@@ -22,7 +22,7 @@ pub const NAME: &str = "gbuffer";
 
 /// Reversed-Z depth of every eye layer.
 pub const DEPTH: Resource = Resource::attachment("depth", Size::Full, wgpu::TextureFormat::Depth32Float);
-/// View-space unit normals (w unused).
+/// View-space unit normals; w is 1 on alpha-tested surfaces (cards), else 0.
 pub const NORMALS: Resource = Resource::attachment("normals", Size::Full, wgpu::TextureFormat::Rgba16Float);
 /// Diffuse albedo (sRGB-encoded, reads back linear).
 pub const ALBEDO: Resource = Resource::attachment("albedo", Size::Full, wgpu::TextureFormat::Rgba8UnormSrgb);

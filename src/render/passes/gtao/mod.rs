@@ -110,17 +110,16 @@ pub fn gtao_inner_band(width: u32) -> u32 {
     (width / 4).next_multiple_of(8).min(width)
 }
 
-/// GTAO's three pipelines (module docs) and its parameters.
-pub struct GtaoPass {
+/// GTAO's three pipelines (module docs) of one variant: solid occluders only, or with
+/// alpha-tested surfaces taken as thin cards (gtao.wgsl `THIN_CARDS`).
+struct Kernels {
     interior: Kernel,
     inner_band: Kernel,
     right_eye: Kernel,
-    params: wgpu::Buffer,
 }
 
-impl GtaoPass {
-    /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu) -> Self {
+impl Kernels {
+    fn new(gpu: &Gpu, thin_cards: bool) -> Self {
         let files = [COMMON, OCCLUSION_WGSL, wgsl!("src/render/passes/gtao/gtao.wgsl")];
         let label = Technique::Gtao.name();
         let kernel = |band: bool, right: bool| {
@@ -128,27 +127,43 @@ impl GtaoPass {
                 ("INNER_BAND", f64::from(band)),
                 ("RIGHT_EYE", f64::from(right)),
                 ("SINGLE_LAYER_OUTPUT", f64::from(right)),
+                ("THIN_CARDS", f64::from(thin_cards)),
             ];
             Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
         };
+        Kernels { interior: kernel(false, false), inner_band: kernel(true, false), right_eye: kernel(false, true) }
+    }
+}
+
+/// GTAO's pipelines and its parameters.
+pub struct GtaoPass {
+    solid: Kernels,
+    /// Built on the first frame of a scene with alpha-tested materials.
+    thin_cards: std::sync::OnceLock<Kernels>,
+    params: wgpu::Buffer,
+}
+
+impl GtaoPass {
+    /// Builds the pass's pipelines.
+    pub fn new(gpu: &Gpu) -> Self {
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("gtao params"),
             size: std::mem::size_of::<GtaoUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        GtaoPass {
-            interior: kernel(false, false),
-            inner_band: kernel(true, false),
-            right_eye: kernel(false, true),
-            params,
-        }
+        GtaoPass { solid: Kernels::new(gpu, false), thin_cards: std::sync::OnceLock::new(), params }
     }
 }
 
 impl Pass for GtaoPass {
     fn declare(&self, setup: &FrameSetup) -> PassDecl {
-        technique_decl(Technique::Gtao.name(), &BINDINGS, &[Technique::Gtao], setup)
+        let decl = technique_decl(Technique::Gtao.name(), &BINDINGS, &[Technique::Gtao], setup);
+        if setup.scene.is_some_and(|scene| scene.has_alpha_test()) {
+            decl.note("alpha-tested samples are cards: each blocks its footprint on the card, not a slab")
+        } else {
+            decl
+        }
     }
 
     fn record(&self, ctx: &mut FrameContext) {
@@ -167,6 +182,12 @@ impl Pass for GtaoPass {
             inner_band: band,
             padding: [0; 2],
         };
+        // The AO engine has no scene, and a host's normals mark no cards.
+        let kernels = if ctx.scene.is_some_and(|scene| scene.alpha_tested) {
+            self.thin_cards.get_or_init(|| Kernels::new(ctx.gpu, true))
+        } else {
+            &self.solid
+        };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
@@ -175,8 +196,8 @@ impl Pass for GtaoPass {
         let resources = ctx.bind(&BINDINGS, &[normals.clone(), normals, self.params.as_entire_binding()]);
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        self.interior.dispatch(device, ctx.encoder, &resources, (width - band, height, marched_layers));
-        self.inner_band.dispatch(device, ctx.encoder, &resources, (band, height, marched_layers));
+        kernels.interior.dispatch(device, ctx.encoder, &resources, (width - band, height, marched_layers));
+        kernels.inner_band.dispatch(device, ctx.encoder, &resources, (band, height, marched_layers));
         if !reuse {
             return;
         }
@@ -190,7 +211,7 @@ impl Pass for GtaoPass {
             &[view(&ao_left), view(&geometry_left), self.params.as_entire_binding()],
             &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))],
         );
-        self.right_eye.dispatch(device, ctx.encoder, &resources, (width, height, 1));
+        kernels.right_eye.dispatch(device, ctx.encoder, &resources, (width, height, 1));
     }
 }
 
