@@ -19,7 +19,8 @@
 // surface back to `thickness` × r behind it (clipped at r). Two successive samples on
 // one continuous surface (their distances closer than `connect` × r) also block the
 // angles between them: a ray that is in front of a continuous surface at one sample
-// and behind it at the next crosses it in between.
+// and behind it at the next crosses it in between. A sample on an alpha-tested surface
+// (a card, `THIN_CARDS`) blocks its share of the march on the card's plane instead.
 //
 // Samples that leave the eye's image through its inner border are looked up in the other
 // eye's layer (occlusion.wgsl `surface_at`, guessing the last sample's distance). The

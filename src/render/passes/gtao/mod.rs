@@ -1,7 +1,8 @@
 //! GTAO with a visibility bitmask (gtao.wgsl) on the shared occlusion layout, in three
 //! pipelines of one shader: the rest of the image, the band along each eye's inner
 //! border whose marches may look into the other eye, and the right eye reusing the left
-//! eye's values where it sees the same point.
+//! eye's values where it sees the same point. A scene with alpha-tested materials gets
+//! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
 use super::{FrameContext, FrameSetup, Pass};
