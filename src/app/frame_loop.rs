@@ -104,11 +104,22 @@ pub const SERIAL_EVERY: u64 = 8;
 impl FrameLoop {
     /// A loop rendering `scene` with `settings` at the headset's recommended size.
     pub fn new(gpu: Arc<Gpu>, scene: &Scene, settings: &Settings, headset: Box<dyn Headset>) -> Result<FrameLoop> {
+        let renderer = Self::renderer_for(&gpu, scene, settings, headset.as_ref())?;
+        Ok(Self::with_renderer(gpu, renderer, headset))
+    }
+
+    /// The renderer a loop for `headset` draws with: `settings` at its recommended size.
+    pub fn renderer_for(gpu: &Arc<Gpu>, scene: &Scene, settings: &Settings, headset: &dyn Headset) -> Result<Renderer> {
         let mut settings = settings.clone();
         (settings.profile.width, settings.profile.height) = headset.recommended_size();
-        let renderer = Renderer::new(gpu.clone(), scene, &settings)?;
+        Renderer::new(gpu.clone(), scene, &settings)
+    }
+
+    /// A loop drawing with `renderer` (made by [`FrameLoop::renderer_for`]) for `headset`.
+    pub fn with_renderer(gpu: Arc<Gpu>, renderer: Renderer, headset: Box<dyn Headset>) -> FrameLoop {
+        let settings = renderer.settings().clone();
         let cpu_adapter = gpu.info.device_type == wgpu::DeviceType::Cpu;
-        Ok(FrameLoop {
+        FrameLoop {
             cpu_adapter,
             in_flight: VecDeque::new(),
             scene_time_origin: None,
@@ -132,7 +143,7 @@ impl FrameLoop {
             cpu_encode_ms: Vec::new(),
             exit_requested: Arc::new(AtomicBool::new(false)),
             exit_sent: false,
-        })
+        }
     }
 
     /// Whether the loop renders on a CPU adapter (lavapipe), where some frames go to

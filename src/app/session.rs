@@ -173,16 +173,25 @@ pub fn run_session(
     };
     let (mut headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
     log::info!("headset: {message}");
-    // Interrupted while the headset opened: end its session now rather than after
-    // compiling the renderer's pipelines (a second on a CPU adapter).
-    if interrupt.load(Ordering::Relaxed) {
-        let state = headset.session_state();
-        headset.request_exit();
-        while headset.wait_frame(&gpu)?.is_some_and(|request| headset.submit(&gpu, &request, None).is_ok()) {}
-        headset.end(&gpu)?;
-        return Ok(RunSummary::before_frames(headset.as_ref(), &gpu, &settings, state, options.frames_in_flight));
-    }
-    let mut frame_loop = FrameLoop::new(gpu, scene, &settings, headset)?;
+    // Interrupted while the headset opened, or while the renderer compiled its pipelines
+    // (up to 2 s on a CPU adapter; the interrupt cuts that short): end the session now.
+    gpu.cancel_builds_on(interrupt.clone());
+    let renderer = if interrupt.load(Ordering::Relaxed) {
+        Err(Error::Interrupted)
+    } else {
+        FrameLoop::renderer_for(&gpu, scene, &settings, headset.as_ref())
+    };
+    let renderer = match renderer {
+        Err(Error::Interrupted) => {
+            let state = headset.session_state();
+            headset.request_exit();
+            while headset.wait_frame(&gpu)?.is_some_and(|request| headset.submit(&gpu, &request, None).is_ok()) {}
+            headset.end(&gpu)?;
+            return Ok(RunSummary::before_frames(headset.as_ref(), &gpu, &settings, state, options.frames_in_flight));
+        }
+        renderer => renderer?,
+    };
+    let mut frame_loop = FrameLoop::with_renderer(gpu, renderer, headset);
     frame_loop.frame_limit = frames;
     frame_loop.exit_requested = interrupt;
     frame_loop.renderer.set_frames_in_flight(options.frames_in_flight);

@@ -44,6 +44,10 @@ pub enum Error {
     /// embedder added), not in the input or the GPU.
     #[error("frame graph: {0}")]
     Plan(String),
+    /// Building was cut short by the caller's cancellation token
+    /// ([`crate::Gpu::cancel_builds_on`]).
+    #[error("interrupted")]
+    Interrupted,
     /// The run finished but did not fit its frame budget (`vrao budget`).
     #[error("{0}")]
     OverBudget(String),
@@ -71,13 +75,16 @@ impl Error {
     pub fn at_line(file: &Path, line: usize, message: impl Into<String>) -> Self {
         Error::Input { file: Some(file.to_path_buf()), line: Some(line), message: message.into() }
     }
-    /// The process exit code for this error: 2 bad input/device/output, 1 GPU failure, 3 over budget.
+    /// The process exit code for this error: 2 bad input/device/output, 1 GPU failure, 3 over
+    /// budget, 130 interrupted.
     pub fn exit_code(&self) -> i32 {
         match self {
             // An output that cannot be written is the path the user gave (or its disk).
             Error::Input { .. } | Error::Device(_) | Error::Unavailable(_) | Error::Output { .. } => EXIT_INPUT,
             Error::Gpu(_) | Error::Plan(_) => 1,
             Error::OverBudget(_) => EXIT_OVER_BUDGET,
+            // The shell's code for a process ended by SIGINT.
+            Error::Interrupted => 130,
         }
     }
 }

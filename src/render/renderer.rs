@@ -189,6 +189,9 @@ impl Renderer {
         let scene_passes = passes::scene_passes(&gpu, scene, &gpu_scene, &frame);
         let ao = AoEngine::with_light_gathering(gpu.clone(), vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]);
         let output_passes = passes::output_passes(&gpu);
+        if gpu.builds_cancelled() {
+            return Err(Error::Interrupted);
+        }
         // A shader file VRAO_SHADER_DIR names but that cannot be read is the error here.
         crate::render::gpu::kernel::take_shader_error()?;
         let timer = PassTimer::new(&gpu)?;

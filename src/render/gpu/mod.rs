@@ -57,6 +57,8 @@ pub struct Gpu {
     /// The first wgpu error no scope caught (validation, out of memory, lost device):
     /// kept here instead of wgpu's default panic, and returned by [`Gpu::take_error`].
     uncaptured: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// The caller's cancellation token for building pipelines ([`Gpu::cancel_builds_on`]).
+    build_interrupt: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Gpu {
@@ -155,6 +157,7 @@ impl Gpu {
             device,
             queue,
             uncaptured,
+            build_interrupt: std::sync::OnceLock::new(),
         };
         gpu.caps.multiview_reliable = gpu.caps.multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
         Ok(gpu)
@@ -176,6 +179,7 @@ impl Gpu {
             device: device.clone(),
             queue: queue.clone(),
             uncaptured: std::sync::Arc::new(std::sync::Mutex::new(None)),
+            build_interrupt: std::sync::OnceLock::new(),
         })
     }
 
@@ -187,6 +191,20 @@ impl Gpu {
             timestamps: features
                 .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
         }
+    }
+
+    /// Lets `interrupt` (the caller's Ctrl-C flag) cut short the building of pipelines on
+    /// this device: once it is set, each kernel compiles a stand-in of no work instead of
+    /// its shader (a CPU adapter takes up to a second and a half for a renderer's), and
+    /// [`crate::Renderer::new`] returns [`crate::Error::Interrupted`]. Only the first
+    /// token given counts.
+    pub fn cancel_builds_on(&self, interrupt: std::sync::Arc<std::sync::atomic::AtomicBool>) {
+        let _ = self.build_interrupt.set(interrupt);
+    }
+
+    /// Whether the token of [`Gpu::cancel_builds_on`] is set.
+    pub fn builds_cancelled(&self) -> bool {
+        self.build_interrupt.get().is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// The first GPU error since the last call, as `Error::Gpu` (then cleared).
