@@ -45,7 +45,7 @@ pub enum Error {
     #[error("frame graph: {0}")]
     Plan(String),
     /// Building was cut short by the caller's cancellation token
-    /// ([`crate::Gpu::cancel_builds_on`]).
+    /// ([`crate::render::gpu::Gpu::cancel_builds_on`]).
     #[error("interrupted")]
     Interrupted,
     /// The run finished but did not fit its frame budget (`vrao budget`).

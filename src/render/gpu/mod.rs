@@ -195,9 +195,9 @@ impl Gpu {
 
     /// Lets `interrupt` (the caller's Ctrl-C flag) cut short the building of pipelines on
     /// this device: once it is set, each kernel compiles a stand-in of no work instead of
-    /// its shader (a CPU adapter takes up to a second and a half for a renderer's), and
-    /// [`crate::Renderer::new`] returns [`crate::Error::Interrupted`]. Only the first
-    /// token given counts.
+    /// its shader (a CPU adapter takes up to two seconds for a renderer's), and
+    /// [`crate::render::renderer::Renderer::new`] returns
+    /// [`crate::render::error::Error::Interrupted`]. Only the first token given counts.
     pub fn cancel_builds_on(&self, interrupt: std::sync::Arc<std::sync::atomic::AtomicBool>) {
         let _ = self.build_interrupt.set(interrupt);
     }

@@ -183,11 +183,14 @@ impl Pass for GtaoPass {
             inner_band: band,
             padding: [0; 2],
         };
-        // The AO engine has no scene, and a host's normals mark no cards.
-        let kernels = if ctx.scene.is_some_and(|scene| scene.alpha_tested) {
-            self.thin_cards.get_or_init(|| Kernels::new(ctx.gpu, true))
-        } else {
-            &self.solid
+        // The AO engine has no scene, and a host's normals mark no cards. Once the
+        // caller's interrupt cuts builds short, kernels built now would be stand-ins for
+        // good: the last frames of an ending session take samples as solid instead.
+        let cards = ctx.scene.is_some_and(|scene| scene.alpha_tested);
+        let kernels = match self.thin_cards.get() {
+            Some(kernels) if cards => kernels,
+            None if cards && !ctx.gpu.builds_cancelled() => self.thin_cards.get_or_init(|| Kernels::new(ctx.gpu, true)),
+            _ => &self.solid,
         };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts; with two
