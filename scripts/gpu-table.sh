@@ -24,7 +24,13 @@ icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$icd" ]; then export VK_DRIVER_FILES="$icd"; fi
 mkdir -p "$out"
 out=$(realpath "$out")
-"$bin" info | tee "$out/info.txt"
+# Bounded: on one fresh device machine the first Vulkan start never returned (the next
+# machine answered in under a second), and a table run would have waited on it for good.
+if ! timeout 120 "$bin" info > "$out/info.txt"; then
+  echo "$bin info: no Vulkan adapter opened within 120 s (or it failed); see $out/info.txt and run again" >&2
+  exit 1
+fi
+cat "$out/info.txt"
 # From the repository root: the default scenes name assets/scenes/sibenik.toml.
 cd "$repo"
 VRAO_SCENES="$scenes" "$bin" table --out "$out/gpu-table.md" "$@" 2>&1 | tee "$out/gpu-table.log"
