@@ -1130,8 +1130,8 @@ fn every_pixel_is_computed_in_both_eyes() {
 }
 
 /// The right eye takes the left eye's value wherever the left eye sees the same surface
-/// point: GTAO's march, and at half resolution every technique's denoise (its vertical
-/// pass) and the AO-only techniques' upsample. The share of stereo-inconsistent points
+/// point: GTAO's march, and at half resolution the AO-only techniques' upsample (SSDO's
+/// denoise, its vertical pass). The share of stereo-inconsistent points
 /// (the bench's measure: AO differing by more than 0.02 between the eyes,
 /// `vrao::measure::stereo_consistency`) falls below ½ of what it is with independent eyes
 /// (measured on the furnished room: GTAO full 1.8 → 0.9 %, half 3.3 → 0.5 %; SSAO half,

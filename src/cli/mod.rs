@@ -87,7 +87,7 @@ pub struct GtaoArgs {
     gtao: GtaoSettings,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
     /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
-    /// every technique's denoise, and the upsampled AO of all but SSDO).
+    /// the upsampled AO, or SSDO's denoise).
     #[arg(long)]
     independent_eyes: bool,
 }

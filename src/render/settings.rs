@@ -383,8 +383,8 @@ pub struct AoSettings {
     pub gtao: GtaoSettings,
     /// With two views, the right eye takes the left eye's value wherever the left eye
     /// sees the same surface point: GTAO's march (the right eye marches only the rest and
-    /// costs a fraction) and, at half resolution, every technique's denoise (its vertical
-    /// pass) and the AO-only techniques' upsample (`passes::upsample::reuses_left_eye_upsample`).
+    /// costs a fraction) and, at half resolution, the AO-only techniques' upsample
+    /// (`passes::upsample::reuses_left_eye_upsample`) or SSDO's denoise (its vertical pass).
     /// Off: each eye computes everything alone.
     pub stereo_reuse: bool,
     /// Fixed foveated occlusion: fewer samples towards each eye's image edges.

@@ -124,14 +124,21 @@ impl Pass for BlurPass {
             Denoise::Tile => ((w.div_ceil(DENOISE_RUN), h, layers), (w, h.div_ceil(DENOISE_RUN))),
             Denoise::Bilateral => ((w, h, layers), (w, h)),
         };
-        // At half resolution only: there each eye upsamples from its own grid and the eyes
-        // drifted apart (furnished, 540×600: 2.0 % of the points both see differ by more
-        // than 0.02; 1.3 % with the reuse, at a cost within the timing noise; the right
-        // eye's upsample reuses the left eye's too for AO-only techniques, and SSDO's
-        // values feed the right eye's own upsample where the left eye does not see). At full
-        // resolution they already agree (Sibenik 1080×1200: 0.5 %) and the reuse's lookups
-        // cost a fifth of the denoise (80–101 against 64–84 ms per eye, lavapipe).
-        let reuse = ao.stereo_reuse && ao.half_res && layers == 2;
+        // At half resolution only, and only for SSDO: there each eye upsamples from its
+        // own grid and the eyes drifted apart (furnished, 540×600: 2.0 % of the points both
+        // see differ by more than 0.02; 1.3 % with this reuse). For the AO-only techniques
+        // the upsampling reuses the left eye's final AO where it sees the same point
+        // (upsample::reuses_left_eye_upsample), which makes this reuse redundant: without
+        // it, 0.24–0.66 % of the points differ against 0.21–0.65 % with it (gtao and ssao,
+        // furnished and Sibenik, three radii), and on an H200 its extra right-eye dispatch
+        // cost the stereo denoise 1.76× the left eye's against 1.50× (docs/gpu-table-h200.md).
+        // At full resolution the eyes already agree (Sibenik 1080×1200: 0.5 %) and the
+        // reuse's lookups cost a fifth of the denoise (80–101 against 64–84 ms per eye,
+        // lavapipe).
+        let reuse = ao.stereo_reuse
+            && ao.half_res
+            && layers == 2
+            && !super::upsample::reuses_left_eye_upsample(&ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
         // Binding 6 is unused before the right eye's vertical dispatch: the geometry stands in.
         let stand_in = [ctx.view(AO_GEOMETRY)];
