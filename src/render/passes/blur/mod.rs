@@ -138,7 +138,7 @@ impl Pass for BlurPass {
         let reuse = ao.stereo_reuse
             && ao.half_res
             && layers == 2
-            && !super::upsample::reuses_left_eye_upsample(&ctx.setup.settings, layers);
+            && !super::upsample::reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
         // Binding 6 is unused before the right eye's vertical dispatch: the geometry stands in.
         let stand_in = [ctx.view(AO_GEOMETRY)];
