@@ -67,12 +67,15 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
 
 /// The full-resolution record of the same technique and setting as `half`.
 fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -> Option<&'a BenchRecord> {
-    let h = half;
     records.iter().find(|f| {
-        f.resolution == Resolution::Full
-            && (f.technique.as_str(), f.samples, f.radius_m, f.depth_peeling, f.temporal, f.foveation)
-                == (h.technique.as_str(), h.samples, h.radius_m, h.depth_peeling, h.temporal, h.foveation)
+        f.resolution == Resolution::Full && f.foveation == half.foveation && sweep_case(f) == sweep_case(half)
     })
+}
+
+/// A record's sweep axes but its resolution and foveation, the two that the partner
+/// lookups (the same case at full resolution, the same case unfoveated) vary.
+fn sweep_case(r: &BenchRecord) -> (&str, u32, f32, bool, bool) {
+    (r.technique.as_str(), r.samples, r.radius_m, r.depth_peeling, r.temporal)
 }
 
 /// Marks each record on the Pareto front of AO RMSE against occlusion ms per eye. Each
@@ -552,11 +555,9 @@ fn chain_ms_per_eye(r: &BenchRecord) -> f64 {
 fn foveation_markdown(records: &[BenchRecord]) -> String {
     let mut table = String::new();
     for r in records.iter().filter(|r| r.foveation != Foveation::Off) {
-        let off = records.iter().find(|b| {
-            b.foveation == Foveation::Off
-                && (b.technique.as_str(), b.samples, b.radius_m, b.resolution, b.depth_peeling, b.temporal)
-                    == (r.technique.as_str(), r.samples, r.radius_m, r.resolution, r.depth_peeling, r.temporal)
-        });
+        let off = records
+            .iter()
+            .find(|b| b.foveation == Foveation::Off && b.resolution == r.resolution && sweep_case(b) == sweep_case(r));
         let Some(off) = off else { continue };
         let difference = |a: Option<f64>, b: Option<f64>| match (a, b) {
             (Some(a), Some(b)) => format!("{:+.4}", a - b),
