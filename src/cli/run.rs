@@ -127,7 +127,7 @@ fn interrupt_on_ctrl_c() -> Arc<AtomicBool> {
     let flag = interrupt.clone();
     let installed = ctrlc::set_handler(move || {
         if flag.swap(true, Ordering::Relaxed) {
-            std::process::exit(130);
+            std::process::exit(vrao::render::error::EXIT_INTERRUPTED);
         }
         eprintln!("interrupted: ending the session (again to stop at once)");
     });

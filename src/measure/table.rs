@@ -16,7 +16,7 @@ use crate::render::passes::{blur, composite, shadow};
 use crate::render::renderer::{Renderer, TimingChoice};
 use crate::render::scene::Scene;
 use crate::render::settings::{AoSettings, Foveation, Quality, Settings, ShadowSettings, Technique};
-use crate::render::stereo::HeadsetProfile;
+use crate::render::stereo::{EyePair, HeadsetProfile};
 use std::fmt::Write as _;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -346,7 +346,7 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
 
 /// Renders rounds of `how` unmeasured until the device has worked for [`SETTLE_TIME`]
 /// (or [`SETTLE_MAX_ROUNDS`] rounds): its clocks up, its caches and allocations warm.
-fn settle(renderer: &mut Renderer, eyes: &crate::render::stereo::EyePair, how: BudgetRun) -> Result<()> {
+fn settle(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<()> {
     let start = Instant::now();
     let one_round = BudgetRun { warmup: 0, frames: 1, ..how };
     for _ in 0..SETTLE_MAX_ROUNDS {

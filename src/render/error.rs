@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 pub const EXIT_INPUT: i32 = 2;
 /// Exit code for a run that finished but did not fit its frame budget.
 pub const EXIT_OVER_BUDGET: i32 = 3;
+/// Exit code for a run ended by Ctrl-C (SIGINT): the shell's code for such a process.
+pub const EXIT_INTERRUPTED: i32 = 130;
 
 /// Every failure vrao reports; each maps to a process exit code ([`Error::exit_code`]).
 #[derive(Debug, thiserror::Error)]
@@ -83,8 +85,7 @@ impl Error {
             Error::Input { .. } | Error::Device(_) | Error::Unavailable(_) | Error::Output { .. } => EXIT_INPUT,
             Error::Gpu(_) | Error::Plan(_) => 1,
             Error::OverBudget(_) => EXIT_OVER_BUDGET,
-            // The shell's code for a process ended by SIGINT.
-            Error::Interrupted => 130,
+            Error::Interrupted => EXIT_INTERRUPTED,
         }
     }
 }
