@@ -16,8 +16,8 @@
 use glam::{DVec3, Vec2, Vec3};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use vrao::render::scene::gltf::write::{write, WriteOptions};
 use vrao::render::scene::{AlphaMode, HeadPath, Light, Material, Mesh, Scene, Texture};
+use vrao::test_assets::gltf_write::{write, WriteOptions};
 use vrao::HeadPose;
 
 /// Cells per side of the grille's checker.

@@ -1,25 +1,27 @@
-//! vrao: a stereo VR renderer for screen-space ambient occlusion on wgpu.
+//! vrao, the application: the `vrao` binary's library. It drives the renderer
+//! (`vrao-render`, built on the AO engine `vrao-ao`) on OpenXR and simulated headsets with
+//! a desktop mirror, and measures it against a ray-traced reference.
 //!
-//! The library is usable without the CLI: load a [`Scene`], open a [`Gpu`], make a
-//! [`Renderer`] with [`Settings`], and render an [`EyePair`] into layered targets.
+//! Folders with a dependency rule (checked by `tests/layout.rs`): `xr` (headsets) imports
+//! only the renderer; `app` (the frame loop, governor and window) and `measure`
+//! (reference, metrics, bench, studies) import the renderer and `xr` but not each other;
+//! `formats` (the bench file, still images, writers) and `test_assets` are shared. The
+//! CLI (`src/cli/`) is the binary's. [`render`] is the renderer crate under the name these
+//! modules use.
 //!
-//! Four folders with a dependency rule (checked by `tests/layout.rs`): [`render`]
-//! imports none of the others; `xr` (headsets) imports only `render`; `app` (the frame
-//! loop, governor and window) and `measure` (reference, metrics, bench, studies) import
-//! `render` and `xr` but not each other. The CLI (`src/cli/`) is the binary's.
-//!
-//! Cargo features: [`render`] is always built and needs only wgpu, the scene and image
-//! loaders and serde. `app` (default) adds `app`, `measure` and `xr` with what they use
+//! Cargo features: `app` (default) adds `app`, `measure` and `xr` with what they use
 //! (winit, egui, clap, the reference tracer's rayon and BVH, the bench's plots and FLIP);
 //! the `vrao` binary needs it. `xr` (default, implies `app`) adds the OpenXR headset.
-//! `testing` adds the test oracle `measure::analytic` (with `app`). The renderer alone:
-//! `vrao = { version = "0.1", default-features = false }`.
+//! `gltf` (default) reads glTF scenes. `testing` adds the test oracle
+//! `measure::analytic` (with `app`).
 
 #[cfg(feature = "app")]
 pub mod app;
+pub mod formats;
 #[cfg(feature = "app")]
 pub mod measure;
 pub mod render;
+pub mod test_assets;
 #[cfg(feature = "app")]
 pub mod xr;
 

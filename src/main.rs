@@ -3,6 +3,7 @@
 mod cli;
 
 use clap::{CommandFactory, Parser, Subcommand};
+use cli::choice;
 use std::process::ExitCode;
 use vrao::BackendChoice;
 
@@ -10,7 +11,7 @@ use vrao::BackendChoice;
 #[command(name = "vrao", version, about = "Stereo VR ambient-occlusion renderer (SSAO, HBAO, GTAO, SSDO) on wgpu")]
 struct Cli {
     /// Graphics backend: auto (a real GPU if present, else lavapipe), vulkan or gl.
-    #[arg(long, global = true, default_value = "auto", hide_possible_values = true)]
+    #[arg(value_parser = choice::<BackendChoice>(), long, global = true, default_value = "auto", hide_possible_values = true)]
     backend: BackendChoice,
     #[command(subcommand)]
     command: Option<Command>,

@@ -3,7 +3,7 @@
 //! the same geometry from the same eyes. One implementation: they must agree.
 
 mod common;
-#[path = "../examples/embed/host.rs"]
+#[path = "../crates/vrao-ao/examples/embed/host.rs"]
 mod host;
 
 use glam::DVec3;

@@ -59,7 +59,7 @@ fn floor_ao_under_the_grille_holes_and_solid_cells_against_the_reference() {
     let dir = common::temp_dir("grille");
     let builtin = Scene::load("builtin:grille").unwrap();
     let glb = dir.join("grille.glb");
-    vrao::render::scene::gltf::write::write(&builtin, &glb, &Default::default()).unwrap();
+    vrao::test_assets::gltf_write::write(&builtin, &glb, &Default::default()).unwrap();
     let mut obj = Scene::load(grille_obj(&dir).to_str().unwrap()).unwrap();
     obj.head = builtin.head.clone();
     let mut from_glb = Scene::load(glb.to_str().unwrap()).unwrap();

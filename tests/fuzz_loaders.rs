@@ -7,7 +7,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
-use vrao::render::scene::fuzz::{load_bytes, Mutator, Target, VALID_GLTF, VALID_MTL, VALID_OBJ, VALID_SCENE};
+use vrao::test_assets::fuzz::{load_bytes, Mutator, Target, VALID_GLTF, VALID_MTL, VALID_OBJ, VALID_SCENE};
 
 /// Time per target; `VRAO_FUZZ_SECONDS` overrides it for longer runs.
 fn budget() -> Duration {
@@ -38,7 +38,7 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
             // The same content as a .glb container, as vrao's writer makes it.
             let glb = scratch("glb-seed").join("seed.glb");
             let scene = vrao::render::scene::Scene::load("builtin:furnished").unwrap();
-            vrao::render::scene::gltf::write::write(&scene, &glb, &Default::default()).unwrap();
+            vrao::test_assets::gltf_write::write(&scene, &glb, &Default::default()).unwrap();
             seeds.push(std::fs::read(glb).unwrap());
         }
     }
@@ -129,7 +129,7 @@ fn every_saved_regression_input_loads_or_errs_without_a_panic() {
 #[test]
 fn mutated_bench_files_are_refused_or_load_in_range_without_a_panic() {
     use vrao::app::governor::Frontier;
-    use vrao::render::bench_file::BenchFile;
+    use vrao::formats::bench_file::BenchFile;
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
     let seed = include_bytes!("../assets/governor/frontier.json").to_vec();

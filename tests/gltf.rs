@@ -8,10 +8,10 @@ mod common;
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use vrao::render::scene::gltf::write::{encode_base64, write, IndexType, Storage, TexcoordType, WriteOptions};
 use vrao::render::scene::{
     AlphaMode, HeadPath, Interpolation, Light, Material, Node, NodeTracks, Scene, Texture, Track, Trs,
 };
+use vrao::test_assets::gltf_write::{encode_base64, write, IndexType, Storage, TexcoordType, WriteOptions};
 use vrao::HeadPose;
 
 /// A 4×4 checker whose dark cells are transparent.

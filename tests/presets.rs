@@ -132,7 +132,7 @@ fn black_surface_pixels(frame: &Frame) -> Vec<(usize, usize)> {
 fn check_view(gpu: &Arc<Gpu>, view: &View) -> Vec<String> {
     let base = Settings {
         profile: HeadsetProfile::with_size("test", view.size.0, view.size.1),
-        ao: AoSettings::fitted_to(&view.scene),
+        ao: vrao::render::settings::ao_fitted_to(&view.scene),
         ..Settings::default()
     };
     let none = Settings { ao: AoSettings { technique: Technique::None, ..base.ao.clone() }, ..base.clone() };

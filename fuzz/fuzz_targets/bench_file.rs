@@ -4,7 +4,7 @@
 //! record in range.
 
 use libfuzzer_sys::fuzz_target;
-use vrao::render::bench_file::BenchFile;
+use vrao::formats::bench_file::BenchFile;
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);

@@ -24,7 +24,7 @@
 //! predicted of its first frame as a factor on later predictions, so the same load does
 //! not try that raise again.
 
-use crate::render::bench_file::{BenchFile, BenchRecord};
+use crate::formats::bench_file::{BenchFile, BenchRecord};
 use crate::render::error::{Error, Result};
 use crate::render::settings::{AoSettings, Foveation, Technique};
 use serde::Serialize;

@@ -2,9 +2,9 @@
 
 use crate::app::governor::GovernorChange;
 use crate::app::{FrameLoop, SERIAL_EVERY};
-use crate::render::bench_file::Resolution;
-use crate::render::gpu::timing::summarize;
-use crate::render::output::significant;
+use crate::formats::bench_file::Resolution;
+use crate::formats::output::significant;
+use crate::formats::spans::summarize;
 use crate::render::settings::AoSettings;
 use crate::render::stats;
 use std::sync::atomic::Ordering;

@@ -1,7 +1,7 @@
 //! `vrao bench`: sweep technique × samples × radius × resolution, timed and scored
 //! against the reference tracer.
 
-use super::{parse_budget_ms, GtaoArgs, SCENE_HELP};
+use super::{choice, parse_budget_ms, GtaoArgs, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
@@ -43,7 +43,7 @@ pub struct BenchArgs {
     #[arg(long, default_value = RENDER_DEFAULT, help = SCENE_HELP)]
     scene: String,
     /// Techniques to sweep, comma-separated (by default every estimator, gtao first).
-    #[arg(long, value_delimiter = ',', value_enum, default_values_t = Technique::estimators(), hide_possible_values = true)]
+    #[arg(value_parser = choice::<Technique>(), long, value_delimiter = ',', default_values_t = Technique::estimators(), hide_possible_values = true)]
     techniques: Vec<Technique>,
     /// Sample counts, comma-separated, each 1..=256 (by default the presets' counts, the
     /// grid of Belonogov 2018).
@@ -65,7 +65,7 @@ pub struct BenchArgs {
     temporal: Sweep,
     /// Fixed foveation levels to sweep, comma-separated: off, low, high (each row also
     /// gets its RMSE within 10° of each eye's view axis, where foveation keeps full rate).
-    #[arg(long, value_delimiter = ',', value_enum, default_values_t = [Foveation::Off], hide_possible_values = true)]
+    #[arg(value_parser = choice::<Foveation>(), long, value_delimiter = ',', default_values_t = [Foveation::Off], hide_possible_values = true)]
     foveation: Vec<Foveation>,
     /// Also measure reflective shadow maps (one bounce of the directional lights) with
     /// these VPL counts (each 1..=1024), comma-separated, gathering within each radius: rows "rsm", whose
@@ -81,13 +81,13 @@ pub struct BenchArgs {
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
     /// eq. 2).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
+    #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
     bounce_form: BounceForm,
     #[command(flatten)]
     gtao: GtaoArgs,
     /// Spatial denoise of every row: tile (edge-aware, 5 taps per axis over the 4×4 noise
     /// tile) or bilateral (11×11 at --blur 5).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Denoise>(), long, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
     denoise: Denoise,
     /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
     #[arg(long, default_value_t = AoSettings::default().blur_radius)]
@@ -112,7 +112,7 @@ pub struct BenchArgs {
     /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one
     /// submission per pass, wall clock) or auto (serial on CPU adapters such as lavapipe,
     /// whose timestamps misattribute work between passes; pipelined on GPUs).
-    #[arg(long, default_value = "auto", hide_possible_values = true)]
+    #[arg(value_parser = choice::<TimingChoice>(), long, default_value = "auto", hide_possible_values = true)]
     timing: TimingChoice,
     /// Output directory for bench.csv, bench.json, bench.md and bench.png.
     #[arg(long, default_value = "bench")]
@@ -140,7 +140,7 @@ pub struct BenchArgs {
 
 pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     // An output folder that cannot be written fails now, not after the sweep.
-    vrao::render::output::check_output_folder(&args.out)?;
+    vrao::formats::output::check_output_folder(&args.out)?;
     let run = match &args.replot {
         Some(path) => replot(path)?,
         None => {

@@ -1,6 +1,6 @@
 //! `vrao budget`: per-pass medians of one setting against the frame budget (exit 3 over it).
 
-use super::{parse_budget_ms, AoArgs, SCENE_HELP};
+use super::{choice, parse_budget_ms, AoArgs, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::budget::{measure_budget, BudgetOptions};
@@ -40,7 +40,7 @@ pub struct BudgetArgs {
     #[arg(long, default_value = "frame", hide_possible_values = true)]
     measure: Measure,
     /// Timing: pipelined, serial or auto (serial on CPU adapters).
-    #[arg(long, default_value = "auto", hide_possible_values = true)]
+    #[arg(value_parser = choice::<TimingChoice>(), long, default_value = "auto", hide_possible_values = true)]
     timing: TimingChoice,
     /// Pick the occlusion setting from this bench JSON (made by `vrao bench` on this
     /// device) with the least error that fits the budget, then measure it.
@@ -55,7 +55,7 @@ pub struct BudgetArgs {
 
 pub fn run(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
     // A report that cannot be written fails now, not after the measurement.
-    vrao::render::output::check_output_file(&args.out)?;
+    vrao::formats::output::check_output_file(&args.out)?;
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
     let options = BudgetOptions {
@@ -73,7 +73,7 @@ pub fn run(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
         fit.notes.iter().for_each(|n| println!("{n}"));
     }
     print!("{}", outcome.report.to_text());
-    vrao::render::output::write_json(&args.out, &outcome.report)?;
+    vrao::formats::output::write_json(&args.out, &outcome.report)?;
     println!("wrote {}", args.out.display());
     outcome.report.over_budget().map_or(Ok(()), Err)
 }

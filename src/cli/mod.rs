@@ -10,9 +10,19 @@ pub mod run;
 pub mod table;
 pub mod temporal;
 
+/// A clap value parser for a setting chosen by name ([`Choice`]): the engine and the
+/// renderer have no command line, so the CLI offers their settings' names itself.
+pub fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
+    let values =
+        T::all().iter().map(|v| clap::builder::PossibleValue::new(v.name()).aliases(v.aliases().iter().copied()));
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(values).map(|name| T::from_name(&name).expect("clap checked the name"))
+}
+
 use clap::Args;
 use glam::DVec3;
 use vrao::render::passes::shadow::suggested_rsm_radius;
+use vrao::render::settings::Choice;
 use vrao::render::settings::{
     AoSettings, BounceForm, Denoise, Foveation, GtaoSettings, Noise, Quality, ShadowSettings, Technique, Temporal,
     TemporalBlend, AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL,
@@ -83,8 +93,19 @@ impl LightArgs {
 /// commands and the bench).
 #[derive(Args, Clone)]
 pub struct GtaoArgs {
-    #[command(flatten)]
-    gtao: GtaoSettings,
+    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
+    /// radius (thin objects stop occluding behind themselves).
+    #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().thickness)]
+    thickness: f32,
+    /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
+    /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
+    #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().step_power)]
+    step_power: f32,
+    /// GTAO: successive samples whose distances differ by less than this fraction of the
+    /// radius lie on one continuous surface, which also blocks the angles between them
+    /// (0: never).
+    #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().connect)]
+    connect: f32,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
     /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
     /// the upsampled AO, or SSDO's denoise).
@@ -93,8 +114,13 @@ pub struct GtaoArgs {
 }
 
 impl GtaoArgs {
+    /// GTAO's own settings as given.
+    pub fn settings(&self) -> GtaoSettings {
+        GtaoSettings { thickness: self.thickness, step_power: self.step_power, connect: self.connect }
+    }
+
     pub fn apply(&self, ao: &mut AoSettings) {
-        ao.gtao = self.gtao.clone();
+        ao.gtao = self.settings();
         ao.stereo_reuse = !self.independent_eyes;
     }
 }
@@ -107,10 +133,10 @@ pub struct AoArgs {
     /// Occlusion technique: none, ssao, hbao, gtao (the default: the most accurate per
     /// millisecond), ssdo, ssdo-bounce or fetch-only (the benchmark baseline with SSAO's
     /// depth taps and no occlusion arithmetic).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().technique, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Technique>(), long, default_value_t = AoSettings::default().technique, hide_possible_values = true)]
     technique: Technique,
     /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
-    #[arg(long, value_enum, default_value_t = Quality::default(), hide_possible_values = true)]
+    #[arg(value_parser = choice::<Quality>(), long, default_value_t = Quality::default(), hide_possible_values = true)]
     quality: Quality,
     /// Depth taps per pixel, 1..=256 (overrides --quality).
     #[arg(long)]
@@ -129,14 +155,14 @@ pub struct AoArgs {
     /// How the bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
     /// the receiver cosine) or patch (Ritschel et al. 2009 eq. 2: area π r²/N, both
     /// cosines, 1/d²).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
+    #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
     bounce_form: BounceForm,
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
     half_res: bool,
     /// Fixed foveated occlusion: off, low (full rate within 25° of each eye's view axis,
     /// half the samples from 40°) or high (full within 15°, half from 30°).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().foveation, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Foveation>(), long, default_value_t = AoSettings::default().foveation, hide_possible_values = true)]
     foveation: Foveation,
     /// SSDO quality mode (Ritschel et al. 2009 §4): peel a second depth layer per eye; a
     /// sample then occludes only inside an object (between the layers), which removes the
@@ -145,7 +171,7 @@ pub struct AoArgs {
     depth_peeling: bool,
     /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
     /// bilateral (separable, --blur px either side).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Denoise>(), long, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
     denoise: Denoise,
     /// Bilateral blur radius in full-resolution pixels, 0..=16 (5 = 11×11); 0 turns any
     /// denoise off.
@@ -155,7 +181,7 @@ pub struct AoArgs {
     #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().blur_plane_sigma)]
     blur_sigma: f32,
     /// Kernel rotation per pixel: halton (per-pixel low-discrepancy) or tiled (5×5 tile).
-    #[arg(long, value_enum, default_value_t = AoSettings::default().noise, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Noise>(), long, default_value_t = AoSettings::default().noise, hide_possible_values = true)]
     noise: Noise,
     #[command(flatten)]
     gtao: GtaoArgs,
@@ -172,7 +198,7 @@ pub struct AoArgs {
     temporal_epsilon: f32,
     /// Temporal blend: average (running mean) or confidence (the history weighed by how
     /// well it agrees with the new frame).
-    #[arg(long, value_enum, default_value_t = Temporal::default().blend, hide_possible_values = true)]
+    #[arg(value_parser = choice::<TemporalBlend>(), long, default_value_t = Temporal::default().blend, hide_possible_values = true)]
     temporal_blend: TemporalBlend,
     /// Frames after which a pixel counts as converged, 1..=1024.
     #[arg(long, default_value_t = Temporal::default().max_frames)]
@@ -234,7 +260,7 @@ impl AoArgs {
                 object_motion: !self.temporal_eyes_only,
                 ..Default::default()
             },
-            gtao: self.gtao.gtao.clone(),
+            gtao: self.gtao.settings(),
             stereo_reuse: !self.gtao.independent_eyes,
             foveation: self.foveation,
         }

@@ -1,13 +1,13 @@
 //! `vrao render`: both eyes of a scene as PNG files.
 
-use super::{parse_vec3, AoArgs, SCENE_HELP};
+use super::{choice, parse_vec3, AoArgs, SCENE_HELP};
 use clap::Args;
 use glam::DVec3;
 use std::path::PathBuf;
+use vrao::formats::still::{render_still, StillOptions};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::HeadPath;
 use vrao::render::settings::{DEFAULT_EXPOSURE, DEFAULT_WHITE_POINT};
-use vrao::render::still::{render_still, StillOptions};
 use vrao::{BackendChoice, Error, HeadPose, HeadsetProfile, Result, Scene, Settings, StereoMode};
 
 #[derive(Args)]
@@ -31,7 +31,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, requires = "eye", allow_hyphen_values = true)]
     look_at: Option<DVec3>,
     /// Stereo G-buffer path: auto, multiview or multipass.
-    #[arg(long, value_enum, default_value_t = StereoMode::default(), hide_possible_values = true)]
+    #[arg(value_parser = choice::<StereoMode>(), long, default_value_t = StereoMode::default(), hide_possible_values = true)]
     stereo: StereoMode,
     /// Per-eye width in pixels, 1..=8192 (Vive-class default).
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
@@ -47,7 +47,7 @@ pub struct RenderArgs {
     exposure: f32,
     /// Timing with --frames: pipelined (GPU timestamps), serial (also wall clock per
     /// pass) or auto (serial on CPU adapters, pipelined on GPUs).
-    #[arg(long, default_value = "pipelined", hide_possible_values = true)]
+    #[arg(value_parser = choice::<TimingChoice>(), long, default_value = "pipelined", hide_possible_values = true)]
     timing: TimingChoice,
     /// Render this many frames and report per-pass GPU medians (with --explain); the
     /// first frames are warm-up and not counted. 1..=100000.

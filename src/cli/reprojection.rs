@@ -25,7 +25,7 @@ pub struct ReprojectionArgs {
 
 pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     if let Some(out) = &args.out {
-        vrao::render::output::check_output_file(out)?;
+        vrao::formats::output::check_output_file(out)?;
     }
     let scene = Scene::load(&args.scene)?;
     let settings = args.ao.eye_settings(&scene, args.width, args.height);
@@ -43,7 +43,7 @@ pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     );
     print!("{}", to_markdown(&rows));
     match &args.out {
-        Some(path) => vrao::render::output::write_json(path, &rows),
+        Some(path) => vrao::formats::output::write_json(path, &rows),
         None => Ok(()),
     }
 }

@@ -1,6 +1,6 @@
 //! `vrao run`: a headset session (OpenXR or the simulated headset), with a desktop window.
 
-use super::{AoArgs, OnOff, SCENE_HELP};
+use super::{choice, AoArgs, OnOff, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -20,7 +20,7 @@ pub struct RunArgs {
     #[arg(long, default_value = "auto", hide_possible_values = true)]
     headset: HeadsetChoice,
     /// Desktop window: none, mirror (both eyes side by side) or single-pass (mono view).
-    #[arg(long, default_value = "mirror", hide_possible_values = true)]
+    #[arg(value_parser = choice::<DisplayMode>(), long, default_value = "mirror", hide_possible_values = true)]
     display: DisplayMode,
     /// Stop after this many frames, 1..=10000000 (default: until the window is closed;
     /// 600 without one).
@@ -86,7 +86,7 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     // here on ends the run cleanly, with its report.
     let interrupt = interrupt_on_ctrl_c();
     for output in [&args.report, &args.screenshot].into_iter().flatten() {
-        vrao::render::output::check_output_file(output)?;
+        vrao::formats::output::check_output_file(output)?;
     }
     let scene = Scene::load(&args.scene)?;
     // The session replaces the profile with the one --profile names.
@@ -114,7 +114,7 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     let summary = run_session(&scene, &settings, &options, interrupt).map_err(name_the_option)?;
     println!("{}", summary.to_text());
     match &args.report {
-        Some(path) => vrao::render::output::write_json(path, &summary),
+        Some(path) => vrao::formats::output::write_json(path, &summary),
         None => Ok(()),
     }
 }

@@ -2,7 +2,7 @@
 //! resolution × foveation, the stereo frame against the budget, per scene — as one
 //! Markdown file.
 
-use super::parse_budget_ms;
+use super::{choice, parse_budget_ms};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::{version, Resolution};
@@ -26,16 +26,16 @@ pub struct TableArgs {
     #[arg(long, value_delimiter = ',', default_values_t = ["assets/scenes/sibenik.toml".to_string(), "builtin:furnished".to_string()])]
     scenes: Vec<String>,
     /// Techniques, comma-separated.
-    #[arg(long, value_delimiter = ',', value_enum, default_values_t = [Technique::Gtao, Technique::Ssao, Technique::Hbao, Technique::Ssdo], hide_possible_values = true)]
+    #[arg(value_parser = choice::<Technique>(), long, value_delimiter = ',', default_values_t = [Technique::Gtao, Technique::Ssao, Technique::Hbao, Technique::Ssdo], hide_possible_values = true)]
     techniques: Vec<Technique>,
     /// Quality presets, comma-separated: low, medium, high, ultra.
-    #[arg(long, value_delimiter = ',', value_enum, default_values_t = Quality::ALL, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Quality>(), long, value_delimiter = ',', default_values_t = Quality::ALL, hide_possible_values = true)]
     qualities: Vec<Quality>,
     /// AO resolutions, comma-separated: full, half.
     #[arg(long, value_delimiter = ',', value_enum, default_values_t = [Res::Full, Res::Half], hide_possible_values = true)]
     resolutions: Vec<Res>,
     /// Foveation settings, comma-separated: off, low, high.
-    #[arg(long, value_delimiter = ',', value_enum, default_values_t = [Foveation::Off, Foveation::High], hide_possible_values = true)]
+    #[arg(value_parser = choice::<Foveation>(), long, value_delimiter = ',', default_values_t = [Foveation::Off, Foveation::High], hide_possible_values = true)]
     foveations: Vec<Foveation>,
     /// Per-eye width in pixels, 1..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width)]
@@ -55,7 +55,7 @@ pub struct TableArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = parse_budget_ms)]
     budget_ms: Option<f64>,
     /// Timing: pipelined, serial or auto (serial on CPU adapters).
-    #[arg(long, default_value = "auto", hide_possible_values = true)]
+    #[arg(value_parser = choice::<TimingChoice>(), long, default_value = "auto", hide_possible_values = true)]
     timing: TimingChoice,
     /// Where to write the Markdown table.
     #[arg(long, default_value = "gpu-table.md")]
@@ -65,7 +65,7 @@ pub struct TableArgs {
 pub fn run(backend: BackendChoice, args: TableArgs) -> Result<()> {
     // A table that cannot be written, or a bad option, fails now: before the scenes load
     // and long before the sweep ends.
-    vrao::render::output::check_output_file(&args.out)?;
+    vrao::formats::output::check_output_file(&args.out)?;
     let options = TableOptions {
         backend,
         timing: args.timing,

@@ -47,7 +47,7 @@ pub struct TemporalArgs {
 
 pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
     if let Some(out) = &args.out {
-        vrao::render::output::check_output_file(out)?;
+        vrao::formats::output::check_output_file(out)?;
     }
     let default_scene = if args.motion { "builtin:moving" } else { "builtin:room" };
     let scene = Scene::load(args.scene.as_deref().unwrap_or(default_scene))?;
@@ -65,12 +65,12 @@ pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
             args.height,
             base.ao.technique.name(),
             base.ao.samples,
-            vrao::render::output::significant(base.ao.radius as f64, 3),
+            vrao::formats::output::significant(base.ao.radius as f64, 3),
             study.adapter
         );
         print!("{}", motion::to_markdown(&study.points));
         return match &args.out {
-            Some(path) => vrao::render::output::write_json(path, &study.points),
+            Some(path) => vrao::formats::output::write_json(path, &study.points),
             None => Ok(()),
         };
     }
@@ -82,12 +82,12 @@ pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
         args.width,
         args.height,
         base.ao.technique.name(),
-        vrao::render::output::significant(base.ao.radius as f64, 3),
+        vrao::formats::output::significant(base.ao.radius as f64, 3),
         study.adapter
     );
     print!("{}", to_markdown(&study.points));
     match &args.out {
-        Some(path) => vrao::render::output::write_json(path, &study.points),
+        Some(path) => vrao::formats::output::write_json(path, &study.points),
         None => Ok(()),
     }
 }

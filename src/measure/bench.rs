@@ -2,18 +2,19 @@
 //! pass per eye over many frames, as a table, CSV and Markdown. (Error against the
 //! reference tracer joins these rows when the tracer exists.)
 
+pub use crate::formats::bench_file::{BenchFile, BenchRecord, LimitInfo, ReferenceInfo, Resolution};
+pub use crate::formats::output::significant;
+use crate::formats::spans::{summarize, SpanSummary};
 use crate::measure::metrics;
 use crate::measure::metrics::luminance;
 use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{ReferenceImage, ReferencePixel};
 use crate::measure::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency, BORDER_PX};
-pub use crate::render::bench_file::{BenchFile, BenchRecord, LimitInfo, ReferenceInfo, Resolution};
 use crate::render::error::{Error, Result};
-use crate::render::gpu::timing::{is_per_eye, summarize, SpanSummary};
+use crate::render::gpu::timing::is_per_eye;
 use crate::render::gpu::Gpu;
 use crate::render::graph::FINAL_AO;
-pub use crate::render::output::significant;
 use crate::render::passes::composite::HDR;
 use crate::render::passes::gbuffer::{DEPTH, NORMALS};
 use crate::render::passes::rsm::{self, RSM_INDIRECT};

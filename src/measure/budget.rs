@@ -8,8 +8,9 @@
 //! what each eye costs. Both are reported. An eye passes when the sum of its passes fits
 //! half the budget; the stereo frame passes when the sum of its passes fits the budget.
 
+use crate::formats::spans::{summarize, SpanSummary};
 use crate::render::error::Result;
-use crate::render::gpu::timing::{is_per_eye, summarize, SpanSummary};
+use crate::render::gpu::timing::is_per_eye;
 use crate::render::graph::Resource;
 use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::{FrameReport, Renderer, Timing};

@@ -1,19 +1,17 @@
-//! The renderer: the GPU device and its helpers, the frame graph and its passes, stereo
-//! views, scenes and settings. It imports nothing else of vrao: `xr`, `app` and
-//! `measure` build on it (checked by `tests/layout.rs`).
+//! The renderer crate ([`vrao_render`], which re-exports the engine's modules) under the
+//! name the application's modules use.
 
-pub mod ao;
-pub mod bench_file;
-pub mod error;
-pub mod frame_targets;
-pub mod gpu;
-pub mod graph;
-pub mod output;
-pub mod passes;
-pub mod renderer;
-pub mod sampling;
-pub mod scene;
-pub mod settings;
-pub mod stats;
-pub mod stereo;
-pub mod still;
+pub use vrao_render::*;
+
+/// A shader of a WGSL file named by its path from the workspace root (the
+/// application's files live in its own folders, beside the code that uses them).
+macro_rules! wgsl {
+    ($path:literal) => {
+        $crate::render::gpu::kernel::Shader {
+            path: $path,
+            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/", $path)),
+        }
+    };
+}
+
+pub(crate) use wgsl;

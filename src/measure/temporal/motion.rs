@@ -246,7 +246,7 @@ fn moving_boxes(scene: &Scene, t: f64) -> Vec<MoverBox> {
             let world = transforms.get(m.node?)?;
             let mut local = crate::render::scene::Aabb::EMPTY;
             m.positions.iter().for_each(|p| local.extend(m.origin + p.as_dvec3()));
-            (!local.is_empty()).then(|| MoverBox::of(&local, world, DVec3::ZERO))
+            (!local.is_empty()).then(|| MoverBox::of((local.min, local.max), world, DVec3::ZERO))
         })
         .collect()
 }

@@ -3,11 +3,12 @@
 //! eye) or positionally (the submitted depth forward-splatted into the new view).
 
 use crate::render::error::Result;
-use crate::render::gpu::kernel::{try_shader_module, wgsl, Bind, Kernel, Slot, COMMON};
+use crate::render::gpu::kernel::{try_shader_module, Bind, Kernel, Slot, COMMON};
 use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::passes::tonemap::COLOR;
 use crate::render::stereo::Eye;
+use crate::render::wgsl;
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 

@@ -1,0 +1,162 @@
+//! vrao's AO inside someone else's wgpu renderer. This program opens its own wgpu device,
+//! draws its own geometry with its own depth prepass (depth and view-space normals, both
+//! eyes in a 2-layer array), then asks vrao's [`AoEngine`] for the ambient occlusion of
+//! both eyes and writes it as `OUT/embed_ao_left.png` and `OUT/embed_ao_right.png`.
+//!
+//! ```text
+//! cargo run --release --example embed [OUT] [--standard-depth] [--no-normals] [--time]
+//! ```
+//!
+//! `--standard-depth` stores depth as `Depth24Plus` with a finite far plane instead of
+//! reversed-Z `Depth32Float`; `--no-normals` lets the engine rebuild normals from depth.
+//! It exits non-zero when the AO is not finite, outside 0..1, or shows no occlusion.
+//! `--time` also times whole frames at 1080×1200 per eye, interleaved: the host's prepass
+//! alone, and with the engine (host normals, rebuilt normals), median wall-clock ms.
+
+mod host;
+
+use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
+use vrao_ao::ao::{
+    AoConfig, AoEngine, AoFrame, DepthConvention, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
+};
+use vrao_ao::settings::AoSettings;
+
+const WIDTH: u32 = 320;
+const HEIGHT: u32 = 360;
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let out = std::path::PathBuf::from(args.iter().find(|a| !a.starts_with("--")).map_or("out", |s| s.as_str()));
+    let depth_kind = if args.iter().any(|a| a == "--standard-depth") {
+        HostDepth::StandardFinite { far: 50.0 }
+    } else {
+        HostDepth::ReversedInfinite
+    };
+    let with_normals = !args.iter().any(|a| a == "--no-normals");
+    std::fs::create_dir_all(&out)?;
+
+    // The host's own device: any adapter with Vulkan (or Metal, DX12) and compute.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // Mesa's WSI probe complains on headless machines without it.
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))?;
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))?;
+    eprintln!("adapter: {}", adapter.get_info().name);
+
+    // The host's frame: its geometry, its eyes, its depth prepass.
+    let prepass = DepthPrepass::new(&device, &demo_geometry(), depth_kind, (WIDTH, HEIGHT));
+    let near = 0.05;
+    let tangents = [[-1.2, 0.9, 1.1, -1.1], [-0.9, 1.2, 1.1, -1.1]];
+    let views: Vec<ViewMatrices> = demo_eyes()
+        .iter()
+        .zip(tangents)
+        .map(|(view, t)| ViewMatrices { view: *view, projection: depth_kind.projection(t, near) })
+        .collect();
+
+    // vrao's AO engine on the host's device, with vrao's default (tuned GTAO) settings.
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(&device, &queue, &config)?;
+    let convention = match depth_kind {
+        HostDepth::ReversedInfinite => DepthConvention::REVERSED_INFINITE,
+        HostDepth::StandardFinite { .. } => DepthConvention::STANDARD_FINITE,
+    };
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(&device, &mut encoder, &views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: convention,
+        normals: with_normals.then_some(normals),
+        views: &views,
+        // The example's geometry stands still.
+        motion: None,
+    };
+    let ao = engine.record(&mut encoder, &frame)?.texture.clone();
+    queue.submit([encoder.finish()]);
+    if args.iter().any(|a| a == "--time") {
+        time_frames(&device, &queue, depth_kind, convention)?;
+    }
+    if let Some(plan) = engine.last_plan() {
+        eprint!("{plan}");
+    }
+
+    for (layer, name) in ["left", "right"].iter().enumerate() {
+        let alpha = host::read_alpha(&device, &queue, &ao, layer as u32);
+        if let Some(bad) = alpha.iter().find(|a| !a.is_finite() || !(0.0..=1.0).contains(*a)) {
+            return Err(format!("{name} eye: AO value {bad} is not within 0..1").into());
+        }
+        let mean = alpha.iter().sum::<f32>() / alpha.len() as f32;
+        if mean > 0.995 {
+            return Err(format!("{name} eye: mean AO {mean:.3} shows no occlusion").into());
+        }
+        let pixels: Vec<u8> = alpha.iter().map(|a| (a * 255.0).round() as u8).collect();
+        let path = out.join(format!("embed_ao_{name}.png"));
+        image::GrayImage::from_raw(WIDTH, HEIGHT, pixels).ok_or("image size")?.save(&path)?;
+        eprintln!("{name} eye: mean AO {mean:.3} -> {}", path.display());
+    }
+    Ok(())
+}
+
+/// Frames of the host's prepass alone and with the engine after it, interleaved so that
+/// the machine's state affects each alike; prints each one's median wall-clock ms per eye.
+fn time_frames(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    depth_kind: HostDepth,
+    convention: DepthConvention,
+) -> Result<(), Box<dyn std::error::Error>> {
+    const SIZE: (u32, u32) = (1080, 1200);
+    const ROUNDS: usize = 9;
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth_kind, SIZE);
+    let tangents = [[-1.2, 0.9, 1.1, -1.1], [-0.9, 1.2, 1.1, -1.1]];
+    let views: Vec<ViewMatrices> = demo_eyes()
+        .iter()
+        .zip(tangents)
+        .map(|(view, t)| ViewMatrices { view: *view, projection: depth_kind.projection(t, 0.05) })
+        .collect();
+    let config = AoConfig { settings: AoSettings::default(), width: SIZE.0, height: SIZE.1, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config)?;
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let labels = ["host prepass alone", "prepass + engine, host normals", "prepass + engine, rebuilt normals"];
+    let mut times = vec![Vec::new(); labels.len()];
+    // One warm-up round, then ROUNDS measured ones.
+    for round in 0..=ROUNDS {
+        for (kind, samples) in times.iter_mut().enumerate() {
+            let started = std::time::Instant::now();
+            let mut encoder = device.create_command_encoder(&Default::default());
+            prepass.record(device, &mut encoder, &views);
+            if kind > 0 {
+                let frame = AoFrame {
+                    depth: &prepass.depth,
+                    depth_convention: convention,
+                    normals: (kind == 1).then_some(normals),
+                    views: &views,
+                    motion: None,
+                };
+                engine.record(&mut encoder, &frame)?;
+            }
+            queue.submit([encoder.finish()]);
+            device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None })?;
+            if round > 0 {
+                samples.push(started.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    for (label, mut samples) in labels.iter().zip(times) {
+        samples.sort_by(f64::total_cmp);
+        eprintln!("{label}: {:.2} ms per eye (median of {ROUNDS})", samples[ROUNDS / 2] / 2.0);
+    }
+    Ok(())
+}

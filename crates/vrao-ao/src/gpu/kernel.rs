@@ -1,0 +1,500 @@
+//! The wgpu plumbing written once: shader modules from WGSL files kept beside their
+//! passes, and compute kernels whose bind-group layout follows from a binding list
+//! ([`Bind`]); binding `i` is entry `i`.
+
+use super::Gpu;
+use crate::error::{Error, Result};
+use crate::graph::Resource;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Bumped whenever targets are made or dropped: every kernel then forgets its bind
+/// groups, which would otherwise keep dropped textures alive.
+static BIND_GROUP_EPOCH: AtomicU64 = AtomicU64::new(0);
+
+/// Bind groups a kernel keeps before it starts over (a frame binds each kernel a few
+/// times; more means the resources change every frame).
+const MAX_CACHED_BIND_GROUPS: usize = 64;
+
+/// Forgets every kernel's cached bind groups (call when targets are recreated).
+pub fn invalidate_bind_groups() {
+    BIND_GROUP_EPOCH.fetch_add(1, Ordering::Relaxed);
+}
+
+/// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
+pub const TILE: u32 = 8;
+
+/// One WGSL file, compiled into the binary so it runs from any directory; `path` is
+/// relative to the workspace root (for `VRAO_SHADER_DIR`). Made by a crate-internal
+/// `wgsl!` macro from the path within its crate.
+#[derive(Clone, Copy, Debug)]
+pub struct Shader {
+    /// The file, relative to the repository root.
+    pub path: &'static str,
+    /// Its text as compiled in.
+    pub source: &'static str,
+}
+
+/// A [`Shader`] of a WGSL file named by its path within this crate; the file lives
+/// beside the code that uses it (`src/passes/<pass>/<pass>.wgsl`).
+macro_rules! wgsl {
+    ($path:literal) => {
+        $crate::gpu::kernel::Shader {
+            path: concat!("crates/", env!("CARGO_PKG_NAME"), "/", $path),
+            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/", $path)),
+        }
+    };
+}
+
+pub(crate) use wgsl;
+
+/// `common.wgsl`: the frame's uniforms and helpers every pass shares.
+pub const COMMON: Shader = wgsl!("shaders/common.wgsl");
+
+/// The environment variable that makes shaders load from disk: `VRAO_SHADER_DIR=.` (the
+/// workspace root) runs an edited shader without rebuilding the binary.
+pub const SHADER_DIR_VAR: &str = "VRAO_SHADER_DIR";
+
+/// The text of `files`, concatenated in order (common first) so passes share
+/// `common.wgsl` without string formatting: as compiled in, or read from the directory
+/// [`SHADER_DIR_VAR`] names when it is set. A file that cannot be read there is
+/// `Error::Input` naming it.
+pub fn shader_source(files: &[Shader]) -> Result<String> {
+    let dir = std::env::var_os(SHADER_DIR_VAR).map(PathBuf::from);
+    source_from(dir.as_deref(), files)
+}
+
+/// [`shader_source`] with the shader directory given (`None`: the compiled-in text).
+fn source_from(dir: Option<&Path>, files: &[Shader]) -> Result<String> {
+    let mut source = String::new();
+    for file in files {
+        match dir {
+            Some(dir) => {
+                let path = dir.join(file.path);
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|e| Error::in_file(&path, format!("cannot read this shader ({SHADER_DIR_VAR}): {e}")))?;
+                source.push_str(&text);
+            }
+            None => source.push_str(file.source),
+        }
+        source.push('\n');
+    }
+    Ok(source)
+}
+
+/// The first error kept until someone takes it.
+struct ErrorSlot(Mutex<Option<Error>>);
+
+impl ErrorSlot {
+    const fn new() -> ErrorSlot {
+        ErrorSlot(Mutex::new(None))
+    }
+
+    /// Keeps `error` unless an earlier one is waiting (then it is only logged, at debug:
+    /// one missing directory fails every shader).
+    fn record(&self, error: Error) {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if slot.is_some() {
+            log::debug!("{error}");
+        } else {
+            log::error!("{error}");
+            *slot = Some(error);
+        }
+    }
+
+    fn take(&self) -> Result<()> {
+        match self.0.lock().unwrap_or_else(|p| p.into_inner()).take() {
+            Some(error) => Err(error),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The first shader that [`shader_module`] could not read since the last
+/// [`take_shader_error`]. Process-wide like the environment variable it comes from.
+static SHADER_ERROR: ErrorSlot = ErrorSlot::new();
+
+/// The first shader file that could not be read from [`SHADER_DIR_VAR`] since the last
+/// call, as the `Error::Input` naming it (then cleared). Whoever makes passes through
+/// the infallible [`shader_module`] or [`Kernel::new`] checks this before using them.
+pub fn take_shader_error() -> Result<()> {
+    SHADER_ERROR.take()
+}
+
+/// A shader module of `files` ([`shader_source`]); an unreadable file is the error.
+pub fn try_shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> Result<wgpu::ShaderModule> {
+    Ok(module_of(device, label, shader_source(files)?))
+}
+
+/// A shader module of `files` ([`shader_source`]) that always succeeds, for the passes'
+/// constructors: a file that cannot be read is recorded for [`take_shader_error`] and
+/// the compiled-in text stands in, so the module is valid until the error is returned.
+pub fn shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
+    let source = shader_source(files).unwrap_or_else(|error| {
+        SHADER_ERROR.record(error);
+        source_from(None, files).expect("the compiled-in text needs no file")
+    });
+    module_of(device, label, source)
+}
+
+fn module_of(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}
+
+/// One binding of a kernel, in binding order. A pass's binding list is the one place
+/// that says what the kernel binds: the bind group layout, the pass's reads and writes
+/// ([`PassDecl::bindings`](crate::graph::PassDecl::bindings)) and the resources
+/// bound each frame all follow from it.
+#[derive(Clone, Copy, Debug)]
+pub enum Bind {
+    /// The frame's uniforms (`Frame` of common.wgsl).
+    Frame,
+    /// The occlusion parameters (`AoParams` of common.wgsl).
+    AoParams,
+    /// The occlusion's hemisphere kernel (storage, read).
+    SampleKernel,
+    /// Both eyes' lights (storage, read).
+    Lights,
+    /// The scene's environment map (`texture_2d<f32>`, filterable).
+    Environment,
+    /// The environment's filtering sampler.
+    EnvironmentSampler,
+    /// A texture of the graph the pass reads: `texture_depth_2d_array` for depth,
+    /// `texture_2d_array<u32>` for unsigned formats, `texture_2d_array<f32>` otherwise.
+    Read(Resource),
+    /// A texture of the graph the pass writes: `texture_storage_2d_array<format, write>`.
+    Write(Resource),
+    /// Something the pass binds itself (its own uniform, a layer view, …), given at dispatch.
+    Own(Slot),
+}
+
+impl Bind {
+    /// The slot type this binding has in the layout.
+    pub fn slot(self) -> Slot {
+        match self {
+            Bind::Frame | Bind::AoParams => Slot::Uniform,
+            Bind::SampleKernel | Bind::Lights => Slot::ReadBuffer,
+            Bind::Environment => Slot::Texture2d,
+            Bind::EnvironmentSampler => Slot::Sampler,
+            Bind::Read(r) if r.format().is_depth_stencil_format() => Slot::Depth,
+            Bind::Read(r) if r.format().sample_type(None, None) == Some(wgpu::TextureSampleType::Uint) => {
+                Slot::UintLayers
+            }
+            Bind::Read(_) => Slot::Layers,
+            Bind::Write(r) => Slot::Output(r.format()),
+            Bind::Own(slot) => slot,
+        }
+    }
+}
+
+/// What a kernel binds at one binding index.
+#[derive(Clone, Copy, Debug)]
+pub enum Slot {
+    /// `texture_depth_2d_array`, read with `textureLoad`.
+    Depth,
+    /// `texture_2d_array<f32>`, read with `textureLoad`.
+    Layers,
+    /// `texture_2d_array<u32>`, read with `textureLoad` (packed data such as `Direct`).
+    UintLayers,
+    /// `texture_2d_array<f32>`, filterable, read with a sampler.
+    FilterableLayers,
+    /// `texture_2d<f32>`, filterable (environment map).
+    Texture2d,
+    /// A filtering sampler.
+    Sampler,
+    /// A comparison sampler (`sampler_comparison`, shadow maps).
+    ComparisonSampler,
+    /// `texture_storage_2d_array<FORMAT, write>`.
+    Output(wgpu::TextureFormat),
+    /// `var<uniform>`.
+    Uniform,
+    /// `var<storage, read>`.
+    ReadBuffer,
+    /// `var<storage, read_write>` (atomics).
+    ReadWriteBuffer,
+}
+
+impl Slot {
+    /// The layout entry of this slot at `binding`, seen by the `visibility` stages.
+    pub fn layout_entry(self, binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+        let ty = match self {
+            Slot::Depth => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::Layers => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::UintLayers => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::FilterableLayers => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            Slot::Texture2d => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            Slot::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            Slot::ComparisonSampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+            Slot::Output(format) => wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+            },
+            Slot::Uniform => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Slot::ReadBuffer => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Slot::ReadWriteBuffer => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+        };
+        wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None }
+    }
+}
+
+/// A full-screen compute kernel over layered targets: one dispatch covers every layer
+/// (`global_id.z` is the layer).
+pub struct Kernel {
+    label: String,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    slots: Vec<Slot>,
+    /// Bind groups made so far, by the identity of what they bind, with the epoch they
+    /// were made in: a frame binds what the last one did, so none is made again.
+    bind_groups: Mutex<(u64, HashMap<u64, wgpu::BindGroup>)>,
+}
+
+impl Kernel {
+    /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding
+    /// `binds`. A shader file that cannot be read is recorded for [`take_shader_error`]
+    /// ([`shader_module`]).
+    pub fn new(gpu: &Gpu, label: &str, files: &[Shader], entry: &str, binds: &[Bind]) -> Kernel {
+        Self::with_constants(gpu, label, files, entry, binds, &[])
+    }
+
+    /// A kernel whose WGSL `override` constants take the given values (a file that
+    /// cannot be read is recorded as by [`Kernel::new`]).
+    pub fn with_constants(
+        gpu: &Gpu,
+        label: &str,
+        files: &[Shader],
+        entry: &str,
+        binds: &[Bind],
+        constants: &[(&str, f64)],
+    ) -> Kernel {
+        if gpu.builds_cancelled() {
+            // The caller gave up on this build: a stand-in of no work compiles at once
+            // (more bindings in the layout than the shader uses is valid).
+            let source = format!("@compute @workgroup_size({TILE}, {TILE}, 1) fn {entry}() {{}}");
+            let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            return Self::from_module(gpu, label, &module, entry, binds, &[]);
+        }
+        let module = shader_module(&gpu.device, label, files);
+        Self::from_module(gpu, label, &module, entry, binds, constants)
+    }
+
+    /// A kernel of `entry` in a module made already (say by [`try_shader_module`], which
+    /// returns a shader file it cannot read as the error), its `override` constants set.
+    pub fn from_module(
+        gpu: &Gpu,
+        label: &str,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        binds: &[Bind],
+        constants: &[(&str, f64)],
+    ) -> Kernel {
+        let device = &gpu.device;
+        let slots: Vec<Slot> = binds.iter().map(|b| b.slot()).collect();
+        // The start-up check refuses adapters that cannot write these formats; a kernel
+        // writing another would fail on them only at its first frame.
+        for slot in &slots {
+            if let Slot::Output(format) = slot {
+                assert!(
+                    super::support::STORAGE_WRITE_FORMATS.contains(format),
+                    "kernel {label} writes {format:?}: add it to support::STORAGE_WRITE_FORMATS"
+                );
+            }
+        }
+        let entries: Vec<_> =
+            slots.iter().enumerate().map(|(i, s)| s.layout_entry(i as u32, wgpu::ShaderStages::COMPUTE)).collect();
+        let layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+            cache: None,
+        });
+        Kernel {
+            label: label.to_string(),
+            pipeline,
+            layout,
+            slots,
+            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
+        }
+    }
+
+    /// Binds `resources` (one per slot, in slot order) and dispatches over
+    /// `width × height × layers` invocations.
+    pub fn dispatch(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &[wgpu::BindingResource],
+        (width, height, layers): (u32, u32, u32),
+    ) {
+        let bind_group = self.bind_group(device, resources);
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);
+    }
+
+    /// Binds `resources` and dispatches the workgroup counts that an earlier dispatch
+    /// wrote into `args` at `offset` (three u32: x, y, z), for work only the GPU knows
+    /// the size of.
+    pub fn dispatch_indirect(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &[wgpu::BindingResource],
+        args: &wgpu::Buffer,
+        offset: u64,
+    ) {
+        let bind_group = self.bind_group(device, resources);
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups_indirect(args, offset);
+    }
+
+    /// The bind group of `resources`: the kept one when these resources were bound
+    /// before, a new one otherwise.
+    fn bind_group(&self, device: &wgpu::Device, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
+        assert_eq!(resources.len(), self.slots.len(), "kernel {}: one resource per slot", self.label);
+        let key = identity(resources);
+        let epoch = BIND_GROUP_EPOCH.load(Ordering::Relaxed);
+        let mut cache = self.bind_groups.lock().expect("bind group cache");
+        if cache.0 != epoch || cache.1.len() >= MAX_CACHED_BIND_GROUPS {
+            *cache = (epoch, HashMap::new());
+        }
+        if let Some(key) = key {
+            if let Some(group) = cache.1.get(&key) {
+                return group.clone();
+            }
+        }
+        let group = self.make_bind_group(device, resources);
+        if let Some(key) = key {
+            cache.1.insert(key, group.clone());
+        }
+        group
+    }
+
+    fn make_bind_group(&self, device: &wgpu::Device, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
+        let entries: Vec<_> = resources
+            .iter()
+            .enumerate()
+            .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
+            .collect();
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(&self.label),
+            layout: &self.layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// A hash of which buffers (and ranges), views and samplers are bound where; `None` for
+/// kinds of binding it does not know (those are never cached).
+fn identity(resources: &[wgpu::BindingResource]) -> Option<u64> {
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for (slot, resource) in resources.iter().enumerate() {
+        slot.hash(&mut hasher);
+        match resource {
+            wgpu::BindingResource::Buffer(b) => {
+                (0u8, b.buffer, b.offset, b.size).hash(&mut hasher);
+            }
+            wgpu::BindingResource::TextureView(view) => (1u8, *view).hash(&mut hasher),
+            wgpu::BindingResource::Sampler(sampler) => (2u8, *sampler).hash(&mut hasher),
+            _ => return None,
+        }
+    }
+    Some(hasher.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const COMMON_AND_MISSING: [Shader; 2] =
+        [COMMON, Shader { path: "crates/vrao-ao/shaders/no-such-file.wgsl", source: "" }];
+
+    #[test]
+    fn compiled_in_sources_are_concatenated_in_order() {
+        let other = Shader { path: "other.wgsl", source: "// other" };
+        let text = source_from(None, &[COMMON, other]).unwrap();
+        assert_eq!(text, format!("{}\n{}\n", COMMON.source, other.source));
+    }
+
+    #[test]
+    fn a_shader_directory_is_read_from_and_a_missing_file_is_an_input_error_naming_it() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let dir = dir.as_path();
+        assert_eq!(source_from(Some(dir), &[COMMON]).unwrap(), format!("{}\n", COMMON.source));
+        let error = source_from(Some(dir), &COMMON_AND_MISSING).unwrap_err();
+        assert_eq!(error.exit_code(), crate::error::EXIT_INPUT);
+        match &error {
+            Error::Input { file: Some(file), .. } => {
+                assert_eq!(file, &dir.join("crates/vrao-ao/shaders/no-such-file.wgsl"))
+            }
+            other => panic!("not an input error naming the file: {other:?}"),
+        }
+        assert!(error.to_string().contains("no-such-file.wgsl") && error.to_string().contains(SHADER_DIR_VAR));
+    }
+
+    #[test]
+    fn the_first_recorded_error_is_returned_once() {
+        let slot = ErrorSlot::new();
+        assert!(slot.take().is_ok());
+        slot.record(Error::input("first"));
+        slot.record(Error::input("second"));
+        assert_eq!(slot.take().unwrap_err().to_string(), "first");
+        assert!(slot.take().is_ok());
+    }
+}

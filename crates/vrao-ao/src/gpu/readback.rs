@@ -1,0 +1,129 @@
+//! Copies layered textures back to the CPU (debug images, tests, error measurement).
+
+use super::targets::LayeredTarget;
+use super::Gpu;
+use crate::error::{Error, Result};
+
+/// Bytes of one texel for the formats vrao reads back.
+fn texel_bytes(format: wgpu::TextureFormat) -> u32 {
+    match format {
+        wgpu::TextureFormat::Rgba8Unorm
+        | wgpu::TextureFormat::Rgba8UnormSrgb
+        | wgpu::TextureFormat::Bgra8Unorm
+        | wgpu::TextureFormat::Bgra8UnormSrgb => 4,
+        wgpu::TextureFormat::R32Float | wgpu::TextureFormat::Depth32Float => 4,
+        wgpu::TextureFormat::Rgba16Float => 8,
+        wgpu::TextureFormat::R16Float => 2,
+        wgpu::TextureFormat::Rg32Uint => 8,
+        wgpu::TextureFormat::Rgba32Float => 16,
+        other => panic!("readback of {other:?} is not supported"), // programming error, not input
+    }
+}
+
+/// Raw bytes of every layer, rows tightly packed (the 256-byte row padding removed).
+pub fn read_layers(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<u8>>> {
+    let bpt = texel_bytes(target.format);
+    let row = target.width * bpt;
+    let padded_row = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let layer_bytes = padded_row as u64 * target.height as u64;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: layer_bytes * target.layers as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let aspect =
+        if target.format.is_depth_stencil_format() { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All };
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture: &target.texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_row),
+                rows_per_image: Some(target.height),
+            },
+        },
+        wgpu::Extent3d { width: target.width, height: target.height, depth_or_array_layers: target.layers },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    gpu.wait_idle()?;
+    rx.recv()
+        .map_err(|_| Error::Gpu("readback callback never ran".into()))?
+        .map_err(|e| Error::Gpu(format!("readback failed: {e}")))?;
+    let data = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?;
+    let layers = (0..target.layers as usize)
+        .map(|layer| {
+            let mut out = Vec::with_capacity((row * target.height) as usize);
+            for y in 0..target.height as usize {
+                let start = layer * layer_bytes as usize + y * padded_row as usize;
+                out.extend_from_slice(&data[start..start + row as usize]);
+            }
+            out
+        })
+        .collect();
+    drop(data);
+    buffer.unmap();
+    Ok(layers)
+}
+
+/// Every layer as f32 values (channels interleaved), for float and depth formats.
+pub fn read_layers_f32(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<f32>>> {
+    let raw = read_layers(gpu, target)?;
+    let half = matches!(target.format, wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::R16Float);
+    Ok(raw
+        .into_iter()
+        .map(|bytes| {
+            if half {
+                bytes.chunks_exact(2).map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32()).collect()
+            } else {
+                bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
+            }
+        })
+        .collect())
+}
+
+/// The `Direct` resource's packed texels (rg32uint, common.wgsl `pack_direct`) as rgba
+/// f32 values per layer: the RGB9E5 radiance, and 0 in alpha (the packed distance is the
+/// bounce's business only).
+pub fn decode_direct(raw: Vec<Vec<u8>>) -> Vec<Vec<f32>> {
+    raw.into_iter()
+        .map(|bytes| {
+            bytes
+                .chunks_exact(8)
+                .flat_map(|t| {
+                    let [r, g, b] = unpack_rgb9e5(u32::from_le_bytes([t[4], t[5], t[6], t[7]]));
+                    [r, g, b, 0.0]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The shared-exponent RGB9E5 form of common.wgsl `pack_rgb9e5`: three 9-bit mantissas
+/// and a 5-bit exponent biased by 15.
+pub fn unpack_rgb9e5(bits: u32) -> [f32; 3] {
+    let scale = 2f32.powi((bits >> 27) as i32 - 24);
+    [bits & 511, (bits >> 9) & 511, (bits >> 18) & 511].map(|m| m as f32 * scale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unpack_rgb9e5;
+
+    #[test]
+    fn rgb9e5_decodes_the_shared_exponent_form() {
+        let texel = |m: [u32; 3], exponent: u32| m[0] | (m[1] << 9) | (m[2] << 18) | (exponent << 27);
+        // 1.0 is mantissa 256 at exponent 16 (2^(16 − 15 − 9) = 1/256).
+        assert_eq!(unpack_rgb9e5(texel([256, 128, 0], 16)), [1.0, 0.5, 0.0]);
+        // The largest value, 511 × 2^7, and the smallest step, 2^-24.
+        assert_eq!(unpack_rgb9e5(texel([511, 0, 1], 31)), [65408.0, 0.0, 128.0]);
+        assert_eq!(unpack_rgb9e5(texel([0, 1, 0], 0)), [0.0, 2f32.powi(-24), 0.0]);
+    }
+}

@@ -1,0 +1,14 @@
+//! The textures the AO chain reads, by name: a renderer's G-buffer writes them (vrao's
+//! does), or the engine's import pass makes them from a host's depth and normals.
+
+use crate::graph::{Resource, Size};
+
+/// Reversed-Z depth of every eye layer.
+pub const DEPTH: Resource = Resource::attachment("depth", Size::Full, wgpu::TextureFormat::Depth32Float);
+/// View-space unit normals; w is 1 on alpha-tested surfaces (cards), else 0.
+pub const NORMALS: Resource = Resource::attachment("normals", Size::Full, wgpu::TextureFormat::Rgba16Float);
+/// Each pixel's motion since the previous frame, of its eye and its object: xy the
+/// previous uv minus this uv (uv 0..1 from the top left), z the previous distance along
+/// the view's −z minus this one, w 1 where valid (0: the point was behind the previous
+/// eye). Written only when the scene moves; a host hands its own to the AO engine.
+pub const MOTION: Resource = Resource::attachment("motion", Size::Full, wgpu::TextureFormat::Rgba16Float);

@@ -1,0 +1,309 @@
+//! One folder per pass: its Rust (`mod.rs`) and its WGSL. A pass declares, in one
+//! builder chain, the textures it creates (constants with their size class and format),
+//! what it reads and writes (its kernels' binding lists), what it provides under the
+//! graph's named outputs, and whether it runs this frame; the graph decides which passes
+//! run, and each records its GPU work when it does. [`ao_chain`] lists the engine's in
+//! execution order; a renderer adds its own passes around them through the same [`Pass`]
+//! trait (vrao-render's G-buffer, lights, SSDO and composite).
+
+pub mod blur;
+pub mod fetch_only;
+pub mod gtao;
+pub mod hbao;
+pub mod inputs;
+pub mod occlusion;
+pub mod ssao;
+pub mod temporal;
+pub mod upsample;
+
+use crate::gpu::frame::ao_extent;
+use crate::gpu::frame::FrameBuffers;
+use crate::gpu::kernel::Bind;
+use crate::gpu::targets::LayeredTarget;
+use crate::gpu::timing::SpanRecorder;
+use crate::gpu::Gpu;
+use crate::graph::{PassDecl, Resource};
+use crate::settings::AoSettings;
+use std::any::Any;
+use std::collections::{BTreeMap, HashMap};
+
+/// The AO chain, in execution order: each technique (one runs), then `light_gathering`
+/// (a renderer's light-gathering technique, such as vrao-render's SSDO), temporal
+/// accumulation, the denoise and the upsampling to full resolution. It reads
+/// [`inputs::DEPTH`] and [`inputs::NORMALS`] and provides [`crate::graph::OCCLUSION`] and
+/// [`crate::graph::FINAL_AO`].
+pub fn ao_chain(gpu: &Gpu, light_gathering: Vec<Box<dyn Pass>>) -> Vec<Box<dyn Pass>> {
+    let mut chain: Vec<Box<dyn Pass>> =
+        vec![Box::new(ssao::pass(gpu)), Box::new(hbao::pass(gpu)), Box::new(gtao::GtaoPass::new(gpu))];
+    chain.extend(light_gathering);
+    chain.push(Box::new(fetch_only::pass(gpu)));
+    chain.push(Box::new(temporal::TemporalPass::new(gpu)));
+    chain.push(Box::new(blur::BlurPass::new(gpu)));
+    chain.push(Box::new(upsample::UpsamplePass::new(gpu)));
+    chain
+}
+
+/// What the AO chain's passes read of the settings: each view's size, the near plane and
+/// the AO settings. A renderer's own settings reach its passes as an extension
+/// ([`DeclareContext::extension`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChainSettings {
+    /// Width of each view in pixels (full resolution).
+    pub width: u32,
+    /// Height of each view in pixels.
+    pub height: u32,
+    /// Near plane distance (reversed-Z, far plane at infinity).
+    pub near: f64,
+    /// The AO settings.
+    pub ao: AoSettings,
+}
+
+/// What passes may consult when declaring themselves for a frame.
+pub struct FrameSetup<'a> {
+    /// What a renderer's own passes read beyond the engine's (its scene, its uploaded
+    /// scene, its settings), found by type ([`FrameSetup::extension`]); empty in the AO
+    /// engine.
+    pub extensions: &'a [&'a dyn Any],
+    /// Whether the normals' w marks alpha-tested surfaces (cards) that GTAO samples as
+    /// thin planes (a renderer's scene with alpha-tested materials; never a host's).
+    pub alpha_cards: bool,
+    /// The f64 origin that view-from-anchored matrices start from (the scene's anchor;
+    /// the world origin for a host's views).
+    pub anchor: glam::DVec3,
+    /// This frame's settings.
+    pub settings: &'a ChainSettings,
+    /// 2 for stereo, 1 for a mono view.
+    pub views: u32,
+    /// Whether the G-buffer draws both layers in one multiview pass.
+    pub multiview: bool,
+    /// Frames this renderer has rendered before this one (turns sampling patterns).
+    pub frame_index: u64,
+    /// This frame's views (empty when only planning).
+    pub current_views: &'a [crate::stereo::Eye],
+    /// The previous frame's views, when it had as many as this one (temporal reuse).
+    pub previous_views: Option<&'a [crate::stereo::Eye]>,
+    /// What moves this frame ([`FrameMotion::STILL`] in a still scene).
+    pub motion: &'a FrameMotion,
+}
+
+/// What moved since the previous frame, for temporal accumulation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameMotion {
+    /// Whether [`inputs::MOTION`] holds each pixel's motion this frame (the scene
+    /// moves, or a host handed its motion vectors to the AO engine).
+    pub vectors: bool,
+    /// Boxes around every moving object, where it is and where it was in the previous
+    /// frame: the AO of what lies within the AO radius of them changes although the
+    /// surface itself does not move.
+    pub movers: Vec<MoverBox>,
+    /// What turns a motion texel's xy into the uv offset to the previous frame
+    /// (1, 1 for the G-buffer's).
+    pub uv_scale: [f32; 2],
+    /// Whether the motion's z holds the change in distance and w its validity (the
+    /// G-buffer's); a host's 2D vectors leave the distance to the eyes' motion.
+    pub with_distance: bool,
+}
+
+/// An oriented box around a moving object (`MoverBox` of temporal.wgsl): a point p of
+/// the anchored frame lies inside when |rows · (p, 1)| ≤ half_extents on each axis.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MoverBox {
+    /// The box's frame from the anchored world frame: three rows of an affine map whose
+    /// rotation is orthonormal, so distances stay in metres.
+    pub box_from_anchored: [[f32; 4]; 3],
+    /// Half the box's size along its axes (metres); w unused.
+    pub half_extents: [f32; 4],
+}
+
+impl MoverBox {
+    /// The box `local` (min and max corners in a node's frame) placed by `world` (world from local,
+    /// rotation and scale without shear), relative to `anchor`.
+    pub fn of(local: (glam::DVec3, glam::DVec3), world: &glam::DMat4, anchor: glam::DVec3) -> MoverBox {
+        let (min, max) = local;
+        let m = glam::DMat3::from_mat4(*world);
+        let axes = [m.x_axis, m.y_axis, m.z_axis];
+        let half = (max - min) * 0.5;
+        let centre = world.transform_point3((min + max) * 0.5) - anchor;
+        let mut rows = [[0.0f32; 4]; 3];
+        let mut half_extents = [0.0f32; 4];
+        for (i, axis) in axes.iter().enumerate() {
+            let length = axis.length();
+            let unit = if length > 0.0 && length.is_finite() { *axis / length } else { glam::DVec3::ZERO };
+            rows[i] = [unit.x as f32, unit.y as f32, unit.z as f32, -unit.dot(centre) as f32];
+            half_extents[i] = (half[i] * length) as f32;
+        }
+        MoverBox { box_from_anchored: rows, half_extents }
+    }
+}
+
+impl FrameMotion {
+    /// Nothing moves but the eyes.
+    pub const STILL: FrameMotion =
+        FrameMotion { vectors: false, movers: Vec::new(), uv_scale: [1.0; 2], with_distance: true };
+}
+
+impl Default for FrameMotion {
+    fn default() -> Self {
+        FrameMotion::STILL
+    }
+}
+
+/// Everything a pass records with.
+pub struct FrameContext<'a> {
+    /// The device and queue.
+    pub gpu: &'a Gpu,
+    /// The encoder the pass records into (with serial timing, a fresh one per pass).
+    pub encoder: &'a mut wgpu::CommandEncoder,
+    /// The targets the graph allocated for this frame.
+    pub targets: &'a BTreeMap<Resource, LayeredTarget>,
+    /// 1×1 stand-ins, by format, for what a binding list names but the pass does not
+    /// read this frame ([`PassDecl::unbind`]).
+    pub placeholders: &'a HashMap<wgpu::TextureFormat, LayeredTarget>,
+    /// This pass's declaration for the frame, named outputs resolved.
+    pub decl: &'a PassDecl,
+    /// The frame's uniform and light buffers.
+    pub frame: &'a FrameBuffers,
+    /// An environment map and its sampler for [`Bind::Environment`] and
+    /// [`Bind::EnvironmentSampler`] (a renderer's; `None` in the AO engine).
+    pub environment: Option<(&'a wgpu::TextureView, &'a wgpu::Sampler)>,
+    /// Timestamp scopes around each pass.
+    pub timer: &'a dyn SpanRecorder,
+    /// What the passes were declared with.
+    pub setup: &'a FrameSetup<'a>,
+}
+
+impl<'a> FrameSetup<'a> {
+    /// The extension of type `T` the driver of the graph put in [`FrameSetup::extensions`]
+    /// (a renderer's scene for its own passes), if any.
+    pub fn extension<T: Any>(&self) -> Option<&'a T> {
+        self.extensions.iter().find_map(|e| e.downcast_ref::<T>())
+    }
+}
+
+impl<'a> FrameContext<'a> {
+    /// The environment a renderer bound ([`FrameContext::environment`]).
+    fn environment(&self) -> (&'a wgpu::TextureView, &'a wgpu::Sampler) {
+        self.environment.expect("only a renderer's passes bind an environment, and it provides one")
+    }
+
+    /// The target of a resource the graph allocated for this frame (a named output: the
+    /// texture it stands for at this pass).
+    pub fn target(&self, r: Resource) -> &'a LayeredTarget {
+        let r = self.decl.resolve(r);
+        self.targets.get(&r).unwrap_or_else(|| panic!("{} was not allocated; the pass did not declare it", r.name()))
+    }
+
+    /// The array view of a resource's target, for a bind group (a placeholder's when the
+    /// pass does not read it this frame).
+    pub fn view(&self, r: Resource) -> wgpu::BindingResource<'a> {
+        if self.decl.unbound.contains(&r) {
+            let placeholder = self.placeholders.get(&r.format()).expect("the renderer makes each unbound format's");
+            return wgpu::BindingResource::TextureView(&placeholder.array_view);
+        }
+        wgpu::BindingResource::TextureView(&self.target(r).array_view)
+    }
+
+    /// The resources of a binding list, in its order; `own` fills its [`Bind::Own`]
+    /// entries, in order.
+    pub fn bind<'b>(&self, binds: &[Bind], own: &[wgpu::BindingResource<'b>]) -> Vec<wgpu::BindingResource<'b>>
+    where
+        'a: 'b,
+    {
+        self.bind_overriding(binds, own, &[])
+    }
+
+    /// [`FrameContext::bind`], with the entries that read or write a named resource
+    /// bound to another view of it instead (the right eye's dispatch of the stereo reuse
+    /// writes layer 1 alone). Every override must name a resource of the list.
+    pub fn bind_overriding<'b>(
+        &self,
+        binds: &[Bind],
+        own: &[wgpu::BindingResource<'b>],
+        overrides: &[(Resource, wgpu::BindingResource<'b>)],
+    ) -> Vec<wgpu::BindingResource<'b>>
+    where
+        'a: 'b,
+    {
+        debug_assert!(
+            overrides
+                .iter()
+                .all(|(r, _)| binds.iter().any(|b| matches!(*b, Bind::Read(x) | Bind::Write(x) if x == *r))),
+            "{}: an override names a resource the binding list does not",
+            self.decl.name
+        );
+        let mut own = own.iter();
+        let resources: Vec<_> = binds
+            .iter()
+            .map(|bind| match *bind {
+                Bind::Read(r) | Bind::Write(r) if overrides.iter().any(|(x, _)| *x == r) => {
+                    overrides.iter().find(|(x, _)| *x == r).expect("checked by the guard").1.clone()
+                }
+                Bind::Frame => self.frame.frame.as_entire_binding(),
+                Bind::AoParams => self.frame.ao.as_entire_binding(),
+                Bind::SampleKernel => self.frame.kernel.as_entire_binding(),
+                Bind::Lights => self.frame.lights.as_entire_binding(),
+                Bind::Environment => wgpu::BindingResource::TextureView(self.environment().0),
+                Bind::EnvironmentSampler => wgpu::BindingResource::Sampler(self.environment().1),
+                Bind::Read(r) | Bind::Write(r) => self.view(r),
+                Bind::Own(_) => own.next().expect("one own resource per Bind::Own").clone(),
+            })
+            .collect();
+        debug_assert!(own.next().is_none(), "{}: more own resources than Bind::Own entries", self.decl.name);
+        resources
+    }
+
+    /// A one-layer array view of `layer` of a resource's target (the stereo reuse binds
+    /// the left eye's layer for the right eye's dispatch).
+    pub fn layer_view(&self, r: Resource, layer: u32) -> wgpu::TextureView {
+        self.target(r).texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(r.name()),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
+    }
+
+    /// Width × height × layers of this frame's full-resolution targets.
+    pub fn extent(&self) -> (u32, u32, u32) {
+        let s = self.setup.settings;
+        (s.width, s.height, self.setup.views)
+    }
+
+    /// Width × height × layers of the quads of 2×2 full-res pixels (rounded up), for the
+    /// passes that work one quad per invocation (upsample, composite).
+    pub fn quad_extent(&self) -> (u32, u32, u32) {
+        let (width, height, layers) = self.extent();
+        (width.div_ceil(2), height.div_ceil(2), layers)
+    }
+
+    /// Width × height × layers of the occlusion targets (half size with half-res).
+    pub fn ao_extent(&self) -> (u32, u32, u32) {
+        let s = self.setup.settings;
+        let (w, h) = ao_extent(s.width, s.height, s.ao.half_res);
+        (w, h, self.setup.views)
+    }
+}
+
+/// Records one pass inside its timestamp span.
+pub fn record(pass: &dyn Pass, ctx: &mut FrameContext) {
+    let span = ctx.timer.begin(ctx.encoder, ctx.decl.name);
+    pass.record(ctx);
+    ctx.timer.end(ctx.encoder, span);
+}
+
+/// One pass of the frame graph: declares what it reads and writes for a frame, and
+/// records its GPU work when the plan keeps it. Send and Sync, so that an embedder may
+/// keep the AO engine in a multi-threaded app's state.
+pub trait Pass: Send + Sync {
+    /// What the pass reads and writes this frame, and whether it runs at all.
+    fn declare(&self, setup: &FrameSetup) -> PassDecl;
+    /// Records the pass's commands into the frame's encoder.
+    fn record(&self, ctx: &mut FrameContext);
+    /// A target the pass keeps itself from one frame to the next (the temporal
+    /// history), for inspection; the graph allocates every other target.
+    fn kept_target(&self, _r: Resource) -> Option<LayeredTarget> {
+        None
+    }
+}

@@ -1,0 +1,547 @@
+//! The AO settings a host chooses: the technique, its sample count and radius, the
+//! denoise, the resolution, temporal accumulation and foveation. Validated once so the
+//! passes can trust them; every default lives here.
+
+use crate::error::{Error, Result};
+pub use crate::passes::gtao::GtaoSettings;
+
+/// The occlusion radius of [`AoSettings::default`], in the host's world units.
+pub const DEFAULT_RADIUS: f32 = 0.5;
+/// The most depth taps per pixel an occlusion technique takes (`--samples`).
+pub const SAMPLES_MAX: u32 = 256;
+
+/// A setting chosen by name from a fixed list: what a command line, a file or a panel
+/// offers (the engine has no command line; its host's wraps these).
+pub trait Choice: Copy + PartialEq + std::fmt::Debug + 'static {
+    /// Every value, in the order lists show them.
+    fn all() -> &'static [Self];
+    /// The value's name (lower case, words joined by `-`).
+    fn name(self) -> &'static str;
+    /// Other spellings a parser accepts for it.
+    fn aliases(self) -> &'static [&'static str] {
+        &[]
+    }
+    /// The value named `name` (or one of its aliases).
+    fn from_name(name: &str) -> Option<Self> {
+        Self::all().iter().copied().find(|v| v.name() == name || v.aliases().contains(&name))
+    }
+}
+
+/// Implements [`Choice`] (and `Display`, as the name) for enums with an inherent `ALL`
+/// and `name`.
+#[macro_export]
+#[doc(hidden)]
+macro_rules! impl_choice {
+    ($($t:ty),* $(,)?) => {$(
+        impl $crate::settings::Choice for $t {
+            fn all() -> &'static [Self] {
+                &<$t>::ALL
+            }
+            fn name(self) -> &'static str {
+                <$t>::name(self)
+            }
+        }
+        impl ::std::fmt::Display for $t {
+            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
+                f.write_str(<$t>::name(*self))
+            }
+        }
+    )*};
+}
+
+crate::impl_choice!(Technique, Quality, BounceForm, Denoise, Foveation, TemporalBlend, crate::gpu::BackendChoice);
+
+impl std::fmt::Display for Noise {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Choice for Noise {
+    fn all() -> &'static [Self] {
+        &Noise::ALL
+    }
+    fn name(self) -> &'static str {
+        Noise::name(self)
+    }
+    fn aliases(self) -> &'static [&'static str] {
+        match self {
+            Noise::Tiled5x5 => &["tiled5x5"],
+            Noise::Halton => &[],
+        }
+    }
+}
+
+/// The occlusion technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Technique {
+    /// No occlusion pass: the ambient term is unoccluded.
+    None,
+    /// Normal-oriented hemisphere SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3).
+    Ssao,
+    /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
+    Hbao,
+    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
+    /// (Jimenez et al. 2016, Therrien et al. 2023). The default: the most accurate per
+    /// millisecond.
+    #[default]
+    Gtao,
+    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
+    Ssdo,
+    /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
+    SsdoBounce,
+    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
+    FetchOnly,
+}
+
+impl Technique {
+    /// The technique's command-line name (`ssao`, `hbao`, …), also used in file names and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::None => "none",
+            Technique::Ssao => "ssao",
+            Technique::Hbao => "hbao",
+            Technique::Ssdo => "ssdo",
+            Technique::SsdoBounce => "ssdo-bounce",
+            Technique::FetchOnly => "fetch-only",
+            Technique::Gtao => "gtao",
+        }
+    }
+    /// True for the techniques whose occlusion targets carry gathered light in rgb
+    /// (SSDO's directional occlusion of the environment, with or without its bounce); the
+    /// others write AO in alpha alone (rgb 0), so the denoise filters alpha alone for them.
+    pub fn carries_light(self) -> bool {
+        matches!(self, Technique::Ssdo | Technique::SsdoBounce)
+    }
+
+    /// Every technique, in the order the CLI and the bench list them (declaration order).
+    pub const ALL: [Technique; 7] = [
+        Technique::None,
+        Technique::Ssao,
+        Technique::Hbao,
+        Technique::Gtao,
+        Technique::Ssdo,
+        Technique::SsdoBounce,
+        Technique::FetchOnly,
+    ];
+
+    /// Every technique, in the order the CLI and the bench list them ([`Technique::ALL`]).
+    pub fn all() -> &'static [Technique] {
+        &Technique::ALL
+    }
+
+    /// The techniques that estimate occlusion (neither `none` nor the fetch-only
+    /// baseline), the default first, then in [`Technique::all`]'s order: what `vrao bench`
+    /// sweeps unless told otherwise.
+    pub fn estimators() -> Vec<Technique> {
+        let default = Technique::default();
+        let others = Technique::all()
+            .iter()
+            .copied()
+            .filter(|&t| ![default, Technique::None, Technique::FetchOnly].contains(&t));
+        std::iter::once(default).chain(others).collect()
+    }
+}
+
+/// Bench files name their techniques, and the governor and `vrao budget --fit` read them
+/// back; the names are the command line's ([`Technique::name`]).
+impl std::str::FromStr for Technique {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Technique::all().iter().map(|t| t.name()).collect();
+            Error::input(format!("unknown technique '{s}' (expected one of {})", names.join(", ")))
+        })
+    }
+}
+
+/// Sampling quality presets: Belonogov 2018's kernel sizes N = 12, 24, 36, 64.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Quality {
+    /// N = 12.
+    Low,
+    /// N = 24 (the default).
+    #[default]
+    Medium,
+    /// N = 36.
+    High,
+    /// N = 64.
+    Ultra,
+}
+
+impl Quality {
+    /// Every preset, lowest first.
+    pub const ALL: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
+    /// The preset's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Low => "low",
+            Quality::Medium => "medium",
+            Quality::High => "high",
+            Quality::Ultra => "ultra",
+        }
+    }
+    /// Depth taps per pixel (SSAO/SSDO samples; HBAO directions × steps).
+    pub fn samples(self) -> u32 {
+        match self {
+            Quality::Low => 12,
+            Quality::Medium => 24,
+            Quality::High => 36,
+            Quality::Ultra => 64,
+        }
+    }
+}
+
+/// Where each pixel's kernel rotation comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Noise {
+    /// A 5×5 tile of rotations repeated over the screen (Belonogov 2018).
+    Tiled5x5,
+    /// A per-pixel rotation from a Halton sequence in bases 2 and 3 (the Czech SSDO thesis).
+    #[default]
+    Halton,
+}
+
+impl Noise {
+    /// Both sources, the default last.
+    pub const ALL: [Noise; 2] = [Noise::Tiled5x5, Noise::Halton];
+    /// The source's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Noise::Tiled5x5 => "tiled",
+            Noise::Halton => "halton",
+        }
+    }
+}
+
+/// How SSDO's bounce weighs a blocking sample's sender.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BounceForm {
+    /// Ritschel et al. 2009 eq. 2: a patch of area π r²/N × strength at the sender pixel,
+    /// weighted by the sender and receiver cosines over d² (as a disc's solid angle, so a
+    /// sender touching the receiver stays bounded).
+    Patch,
+    /// The sender's radiance through the blocked direction's share of the hemisphere,
+    /// 2π/N, × the receiver's cosine towards the sender, as eq. 1 treats unblocked
+    /// directions: for diffuse senders the radiance arriving along a direction does not
+    /// depend on the sender's orientation or distance. Against the reference's bounce it
+    /// roughly halves eq. 2's low bias and error (red wall, crease, Cornell box), and it
+    /// needs no sender normal.
+    #[default]
+    Direction,
+}
+
+impl BounceForm {
+    /// Both forms, the default first.
+    pub const ALL: [BounceForm; 2] = [BounceForm::Direction, BounceForm::Patch];
+    /// The form's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            BounceForm::Patch => "patch",
+            BounceForm::Direction => "direction",
+        }
+    }
+}
+
+/// The spatial denoise of the occlusion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Denoise {
+    /// Edge-aware box over the 4×4 noise tile, 5 taps per axis in two passes
+    /// (src/render/passes/blur/denoise.wgsl).
+    #[default]
+    Tile,
+    /// Separable geometry-aware bilateral blur of `blur_radius` (11×11 at 5; the Czech SSDO
+    /// thesis).
+    Bilateral,
+}
+
+impl Denoise {
+    /// Both denoisers, the default first.
+    pub const ALL: [Denoise; 2] = [Denoise::Tile, Denoise::Bilateral];
+    /// The denoiser's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Denoise::Tile => "tile",
+            Denoise::Bilateral => "bilateral",
+        }
+    }
+}
+
+/// Fixed foveated occlusion: every eye's AO at its full sample count near the eye's
+/// view axis and fewer samples towards the image's edges, where the flat projection
+/// spends more pixels per degree than at the centre, the lens squeezes them together
+/// and the eye, looking ahead through the lens, resolves less. The map is in degrees
+/// off each eye's own view axis, so it follows every headset profile's and every
+/// runtime's asymmetric field of view (its centre lies towards the nose, where the
+/// axis meets the image).
+/// Levels order by how much they save: `Off < Low < High`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum Foveation {
+    /// Every pixel at the full sample count.
+    #[default]
+    Off,
+    /// Full rate within 25° of the axis, down to half the samples at 40° and beyond.
+    Low,
+    /// Full rate within 15° of the axis, down to half the samples at 30° and beyond: the
+    /// same floor as `low` over most of the image.
+    High,
+}
+
+/// Where a [`Foveation`] level lowers the sample count: the full count within
+/// `full_rate_deg` of an eye's view axis, then falling linearly in the tangent of the
+/// angle to `edge_rate` of it at `edge_deg` and beyond. Pixels take whole counts: one
+/// between two counts takes the higher one with the probability of its fraction (a 4×4
+/// ordered dither the denoise averages), so the map has no seam.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FoveationMap {
+    /// Angle off the view axis within which every pixel spends its full count (degrees).
+    pub full_rate_deg: f32,
+    /// Angle from which on pixels spend `edge_rate` of it (degrees).
+    pub edge_deg: f32,
+    /// The share of the full count spent at and beyond `edge_deg`, in (0, 1].
+    pub edge_rate: f32,
+}
+
+impl Foveation {
+    /// Every level, off first.
+    pub const ALL: [Foveation; 3] = [Foveation::Off, Foveation::Low, Foveation::High];
+
+    /// The level's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Foveation::Off => "off",
+            Foveation::Low => "low",
+            Foveation::High => "high",
+        }
+    }
+
+    /// The level's map (every level's numbers live here).
+    pub fn map(self) -> FoveationMap {
+        match self {
+            Foveation::Off => FoveationMap { full_rate_deg: 90.0, edge_deg: 90.0, edge_rate: 1.0 },
+            Foveation::Low => FoveationMap { full_rate_deg: 25.0, edge_deg: 40.0, edge_rate: 0.5 },
+            // Half, not less: a marching technique's half is one of its two slices with
+            // every step (unbiased: the slices turn with the noise tile); a third took
+            // steps too, which lightened the edges (GTAO N = 24 half, furnished and
+            // Sibenik at 540×600: FLIP 1.05–1.14× of off against 1.01–1.04× at a half)
+            // and saved little more, the per-pixel set-up and denoise staying the same.
+            Foveation::High => FoveationMap { full_rate_deg: 15.0, edge_deg: 30.0, edge_rate: 0.5 },
+        }
+    }
+}
+
+impl FoveationMap {
+    /// The share of the full sample count a pixel `angle_deg` off its eye's view axis
+    /// spends (what the occlusion shaders' `foveation_rate` computes).
+    pub fn rate(&self, angle_deg: f32) -> f32 {
+        if self.edge_rate >= 1.0 || angle_deg <= self.full_rate_deg {
+            return 1.0;
+        }
+        let (inner, outer) = (self.full_rate_deg.to_radians().tan(), self.edge_deg.to_radians().tan());
+        let tan = angle_deg.min(89.0).to_radians().tan();
+        let t = ((tan - inner) / (outer - inner).max(1e-6)).clamp(0.0, 1.0);
+        1.0 + (self.edge_rate - 1.0) * t
+    }
+}
+
+/// Occlusion parameters shared by every technique.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AoSettings {
+    /// Which technique estimates the occlusion.
+    pub technique: Technique,
+    /// Depth taps per pixel, 1..=256 (a quality preset sets it).
+    pub samples: u32,
+    /// World-space radius r (SSAO/SSDO r_max, HBAO R), metres.
+    pub radius: f32,
+    /// Occlusion weight: 0 leaves the ambient untouched, 1 applies the full occlusion.
+    pub strength: f32,
+    /// Depth bias against self-occlusion, as a fraction of the radius.
+    pub bias: f32,
+    /// Range check: an occluder farther than the radius from the pixel counts less
+    /// (SSAO's depth constraint) instead of darkening distant backgrounds.
+    pub range_check: bool,
+    /// SSDO bounce strength (scales each sender's weight); 0 turns the bounce off.
+    pub bounce: f32,
+    /// How the bounce weighs its senders.
+    pub bounce_form: BounceForm,
+    /// Where each pixel's kernel rotation comes from.
+    pub noise: Noise,
+    /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
+    pub half_res: bool,
+    /// Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer, and a sample
+    /// occludes only between the first and second layer (inside an object). Off by default.
+    pub depth_peeling: bool,
+    /// Which spatial denoise runs.
+    pub denoise: Denoise,
+    /// The bilateral blur's radius in full-resolution pixels (5 = 11×11; at half
+    /// resolution 3 taps either side cover the same footprint); 0 turns any denoise off.
+    pub blur_radius: u32,
+    /// The blur's depth edge: a neighbour this far off the centre's tangent plane, as a
+    /// fraction of the centre's distance, loses most of its weight. Near 0 every
+    /// neighbour's weight vanishes and the centre value is kept.
+    pub blur_plane_sigma: f32,
+    /// Temporal accumulation by reverse reprojection (Lin's NCTU thesis §3.1).
+    pub temporal: Temporal,
+    /// GTAO's own parameters (passes/gtao).
+    pub gtao: GtaoSettings,
+    /// With two views, the right eye takes the left eye's value wherever the left eye
+    /// sees the same surface point: GTAO's march (the right eye marches only the rest and
+    /// costs a fraction) and, at half resolution, the AO-only techniques' upsample
+    /// (`passes::upsample::reuses_left_eye_upsample`) or SSDO's denoise (its vertical pass).
+    /// Off: each eye computes everything alone.
+    pub stereo_reuse: bool,
+    /// Fixed foveated occlusion: fewer samples towards each eye's image edges.
+    pub foveation: Foveation,
+}
+
+/// How the temporal pass blends the new frame into the history.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TemporalBlend {
+    /// The running mean of the last `max_frames` frames: each frame's rotated pattern
+    /// counts equally, so N frames of n samples approach one frame of N·n.
+    #[default]
+    Average,
+    /// Lin's NCTU thesis eqs. 4–5: c = 1 − saturate(|V_{t−1} − V_t|)/(1 + bias),
+    /// V = c·V_{t−1} + (1 − c)·V_t.
+    Confidence,
+}
+
+impl TemporalBlend {
+    /// Both blends, the default first.
+    pub const ALL: [TemporalBlend; 2] = [TemporalBlend::Average, TemporalBlend::Confidence];
+    /// The blend's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            TemporalBlend::Average => "average",
+            TemporalBlend::Confidence => "confidence",
+        }
+    }
+}
+
+/// Temporal accumulation settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Temporal {
+    /// Accumulate occlusion over frames (off by default).
+    pub enabled: bool,
+    /// Disocclusion threshold ε in metres on the world-position distance (Lin's NCTU
+    /// thesis eq. 3). The pass also allows two pixel footprints at the pixel's distance (an
+    /// extension: a fixed ε would reject every distant pixel, whose neighbour is
+    /// centimetres away).
+    pub epsilon_m: f32,
+    /// How a pixel's history and this frame's value are blended.
+    pub blend: TemporalBlend,
+    /// Frames after which a pixel counts as converged: the mean stops growing and
+    /// becomes a moving average over this many frames.
+    pub max_frames: u32,
+    /// The confidence bias of Lin's NCTU thesis (only for the confidence blend).
+    pub confidence_bias: f32,
+    /// Motion-adaptive window of the running mean: a pixel that moved m occlusion
+    /// pixels since the last frame keeps at most max_frames / (1 + m / motion_px)
+    /// frames (at least 4). Screen-space occlusion changes with the view, so a long
+    /// mean lags a turning head (ghosting); a still head keeps the whole window. 0 = off.
+    pub motion_px: f32,
+    /// In a scene that moves: reproject each pixel by its motion vector (its object's
+    /// motion and the eye's) and keep only a short history, clamped to this frame's
+    /// neighbourhood, within the AO radius of a moving object. Off: the eyes alone, as
+    /// in a still scene (what `vrao temporal --motion` compares against).
+    pub object_motion: bool,
+}
+
+impl Default for Temporal {
+    fn default() -> Self {
+        Temporal {
+            enabled: false,
+            epsilon_m: 0.02,
+            blend: TemporalBlend::Average,
+            max_frames: 16,
+            confidence_bias: 0.1,
+            motion_px: 0.5,
+            object_motion: true,
+        }
+    }
+}
+
+/// GTAO at the medium preset (N = 24) and full resolution, the tile denoise, no temporal
+/// accumulation and a radius of [`DEFAULT_RADIUS`] in the host's units (half a metre when
+/// they are metres). Constant: no scene is consulted. A host sets the radius to the
+/// scale of the detail it wants shaded; vrao's renderer fits it to each scene.
+impl Default for AoSettings {
+    fn default() -> Self {
+        AoSettings {
+            technique: Technique::default(),
+            samples: Quality::default().samples(),
+            radius: DEFAULT_RADIUS,
+            strength: 1.0,
+            bias: 0.02,
+            range_check: true,
+            bounce: 1.0,
+            bounce_form: BounceForm::Direction,
+            noise: Noise::Halton,
+            half_res: false,
+            depth_peeling: false,
+            denoise: Denoise::Tile,
+            blur_radius: 5,
+            blur_plane_sigma: 0.02,
+            temporal: Temporal::default(),
+            gtao: GtaoSettings::default(),
+            stereo_reuse: true,
+            foveation: Foveation::Off,
+        }
+    }
+}
+
+impl AoSettings {
+    /// Checks every value's range; the error names the value and its range.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=SAMPLES_MAX).contains(&self.samples) {
+            return Err(Error::input(format!("samples {} is not within 1..={SAMPLES_MAX}", self.samples)));
+        }
+        if !(self.radius.is_finite() && self.radius > 0.0 && self.radius <= 1e6) {
+            return Err(Error::input(format!("radius {} m must be a finite number in (0, 1e6]", self.radius)));
+        }
+        if !(self.strength.is_finite() && (0.0..=4.0).contains(&self.strength)) {
+            return Err(Error::input(format!("strength {} is not within 0..=4", self.strength)));
+        }
+        if !(self.bias.is_finite() && (0.0..1.0).contains(&self.bias)) {
+            return Err(Error::input(format!("bias {} is not within 0..1 (a fraction of the radius)", self.bias)));
+        }
+        if !(self.bounce.is_finite() && (0.0..=100.0).contains(&self.bounce)) {
+            return Err(Error::input(format!("bounce {} is not within 0..=100", self.bounce)));
+        }
+        let t = &self.temporal;
+        if !(t.epsilon_m.is_finite() && t.epsilon_m >= 0.0) {
+            return Err(Error::input(format!("temporal epsilon {} m must be finite and ≥ 0", t.epsilon_m)));
+        }
+        if !(1..=1024).contains(&t.max_frames) {
+            return Err(Error::input(format!("temporal frame cap {} is not within 1..=1024", t.max_frames)));
+        }
+        if !(t.motion_px.is_finite() && t.motion_px >= 0.0) {
+            return Err(Error::input(format!("temporal motion scale {} px must be finite and ≥ 0", t.motion_px)));
+        }
+        if !(t.confidence_bias.is_finite() && t.confidence_bias >= 0.0) {
+            return Err(Error::input(format!("temporal confidence bias {} must be finite and ≥ 0", t.confidence_bias)));
+        }
+        if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
+            return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
+        }
+        self.gtao.validate()?;
+        if self.blur_radius > 16 {
+            return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));
+        }
+        Ok(())
+    }
+
+    /// The graph pass that runs the technique: SSDO is `ssdo-bounce` only while the
+    /// bounce strength is above 0.
+    pub fn pass_name(&self) -> &'static str {
+        match self.technique {
+            Technique::SsdoBounce if !self.bounce_active() => Technique::Ssdo.name(),
+            technique => technique.name(),
+        }
+    }
+
+    /// True when the SSDO pass also gathers the bounce.
+    pub fn bounce_active(&self) -> bool {
+        self.technique == Technique::SsdoBounce && self.bounce > 0.0
+    }
+}

@@ -1,0 +1,20 @@
+//! The engine's kernel plumbing ([`vrao_ao::gpu::kernel`]) and the renderer's shared
+//! WGSL files.
+
+pub use vrao_ao::gpu::kernel::*;
+
+/// A [`Shader`] of a WGSL file named by its path within this crate; the file lives
+/// beside the code that uses it (`src/passes/<pass>/<pass>.wgsl`).
+macro_rules! wgsl {
+    ($path:literal) => {
+        $crate::gpu::kernel::Shader {
+            path: concat!("crates/", env!("CARGO_PKG_NAME"), "/", $path),
+            source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/", $path)),
+        }
+    };
+}
+
+pub(crate) use wgsl;
+
+/// `irradiance.wgsl`: the environment's irradiance and radiance quadratics.
+pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");

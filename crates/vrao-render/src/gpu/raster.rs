@@ -1,0 +1,80 @@
+//! The mesh-drawing pieces of the renderer's raster passes: the scene's vertex layout and
+//! the mesh pipeline (G-buffer, depth peeling, shadow maps). The engine's raster pieces
+//! (full-screen pipeline, layer views) are re-exported here.
+
+use super::scene::Vertex;
+pub use vrao_ao::gpu::raster::*;
+
+/// The scene's vertices (position, normal, uv) as the raster passes read them.
+pub const MESH_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+
+/// One vertex buffer of [`Vertex`] with the given attributes (all, or the position only).
+pub fn mesh_vertex_buffer(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexBufferLayout<'_> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes,
+    }
+}
+
+/// What differs between the mesh-drawing pipelines (G-buffer, depth peeling, shadow maps).
+pub struct MeshPipeline<'a> {
+    /// The pipeline's label.
+    pub label: &'a str,
+    /// Its bind group layouts.
+    pub layout: &'a wgpu::PipelineLayout,
+    /// The module holding both entry points.
+    pub module: &'a wgpu::ShaderModule,
+    /// The vertex entry point and the vertex attributes it reads ([`MESH_ATTRIBUTES`] or
+    /// a prefix of them).
+    pub vertex: (&'a str, &'a [wgpu::VertexAttribute]),
+    /// The depth attachment's format and test.
+    pub depth: (wgpu::TextureFormat, wgpu::CompareFunction),
+    /// The fragment entry point and its colour targets; `None` for depth only.
+    pub fragment: Option<(&'a str, &'a [Option<wgpu::ColorTargetState>])>,
+    /// Multiview's view mask, if the pipeline draws every layer at once.
+    pub multiview_mask: Option<std::num::NonZeroU32>,
+    /// Whether the fragment stage discards alpha-tested holes (mesh.wgsl's `ALPHA_TEST`
+    /// override; the module must include mesh.wgsl and have a fragment stage).
+    pub alpha_test: bool,
+}
+
+/// A pipeline that draws the scene's meshes two-sided, writing depth (OBJ windings are
+/// not trusted: the G-buffer faces normals towards the eye, depth peeling wants the back
+/// faces, and both faces of a surface cast shadows).
+pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipeline {
+    let (format, compare) = p.depth;
+    let alpha_constants = [("ALPHA_TEST", 1.0)];
+    let fragment_options = wgpu::PipelineCompilationOptions {
+        constants: if p.alpha_test { &alpha_constants } else { &[] },
+        ..Default::default()
+    };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(p.label),
+        layout: Some(p.layout),
+        vertex: wgpu::VertexState {
+            module: p.module,
+            entry_point: Some(p.vertex.0),
+            compilation_options: Default::default(),
+            buffers: &[Some(mesh_vertex_buffer(p.vertex.1))],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: p.fragment.map(|(entry, targets)| wgpu::FragmentState {
+            module: p.module,
+            entry_point: Some(entry),
+            compilation_options: fragment_options,
+            targets,
+        }),
+        multiview_mask: p.multiview_mask,
+        cache: None,
+    })
+}

@@ -1,0 +1,455 @@
+//! The scene on the GPU: one vertex and one index buffer for all meshes, positions
+//! relative to an f64 anchor, one uniform + texture per material, and one transform slot
+//! per moving object.
+//!
+//! Static meshes are uploaded in the anchored world frame and drawn with object 0, whose
+//! transform is the identity (exact in f32: the multiply changes no bit). A moving mesh
+//! ([`crate::scene::Mesh::node`]) is uploaded once in its node's local frame and
+//! moved by its object's transform, which [`GpuScene::set_time`] writes each frame with the
+//! previous frame's beside it (the G-buffer's motion vectors), so nothing is re-uploaded.
+
+use super::kernel::{wgsl, Shader};
+use super::Gpu;
+use crate::scene::{Environment, Scene};
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3};
+use wgpu::util::DeviceExt;
+
+/// mesh.wgsl: the material bind group, `VertexIn` and the material's albedo, shared by
+/// the passes that draw the meshes with their materials.
+pub const MESH_WGSL: Shader = wgsl!("shaders/mesh.wgsl");
+
+/// One mesh vertex as the vertex buffer holds it.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct Vertex {
+    /// Position in metres relative to [`GpuScene::anchor`].
+    pub position: [f32; 3],
+    /// Unit surface normal in world space.
+    pub normal: [f32; 3],
+    /// Texture coordinates of the diffuse texture.
+    pub uv: [f32; 2],
+}
+
+/// One material's constants (`Material` uniform of the G-buffer shader).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct MaterialUniform {
+    /// Diffuse albedo in rgb; w is 1 when a diffuse texture multiplies it, else 0.
+    pub diffuse: [f32; 4],
+    /// Emitted radiance in rgb; w unused.
+    pub emission: [f32; 4],
+    /// x: alpha factor; y: the alpha-test cutoff (−1 for a solid material); zw unused.
+    pub alpha: [f32; 4],
+}
+
+/// One object's transforms (`Object` of mesh.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct ObjectUniform {
+    /// This frame's anchored-from-local transform.
+    pub anchored_from_local: [[f32; 4]; 4],
+    /// The previous frame's (motion vectors).
+    pub previous_anchored_from_local: [[f32; 4]; 4],
+    /// The inverse transpose of this frame's, for normals.
+    pub normal_from_local: [[f32; 4]; 4],
+}
+
+/// Bytes between objects' slots in the object buffer: the largest uniform-offset
+/// alignment a device may ask for.
+const OBJECT_STRIDE: u64 = 256;
+
+/// Which draws [`GpuScene::draw`] records: passes with an alpha-tested pipeline draw the
+/// solid materials with their plain pipeline and the alpha-tested ones with the other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawSet {
+    /// Every draw (a scene without alpha-tested materials, or a pass that ignores alpha).
+    All,
+    /// Draws of materials without an alpha test.
+    Solid,
+    /// Draws of alpha-tested materials.
+    AlphaTested,
+}
+
+/// One material on the GPU: its uniform and diffuse texture.
+pub struct GpuMaterial {
+    /// The [`MaterialUniform`].
+    pub uniform: wgpu::Buffer,
+    /// The diffuse texture, or a 1×1 white placeholder without one.
+    pub texture: wgpu::TextureView,
+    /// Whether `texture` is the material's own texture rather than the placeholder.
+    pub has_texture: bool,
+}
+
+/// A contiguous range of indices drawn with one material and one object transform.
+pub struct Draw {
+    /// Indices into [`GpuScene::indices`] to draw.
+    pub indices: std::ops::Range<u32>,
+    /// Index into [`GpuScene::materials`].
+    pub material: usize,
+    /// The object slot that moves it (0: static geometry).
+    pub object: usize,
+    /// Whether its material is alpha-tested.
+    pub alpha_tested: bool,
+    /// Its material and object (layout: [`GpuScene::material_layout`]).
+    pub group: wgpu::BindGroup,
+}
+
+/// The scene's meshes, materials and environment uploaded once, shared by every pass.
+pub struct GpuScene {
+    /// Every position on the GPU is relative to this world point (f64), so geometry far
+    /// from the world origin keeps f32 precision.
+    pub anchor: DVec3,
+    /// Every mesh's [`Vertex`]es, concatenated.
+    pub vertices: wgpu::Buffer,
+    /// Every mesh's u32 indices, offset into `vertices`.
+    pub indices: wgpu::Buffer,
+    /// One draw per contiguous run of one material.
+    pub draws: Vec<Draw>,
+    /// The scene's materials, in scene order.
+    pub materials: Vec<GpuMaterial>,
+    /// Layout of a draw's bind group (material uniform, diffuse texture, sampler, object
+    /// transforms): the G-buffer, the light-space pass and the depth peel draw the scene
+    /// with it, at group 1.
+    pub material_layout: wgpu::BindGroupLayout,
+    /// One [`ObjectUniform`] slot per object, 256 bytes apart (`OBJECT_STRIDE`); slot 0 is the
+    /// static geometry's identity.
+    pub objects: wgpu::Buffer,
+    /// The scene node each object slot after 0 follows.
+    pub object_nodes: Vec<usize>,
+    /// Whether some draw is alpha-tested (passes then build their alpha-tested pipelines).
+    pub alpha_tested: bool,
+    /// The environment as a filterable equirectangular texture (1×1 black without one).
+    pub environment: wgpu::TextureView,
+    /// Sampler of the materials' diffuse textures.
+    pub sampler: wgpu::Sampler,
+}
+
+impl GpuScene {
+    /// Records the draws of `set` into `pass`, binding each draw's material and object at
+    /// group 1.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass, set: DrawSet) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        let wanted = |d: &&Draw| match set {
+            DrawSet::All => true,
+            DrawSet::Solid => !d.alpha_tested,
+            DrawSet::AlphaTested => d.alpha_tested,
+        };
+        for draw in self.draws.iter().filter(|d| !d.indices.is_empty()).filter(wanted) {
+            pass.set_bind_group(1, &draw.group, &[]);
+            pass.draw_indexed(draw.indices.clone(), 0, 0..1);
+        }
+    }
+
+    /// Draws every mesh with `solid`, or, when the pass has an `alpha_tested` pipeline,
+    /// the solid materials first (early depth test) and the alpha-tested ones with it.
+    pub fn draw_with(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        solid: &wgpu::RenderPipeline,
+        alpha_tested: Option<&wgpu::RenderPipeline>,
+    ) {
+        pass.set_pipeline(solid);
+        match alpha_tested {
+            Some(alpha_tested) => {
+                self.draw(pass, DrawSet::Solid);
+                pass.set_pipeline(alpha_tested);
+                self.draw(pass, DrawSet::AlphaTested);
+            }
+            None => self.draw(pass, DrawSet::All),
+        }
+    }
+
+    /// Whether some object moves (the scene has animated meshes).
+    pub fn has_moving_objects(&self) -> bool {
+        !self.object_nodes.is_empty()
+    }
+
+    /// Writes every moving object's transform at scene time `time`, with `previous` (the
+    /// previous frame's time; `None` on a first frame or after a cut: no motion) beside it.
+    pub fn set_time(&self, queue: &wgpu::Queue, scene: &Scene, time: f64, previous: Option<f64>) {
+        if self.object_nodes.is_empty() {
+            return;
+        }
+        let now = scene.node_transforms(time);
+        let before = previous.map(|t| scene.node_transforms(t));
+        for (i, &node) in self.object_nodes.iter().enumerate() {
+            let current = now.get(node).copied().unwrap_or(DMat4::IDENTITY);
+            let last = before.as_ref().and_then(|b| b.get(node).copied()).unwrap_or(current);
+            let uniform = object_uniform(self.anchor, current, last);
+            queue.write_buffer(&self.objects, (i as u64 + 1) * OBJECT_STRIDE, bytemuck::bytes_of(&uniform));
+        }
+    }
+
+    /// Uploads `scene`'s geometry (relative to the centre of its bounds), materials and environment.
+    pub fn upload(gpu: &Gpu, scene: &Scene) -> GpuScene {
+        let bounds = scene.bounds();
+        let anchor = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
+        let mut vertices = Vec::new();
+        let mut indices = Vec::new();
+        // (indices, material, object) of each draw; bind groups are made below.
+        let mut runs = Vec::new();
+        // Object slot 0 is static geometry; each animated node a mesh hangs from gets one.
+        let mut object_nodes: Vec<usize> = Vec::new();
+        for mesh in &scene.meshes {
+            let base = vertices.len() as u32;
+            let (offset, object) = match mesh.node {
+                // In the node's local frame; the object transform adds the anchor.
+                Some(node) => {
+                    let slot = object_nodes.iter().position(|&n| n == node).unwrap_or_else(|| {
+                        object_nodes.push(node);
+                        object_nodes.len() - 1
+                    });
+                    (mesh.origin.as_vec3(), slot + 1)
+                }
+                None => ((mesh.origin - anchor).as_vec3(), 0),
+            };
+            for i in 0..mesh.positions.len() {
+                vertices.push(Vertex {
+                    position: (mesh.positions[i] + offset).to_array(),
+                    normal: mesh.normals[i].to_array(),
+                    uv: mesh.uvs.get(i).copied().unwrap_or_default().to_array(),
+                });
+            }
+            let start = indices.len() as u32;
+            indices.extend(mesh.indices.iter().map(|i| i + base));
+            runs.push((start..indices.len() as u32, mesh.material, object));
+        }
+        // wgpu rejects empty buffers; an empty scene draws nothing from a dummy vertex.
+        if vertices.is_empty() {
+            vertices.push(Vertex::zeroed());
+            indices.extend([0, 0, 0]);
+        }
+        let device = &gpu.device;
+        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene vertices"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene indices"),
+            contents: bytemuck::cast_slice(&indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        // Each material's alpha-test cutoff, found once (it scans the texture's alpha).
+        let cutoffs: Vec<Option<f32>> = scene.materials.iter().map(|m| m.alpha_cutoff()).collect();
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .zip(&cutoffs)
+            .map(|(m, cutoff)| {
+                let (texture, has_texture) = match &m.diffuse_texture {
+                    Some(t) => (rgba8_texture(gpu, &m.name, t.width, t.height, &t.rgba8), true),
+                    None => (rgba8_texture(gpu, "white", 1, 1, &[255; 4]), false),
+                };
+                let uniform = MaterialUniform {
+                    diffuse: [m.diffuse.x, m.diffuse.y, m.diffuse.z, if has_texture { 1.0 } else { 0.0 }],
+                    emission: [m.emissive.x, m.emissive.y, m.emissive.z, 0.0],
+                    alpha: [m.alpha, cutoff.unwrap_or(-1.0), 0.0, 0.0],
+                };
+                GpuMaterial {
+                    uniform: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&m.name),
+                        contents: bytemuck::bytes_of(&uniform),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    }),
+                    texture,
+                    has_texture,
+                }
+            })
+            .collect();
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("linear repeat"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+            ..Default::default()
+        });
+        let material_layout = material_layout(device);
+        // Every slot starts at the identity (static geometry, and moving objects until
+        // the first `set_time`) with no motion.
+        let identity = object_uniform(anchor, DMat4::from_translation(anchor), DMat4::from_translation(anchor));
+        let slots: Vec<u8> = (0..=object_nodes.len())
+            .flat_map(|_| {
+                let mut slot = bytemuck::bytes_of(&identity).to_vec();
+                slot.resize(OBJECT_STRIDE as usize, 0);
+                slot
+            })
+            .collect();
+        let objects = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene objects"),
+            contents: &slots,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let draws = runs
+            .into_iter()
+            .map(|(range, material, object)| {
+                let m = &materials[material];
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("material and object"),
+                    layout: &material_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
+                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&sampler) },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer: &objects,
+                                offset: object as u64 * OBJECT_STRIDE,
+                                size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
+                            }),
+                        },
+                    ],
+                });
+                Draw { indices: range, material, object, alpha_tested: cutoffs[material].is_some(), group }
+            })
+            .collect::<Vec<_>>();
+        let alpha_tested = draws.iter().any(|d| d.alpha_tested);
+        GpuScene {
+            anchor,
+            vertices: vertex_buffer,
+            indices: index_buffer,
+            draws,
+            materials,
+            material_layout,
+            objects,
+            object_nodes,
+            alpha_tested,
+            environment: environment_texture(gpu, scene.environment.as_ref()),
+            sampler,
+        }
+    }
+}
+
+/// An object's uniform: `world_from_local` now and in the previous frame, made relative
+/// to the anchor in f64 before rounding to f32.
+fn object_uniform(anchor: DVec3, world_from_local: DMat4, previous_world_from_local: DMat4) -> ObjectUniform {
+    let anchored = DMat4::from_translation(-anchor);
+    let now = anchored * world_from_local;
+    let normal = glam::DMat3::from_mat4(now).inverse().transpose();
+    let normal = if normal.is_finite() { DMat4::from_mat3(normal) } else { DMat4::IDENTITY };
+    ObjectUniform {
+        anchored_from_local: now.as_mat4().to_cols_array_2d(),
+        previous_anchored_from_local: (anchored * previous_world_from_local).as_mat4().to_cols_array_2d(),
+        normal_from_local: normal.as_mat4().to_cols_array_2d(),
+    }
+}
+
+fn rgba8_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8]) -> wgpu::TextureView {
+    let texture = gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        rgba8,
+    );
+    texture.create_view(&Default::default())
+}
+
+/// `v` as f16 bits, saturated to ±65504 and NaN as 0: `half` alone would give Inf or
+/// NaN, and an upload must never carry a non-finite value.
+fn saturating_f16(v: f32) -> u16 {
+    let max = half::f16::MAX.to_f32();
+    half::f16::from_f32(if v.is_nan() { 0.0 } else { v.clamp(-max, max) }).to_bits()
+}
+
+/// The environment's radiance (times its intensity) as Rgba16Float, for the sky behind
+/// the scene. Values beyond the half range saturate rather than turn into Inf.
+fn environment_texture(gpu: &Gpu, env: Option<&Environment>) -> wgpu::TextureView {
+    let (width, height, texels): (u32, u32, Vec<[f32; 3]>) = match env {
+        Some(e) => (e.width, e.height, e.texels.iter().map(|t| t.map(|c| c * e.intensity)).collect()),
+        None => (1, 1, vec![[0.0; 3]]),
+    };
+    let data: Vec<u16> = texels.iter().flat_map(|t| [t[0], t[1], t[2], 1.0]).map(saturating_f16).collect();
+    let texture = gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("environment"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&data),
+    );
+    texture.create_view(&Default::default())
+}
+
+/// The bind-group layout of one draw: its material's uniform, diffuse texture and
+/// sampler, and its object's transforms.
+fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let fragment = wgpu::ShaderStages::FRAGMENT;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("material"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: fragment,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: fragment,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: fragment,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
+                },
+                count: None,
+            },
+        ],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::saturating_f16;
+    use half::f16;
+
+    #[test]
+    fn environment_texels_saturate_and_never_carry_nan() {
+        let back = |v: f32| f16::from_bits(saturating_f16(v)).to_f32();
+        assert_eq!(back(1.0), 1.0);
+        assert_eq!(back(-2.5), -2.5);
+        assert_eq!(back(1e30), 65504.0);
+        assert_eq!(back(f32::NEG_INFINITY), -65504.0);
+        assert_eq!(back(f32::NAN), 0.0);
+    }
+}

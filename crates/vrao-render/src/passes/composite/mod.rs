@@ -1,0 +1,186 @@
+//! Composite: direct light plus the ambient term, attenuated by the occlusion the graph
+//! produced (or unoccluded when the technique is none), and the sky, one invocation per
+//! quad of 2×2 pixels. Half-resolution occlusion is upsampled here (3×3 joint bilateral,
+//! shared with the upsample pass), so a frame writes and reads no full-resolution
+//! occlusion target. With reflective shadow maps, their half-resolution one-bounce
+//! irradiance is upsampled the same way and added to the ambient. With the stereo reuse
+//! of half-resolution AO (`reuses_left_eye_upsample`) the left eye is composited first
+//! and the right eye, in a dispatch of its own, takes the left eye's AO from the output's
+//! alpha wherever the left eye sees the same point; the quads it does not fully see are
+//! listed on the GPU and composited by an indirect dispatch over just them.
+
+use super::direct::DIRECT;
+use super::gbuffer::{ALBEDO, DEPTH, NORMALS};
+use super::occlusion::AO_GEOMETRY;
+use super::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
+use super::shadow::rsm_active;
+use super::upsample::{reuses_left_eye_upsample, JOINT_UPSAMPLE_WGSL};
+use super::{scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, IRRADIANCE};
+use crate::gpu::Gpu;
+use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
+use crate::settings::Technique;
+use std::sync::Mutex;
+use wgpu::util::DeviceExt;
+
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "composite";
+
+/// Lit scene radiance before tone mapping.
+pub const HDR: Resource = Resource::storage("hdr", Size::Full, wgpu::TextureFormat::Rgba16Float);
+
+/// The composite: direct light plus the occluded ambient term in HDR, upsampling half-
+/// resolution AO inline (module docs).
+pub struct CompositePass {
+    /// Variants by (half resolution, RSM bounce): pipeline constants, so a frame without
+    /// them runs none of their code.
+    kernels: [[Kernel; 2]; 2],
+    /// The right eye's half-resolution dispatches, by RSM bounce: reusing the left eye's
+    /// AO (listing the quads it cannot), and over the listed quads.
+    right_eye: [Kernel; 2],
+    right_eye_fallback: [Kernel; 2],
+    /// The list of right-eye quads the left eye does not fully see, with the indirect
+    /// dispatch's arguments in front (composite.wgsl `FallbackQuads`), grown to the
+    /// frame's quads when needed; and the header it starts each frame from.
+    fallback: Mutex<Option<wgpu::Buffer>>,
+    fallback_header: wgpu::Buffer,
+    /// The indirect arguments copied out of the list (a buffer may not be both the
+    /// dispatch's read-write binding and its arguments).
+    fallback_args: wgpu::Buffer,
+}
+
+/// Bytes of `FallbackQuads` before its list: the indirect arguments (x, y, z) and the count.
+const FALLBACK_HEADER_BYTES: u64 = 16;
+
+/// composite.wgsl's bindings: frame, AO parameters, the G-buffer, the direct light, the
+/// occlusion, the environment, the HDR out, the occlusion's geometry, the RSM bounce and
+/// its geometry and, for the right eye's dispatches, the output's left-eye layer and the
+/// fallback list.
+const BINDINGS: [Bind; 15] = [
+    Bind::Frame,
+    Bind::AoParams,
+    Bind::Read(DEPTH),
+    Bind::Read(NORMALS),
+    Bind::Read(ALBEDO),
+    Bind::Read(DIRECT),
+    Bind::Read(OCCLUSION),
+    Bind::Environment,
+    Bind::EnvironmentSampler,
+    Bind::Write(HDR),
+    Bind::Read(AO_GEOMETRY),
+    Bind::Read(RSM_INDIRECT),
+    Bind::Read(RSM_GEOMETRY),
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::ReadWriteBuffer),
+];
+
+impl CompositePass {
+    /// Builds the pass's pipelines.
+    pub fn new(gpu: &Gpu) -> Self {
+        let files = [COMMON, IRRADIANCE, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/composite/composite.wgsl")];
+        let variant = |half_res: bool, rsm: bool, right_eye: bool, fallback: bool| {
+            let constants = [
+                ("HALF_RES", f64::from(half_res)),
+                ("RSM", f64::from(rsm)),
+                ("RIGHT_EYE", f64::from(right_eye)),
+                ("FALLBACK", f64::from(fallback)),
+            ];
+            let label = match (right_eye, fallback) {
+                (false, _) => "composite",
+                (true, false) => "composite right eye",
+                (true, true) => "composite right eye fallback",
+            };
+            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
+        };
+        let fallback_header = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("composite fallback header"),
+            // No workgroups yet (x = 0), y = z = 1, no quads listed; room for a list of
+            // one, so that it also binds where no list is used.
+            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0, 0, 0, 0]),
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::STORAGE,
+        });
+        let fallback_args = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("composite fallback dispatch"),
+            size: FALLBACK_HEADER_BYTES,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        CompositePass {
+            fallback_args,
+            kernels: [false, true].map(|half_res| [false, true].map(|rsm| variant(half_res, rsm, false, false))),
+            right_eye: [false, true].map(|rsm| variant(true, rsm, true, false)),
+            right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true)),
+            fallback: Mutex::new(None),
+            fallback_header,
+        }
+    }
+}
+
+impl Pass for CompositePass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let settings = settings_of(setup);
+        let mut decl = PassDecl::new(NAME).bindings(&BINDINGS);
+        if settings.ao.technique == Technique::None {
+            decl = decl.unbind(OCCLUSION).unbind(AO_GEOMETRY);
+        } else if settings.ao.half_res {
+            decl = decl.note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)");
+        } else {
+            decl = decl.unbind(AO_GEOMETRY);
+        }
+        if rsm_active(scene_of(setup), settings) {
+            decl
+        } else {
+            decl.unbind(RSM_INDIRECT).unbind(RSM_GEOMETRY)
+        }
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let half_res = settings_of(ctx.setup).ao.half_res;
+        let rsm = rsm_active(scene_of(ctx.setup), settings_of(ctx.setup));
+        // The output's left-eye layer is unused before the right eye's dispatch: the
+        // geometry (or its placeholder) stands in.
+        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), self.fallback_header.as_entire_binding()]);
+        // One invocation per quad of 2×2 pixels (composite.wgsl): both eyes alike, or the
+        // left eye, then the right eye reusing its AO, then the quads it listed.
+        let (w, h, layers) = ctx.quad_extent();
+        let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
+        let device = &ctx.gpu.device;
+        let kernel = &self.kernels[half_res as usize][rsm as usize];
+        kernel.dispatch(device, ctx.encoder, &resources, (w, h, if reuse { 1 } else { layers }));
+        if reuse {
+            let fallback = self.fallback_list(device, u64::from(w) * u64::from(h));
+            ctx.encoder.copy_buffer_to_buffer(&self.fallback_header, 0, &fallback, 0, FALLBACK_HEADER_BYTES);
+            // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists
+            // the quads it could not reuse in `fallback`.
+            let (right, left) = (ctx.layer_view(HDR, 1), ctx.layer_view(HDR, 0));
+            let resources = ctx.bind_overriding(
+                &BINDINGS,
+                &[wgpu::BindingResource::TextureView(&left), fallback.as_entire_binding()],
+                &[(HDR, wgpu::BindingResource::TextureView(&right))],
+            );
+            self.right_eye[rsm as usize].dispatch(device, ctx.encoder, &resources, (w, h, 1));
+            ctx.encoder.copy_buffer_to_buffer(&fallback, 0, &self.fallback_args, 0, 12);
+            let args = &self.fallback_args;
+            self.right_eye_fallback[rsm as usize].dispatch_indirect(device, ctx.encoder, &resources, args, 0);
+        }
+    }
+}
+
+impl CompositePass {
+    /// The fallback list, room for `quads` (a clone of the one buffer: wgpu buffers are
+    /// shared handles).
+    fn fallback_list(&self, device: &wgpu::Device, quads: u64) -> wgpu::Buffer {
+        let size = FALLBACK_HEADER_BYTES + 4 * quads;
+        let mut list = self.fallback.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if list.as_ref().is_none_or(|b| b.size() < size) {
+            *list = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("composite fallback quads"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        list.as_ref().expect("allocated above").clone()
+    }
+}

@@ -1,0 +1,70 @@
+//! Direct light from the scene's point and directional lights, plus emission, as
+//! outgoing radiance. The composite builds on it; SSDO's bounce reads it as L_pixel.
+//! Directional lights are shadowed by their shadow maps (3×3 PCF, passes/shadow) when
+//! shadows are on.
+
+use super::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS};
+use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
+use super::{scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::Gpu;
+use crate::graph::{PassDecl, Resource, Size};
+use std::sync::Arc;
+
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "direct";
+
+/// Outgoing direct radiance (lights and emission) and the view distance, packed
+/// (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the composite's base, and
+/// the depth test plus sender radiance of SSDO's bounce in a single fetch.
+pub const DIRECT: Resource = Resource::storage("direct", Size::Full, wgpu::TextureFormat::Rg32Uint);
+
+/// direct.wgsl's bindings: the G-buffer in, the direct light out, and the shadows
+/// (their `Shadows` uniform, every light's map, the comparison sampler).
+const BINDINGS: [Bind; 10] = [
+    Bind::Frame,
+    Bind::Lights,
+    Bind::Read(DEPTH),
+    Bind::Read(NORMALS),
+    Bind::Read(ALBEDO),
+    Bind::Read(EMISSION),
+    Bind::Write(DIRECT),
+    Bind::Own(Slot::Uniform),
+    Bind::Read(SHADOW_MAP),
+    Bind::Own(Slot::ComparisonSampler),
+];
+
+/// Direct light of every light, shadowed where shadow maps exist (module docs).
+pub struct DirectLightPass {
+    kernel: Kernel,
+    light_space: Arc<LightSpace>,
+}
+
+impl DirectLightPass {
+    /// Builds the pass's pipelines.
+    pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> Self {
+        let files = [COMMON, SHADOW_WGSL, wgsl!("src/passes/direct/direct.wgsl")];
+        DirectLightPass { kernel: Kernel::new(gpu, "direct", &files, "main", &BINDINGS), light_space }
+    }
+}
+
+impl Pass for DirectLightPass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let decl = PassDecl::new(NAME).bindings(&BINDINGS);
+        if shadows_active(scene_of(setup), settings_of(setup)) {
+            decl.note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
+        } else {
+            decl.unbind(SHADOW_MAP)
+        }
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        // Shadows (shadow.wgsl): every light's map, or no light and a placeholder map.
+        let shadowed = shadows_active(scene_of(ctx.setup), settings_of(ctx.setup));
+        let shadows = if shadowed { &self.light_space.uniform } else { &self.light_space.none };
+        let own = [shadows.as_entire_binding(), wgpu::BindingResource::Sampler(&self.light_space.comparison)];
+        let resources = ctx.bind(&BINDINGS, &own);
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.extent());
+    }
+}

@@ -1,0 +1,275 @@
+//! The layered G-buffer: reversed-Z depth, view-space normals, albedo and emission for
+//! every eye layer, and in a scene that moves each pixel's motion ([`MOTION`]).
+//! Multiview draws both eyes in one pass; otherwise one pass per eye. Both paths share the
+//! fragment shader and vertex transform, so they give equal pixels. Alpha-tested
+//! materials are drawn after the solid ones with a pipeline that discards their holes;
+//! a scene without them (or without motion) gets neither pipeline nor target.
+
+use super::{gpu_scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use crate::gpu::frame::FrameBuffers;
+use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
+use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
+use crate::gpu::scene::{GpuScene, MESH_WGSL};
+use crate::gpu::Gpu;
+use crate::graph::{PassDecl, Resource, Size, PIXEL_MOTION};
+use bytemuck::{Pod, Zeroable};
+use std::num::NonZeroU32;
+use wgpu::util::DeviceExt;
+
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "gbuffer";
+
+/// The depth, normals and motion the G-buffer writes are the textures the AO engine
+/// reads.
+pub use vrao_ao::passes::inputs::{DEPTH, MOTION, NORMALS};
+/// Diffuse albedo (sRGB-encoded, reads back linear).
+pub const ALBEDO: Resource = Resource::attachment("albedo", Size::Full, wgpu::TextureFormat::Rgba8UnormSrgb);
+/// Emitted radiance.
+pub const EMISSION: Resource = Resource::attachment("emission", Size::Full, wgpu::TextureFormat::Rgba16Float);
+
+const COLOR_TARGETS: [Resource; 4] = [NORMALS, ALBEDO, EMISSION, MOTION];
+
+/// gbuffer.wgsl: the vertex transform and fragment shader both paths share.
+const GBUFFER_WGSL: Shader = wgsl!("src/passes/gbuffer/gbuffer.wgsl");
+
+/// Mirrors `PreviousEyes` in gbuffer.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PreviousEyes {
+    clip_from_anchored: [[[f32; 4]; 4]; 2],
+    view_from_anchored: [[[f32; 4]; 4]; 2],
+}
+
+/// The pipelines of one path (multiview or per eye): solid materials, and alpha-tested
+/// ones when the scene has any.
+struct Pipelines {
+    solid: wgpu::RenderPipeline,
+    alpha_tested: Option<wgpu::RenderPipeline>,
+}
+
+impl Pipelines {
+    /// Draws the scene: solid materials first (early depth test), then the alpha-tested.
+    fn draw(&self, pass: &mut wgpu::RenderPass, scene: &GpuScene) {
+        scene.draw_with(pass, &self.solid, self.alpha_tested.as_ref());
+    }
+}
+
+/// The G-buffer of both eyes: depth, normals, albedo, emission and (when the scene moves)
+/// motion, multiview or one pass per eye (module docs).
+pub struct GBufferPass {
+    frame_group: wgpu::BindGroup,
+    /// One pass for both layers; `None` when the adapter lacks multiview.
+    multiview: Option<Pipelines>,
+    multipass: Pipelines,
+    /// Bind groups selecting eye 0 and eye 1 for the per-eye path.
+    eye_select: [wgpu::BindGroup; 2],
+    /// Whether the scene moves: the pipelines then write [`MOTION`].
+    motion: bool,
+    /// The previous frame's eyes (`PreviousEyes`).
+    previous_eyes: wgpu::Buffer,
+}
+
+impl GBufferPass {
+    /// Builds the pass's pipelines.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
+        let device = &gpu.device;
+        let vs_fs = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gbuffer frame"),
+            entries: &[uniform_entry(0, vs_fs), uniform_entry(1, wgpu::ShaderStages::VERTEX)],
+        });
+        let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gbuffer eye select"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+        });
+        let eye_select = [0u32, 1].map(|eye| {
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("eye select"),
+                contents: bytemuck::cast_slice(&[eye, 0, 0, 0]),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("eye select"),
+                layout: &eye_layout,
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+            })
+        });
+        let motion = scene.has_moving_objects();
+        let pipelines = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, mask: Option<NonZeroU32>| {
+            let make = |alpha_test: bool| pipeline(device, layout, module, mask, motion, alpha_test);
+            Pipelines { solid: make(false), alpha_tested: scene.alpha_tested.then(|| make(true)) }
+        };
+        let multiview = gpu.caps.multiview.then(|| {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gbuffer multiview"),
+                bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout)],
+                immediate_size: 0,
+            });
+            let module = shader_module(
+                device,
+                "gbuffer multiview",
+                &[COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/passes/gbuffer/gbuffer_multiview.wgsl")],
+            );
+            pipelines(&layout, &module, NonZeroU32::new(0b11))
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer multipass"),
+            bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
+            immediate_size: 0,
+        });
+        let module = shader_module(
+            device,
+            "gbuffer multipass",
+            &[COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/passes/gbuffer/gbuffer_multipass.wgsl")],
+        );
+        let multipass = pipelines(&layout, &module, None);
+        let previous_eyes = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gbuffer previous eyes"),
+            size: std::mem::size_of::<PreviousEyes>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer frame"),
+            layout: &frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: frame.frame.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: previous_eyes.as_entire_binding() },
+            ],
+        });
+        GBufferPass { frame_group, multiview, multipass, eye_select, motion, previous_eyes }
+    }
+
+    /// The colour targets this scene's pipelines write.
+    fn color_targets(&self) -> &'static [Resource] {
+        if self.motion {
+            &COLOR_TARGETS
+        } else {
+            &COLOR_TARGETS[..3]
+        }
+    }
+
+    /// Writes the previous frame's eyes (this frame's when there is none: then only
+    /// objects move).
+    fn write_previous_eyes(&self, ctx: &FrameContext) {
+        let setup = ctx.setup;
+        let eyes = setup.previous_views.unwrap_or(setup.current_views);
+        let mut u = PreviousEyes::zeroed();
+        for (layer, eye) in eyes.iter().take(2).enumerate() {
+            u.clip_from_anchored[layer] =
+                eye.clip_from_anchored(setup.anchor, settings_of(setup).near).to_cols_array_2d();
+            let view_from_anchored = eye.view_from_world() * glam::DMat4::from_translation(setup.anchor);
+            u.view_from_anchored[layer] = view_from_anchored.as_mat4().to_cols_array_2d();
+        }
+        ctx.gpu.queue.write_buffer(&self.previous_eyes, 0, bytemuck::bytes_of(&u));
+    }
+}
+
+fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    multiview_mask: Option<NonZeroU32>,
+    motion: bool,
+    alpha_test: bool,
+) -> wgpu::RenderPipeline {
+    let count = if motion { 4 } else { 3 };
+    let targets: Vec<_> =
+        COLOR_TARGETS[..count].iter().map(|r| Some(wgpu::ColorTargetState::from(r.format()))).collect();
+    let (vertex, fragment) = if motion { ("vs_motion", "fs_motion") } else { ("vs_main", "fs_main") };
+    mesh_pipeline(
+        device,
+        MeshPipeline {
+            label: if alpha_test { "gbuffer alpha-tested" } else { "gbuffer" },
+            layout,
+            module,
+            vertex: (vertex, &MESH_ATTRIBUTES),
+            // Reversed Z: nearer is greater.
+            depth: (DEPTH.format(), wgpu::CompareFunction::Greater),
+            fragment: Some((fragment, &targets)),
+            multiview_mask,
+            alpha_test,
+        },
+    )
+}
+
+impl Pass for GBufferPass {
+    fn declare(&self, _: &FrameSetup) -> PassDecl {
+        let mut decl = PassDecl::new(NAME).write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION);
+        decl = if self.motion {
+            decl.write(MOTION).provide(PIXEL_MOTION, MOTION)
+        } else {
+            decl.note("motion vectors left out: nothing in the scene moves")
+        };
+        if self.multipass.alpha_tested.is_none() {
+            decl = decl.note("alpha test left out: no material has holes");
+        }
+        decl
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let gpu_scene = gpu_scene_of(ctx.setup);
+        if self.motion {
+            self.write_previous_eyes(ctx);
+        }
+        let targets = self.color_targets();
+        let multiview = ctx.setup.multiview && ctx.setup.views == 2;
+        if multiview {
+            let pipelines = self.multiview.as_ref().expect("multiview requested without adapter support");
+            let views = |r: Resource| &ctx.targets[&r].array_view;
+            let mut pass = begin(ctx.encoder, targets, views, NonZeroU32::new(0b11));
+            pass.set_bind_group(0, &self.frame_group, &[]);
+            pipelines.draw(&mut pass, gpu_scene);
+        } else {
+            for layer in 0..ctx.setup.views as usize {
+                let label = if layer == 0 { "gbuffer left" } else { "gbuffer right" };
+                let span = ctx.timer.begin(ctx.encoder, label);
+                {
+                    let views = |r: Resource| &ctx.targets[&r].layer_views[layer];
+                    let mut pass = begin(ctx.encoder, targets, views, None);
+                    pass.set_bind_group(0, &self.frame_group, &[]);
+                    pass.set_bind_group(2, &self.eye_select[layer], &[]);
+                    self.multipass.draw(&mut pass, gpu_scene);
+                }
+                ctx.timer.end(ctx.encoder, span);
+            }
+        }
+    }
+}
+
+/// A render pass clearing every G-buffer target (depth to 0 = infinitely far, motion to
+/// 0 = invalid).
+fn begin<'e, 't>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    targets: &[Resource],
+    views: impl Fn(Resource) -> &'t wgpu::TextureView,
+    multiview_mask: Option<NonZeroU32>,
+) -> wgpu::RenderPass<'e> {
+    let color: Vec<_> = targets
+        .iter()
+        .map(|&r| {
+            Some(wgpu::RenderPassColorAttachment {
+                view: views(r),
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+        .collect();
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("gbuffer"),
+        color_attachments: &color,
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: views(DEPTH),
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask,
+    })
+}

@@ -1,0 +1,160 @@
+//! Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
+//! surface behind the G-buffer's depth (peel.wgsl). With it SSDO counts a sample
+//! as an occluder only between the first and second layer, inside an object, so thin
+//! objects in front of a background no longer cast a halo onto it. An optional quality
+//! mode (`ao.depth_peeling`): the pass exists only while SSDO runs with peeling on.
+//!
+//! One depth-only render pass per eye layer, whatever the G-buffer uses: multiview is
+//! unreliable on lavapipe, and each pass reads its own layer of the first depth.
+
+use super::{gpu_scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use crate::gpu::frame::FrameBuffers;
+use crate::gpu::kernel::{shader_module, wgsl, COMMON};
+use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
+use crate::gpu::scene::{GpuScene, MESH_WGSL};
+use crate::gpu::Gpu;
+use crate::graph::{PassDecl, Resource, Size};
+use crate::passes::gbuffer::DEPTH;
+use crate::settings::Technique;
+use wgpu::util::DeviceExt;
+
+/// The pass's name: its declaration in the graph, its timestamp span, and what reports
+/// look its cost up by.
+pub const NAME: &str = "depth-peel";
+
+/// Depth peeling's second layer (SSDO's quality mode): the nearest surface behind
+/// [`DEPTH`], reversed-Z, 0 where nothing lies behind.
+pub const DEPTH_LAYER_2: Resource =
+    Resource::attachment("depth-layer-2", Size::Full, wgpu::TextureFormat::Depth32Float);
+
+/// Depth peeling's second depth layer of each eye (module docs).
+pub struct DepthPeelPass {
+    pipeline: wgpu::RenderPipeline,
+    /// The alpha-tested materials' (a scene with some only).
+    alpha_tested: Option<wgpu::RenderPipeline>,
+    frame_group: wgpu::BindGroup,
+    eye_layout: wgpu::BindGroupLayout,
+    /// The eye index (0 left, 1 right) each per-eye pass binds.
+    eye_index: [wgpu::Buffer; 2],
+}
+
+impl DepthPeelPass {
+    /// Builds the pass's pipelines.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
+        let device = &gpu.device;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth peel frame"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+        });
+        let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth peel eye"),
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth peel"),
+            bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
+            immediate_size: 0,
+        });
+        let module = shader_module(device, "depth peel", &[COMMON, MESH_WGSL, wgsl!("src/passes/peel/peel.wgsl")]);
+        let make = |alpha_test: bool| {
+            mesh_pipeline(
+                device,
+                MeshPipeline {
+                    label: "depth peel",
+                    layout: &layout,
+                    module: &module,
+                    vertex: ("vs_peel", &MESH_ATTRIBUTES),
+                    // Reversed Z; two-sided: the back faces are what this pass is for.
+                    depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
+                    fragment: Some(("fs_peel", &[])),
+                    multiview_mask: None,
+                    alpha_test,
+                },
+            )
+        };
+        let pipeline = make(false);
+        let alpha_tested = scene.alpha_tested.then(|| make(true));
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("depth peel frame"),
+            layout: &frame_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.frame.as_entire_binding() }],
+        });
+        let eye_index = [0u32, 1].map(|eye| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("depth peel eye"),
+                contents: bytemuck::cast_slice(&[eye, 0, 0, 0]),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        });
+        DepthPeelPass { pipeline, alpha_tested, frame_group, eye_layout, eye_index }
+    }
+}
+
+impl Pass for DepthPeelPass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let ao = &settings_of(setup).ao;
+        let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
+        PassDecl::new(NAME)
+            .read(DEPTH)
+            .write(DEPTH_LAYER_2)
+            .occlusion_cost()
+            .disabled_if(!ao.depth_peeling, "depth peeling is off (an SSDO quality mode)")
+            .disabled_if(
+                !ssdo,
+                format!("technique is {}: only SSDO tests occluders against a second depth layer", ao.technique.name()),
+            )
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let gpu_scene = gpu_scene_of(ctx.setup);
+        let first = ctx.view(DEPTH);
+        let second = ctx.target(DEPTH_LAYER_2);
+        for layer in 0..ctx.setup.views as usize {
+            let eye_group = ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("depth peel eye"),
+                layout: &self.eye_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.eye_index[layer].as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: first.clone() },
+                ],
+            });
+            let label = if layer == 0 { "depth-peel left" } else { "depth-peel right" };
+            let span = ctx.timer.begin(ctx.encoder, label);
+            {
+                let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("depth peel"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &second.layer_views[layer],
+                        // Cleared to 0 = infinitely far: where nothing lies behind the first
+                        // layer, every sample behind it counts as inside.
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(0.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_bind_group(0, &self.frame_group, &[]);
+                pass.set_bind_group(2, &eye_group, &[]);
+                gpu_scene.draw_with(&mut pass, &self.pipeline, self.alpha_tested.as_ref());
+            }
+            ctx.timer.end(ctx.encoder, span);
+        }
+    }
+}

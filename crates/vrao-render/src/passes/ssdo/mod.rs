@@ -1,0 +1,78 @@
+//! SSDO, with the optional bounce gathered in the same loop (Ritschel et al. 2009 eqs. 1–2,
+//! Belonogov 2018 §4.1–4.2). The technique itself is ssdo.wgsl on the shared occlusion
+//! layout; a bounce strength of 0 selects the pipeline compiled without bounce work,
+//! which also does not read the direct light, so the graph need not produce it for an
+//! occlusion-only frame.
+
+use super::direct::DIRECT;
+use super::occlusion::{self, technique_decl, OCCLUSION_WGSL};
+use super::peel::DEPTH_LAYER_2;
+use super::{settings_of, FrameContext, FrameSetup, Pass};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON, IRRADIANCE};
+use crate::gpu::Gpu;
+use crate::graph::PassDecl;
+use crate::settings::{BounceForm, Technique};
+
+/// The shared occlusion bindings plus the direct light (binding 7, the bounce's senders)
+/// and the second depth layer (binding 8, depth peeling).
+const BINDINGS: [Bind; 9] = occlusion::bindings_and([Bind::Read(DIRECT), Bind::Read(DEPTH_LAYER_2)]);
+
+/// SSDO, with its bounce when the technique asks for it (module docs).
+pub struct SsdoPass {
+    /// Pipelines by [depth peeling][bounce: none, direction form, patch form]: pipeline
+    /// constants, so a frame runs no code of what it left out.
+    kernels: [[Kernel; 3]; 2],
+}
+
+impl SsdoPass {
+    /// Builds the pass's pipelines.
+    pub fn new(gpu: &Gpu) -> Self {
+        let files = [COMMON, IRRADIANCE, OCCLUSION_WGSL, wgsl!("src/passes/ssdo/ssdo.wgsl")];
+        let labels = [
+            ["ssdo", "ssdo-bounce", "ssdo-bounce patch"],
+            ["ssdo peeled", "ssdo-bounce peeled", "ssdo-bounce patch peeled"],
+        ];
+        let kernels = [0, 1].map(|peel| {
+            [0, 1, 2].map(|bounce| {
+                let constants = [
+                    ("PEEL", peel as f64),
+                    ("BOUNCE", f64::from(bounce > 0)),
+                    ("BOUNCE_PATCH", f64::from(bounce == 2)),
+                ];
+                Kernel::with_constants(gpu, labels[peel][bounce], &files, "main", &BINDINGS, &constants)
+            })
+        });
+        SsdoPass { kernels }
+    }
+}
+
+impl Pass for SsdoPass {
+    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+        let ao = &settings_of(setup).ao;
+        let name = if ao.bounce_active() { "ssdo-bounce" } else { "ssdo" };
+        let mut decl = technique_decl(name, &BINDINGS, &[Technique::Ssdo, Technique::SsdoBounce], setup);
+        if !ao.bounce_active() {
+            decl = decl.unbind(DIRECT);
+            if ao.technique == Technique::SsdoBounce {
+                decl = decl.note("bounce left out: bounce strength is 0");
+            }
+        }
+        if ao.depth_peeling {
+            decl.note("depth peeling: occluders only between the first and second depth layer")
+        } else {
+            decl.unbind(DEPTH_LAYER_2)
+        }
+    }
+
+    fn record(&self, ctx: &mut FrameContext) {
+        let ao = &settings_of(ctx.setup).ao;
+        let form = match (ao.bounce_active(), ao.bounce_form) {
+            (false, _) => 0,
+            (true, BounceForm::Direction) => 1,
+            (true, BounceForm::Patch) => 2,
+        };
+        let kernel = &self.kernels[ao.depth_peeling as usize][form];
+        let resources = ctx.bind(&BINDINGS, &[]);
+        kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.ao_extent());
+    }
+}

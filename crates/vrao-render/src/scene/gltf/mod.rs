@@ -1,0 +1,1112 @@
+//! glTF 2.0 loading: `.gltf` (JSON with external or data-URI buffers and images) and
+//! `.glb` (binary, with its BIN chunk).
+//!
+//! The `gltf` crate parses and validates the JSON (every index names an element that
+//! exists); everything the JSON cannot say is checked here before it is used: the GLB
+//! container, each buffer's bytes, every accessor's byte range against its buffer view and
+//! buffer, finite numbers, indices against vertex counts, node cycles, key times, and a
+//! bound on every count ([`MAX_FILE_BYTES`], [`MAX_TRIANGLES`], ...). Accessors are decoded
+//! here rather than by the crate's readers, which assume valid ranges. Anything wrong is
+//! one [`Error::Input`] line naming the file and the element.
+//!
+//! What is read: the default scene (else the first; else every root node) with its
+//! TRS and matrix transforms; triangle primitives (indexed u8/u16/u32 or not; other modes
+//! are an error); POSITION, NORMAL (computed as for OBJ when missing), TEXCOORD_0 (float
+//! or normalised integers); the base-colour factor and texture; `alphaMode`
+//! OPAQUE / MASK (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]); the
+//! emissive factor × `KHR_materials_emissive_strength`, so emitters become lights as in
+//! OBJ when the file has no punctual light; `KHR_lights_punctual` directional, point and
+//! spot lights (intensities taken as vrao's units: lux as irradiance, candela as radiant
+//! intensity; `range` ignored); the first camera's node as the head pose; translation,
+//! rotation and scale animation channels (STEP, LINEAR, CUBICSPLINE).
+//!
+//! Not read: `doubleSided` (vrao draws every face from both sides, as for OBJ), metallic,
+//! roughness, normal, occlusion and emissive textures, samplers, texture sets other than 0,
+//! skins and morph targets (drawn in the bind pose, one warning), weight animations.
+//! Lights hang where their nodes are at time 0 (they do not move).
+//!
+//! Motion: only meshes below an animated node keep a [`Node`]; static geometry is baked
+//! into world space (f64 transform, then [`Mesh::recentre`], exactly as the OBJ loader
+//! recentres), so a still glTF gives `Scene::nodes` empty. Static ancestors of an animated
+//! node fold into its `base`; a matrix node below an animated one becomes a node whose
+//! `base` is the matrix.
+
+use super::normals::{self, Geometry};
+use super::{obj, AlphaMode, Environment, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene};
+use super::{Texture, Track, Trs};
+use crate::error::{Error, Result};
+use crate::stereo::HeadPose;
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::json;
+use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3};
+use std::collections::{BTreeSet, HashMap};
+use std::path::{Path, PathBuf};
+
+/// The largest `.gltf`/`.glb`, external buffer or image file read (1 GiB).
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// The most triangles over every drawn mesh instance (20 million).
+pub const MAX_TRIANGLES: usize = 20_000_000;
+/// The most vertices over every drawn mesh instance (20 million).
+pub const MAX_VERTICES: usize = 20_000_000;
+/// The most nodes a file may declare.
+pub const MAX_NODES: usize = 100_000;
+/// The most animation keys over all channels (10 million).
+pub const MAX_KEYS: usize = 10_000_000;
+/// The largest texture side in texels.
+pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+/// The most elements one accessor may declare (more than any bound above needs).
+const MAX_ACCESSOR_COUNT: usize = 3 * MAX_TRIANGLES;
+
+/// Extensions whose meaning vrao honours; a file that requires any other is refused.
+/// (`KHR_mesh_quantization` only widens the accessor types, which are all decoded here.)
+pub const SUPPORTED_EXTENSIONS: [&str; 3] =
+    ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization"];
+
+/// What a glTF file contributes to a scene: the scene-file loader places it, the bare
+/// loader ([`load`]) frames and lights it.
+#[derive(Clone, Debug)]
+pub struct Content {
+    /// Meshes; static ones in world space, moving ones in their node's frame.
+    pub meshes: Vec<Mesh>,
+    /// Materials; [`Mesh::material`] counts from the `material_offset` given to [`load_content`].
+    pub materials: Vec<Material>,
+    /// The motion hierarchy; [`Mesh::node`] indexes it from 0.
+    pub nodes: Vec<Node>,
+    /// The punctual lights (`KHR_lights_punctual`), in world space.
+    pub lights: Vec<Light>,
+    /// The first camera's pose, if the default scene has a camera.
+    pub camera: Option<HeadPose>,
+}
+
+/// A glTF file as a scene: its camera as the head pose (else framed as a bare OBJ), its
+/// punctual lights (else [`obj::default_lights`]), under the default sky.
+pub fn load(path: &Path) -> Result<Scene> {
+    let content = load_content(path, 0)?;
+    let mut scene = Scene {
+        name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        meshes: content.meshes,
+        materials: content.materials,
+        lights: Vec::new(),
+        environment: Some(Environment::default_sky()),
+        head: HeadPath::fixed(HeadPose::IDENTITY),
+        nodes: content.nodes,
+    };
+    scene.lights = if content.lights.is_empty() {
+        // Emitters where they are at time 0 (a moving emitter's positions are local).
+        let still = scene.at_time(0.0);
+        obj::default_lights(&still.meshes, &still.materials)
+    } else {
+        content.lights
+    };
+    scene.head = HeadPath::fixed(content.camera.unwrap_or_else(|| scene.bounds().framing_pose()));
+    Ok(scene)
+}
+
+/// Reads a `.gltf` or `.glb`. Material indices start at `material_offset`.
+pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
+    let bytes = read_bounded(path, path)?;
+    let (json_bytes, bin) = if bytes.starts_with(b"glTF") {
+        let (json, bin) = split_glb(path, &bytes)?;
+        (json.to_vec(), bin.map(<[u8]>::to_vec))
+    } else {
+        (bytes, None)
+    };
+    let mut root: json::Root = json::deserialize::from_slice(&json_bytes)
+        .map_err(|e| Error::in_file(path, format!("not valid glTF JSON: {e}")))?;
+    drop(json_bytes);
+
+    let mut warnings = Warnings::default();
+    for required in &root.extensions_required {
+        if !SUPPORTED_EXTENSIONS.contains(&required.as_str()) {
+            return Err(Error::in_file(path, format!("requires extension {required}, which vrao does not support")));
+        }
+    }
+    for used in &root.extensions_used {
+        if !SUPPORTED_EXTENSIONS.contains(&used.as_str()) {
+            warnings.extensions.insert(used.clone());
+        }
+    }
+    // The crate's validation refuses required extensions it has no feature for; vrao
+    // decodes quantised accessors itself, so that one is checked above instead.
+    root.extensions_required.retain(|e| e != "KHR_mesh_quantization");
+    if root.nodes.len() > MAX_NODES {
+        return Err(Error::in_file(path, format!("{} nodes, more than vrao's limit of {MAX_NODES}", root.nodes.len())));
+    }
+    precheck(&root).map_err(|Problem(m)| Error::in_file(path, m))?;
+    let document = ::gltf::Document::from_json(root).map_err(|e| Error::in_file(path, first_line(&e.to_string())))?;
+
+    let buffers = load_buffers(path, &document, bin)?;
+    let mut loader = Loader {
+        path,
+        document: &document,
+        buffers,
+        warnings,
+        images: HashMap::new(),
+        materials: Vec::new(),
+        material_of: HashMap::new(),
+        material_offset,
+        primitives: HashMap::new(),
+        triangles: 0,
+        vertices: 0,
+    };
+    let content = loader.build()?;
+    check_limits(path, &content)?;
+    loader.warnings.emit(path);
+    Ok(content)
+}
+
+/// Refuses, naming the file, what lies beyond what the renderer can draw (`limits.rs`,
+/// as for OBJ and scene files): static geometry beyond 10⁶ m, emission or lights
+/// brighter than the HDR buffer holds. (Moving meshes are in their node's frame.)
+fn check_limits(path: &Path, content: &Content) -> Result<()> {
+    use super::limits::{coordinate_trouble, mesh_trouble, radiance_trouble};
+    let meshes = content.meshes.iter().filter(|m| m.node.is_none()).find_map(mesh_trouble);
+    let emitters = content
+        .materials
+        .iter()
+        .find_map(|m| radiance_trouble(&format!("material '{}' emission", m.name), m.emissive.max_element() as f64));
+    let lights = content.lights.iter().find_map(|light| {
+        let (colour, intensity, position) = match *light {
+            Light::Directional { color, intensity, .. } => (color, intensity, None),
+            Light::Point { color, intensity, position } | Light::Spot { color, intensity, position, .. } => {
+                (color, intensity, Some(position))
+            }
+        };
+        let far = position.and_then(|p| coordinate_trouble("light position", p.abs().max_element()));
+        far.or_else(|| radiance_trouble("light colour × intensity", (colour * intensity).max_element() as f64))
+    });
+    match meshes.or(emitters).or(lights) {
+        Some(trouble) => Err(Error::in_file(path, trouble)),
+        None => Ok(()),
+    }
+}
+
+/// What is wrong with a file, for the caller to name the file (and element) with.
+struct Problem(String);
+
+impl From<String> for Problem {
+    fn from(message: String) -> Problem {
+        Problem(message)
+    }
+}
+
+/// What the crate's validation leaves out and its accessors would panic on (found by
+/// fuzzing, gltf-json 1.4.1): animation channel targets (node index and path), a spot
+/// light without its cone, and a primitive's POSITION accessor that does not exist (the
+/// crate's own primitive check indexes the accessors with it before checking it).
+fn precheck(root: &json::Root) -> std::result::Result<(), Problem> {
+    use json::validation::Checked;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "an attribute".into(),
+                    };
+                    return Err(Problem(format!(
+                        "mesh {m} primitive {p}: {name} accessor {} does not exist",
+                        accessor.value()
+                    )));
+                }
+            }
+        }
+    }
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let node = channel.target.node.value();
+            if node >= root.nodes.len() {
+                return Err(Problem(format!("animation {a} channel {c}: target node {node} does not exist")));
+            }
+            if !matches!(channel.target.path, Checked::Valid(_)) {
+                return Err(Problem(format!(
+                    "animation {a} channel {c}: target path is not one of the glTF properties"
+                )));
+            }
+            if channel.sampler.value() >= animation.samplers.len() {
+                return Err(Problem(format!("animation {a} channel {c}: sampler does not exist")));
+            }
+        }
+    }
+    let lights = root.extensions.as_ref().and_then(|e| e.khr_lights_punctual.as_ref());
+    for (i, light) in lights.map_or(&[][..], |l| &l.lights[..]).iter().enumerate() {
+        use json::extensions::scene::khr_lights_punctual::Type;
+        if matches!(light.type_, Checked::Valid(Type::Spot)) && light.spot.is_none() {
+            return Err(Problem(format!("light {i}: a spot light needs its \"spot\" cone angles")));
+        }
+    }
+    Ok(())
+}
+
+/// The first line of a (possibly multi-line) message.
+fn first_line(message: &str) -> String {
+    let mut lines = message.lines().filter(|l| !l.trim().is_empty());
+    let first = lines.next().unwrap_or("").trim().to_string();
+    match lines.count() {
+        0 => first,
+        more => format!("{first} (and {more} more)"),
+    }
+}
+
+/// Reads `file` (the glTF itself or a file it names), refusing files over [`MAX_FILE_BYTES`].
+/// Errors name `gltf`, the file the user gave, and `file` when it differs.
+fn read_bounded(gltf: &Path, file: &Path) -> Result<Vec<u8>> {
+    let what = if gltf == file { String::new() } else { format!("{}: ", file.display()) };
+    let size = std::fs::metadata(file).map_err(|e| Error::in_file(gltf, format!("{what}cannot read: {e}")))?.len();
+    if size > MAX_FILE_BYTES {
+        return Err(Error::in_file(gltf, format!("{what}{size} bytes, more than vrao's limit of {MAX_FILE_BYTES}")));
+    }
+    std::fs::read(file).map_err(|e| Error::in_file(gltf, format!("{what}cannot read: {e}")))
+}
+
+/// The JSON chunk and the optional BIN chunk of a GLB container, checked here (the
+/// crate's parser trusts the header's lengths).
+fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<&'a [u8]>)> {
+    let bad = |message: String| Error::in_file(path, message);
+    let word = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err(bad(format!("truncated .glb: {} bytes, shorter than the 12-byte header", bytes.len())));
+    };
+    if version != 2 {
+        return Err(bad(format!(".glb container version {version}; vrao reads glTF 2.0 (version 2)")));
+    }
+    let length = length as usize;
+    if length > bytes.len() {
+        return Err(bad(format!("truncated .glb: the header says {length} bytes, the file has {}", bytes.len())));
+    }
+    let mut chunks = Vec::new();
+    let mut at = 12;
+    while at < length {
+        let (Some(chunk_length), Some(kind)) = (word(at), word(at + 4)) else {
+            return Err(bad(format!("truncated .glb: chunk header at byte {at} runs past the end")));
+        };
+        let start = at + 8;
+        let end = start.checked_add(chunk_length as usize).filter(|&e| e <= length).ok_or_else(|| {
+            bad(format!("truncated .glb: chunk at byte {at} says {chunk_length} bytes, past the end ({length})"))
+        })?;
+        chunks.push((kind, &bytes[start..end]));
+        at = end;
+    }
+    const JSON: u32 = 0x4E4F_534A;
+    const BIN: u32 = 0x004E_4942;
+    match chunks.first() {
+        Some(&(JSON, json)) => Ok((json, chunks.get(1).filter(|c| c.0 == BIN).map(|c| c.1))),
+        _ => Err(bad("not a valid .glb: the first chunk is not JSON".into())),
+    }
+}
+
+/// The bytes of every buffer: the GLB's BIN chunk, a data URI or a file beside the glTF.
+fn load_buffers(path: &Path, document: &::gltf::Document, mut bin: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        let data = match buffer.source() {
+            ::gltf::buffer::Source::Bin => bin.take().ok_or_else(|| {
+                Error::in_file(path, format!("buffer {i} refers to the .glb's binary chunk, which is missing"))
+            })?,
+            ::gltf::buffer::Source::Uri(uri) => {
+                resolve_uri(path, uri).map_err(|m| Error::in_file(path, format!("buffer {i}: {m}")))?
+            }
+        };
+        if data.len() < buffer.length() {
+            let message = format!("buffer {i} has {} bytes, the file says {}", data.len(), buffer.length());
+            return Err(Error::in_file(path, message));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// The bytes a URI names: a base64 data URI, or a file relative to the glTF's folder.
+fn resolve_uri(path: &Path, uri: &str) -> std::result::Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (header, payload) = rest.split_once(',').ok_or("data URI without a ',' before its data")?;
+        if !header.ends_with(";base64") {
+            return Err("data URI is not base64 (';base64,' expected)".into());
+        }
+        if payload.len() as u64 > MAX_FILE_BYTES / 3 * 4 {
+            return Err(format!("data URI of {} characters, over vrao's limit", payload.len()));
+        }
+        return decode_base64(payload).ok_or_else(|| "data URI holds invalid base64".to_string());
+    }
+    if uri.contains("://") {
+        return Err(format!("URI '{uri}' is not a file beside the glTF (vrao reads no network)"));
+    }
+    let relative = percent_decode(uri).ok_or_else(|| format!("URI '{uri}' has a bad %-escape"))?;
+    let file = path.parent().unwrap_or(Path::new("")).join(relative);
+    if !file.is_file() {
+        return Err(format!("file '{uri}' not found (looked for {})", file.display()));
+    }
+    read_bounded(path, &file).map_err(|e| match e {
+        Error::Input { message, .. } => message,
+        other => other.to_string(),
+    })
+}
+
+/// Standard base64 (RFC 4648) with optional padding; `None` for any other character.
+pub fn decode_base64(text: &str) -> Option<Vec<u8>> {
+    let digit = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => return None,
+        } as u32)
+    };
+    let body = text.trim_end_matches('=').as_bytes();
+    if text.len() - body.len() > 2 || body.len() % 4 == 1 {
+        return None;
+    }
+    let mut out = Vec::with_capacity(body.len() / 4 * 3 + 2);
+    for chunk in body.chunks(4) {
+        let mut bits = 0u32;
+        for &c in chunk {
+            bits = (bits << 6) | digit(c)?;
+        }
+        bits <<= 6 * (4 - chunk.len()) as u32;
+        let bytes = bits.to_be_bytes();
+        out.extend_from_slice(&bytes[1..chunk.len()]);
+    }
+    Some(out)
+}
+
+/// `%XX` escapes decoded (URIs in glTF are percent-encoded); `None` for a broken escape.
+fn percent_decode(uri: &str) -> Option<PathBuf> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    Some(PathBuf::from(String::from_utf8(out).ok()?))
+}
+
+/// What was read but not honoured, reported as one warning line per kind at the end.
+#[derive(Default)]
+struct Warnings {
+    extensions: BTreeSet<String>,
+    ignored: BTreeSet<&'static str>,
+}
+
+impl Warnings {
+    fn emit(&self, path: &Path) {
+        if !self.extensions.is_empty() {
+            let list: Vec<&str> = self.extensions.iter().map(String::as_str).collect();
+            log::warn!("{}: optional extensions not supported (ignored): {}", path.display(), list.join(", "));
+        }
+        if !self.ignored.is_empty() {
+            let list: Vec<&str> = self.ignored.iter().copied().collect();
+            log::warn!("{}: not supported (ignored): {}", path.display(), list.join("; "));
+        }
+    }
+}
+
+/// One primitive decoded in its mesh's local frame.
+#[derive(Clone)]
+struct LocalPrimitive {
+    name: String,
+    geometry: Geometry,
+    /// Index into the loaded materials (before the offset).
+    material: usize,
+}
+
+/// State of one load.
+struct Loader<'a> {
+    path: &'a Path,
+    document: &'a ::gltf::Document,
+    buffers: Vec<Vec<u8>>,
+    warnings: Warnings,
+    /// Decoded images by glTF image index.
+    images: HashMap<usize, Texture>,
+    materials: Vec<Material>,
+    /// vrao material index by glTF material index (`None` = the default material).
+    material_of: HashMap<Option<usize>, usize>,
+    material_offset: usize,
+    /// Decoded primitives by glTF mesh index (a mesh drawn by several nodes is read once).
+    primitives: HashMap<usize, Vec<LocalPrimitive>>,
+    /// Drawn so far, over every instance (bounded).
+    triangles: usize,
+    vertices: usize,
+}
+
+/// Where a node sits while the hierarchy is walked.
+#[derive(Clone, Copy)]
+struct Parent {
+    /// World transform of the static chain above (used while no ancestor moves).
+    world: DMat4,
+    /// The nearest moving ancestor's node, once there is one.
+    node: Option<usize>,
+}
+
+impl Loader<'_> {
+    fn error(&self, message: impl Into<String>) -> Error {
+        Error::in_file(self.path, message)
+    }
+
+    fn build(&mut self) -> Result<Content> {
+        let document = self.document;
+        let tracks = self.animation_tracks()?;
+        let roots: Vec<::gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
+            Some(scene) => scene.nodes().collect(),
+            None => {
+                // No scene: every node that is nobody's child.
+                let mut is_child = vec![false; document.nodes().len()];
+                document.nodes().flat_map(|n| n.children()).for_each(|c| is_child[c.index()] = true);
+                document.nodes().filter(|n| !is_child[n.index()]).collect()
+            }
+        };
+        if document.skins().next().is_some() {
+            self.warnings.ignored.insert("skins (drawn in the bind pose)");
+        }
+
+        let mut content =
+            Content { meshes: Vec::new(), materials: Vec::new(), nodes: Vec::new(), lights: Vec::new(), camera: None };
+        let mut visited = vec![false; document.nodes().len()];
+        let mut stack: Vec<(::gltf::Node, Parent)> =
+            roots.into_iter().rev().map(|n| (n, Parent { world: DMat4::IDENTITY, node: None })).collect();
+        // The world transform of every vrao node at time 0, for lights and the camera.
+        let mut node_rest_world: Vec<DMat4> = Vec::new();
+        while let Some((node, parent)) = stack.pop() {
+            let index = node.index();
+            if std::mem::replace(&mut visited[index], true) {
+                return Err(self.error(format!("node {index} is reached twice (a cycle, or a node with two parents)")));
+            }
+            let local = self.local_transform(&node)?;
+            let animated = tracks.get(&index);
+            let here = if parent.node.is_none() && animated.is_none() {
+                Parent { world: parent.world * local.matrix(), node: None }
+            } else {
+                let (base, rest) = match (parent.node, local) {
+                    // A moving root: its static ancestors fold into its base.
+                    (None, local) => (parent.world, local.trs()),
+                    (Some(_), Local::Matrix(m)) => (m, Trs::IDENTITY),
+                    (Some(_), Local::Trs(trs)) => (DMat4::IDENTITY, trs),
+                };
+                content.nodes.push(Node {
+                    name: node.name().map_or_else(|| format!("node {index}"), str::to_string),
+                    parent: parent.node,
+                    base,
+                    rest,
+                    tracks: animated.cloned().unwrap_or_default(),
+                });
+                Parent { world: parent.world, node: Some(content.nodes.len() - 1) }
+            };
+            let world_at_rest = match here.node {
+                None => here.world,
+                Some(k) if k == node_rest_world.len() => {
+                    let local = content.nodes[k].local_at(0.0);
+                    let world = parent.node.map_or(local, |p| node_rest_world[p] * local);
+                    node_rest_world.push(world);
+                    world
+                }
+                Some(k) => node_rest_world[k],
+            };
+
+            if let Some(mesh) = node.mesh() {
+                self.place_mesh(&mesh, &here, &mut content.meshes)?;
+            }
+            if let Some(light) = node.light() {
+                content.lights.push(self.light(&light, &world_at_rest)?);
+            }
+            if node.camera().is_some() && content.camera.is_none() {
+                let (_, rotation, translation) = world_at_rest.to_scale_rotation_translation();
+                if translation.is_finite() && rotation.is_finite() {
+                    content.camera = Some(HeadPose { position: translation, orientation: rotation.normalize() });
+                }
+            }
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child, here));
+            }
+        }
+        // Nodes without meshes below them are kept: cheap, and their indices stay simple.
+        content.materials = std::mem::take(&mut self.materials);
+        if content.meshes.is_empty() {
+            return Err(self.error("contains no triangles (no mesh in the default scene)"));
+        }
+        Ok(content)
+    }
+
+    /// A node's local transform, checked finite.
+    fn local_transform(&self, node: &::gltf::Node) -> Result<Local> {
+        let local = match node.transform() {
+            ::gltf::scene::Transform::Matrix { matrix } => {
+                Local::Matrix(DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))))
+            }
+            ::gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+                let [x, y, z, w] = rotation.map(f64::from);
+                let q = DQuat::from_xyzw(x, y, z, w);
+                if q.length().is_nan() || q.length() <= 1e-6 {
+                    return Err(self.error(format!("node {}: rotation {rotation:?} is not a quaternion", node.index())));
+                }
+                Local::Trs(Trs {
+                    translation: DVec3::from(translation.map(f64::from)),
+                    rotation: q.normalize(),
+                    scale: DVec3::from(scale.map(f64::from)),
+                })
+            }
+        };
+        if !local.matrix().is_finite() {
+            return Err(self.error(format!("node {}: transform is not finite", node.index())));
+        }
+        Ok(local)
+    }
+
+    /// The mesh's primitives placed by `at`: baked into world space when static, in the
+    /// node's frame when it moves.
+    fn place_mesh(&mut self, mesh: &::gltf::Mesh, at: &Parent, out: &mut Vec<Mesh>) -> Result<()> {
+        if !self.primitives.contains_key(&mesh.index()) {
+            let decoded = self.decode_mesh(mesh)?;
+            self.primitives.insert(mesh.index(), decoded);
+        }
+        for primitive in &self.primitives[&mesh.index()] {
+            let g = &primitive.geometry;
+            // Nothing to draw (an OBJ object without faces is dropped the same way).
+            if g.indices.is_empty() {
+                continue;
+            }
+            self.triangles += g.indices.len() / 3;
+            self.vertices += g.positions.len();
+            if self.triangles > MAX_TRIANGLES || self.vertices > MAX_VERTICES {
+                return Err(self.error(format!(
+                    "more than {MAX_TRIANGLES} triangles or {MAX_VERTICES} vertices over all mesh instances (vrao's limit)"
+                )));
+            }
+            let material = self.material_offset + primitive.material;
+            out.push(match at.node {
+                Some(node) => {
+                    let points: Vec<DVec3> = g.positions.iter().map(|p| p.as_dvec3()).collect();
+                    let (origin, positions) = Mesh::recentre(&points);
+                    Mesh {
+                        name: primitive.name.clone(),
+                        origin,
+                        positions,
+                        normals: g.normals.clone(),
+                        uvs: g.uvs.clone(),
+                        indices: g.indices.clone(),
+                        material,
+                        node: Some(node),
+                    }
+                }
+                None => bake_static(&primitive.name, g, &at.world, material),
+            });
+        }
+        Ok(())
+    }
+
+    /// Every primitive of a mesh in its local frame, with normals.
+    fn decode_mesh(&mut self, mesh: &::gltf::Mesh) -> Result<Vec<LocalPrimitive>> {
+        let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), |n| format!("mesh '{n}'"));
+        let mut out = Vec::new();
+        for primitive in mesh.primitives() {
+            let what = format!("{mesh_name} primitive {}", primitive.index());
+            if primitive.mode() != ::gltf::mesh::Mode::Triangles {
+                let message =
+                    format!("{what}: mode {:?} is not supported (vrao draws triangles only)", primitive.mode());
+                return Err(self.error(message));
+            }
+            if primitive.morph_targets().next().is_some() {
+                self.warnings.ignored.insert("morph targets (drawn in the bind pose)");
+            }
+            let position = primitive
+                .get(&::gltf::Semantic::Positions)
+                .ok_or_else(|| self.error(format!("{what} has no POSITION attribute")))?;
+            let positions: Vec<Vec3> =
+                self.read_vectors::<3>(&position, &format!("{what} POSITION"))?.into_iter().map(Vec3::from).collect();
+            let count = positions.len();
+            let indices: Vec<u32> = match primitive.indices() {
+                Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
+                None => (0..count as u32).collect(),
+            };
+            if !indices.len().is_multiple_of(3) {
+                return Err(self.error(format!("{what}: {} indices, not a whole number of triangles", indices.len())));
+            }
+            let uvs: Vec<Vec2> = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
+                Some(accessor) => {
+                    let label = format!("{what} TEXCOORD_0");
+                    let uvs = self.read_vectors::<2>(&accessor, &label)?;
+                    self.same_count(uvs.len(), count, &label)?;
+                    uvs.into_iter().map(Vec2::from).collect()
+                }
+                None => Vec::new(),
+            };
+            if primitive.get(&::gltf::Semantic::TexCoords(1)).is_some() {
+                self.warnings.ignored.insert("texture coordinate sets other than 0");
+            }
+            let geometry = match primitive.get(&::gltf::Semantic::Normals) {
+                Some(accessor) => {
+                    let label = format!("{what} NORMAL");
+                    let mut normals: Vec<Vec3> =
+                        self.read_vectors::<3>(&accessor, &label)?.into_iter().map(Vec3::from).collect();
+                    self.same_count(normals.len(), count, &label)?;
+                    keep_unit_repair_others(&positions, &mut normals, &indices);
+                    let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
+                    Geometry { positions, normals, uvs, indices }
+                }
+                None => normals::compute_normals(&positions, &uvs, &indices, normals::DEFAULT_CREASE_DEG),
+            };
+            let material = self.material(&primitive.material())?;
+            let name = match mesh.primitives().len() {
+                1 => mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string),
+                _ => format!("{}.{}", mesh.name().unwrap_or("mesh"), primitive.index()),
+            };
+            out.push(LocalPrimitive { name, geometry, material });
+        }
+        Ok(out)
+    }
+
+    fn same_count(&self, found: usize, expected: usize, what: &str) -> Result<()> {
+        if found != expected {
+            return Err(self.error(format!("{what} has {found} elements, POSITION has {expected}")));
+        }
+        Ok(())
+    }
+
+    /// The bytes an accessor reads, checked against its view and buffer: (bytes from the
+    /// accessor's first element, stride, element size). `None` for an accessor without a
+    /// buffer view (all zeros, per the spec).
+    fn accessor_bytes(&self, accessor: &::gltf::Accessor, what: &str) -> Result<Option<(&[u8], usize, usize)>> {
+        let index = accessor.index();
+        if accessor.sparse().is_some() {
+            return Err(self.error(format!("{what}: accessor {index} is sparse, which vrao does not read")));
+        }
+        let count = accessor.count();
+        if count > MAX_ACCESSOR_COUNT {
+            return Err(self.error(format!(
+                "{what}: accessor {index} declares {count} elements (vrao's limit: {MAX_ACCESSOR_COUNT})"
+            )));
+        }
+        let element = accessor.dimensions().multiplicity() * accessor.data_type().size();
+        let Some(view) = accessor.view() else { return Ok(None) };
+        let buffer = &self.buffers[view.buffer().index()];
+        let view_end =
+            view.offset().checked_add(view.length()).filter(|&end| end <= buffer.len()).ok_or_else(|| {
+                self.error(format!(
+                    "buffer view {} (bytes {}..+{}) runs past the end of buffer {} ({} bytes)",
+                    view.index(),
+                    view.offset(),
+                    view.length(),
+                    view.buffer().index(),
+                    buffer.len()
+                ))
+            })?;
+        let stride = view.stride().unwrap_or(element);
+        if stride < element {
+            return Err(
+                self.error(format!("{what}: accessor {index} stride {stride} is less than its element size {element}"))
+            );
+        }
+        let needed = match count {
+            0 => Some(accessor.offset()),
+            n => (n - 1).checked_mul(stride).and_then(|b| b.checked_add(accessor.offset() + element)),
+        };
+        let data = &buffer[view.offset()..view_end];
+        match needed {
+            Some(needed) if needed <= data.len() => Ok(Some((&data[accessor.offset()..], stride, element))),
+            _ => Err(self.error(format!(
+                "{what}: accessor {index} ({count} elements) runs past the end of buffer view {} ({} bytes)",
+                view.index(),
+                view.length()
+            ))),
+        }
+    }
+
+    /// An accessor of N-component float vectors (f32, or normalised integers as
+    /// `KHR_mesh_quantization` allows), every value finite.
+    fn read_vectors<const N: usize>(&self, accessor: &::gltf::Accessor, what: &str) -> Result<Vec<[f32; N]>> {
+        let dimensions = accessor.dimensions();
+        if dimensions.multiplicity() != N || matches!(dimensions, Dimensions::Mat2) {
+            return Err(
+                self.error(format!("{what}: accessor {} is {dimensions:?}, expected {N} components", accessor.index()))
+            );
+        }
+        let data_type = accessor.data_type();
+        let normalized = accessor.normalized();
+        if data_type == DataType::U32 || (data_type != DataType::F32 && !normalized && N != 3) {
+            let message =
+                format!("{what}: accessor {} has {data_type:?} components, not float or normalised", accessor.index());
+            return Err(self.error(message));
+        }
+        let count = accessor.count();
+        let Some((data, stride, _)) = self.accessor_bytes(accessor, what)? else {
+            return Ok(vec![[0.0; N]; count]);
+        };
+        let size = data_type.size();
+        let mut out = Vec::with_capacity(count);
+        for k in 0..count {
+            let mut v = [0.0f32; N];
+            for (j, c) in v.iter_mut().enumerate() {
+                let at = k * stride + j * size;
+                *c = component(&data[at..at + size], data_type, normalized);
+            }
+            if !v.iter().all(|c| c.is_finite()) {
+                return Err(
+                    self.error(format!("{what}: accessor {} element {k} is not finite ({v:?})", accessor.index()))
+                );
+            }
+            out.push(v);
+        }
+        Ok(out)
+    }
+
+    /// An index accessor (scalar u8, u16 or u32), every index below `vertices`.
+    fn read_indices(&self, accessor: &::gltf::Accessor, vertices: usize, what: &str) -> Result<Vec<u32>> {
+        let data_type = accessor.data_type();
+        if accessor.dimensions() != Dimensions::Scalar
+            || !matches!(data_type, DataType::U8 | DataType::U16 | DataType::U32)
+        {
+            return Err(self.error(format!(
+                "{what}: accessor {} is {:?} {data_type:?}, expected unsigned scalar indices",
+                accessor.index(),
+                accessor.dimensions()
+            )));
+        }
+        let count = accessor.count();
+        let Some((data, stride, size)) = self.accessor_bytes(accessor, what)? else {
+            return Ok(vec![0; count]);
+        };
+        let mut out = Vec::with_capacity(count);
+        for k in 0..count {
+            let b = &data[k * stride..k * stride + size];
+            let index = match data_type {
+                DataType::U8 => b[0] as u32,
+                DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            };
+            if index as usize >= vertices {
+                return Err(self.error(format!("{what}: index {index} at {k} is out of range ({vertices} vertices)")));
+            }
+            out.push(index);
+        }
+        Ok(out)
+    }
+
+    /// A scalar float accessor (animation times).
+    fn read_scalars(&self, accessor: &::gltf::Accessor, what: &str) -> Result<Vec<f64>> {
+        Ok(self.read_vectors::<1>(accessor, what)?.into_iter().map(|[t]| t as f64).collect())
+    }
+
+    /// The vrao material for a glTF material, made on first use.
+    fn material(&mut self, material: &::gltf::Material) -> Result<usize> {
+        if let Some(&i) = self.material_of.get(&material.index()) {
+            return Ok(i);
+        }
+        let name = match material.index() {
+            Some(i) => material.name().map_or_else(|| format!("material {i}"), str::to_string),
+            None => "default".to_string(),
+        };
+        let pbr = material.pbr_metallic_roughness();
+        let factor = pbr.base_color_factor();
+        let emissive = Vec3::from(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
+        if !factor.iter().all(|c| c.is_finite()) || !emissive.is_finite() || emissive.min_element() < 0.0 {
+            return Err(self.error(format!("material '{name}': colour factors must be finite and not negative")));
+        }
+        let alpha_mode = match material.alpha_mode() {
+            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            ::gltf::material::AlphaMode::Mask => {
+                let cutoff = material.alpha_cutoff().unwrap_or(0.5);
+                if !(0.0..=1.0).contains(&cutoff) {
+                    return Err(self.error(format!("material '{name}': alphaCutoff {cutoff} is not in [0, 1]")));
+                }
+                AlphaMode::Mask { cutoff }
+            }
+            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        let diffuse_texture = match pbr.base_color_texture() {
+            Some(info) => {
+                if info.tex_coord() != 0 {
+                    self.warnings.ignored.insert("texture coordinate sets other than 0");
+                }
+                Some(self.image(&info.texture().source())?)
+            }
+            None => None,
+        };
+        self.materials.push(Material {
+            name,
+            diffuse: Vec3::new(factor[0], factor[1], factor[2]).clamp(Vec3::ZERO, Vec3::ONE),
+            emissive,
+            diffuse_texture,
+            alpha: factor[3].clamp(0.0, 1.0),
+            alpha_mode,
+        });
+        let i = self.materials.len() - 1;
+        self.material_of.insert(material.index(), i);
+        Ok(i)
+    }
+
+    /// A decoded image (PNG, JPEG, ... by content), once per image.
+    fn image(&mut self, image: &::gltf::Image) -> Result<Texture> {
+        let index = image.index();
+        if let Some(t) = self.images.get(&index) {
+            return Ok(t.clone());
+        }
+        let what = format!("image {index}");
+        let bytes: Vec<u8> = match image.source() {
+            ::gltf::image::Source::View { view, .. } => {
+                let buffer = &self.buffers[view.buffer().index()];
+                let range = view.offset()..view.offset().saturating_add(view.length());
+                buffer
+                    .get(range)
+                    .ok_or_else(|| self.error(format!("{what}: buffer view {} runs past its buffer", view.index())))?
+                    .to_vec()
+            }
+            ::gltf::image::Source::Uri { uri, .. } => {
+                resolve_uri(self.path, uri).map_err(|m| self.error(format!("{what}: {m}")))?
+            }
+        };
+        let texture = decode_image(&bytes).map_err(|Problem(m)| self.error(format!("{what}: {m}")))?;
+        self.images.insert(index, texture.clone());
+        Ok(texture)
+    }
+
+    /// A punctual light at its node's world transform (lights shine along the node's −Z).
+    fn light(&self, light: &::gltf::khr_lights_punctual::Light, world: &DMat4) -> Result<Light> {
+        let color = Vec3::from(light.color());
+        let intensity = light.intensity();
+        if !color.is_finite() || color.min_element() < 0.0 || !intensity.is_finite() || intensity < 0.0 {
+            return Err(
+                self.error(format!("light {}: colour and intensity must be finite and not negative", light.index()))
+            );
+        }
+        let position = world.transform_point3(DVec3::ZERO);
+        let direction = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero().as_vec3();
+        if direction == Vec3::ZERO && !matches!(light.kind(), ::gltf::khr_lights_punctual::Kind::Point) {
+            return Err(self.error(format!("light {}: its node's transform gives it no direction", light.index())));
+        }
+        Ok(match light.kind() {
+            ::gltf::khr_lights_punctual::Kind::Directional => Light::Directional { direction, color, intensity },
+            ::gltf::khr_lights_punctual::Kind::Point => Light::Point { position, color, intensity },
+            ::gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                let right = std::f32::consts::FRAC_PI_2;
+                if !(0.0..right).contains(&inner_cone_angle)
+                    || !(inner_cone_angle..=right).contains(&outer_cone_angle)
+                    || outer_cone_angle <= inner_cone_angle
+                {
+                    return Err(self.error(format!(
+                        "light {}: spot cone angles {inner_cone_angle}, {outer_cone_angle} need 0 <= inner < outer <= pi/2",
+                        light.index()
+                    )));
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    color,
+                    intensity,
+                    inner_cone: inner_cone_angle,
+                    outer_cone: outer_cone_angle,
+                }
+            }
+        })
+    }
+
+    /// The translation, rotation and scale tracks of every animated node. When several
+    /// animations drive the same property, the first one's track is kept.
+    fn animation_tracks(&mut self) -> Result<HashMap<usize, NodeTracks>> {
+        let mut tracks: HashMap<usize, NodeTracks> = HashMap::new();
+        let mut keys = 0usize;
+        for animation in self.document.animations() {
+            for channel in animation.channels() {
+                let what = format!("animation {} channel {}", animation.index(), channel.index());
+                let sampler = channel.sampler();
+                let interpolation = match sampler.interpolation() {
+                    ::gltf::animation::Interpolation::Step => Interpolation::Step,
+                    ::gltf::animation::Interpolation::Linear => Interpolation::Linear,
+                    ::gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
+                };
+                let property = channel.target().property();
+                if property == ::gltf::animation::Property::MorphTargetWeights {
+                    self.warnings.ignored.insert("morph target weight animations");
+                    continue;
+                }
+                let times = self.read_scalars(&sampler.input(), &format!("{what} input"))?;
+                keys += times.len();
+                if keys > MAX_KEYS {
+                    return Err(self.error(format!("more than {MAX_KEYS} animation keys (vrao's limit)")));
+                }
+                if times.is_empty() {
+                    return Err(self.error(format!("{what}: no keys")));
+                }
+                if let Some(t) = times.iter().find(|t| **t < 0.0) {
+                    return Err(self.error(format!("{what}: key time {t} is negative")));
+                }
+                if let Some(w) = times.windows(2).find(|w| w[1] <= w[0]) {
+                    return Err(self.error(format!("{what}: key times {} then {} are not increasing", w[0], w[1])));
+                }
+                let stride = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+                let output = sampler.output();
+                let label = format!("{what} output");
+                let expected = times.len() * stride;
+                let node = tracks.entry(channel.target().node().index()).or_default();
+                let mismatch =
+                    |found: usize| format!("{label}: {found} values for {} keys (expected {expected})", times.len());
+                match property {
+                    ::gltf::animation::Property::Rotation => {
+                        let values = self.read_vectors::<4>(&output, &label)?;
+                        if values.len() != expected {
+                            return Err(Error::in_file(self.path, mismatch(values.len())));
+                        }
+                        let values = values
+                            .into_iter()
+                            .map(|[x, y, z, w]| DQuat::from_xyzw(x as f64, y as f64, z as f64, w as f64))
+                            .collect();
+                        node.rotation.get_or_insert(Track { interpolation, times, values });
+                    }
+                    _ => {
+                        let values = self.read_vectors::<3>(&output, &label)?;
+                        if values.len() != expected {
+                            return Err(Error::in_file(self.path, mismatch(values.len())));
+                        }
+                        let values = values.into_iter().map(|v| Vec3::from(v).as_dvec3()).collect();
+                        let track = Track { interpolation, times, values };
+                        if property == ::gltf::animation::Property::Translation {
+                            node.translation.get_or_insert(track);
+                        } else {
+                            node.scale.get_or_insert(track);
+                        }
+                    }
+                }
+            }
+        }
+        tracks.retain(|_, t| !t.is_empty());
+        Ok(tracks)
+    }
+}
+
+/// A node's local transform as the file gives it.
+#[derive(Clone, Copy)]
+enum Local {
+    Matrix(DMat4),
+    Trs(Trs),
+}
+
+impl Local {
+    fn matrix(&self) -> DMat4 {
+        match self {
+            Local::Matrix(m) => *m,
+            Local::Trs(trs) => trs.matrix(),
+        }
+    }
+    /// As a TRS (a matrix decomposed; glTF forbids animating matrix nodes, so this only
+    /// serves a file that does it anyway).
+    fn trs(&self) -> Trs {
+        match self {
+            Local::Trs(trs) => *trs,
+            Local::Matrix(m) => {
+                let (scale, rotation, translation) = m.to_scale_rotation_translation();
+                Trs { translation, rotation, scale }
+            }
+        }
+    }
+}
+
+/// One component, converted as glTF's normalised integers are (signed: max(c / MAX, −1)).
+fn component(b: &[u8], data_type: DataType, normalized: bool) -> f32 {
+    match (data_type, normalized) {
+        (DataType::F32, _) => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        (DataType::U8, true) => b[0] as f32 / 255.0,
+        (DataType::U8, false) => b[0] as f32,
+        (DataType::I8, true) => (b[0] as i8 as f32 / 127.0).max(-1.0),
+        (DataType::I8, false) => b[0] as i8 as f32,
+        (DataType::U16, true) => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+        (DataType::U16, false) => u16::from_le_bytes([b[0], b[1]]) as f32,
+        (DataType::I16, true) => (i16::from_le_bytes([b[0], b[1]]) as f32 / 32767.0).max(-1.0),
+        (DataType::I16, false) => i16::from_le_bytes([b[0], b[1]]) as f32,
+        (DataType::U32, _) => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+    }
+}
+
+/// Decodes an image to RGBA8, refusing sides over [`MAX_TEXTURE_SIDE`] before decoding.
+fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, Problem> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot decode: {e}"))?;
+    let (width, height) = reader.into_dimensions().map_err(|e| format!("cannot decode: {e}"))?;
+    if width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE || width == 0 || height == 0 {
+        return Err(Problem(format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}")));
+    }
+    let image = image::load_from_memory(bytes).map_err(|e| format!("cannot decode: {e}"))?.into_rgba8();
+    Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw(), source: None })
+}
+
+/// Normals as [`normals::repair_normals`] leaves them, except that a normal already of
+/// unit length keeps its exact bits (normalising again may move the last bit, and a file
+/// written from a loaded OBJ should give that OBJ's normals exactly).
+fn keep_unit_repair_others(positions: &[Vec3], normals: &mut [Vec3], indices: &[u32]) {
+    let is_unit = |n: &Vec3| (n.length_squared() - 1.0).abs() < 1e-6;
+    if normals.iter().all(is_unit) {
+        return;
+    }
+    let mut repaired = normals.to_vec();
+    normals::repair_normals(positions, &mut repaired, indices);
+    for (n, r) in normals.iter_mut().zip(repaired) {
+        if !is_unit(n) {
+            *n = r;
+        }
+    }
+}
+
+/// A static primitive in world space: positions through `world` in f64 and recentred as
+/// the OBJ loader does (so the identity gives the OBJ loader's mesh), normals by the
+/// inverse transpose, winding reversed by a mirroring transform.
+fn bake_static(name: &str, g: &Geometry, world: &DMat4, material: usize) -> Mesh {
+    let identity = *world == DMat4::IDENTITY;
+    let points: Vec<DVec3> = g.positions.iter().map(|p| world.transform_point3(p.as_dvec3())).collect();
+    let (origin, positions) = Mesh::recentre(&points);
+    let mut indices = g.indices.clone();
+    let mut normals = g.normals.clone();
+    if !identity {
+        let linear = DMat3::from_mat4(*world);
+        let normal_matrix = linear.inverse().transpose();
+        normals = normals.iter().map(|n| (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()).collect();
+        if linear.determinant() < 0.0 {
+            indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
+        }
+        // A singular transform flattens the mesh; its normals then come from the faces.
+        normals::repair_normals(&positions, &mut normals, &indices);
+    }
+    Mesh { name: name.to_string(), origin, positions, normals, uvs: g.uvs.clone(), indices, material, node: None }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_decodes_with_and_without_padding() {
+        assert_eq!(decode_base64("aGVsbG8=").unwrap(), b"hello");
+        assert_eq!(decode_base64("aGVsbG8").unwrap(), b"hello");
+        assert_eq!(decode_base64("aGk=").unwrap(), b"hi");
+        assert_eq!(decode_base64("").unwrap(), b"");
+        assert!(decode_base64("aGk*").is_none());
+        assert!(decode_base64("a").is_none());
+        assert!(decode_base64("aG===").is_none());
+    }
+
+    #[test]
+    fn percent_escapes_decode() {
+        assert_eq!(percent_decode("my%20file.bin").unwrap(), PathBuf::from("my file.bin"));
+        assert!(percent_decode("bad%2").is_none());
+        assert!(percent_decode("bad%zz").is_none());
+    }
+
+    #[test]
+    fn glb_container_is_checked_before_parsing() {
+        let p = Path::new("t.glb");
+        let err = |bytes: &[u8]| split_glb(p, bytes).unwrap_err().to_string();
+        assert!(err(b"glTF\x02\0\0").contains("shorter than the 12-byte header"));
+        assert!(err(b"glTF\x01\0\0\0\x0c\0\0\0").contains("version 1"));
+        assert!(err(b"glTF\x02\0\0\0\xff\0\0\0").contains("the header says 255 bytes, the file has 12"));
+        let mut chunk = b"glTF\x02\0\0\0\x18\0\0\0".to_vec();
+        chunk.extend_from_slice(&[100, 0, 0, 0]);
+        chunk.extend_from_slice(b"JSON{}  ");
+        assert!(err(&chunk).contains("says 100 bytes, past the end"), "{}", err(&chunk));
+    }
+}

@@ -1,0 +1,225 @@
+//! Render settings, validated once so passes can trust them: the engine's AO settings
+//! ([`vrao_ao::settings`], re-exported here) and the renderer's own around them.
+
+use crate::error::{Error, Result};
+use crate::passes::shadow::suggested_rsm_radius;
+use crate::scene::{Scene, RENDER_DEFAULT};
+use crate::stereo::{HeadsetProfile, DEFAULT_NEAR};
+use std::sync::OnceLock;
+pub use vrao_ao::settings::*;
+
+/// A scene's default occlusion radius is this fraction of its bounding-box diagonal
+/// ([`Scene::suggested_ao_radius`]), kept within [`AO_RADIUS_MIN`]..=[`AO_RADIUS_MAX`].
+pub const AO_RADIUS_OF_DIAGONAL: f64 = 0.08;
+/// The smallest default occlusion radius, metres (a scene of a few centimetres).
+pub const AO_RADIUS_MIN: f32 = 0.01;
+/// The largest default occlusion radius, metres: room-scale detail, even in a cathedral.
+pub const AO_RADIUS_MAX: f32 = 1.0;
+/// The most virtual point lights the reflective shadow maps gather per pixel.
+pub const RSM_SAMPLES_MAX: u32 = 1024;
+/// Linear exposure applied before tone mapping, by default.
+pub const DEFAULT_EXPOSURE: f32 = 1.0;
+/// Reinhard's white point, by default.
+pub const DEFAULT_WHITE_POINT: f32 = 4.0;
+
+/// The occlusion and RSM radii that the default scene ([`RENDER_DEFAULT`], what `vrao
+/// render` draws when no scene is named) suggests: [`Settings::default`] is that
+/// command's setting with no options, so its radii are the default scene's. Built once.
+fn default_scene_radii() -> (f32, f32) {
+    static RADII: OnceLock<(f32, f32)> = OnceLock::new();
+    *RADII.get_or_init(|| {
+        let scene = Scene::load(RENDER_DEFAULT).expect("the default scene is built in");
+        (scene.suggested_ao_radius(), suggested_rsm_radius(&scene))
+    })
+}
+
+/// How the G-buffer reaches both eye layers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StereoMode {
+    /// Multiview when the adapter has it, one pass per eye otherwise.
+    #[default]
+    Auto,
+    /// One render pass writes both layers (`view_index` selects the eye).
+    Multiview,
+    /// One render pass per eye layer.
+    Multipass,
+}
+
+impl StereoMode {
+    /// Every mode, the default first.
+    pub const ALL: [StereoMode; 3] = [StereoMode::Auto, StereoMode::Multiview, StereoMode::Multipass];
+    /// The mode's command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            StereoMode::Auto => "auto",
+            StereoMode::Multiview => "multiview",
+            StereoMode::Multipass => "multipass",
+        }
+    }
+}
+
+vrao_ao::impl_choice!(StereoMode, DisplayMode, crate::renderer::TimingChoice);
+
+/// What the desktop window shows (Belonogov 2018 §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DisplayMode {
+    /// No window: the headset alone.
+    #[default]
+    None,
+    /// Both eye images side by side, as the headset shows them.
+    Mirror,
+    /// The scene rendered once more in mono from the head's viewpoint at the window's size.
+    SinglePass,
+}
+
+impl DisplayMode {
+    /// Every mode, in the order the CLI lists them.
+    pub const ALL: [DisplayMode; 3] = [DisplayMode::None, DisplayMode::Mirror, DisplayMode::SinglePass];
+    /// The mode's command-line name (`none`, `mirror`, `single-pass`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DisplayMode::None => "none",
+            DisplayMode::Mirror => "mirror",
+            DisplayMode::SinglePass => "single-pass",
+        }
+    }
+}
+
+/// Everything a frame is rendered with: the headset, the stereo path, tone mapping,
+/// occlusion and shadows. Start from [`Settings::default`] and change what you need;
+/// [`Settings::validate`] (also run by
+/// [`Renderer::new`](crate::renderer::Renderer::new)) rejects values out of range
+/// with a one-line error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// The headset's per-eye size, refresh rate, IPD and fields of view.
+    pub profile: HeadsetProfile,
+    /// How the G-buffer reaches both eye layers.
+    pub stereo: StereoMode,
+    /// Near plane in metres (the far plane is at infinity).
+    pub near: f64,
+    /// Linear exposure applied before tone mapping.
+    pub exposure: f32,
+    /// Reinhard's L_white: the smallest (exposed) luminance mapped to white.
+    pub white_point: f32,
+    /// Ambient occlusion: technique, samples, radius, denoise, resolution, temporal.
+    pub ao: AoSettings,
+    /// Shadow maps and reflective shadow maps of directional lights.
+    pub shadows: ShadowSettings,
+}
+
+/// The engine's default AO settings with `scene`'s own occlusion radius
+/// ([`Scene::suggested_ao_radius`]), as `vrao render` sets them up for a scene when no
+/// radius is given.
+pub fn ao_fitted_to(scene: &Scene) -> AoSettings {
+    AoSettings { radius: scene.suggested_ao_radius(), ..AoSettings::default() }
+}
+
+/// Shadow maps with PCF (the Czech SSDO thesis) and reflective shadow maps (Lin's NCTU thesis)
+/// for the scene's directional lights (passes/shadow.rs, passes/rsm.rs). A scene without a
+/// directional light has neither, whatever these say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Shadow the directional lights' direct light (`--shadows on|off`).
+    pub enabled: bool,
+    /// Texels along each side of the square light-space maps (`--shadow-size`).
+    pub size: u32,
+    /// Add one bounce of the directional lights from reflective shadow maps (`--rsm on|off`).
+    pub rsm: bool,
+    /// Virtual point lights gathered per pixel and light (`--rsm-samples`).
+    pub rsm_samples: u32,
+    /// Gather radius around each pixel in the light's image plane, metres (`--rsm-radius`).
+    pub rsm_radius: f32,
+}
+
+/// Shadows on (2048² maps), no RSM; the RSM radius is the default scene's
+/// ([`suggested_rsm_radius`]), as `vrao render` sets it with no options.
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: default_scene_radii().1 }
+    }
+}
+
+impl ShadowSettings {
+    /// Checks the map size, the RSM samples and the RSM radius.
+    pub fn validate(&self) -> Result<()> {
+        if !(16..=8192).contains(&self.size) {
+            return Err(Error::input(format!("shadow map size {} is not within 16..=8192", self.size)));
+        }
+        if !(1..=RSM_SAMPLES_MAX).contains(&self.rsm_samples) {
+            return Err(Error::input(format!("RSM samples {} is not within 1..={RSM_SAMPLES_MAX}", self.rsm_samples)));
+        }
+        if !(self.rsm_radius.is_finite() && self.rsm_radius > 0.0 && self.rsm_radius <= 1e6) {
+            return Err(Error::input(format!("RSM radius {} m must be a finite number in (0, 1e6]", self.rsm_radius)));
+        }
+        Ok(())
+    }
+}
+
+/// Exactly what `vrao render` uses with no options (the one place its defaults come
+/// from): a Vive-class headset (1080×1200 per eye, IPD 64 mm), the G-buffer path the
+/// adapter supports best, exposure 1 and white point 4, [`AoSettings::default`] and
+/// [`ShadowSettings::default`].
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            profile: HeadsetProfile::vive(),
+            stereo: StereoMode::Auto,
+            near: DEFAULT_NEAR,
+            exposure: DEFAULT_EXPOSURE,
+            white_point: DEFAULT_WHITE_POINT,
+            ao: AoSettings { radius: default_scene_radii().0, ..AoSettings::default() },
+            shadows: ShadowSettings::default(),
+        }
+    }
+}
+
+impl Settings {
+    /// Checks every value; the error names the setting and the value.
+    pub fn validate(&self) -> Result<()> {
+        let p = &self.profile;
+        if p.width == 0 || p.height == 0 || p.width > 8192 || p.height > 8192 {
+            return Err(Error::input(format!("eye size {}x{} is not within 1..=8192", p.width, p.height)));
+        }
+        if !(p.ipd.is_finite() && (0.0..=1.0).contains(&p.ipd)) {
+            return Err(Error::input(format!("ipd {} m is not within 0..=1 m", p.ipd)));
+        }
+        for fov in [p.fov_left, p.fov_right] {
+            fov.validate().map_err(Error::input)?;
+        }
+        if !(self.near.is_finite() && self.near > 0.0) {
+            return Err(Error::input(format!("near plane {} m must be a positive finite number", self.near)));
+        }
+        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+            return Err(Error::input(format!("exposure {} must be a positive finite number", self.exposure)));
+        }
+        if !(self.white_point.is_finite() && self.white_point > 0.0) {
+            return Err(Error::input(format!("white point {} must be a positive finite number", self.white_point)));
+        }
+        self.ao.validate()?;
+        self.shadows.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn foveation_maps_keep_full_rate_near_the_axis_and_fall_monotonically_to_their_edge_rate() {
+        for level in Foveation::ALL {
+            let map = level.map();
+            assert_eq!(map.rate(0.0), 1.0);
+            assert_eq!(map.rate(map.full_rate_deg), 1.0);
+            assert!((map.rate(map.edge_deg + 10.0) - map.edge_rate).abs() < 1e-6, "{}", level.name());
+            let rates: Vec<f32> = (0..=90).map(|deg| map.rate(deg as f32)).collect();
+            assert!(rates.windows(2).all(|w| w[1] <= w[0]), "{}: not monotone", level.name());
+            assert!(rates.iter().all(|r| (map.edge_rate..=1.0).contains(r)));
+        }
+        assert!(Foveation::Off.map().rate(80.0) == 1.0);
+        // Each level spends no more than the one before at any angle, and less somewhere.
+        let (low, high) = (Foveation::Low.map(), Foveation::High.map());
+        assert!((0..=90).all(|deg| high.rate(deg as f32) <= low.rate(deg as f32)));
+        assert!(high.rate(30.0) < low.rate(30.0));
+    }
+}

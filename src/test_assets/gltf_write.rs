@@ -1,0 +1,542 @@
+//! Writes a [`Scene`] as glTF 2.0 (`.glb` or `.gltf`): the project's own test assets and
+//! converted scenes (`examples/make_gltf.rs`, `tests/gltf.rs`).
+//!
+//! Written: every mesh (static meshes in world space, moving ones under their node),
+//! materials (base colour and alpha factor, texture as PNG, alpha mode and cutoff,
+//! emission with `KHR_materials_emissive_strength` above 1, `doubleSided: true`), the node
+//! hierarchy with its tracks (a node's `base` becomes a matrix parent of its TRS node),
+//! lights (`KHR_lights_punctual`), and an optional camera. [`WriteOptions`] picks how
+//! indices, texture coordinates, buffers and images are stored, so that tests reach every
+//! path of the loader. The document is built as JSON, read back into `gltf::json::Root`
+//! and validated by the `gltf` crate before it is serialised, so what is written is glTF
+//! the loader's parser accepts.
+//!
+//! Positions are written as f32 (an origin far from zero loses what f32 loses); times as
+//! f32.
+
+use crate::render::error::{Error, Result};
+use crate::render::scene::{AlphaMode, Interpolation, Light, Scene, Texture, Track};
+use crate::render::stereo::HeadPose;
+use glam::{DMat4, DQuat, DVec3, Vec3};
+use serde_json::{json, Value};
+use std::path::Path;
+
+/// Where buffers or images go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Storage {
+    /// In the `.glb`'s binary chunk (a `.gltf`'s buffer then becomes a data URI; an image
+    /// goes into a buffer view).
+    Embedded,
+    /// As base64 data URIs in the JSON.
+    DataUri,
+    /// As files beside the glTF (`NAME.bin`, `NAME_imageI.png`).
+    External,
+}
+
+/// How triangle indices are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IndexType {
+    /// The smallest of u8, u16 and u32 that holds every index.
+    Smallest,
+    /// Unsigned bytes (at most 256 vertices per mesh).
+    U8,
+    /// Unsigned shorts (at most 65536 vertices per mesh).
+    U16,
+    /// Unsigned ints.
+    U32,
+    /// No indices: three vertices per triangle, repeated where triangles share them.
+    NonIndexed,
+}
+
+/// How texture coordinates are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexcoordType {
+    /// f32.
+    F32,
+    /// Normalised u8 (coordinates in [0, 1], rounded to 1/255).
+    U8Normalized,
+    /// Normalised u16 (coordinates in [0, 1], rounded to 1/65535).
+    U16Normalized,
+}
+
+/// Choices for [`write()`].
+#[derive(Clone, Debug)]
+pub struct WriteOptions {
+    /// Where the geometry buffer goes.
+    pub buffers: Storage,
+    /// Where images go.
+    pub images: Storage,
+    /// Index storage.
+    pub indices: IndexType,
+    /// Texture coordinate storage (written only for textured materials' meshes).
+    pub texcoords: TexcoordType,
+    /// Whether to write normals (without them the loader computes normals).
+    pub normals: bool,
+    /// A camera at this pose (the loader takes it as the head pose).
+    pub camera: Option<HeadPose>,
+}
+
+impl Default for WriteOptions {
+    fn default() -> Self {
+        WriteOptions {
+            buffers: Storage::Embedded,
+            images: Storage::Embedded,
+            indices: IndexType::Smallest,
+            texcoords: TexcoordType::F32,
+            normals: true,
+            camera: None,
+        }
+    }
+}
+
+/// The binary buffer being filled, and the JSON arrays that point into it.
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    /// Appends `bytes` as a buffer view (4-byte aligned) and returns its index.
+    fn view(&mut self, bytes: &[u8]) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.views.push(json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() }));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    /// Appends an accessor over new bytes and returns its index.
+    fn accessor(&mut self, bytes: &[u8], component: u32, kind: &str, count: usize, extra: Value) -> usize {
+        let view = self.view(bytes);
+        let mut accessor = json!({ "bufferView": view, "componentType": component, "type": kind, "count": count });
+        if let (Some(a), Value::Object(e)) = (accessor.as_object_mut(), extra) {
+            a.extend(e);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    fn floats(&mut self, values: &[f32], kind: &str, count: usize, extra: Value) -> usize {
+        self.accessor(bytemuck::cast_slice(values), FLOAT, kind, count, extra)
+    }
+}
+
+const FLOAT: u32 = 5126;
+const UNSIGNED_BYTE: u32 = 5121;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+
+/// Writes `scene` to `path`: a `.glb` when its extension says so, else `.gltf` JSON.
+pub fn write(scene: &Scene, path: &Path, options: &WriteOptions) -> Result<()> {
+    let glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    let directory = path.parent().unwrap_or(Path::new(""));
+    let output =
+        |file: &Path, e: &dyn std::fmt::Display| Error::Output { path: file.to_path_buf(), message: e.to_string() };
+    let mut b = Builder { bin: Vec::new(), views: Vec::new(), accessors: Vec::new() };
+    let mut extensions_used: Vec<&str> = Vec::new();
+
+    // Materials and their images.
+    let mut images = Vec::new();
+    let mut materials = Vec::new();
+    for (i, m) in scene.materials.iter().enumerate() {
+        let mut pbr = json!({
+            "baseColorFactor": [m.diffuse.x, m.diffuse.y, m.diffuse.z, m.alpha],
+            "metallicFactor": 0.0,
+            "roughnessFactor": 1.0,
+        });
+        if let Some(texture) = &m.diffuse_texture {
+            let png = encode_png(texture).map_err(|e| output(path, &e))?;
+            let image = match options.images {
+                Storage::Embedded => json!({ "bufferView": b.view(&png), "mimeType": "image/png" }),
+                Storage::DataUri => json!({ "uri": format!("data:image/png;base64,{}", encode_base64(&png)) }),
+                Storage::External => {
+                    let name = format!("{stem}_image{i}.png");
+                    std::fs::write(directory.join(&name), &png).map_err(|e| output(&directory.join(&name), &e))?;
+                    json!({ "uri": name })
+                }
+            };
+            images.push(image);
+            pbr["baseColorTexture"] = json!({ "index": images.len() - 1 });
+        }
+        let mut material = json!({ "name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": true });
+        let peak = m.emissive.max_element();
+        if peak > 0.0 {
+            // emissiveFactor is limited to [0, 1]: the rest goes into the strength.
+            let strength = peak.max(1.0);
+            let factor = m.emissive / strength;
+            material["emissiveFactor"] = json!([factor.x, factor.y, factor.z]);
+            if strength > 1.0 {
+                material["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": strength } });
+                extensions_used.push("KHR_materials_emissive_strength");
+            }
+        }
+        match m.alpha_mode {
+            AlphaMode::Opaque => material["alphaMode"] = json!("OPAQUE"),
+            AlphaMode::Mask { cutoff } => {
+                material["alphaMode"] = json!("MASK");
+                material["alphaCutoff"] = json!(cutoff);
+            }
+            AlphaMode::Blend => material["alphaMode"] = json!("BLEND"),
+        }
+        materials.push(material);
+    }
+    let textures: Vec<Value> = (0..images.len()).map(|i| json!({ "source": i })).collect();
+
+    // Nodes: vrao node k is glTF node trs[k] (under a matrix node when it has a base).
+    let mut nodes: Vec<Value> = Vec::new();
+    let mut roots: Vec<usize> = Vec::new();
+    let mut trs_of = Vec::with_capacity(scene.nodes.len());
+    let add_child = |nodes: &mut Vec<Value>, parent: Option<usize>, child: usize, roots: &mut Vec<usize>| match parent {
+        Some(p) => {
+            let children = nodes[p].as_object_mut().map(|o| o.entry("children").or_insert(json!([])));
+            if let Some(Value::Array(c)) = children {
+                c.push(json!(child));
+            }
+        }
+        None => roots.push(child),
+    };
+    for node in &scene.nodes {
+        let parent = node.parent.and_then(|p| trs_of.get(p).copied());
+        let mut attach = parent;
+        if node.base != DMat4::IDENTITY {
+            nodes.push(json!({ "name": format!("{} base", node.name), "matrix": node.base.as_mat4().to_cols_array() }));
+            let child = nodes.len() - 1;
+            add_child(&mut nodes, attach, child, &mut roots);
+            attach = Some(nodes.len() - 1);
+        }
+        let r = node.rest;
+        nodes.push(json!({
+            "name": node.name,
+            "translation": r.translation.as_vec3().to_array(),
+            "rotation": r.rotation.as_quat().normalize().to_array(),
+            "scale": r.scale.as_vec3().to_array(),
+        }));
+        let child = nodes.len() - 1;
+        add_child(&mut nodes, attach, child, &mut roots);
+        trs_of.push(nodes.len() - 1);
+    }
+
+    // Meshes: one glTF mesh with one primitive each, on a node of its own.
+    let mut meshes = Vec::new();
+    for mesh in &scene.meshes {
+        let material = &scene.materials.get(mesh.material);
+        let textured = material.is_some_and(|m| m.diffuse_texture.is_some());
+        let mut positions = world_f32(mesh.origin, &mesh.positions);
+        let mut normals = mesh.normals.clone();
+        let mut uvs = mesh.uvs.clone();
+        let mut indices = mesh.indices.clone();
+        if options.indices == IndexType::NonIndexed {
+            positions = indices.iter().map(|&i| positions[i as usize]).collect();
+            normals = indices.iter().map(|&i| normals[i as usize]).collect();
+            uvs = indices.iter().map(|&i| uvs[i as usize]).collect();
+            indices = (0..positions.len() as u32).collect();
+        }
+        let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        positions.iter().for_each(|p| {
+            min = min.min(*p);
+            max = max.max(*p);
+        });
+        let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+        let count = positions.len();
+        let mut attributes = json!({
+            "POSITION": b.floats(&flat, "VEC3", count, json!({ "min": min.to_array(), "max": max.to_array() }))
+        });
+        if options.normals {
+            let flat: Vec<f32> = normals.iter().flat_map(|n| n.to_array()).collect();
+            attributes["NORMAL"] = json!(b.floats(&flat, "VEC3", count, json!({})));
+        }
+        if textured && uvs.len() == count {
+            attributes["TEXCOORD_0"] = json!(match options.texcoords {
+                TexcoordType::F32 => {
+                    let flat: Vec<f32> = uvs.iter().flat_map(|t| t.to_array()).collect();
+                    b.floats(&flat, "VEC2", count, json!({}))
+                }
+                TexcoordType::U8Normalized => {
+                    let q: Vec<u8> = uvs
+                        .iter()
+                        .flat_map(|t| t.to_array())
+                        .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
+                        .collect();
+                    // Each element padded to 4 bytes, as the spec requires of vertex attributes.
+                    let padded: Vec<u8> = q.chunks_exact(2).flat_map(|c| [c[0], c[1], 0, 0]).collect();
+                    let view = b.view(&padded);
+                    b.views[view]["byteStride"] = json!(4);
+                    b.accessors.push(json!({ "bufferView": view, "componentType": UNSIGNED_BYTE, "type": "VEC2", "count": count, "normalized": true }));
+                    b.accessors.len() - 1
+                }
+                TexcoordType::U16Normalized => {
+                    let q: Vec<u16> = uvs
+                        .iter()
+                        .flat_map(|t| t.to_array())
+                        .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16)
+                        .collect();
+                    b.accessor(bytemuck::cast_slice(&q), UNSIGNED_SHORT, "VEC2", count, json!({ "normalized": true }))
+                }
+            });
+        }
+        let mut primitive = json!({ "attributes": attributes, "mode": 4, "material": mesh.material });
+        let index_type = match options.indices {
+            IndexType::NonIndexed => None,
+            IndexType::Smallest if count <= 256 => Some(IndexType::U8),
+            IndexType::Smallest if count <= 65536 => Some(IndexType::U16),
+            IndexType::Smallest => Some(IndexType::U32),
+            other => Some(other),
+        };
+        if let Some(t) = index_type {
+            let fits = match t {
+                IndexType::U8 => count <= 256,
+                IndexType::U16 => count <= 65536,
+                _ => true,
+            };
+            if !fits {
+                return Err(Error::input(format!("mesh '{}': {count} vertices do not fit {t:?} indices", mesh.name)));
+            }
+            let n = indices.len();
+            primitive["indices"] = json!(match t {
+                IndexType::U8 => b.accessor(
+                    &indices.iter().map(|&i| i as u8).collect::<Vec<_>>(),
+                    UNSIGNED_BYTE,
+                    "SCALAR",
+                    n,
+                    json!({})
+                ),
+                IndexType::U16 => {
+                    let v: Vec<u16> = indices.iter().map(|&i| i as u16).collect();
+                    b.accessor(bytemuck::cast_slice(&v), UNSIGNED_SHORT, "SCALAR", n, json!({}))
+                }
+                _ => b.accessor(bytemuck::cast_slice(&indices), UNSIGNED_INT, "SCALAR", n, json!({})),
+            });
+        }
+        meshes.push(json!({ "name": mesh.name, "primitives": [primitive] }));
+        nodes.push(json!({ "name": mesh.name, "mesh": meshes.len() - 1 }));
+        let parent = mesh.node.and_then(|k| trs_of.get(k).copied());
+        let child = nodes.len() - 1;
+        add_child(&mut nodes, parent, child, &mut roots);
+    }
+
+    // Animation: one channel per animated property.
+    let mut channels = Vec::new();
+    let mut samplers = Vec::new();
+    for (k, node) in scene.nodes.iter().enumerate() {
+        let target = trs_of[k];
+        if let Some(t) = &node.tracks.translation {
+            let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+            samplers.push(sampler(&mut b, t, &values, "VEC3"));
+            channels
+                .push(json!({ "sampler": samplers.len() - 1, "target": { "node": target, "path": "translation" } }));
+        }
+        if let Some(t) = &node.tracks.rotation {
+            let values: Vec<f32> = t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
+            samplers.push(sampler(&mut b, t, &values, "VEC4"));
+            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": target, "path": "rotation" } }));
+        }
+        if let Some(t) = &node.tracks.scale {
+            let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+            samplers.push(sampler(&mut b, t, &values, "VEC3"));
+            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": target, "path": "scale" } }));
+        }
+    }
+
+    // Lights shine along their node's −Z.
+    let mut lights = Vec::new();
+    for light in &scene.lights {
+        let (kind, position, direction, color, intensity) = match *light {
+            Light::Directional { direction, color, intensity } => {
+                ("directional", DVec3::ZERO, direction, color, intensity)
+            }
+            Light::Point { position, color, intensity } => ("point", position, Vec3::NEG_Z, color, intensity),
+            Light::Spot { position, direction, color, intensity, .. } => {
+                ("spot", position, direction, color, intensity)
+            }
+        };
+        let mut entry = json!({ "type": kind, "color": color.to_array(), "intensity": intensity });
+        if let Light::Spot { inner_cone, outer_cone, .. } = *light {
+            entry["spot"] = json!({ "innerConeAngle": inner_cone, "outerConeAngle": outer_cone });
+        }
+        lights.push(entry);
+        let rotation = DQuat::from_rotation_arc(DVec3::NEG_Z, direction.as_dvec3().normalize_or(DVec3::NEG_Z));
+        nodes.push(json!({
+            "name": format!("light {}", lights.len() - 1),
+            "translation": position.as_vec3().to_array(),
+            "rotation": rotation.as_quat().normalize().to_array(),
+            "extensions": { "KHR_lights_punctual": { "light": lights.len() - 1 } },
+        }));
+        roots.push(nodes.len() - 1);
+    }
+    if !lights.is_empty() {
+        extensions_used.push("KHR_lights_punctual");
+    }
+
+    let mut cameras = Vec::new();
+    if let Some(pose) = options.camera {
+        cameras.push(json!({ "type": "perspective", "perspective": { "yfov": 1.6, "znear": 0.05 } }));
+        nodes.push(json!({
+            "name": "camera",
+            "camera": 0,
+            "translation": pose.position.as_vec3().to_array(),
+            "rotation": pose.orientation.as_quat().normalize().to_array(),
+        }));
+        roots.push(nodes.len() - 1);
+    }
+
+    while !b.bin.len().is_multiple_of(4) {
+        b.bin.push(0);
+    }
+    let buffer = match (glb, options.buffers) {
+        (true, _) => json!({ "byteLength": b.bin.len() }),
+        (false, Storage::External) => {
+            let name = format!("{stem}.bin");
+            std::fs::write(directory.join(&name), &b.bin).map_err(|e| output(&directory.join(&name), &e))?;
+            json!({ "byteLength": b.bin.len(), "uri": name })
+        }
+        (false, _) => json!({
+            "byteLength": b.bin.len(),
+            "uri": format!("data:application/octet-stream;base64,{}", encode_base64(&b.bin)),
+        }),
+    };
+
+    let mut document = json!({
+        "asset": { "version": "2.0", "generator": "vrao" },
+        "scene": 0,
+        "scenes": [{ "name": scene.name, "nodes": roots }],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [buffer],
+    });
+    let object = document.as_object_mut().expect("an object");
+    for (key, list) in [("images", images), ("textures", textures), ("cameras", cameras)] {
+        if !list.is_empty() {
+            object.insert(key.into(), Value::Array(list));
+        }
+    }
+    if !channels.is_empty() {
+        object.insert("animations".into(), json!([{ "name": "motion", "channels": channels, "samplers": samplers }]));
+    }
+    if !lights.is_empty() {
+        object.insert("extensions".into(), json!({ "KHR_lights_punctual": { "lights": lights } }));
+    }
+    if !extensions_used.is_empty() {
+        extensions_used.dedup();
+        object.insert("extensionsUsed".into(), json!(extensions_used));
+    }
+
+    // Through gltf::json and its validation: the writer's output is glTF the loader reads.
+    let root: ::gltf::json::Root =
+        serde_json::from_value(document).map_err(|e| Error::input(format!("glTF writer built invalid JSON: {e}")))?;
+    let root = ::gltf::Document::from_json(root)
+        .map_err(|e| Error::input(format!("glTF writer built an invalid document: {e}")))?
+        .into_json();
+    let text = ::gltf::json::serialize::to_vec(&root).map_err(|e| output(path, &e))?;
+    let bytes = if glb {
+        let glb = ::gltf::binary::Glb {
+            header: ::gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
+            json: text.into(),
+            bin: Some(b.bin.into()),
+        };
+        glb.to_vec().map_err(|e| output(path, &e))?
+    } else {
+        text
+    };
+    std::fs::write(path, bytes).map_err(|e| output(path, &e))
+}
+
+/// World positions as f32 that the loaders' recentring (on the centre of their bounds)
+/// turns back into exactly `origin` and `offsets`, so that a loaded OBJ written as glTF
+/// loads bit for bit as the OBJ did. Each coordinate is the nearest f32 to origin + offset
+/// or a neighbour of it (the OBJ's own f32 is one of these); the extremes are chosen as a
+/// pair whose centre is `origin`.
+fn world_f32(origin: DVec3, offsets: &[Vec3]) -> Vec<Vec3> {
+    let mut out = vec![Vec3::ZERO; offsets.len()];
+    for k in 0..3 {
+        let o = origin[k];
+        let (lo, hi) = offsets.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| (a.min(p[k]), b.max(p[k])));
+        let pair = candidates(o, lo)
+            .into_iter()
+            .flat_map(|a| candidates(o, hi).into_iter().map(move |b| (a, b)))
+            .find(|&(a, b)| (a as f64 + b as f64) * 0.5 == o);
+        for (w, p) in out.iter_mut().zip(offsets) {
+            w[k] = match pair {
+                Some((a, _)) if p[k] == lo => a,
+                Some((_, b)) if p[k] == hi => b,
+                _ => candidates(o, p[k]).first().copied().unwrap_or((o + p[k] as f64) as f32),
+            };
+        }
+    }
+    out
+}
+
+/// The f32 values within one step of origin + offset whose offset from `origin`, rounded
+/// to f32, is `offset` again (nearest first).
+fn candidates(origin: f64, offset: f32) -> Vec<f32> {
+    let nearest = (origin + offset as f64) as f32;
+    [nearest, nearest.next_down(), nearest.next_up()]
+        .into_iter()
+        .filter(|&w| ((w as f64 - origin) as f32).to_bits() == offset.to_bits())
+        .collect()
+}
+
+/// A sampler's JSON with its input (times) and output (values) accessors.
+fn sampler<T>(b: &mut Builder, track: &Track<T>, values: &[f32], kind: &str) -> Value {
+    let times: Vec<f32> = track.times.iter().map(|&t| t as f32).collect();
+    let (lo, hi) = (times.first().copied().unwrap_or(0.0), times.last().copied().unwrap_or(0.0));
+    let input = b.floats(&times, "SCALAR", times.len(), json!({ "min": [lo], "max": [hi] }));
+    let per = if kind == "VEC4" { 4 } else { 3 };
+    let output = b.floats(values, kind, values.len() / per, json!({}));
+    let interpolation = match track.interpolation {
+        Interpolation::Step => "STEP",
+        Interpolation::Linear => "LINEAR",
+        Interpolation::CubicSpline => "CUBICSPLINE",
+    };
+    json!({ "input": input, "output": output, "interpolation": interpolation })
+}
+
+/// A texture as PNG bytes.
+fn encode_png(texture: &Texture) -> std::result::Result<Vec<u8>, image::ImageError> {
+    let mut png = Vec::new();
+    let encoder = image::codecs::png::PngEncoder::new(&mut png);
+    image::ImageEncoder::write_image(
+        encoder,
+        &texture.rgba8,
+        texture.width,
+        texture.height,
+        image::ExtendedColorType::Rgba8,
+    )?;
+    Ok(png)
+}
+
+/// Standard base64 with padding.
+pub fn encode_base64(bytes: &[u8]) -> String {
+    const DIGITS: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let bits = chunk.iter().enumerate().fold(0u32, |acc, (i, &b)| acc | (b as u32) << (16 - 8 * i));
+        for i in 0..4 {
+            if i <= chunk.len() {
+                out.push(DIGITS[(bits >> (18 - 6 * i) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn base64_round_trips() {
+        for n in 0..10 {
+            let bytes: Vec<u8> = (0..n).map(|i| (i * 37 + 11) as u8).collect();
+            let text = super::encode_base64(&bytes);
+            assert_eq!(text.len() % 4, 0);
+            assert_eq!(crate::render::scene::gltf::decode_base64(&text).unwrap(), bytes, "{text}");
+        }
+        assert_eq!(super::encode_base64(b"hello"), "aGVsbG8=");
+    }
+}

@@ -1,0 +1,5 @@
+//! Writers of test assets: glTF files with every feature vrao reads, and the loaders'
+//! fuzzing entry points.
+
+pub mod fuzz;
+pub mod gltf_write;
