@@ -130,7 +130,7 @@ fn an_open_plane_stays_unoccluded_when_foveated() {
             }
         }
         eprintln!("plane {} foveated: min AO {worst:.4}", technique.name());
-        // As without foveation (tests/occlusion.rs): an open plane occludes nothing.
+        // As without foveation (tests/occlusion_robustness.rs): an open plane occludes nothing.
         assert!(worst >= 0.98, "{}: AO {worst} on the open plane with foveation", technique.name());
     }
 }

@@ -2,4 +2,5 @@
 //! fuzzing entry points.
 
 pub mod fuzz;
+#[cfg(feature = "gltf")]
 pub mod gltf_write;

@@ -3,6 +3,13 @@
 
 #![allow(dead_code)]
 
+// The occlusion tests' frame and crease helpers (tests/occlusion_*.rs, all of which
+// require `app`; the crease needs `vrao::measure`).
+#[cfg(feature = "app")]
+pub mod crease;
+#[cfg(feature = "app")]
+pub mod occlusion;
+
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 use vrao::render::scene::{HeadPath, Material, Mesh, Scene};
 use vrao::{BackendChoice, Gpu};

@@ -72,6 +72,12 @@ fn finite_or_zero3(v: vec3<f32>) -> vec3<f32> {
     return clamp(select(vec3<f32>(0.0), v, ok), vec3<f32>(-65504.0), vec3<f32>(65504.0));
 }
 
+// How the composite applies the technique's output (`AoParams::technique`; the
+// technique table's `CompositeMode`, crates/vrao-ao/src/technique.rs).
+const COMPOSITE_UNOCCLUDED: u32 = 0u;
+const COMPOSITE_SCALAR_AO: u32 = 1u;
+const COMPOSITE_DIRECTIONAL: u32 = 2u;
+
 // Parameters of the occlusion passes (AO technique, blur, upsample, composite).
 struct AoParams {
     // Size of the occlusion targets (half the full size, rounded up, with half-res).

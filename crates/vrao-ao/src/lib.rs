@@ -23,6 +23,7 @@ pub mod sampling;
 pub mod settings;
 pub mod stats;
 pub mod stereo;
+pub mod technique;
 
 pub use ao::{AoConfig, AoEngine, AoFrame, AoOutput, DepthConvention, HostMotion, HostNormals, ViewMatrices};
 pub use error::{Error, Result};

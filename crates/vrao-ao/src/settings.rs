@@ -4,6 +4,7 @@
 
 use crate::error::{Error, Result};
 pub use crate::passes::gtao::GtaoSettings;
+pub use crate::technique::Technique;
 
 /// The occlusion radius of [`AoSettings::default`], in the host's world units.
 pub const DEFAULT_RADIUS: f32 = 0.5;
@@ -69,89 +70,6 @@ impl Choice for Noise {
             Noise::Tiled5x5 => &["tiled5x5"],
             Noise::Halton => &[],
         }
-    }
-}
-
-/// The occlusion technique.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Technique {
-    /// No occlusion pass: the ambient term is unoccluded.
-    None,
-    /// Normal-oriented hemisphere SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3).
-    Ssao,
-    /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
-    Hbao,
-    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
-    /// (Jimenez et al. 2016, Therrien et al. 2023). The default: the most accurate per
-    /// millisecond.
-    #[default]
-    Gtao,
-    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
-    Ssdo,
-    /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
-    SsdoBounce,
-    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
-    FetchOnly,
-}
-
-impl Technique {
-    /// The technique's command-line name (`ssao`, `hbao`, …), also used in file names and reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            Technique::None => "none",
-            Technique::Ssao => "ssao",
-            Technique::Hbao => "hbao",
-            Technique::Ssdo => "ssdo",
-            Technique::SsdoBounce => "ssdo-bounce",
-            Technique::FetchOnly => "fetch-only",
-            Technique::Gtao => "gtao",
-        }
-    }
-    /// True for the techniques whose occlusion targets carry gathered light in rgb
-    /// (SSDO's directional occlusion of the environment, with or without its bounce); the
-    /// others write AO in alpha alone (rgb 0), so the denoise filters alpha alone for them.
-    pub fn carries_light(self) -> bool {
-        matches!(self, Technique::Ssdo | Technique::SsdoBounce)
-    }
-
-    /// Every technique, in the order the CLI and the bench list them (declaration order).
-    pub const ALL: [Technique; 7] = [
-        Technique::None,
-        Technique::Ssao,
-        Technique::Hbao,
-        Technique::Gtao,
-        Technique::Ssdo,
-        Technique::SsdoBounce,
-        Technique::FetchOnly,
-    ];
-
-    /// Every technique, in the order the CLI and the bench list them ([`Technique::ALL`]).
-    pub fn all() -> &'static [Technique] {
-        &Technique::ALL
-    }
-
-    /// The techniques that estimate occlusion (neither `none` nor the fetch-only
-    /// baseline), the default first, then in [`Technique::all`]'s order: what `vrao bench`
-    /// sweeps unless told otherwise.
-    pub fn estimators() -> Vec<Technique> {
-        let default = Technique::default();
-        let others = Technique::all()
-            .iter()
-            .copied()
-            .filter(|&t| ![default, Technique::None, Technique::FetchOnly].contains(&t));
-        std::iter::once(default).chain(others).collect()
-    }
-}
-
-/// Bench files name their techniques, and the governor and `vrao budget --fit` read them
-/// back; the names are the command line's ([`Technique::name`]).
-impl std::str::FromStr for Technique {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
-            let names: Vec<&str> = Technique::all().iter().map(|t| t.name()).collect();
-            Error::input(format!("unknown technique '{s}' (expected one of {})", names.join(", ")))
-        })
     }
 }
 

@@ -256,7 +256,7 @@ fn hbao_on_an_open_floor_is_one_and_on_the_crease_near_the_reference() {
             assert_eq!(v, 1.0, "open floor at x = {x}");
         } else if x > 0.1 {
             // Discretisation, angle bias and perspective keep HBAO light of the hard
-            // cut-off reference by at most 0.17 (as in tests/occlusion.rs on the same
+            // cut-off reference by at most 0.17 (as in tests/occlusion_hbao_gtao.rs on the same
             // crease); it never darkens more than the reference.
             let f = crease_visibility(x, R);
             assert!(v - f < 0.17 && v >= f - 0.02, "x = {x}: hbao {v}, reference {f}");

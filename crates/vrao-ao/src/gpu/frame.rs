@@ -3,8 +3,9 @@
 
 use crate::passes::ChainSettings;
 use crate::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
-use crate::settings::{Noise, Technique};
+use crate::settings::Noise;
 use crate::stereo::Eye;
+use crate::technique::SamplePattern;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4};
 
@@ -208,7 +209,11 @@ impl FrameBuffers {
         let (width, height) = ao_extent(settings.width, settings.height, ao.half_res);
         let (directions, steps) = hbao_directions_steps(ao.samples);
         // SSDO weighs each direction's light by cos θ itself, so its samples are uniform.
-        let density = if ao.technique.carries_light() { HemisphereDensity::Uniform } else { HemisphereDensity::Cosine };
+        let entry = ao.technique.entry();
+        let density = match entry.samples {
+            SamplePattern::HemisphereUniform => HemisphereDensity::Uniform,
+            _ => HemisphereDensity::Cosine,
+        };
         // With temporal accumulation each frame of the window takes its own part of a
         // longer Halton kernel, so the accumulated samples are as stratified as one
         // kernel of window × N. Measured (room, SSAO N = 8, 270×300, noise against the
@@ -218,9 +223,7 @@ impl FrameBuffers {
         // by parts and only the marching techniques (HBAO, GTAO), whose directions are not
         // a Halton kernel, turn.
         let part = if ao.temporal.enabled { (frame_index % ao.temporal.max_frames as u64) as u32 } else { 0 };
-        let hemisphere =
-            matches!(ao.technique, Technique::Ssao | Technique::Ssdo | Technique::SsdoBounce | Technique::FetchOnly);
-        let turns = ao.temporal.enabled && !hemisphere;
+        let turns = ao.temporal.enabled && entry.samples == SamplePattern::Directions;
         let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
         let foveation = ao.foveation.map();
         let params = AoParamsUniform {
@@ -229,11 +232,7 @@ impl FrameBuffers {
             samples: ao.samples,
             directions,
             steps,
-            technique: match ao.technique {
-                Technique::None => 0,
-                t if t.carries_light() => 2,
-                _ => 1,
-            },
+            technique: entry.composite as u32,
             noise: match ao.noise {
                 Noise::Tiled5x5 => 0,
                 Noise::Halton => 1,

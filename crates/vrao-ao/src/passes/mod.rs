@@ -24,19 +24,20 @@ use crate::gpu::timing::SpanRecorder;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::settings::AoSettings;
+use crate::technique::TECHNIQUES;
 use std::any::Any;
 use std::collections::{BTreeMap, HashMap};
 
-/// The AO chain, in execution order: each technique (one runs), then `light_gathering`
+/// The AO chain, in execution order: each technique of the table that has a pass (one
+/// runs; [`crate::technique::TECHNIQUES`]), then `light_gathering`
 /// (a renderer's light-gathering technique, such as vrao-render's SSDO), temporal
 /// accumulation, the denoise and the upsampling to full resolution. It reads
 /// [`inputs::DEPTH`] and [`inputs::NORMALS`] and provides [`crate::graph::OCCLUSION`] and
 /// [`crate::graph::FINAL_AO`].
 pub fn ao_chain(gpu: &Gpu, light_gathering: Vec<Box<dyn Pass>>) -> Vec<Box<dyn Pass>> {
     let mut chain: Vec<Box<dyn Pass>> =
-        vec![Box::new(ssao::pass(gpu)), Box::new(hbao::pass(gpu)), Box::new(gtao::GtaoPass::new(gpu))];
+        TECHNIQUES.iter().filter_map(|entry| entry.pass).map(|make| make(gpu)).collect();
     chain.extend(light_gathering);
-    chain.push(Box::new(fetch_only::pass(gpu)));
     chain.push(Box::new(temporal::TemporalPass::new(gpu)));
     chain.push(Box::new(blur::BlurPass::new(gpu)));
     chain.push(Box::new(upsample::UpsamplePass::new(gpu)));

@@ -2,10 +2,10 @@
 // HALF_RES the occlusion arrives at half resolution and is upsampled here, instead of in
 // a pass of its own; so is the RSM bounce. One invocation shades a quad of 2×2 pixels
 // (joint_upsample.wgsl `upsample_quad`: each low-res sample fetched once per quad);
-// without upsampling this costs what one pixel per invocation does (540×600 Sibenik:
-// 15.5–16.7 against 15.5–16.3 ms per eye).
-// technique 0: unoccluded ambient (SH irradiance of the environment);
-// 1: ambient × AO (SSAO, HBAO); 2: SSDO's gathered irradiance (rgb) replaces it.
+// without upsampling this costs what one pixel per invocation does (docs/measurements.md).
+// `ao.technique` is the technique table's composite mode: COMPOSITE_UNOCCLUDED, the
+// unoccluded ambient (SH irradiance of the environment); COMPOSITE_SCALAR_AO, ambient × AO
+// (GTAO, SSAO, HBAO); COMPOSITE_DIRECTIONAL, SSDO's gathered irradiance (rgb) replaces it.
 // Sky pixels show the environment. The output's alpha holds the pixel's AO.
 //
 // With the stereo reuse at half resolution (AO-only techniques) the left eye is
@@ -76,9 +76,9 @@ fn shade(pixel: vec2<u32>, layer: u32, eye: Eye, depth: f32, n: vec3<f32>, occlu
     if (frame.has_environment != 0u) {
         ambient = environment_irradiance(layer, n);
     }
-    if (ao.technique == 1u) {
+    if (ao.technique == COMPOSITE_SCALAR_AO) {
         ambient *= saturate_ao(occlusion.a);
-    } else if (ao.technique == 2u) {
+    } else if (ao.technique == COMPOSITE_DIRECTIONAL) {
         ambient = max(occlusion.rgb, vec3<f32>(0.0));
     }
     return direct_radiance(textureLoad(direct_layers, p, i32(layer), 0)) + albedo / PI * (ambient + bounce);
@@ -111,7 +111,7 @@ fn main(
     let unoccluded = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     var occlusion = array<vec4<f32>, 4>(unoccluded, unoccluded, unoccluded, unoccluded);
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    if (ao.technique != 0u) {
+    if (ao.technique != COMPOSITE_UNOCCLUDED) {
         if (HALF_RES && RIGHT_EYE && !FALLBACK) {
             let left = left_eye_quad(depth_layers, left_hdr, quad);
             if (!all(left.found)) {

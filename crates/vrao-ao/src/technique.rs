@@ -1,0 +1,301 @@
+//! The technique table: every occlusion technique's name, kind, composite mode, sample
+//! pattern, foveation rule and pass, in one place. Adding a technique is its folder under
+//! `src/passes/` (its Rust and WGSL), its variant below and its line in [`TECHNIQUES`];
+//! the chain ([`crate::passes::ao_chain`]), the uniforms ([`crate::gpu::frame`]), the
+//! denoise and the composite read what they need from the entry.
+
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::passes::{fetch_only, gtao, hbao, ssao, Pass};
+
+/// The occlusion technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Technique {
+    /// No occlusion pass: the ambient term is unoccluded.
+    None,
+    /// Normal-oriented hemisphere SSAO (Belonogov 2018 §3.2, the Czech SSDO thesis ch. 3).
+    Ssao,
+    /// Horizon-based AO, directions × steps ray-marched in depth (Belonogov 2018 §3.3).
+    Hbao,
+    /// Ground-truth AO over screen-space slices with a visibility bitmask and a thickness
+    /// (Jimenez et al. 2016, Therrien et al. 2023). The default: the most accurate per
+    /// millisecond.
+    #[default]
+    Gtao,
+    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
+    Ssdo,
+    /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
+    SsdoBounce,
+    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
+    FetchOnly,
+}
+
+/// What kind of estimate a technique makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TechniqueKind {
+    /// No estimate (the ambient is unoccluded).
+    Off,
+    /// Depth tests of a kernel of points in the normal's hemisphere.
+    Hemisphere,
+    /// Horizons or sectors found by marching depth along screen-space directions.
+    HorizonMarch,
+    /// Occlusion and the light that arrives through the unblocked directions, in colour:
+    /// it needs a renderer's light (vrao-render's SSDO); the AO engine refuses it.
+    LightGathering,
+    /// A cost baseline that estimates nothing.
+    Baseline,
+}
+
+/// How the composite applies the technique's output (`ao.technique` in the shaders; the
+/// constants `COMPOSITE_*` of common.wgsl hold the same numbers).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum CompositeMode {
+    /// Unoccluded ambient.
+    Unoccluded = 0,
+    /// The ambient times the AO in alpha.
+    ScalarAo = 1,
+    /// The gathered light in rgb replaces the ambient (SSDO).
+    Directional = 2,
+}
+
+/// The pattern a technique's samples follow, and how it changes frame to frame with
+/// temporal accumulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplePattern {
+    /// None.
+    Nothing,
+    /// The Halton hemisphere kernel, cosine-weighted; temporal accumulation gives each
+    /// frame its own part of a longer kernel.
+    HemisphereCosine,
+    /// The Halton hemisphere kernel, uniform (the technique weighs each direction by its
+    /// cosine itself); parts per frame as above.
+    HemisphereUniform,
+    /// Screen-space directions; temporal accumulation turns them by the golden angle.
+    Directions,
+}
+
+/// What fixed foveation thins towards the image's edges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FoveationRule {
+    /// Nothing (no per-pixel work to thin).
+    Unaffected,
+    /// The hemisphere kernel's sample count.
+    Samples,
+    /// The march's directions (slices), then its steps.
+    DirectionsThenSteps,
+}
+
+/// One technique's line of the table.
+#[derive(Clone, Copy, Debug)]
+pub struct TechniqueEntry {
+    /// The technique.
+    pub technique: Technique,
+    /// Its command-line name, also its pass's name and the name in files and reports.
+    pub name: &'static str,
+    /// What kind of estimate it makes.
+    pub kind: TechniqueKind,
+    /// How the composite applies it.
+    pub composite: CompositeMode,
+    /// Its samples' pattern (which kernel the frame's uniforms carry).
+    pub samples: SamplePattern,
+    /// What foveation thins.
+    pub foveation: FoveationRule,
+    /// Makes its pass for the engine's chain; `None` where the engine has none (`none`,
+    /// or a light-gathering technique whose pass a renderer supplies).
+    pub pass: Option<fn(&Gpu) -> Box<dyn Pass>>,
+}
+
+/// Every technique, in the order the CLI and the bench list them.
+pub const TECHNIQUES: [TechniqueEntry; 7] = [
+    TechniqueEntry {
+        technique: Technique::None,
+        name: "none",
+        kind: TechniqueKind::Off,
+        composite: CompositeMode::Unoccluded,
+        samples: SamplePattern::Nothing,
+        foveation: FoveationRule::Unaffected,
+        pass: None,
+    },
+    TechniqueEntry {
+        technique: Technique::Ssao,
+        name: "ssao",
+        kind: TechniqueKind::Hemisphere,
+        composite: CompositeMode::ScalarAo,
+        samples: SamplePattern::HemisphereCosine,
+        foveation: FoveationRule::Samples,
+        pass: Some(|gpu| Box::new(ssao::pass(gpu))),
+    },
+    TechniqueEntry {
+        technique: Technique::Hbao,
+        name: "hbao",
+        kind: TechniqueKind::HorizonMarch,
+        composite: CompositeMode::ScalarAo,
+        samples: SamplePattern::Directions,
+        foveation: FoveationRule::DirectionsThenSteps,
+        pass: Some(|gpu| Box::new(hbao::pass(gpu))),
+    },
+    TechniqueEntry {
+        technique: Technique::Gtao,
+        name: "gtao",
+        kind: TechniqueKind::HorizonMarch,
+        composite: CompositeMode::ScalarAo,
+        samples: SamplePattern::Directions,
+        foveation: FoveationRule::DirectionsThenSteps,
+        pass: Some(|gpu| Box::new(gtao::GtaoPass::new(gpu))),
+    },
+    TechniqueEntry {
+        technique: Technique::Ssdo,
+        name: "ssdo",
+        kind: TechniqueKind::LightGathering,
+        composite: CompositeMode::Directional,
+        samples: SamplePattern::HemisphereUniform,
+        foveation: FoveationRule::Samples,
+        pass: None,
+    },
+    TechniqueEntry {
+        technique: Technique::SsdoBounce,
+        name: "ssdo-bounce",
+        kind: TechniqueKind::LightGathering,
+        composite: CompositeMode::Directional,
+        samples: SamplePattern::HemisphereUniform,
+        foveation: FoveationRule::Samples,
+        pass: None,
+    },
+    TechniqueEntry {
+        technique: Technique::FetchOnly,
+        name: "fetch-only",
+        kind: TechniqueKind::Baseline,
+        composite: CompositeMode::ScalarAo,
+        samples: SamplePattern::HemisphereCosine,
+        foveation: FoveationRule::Samples,
+        pass: Some(|gpu| Box::new(fetch_only::pass(gpu))),
+    },
+];
+
+impl Technique {
+    /// Every technique, in the order the CLI and the bench list them (the table's).
+    pub const ALL: [Technique; TECHNIQUES.len()] = {
+        let mut all = [Technique::None; TECHNIQUES.len()];
+        let mut i = 0;
+        while i < TECHNIQUES.len() {
+            all[i] = TECHNIQUES[i].technique;
+            i += 1;
+        }
+        all
+    };
+
+    /// The technique's line of [`TECHNIQUES`].
+    pub fn entry(self) -> &'static TechniqueEntry {
+        TECHNIQUES.iter().find(|e| e.technique == self).expect("every technique has a line (checked by a test)")
+    }
+
+    /// The technique's command-line name (`ssao`, `hbao`, …), also used in file names and reports.
+    pub fn name(self) -> &'static str {
+        self.entry().name
+    }
+
+    /// True for the techniques whose occlusion targets carry gathered light in rgb
+    /// ([`TechniqueKind::LightGathering`]); the others write AO in alpha alone (rgb 0),
+    /// so the denoise filters alpha alone for them.
+    pub fn carries_light(self) -> bool {
+        self.entry().kind == TechniqueKind::LightGathering
+    }
+
+    /// Every technique, in the order the CLI and the bench list them ([`Technique::ALL`]).
+    pub fn all() -> &'static [Technique] {
+        &Technique::ALL
+    }
+
+    /// The techniques that estimate occlusion (neither `none` nor the fetch-only
+    /// baseline), the default first, then in [`Technique::all`]'s order: what `vrao bench`
+    /// sweeps unless told otherwise.
+    pub fn estimators() -> Vec<Technique> {
+        let default = Technique::default();
+        let estimates = |t: &Technique| !matches!(t.entry().kind, TechniqueKind::Off | TechniqueKind::Baseline);
+        let others = Technique::all().iter().copied().filter(|&t| t != default && estimates(&t));
+        std::iter::once(default).chain(others).collect()
+    }
+}
+
+/// Bench files name their techniques, and the governor and `vrao budget --fit` read them
+/// back; the names are the command line's ([`Technique::name`]).
+impl std::str::FromStr for Technique {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Technique::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Technique::all().iter().map(|t| t.name()).collect();
+            Error::input(format!("unknown technique '{s}' (expected one of {})", names.join(", ")))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_technique_has_exactly_one_line_and_distinct_names() {
+        for (i, entry) in TECHNIQUES.iter().enumerate() {
+            let lines = TECHNIQUES.iter().filter(|e| e.technique == entry.technique).count();
+            assert_eq!(lines, 1, "{:?} has {lines} lines", entry.technique);
+            assert!(TECHNIQUES[..i].iter().all(|e| e.name != entry.name), "{} is named twice", entry.name);
+        }
+        // Every variant has a line: a match without a wildcard fails to compile when a
+        // variant is added, and the variant must then be given a line here.
+        for t in [
+            Technique::None,
+            Technique::Ssao,
+            Technique::Hbao,
+            Technique::Gtao,
+            Technique::Ssdo,
+            Technique::SsdoBounce,
+            Technique::FetchOnly,
+        ] {
+            match t {
+                Technique::None
+                | Technique::Ssao
+                | Technique::Hbao
+                | Technique::Gtao
+                | Technique::Ssdo
+                | Technique::SsdoBounce
+                | Technique::FetchOnly => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
+            }
+        }
+    }
+
+    #[test]
+    fn the_entries_fields_agree_with_each_other() {
+        for e in &TECHNIQUES {
+            let off = e.kind == TechniqueKind::Off;
+            assert_eq!(off, e.composite == CompositeMode::Unoccluded, "{}", e.name);
+            assert_eq!(off, e.samples == SamplePattern::Nothing, "{}", e.name);
+            assert_eq!(
+                e.kind == TechniqueKind::LightGathering,
+                e.composite == CompositeMode::Directional,
+                "{}",
+                e.name
+            );
+            // The engine builds a pass for every technique but `none` and the light
+            // gathering ones, which a renderer supplies.
+            let engine_pass = !matches!(e.kind, TechniqueKind::Off | TechniqueKind::LightGathering);
+            assert_eq!(e.pass.is_some(), engine_pass, "{}", e.name);
+            let marches = e.kind == TechniqueKind::HorizonMarch;
+            assert_eq!(marches, e.samples == SamplePattern::Directions, "{}", e.name);
+            assert_eq!(marches, e.foveation == FoveationRule::DirectionsThenSteps, "{}", e.name);
+        }
+    }
+
+    #[test]
+    fn the_composite_codes_are_the_shaders() {
+        let common = include_str!("../shaders/common.wgsl");
+        for (name, mode) in [
+            ("COMPOSITE_UNOCCLUDED", CompositeMode::Unoccluded),
+            ("COMPOSITE_SCALAR_AO", CompositeMode::ScalarAo),
+            ("COMPOSITE_DIRECTIONAL", CompositeMode::Directional),
+        ] {
+            let line = format!("const {name}: u32 = {}u;", mode as u32);
+            assert!(common.contains(&line), "common.wgsl lacks `{line}`");
+        }
+    }
+}
