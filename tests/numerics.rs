@@ -8,7 +8,7 @@ mod common;
 
 use glam::{DQuat, DVec3, Vec3};
 use std::sync::Arc;
-use vrao::render::gpu::targets::LayeredTarget;
+use vrao::render::gpu::layered_target::LayeredTarget;
 use vrao::render::graph::FINAL_AO;
 use vrao::render::passes::blur::AO_BLURRED;
 use vrao::render::passes::composite::HDR;

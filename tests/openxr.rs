@@ -13,8 +13,8 @@ mod common;
 
 use std::path::PathBuf;
 use std::sync::Arc;
+use vrao::render::gpu::layered_target::LayeredTarget;
 use vrao::render::gpu::readback::{read_layers, read_layers_f32};
-use vrao::render::gpu::targets::LayeredTarget;
 use vrao::render::passes::gbuffer::DEPTH;
 use vrao::render::passes::tonemap::COLOR;
 use vrao::render::scene::Scene;

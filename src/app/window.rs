@@ -462,7 +462,7 @@ impl WindowState {
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         self.encode_picture(frame_loop, &view, &paint_jobs, &screen);
-        let target = crate::render::gpu::targets::LayeredTarget {
+        let target = crate::render::gpu::layered_target::LayeredTarget {
             layer_views: vec![],
             array_view: texture.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),

@@ -6,7 +6,7 @@ pub mod output;
 pub mod spans;
 pub mod still;
 
-/// Serde for a setting chosen by name ([`Choice`]): written as its name, read from its
+/// Serde for a setting chosen by name ([`Choice`](crate::render::settings::Choice)): written as its name, read from its
 /// name or an alias, an unknown name refused with the accepted ones
 /// (`#[serde(with = "crate::formats::by_name")]`).
 pub mod by_name {

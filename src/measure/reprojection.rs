@@ -94,10 +94,20 @@ pub fn measure(
     // Keep the source frame: the fresh renders below reuse the renderer's targets.
     let extent = renderer.target(COLOR).expect("rendered").extent();
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-    let color =
-        crate::render::gpu::targets::LayeredTarget::new(&gpu.device, "source colour", COLOR.format(), extent, usage);
-    let depth =
-        crate::render::gpu::targets::LayeredTarget::new(&gpu.device, "source depth", DEPTH.format(), extent, usage);
+    let color = crate::render::gpu::layered_target::LayeredTarget::new(
+        &gpu.device,
+        "source colour",
+        COLOR.format(),
+        extent,
+        usage,
+    );
+    let depth = crate::render::gpu::layered_target::LayeredTarget::new(
+        &gpu.device,
+        "source depth",
+        DEPTH.format(),
+        extent,
+        usage,
+    );
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     for (resource, copy) in [(COLOR, &color), (DEPTH, &depth)] {
         let from = renderer.target(resource).expect("rendered");

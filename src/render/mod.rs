@@ -5,6 +5,7 @@ pub use vrao_render::*;
 
 /// A shader of a WGSL file named by its path from the workspace root (the
 /// application's files live in its own folders, beside the code that uses them).
+#[cfg(feature = "app")]
 macro_rules! wgsl {
     ($path:literal) => {
         $crate::render::gpu::kernel::Shader {
@@ -14,4 +15,5 @@ macro_rules! wgsl {
     };
 }
 
+#[cfg(feature = "app")]
 pub(crate) use wgsl;

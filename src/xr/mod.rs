@@ -7,7 +7,7 @@ pub mod profiles;
 pub mod simulated;
 
 use crate::render::error::Result;
-use crate::render::gpu::targets::LayeredTarget;
+use crate::render::gpu::layered_target::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::stereo::EyePair;
 use serde::Serialize;

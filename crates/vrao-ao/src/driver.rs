@@ -6,12 +6,12 @@
 //! when the encoder is submitted.
 
 use crate::error::Result;
-use crate::frame_targets::FrameTargets;
-use crate::gpu::frame::{FrameBuffers, FrameLighting};
 use crate::gpu::timing::{PassTimer, SpanRecorder};
+use crate::gpu::uniforms::{FrameLighting, FrameUniforms};
 use crate::gpu::Gpu;
 use crate::graph::{self, Plan, Resource};
-use crate::passes::{self, ChainSettings, FrameContext, FrameMotion, FrameSetup, Pass};
+use crate::graph_targets::GraphTargets;
+use crate::passes::{self, ChainSettings, DeclareContext, FrameMotion, Pass, RecordContext};
 use crate::stereo::Eye;
 use glam::DVec3;
 use std::any::Any;
@@ -23,9 +23,9 @@ use std::time::Instant;
 pub struct FrameParams<'a> {
     /// The chain's settings: each view's size, the near plane, the AO settings.
     pub settings: &'a ChainSettings,
-    /// What the owner's own passes read, found by type ([`FrameSetup::extension`]).
+    /// What the owner's own passes read, found by type ([`DeclareContext::extension`]).
     pub extensions: &'a [&'a dyn Any],
-    /// Whether the normals' w marks alpha-tested cards ([`FrameSetup::alpha_cards`]).
+    /// Whether the normals' w marks alpha-tested cards ([`DeclareContext::alpha_cards`]).
     pub alpha_cards: bool,
     /// The f64 origin of the anchored frame.
     pub anchor: DVec3,
@@ -76,8 +76,8 @@ struct PlanKey<K> {
 /// Runs one frame graph frame after frame: plan cache, targets, uniforms, record loop and
 /// timer. `K` is what the owner's plan depends on (its settings).
 pub struct GraphDriver<K> {
-    targets: FrameTargets,
-    uniforms: FrameBuffers,
+    targets: GraphTargets,
+    uniforms: FrameUniforms,
     timer: PassTimer,
     plan_cache: Option<(PlanKey<K>, Plan)>,
     frame_index: u64,
@@ -89,8 +89,8 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
     /// passes with `timer`.
     pub fn new(gpu: &Gpu, lights_per_view: usize, timer: PassTimer) -> Self {
         GraphDriver {
-            targets: FrameTargets::default(),
-            uniforms: FrameBuffers::new(&gpu.device, lights_per_view),
+            targets: GraphTargets::default(),
+            uniforms: FrameUniforms::new(&gpu.device, lights_per_view),
             timer,
             plan_cache: None,
             frame_index: 0,
@@ -114,17 +114,17 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
     }
 
     /// The frame's uniform buffers (a raster pass binds them when it is made).
-    pub fn uniforms(&self) -> &FrameBuffers {
+    pub fn uniforms(&self) -> &FrameUniforms {
         &self.uniforms
     }
 
     /// The targets, placeholders and imported textures.
-    pub fn targets(&self) -> &FrameTargets {
+    pub fn targets(&self) -> &GraphTargets {
         &self.targets
     }
 
     /// The targets, to import a host's textures into.
-    pub fn targets_mut(&mut self) -> &mut FrameTargets {
+    pub fn targets_mut(&mut self) -> &mut GraphTargets {
         &mut self.targets
     }
 
@@ -140,8 +140,8 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
 
     /// What the passes consult this frame: `params` with the driver's frame number and
     /// history, for `views` (empty when only planning) of `layers` layers.
-    pub fn setup<'a>(&'a self, params: &FrameParams<'a>, views: &'a [Eye], layers: u32) -> FrameSetup<'a> {
-        FrameSetup {
+    pub fn setup<'a>(&'a self, params: &FrameParams<'a>, views: &'a [Eye], layers: u32) -> DeclareContext<'a> {
+        DeclareContext {
             extensions: params.extensions,
             alpha_cards: params.alpha_cards,
             anchor: params.anchor,
@@ -229,7 +229,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
         let mut recorded = Recorded::default();
         for (step, (&index, name)) in plan.run.iter().zip(&plan.names).enumerate() {
             let encode_start = Instant::now();
-            let mut ctx = FrameContext {
+            let mut ctx = RecordContext {
                 gpu,
                 encoder: &mut *encoder,
                 targets: &self.targets.targets,

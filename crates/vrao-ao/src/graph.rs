@@ -13,7 +13,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::kernel::Bind;
-use crate::passes::FrameSetup;
+use crate::passes::DeclareContext;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
@@ -29,7 +29,7 @@ pub enum Size {
     /// Width × height × layers worked out by the creating pass (the lights' maps: one
     /// layer per shadowed light, `--shadow-size` a side), from the frame's setup and the
     /// device's largest 2D texture side.
-    Computed(fn(&FrameSetup, u32) -> (u32, u32, u32)),
+    Computed(fn(&DeclareContext, u32) -> (u32, u32, u32)),
 }
 
 /// How a texture is written, which decides its usages.

@@ -15,9 +15,9 @@
 pub mod ao;
 pub mod driver;
 pub mod error;
-pub mod frame_targets;
 pub mod gpu;
 pub mod graph;
+pub mod graph_targets;
 pub mod passes;
 pub mod sampling;
 pub mod settings;

@@ -1,7 +1,7 @@
 //! The technique table: every occlusion technique's name, kind, composite mode, sample
 //! pattern, foveation rule and pass, in one place. Adding a technique is its folder under
 //! `src/passes/` (its Rust and WGSL), its variant below and its line in [`TECHNIQUES`];
-//! the chain ([`crate::passes::ao_chain`]), the uniforms ([`crate::gpu::frame`]), the
+//! the chain ([`crate::passes::ao_chain`]), the uniforms ([`crate::gpu::uniforms`]), the
 //! denoise and the composite read what they need from the entry.
 
 use crate::error::{Error, Result};
@@ -86,6 +86,9 @@ pub enum FoveationRule {
     DirectionsThenSteps,
 }
 
+/// What makes a technique's pass for the engine's chain.
+pub type MakePass = fn(&Gpu) -> Box<dyn Pass>;
+
 /// One technique's line of the table.
 #[derive(Clone, Copy, Debug)]
 pub struct TechniqueEntry {
@@ -103,7 +106,7 @@ pub struct TechniqueEntry {
     pub foveation: FoveationRule,
     /// Makes its pass for the engine's chain; `None` where the engine has none (`none`,
     /// or a light-gathering technique whose pass a renderer supplies).
-    pub pass: Option<fn(&Gpu) -> Box<dyn Pass>>,
+    pub pass: Option<MakePass>,
 }
 
 /// Every technique, in the order the CLI and the bench list them.

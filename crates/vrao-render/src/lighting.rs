@@ -1,7 +1,7 @@
 //! The scene's lights and environment as the frame uniforms hold them: in each view's
 //! space, for the engine's [`FrameLighting`].
 
-use crate::gpu::frame::{FrameLighting, LightUniform};
+use crate::gpu::uniforms::{FrameLighting, LightUniform};
 use crate::scene::environment::quadratic_in_view;
 use crate::scene::{spot_ramp, Light, Scene};
 use crate::settings::Settings;

@@ -9,9 +9,9 @@
 //! [`Renderer::render_and_wait`] (measurements) wait.
 
 use crate::error::{Error, Result};
+use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::readback;
 use crate::gpu::scene::GpuScene;
-use crate::gpu::targets::LayeredTarget;
 use crate::gpu::timing::{FrameTiming, PassTimer};
 use crate::gpu::Gpu;
 use crate::graph::{Plan, Resource};

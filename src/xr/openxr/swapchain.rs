@@ -16,8 +16,8 @@
 //! (frag_depth), which also leaves it in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
 
 use super::RuntimeFailure;
+use crate::render::gpu::layered_target::LayeredTarget;
 use crate::render::gpu::raster::fullscreen_pipeline;
-use crate::render::gpu::targets::LayeredTarget;
 use crate::render::gpu::Gpu;
 use ash::vk;
 use ash::vk::Handle as _;

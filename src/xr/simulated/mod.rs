@@ -14,7 +14,7 @@ pub mod reproject;
 
 use super::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use crate::render::error::{Error, Result};
-use crate::render::gpu::targets::LayeredTarget;
+use crate::render::gpu::layered_target::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::passes::gbuffer::DEPTH;
 use crate::render::passes::tonemap::COLOR;

@@ -4,7 +4,7 @@
 
 use crate::render::error::Result;
 use crate::render::gpu::kernel::{try_shader_module, Bind, Kernel, Slot, COMMON};
-use crate::render::gpu::targets::LayeredTarget;
+use crate::render::gpu::layered_target::LayeredTarget;
 use crate::render::gpu::Gpu;
 use crate::render::passes::tonemap::COLOR;
 use crate::render::stereo::Eye;

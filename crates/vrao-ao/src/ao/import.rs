@@ -11,7 +11,7 @@ use crate::gpu::raster;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, PIXEL_MOTION};
 use crate::passes::inputs::{DEPTH, NORMALS};
-use crate::passes::{FrameContext, FrameSetup, Pass};
+use crate::passes::{DeclareContext, Pass, RecordContext};
 use bytemuck::{Pod, Zeroable};
 use std::sync::Mutex;
 
@@ -229,7 +229,7 @@ impl ImportPass {
 }
 
 impl Pass for ImportPass {
-    fn declare(&self, _setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, _setup: &DeclareContext) -> PassDecl {
         let decl = PassDecl::new(NAME).read(HOST_DEPTH).read(HOST_NORMALS).write(DEPTH).write(NORMALS);
         // The host's motion goes to temporal accumulation as it is.
         let decl = match self.source() {
@@ -242,7 +242,7 @@ impl Pass for ImportPass {
         }
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let Some(source) = self.source() else { return };
         let source = source.with_near(ctx.setup.settings.near as f32);
         ctx.gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&source.params));

@@ -22,8 +22,8 @@ pub mod import;
 
 use crate::driver::{FrameParams, GraphDriver, Submission};
 use crate::error::{Error, Result};
-use crate::gpu::frame::FrameLighting;
 use crate::gpu::timing::{PassTimer, SpanRecorder};
+use crate::gpu::uniforms::FrameLighting;
 use crate::gpu::Gpu;
 use crate::graph::{Plan, FINAL_AO};
 use crate::passes::{self, ChainSettings, FrameMotion, Pass};

@@ -1,14 +1,14 @@
 //! Device and adapter choice, layered targets, compute-kernel plumbing, GPU timing and
 //! readback. Everything GPU-side that is not a technique lives here.
 
-pub mod frame;
 pub mod kernel;
+pub mod layered_target;
 pub mod multiview_probe;
 pub mod raster;
 pub mod readback;
 pub mod support;
-pub mod targets;
 pub mod timing;
+pub mod uniforms;
 
 use crate::error::{Error, Result};
 use std::fmt::Write as _;
@@ -207,7 +207,7 @@ impl Gpu {
     /// Lets `interrupt` (the caller's Ctrl-C flag) cut short the building of pipelines on
     /// this device: once it is set, each kernel compiles a stand-in of no work instead of
     /// its shader (a CPU adapter takes up to two seconds for a renderer's), and
-    /// [`crate::renderer::Renderer::new`] returns
+    /// vrao-render's `Renderer::new` returns
     /// [`crate::error::Error::Interrupted`]. Only the first token given counts.
     pub fn cancel_builds_on(&self, interrupt: std::sync::Arc<std::sync::atomic::AtomicBool>) {
         let _ = self.build_interrupt.set(interrupt);

@@ -4,8 +4,8 @@
 //! is used one pass per eye unless the user insists.
 
 use super::kernel::shader_module;
+use super::layered_target::LayeredTarget;
 use super::readback::read_layers;
-use super::targets::LayeredTarget;
 use super::Gpu;
 use crate::gpu::kernel::wgsl;
 use crate::gpu::raster::fullscreen_pipeline;

@@ -1,6 +1,6 @@
 //! Copies layered textures back to the CPU (debug images, tests, error measurement).
 
-use super::targets::LayeredTarget;
+use super::layered_target::LayeredTarget;
 use super::Gpu;
 use crate::error::{Error, Result};
 

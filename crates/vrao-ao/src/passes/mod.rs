@@ -16,11 +16,11 @@ pub mod ssao;
 pub mod temporal;
 pub mod upsample;
 
-use crate::gpu::frame::ao_extent;
-use crate::gpu::frame::FrameBuffers;
 use crate::gpu::kernel::Bind;
-use crate::gpu::targets::LayeredTarget;
+use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::timing::SpanRecorder;
+use crate::gpu::uniforms::ao_extent;
+use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::settings::AoSettings;
@@ -60,9 +60,9 @@ pub struct ChainSettings {
 }
 
 /// What passes may consult when declaring themselves for a frame.
-pub struct FrameSetup<'a> {
+pub struct DeclareContext<'a> {
     /// What a renderer's own passes read beyond the engine's (its scene, its uploaded
-    /// scene, its settings), found by type ([`FrameSetup::extension`]); empty in the AO
+    /// scene, its settings), found by type ([`DeclareContext::extension`]); empty in the AO
     /// engine.
     pub extensions: &'a [&'a dyn Any],
     /// Whether the normals' w marks alpha-tested surfaces (cards) that GTAO samples as
@@ -151,7 +151,7 @@ impl Default for FrameMotion {
 }
 
 /// Everything a pass records with.
-pub struct FrameContext<'a> {
+pub struct RecordContext<'a> {
     /// The device and queue.
     pub gpu: &'a Gpu,
     /// The encoder the pass records into (with serial timing, a fresh one per pass).
@@ -164,26 +164,26 @@ pub struct FrameContext<'a> {
     /// This pass's declaration for the frame, named outputs resolved.
     pub decl: &'a PassDecl,
     /// The frame's uniform and light buffers.
-    pub frame: &'a FrameBuffers,
+    pub frame: &'a FrameUniforms,
     /// An environment map and its sampler for [`Bind::Environment`] and
     /// [`Bind::EnvironmentSampler`] (a renderer's; `None` in the AO engine).
     pub environment: Option<(&'a wgpu::TextureView, &'a wgpu::Sampler)>,
     /// Timestamp scopes around each pass.
     pub timer: &'a dyn SpanRecorder,
     /// What the passes were declared with.
-    pub setup: &'a FrameSetup<'a>,
+    pub setup: &'a DeclareContext<'a>,
 }
 
-impl<'a> FrameSetup<'a> {
-    /// The extension of type `T` the driver of the graph put in [`FrameSetup::extensions`]
+impl<'a> DeclareContext<'a> {
+    /// The extension of type `T` the driver of the graph put in [`DeclareContext::extensions`]
     /// (a renderer's scene for its own passes), if any.
     pub fn extension<T: Any>(&self) -> Option<&'a T> {
         self.extensions.iter().find_map(|e| e.downcast_ref::<T>())
     }
 }
 
-impl<'a> FrameContext<'a> {
-    /// The environment a renderer bound ([`FrameContext::environment`]).
+impl<'a> RecordContext<'a> {
+    /// The environment a renderer bound ([`RecordContext::environment`]).
     fn environment(&self) -> (&'a wgpu::TextureView, &'a wgpu::Sampler) {
         self.environment.expect("only a renderer's passes bind an environment, and it provides one")
     }
@@ -214,7 +214,7 @@ impl<'a> FrameContext<'a> {
         self.bind_overriding(binds, own, &[])
     }
 
-    /// [`FrameContext::bind`], with the entries that read or write a named resource
+    /// [`RecordContext::bind`], with the entries that read or write a named resource
     /// bound to another view of it instead (the right eye's dispatch of the stereo reuse
     /// writes layer 1 alone). Every override must name a resource of the list.
     pub fn bind_overriding<'b>(
@@ -288,7 +288,7 @@ impl<'a> FrameContext<'a> {
 }
 
 /// Records one pass inside its timestamp span.
-pub fn record(pass: &dyn Pass, ctx: &mut FrameContext) {
+pub fn record(pass: &dyn Pass, ctx: &mut RecordContext) {
     let span = ctx.timer.begin(ctx.encoder, ctx.decl.name);
     pass.record(ctx);
     ctx.timer.end(ctx.encoder, span);
@@ -299,9 +299,9 @@ pub fn record(pass: &dyn Pass, ctx: &mut FrameContext) {
 /// keep the AO engine in a multi-threaded app's state.
 pub trait Pass: Send + Sync {
     /// What the pass reads and writes this frame, and whether it runs at all.
-    fn declare(&self, setup: &FrameSetup) -> PassDecl;
+    fn declare(&self, setup: &DeclareContext) -> PassDecl;
     /// Records the pass's commands into the frame's encoder.
-    fn record(&self, ctx: &mut FrameContext);
+    fn record(&self, ctx: &mut RecordContext);
     /// A target the pass keeps itself from one frame to the next (the temporal
     /// history), for inspection; the graph allocates every other target.
     fn kept_target(&self, _r: Resource) -> Option<LayeredTarget> {

@@ -14,8 +14,8 @@ pub mod shadow;
 pub mod ssdo;
 pub mod tonemap;
 
-use crate::gpu::frame::FrameBuffers;
 use crate::gpu::scene::GpuScene;
+use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Gpu;
 use crate::scene::Scene;
 use crate::settings::Settings;
@@ -25,7 +25,7 @@ use std::sync::Arc;
 /// directional lights' maps and direct light, their bounce, and the second depth layer
 /// SSDO may read. A new pass is its own folder, its `pub mod` line above and one entry
 /// here or in [`output_passes`].
-pub fn scene_passes(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameBuffers) -> Vec<Box<dyn Pass>> {
+pub fn scene_passes(gpu: &Gpu, scene: &Scene, gpu_scene: &GpuScene, frame: &FrameUniforms) -> Vec<Box<dyn Pass>> {
     // Directional lights' orthographic fits, shared by the shadow, direct and RSM passes.
     let light_space = Arc::new(shadow::LightSpace::new(gpu, scene, gpu_scene.anchor));
     vec![
@@ -43,16 +43,16 @@ pub fn output_passes(gpu: &Gpu) -> Vec<Box<dyn Pass>> {
 }
 
 /// The scene being rendered, for the renderer's own passes.
-pub fn scene_of<'a>(setup: &FrameSetup<'a>) -> &'a Scene {
+pub fn scene_of<'a>(setup: &DeclareContext<'a>) -> &'a Scene {
     setup.extension::<Scene>().expect("the renderer's passes run in the renderer, which puts its scene in the frame")
 }
 
 /// The scene as uploaded to the GPU, for the renderer's raster passes.
-pub fn gpu_scene_of<'a>(setup: &FrameSetup<'a>) -> &'a GpuScene {
+pub fn gpu_scene_of<'a>(setup: &DeclareContext<'a>) -> &'a GpuScene {
     setup.extension::<GpuScene>().expect("the renderer puts its uploaded scene in the frame")
 }
 
 /// The renderer's settings (tone mapping, shadows, stereo path), for its own passes.
-pub fn settings_of<'a>(setup: &FrameSetup<'a>) -> &'a Settings {
+pub fn settings_of<'a>(setup: &DeclareContext<'a>) -> &'a Settings {
     setup.extension::<Settings>().expect("the renderer puts its settings in the frame")
 }

@@ -6,7 +6,7 @@
 
 use super::inputs::DEPTH;
 use super::occlusion::AO_GEOMETRY;
-use super::{FrameContext, FrameSetup, Pass};
+use super::{DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
@@ -101,7 +101,7 @@ impl BlurPass {
 }
 
 impl Pass for BlurPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &setup.settings.ao;
         PassDecl::new(NAME)
             .bindings(&HORIZONTAL)
@@ -112,7 +112,7 @@ impl Pass for BlurPass {
             .disabled_if(ao.blur_radius == 0, "blur radius is 0")
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let ao = &ctx.setup.settings.ao;
         let kernels = match ao.denoise {
             Denoise::Tile => &self.tile[usize::from(ao.technique.carries_light())],

@@ -5,7 +5,7 @@
 //! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
-use super::{FrameContext, FrameSetup, Pass};
+use super::{DeclareContext, Pass, RecordContext};
 use crate::error::{Error, Result};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::gpu::Gpu;
@@ -154,7 +154,7 @@ impl GtaoPass {
 }
 
 impl Pass for GtaoPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let decl = technique_decl(Technique::Gtao.name(), &BINDINGS, &[Technique::Gtao], setup);
         if setup.alpha_cards {
             decl.note("alpha-tested samples are cards: each blocks its footprint on the card, not a slab")
@@ -163,7 +163,7 @@ impl Pass for GtaoPass {
         }
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let (width, height, layers) = ctx.ao_extent();
         let device = &ctx.gpu.device;
         let ao = &ctx.setup.settings.ao;

@@ -4,7 +4,7 @@
 //! of that layout (SSAO, HBAO, the fetch-only baseline). GTAO and SSDO, which bind more,
 //! are passes of their own in their folders.
 
-use super::{FrameContext, FrameSetup, Pass};
+use super::{DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, COMMON};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
@@ -54,7 +54,7 @@ pub const fn bindings_and<const N: usize, const M: usize>(own: [Bind; N]) -> [Bi
 /// A technique pass's declaration: its bindings (the G-buffer in, the raw occlusion and
 /// its geometry out), the raw occlusion provided as the AO chain's start, counted as the
 /// occlusion's cost, and left out unless the chosen technique is one of `runs_for`.
-pub fn technique_decl(name: &'static str, binds: &[Bind], runs_for: &[Technique], setup: &FrameSetup) -> PassDecl {
+pub fn technique_decl(name: &'static str, binds: &[Bind], runs_for: &[Technique], setup: &DeclareContext) -> PassDecl {
     let chosen = setup.settings.ao.technique;
     let reason = if chosen == Technique::None {
         "technique is none: no occlusion pass".to_string()
@@ -84,11 +84,11 @@ impl TechniquePass {
 }
 
 impl Pass for TechniquePass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         technique_decl(self.technique.name(), &BINDINGS, &[self.technique], setup)
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let resources = ctx.bind(&BINDINGS, &[]);
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.ao_extent());
     }

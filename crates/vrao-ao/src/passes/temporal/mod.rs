@@ -5,9 +5,9 @@
 //! allocates, and makes them again only when the occlusion's size changes.
 
 use super::occlusion::AO_GEOMETRY;
-use super::{FrameContext, FrameSetup, MoverBox, Pass};
+use super::{DeclareContext, MoverBox, Pass, RecordContext};
 use crate::gpu::kernel::{invalidate_bind_groups, wgsl, Bind, Kernel, Slot, COMMON};
-use crate::gpu::targets::LayeredTarget;
+use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION, PIXEL_MOTION};
 use crate::settings::{Technique, TemporalBlend};
@@ -128,7 +128,7 @@ impl TemporalPass {
 }
 
 impl Pass for TemporalPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &setup.settings.ao;
         let decl = PassDecl::new(NAME).bindings(&BINDINGS);
         let decl = if uses_motion(setup) {
@@ -142,7 +142,7 @@ impl Pass for TemporalPass {
             .disabled_if(!ao.temporal.enabled, "temporal accumulation is off")
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let setup = ctx.setup;
         let t = &setup.settings.ao.temporal;
         let near = setup.settings.near;
@@ -217,6 +217,6 @@ impl Pass for TemporalPass {
 
 /// Whether this frame reprojects by motion vectors (the scene moves or the host gave
 /// them, and the settings ask for it).
-fn uses_motion(setup: &FrameSetup) -> bool {
+fn uses_motion(setup: &DeclareContext) -> bool {
     setup.motion.vectors && setup.settings.ao.temporal.object_motion
 }

@@ -6,7 +6,7 @@
 
 use super::inputs::{DEPTH, NORMALS};
 use super::occlusion::AO_GEOMETRY;
-use super::{FrameContext, FrameSetup, Pass};
+use super::{DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
@@ -67,7 +67,7 @@ impl UpsamplePass {
 }
 
 impl Pass for UpsamplePass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &setup.settings.ao;
         PassDecl::new(NAME)
             .bindings(&BINDINGS)
@@ -77,7 +77,7 @@ impl Pass for UpsamplePass {
             .disabled_if(!ao.half_res, "occlusion runs at full resolution")
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY)]);
         // One invocation per quad of 2×2 full-res pixels (upsample.wgsl): both eyes
         // alike, or the left eye and then the right eye reusing it.

@@ -15,7 +15,7 @@ use super::occlusion::AO_GEOMETRY;
 use super::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
 use super::shadow::rsm_active;
 use super::upsample::{reuses_left_eye_upsample, JOINT_UPSAMPLE_WGSL};
-use super::{scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, IRRADIANCE};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
@@ -118,7 +118,7 @@ impl CompositePass {
 }
 
 impl Pass for CompositePass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let settings = settings_of(setup);
         let mut decl = PassDecl::new(NAME).bindings(&BINDINGS);
         if settings.ao.technique == Technique::None {
@@ -135,7 +135,7 @@ impl Pass for CompositePass {
         }
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let half_res = settings_of(ctx.setup).ao.half_res;
         let rsm = rsm_active(scene_of(ctx.setup), settings_of(ctx.setup));
         // The output's left-eye layer is unused before the right eye's dispatch: the

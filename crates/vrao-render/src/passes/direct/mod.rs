@@ -5,7 +5,7 @@
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS};
 use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
-use super::{scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size};
@@ -50,7 +50,7 @@ impl DirectLightPass {
 }
 
 impl Pass for DirectLightPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let decl = PassDecl::new(NAME).bindings(&BINDINGS);
         if shadows_active(scene_of(setup), settings_of(setup)) {
             decl.note("directional light shadowed: 3×3 PCF, bilinear compare, slope-scaled bias")
@@ -59,7 +59,7 @@ impl Pass for DirectLightPass {
         }
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         // Shadows (shadow.wgsl): every light's map, or no light and a placeholder map.
         let shadowed = shadows_active(scene_of(ctx.setup), settings_of(ctx.setup));
         let shadows = if shadowed { &self.light_space.uniform } else { &self.light_space.none };

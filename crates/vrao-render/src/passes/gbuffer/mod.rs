@@ -5,11 +5,11 @@
 //! materials are drawn after the solid ones with a pipeline that discards their holes;
 //! a scene without them (or without motion) gets neither pipeline nor target.
 
-use super::{gpu_scene_of, settings_of, FrameContext, FrameSetup, Pass};
-use crate::gpu::frame::FrameBuffers;
+use super::{gpu_scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
+use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, PIXEL_MOTION};
 use bytemuck::{Pod, Zeroable};
@@ -72,7 +72,7 @@ pub struct GBufferPass {
 
 impl GBufferPass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameUniforms) -> Self {
         let device = &gpu.device;
         let vs_fs = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -152,7 +152,7 @@ impl GBufferPass {
 
     /// Writes the previous frame's eyes (this frame's when there is none: then only
     /// objects move).
-    fn write_previous_eyes(&self, ctx: &FrameContext) {
+    fn write_previous_eyes(&self, ctx: &RecordContext) {
         let setup = ctx.setup;
         let eyes = setup.previous_views.unwrap_or(setup.current_views);
         let mut u = PreviousEyes::zeroed();
@@ -195,7 +195,7 @@ fn pipeline(
 }
 
 impl Pass for GBufferPass {
-    fn declare(&self, _: &FrameSetup) -> PassDecl {
+    fn declare(&self, _: &DeclareContext) -> PassDecl {
         let mut decl = PassDecl::new(NAME).write(DEPTH).write(NORMALS).write(ALBEDO).write(EMISSION);
         decl = if self.motion {
             decl.write(MOTION).provide(PIXEL_MOTION, MOTION)
@@ -208,7 +208,7 @@ impl Pass for GBufferPass {
         decl
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let gpu_scene = gpu_scene_of(ctx.setup);
         if self.motion {
             self.write_previous_eyes(ctx);

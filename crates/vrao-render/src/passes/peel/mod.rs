@@ -7,11 +7,11 @@
 //! One depth-only render pass per eye layer, whatever the G-buffer uses: multiview is
 //! unreliable on lavapipe, and each pass reads its own layer of the first depth.
 
-use super::{gpu_scene_of, settings_of, FrameContext, FrameSetup, Pass};
-use crate::gpu::frame::FrameBuffers;
+use super::{gpu_scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{shader_module, wgsl, COMMON};
 use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
+use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size};
 use crate::passes::gbuffer::DEPTH;
@@ -40,7 +40,7 @@ pub struct DepthPeelPass {
 
 impl DepthPeelPass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBuffers) -> Self {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameUniforms) -> Self {
         let device = &gpu.device;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth peel frame"),
@@ -103,7 +103,7 @@ impl DepthPeelPass {
 }
 
 impl Pass for DepthPeelPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &settings_of(setup).ao;
         let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
         PassDecl::new(NAME)
@@ -117,7 +117,7 @@ impl Pass for DepthPeelPass {
             )
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let gpu_scene = gpu_scene_of(ctx.setup);
         let first = ctx.view(DEPTH);
         let second = ctx.target(DEPTH_LAYER_2);

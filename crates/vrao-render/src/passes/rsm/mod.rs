@@ -6,9 +6,9 @@
 
 use super::gbuffer::{DEPTH, NORMALS};
 use super::shadow::{rsm_active, shadow_casters, LightSpace, RSM_FLUX, RSM_NORMAL, SHADOW_MAP, SHADOW_WGSL};
-use super::{scene_of, settings_of, FrameContext, FrameSetup, Pass};
-use crate::gpu::frame::ao_extent;
+use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::uniforms::ao_extent;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size};
 use bytemuck::{Pod, Zeroable};
@@ -78,7 +78,7 @@ impl RsmPass {
 }
 
 impl Pass for RsmPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let s = &settings_of(setup).shadows;
         let lights = shadow_casters(scene_of(setup)).len();
         PassDecl::new(NAME)
@@ -93,7 +93,7 @@ impl Pass for RsmPass {
             ))
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         debug_assert!(rsm_active(scene_of(ctx.setup), settings_of(ctx.setup)));
         let p = &settings_of(ctx.setup).profile;
         let (w, h) = ao_extent(p.width, p.height, true);

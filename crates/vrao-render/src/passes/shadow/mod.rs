@@ -17,7 +17,7 @@
 //! ~2.4 cm texels. Cascades (or a fit to the visible depth range, which needs a GPU
 //! reduction) are the way to spend texels on what is near; see the report.
 
-use super::{gpu_scene_of, scene_of, settings_of, FrameContext, FrameSetup, Pass};
+use super::{gpu_scene_of, scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
@@ -136,7 +136,7 @@ pub fn suggested_rsm_radius(scene: &Scene) -> f32 {
 
 /// Width × height × layers of the light-space targets: the map size (within the
 /// device's limit) and one layer per shadowed light.
-pub fn light_extent(setup: &FrameSetup, max_dimension: u32) -> (u32, u32, u32) {
+pub fn light_extent(setup: &DeclareContext, max_dimension: u32) -> (u32, u32, u32) {
     let size = settings_of(setup).shadows.size.min(max_dimension).max(16);
     (size, size, shadow_casters(scene_of(setup)).len().max(1) as u32)
 }
@@ -381,7 +381,7 @@ fn pipeline(
 }
 
 impl Pass for ShadowPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let (scene, settings) = (scene_of(setup), settings_of(setup));
         let mut decl = PassDecl::new(NAME).write(SHADOW_MAP);
         if rsm_active(scene, settings) {
@@ -405,7 +405,7 @@ impl Pass for ShadowPass {
         }
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let gpu_scene = gpu_scene_of(ctx.setup);
         let size = ctx.target(SHADOW_MAP).width;
         let uniform = self.light_space.shadows_uniform(size);

@@ -7,7 +7,7 @@
 use super::direct::DIRECT;
 use super::occlusion::{self, technique_decl, OCCLUSION_WGSL};
 use super::peel::DEPTH_LAYER_2;
-use super::{settings_of, FrameContext, FrameSetup, Pass};
+use super::{settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON, IRRADIANCE};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
@@ -47,7 +47,7 @@ impl SsdoPass {
 }
 
 impl Pass for SsdoPass {
-    fn declare(&self, setup: &FrameSetup) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &settings_of(setup).ao;
         let name = if ao.bounce_active() { "ssdo-bounce" } else { "ssdo" };
         let mut decl = technique_decl(name, &BINDINGS, &[Technique::Ssdo, Technique::SsdoBounce], setup);
@@ -64,7 +64,7 @@ impl Pass for SsdoPass {
         }
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let ao = &settings_of(ctx.setup).ao;
         let form = match (ao.bounce_active(), ao.bounce_form) {
             (false, _) => 0,

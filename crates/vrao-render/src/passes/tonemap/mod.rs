@@ -1,7 +1,7 @@
 //! Reinhard tone mapping with a white point (the Czech SSDO thesis, eq. 2.4) and sRGB encoding.
 
 use super::composite::HDR;
-use super::{FrameContext, FrameSetup, Pass};
+use super::{DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size};
@@ -29,11 +29,11 @@ impl TonemapPass {
 }
 
 impl Pass for TonemapPass {
-    fn declare(&self, _: &FrameSetup) -> PassDecl {
+    fn declare(&self, _: &DeclareContext) -> PassDecl {
         PassDecl::new(NAME).bindings(&BINDINGS)
     }
 
-    fn record(&self, ctx: &mut FrameContext) {
+    fn record(&self, ctx: &mut RecordContext) {
         let resources = ctx.bind(&BINDINGS, &[]);
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.extent());
     }

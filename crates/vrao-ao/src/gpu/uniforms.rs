@@ -146,7 +146,7 @@ impl FrameLighting<'_> {
 }
 
 /// The uniform and light buffers of one frame.
-pub struct FrameBuffers {
+pub struct FrameUniforms {
     /// The [`FrameUniform`].
     pub frame: wgpu::Buffer,
     /// [`LightUniform`]s of both eyes (at least one element: wgpu rejects empty bindings).
@@ -168,12 +168,12 @@ pub fn ao_extent(width: u32, height: u32, half_res: bool) -> (u32, u32) {
     }
 }
 
-impl FrameBuffers {
+impl FrameUniforms {
     /// Allocates the buffers, with room for `light_count` lights per eye; the renderer fills them each frame.
-    pub fn new(device: &wgpu::Device, light_count: usize) -> FrameBuffers {
+    pub fn new(device: &wgpu::Device, light_count: usize) -> FrameUniforms {
         // Both eyes' copies; at least one element since wgpu rejects empty bindings.
         let light_capacity = (light_count * 2).max(1);
-        FrameBuffers {
+        FrameUniforms {
             frame: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
                 size: std::mem::size_of::<FrameUniform>() as u64,
@@ -274,7 +274,7 @@ impl FrameBuffers {
             };
         }
         let light_count = lights.len().checked_div(views.len()).unwrap_or(0);
-        debug_assert!(lights.len() <= self.light_capacity, "more lights than FrameBuffers::new made room for");
+        debug_assert!(lights.len() <= self.light_capacity, "more lights than FrameUniforms::new made room for");
         let uniform = FrameUniform {
             eyes,
             size: [settings.width, settings.height],

@@ -3,23 +3,23 @@
 //! but a pass does not read; and the textures imported from outside the graph (a host's
 //! depth buffer). The renderer and the AO engine each own one.
 
-use crate::gpu::frame::ao_extent;
 use crate::gpu::kernel::invalidate_bind_groups;
-use crate::gpu::targets::LayeredTarget;
+use crate::gpu::layered_target::LayeredTarget;
+use crate::gpu::uniforms::ao_extent;
 use crate::graph::{Kind, Plan, Resource, Size, Written};
-use crate::passes::FrameSetup;
+use crate::passes::DeclareContext;
 use std::collections::{BTreeMap, HashMap};
 
 /// The targets, placeholders and imported textures of one frame graph.
 #[derive(Default)]
-pub struct FrameTargets {
+pub struct GraphTargets {
     /// Allocated and imported textures by resource (passes look them up here).
     pub targets: BTreeMap<Resource, LayeredTarget>,
     /// 1×1 stand-ins, by format, for what binding lists name but a pass does not read.
     pub placeholders: HashMap<wgpu::TextureFormat, LayeredTarget>,
 }
 
-impl FrameTargets {
+impl GraphTargets {
     /// Binds `texture` (`layers` layers of its `aspect`) as the imported resource `r` for
     /// the next frames. Its views and the bind groups that hold them are made anew only
     /// when the texture changed.
@@ -36,7 +36,7 @@ impl FrameTargets {
     /// of another size are dropped, so a resource no pass needs costs no memory. Makes
     /// the placeholders the plan's passes bind in place of what they do not read.
     /// Imported textures are left as they are.
-    pub fn allocate(&mut self, device: &wgpu::Device, plan: &Plan, setup: &FrameSetup) {
+    pub fn allocate(&mut self, device: &wgpu::Device, plan: &Plan, setup: &DeclareContext) {
         let max_side = device.limits().max_texture_dimension_2d;
         let extent_of = |r: Resource| extent(r, setup, max_side);
         let allocated = |r: &Resource| !matches!(r.kind(), Kind::Imported);
@@ -85,7 +85,7 @@ impl FrameTargets {
 }
 
 /// Width × height × layers of a texture this frame.
-fn extent(r: Resource, setup: &FrameSetup, max_side: u32) -> (u32, u32, u32) {
+fn extent(r: Resource, setup: &DeclareContext, max_side: u32) -> (u32, u32, u32) {
     let p = setup.settings;
     let Kind::Texture { size, .. } = r.kind() else { unreachable!("only textures are allocated") };
     let (width, height) = match size {
