@@ -153,7 +153,11 @@ fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
     let (gpu, _lock) = common::gpu();
     for technique in [Technique::Ssao, Technique::Hbao, Technique::Gtao] {
         for half_res in [false, true] {
-            let ao = AoSettings { technique, half_res, ..AoSettings::default() };
+            let ao = AoSettings {
+                technique,
+                resolution: vrao::render::settings::Resolution::from_half_res(half_res),
+                ..AoSettings::default()
+            };
             let error = rmse(&engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true), &renderer_ao(&gpu, &ao));
             assert!(error <= 1e-3, "{} half_res {half_res}: RMSE {error}", technique.name());
         }
@@ -325,4 +329,57 @@ fn host_motion_vectors_reach_temporal_accumulation() {
     };
     let e = engine.record(&mut encoder, &frame).err().expect("motion of another size");
     assert!(e.to_string().contains("motion") && e.to_string().contains("does not match"), "{e}");
+}
+
+#[test]
+fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_resize() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let depth = HostDepth::ReversedInfinite;
+    let views = host_views(&eyes(), depth);
+    let frame_at = |engine: &mut AoEngine, (width, height): (u32, u32)| -> f32 {
+        let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (width, height));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        prepass.record(device, &mut encoder, &views);
+        let frame = AoFrame {
+            depth: &prepass.depth,
+            depth_convention: DepthConvention::REVERSED_INFINITE,
+            normals: None,
+            views: &views,
+            motion: None,
+        };
+        let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+        assert_eq!((texture.width(), texture.height()), (width, height), "the AO has the engine's size");
+        queue.submit([encoder.finish()]);
+        let alpha = host::read_alpha(device, queue, &texture, 0);
+        alpha.iter().sum::<f32>() / alpha.len() as f32
+    };
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    assert_eq!(engine.pipelines_built(), 0, "nothing compiles before the first frame");
+    let small = frame_at(&mut engine, (WIDTH, HEIGHT));
+    let built = engine.pipelines_built();
+    // Every technique's chain built up front, as the renderer does.
+    let eager = vrao::Gpu::from_host(device, queue).unwrap();
+    let _chain = vrao::render::passes::ao_chain(&eager, Vec::new());
+    assert!(
+        built > 0 && built < eager.pipelines_built(),
+        "{built} compiled for GTAO, {} for every technique",
+        eager.pipelines_built()
+    );
+
+    // A window resize: new targets, the same pipelines, the same picture at a finer grain.
+    engine.resize(WIDTH * 3 / 2, HEIGHT * 3 / 2).unwrap();
+    let large = frame_at(&mut engine, (WIDTH * 3 / 2, HEIGHT * 3 / 2));
+    assert_eq!(engine.pipelines_built(), built, "a resize compiles nothing");
+    assert!((large - small).abs() < 0.03, "mean AO {small} at {WIDTH}x{HEIGHT}, {large} after the resize");
+    assert!(
+        engine.resize(0, HEIGHT).is_err() && engine.config().width == WIDTH * 3 / 2,
+        "a bad size is refused and kept out"
+    );
+
+    // Another technique compiles its own kernels when first chosen.
+    engine.set_settings(&AoSettings { technique: Technique::Ssao, ..AoSettings::default() }).unwrap();
+    frame_at(&mut engine, (WIDTH * 3 / 2, HEIGHT * 3 / 2));
+    assert!(engine.pipelines_built() > built);
 }

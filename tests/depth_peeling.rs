@@ -218,7 +218,10 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
 fn peeling_at_half_resolution_with_the_bounce_stays_finite() {
     let scene = Scene::load("builtin:room").unwrap();
     for technique in [Technique::Ssdo, Technique::SsdoBounce] {
-        let s = settings(AoSettings { half_res: true, ..AoSettings { technique, ..ssdo(true) } });
+        let s = settings(AoSettings {
+            resolution: vrao::render::settings::Resolution::Half,
+            ..AoSettings { technique, ..ssdo(true) }
+        });
         render(&scene, &s);
     }
 }

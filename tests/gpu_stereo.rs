@@ -202,7 +202,7 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
     let mut s = settings(64, 72, StereoMode::Auto);
     // GTAO at full resolution, denoised, without temporal accumulation.
     s.ao.technique = vrao::render::settings::Technique::Gtao;
-    s.ao.half_res = false;
+    s.ao.resolution = vrao::render::settings::Resolution::Full;
     s.ao.temporal.enabled = false;
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);

@@ -78,7 +78,7 @@ fn every_technique(gpu: &Arc<Gpu>, label: &str, scene: &Scene, base: &Settings, 
         for half_res in [false, true] {
             let mut s = base.clone();
             s.ao.technique = technique;
-            s.ao.half_res = half_res;
+            s.ao.resolution = vrao::render::settings::Resolution::from_half_res(half_res);
             all.push(render_checked(gpu, &format!("{label} / {} half={half_res}", technique.name()), scene, &s, head));
         }
     }
@@ -247,7 +247,15 @@ fn sizes_1x1_3x5_and_1081x1199_at_half_resolution() {
         );
     }
     for technique in TECHNIQUES {
-        let s = settings((1081, 1199), AoSettings { technique, half_res: true, samples: 8, ..AoSettings::default() });
+        let s = settings(
+            (1081, 1199),
+            AoSettings {
+                technique,
+                resolution: vrao::render::settings::Resolution::Half,
+                samples: 8,
+                ..AoSettings::default()
+            },
+        );
         render_checked(&gpu, &format!("1081x1199 half {}", technique.name()), &scene, &s, &room_head());
     }
 }

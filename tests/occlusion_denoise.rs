@@ -116,7 +116,7 @@ fn half_resolution_stays_close_to_full_resolution() {
     for technique in [Technique::Ssao, Technique::Hbao, Technique::Ssdo] {
         let full = settings(128, 144, ao(technique, 24, 1.0));
         let mut half = full.clone();
-        half.ao.half_res = true;
+        half.ao.resolution = vrao::render::settings::Resolution::Half;
         let f = render(&gpu, &scene, &full, &head, &[AO_BLURRED]);
         let g = render(&gpu, &scene, &half, &head, &[AO_FULL]);
         let pairs: Vec<(f64, f64)> = f
@@ -162,7 +162,7 @@ fn odd_sizes_work_at_half_resolution() {
     let head = scene.head.pose_at(0.0);
     for technique in AO_TECHNIQUES {
         let mut a = ao(technique, 12, 0.5);
-        a.half_res = true;
+        a.resolution = vrao::render::settings::Resolution::Half;
         let s = settings(97, 109, a);
         let outputs = [AO_RAW, AO_BLURRED, AO_FULL, HDR];
         let f = render(&gpu, &scene, &s, &head, &outputs);
@@ -192,7 +192,7 @@ fn the_composite_upsamples_half_resolution_occlusion_inline() {
     for technique in [Technique::Ssao, Technique::Ssdo] {
         let base = AoSettings { technique, samples: 32, radius: 1.0, ..AoSettings::default() };
         let full = render(&gpu, &scene, &settings(128, 144, base.clone()), &head, &[HDR]);
-        let half_settings = AoSettings { half_res: true, ..base };
+        let half_settings = AoSettings { resolution: vrao::render::settings::Resolution::Half, ..base };
         let half = render(&gpu, &scene, &settings(128, 144, half_settings), &head, &[HDR]);
         assert!(!half.report.plan.runs("upsample"), "the frame upsampled in a pass of its own");
         let (mut diff, mut total) = (0.0, 0.0);

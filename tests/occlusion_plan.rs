@@ -13,7 +13,7 @@ use vrao::render::passes::temporal::AO_ACCUMULATED;
 use vrao::render::passes::tonemap::COLOR;
 use vrao::render::passes::upsample::AO_FULL;
 use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Technique};
+use vrao::render::settings::{AoSettings, Resolution, Technique};
 use vrao::Renderer;
 
 // ---------------------------------------------------------------------------------------
@@ -35,7 +35,12 @@ fn the_final_ao_is_what_the_ao_chain_last_provided() {
         (Technique::Ssdo, 4, true, true, AO_FULL, vec!["ssdo", "temporal", "blur", "upsample"]),
     ];
     for (technique, blur_radius, half_res, temporal, expected, chain) in cases {
-        let mut ao = AoSettings { technique, blur_radius, half_res, ..AoSettings::default() };
+        let mut ao = AoSettings {
+            technique,
+            blur_radius,
+            resolution: Resolution::from_half_res(half_res),
+            ..AoSettings::default()
+        };
         ao.temporal.enabled = temporal;
         let renderer = Renderer::new(gpu.clone(), &scene, &settings(64, 72, ao)).unwrap();
         let plan = renderer.plan(2, &[FINAL_AO]).unwrap();
@@ -86,8 +91,12 @@ fn the_plan_explains_what_occlusion_left_out() {
         off.notes
     );
 
-    let on =
-        plan_for(AoSettings { technique: Technique::SsdoBounce, bounce: 1.0, half_res: true, ..AoSettings::default() });
+    let on = plan_for(AoSettings {
+        technique: Technique::SsdoBounce,
+        bounce: 1.0,
+        resolution: Resolution::Half,
+        ..AoSettings::default()
+    });
     eprintln!("ssdo-bounce, half res:\n{on}");
     assert_eq!(on.names, ["gbuffer", "direct", "ssdo-bounce", "blur", "composite", "tonemap"]);
     assert!(on.notes.iter().all(|(_, note)| !note.contains("bounce left out")));
@@ -95,8 +104,12 @@ fn the_plan_explains_what_occlusion_left_out() {
     // occlusion target) runs only when that target itself is asked for.
     assert!(on.notes.iter().any(|(pass, note)| *pass == "composite" && note.contains("upsamples")), "{:?}", on.notes);
     assert!(on.left_out.iter().any(|(pass, why)| *pass == "upsample" && why.contains("ao-full")), "{:?}", on.left_out);
-    let half_bounce =
-        AoSettings { technique: Technique::SsdoBounce, bounce: 1.0, half_res: true, ..AoSettings::default() };
+    let half_bounce = AoSettings {
+        technique: Technique::SsdoBounce,
+        bounce: 1.0,
+        resolution: Resolution::Half,
+        ..AoSettings::default()
+    };
     let debug = render(&gpu, &scene, &settings(64, 72, half_bounce), &head, &[COLOR, AO_FULL]).report.plan;
     assert!(debug.runs("upsample") && debug.runs("composite"), "{:?}", debug.names);
     for (technique, pass) in [(Technique::Ssao, "ssao"), (Technique::Hbao, "hbao"), (Technique::Ssdo, "ssdo")] {

@@ -78,7 +78,7 @@ fn flipped_normals_give_no_zero_ao_and_no_black_pixel() {
     for technique in AO_TECHNIQUES {
         for half_res in [false, true] {
             let mut a = ao(technique, 12, scene.suggested_ao_radius());
-            a.half_res = half_res;
+            a.resolution = vrao::render::settings::Resolution::from_half_res(half_res);
             let s = settings(270, 300, a);
             // The final full-resolution AO.
             let final_ao = if half_res { AO_FULL } else { AO_BLURRED };
@@ -147,29 +147,46 @@ fn no_output_is_ever_nan_or_inf() {
     for technique in AO_TECHNIQUES {
         for half_res in [false, true] {
             for (name, scene) in [("room", &room), ("plane", &plane)] {
-                cases.push((name, scene, AoSettings { half_res, ..ao(technique, 24, 0.5) }));
+                cases.push((
+                    name,
+                    scene,
+                    AoSettings {
+                        resolution: vrao::render::settings::Resolution::from_half_res(half_res),
+                        ..ao(technique, 24, 0.5)
+                    },
+                ));
             }
         }
         // Stiff settings: one sample and a micro radius, every sample and a huge radius,
         // no bias with the strongest strength and widest blur, the tiled noise without range
         // check.
-        cases.push(("room", &room, AoSettings { half_res: true, ..ao(technique, 1, 1e-4) }));
+        cases.push((
+            "room",
+            &room,
+            AoSettings { resolution: vrao::render::settings::Resolution::Half, ..ao(technique, 1, 1e-4) },
+        ));
         cases.push(("plane", &plane, ao(technique, 256, 1e4)));
         cases.push(("room", &room, AoSettings { bias: 0.0, strength: 4.0, blur_radius: 16, ..ao(technique, 12, 2.0) }));
         cases.push((
             "plane",
             &plane,
-            AoSettings { noise: Noise::Tiled5x5, range_check: false, half_res: true, ..ao(technique, 12, 1.0) },
+            AoSettings {
+                noise: Noise::Tiled5x5,
+                range_check: false,
+                resolution: vrao::render::settings::Resolution::Half,
+                ..ao(technique, 12, 1.0)
+            },
         ));
     }
     for (name, scene, a) in cases {
-        let label = format!("{name} {} N={} r={} half={}", a.technique.name(), a.samples, a.radius, a.half_res);
-        let (w, h) = if a.half_res { (97, 109) } else { (96, 108) };
+        let label =
+            format!("{name} {} N={} r={} half={}", a.technique.name(), a.samples, a.radius, a.resolution.is_half());
+        let (w, h) = if a.resolution.is_half() { (97, 109) } else { (96, 108) };
         let mut outputs = vec![AO_RAW, HDR];
         if a.blur_radius > 0 {
             outputs.push(AO_BLURRED);
         }
-        if a.half_res {
+        if a.resolution.is_half() {
             outputs.push(AO_FULL);
         }
         let f = render(&gpu, scene, &settings(w, h, a), &scene.head.pose_at(0.0), &outputs);

@@ -81,7 +81,7 @@ fn cases() -> Vec<AoSettings> {
     cases.push(AoSettings {
         technique: Technique::Gtao,
         samples: Quality::Ultra.samples(),
-        half_res: true,
+        resolution: vrao::render::settings::Resolution::Half,
         ..defaults.clone()
     });
     for technique in Technique::estimators() {
@@ -157,7 +157,7 @@ fn check_view(gpu: &Arc<Gpu>, view: &View) -> Vec<String> {
             view.name,
             settings.ao.technique.name(),
             settings.ao.samples,
-            if settings.ao.half_res { " half" } else { "" }
+            if settings.ao.resolution.is_half() { " half" } else { "" }
         );
         let values = frame.ao.iter().flat_map(|layer| layer.iter().skip(3).step_by(4));
         let (zeros, least) = values.fold((0, f32::INFINITY), |(n, m), &a| (n + (a == 0.0) as usize, m.min(a)));

@@ -423,7 +423,7 @@ fn no_shadow_or_rsm_output_is_ever_nan_or_inf() {
     }
     let mut ssdo = base.clone();
     ssdo.ao.technique = Technique::SsdoBounce;
-    ssdo.ao.half_res = true;
+    ssdo.ao.resolution = vrao::render::settings::Resolution::Half;
     cases.push(("ssdo-bounce half-res".into(), boxed.clone(), ssdo));
     for (label, scene, s) in &cases {
         let f = render(&gpu, scene, s, &outputs);

@@ -47,7 +47,11 @@ fn five_thousand_frames_keep_memory_and_gpu_resources_flat() {
         // The bilateral blur is off: on lavapipe 22.3 its two dispatches grow RSS by about
         // 0.5 MB a frame inside the driver (wgpu's live objects stay flat; reported in
         // the closing note of the numerics issue). Everything else runs.
-        ao: AoSettings { half_res: true, blur_radius: 0, ..AoSettings::default() },
+        ao: AoSettings {
+            resolution: vrao::render::settings::Resolution::Half,
+            blur_radius: 0,
+            ..AoSettings::default()
+        },
         ..Settings::default()
     };
     let headset = SimulatedHeadset::new(SimulatedOptions {

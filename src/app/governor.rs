@@ -68,7 +68,7 @@ impl Level {
         let mut out = ao.clone();
         out.technique = self.technique;
         out.samples = self.samples;
-        out.half_res = self.half_res;
+        out.resolution = crate::render::settings::Resolution::from_half_res(self.half_res);
         out.temporal.enabled = self.temporal;
         out.foveation = self.foveation.max(ao.foveation);
         out

@@ -101,7 +101,7 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
             }
             ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
             ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
-            ui.checkbox(&mut ao.half_res, "half resolution");
+            ui.checkbox(&mut ao.resolution.is_half(), "half resolution");
             ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
             egui::ComboBox::from_label("foveation").selected_text(ao.foveation.name()).show_ui(ui, |ui| {
                 for level in Foveation::ALL {

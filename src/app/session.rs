@@ -262,7 +262,7 @@ fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
         .position(|l| {
             l.technique == ao.technique
                 && l.samples == ao.samples
-                && l.half_res == ao.half_res
+                && l.half_res == ao.resolution.is_half()
                 && l.temporal == ao.temporal.enabled
         })
         .unwrap_or(frontier.top());

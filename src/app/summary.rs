@@ -2,7 +2,6 @@
 
 use crate::app::governor::GovernorChange;
 use crate::app::{FrameLoop, SERIAL_EVERY};
-use crate::formats::bench_file::Resolution;
 use crate::formats::output::significant;
 use crate::formats::spans::summarize;
 use crate::render::settings::AoSettings;
@@ -224,7 +223,7 @@ fn pass_medians(frame_loop: &FrameLoop) -> Vec<(String, f64)> {
 fn ao_setting(ao: &AoSettings) -> String {
     let temporal = if ao.temporal.enabled { " temporal" } else { "" };
     let r = significant(ao.radius as f64, 3);
-    let resolution = Resolution::from_half_res(ao.half_res);
+    let resolution = ao.resolution;
     format!("{}{temporal} N={} r={r} m {resolution}", ao.technique.name(), ao.samples)
 }
 
@@ -234,10 +233,15 @@ mod tests {
 
     #[test]
     fn the_ao_setting_names_technique_samples_radius_and_resolution() {
-        let mut ao = AoSettings { samples: 24, radius: 0.3, half_res: true, ..AoSettings::default() };
+        let mut ao = AoSettings {
+            samples: 24,
+            radius: 0.3,
+            resolution: crate::render::settings::Resolution::Half,
+            ..AoSettings::default()
+        };
         ao.temporal.enabled = true;
         assert_eq!(ao_setting(&ao), format!("{} temporal N=24 r=0.3 m half", ao.technique.name()));
-        ao.half_res = false;
+        ao.resolution = crate::render::settings::Resolution::Full;
         ao.temporal.enabled = false;
         assert!(ao_setting(&ao).ends_with("N=24 r=0.3 m full"), "{}", ao_setting(&ao));
     }

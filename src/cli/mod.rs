@@ -246,7 +246,7 @@ impl AoArgs {
             bounce: self.bounce,
             bounce_form: self.bounce_form,
             noise: self.noise,
-            half_res: self.half_res,
+            resolution: vrao::render::settings::Resolution::from_half_res(self.half_res),
             depth_peeling: self.depth_peeling,
             denoise: self.denoise,
             blur_radius: self.blur,

@@ -135,7 +135,7 @@ mod tests {
         let settings = args.settings(&Scene::load(&args.scene).unwrap());
         let ao = &settings.ao;
         assert_eq!(
-            (ao.samples, ao.half_res, ao.radius, ao.technique),
+            (ao.samples, ao.resolution.is_half(), ao.radius, ao.technique),
             (64, true, 0.25, vrao::render::settings::Technique::Hbao)
         );
         assert!(ao.temporal.enabled);

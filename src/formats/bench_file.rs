@@ -6,46 +6,9 @@ use crate::render::settings::{Foveation, Technique, RSM_SAMPLES_MAX, SAMPLES_MAX
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The resolution the occlusion runs at. Reports and bench files write it as `full` or
-/// `half` ([`Resolution::name`]), as they always have.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Resolution {
-    /// The eye's own size.
-    Full,
-    /// Half the size per axis, then upsampled (`AoSettings::half_res`).
-    Half,
-}
-
-impl Resolution {
-    /// `Half` when the occlusion runs at half resolution (`AoSettings::half_res`).
-    pub fn from_half_res(half_res: bool) -> Resolution {
-        if half_res {
-            Resolution::Half
-        } else {
-            Resolution::Full
-        }
-    }
-
-    /// Whether this is half resolution (the value of `AoSettings::half_res`).
-    pub fn is_half(self) -> bool {
-        self == Resolution::Half
-    }
-
-    /// `full` or `half`: the name reports, tables and bench files use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Resolution::Full => "full",
-            Resolution::Half => "half",
-        }
-    }
-}
-
-impl std::fmt::Display for Resolution {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+/// The occlusion's resolution: bench files name it `full` or `half`
+/// ([`Resolution::name`]), as they always have.
+pub use crate::render::settings::Resolution;
 
 /// One row as written to CSV, JSON and Markdown.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -57,6 +20,7 @@ pub struct BenchRecord {
     /// Occlusion radius in metres.
     pub radius_m: f32,
     /// The resolution the occlusion ran at (`full` or `half` in the file).
+    #[serde(with = "crate::formats::by_name")]
     pub resolution: Resolution,
     /// Fixed foveation (`off`, `low` or `high`; `off` in files written before it existed).
     #[serde(default, with = "crate::formats::by_name")]
@@ -302,13 +266,15 @@ mod tests {
 
     #[test]
     fn resolutions_keep_their_names_in_files() {
+        #[derive(serde::Serialize, serde::Deserialize, Debug, PartialEq)]
+        struct InFile(#[serde(with = "crate::formats::by_name")] Resolution);
         for (r, name) in [(Resolution::Full, "full"), (Resolution::Half, "half")] {
             assert_eq!(r.name(), name);
             assert_eq!(r.to_string(), name);
-            assert_eq!(serde_json::to_string(&r).unwrap(), format!("\"{name}\""));
-            assert_eq!(serde_json::from_str::<Resolution>(&format!("\"{name}\"")).unwrap(), r);
+            assert_eq!(serde_json::to_string(&InFile(r)).unwrap(), format!("\"{name}\""));
+            assert_eq!(serde_json::from_str::<InFile>(&format!("\"{name}\"")).unwrap(), InFile(r));
         }
-        assert!(serde_json::from_str::<Resolution>("\"quarter\"").is_err());
+        assert!(serde_json::from_str::<InFile>("\"quarter\"").is_err());
         assert!(Resolution::from_half_res(true).is_half() && !Resolution::from_half_res(false).is_half());
     }
 

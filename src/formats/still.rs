@@ -86,7 +86,7 @@ pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) 
         settings.ao.technique.name(),
         settings.ao.samples,
         crate::formats::output::significant(settings.ao.radius as f64, 3),
-        if settings.ao.half_res { ", half resolution" } else { "" },
+        if settings.ao.resolution.is_half() { ", half resolution" } else { "" },
     );
     let mut explain = report.plan.to_string();
     let _ = writeln!(

@@ -170,7 +170,7 @@ impl CaseRun {
         settings.ao.technique = case.technique;
         settings.ao.samples = case.samples;
         settings.ao.radius = case.radius;
-        settings.ao.half_res = case.half_res;
+        settings.ao.resolution = crate::render::settings::Resolution::from_half_res(case.half_res);
         settings.ao.depth_peeling = case.depth_peeling;
         settings.ao.temporal.enabled = case.temporal;
         settings.ao.foveation = case.foveation;

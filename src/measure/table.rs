@@ -134,7 +134,7 @@ impl TableCase {
         let mut settings = base.clone();
         settings.ao.technique = self.technique;
         settings.ao.samples = self.quality.samples();
-        settings.ao.half_res = self.resolution.is_half();
+        settings.ao.resolution = self.resolution;
         settings.ao.foveation = self.foveation;
         settings
     }
@@ -388,7 +388,7 @@ fn chain(renderer: &Renderer) -> Result<Vec<&'static str>> {
             }
         }
     }
-    if renderer.settings().ao.half_res {
+    if renderer.settings().ao.resolution.is_half() {
         chain.push(composite::NAME);
     }
     Ok(chain)

@@ -90,7 +90,7 @@ fn extent(r: Resource, setup: &DeclareContext, max_side: u32) -> (u32, u32, u32)
     let Kind::Texture { size, .. } = r.kind() else { unreachable!("only textures are allocated") };
     let (width, height) = match size {
         Size::Full => (p.width, p.height),
-        Size::Occlusion => ao_extent(p.width, p.height, setup.settings.ao.half_res),
+        Size::Occlusion => ao_extent(p.width, p.height, setup.settings.ao.resolution.is_half()),
         Size::Half => ao_extent(p.width, p.height, true),
         Size::Computed(extent) => return extent(setup, max_side),
     };

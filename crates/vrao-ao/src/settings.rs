@@ -50,7 +50,54 @@ macro_rules! impl_choice {
     )*};
 }
 
-crate::impl_choice!(Technique, Quality, BounceForm, Denoise, Foveation, TemporalBlend, crate::gpu::BackendChoice);
+crate::impl_choice!(
+    Technique,
+    Quality,
+    BounceForm,
+    Denoise,
+    Foveation,
+    TemporalBlend,
+    Resolution,
+    crate::gpu::BackendChoice
+);
+
+/// The resolution the occlusion runs at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Resolution {
+    /// The view's own size.
+    #[default]
+    Full,
+    /// Half the size per axis (rounded up), then upsampled joint-bilaterally to full
+    /// resolution: about a quarter of the technique's cost.
+    Half,
+}
+
+impl Resolution {
+    /// Both, full first.
+    pub const ALL: [Resolution; 2] = [Resolution::Full, Resolution::Half];
+
+    /// `Half` when `half` is true.
+    pub fn from_half_res(half: bool) -> Resolution {
+        if half {
+            Resolution::Half
+        } else {
+            Resolution::Full
+        }
+    }
+
+    /// Whether this is half resolution.
+    pub fn is_half(self) -> bool {
+        self == Resolution::Half
+    }
+
+    /// `full` or `half`: the name the command line, reports, tables and bench files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Resolution::Full => "full",
+            Resolution::Half => "half",
+        }
+    }
+}
 
 impl std::fmt::Display for Noise {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -284,8 +331,8 @@ pub struct AoSettings {
     pub bounce_form: BounceForm,
     /// Where each pixel's kernel rotation comes from.
     pub noise: Noise,
-    /// Compute occlusion at half resolution per axis and upsample (3×3 joint bilateral).
-    pub half_res: bool,
+    /// The resolution the occlusion runs at (half: per axis, then upsampled).
+    pub resolution: Resolution,
     /// Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer, and a sample
     /// occludes only between the first and second layer (inside an object). Off by default.
     pub depth_peeling: bool,
@@ -395,7 +442,7 @@ impl Default for AoSettings {
             bounce: 1.0,
             bounce_form: BounceForm::Direction,
             noise: Noise::Halton,
-            half_res: false,
+            resolution: Resolution::Full,
             depth_peeling: false,
             denoise: Denoise::Tile,
             blur_radius: 5,

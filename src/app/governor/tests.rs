@@ -1,6 +1,7 @@
 //! Tests of `governor.rs`.
 
 use super::*;
+use crate::render::settings::Resolution;
 use crate::xr::simulated::compositor::{Clock, Compositor, VsyncOutcome};
 
 /// A bench file of rows (technique, samples, half, temporal, radius, ms per eye, RMSE).
@@ -405,10 +406,16 @@ fn the_builtin_frontier_is_the_benchs_own_pareto_front() {
 fn a_level_sets_technique_samples_resolution_and_temporal_only() {
     let frontier = synthetic();
     let level = &frontier.levels()[4];
-    let ao = AoSettings { radius: 0.7, half_res: true, ..AoSettings::default() };
+    let ao = AoSettings { radius: 0.7, resolution: Resolution::Half, ..AoSettings::default() };
     let out = level.apply(&ao);
-    assert_eq!((out.technique, out.samples, out.half_res, out.temporal.enabled), (Technique::Gtao, 24, false, false));
-    assert_eq!(AoSettings { technique: ao.technique, samples: ao.samples, half_res: true, ..out.clone() }, ao);
+    assert_eq!(
+        (out.technique, out.samples, out.resolution, out.temporal.enabled),
+        (Technique::Gtao, 24, Resolution::Full, false)
+    );
+    assert_eq!(
+        AoSettings { technique: ao.technique, samples: ao.samples, resolution: Resolution::Half, ..out.clone() },
+        ao
+    );
     let temporal = Level { temporal: true, ..level.clone() }.apply(&ao);
     assert!(temporal.temporal.enabled);
     // The user's foveation is a floor: a level measured without foveation keeps it, one

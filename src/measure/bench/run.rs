@@ -181,8 +181,13 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
     crate::measure::check_frames(options.warmup, options.frames)?;
     for case in cases {
         let mut s = base.clone();
-        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.half_res, s.ao.depth_peeling) =
-            (case.technique, case.samples, case.radius, case.half_res, case.depth_peeling);
+        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.resolution, s.ao.depth_peeling) = (
+            case.technique,
+            case.samples,
+            case.radius,
+            crate::render::settings::Resolution::from_half_res(case.half_res),
+            case.depth_peeling,
+        );
         s.validate()?;
         if case.technique == Technique::None {
             return Err(Error::input("the bench's techniques include none, which has no occlusion to measure"));

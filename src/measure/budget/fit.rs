@@ -137,7 +137,7 @@ pub fn fit_setting(
     ao.technique = chosen.technique.parse().map_err(|e: Error| Error::in_file(path, e.to_string()))?;
     ao.samples = chosen.samples;
     ao.radius = chosen.radius_m;
-    ao.half_res = chosen.resolution.is_half();
+    ao.resolution = chosen.resolution;
     ao.depth_peeling = chosen.depth_peeling;
     Ok(Fit { ao, warnings, notes })
 }

@@ -159,10 +159,12 @@ impl AoEngine {
     /// (a refusal names the missing capability) and the settings are validated. The
     /// host's uncaptured-error handler is left alone.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, config: &AoConfig) -> Result<AoEngine> {
-        let gpu = Arc::new(Gpu::from_host(device, queue)?);
+        let mut gpu = Gpu::from_host(device, queue)?;
+        // Each kernel compiles at its first frame: the host pays for the technique, denoise
+        // and upsampling it runs, and another technique costs its build when first chosen.
+        gpu.set_lazy_pipelines(true);
+        let gpu = Arc::new(gpu);
         host_settings(config, crate::stereo::DEFAULT_NEAR)?;
-        // The pipelines are checked here, so a device that cannot build them is refused
-        // once, as a typed error, instead of through the host's error handler each frame.
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let chain = passes::ao_chain(&gpu, Vec::new());
         let import = ImportPass::new(&gpu);
@@ -196,6 +198,12 @@ impl AoEngine {
         }
         self.config = config;
         Ok(())
+    }
+
+    /// Compute pipelines the engine has compiled so far: the chosen technique's chain
+    /// after the first frame; a resize adds none.
+    pub fn pipelines_built(&self) -> usize {
+        self.gpu.pipelines_built()
     }
 
     /// The configuration the next frame runs with.
@@ -279,7 +287,15 @@ impl AoEngine {
         let key = (settings.clone(), frame.motion.is_some());
         let plan = self.driver.plan(&key, &passes, &params, layers, &[FINAL_AO], &imported)?;
         self.driver.prepare(&self.gpu, &plan, &params, &FrameLighting::NONE, &eyes);
-        self.driver.record(&self.gpu, encoder, &passes, &plan, &params, &eyes, None, spans, Submission::OneEncoder)?;
+        // Kernels compile at their first frame: a device that cannot build one is refused
+        // here, as a typed error, not through the host's uncaptured-error handler.
+        let scope = self.gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let recorded =
+            self.driver.record(&self.gpu, encoder, &passes, &plan, &params, &eyes, None, spans, Submission::OneEncoder);
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
+        }
+        recorded?;
         self.driver.end_frame(&eyes);
         let output = plan.resolve(FINAL_AO).ok_or_else(|| Error::Plan("nothing provides the final AO".into()))?;
         let target = self

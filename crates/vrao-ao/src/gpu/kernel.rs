@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// Bumped whenever targets are made or dropped: every kernel then forgets its bind
 /// groups, which would otherwise keep dropped textures alive.
@@ -277,15 +277,59 @@ impl Slot {
 }
 
 /// A full-screen compute kernel over layered targets: one dispatch covers every layer
-/// (`global_id.z` is the layer).
+/// (`global_id.z` is the layer). Compiled when made, or at its first dispatch on a
+/// [`Gpu`] with lazy pipelines ([`Gpu::set_lazy_pipelines`]).
 pub struct Kernel {
     label: String,
-    pipeline: wgpu::ComputePipeline,
+    pipeline: OnceLock<wgpu::ComputePipeline>,
+    /// What compiles the pipeline at the first dispatch, for a lazy kernel.
+    recipe: Option<Recipe>,
     layout: wgpu::BindGroupLayout,
     slots: Vec<Slot>,
     /// Bind groups made so far, by the identity of what they bind, with the epoch they
     /// were made in: a frame binds what the last one did, so none is made again.
     bind_groups: Mutex<(u64, HashMap<u64, wgpu::BindGroup>)>,
+}
+
+/// A lazy kernel's shader and how to compile it.
+struct Recipe {
+    source: String,
+    entry: String,
+    constants: Vec<(String, f64)>,
+    pipeline_layout: wgpu::PipelineLayout,
+    /// The caller's cancellation token ([`Gpu::cancel_builds_on`]): set, the kernel
+    /// compiles as a stand-in of no work.
+    interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// The device's count of compiled pipelines ([`Gpu::pipelines_built`]).
+    built: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+}
+
+/// The module of a kernel whose build was cancelled: no work (more bindings in the layout
+/// than the shader uses is valid).
+fn stand_in_module(device: &wgpu::Device, label: &str, entry: &str) -> wgpu::ShaderModule {
+    let source = format!("@compute @workgroup_size({TILE}, {TILE}, 1) fn {entry}() {{}}");
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}
+
+fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+        cache: None,
+    })
 }
 
 impl Kernel {
@@ -307,21 +351,41 @@ impl Kernel {
         constants: &[(&str, f64)],
     ) -> Kernel {
         if gpu.builds_cancelled() {
-            // The caller gave up on this build: a stand-in of no work compiles at once
-            // (more bindings in the layout than the shader uses is valid).
-            let source = format!("@compute @workgroup_size({TILE}, {TILE}, 1) fn {entry}() {{}}");
-            let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(label),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
+            // The caller gave up on this build: a stand-in of no work compiles at once.
+            let module = stand_in_module(&gpu.device, label, entry);
             return Self::from_module(gpu, label, &module, entry, binds, &[]);
         }
-        let module = shader_module(&gpu.device, label, files);
-        Self::from_module(gpu, label, &module, entry, binds, constants)
+        if !gpu.lazy_pipelines() {
+            let module = shader_module(&gpu.device, label, files);
+            return Self::from_module(gpu, label, &module, entry, binds, constants);
+        }
+        // The files are read now, so an unreadable one is the error of whoever makes the
+        // kernel (as for an eager one); only the compilation waits.
+        let source = shader_source(files).unwrap_or_else(|error| {
+            SHADER_ERROR.record(error);
+            source_from(None, files).expect("the compiled-in text needs no file")
+        });
+        let (layout, pipeline_layout, slots) = Self::layouts(&gpu.device, label, binds);
+        Kernel {
+            label: label.to_string(),
+            pipeline: OnceLock::new(),
+            recipe: Some(Recipe {
+                source,
+                entry: entry.to_string(),
+                constants: constants.iter().map(|(name, value)| (name.to_string(), *value)).collect(),
+                pipeline_layout,
+                interrupt: gpu.build_interrupt(),
+                built: gpu.pipeline_counter(),
+            }),
+            layout,
+            slots,
+            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
+        }
     }
 
     /// A kernel of `entry` in a module made already (say by [`try_shader_module`], which
-    /// returns a shader file it cannot read as the error), its `override` constants set.
+    /// returns a shader file it cannot read as the error), its `override` constants set;
+    /// compiled now.
     pub fn from_module(
         gpu: &Gpu,
         label: &str,
@@ -330,7 +394,25 @@ impl Kernel {
         binds: &[Bind],
         constants: &[(&str, f64)],
     ) -> Kernel {
-        let device = &gpu.device;
+        let (layout, pipeline_layout, slots) = Self::layouts(&gpu.device, label, binds);
+        let pipeline = compute_pipeline(&gpu.device, label, &pipeline_layout, module, entry, constants);
+        gpu.pipeline_counter().fetch_add(1, Ordering::Relaxed);
+        Kernel {
+            label: label.to_string(),
+            pipeline: OnceLock::from(pipeline),
+            recipe: None,
+            layout,
+            slots,
+            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
+        }
+    }
+
+    /// The bind group layout, the pipeline layout and the slots of `binds`.
+    fn layouts(
+        device: &wgpu::Device,
+        label: &str,
+        binds: &[Bind],
+    ) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout, Vec<Slot>) {
         let slots: Vec<Slot> = binds.iter().map(|b| b.slot()).collect();
         // The start-up check refuses adapters that cannot write these formats; a kernel
         // writing another would fail on them only at its first frame.
@@ -351,21 +433,32 @@ impl Kernel {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-            cache: None,
-        });
-        Kernel {
-            label: label.to_string(),
-            pipeline,
-            layout,
-            slots,
-            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
-        }
+        (layout, pipeline_layout, slots)
+    }
+
+    /// Whether the pipeline has been compiled.
+    pub fn is_compiled(&self) -> bool {
+        self.pipeline.get().is_some()
+    }
+
+    /// The pipeline, compiled now if it has not been.
+    fn pipeline(&self, device: &wgpu::Device) -> &wgpu::ComputePipeline {
+        self.pipeline.get_or_init(|| {
+            let recipe = self.recipe.as_ref().expect("a kernel without a pipeline has a recipe");
+            let cancelled = recipe.interrupt.as_ref().is_some_and(|flag| flag.load(Ordering::Relaxed));
+            let module = if cancelled {
+                stand_in_module(device, &self.label, &recipe.entry)
+            } else {
+                module_of(device, &self.label, recipe.source.clone())
+            };
+            let constants: Vec<(&str, f64)> = if cancelled {
+                Vec::new()
+            } else {
+                recipe.constants.iter().map(|(name, value)| (name.as_str(), *value)).collect()
+            };
+            recipe.built.fetch_add(1, Ordering::Relaxed);
+            compute_pipeline(device, &self.label, &recipe.pipeline_layout, &module, &recipe.entry, &constants)
+        })
     }
 
     /// Binds `resources` (one per slot, in slot order) and dispatches over
@@ -380,7 +473,7 @@ impl Kernel {
         let bind_group = self.bind_group(device, resources);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline(device));
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);
     }
@@ -399,7 +492,7 @@ impl Kernel {
         let bind_group = self.bind_group(device, resources);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline(device));
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups_indirect(args, offset);
     }

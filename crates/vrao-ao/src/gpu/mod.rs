@@ -70,6 +70,11 @@ pub struct Gpu {
     uncaptured: std::sync::Arc<std::sync::Mutex<Option<String>>>,
     /// The caller's cancellation token for building pipelines ([`Gpu::cancel_builds_on`]).
     build_interrupt: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Whether kernels compile on their first dispatch instead of when they are made
+    /// ([`Gpu::set_lazy_pipelines`]).
+    lazy_pipelines: bool,
+    /// Compute pipelines compiled on this device so far.
+    pipelines_built: std::sync::Arc<std::sync::atomic::AtomicUsize>,
 }
 
 impl Gpu {
@@ -169,6 +174,8 @@ impl Gpu {
             queue,
             uncaptured,
             build_interrupt: std::sync::OnceLock::new(),
+            lazy_pipelines: false,
+            pipelines_built: Default::default(),
         };
         gpu.caps.multiview_reliable = gpu.caps.multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
         Ok(gpu)
@@ -191,6 +198,8 @@ impl Gpu {
             queue: queue.clone(),
             uncaptured: std::sync::Arc::new(std::sync::Mutex::new(None)),
             build_interrupt: std::sync::OnceLock::new(),
+            lazy_pipelines: false,
+            pipelines_built: Default::default(),
         })
     }
 
@@ -211,6 +220,34 @@ impl Gpu {
     /// [`crate::error::Error::Interrupted`]. Only the first token given counts.
     pub fn cancel_builds_on(&self, interrupt: std::sync::Arc<std::sync::atomic::AtomicBool>) {
         let _ = self.build_interrupt.set(interrupt);
+    }
+
+    /// Makes kernels made from now on compile at their first dispatch (the AO engine: a
+    /// host pays only for the technique it runs) instead of when they are made (the
+    /// renderer, whose governor switches techniques mid-session and must not stall a
+    /// frame compiling one).
+    pub fn set_lazy_pipelines(&mut self, lazy: bool) {
+        self.lazy_pipelines = lazy;
+    }
+
+    /// Whether kernels compile at their first dispatch ([`Gpu::set_lazy_pipelines`]).
+    pub fn lazy_pipelines(&self) -> bool {
+        self.lazy_pipelines
+    }
+
+    /// Compute pipelines compiled through this `Gpu` so far (kernels, eager or lazy).
+    pub fn pipelines_built(&self) -> usize {
+        self.pipelines_built.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// The counter of [`Gpu::pipelines_built`], for kernels that compile later.
+    pub(crate) fn pipeline_counter(&self) -> std::sync::Arc<std::sync::atomic::AtomicUsize> {
+        self.pipelines_built.clone()
+    }
+
+    /// The token of [`Gpu::cancel_builds_on`], for builds that happen later (lazy kernels).
+    pub(crate) fn build_interrupt(&self) -> Option<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+        self.build_interrupt.get().cloned()
     }
 
     /// Whether the token of [`Gpu::cancel_builds_on`] is set.

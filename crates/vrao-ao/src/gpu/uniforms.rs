@@ -206,7 +206,7 @@ impl FrameUniforms {
     /// `frame_index` changes the sampling pattern when temporal accumulation is on.
     pub fn update_ao(&self, queue: &wgpu::Queue, settings: &ChainSettings, frame_index: u64) {
         let ao = &settings.ao;
-        let (width, height) = ao_extent(settings.width, settings.height, ao.half_res);
+        let (width, height) = ao_extent(settings.width, settings.height, ao.resolution.is_half());
         let (directions, steps) = hbao_directions_steps(ao.samples);
         // SSDO weighs each direction's light by cos θ itself, so its samples are uniform.
         let entry = ao.technique.entry();
@@ -228,7 +228,7 @@ impl FrameUniforms {
         let foveation = ao.foveation.map();
         let params = AoParamsUniform {
             ao_size: [width, height],
-            scale: if ao.half_res { 2 } else { 1 },
+            scale: if ao.resolution.is_half() { 2 } else { 1 },
             samples: ao.samples,
             directions,
             steps,
@@ -245,7 +245,7 @@ impl FrameUniforms {
             frame_angle: if turns { temporal_angle(frame_index) } else { 0.0 },
             // The blur radius is in full-resolution pixels: at half resolution the same
             // screen footprint takes half as many taps.
-            blur_radius: if ao.half_res { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
+            blur_radius: if ao.resolution.is_half() { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
             blur_plane_sigma: ao.blur_plane_sigma,
             range_scale: if turns { temporal_range_scale(frame_index) } else { 1.0 },
             foveation_full_rate_tan: foveation.full_rate_deg.to_radians().tan(),

@@ -282,7 +282,7 @@ impl<'a> RecordContext<'a> {
     /// Width × height × layers of the occlusion targets (half size with half-res).
     pub fn ao_extent(&self) -> (u32, u32, u32) {
         let s = self.setup.settings;
-        let (w, h) = ao_extent(s.width, s.height, s.ao.half_res);
+        let (w, h) = ao_extent(s.width, s.height, s.ao.resolution.is_half());
         (w, h, self.setup.views)
     }
 }

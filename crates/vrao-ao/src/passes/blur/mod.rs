@@ -136,7 +136,7 @@ impl Pass for BlurPass {
         // reuse's lookups cost a fifth of the denoise (80–101 against 64–84 ms per eye,
         // lavapipe).
         let reuse = ao.stereo_reuse
-            && ao.half_res
+            && ao.resolution.is_half()
             && layers == 2
             && !super::upsample::reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;

@@ -189,7 +189,7 @@ impl Pass for TemporalPass {
         u.history_valid = (setup.previous_views.is_some() && !fresh) as u32;
         // The frame's own views (an OpenXR runtime's, every frame), not the profile's.
         let [l, r, _, _] = current.first().map_or([-1.0, 1.0, 1.0, -1.0], |eye| eye.fov.tangents());
-        let scale = if setup.settings.ao.half_res { 2.0 } else { 1.0 };
+        let scale = if setup.settings.ao.resolution.is_half() { 2.0 } else { 1.0 };
         u.pixel_tangent = ((r - l) / setup.settings.width as f64 * scale) as f32;
         ctx.gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&u));
         // This frame reads one (value, position) pair and writes the other; they swap each frame.

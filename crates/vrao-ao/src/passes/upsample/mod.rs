@@ -45,7 +45,11 @@ const BINDINGS: [Bind; 8] = [
 /// AO waits for the right eye, cannot hold).
 pub fn reuses_left_eye_upsample(settings: &ChainSettings, layers: u32) -> bool {
     let ao = &settings.ao;
-    ao.stereo_reuse && ao.half_res && layers == 2 && ao.technique != Technique::None && !ao.technique.carries_light()
+    ao.stereo_reuse
+        && ao.resolution.is_half()
+        && layers == 2
+        && ao.technique != Technique::None
+        && !ao.technique.carries_light()
 }
 
 /// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
@@ -74,7 +78,7 @@ impl Pass for UpsamplePass {
             .provide(FINAL_AO, AO_FULL)
             .occlusion_cost()
             .disabled_if(ao.technique == Technique::None, "technique is none: nothing to upsample")
-            .disabled_if(!ao.half_res, "occlusion runs at full resolution")
+            .disabled_if(!ao.resolution.is_half(), "occlusion runs at full resolution")
     }
 
     fn record(&self, ctx: &mut RecordContext) {

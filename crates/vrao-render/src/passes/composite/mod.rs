@@ -123,7 +123,7 @@ impl Pass for CompositePass {
         let mut decl = PassDecl::new(NAME).bindings(&BINDINGS);
         if settings.ao.technique == Technique::None {
             decl = decl.unbind(OCCLUSION).unbind(AO_GEOMETRY);
-        } else if settings.ao.half_res {
+        } else if settings.ao.resolution.is_half() {
             decl = decl.note("upsamples the half-resolution occlusion inline (3×3 joint bilateral)");
         } else {
             decl = decl.unbind(AO_GEOMETRY);
@@ -136,7 +136,7 @@ impl Pass for CompositePass {
     }
 
     fn record(&self, ctx: &mut RecordContext) {
-        let half_res = settings_of(ctx.setup).ao.half_res;
+        let half_res = settings_of(ctx.setup).ao.resolution.is_half();
         let rsm = rsm_active(scene_of(ctx.setup), settings_of(ctx.setup));
         // The output's left-eye layer is unused before the right eye's dispatch: the
         // geometry (or its placeholder) stands in.
