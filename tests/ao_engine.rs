@@ -383,3 +383,21 @@ fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_
     frame_at(&mut engine, (WIDTH * 3 / 2, HEIGHT * 3 / 2));
     assert!(engine.pipelines_built() > built);
 }
+
+#[test]
+fn each_gpu_keeps_its_own_shader_directory_and_shader_errors() {
+    let (gpu, _lock) = common::gpu();
+    let missing = std::env::temp_dir().join("vrao-no-such-shader-dir");
+    let mut broken = vrao::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
+    broken.set_shader_dir(Some(missing.clone()));
+    let healthy = vrao::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
+    // Two chains made at once on two threads, one reading shaders from a missing folder.
+    std::thread::scope(|s| {
+        s.spawn(|| drop(vrao::render::passes::ao_chain(&broken, Vec::new())));
+        s.spawn(|| drop(vrao::render::passes::ao_chain(&healthy, Vec::new())));
+    });
+    assert!(healthy.take_shader_error().is_ok(), "the other Gpu's error leaked");
+    let error = broken.take_shader_error().unwrap_err().to_string();
+    assert!(error.contains("vrao-no-such-shader-dir"), "{error}");
+    assert!(broken.take_shader_error().is_ok(), "an error is returned once");
+}

@@ -202,7 +202,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
     pub fn prepare(&mut self, gpu: &Gpu, plan: &Plan, params: &FrameParams, lighting: &FrameLighting, views: &[Eye]) {
         let layers = views.len() as u32;
         let mut targets = std::mem::take(&mut self.targets);
-        targets.allocate(&gpu.device, plan, &self.setup(params, &[], layers));
+        targets.allocate(gpu, plan, &self.setup(params, &[], layers));
         self.targets = targets;
         self.uniforms.update(&gpu.queue, lighting, views, params.settings);
         self.uniforms.update_ao(&gpu.queue, params.settings, self.frame_index);

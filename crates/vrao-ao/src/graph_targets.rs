@@ -3,9 +3,9 @@
 //! but a pass does not read; and the textures imported from outside the graph (a host's
 //! depth buffer). The renderer and the AO engine each own one.
 
-use crate::gpu::kernel::invalidate_bind_groups;
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::uniforms::ao_extent;
+use crate::gpu::Gpu;
 use crate::graph::{Kind, Plan, Resource, Size, Written};
 use crate::passes::DeclareContext;
 use std::collections::{BTreeMap, HashMap};
@@ -23,12 +23,19 @@ impl GraphTargets {
     /// Binds `texture` (`layers` layers of its `aspect`) as the imported resource `r` for
     /// the next frames. Its views and the bind groups that hold them are made anew only
     /// when the texture changed.
-    pub fn import(&mut self, r: Resource, texture: &wgpu::Texture, aspect: wgpu::TextureAspect, layers: u32) {
+    pub fn import(
+        &mut self,
+        gpu: &Gpu,
+        r: Resource,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+        layers: u32,
+    ) {
         debug_assert!(matches!(r.kind(), Kind::Imported), "{} is not an imported resource", r.name());
         let same = self.targets.get(&r).is_some_and(|t| t.texture == *texture && t.layers == layers);
         if !same {
             self.targets.insert(r, LayeredTarget::wrap(texture, r.name(), aspect, layers));
-            invalidate_bind_groups();
+            gpu.invalidate_bind_groups();
         }
     }
 
@@ -36,7 +43,8 @@ impl GraphTargets {
     /// of another size are dropped, so a resource no pass needs costs no memory. Makes
     /// the placeholders the plan's passes bind in place of what they do not read.
     /// Imported textures are left as they are.
-    pub fn allocate(&mut self, device: &wgpu::Device, plan: &Plan, setup: &DeclareContext) {
+    pub fn allocate(&mut self, gpu: &Gpu, plan: &Plan, setup: &DeclareContext) {
+        let device = &gpu.device;
         let max_side = device.limits().max_texture_dimension_2d;
         let extent_of = |r: Resource| extent(r, setup, max_side);
         let allocated = |r: &Resource| !matches!(r.kind(), Kind::Imported);
@@ -79,7 +87,7 @@ impl GraphTargets {
             }
         }
         if changed {
-            invalidate_bind_groups();
+            gpu.invalidate_bind_groups();
         }
     }
 }

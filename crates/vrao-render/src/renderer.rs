@@ -186,7 +186,7 @@ impl Renderer {
             return Err(Error::Interrupted);
         }
         // A shader file VRAO_SHADER_DIR names but that cannot be read is the error here.
-        crate::gpu::kernel::take_shader_error()?;
+        gpu.take_shader_error()?;
         gpu.take_error()?;
         let mover_bounds = mover_bounds(scene, &gpu_scene);
         let motion = FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL };

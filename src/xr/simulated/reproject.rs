@@ -74,7 +74,7 @@ impl Reprojector {
     /// Compiles the warp's kernels (splat, positional, rotational); a shader file that
     /// cannot be read (`VRAO_SHADER_DIR`) is the error.
     pub fn new(gpu: &Gpu) -> Result<Reprojector> {
-        let module = try_shader_module(&gpu.device, "reproject", &[COMMON, wgsl!("src/xr/simulated/reproject.wgsl")])?;
+        let module = try_shader_module(gpu, "reproject", &[COMMON, wgsl!("src/xr/simulated/reproject.wgsl")])?;
         let variant = |label, entry, positional: bool| {
             Kernel::from_module(gpu, label, &module, entry, &BINDINGS, &[("POSITIONAL", f64::from(positional))])
         };

@@ -181,7 +181,7 @@ impl ImportPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, NAME, &[IMPORT_WGSL]);
+        let module = shader_module(gpu, NAME, &[IMPORT_WGSL]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(NAME),
             layout: Some(&pipeline_layout),

@@ -172,7 +172,7 @@ impl AoEngine {
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
         }
-        crate::gpu::kernel::take_shader_error()?;
+        gpu.take_shader_error()?;
         Ok(AoEngine { gpu, config: config.clone(), import, chain, driver, motion: FrameMotion::STILL })
     }
 
@@ -254,13 +254,13 @@ impl AoEngine {
         let settings = host_settings(config, projections[0].near)?;
         let layers = config.views;
         let targets = self.driver.targets_mut();
-        targets.import(HOST_DEPTH, frame.depth, wgpu::TextureAspect::DepthOnly, layers);
+        targets.import(&self.gpu, HOST_DEPTH, frame.depth, wgpu::TextureAspect::DepthOnly, layers);
         if let Some(normals) = &frame.normals {
-            targets.import(HOST_NORMALS, normals.texture, wgpu::TextureAspect::All, layers);
+            targets.import(&self.gpu, HOST_NORMALS, normals.texture, wgpu::TextureAspect::All, layers);
         }
         self.motion = match &frame.motion {
             Some(motion) => {
-                targets.import(HOST_MOTION, motion.texture, wgpu::TextureAspect::All, layers);
+                targets.import(&self.gpu, HOST_MOTION, motion.texture, wgpu::TextureAspect::All, layers);
                 FrameMotion {
                     vectors: true,
                     uv_scale: motion.to_previous_uv,

@@ -7,22 +7,13 @@ use crate::error::{Error, Result};
 use crate::graph::Resource;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock};
-
-/// Bumped whenever targets are made or dropped: every kernel then forgets its bind
-/// groups, which would otherwise keep dropped textures alive.
-static BIND_GROUP_EPOCH: AtomicU64 = AtomicU64::new(0);
 
 /// Bind groups a kernel keeps before it starts over (a frame binds each kernel a few
 /// times; more means the resources change every frame).
 const MAX_CACHED_BIND_GROUPS: usize = 64;
-
-/// Forgets every kernel's cached bind groups (call when targets are recreated).
-pub fn invalidate_bind_groups() {
-    BIND_GROUP_EPOCH.fetch_add(1, Ordering::Relaxed);
-}
 
 /// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
 pub const TILE: u32 = 8;
@@ -54,17 +45,17 @@ pub(crate) use wgsl;
 /// `common.wgsl`: the frame's uniforms and helpers every pass shares.
 pub const COMMON: Shader = wgsl!("shaders/common.wgsl");
 
-/// The environment variable that makes shaders load from disk: `VRAO_SHADER_DIR=.` (the
-/// workspace root) runs an edited shader without rebuilding the binary.
+/// The environment variable that makes the application's shaders load from disk
+/// (`Gpu::new` reads it; [`Gpu::set_shader_dir`] sets a directory for one `Gpu`):
+/// `VRAO_SHADER_DIR=.` (the workspace root) runs an edited shader without rebuilding.
 pub const SHADER_DIR_VAR: &str = "VRAO_SHADER_DIR";
 
 /// The text of `files`, concatenated in order (common first) so passes share
-/// `common.wgsl` without string formatting: as compiled in, or read from the directory
-/// [`SHADER_DIR_VAR`] names when it is set. A file that cannot be read there is
-/// `Error::Input` naming it.
-pub fn shader_source(files: &[Shader]) -> Result<String> {
-    let dir = std::env::var_os(SHADER_DIR_VAR).map(PathBuf::from);
-    source_from(dir.as_deref(), files)
+/// `common.wgsl` without string formatting: as compiled in, or read from `gpu`'s shader
+/// directory when it has one ([`Gpu::set_shader_dir`]). A file that cannot be read there
+/// is `Error::Input` naming it.
+pub fn shader_source(gpu: &Gpu, files: &[Shader]) -> Result<String> {
+    source_from(gpu.shader_dir(), files)
 }
 
 /// [`shader_source`] with the shader directory given (`None`: the compiled-in text).
@@ -85,17 +76,19 @@ fn source_from(dir: Option<&Path>, files: &[Shader]) -> Result<String> {
     Ok(source)
 }
 
-/// The first error kept until someone takes it.
-struct ErrorSlot(Mutex<Option<Error>>);
+/// The first error kept until someone takes it (each `Gpu` has one for its shaders).
+#[derive(Default)]
+pub(crate) struct ErrorSlot(Mutex<Option<Error>>);
 
 impl ErrorSlot {
+    #[cfg(test)]
     const fn new() -> ErrorSlot {
         ErrorSlot(Mutex::new(None))
     }
 
     /// Keeps `error` unless an earlier one is waiting (then it is only logged, at debug:
     /// one missing directory fails every shader).
-    fn record(&self, error: Error) {
+    pub(crate) fn record(&self, error: Error) {
         let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
         if slot.is_some() {
             log::debug!("{error}");
@@ -105,7 +98,7 @@ impl ErrorSlot {
         }
     }
 
-    fn take(&self) -> Result<()> {
+    pub(crate) fn take(&self) -> Result<()> {
         match self.0.lock().unwrap_or_else(|p| p.into_inner()).take() {
             Some(error) => Err(error),
             None => Ok(()),
@@ -113,31 +106,25 @@ impl ErrorSlot {
     }
 }
 
-/// The first shader that [`shader_module`] could not read since the last
-/// [`take_shader_error`]. Process-wide like the environment variable it comes from.
-static SHADER_ERROR: ErrorSlot = ErrorSlot::new();
-
-/// The first shader file that could not be read from [`SHADER_DIR_VAR`] since the last
-/// call, as the `Error::Input` naming it (then cleared). Whoever makes passes through
-/// the infallible [`shader_module`] or [`Kernel::new`] checks this before using them.
-pub fn take_shader_error() -> Result<()> {
-    SHADER_ERROR.take()
+/// A shader module of `files` ([`shader_source`]); an unreadable file is the error.
+pub fn try_shader_module(gpu: &Gpu, label: &str, files: &[Shader]) -> Result<wgpu::ShaderModule> {
+    Ok(module_of(&gpu.device, label, shader_source(gpu, files)?))
 }
 
-/// A shader module of `files` ([`shader_source`]); an unreadable file is the error.
-pub fn try_shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> Result<wgpu::ShaderModule> {
-    Ok(module_of(device, label, shader_source(files)?))
+/// The text of `files` ([`shader_source`]) that always comes: a file that cannot be read
+/// is recorded for [`Gpu::take_shader_error`] and the compiled-in text stands in.
+fn source_or_recorded(gpu: &Gpu, files: &[Shader]) -> String {
+    shader_source(gpu, files).unwrap_or_else(|error| {
+        gpu.shader_error.record(error);
+        source_from(None, files).expect("the compiled-in text needs no file")
+    })
 }
 
 /// A shader module of `files` ([`shader_source`]) that always succeeds, for the passes'
-/// constructors: a file that cannot be read is recorded for [`take_shader_error`] and
-/// the compiled-in text stands in, so the module is valid until the error is returned.
-pub fn shader_module(device: &wgpu::Device, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
-    let source = shader_source(files).unwrap_or_else(|error| {
-        SHADER_ERROR.record(error);
-        source_from(None, files).expect("the compiled-in text needs no file")
-    });
-    module_of(device, label, source)
+/// constructors: a file that cannot be read is recorded for [`Gpu::take_shader_error`]
+/// and the compiled-in text stands in, so the module is valid until the error is returned.
+pub fn shader_module(gpu: &Gpu, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
+    module_of(&gpu.device, label, source_or_recorded(gpu, files))
 }
 
 fn module_of(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
@@ -289,6 +276,8 @@ pub struct Kernel {
     /// Bind groups made so far, by the identity of what they bind, with the epoch they
     /// were made in: a frame binds what the last one did, so none is made again.
     bind_groups: Mutex<(u64, HashMap<u64, wgpu::BindGroup>)>,
+    /// The `Gpu`'s bind-group epoch ([`Gpu::invalidate_bind_groups`]).
+    epoch: std::sync::Arc<AtomicU64>,
 }
 
 /// A lazy kernel's shader and how to compile it.
@@ -356,15 +345,12 @@ impl Kernel {
             return Self::from_module(gpu, label, &module, entry, binds, &[]);
         }
         if !gpu.lazy_pipelines() {
-            let module = shader_module(&gpu.device, label, files);
+            let module = shader_module(gpu, label, files);
             return Self::from_module(gpu, label, &module, entry, binds, constants);
         }
         // The files are read now, so an unreadable one is the error of whoever makes the
         // kernel (as for an eager one); only the compilation waits.
-        let source = shader_source(files).unwrap_or_else(|error| {
-            SHADER_ERROR.record(error);
-            source_from(None, files).expect("the compiled-in text needs no file")
-        });
+        let source = source_or_recorded(gpu, files);
         let (layout, pipeline_layout, slots) = Self::layouts(&gpu.device, label, binds);
         Kernel {
             label: label.to_string(),
@@ -379,7 +365,8 @@ impl Kernel {
             }),
             layout,
             slots,
-            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
+            bind_groups: Mutex::new((gpu.bind_group_epoch.load(Ordering::Relaxed), HashMap::new())),
+            epoch: gpu.bind_group_epoch.clone(),
         }
     }
 
@@ -403,7 +390,8 @@ impl Kernel {
             recipe: None,
             layout,
             slots,
-            bind_groups: Mutex::new((BIND_GROUP_EPOCH.load(Ordering::Relaxed), HashMap::new())),
+            bind_groups: Mutex::new((gpu.bind_group_epoch.load(Ordering::Relaxed), HashMap::new())),
+            epoch: gpu.bind_group_epoch.clone(),
         }
     }
 
@@ -502,7 +490,7 @@ impl Kernel {
     fn bind_group(&self, device: &wgpu::Device, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
         assert_eq!(resources.len(), self.slots.len(), "kernel {}: one resource per slot", self.label);
         let key = identity(resources);
-        let epoch = BIND_GROUP_EPOCH.load(Ordering::Relaxed);
+        let epoch = self.epoch.load(Ordering::Relaxed);
         let mut cache = self.bind_groups.lock().expect("bind group cache");
         if cache.0 != epoch || cache.1.len() >= MAX_CACHED_BIND_GROUPS {
             *cache = (epoch, HashMap::new());

@@ -75,6 +75,13 @@ pub struct Gpu {
     lazy_pipelines: bool,
     /// Compute pipelines compiled on this device so far.
     pipelines_built: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    /// Where shaders are read from instead of the compiled-in text ([`Gpu::set_shader_dir`]).
+    shader_dir: Option<std::path::PathBuf>,
+    /// The first shader file that could not be read ([`Gpu::take_shader_error`]).
+    pub(crate) shader_error: std::sync::Arc<kernel::ErrorSlot>,
+    /// Bumped whenever targets are made or dropped: every kernel made on this `Gpu` then
+    /// forgets its bind groups, which would otherwise keep dropped textures alive.
+    pub(crate) bind_group_epoch: std::sync::Arc<std::sync::atomic::AtomicU64>,
 }
 
 impl Gpu {
@@ -176,6 +183,11 @@ impl Gpu {
             build_interrupt: std::sync::OnceLock::new(),
             lazy_pipelines: false,
             pipelines_built: Default::default(),
+            // The application's override (the engine on a host's device reads no
+            // environment: Gpu::from_host).
+            shader_dir: std::env::var_os(kernel::SHADER_DIR_VAR).map(std::path::PathBuf::from),
+            shader_error: Default::default(),
+            bind_group_epoch: Default::default(),
         };
         gpu.caps.multiview_reliable = gpu.caps.multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
         Ok(gpu)
@@ -200,6 +212,9 @@ impl Gpu {
             build_interrupt: std::sync::OnceLock::new(),
             lazy_pipelines: false,
             pipelines_built: Default::default(),
+            shader_dir: None,
+            shader_error: Default::default(),
+            bind_group_epoch: Default::default(),
         })
     }
 
@@ -233,6 +248,32 @@ impl Gpu {
     /// Whether kernels compile at their first dispatch ([`Gpu::set_lazy_pipelines`]).
     pub fn lazy_pipelines(&self) -> bool {
         self.lazy_pipelines
+    }
+
+    /// Reads this `Gpu`'s shaders from `dir` (the workspace root's layout, files named as
+    /// in each [`kernel::Shader`]) instead of the compiled-in text, for passes made from
+    /// now on; `None` returns to the compiled-in text.
+    pub fn set_shader_dir(&mut self, dir: Option<std::path::PathBuf>) {
+        self.shader_dir = dir;
+    }
+
+    /// The directory shaders are read from, if any ([`Gpu::set_shader_dir`]).
+    pub fn shader_dir(&self) -> Option<&std::path::Path> {
+        self.shader_dir.as_deref()
+    }
+
+    /// The first shader file that could not be read from the shader directory since the
+    /// last call, as the `Error::Input` naming it (then cleared). Whoever makes passes
+    /// through the infallible [`kernel::shader_module`] or [`kernel::Kernel::new`] checks
+    /// this before using them.
+    pub fn take_shader_error(&self) -> Result<()> {
+        self.shader_error.take()
+    }
+
+    /// Makes every kernel on this `Gpu` forget its cached bind groups (call when targets
+    /// are made or dropped).
+    pub fn invalidate_bind_groups(&self) {
+        self.bind_group_epoch.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// Compute pipelines compiled through this `Gpu` so far (kernels, eager or lazy).

@@ -19,7 +19,7 @@ pub fn multiview_reaches_every_layer(gpu: &Gpu) -> bool {
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let target =
         LayeredTarget::new(device, "multiview probe", format, (SIZE, SIZE, 2), wgpu::TextureUsages::RENDER_ATTACHMENT);
-    let module = shader_module(device, "multiview probe", &[wgsl!("src/gpu/multiview_probe.wgsl")]);
+    let module = shader_module(gpu, "multiview probe", &[wgsl!("src/gpu/multiview_probe.wgsl")]);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("multiview probe"),
         bind_group_layouts: &[],

@@ -24,7 +24,7 @@ use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::settings::AoSettings;
-use crate::technique::TECHNIQUES;
+use crate::technique::{TechniqueKind, TECHNIQUES};
 use std::any::Any;
 use std::collections::{BTreeMap, HashMap};
 
@@ -35,9 +35,18 @@ use std::collections::{BTreeMap, HashMap};
 /// [`inputs::DEPTH`] and [`inputs::NORMALS`] and provides [`crate::graph::OCCLUSION`] and
 /// [`crate::graph::FINAL_AO`].
 pub fn ao_chain(gpu: &Gpu, light_gathering: Vec<Box<dyn Pass>>) -> Vec<Box<dyn Pass>> {
-    let mut chain: Vec<Box<dyn Pass>> =
-        TECHNIQUES.iter().filter_map(|entry| entry.pass).map(|make| make(gpu)).collect();
-    chain.extend(light_gathering);
+    let mut chain: Vec<Box<dyn Pass>> = Vec::new();
+    let mut light_gathering = Some(light_gathering);
+    for entry in &TECHNIQUES {
+        match entry.pass {
+            Some(make) => chain.push(make(gpu)),
+            // The renderer's light-gathering passes take the table's place for them.
+            None if entry.kind == TechniqueKind::LightGathering => {
+                chain.extend(light_gathering.take().into_iter().flatten())
+            }
+            None => {}
+        }
+    }
     chain.push(Box::new(temporal::TemporalPass::new(gpu)));
     chain.push(Box::new(blur::BlurPass::new(gpu)));
     chain.push(Box::new(upsample::UpsamplePass::new(gpu)));

@@ -6,7 +6,7 @@
 
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, MoverBox, Pass, RecordContext};
-use crate::gpu::kernel::{invalidate_bind_groups, wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION, PIXEL_MOTION};
@@ -108,7 +108,7 @@ impl TemporalPass {
 
     /// The history targets at `extent`, made (zeroed) when they are missing or of another
     /// size; `true` when they were just made and hold no history.
-    fn history_at(&self, device: &wgpu::Device, extent: (u32, u32, u32)) -> (Vec<LayeredTarget>, bool) {
+    fn history_at(&self, gpu: &Gpu, extent: (u32, u32, u32)) -> (Vec<LayeredTarget>, bool) {
         let mut history = self.history.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         let fresh = history.first().is_none_or(|t| t.extent() != extent);
         if fresh {
@@ -119,9 +119,9 @@ impl TemporalPass {
             *history = HISTORY_VALUE
                 .iter()
                 .chain(&HISTORY_POSITION)
-                .map(|r| LayeredTarget::new(device, r.name(), r.format(), extent, usage))
+                .map(|r| LayeredTarget::new(&gpu.device, r.name(), r.format(), extent, usage))
                 .collect();
-            invalidate_bind_groups();
+            gpu.invalidate_bind_groups();
         }
         (history.clone(), fresh)
     }
@@ -185,7 +185,7 @@ impl Pass for TemporalPass {
             TemporalBlend::Confidence => 1,
         };
         let extent = ctx.ao_extent();
-        let (history, fresh) = self.history_at(&ctx.gpu.device, extent);
+        let (history, fresh) = self.history_at(ctx.gpu, extent);
         u.history_valid = (setup.previous_views.is_some() && !fresh) as u32;
         // The frame's own views (an OpenXR runtime's, every frame), not the profile's.
         let [l, r, _, _] = current.first().map_or([-1.0, 1.0, 1.0, -1.0], |eye| eye.fov.tangents());

@@ -107,7 +107,7 @@ impl GBufferPass {
                 immediate_size: 0,
             });
             let module = shader_module(
-                device,
+                gpu,
                 "gbuffer multiview",
                 &[COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/passes/gbuffer/gbuffer_multiview.wgsl")],
             );
@@ -119,7 +119,7 @@ impl GBufferPass {
             immediate_size: 0,
         });
         let module = shader_module(
-            device,
+            gpu,
             "gbuffer multipass",
             &[COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/passes/gbuffer/gbuffer_multipass.wgsl")],
         );

@@ -67,7 +67,7 @@ impl DepthPeelPass {
             bind_group_layouts: &[Some(&frame_layout), Some(&scene.material_layout), Some(&eye_layout)],
             immediate_size: 0,
         });
-        let module = shader_module(device, "depth peel", &[COMMON, MESH_WGSL, wgsl!("src/passes/peel/peel.wgsl")]);
+        let module = shader_module(gpu, "depth peel", &[COMMON, MESH_WGSL, wgsl!("src/passes/peel/peel.wgsl")]);
         let make = |alpha_test: bool| {
             mesh_pipeline(
                 device,

@@ -313,7 +313,7 @@ impl ShadowPass {
             immediate_size: 0,
         });
         let module = shader_module(
-            device,
+            gpu,
             "shadow map",
             &[COMMON, SHADOW_WGSL, MESH_WGSL, wgsl!("src/passes/shadow/shadow_map.wgsl")],
         );
