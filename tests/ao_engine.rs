@@ -401,3 +401,43 @@ fn each_gpu_keeps_its_own_shader_directory_and_shader_errors() {
     assert!(error.contains("vrao-no-such-shader-dir"), "{error}");
     assert!(broken.take_shader_error().is_ok(), "an error is returned once");
 }
+
+#[test]
+fn the_single_channel_outputs_hold_the_visibility_the_default_output_holds() {
+    use vrao::ao::AoOutputFormat;
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let depth = HostDepth::ReversedInfinite;
+    let views = host_views(&eyes(), depth);
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let mut visibility = |format: AoOutputFormat| {
+        engine.set_output_format(format);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        prepass.record(device, &mut encoder, &views);
+        let frame = AoFrame {
+            depth: &prepass.depth,
+            depth_convention: DepthConvention::REVERSED_INFINITE,
+            normals: None,
+            views: &views,
+            motion: None,
+        };
+        let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+        assert_eq!(texture.format(), format.texture_format());
+        queue.submit([encoder.finish()]);
+        (0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect::<Vec<_>>()
+    };
+    let rgba = visibility(AoOutputFormat::Rgba16Float);
+    let r16 = visibility(AoOutputFormat::R16Float);
+    let r8 = visibility(AoOutputFormat::R8Unorm);
+    let max_difference = |a: &[Vec<f32>], b: &[Vec<f32>]| {
+        a.iter().flatten().zip(b.iter().flatten()).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max)
+    };
+    // The same f16 value copied; 8-bit rounding is within half a step.
+    assert_eq!(max_difference(&rgba, &r16), 0.0);
+    assert!(max_difference(&rgba, &r8) <= 0.5 / 255.0 + 1e-6, "{}", max_difference(&rgba, &r8));
+    assert_eq!(AoOutputFormat::R8Unorm.bytes_per_pixel(), 1);
+    assert_eq!(AoOutputFormat::R16Float.bytes_per_pixel(), 2);
+    assert_eq!(AoOutputFormat::Rgba16Float.bytes_per_pixel(), 8);
+}

@@ -321,7 +321,14 @@ impl DepthPrepass {
 /// (the engine's AO), row by row.
 pub fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
     let size = texture.size();
-    let row = (size.width * 8).div_ceil(256) * 256;
+    // The visibility: alpha of Rgba16Float, red of the single-channel outputs.
+    let (texel, value): (u32, fn(&[u8]) -> f32) = match texture.format() {
+        wgpu::TextureFormat::Rgba16Float => (8, |t| half::f16::from_bits(u16::from_le_bytes([t[6], t[7]])).to_f32()),
+        wgpu::TextureFormat::R16Float => (2, |t| half::f16::from_bits(u16::from_le_bytes([t[0], t[1]])).to_f32()),
+        wgpu::TextureFormat::R8Unorm => (1, |t| f32::from(t[0]) / 255.0),
+        other => panic!("the engine does not write {other:?}"),
+    };
+    let row = (size.width * texel).div_ceil(256) * 256;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: u64::from(row * size.height),
@@ -350,8 +357,8 @@ pub fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Te
     let mut alpha = Vec::with_capacity((size.width * size.height) as usize);
     for y in 0..size.height {
         let start = (y * row) as usize;
-        let texels = &data[start..start + (size.width * 8) as usize];
-        alpha.extend(texels.chunks(8).map(|t| half::f16::from_bits(u16::from_le_bytes([t[6], t[7]])).to_f32()));
+        let texels = &data[start..start + (size.width * texel) as usize];
+        alpha.extend(texels.chunks(texel as usize).map(value));
     }
     alpha
 }

@@ -16,6 +16,7 @@
 mod host;
 
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
+use vrao_ao::ao::AoOutputFormat;
 use vrao_ao::ao::{
     AoConfig, AoEngine, AoFrame, DepthConvention, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
 };
@@ -88,6 +89,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     if args.iter().any(|a| a == "--time") {
         time_frames(&device, &queue, depth_kind, convention)?;
     }
+    if args.iter().any(|a| a == "--time-setup") {
+        time_setup(&device, &queue, &prepass, &views, convention)?;
+    }
     if let Some(plan) = engine.last_plan() {
         eprint!("{plan}");
     }
@@ -106,6 +110,56 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         image::GrayImage::from_raw(WIDTH, HEIGHT, pixels).ok_or("image size")?.save(&path)?;
         eprintln!("{name} eye: mean AO {mean:.3} -> {}", path.display());
     }
+    Ok(())
+}
+
+/// What a host waits for: making the engine (its kernels compile at the first frame),
+/// that first frame, a resize and the frame after it (no kernel compiles), and the
+/// same before this crate compiled lazily (every technique's kernels at `new`).
+fn time_setup(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    prepass: &DepthPrepass,
+    views: &[ViewMatrices],
+    convention: DepthConvention,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let ms = |start: std::time::Instant| start.elapsed().as_secs_f64() * 1e3;
+    let frame = |engine: &mut AoEngine, depth: &wgpu::Texture| -> Result<f64, Box<dyn std::error::Error>> {
+        let started = std::time::Instant::now();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let frame = AoFrame { depth, depth_convention: convention, normals: None, views, motion: None };
+        engine.record(&mut encoder, &frame)?;
+        queue.submit([encoder.finish()]);
+        device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None })?;
+        Ok(ms(started))
+    };
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let started = std::time::Instant::now();
+    let mut engine = AoEngine::new(device, queue, &config)?;
+    let new_ms = ms(started);
+    let first_ms = frame(&mut engine, &prepass.depth)?;
+    let built = engine.pipelines_built();
+    let second_ms = frame(&mut engine, &prepass.depth)?;
+    let (width, height) = (WIDTH * 2, HEIGHT * 2);
+    let larger = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (width, height));
+    let started = std::time::Instant::now();
+    engine.resize(width, height)?;
+    let resize_ms = ms(started);
+    let after_resize_ms = frame(&mut engine, &larger.depth)?;
+    let eager = vrao_ao::gpu::Gpu::from_host(device, queue)?;
+    let started = std::time::Instant::now();
+    let chain = vrao_ao::passes::ao_chain(&eager, Vec::new());
+    let eager_ms = ms(started);
+    drop(chain);
+    eprintln!(
+        "AoEngine::new {new_ms:.1} ms (every technique's kernels at new, as before: {eager_ms:.1} ms, {} kernels)",
+        eager.pipelines_built()
+    );
+    eprintln!("first frame {first_ms:.1} ms ({built} kernels compiled), second {second_ms:.1} ms");
+    eprintln!(
+        "resize to {width}x{height}: {resize_ms:.3} ms, next frame {after_resize_ms:.1} ms ({} kernels compiled since)",
+        engine.pipelines_built() - built
+    );
     Ok(())
 }
 
@@ -129,7 +183,12 @@ fn time_frames(
     let config = AoConfig { settings: AoSettings::default(), width: SIZE.0, height: SIZE.1, views: 2 };
     let mut engine = AoEngine::new(device, queue, &config)?;
     let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
-    let labels = ["host prepass alone", "prepass + engine, host normals", "prepass + engine, rebuilt normals"];
+    let labels = [
+        "host prepass alone",
+        "prepass + engine, host normals",
+        "prepass + engine, rebuilt normals",
+        "prepass + engine, host normals, R8Unorm output",
+    ];
     let mut times = vec![Vec::new(); labels.len()];
     // One warm-up round, then ROUNDS measured ones.
     for round in 0..=ROUNDS {
@@ -138,10 +197,12 @@ fn time_frames(
             let mut encoder = device.create_command_encoder(&Default::default());
             prepass.record(device, &mut encoder, &views);
             if kind > 0 {
+                let format = if kind == 3 { AoOutputFormat::R8Unorm } else { AoOutputFormat::Rgba16Float };
+                engine.set_output_format(format);
                 let frame = AoFrame {
                     depth: &prepass.depth,
                     depth_convention: convention,
-                    normals: (kind == 1).then_some(normals),
+                    normals: (kind != 2).then_some(normals),
                     views: &views,
                     motion: None,
                 };

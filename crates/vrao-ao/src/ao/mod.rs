@@ -19,6 +19,9 @@
 //! frame's [`DepthConvention`] says; one depth layer per view.
 
 pub mod import;
+mod pack;
+
+pub use pack::AoOutputFormat;
 
 use crate::driver::{FrameParams, GraphDriver, Submission};
 use crate::error::{Error, Result};
@@ -31,6 +34,7 @@ use crate::settings::{AoSettings, Technique};
 use crate::stereo::{Eye, EyeSide, Fov, HeadPose};
 use glam::{DMat4, DQuat, Mat4};
 use import::{ImportPass, ImportSource, HOST_DEPTH, HOST_MOTION, HOST_NORMALS};
+use pack::PackPass;
 use std::sync::Arc;
 
 /// How the host's depth buffer maps distance to depth.
@@ -133,8 +137,9 @@ pub struct AoConfig {
     pub views: u32,
 }
 
-/// The engine's AO for the frame just recorded: full resolution, one layer per view,
-/// `Rgba16Float` with the ambient visibility (1 open, 0 fully occluded) in alpha.
+/// The engine's AO for the frame just recorded: full resolution, one layer per view, the
+/// ambient visibility (1 open, 0 fully occluded) in alpha of `Rgba16Float` or in red of a
+/// single-channel format ([`AoEngine::set_output_format`]).
 pub struct AoOutput<'a> {
     /// The texture (it can be sampled and copied from).
     pub texture: &'a wgpu::Texture,
@@ -150,6 +155,9 @@ pub struct AoEngine {
     import: ImportPass,
     chain: Vec<Box<dyn Pass>>,
     driver: GraphDriver<(ChainSettings, bool)>,
+    /// The copy into a single-channel output, and the format chosen.
+    pack: PackPass,
+    output_format: AoOutputFormat,
     /// Whether this frame has the host's motion vectors.
     motion: FrameMotion,
 }
@@ -168,12 +176,22 @@ impl AoEngine {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let chain = passes::ao_chain(&gpu, Vec::new());
         let import = ImportPass::new(&gpu);
+        let pack = PackPass::new(&gpu);
         let driver = GraphDriver::new(&gpu, 0, PassTimer::disabled(&gpu)?);
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
         }
         gpu.take_shader_error()?;
-        Ok(AoEngine { gpu, config: config.clone(), import, chain, driver, motion: FrameMotion::STILL })
+        Ok(AoEngine {
+            gpu,
+            config: config.clone(),
+            import,
+            chain,
+            driver,
+            pack,
+            output_format: AoOutputFormat::default(),
+            motion: FrameMotion::STILL,
+        })
     }
 
     /// Changes the AO settings (validated; a different technique or resolution
@@ -198,6 +216,14 @@ impl AoEngine {
         }
         self.config = config;
         Ok(())
+    }
+
+    /// The texel format of the AO the next frames return: `Rgba16Float` (the default, no
+    /// extra work), or the visibility alone in `R16Float` or `R8Unorm` for a quarter or
+    /// an eighth of the bytes a host's sample reads, at the cost of one full-screen draw
+    /// per view that reads the `Rgba16Float` AO once.
+    pub fn set_output_format(&mut self, format: AoOutputFormat) {
+        self.output_format = format;
     }
 
     /// Compute pipelines the engine has compiled so far: the chosen technique's chain
@@ -304,7 +330,15 @@ impl AoEngine {
             .targets
             .get(&output)
             .ok_or_else(|| Error::Plan(format!("{} was not allocated", output.name())))?;
-        Ok(AoOutput { texture: &target.texture, view: &target.array_view })
+        if self.output_format == AoOutputFormat::Rgba16Float {
+            return Ok(AoOutput { texture: &target.texture, view: &target.array_view });
+        }
+        let span = spans.map(|s| (s, s.begin(encoder, "pack")));
+        let packed = self.pack.record(&self.gpu, encoder, target, self.output_format);
+        if let Some((s, span)) = span {
+            s.end(encoder, span);
+        }
+        Ok(AoOutput { texture: &packed.texture, view: &packed.array_view })
     }
 }
 

@@ -1,0 +1,144 @@
+//! The engine's output in the format the host chose ([`AoOutputFormat`]): the final AO
+//! as the chain leaves it (`Rgba16Float`, visibility in alpha), or its alpha alone in a
+//! single-channel texture that costs the host's lighting pass 2 or 1 bytes a pixel
+//! instead of 8, for one extra full-screen draw per view here.
+
+use crate::gpu::kernel::{shader_module, wgsl, Slot};
+use crate::gpu::layered_target::LayeredTarget;
+use crate::gpu::raster::fullscreen_pipeline;
+use crate::gpu::Gpu;
+
+/// The texel format of the engine's output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AoOutputFormat {
+    /// The chain's own target, no extra pass: `Rgba16Float`, the visibility in alpha
+    /// (rgb 0), 8 bytes a pixel.
+    #[default]
+    Rgba16Float,
+    /// The visibility in red, 2 bytes a pixel; one extra draw per view.
+    R16Float,
+    /// The visibility in red quantised to 1/255, 1 byte a pixel; one extra draw per view.
+    R8Unorm,
+}
+
+impl AoOutputFormat {
+    /// The texture format.
+    pub fn texture_format(self) -> wgpu::TextureFormat {
+        match self {
+            AoOutputFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
+            AoOutputFormat::R16Float => wgpu::TextureFormat::R16Float,
+            AoOutputFormat::R8Unorm => wgpu::TextureFormat::R8Unorm,
+        }
+    }
+
+    /// Bytes a pixel of the output holds (what the host's pass reads per sample).
+    pub fn bytes_per_pixel(self) -> u32 {
+        self.texture_format().block_copy_size(None).expect("uncompressed colour formats")
+    }
+}
+
+/// The pass that copies the final AO's visibility into a single-channel target.
+pub(crate) struct PackPass {
+    layout: wgpu::BindGroupLayout,
+    pipelines: [(AoOutputFormat, wgpu::RenderPipeline); 2],
+    /// One uniform per view layer: the layer its draw reads.
+    layer_uniforms: [wgpu::Buffer; 2],
+    /// The output target and the format it was made for.
+    target: Option<(AoOutputFormat, LayeredTarget)>,
+}
+
+impl PackPass {
+    pub(crate) fn new(gpu: &Gpu) -> PackPass {
+        let device = &gpu.device;
+        let entries = [
+            Slot::Layers.layout_entry(0, wgpu::ShaderStages::FRAGMENT),
+            Slot::Uniform.layout_entry(1, wgpu::ShaderStages::FRAGMENT),
+        ];
+        let layout = device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("pack"), entries: &entries });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pack"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = shader_module(gpu, "pack", &[wgsl!("src/ao/pack.wgsl")]);
+        let pipeline = |format: AoOutputFormat| {
+            let pipeline = fullscreen_pipeline(
+                device,
+                "pack",
+                &pipeline_layout,
+                (&module, "fs_main"),
+                format.texture_format(),
+                None,
+                None,
+            );
+            (format, pipeline)
+        };
+        let layer_uniform = |layer: u32| {
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pack layer"),
+                size: 16,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            gpu.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&[layer, 0, 0, 0]));
+            buffer
+        };
+        PackPass {
+            layout,
+            pipelines: [pipeline(AoOutputFormat::R16Float), pipeline(AoOutputFormat::R8Unorm)],
+            layer_uniforms: [layer_uniform(0), layer_uniform(1)],
+            target: None,
+        }
+    }
+
+    /// Records the copy of `final_ao`'s visibility into this pass's target of `format`
+    /// (made anew at a new size or format) and returns the target.
+    pub(crate) fn record(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        final_ao: &LayeredTarget,
+        format: AoOutputFormat,
+    ) -> &LayeredTarget {
+        let extent = final_ao.extent();
+        let stale = self.target.as_ref().is_none_or(|(f, t)| *f != format || t.extent() != extent);
+        if stale {
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+            let target = LayeredTarget::new(&gpu.device, "ao output", format.texture_format(), extent, usage);
+            self.target = Some((format, target));
+        }
+        let (_, target) = self.target.as_ref().expect("made above");
+        let pipeline = &self.pipelines.iter().find(|(f, _)| *f == format).expect("a single-channel format").1;
+        for (layer, view) in target.layer_views.iter().enumerate() {
+            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pack"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&final_ao.array_view),
+                    },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.layer_uniforms[layer].as_entire_binding() },
+                ],
+            });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("pack"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        target
+    }
+}
