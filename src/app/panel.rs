@@ -4,7 +4,9 @@
 
 use super::governor::Governor;
 use super::{BufferView, PassHistory};
-use crate::render::settings::{BounceForm, DisplayMode, Foveation, Quality, Settings, Technique};
+use crate::render::settings::{
+    AoSettings, BounceForm, DisplayMode, Foveation, Quality, Resolution, Settings, Technique,
+};
 use crate::xr::FrameCounters;
 
 /// Width of the egui side panel in points.
@@ -77,96 +79,134 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
     let before = (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone());
     egui::Panel::left("vrao panel").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
         ui.heading("vrao");
-        let ao = &mut panel.settings.ao;
-        egui::ComboBox::from_label("technique").selected_text(ao.technique.name()).show_ui(ui, |ui| {
-            // Every technique but the bench's fetch-only baseline, which is not an occlusion.
-            for &t in Technique::all().iter().filter(|t| **t != Technique::FetchOnly) {
-                ui.selectable_value(&mut ao.technique, t, t.name());
-            }
-        });
-        let any = ao.technique != Technique::None;
-        let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
-        let bounce = ao.technique == Technique::SsdoBounce;
-        ui.add_enabled_ui(any, |ui| {
-            let quality_text = panel.quality.map_or("custom", |q| q.name());
-            egui::ComboBox::from_label("quality").selected_text(quality_text).show_ui(ui, |ui| {
-                for q in Quality::ALL {
-                    if ui.selectable_value(&mut panel.quality, Some(q), q.name()).clicked() {
-                        ao.samples = q.samples();
-                    }
-                }
-            });
-            if ui.add(egui::Slider::new(&mut ao.samples, 1..=256).text("samples")).changed() {
-                panel.quality = Quality::ALL.into_iter().find(|q| q.samples() == ao.samples);
-            }
-            ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
-            ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
-            ui.checkbox(&mut ao.resolution.is_half(), "half resolution");
-            ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
-            egui::ComboBox::from_label("foveation").selected_text(ao.foveation.name()).show_ui(ui, |ui| {
-                for level in Foveation::ALL {
-                    ui.selectable_value(&mut ao.foveation, level, level.name());
-                }
-            });
-        });
-        ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
-        let mut patch = ao.bounce_form == BounceForm::Patch;
-        if ui.add_enabled(bounce, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches")).changed() {
-            ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
-        }
-        ui.add_enabled(ssdo, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (SSDO)"));
-        ui.checkbox(&mut panel.settings.shadows.enabled, "shadows (directional lights)");
-        ui.checkbox(&mut panel.settings.shadows.rsm, "reflective shadow maps (sun bounce)");
+        settings_ui(ui, panel);
         ui.separator();
-        ui.label("display");
-        ui.horizontal(|ui| {
-            ui.radio_value(&mut panel.mode, DisplayMode::Mirror, "mirror");
-            ui.radio_value(&mut panel.mode, DisplayMode::SinglePass, "single-pass");
-        });
-        egui::ComboBox::from_label("show (each eye)").selected_text(buffer_label(panel.show)).show_ui(ui, |ui| {
-            for &view in <BufferView as clap::ValueEnum>::value_variants() {
-                ui.selectable_value(&mut panel.show, view, buffer_label(view));
-            }
-        });
-        if panel.show != BufferView::Eyes && panel.show.resource(&panel.settings).is_none() {
-            ui.small("no AO buffer: the technique is none");
-        }
+        display_ui(ui, panel);
         ui.separator();
-        match &info.openxr {
-            // OpenXR does not say what its compositor presented or reprojected.
-            Some(x) => ui.label(format!(
-                "OpenXR: {} layers submitted, {} not to render, {} display periods missed; period {:.2} ms",
-                x.layers_submitted, x.not_rendered, x.missed_display_periods, x.display_period_ms
-            )),
-            None => {
-                let [presented, reprojected, dropped] = panel.rates;
-                ui.label(format!(
-                    "per second: {presented:.0} presented, {reprojected:.0} reprojected, {dropped:.1} dropped\nlatency: median {:.1} ms, p95 {:.1} ms",
-                    counters.latency_median_ms, counters.latency_p95_ms
-                ))
-            }
-        };
+        frame_rates_ui(ui, panel.rates, info, counters);
         ui.separator();
-        match info.governor {
-            Some(governor) => {
-                ui.label(format!(
-                    "governor: level {} of {}: {}",
-                    governor.level(),
-                    governor.frontier().top(),
-                    governor.current().setting
-                ));
-                for change in governor.changes().iter().rev().take(4) {
-                    ui.small(format!("frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason));
-                }
-            }
-            None => {
-                ui.label("governor: off");
-            }
-        }
+        governor_ui(ui, info.governor);
         ui.separator();
         profiler_ui(ui, info);
     });
     (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone()) != before
+}
+
+/// The settings the panel edits: technique, its parameters, bounce and shadows.
+fn settings_ui(ui: &mut egui::Ui, panel: &mut PanelState) {
+    let ao = &mut panel.settings.ao;
+    technique_ui(ui, ao);
+    let any = ao.technique != Technique::None;
+    ui.add_enabled_ui(any, |ui| ao_parameters_ui(ui, ao, &mut panel.quality));
+    bounce_ui(ui, ao);
+    ui.checkbox(&mut panel.settings.shadows.enabled, "shadows (directional lights)");
+    ui.checkbox(&mut panel.settings.shadows.rsm, "reflective shadow maps (sun bounce)");
+}
+
+/// The technique's combo box.
+fn technique_ui(ui: &mut egui::Ui, ao: &mut AoSettings) {
+    egui::ComboBox::from_label("technique").selected_text(ao.technique.name()).show_ui(ui, |ui| {
+        // Every technique but the bench's fetch-only baseline, which is not an occlusion.
+        for &t in Technique::all().iter().filter(|t| **t != Technique::FetchOnly) {
+            ui.selectable_value(&mut ao.technique, t, t.name());
+        }
+    });
+}
+
+/// The parameters every technique shares: quality (or samples), radius, strength,
+/// resolution, temporal accumulation and foveation.
+fn ao_parameters_ui(ui: &mut egui::Ui, ao: &mut AoSettings, quality: &mut Option<Quality>) {
+    let quality_text = quality.map_or("custom", |q| q.name());
+    egui::ComboBox::from_label("quality").selected_text(quality_text).show_ui(ui, |ui| {
+        for q in Quality::ALL {
+            if ui.selectable_value(quality, Some(q), q.name()).clicked() {
+                ao.samples = q.samples();
+            }
+        }
+    });
+    if ui.add(egui::Slider::new(&mut ao.samples, 1..=256).text("samples")).changed() {
+        *quality = Quality::ALL.into_iter().find(|q| q.samples() == ao.samples);
+    }
+    ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
+    ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));
+    let mut half = ao.resolution.is_half();
+    if ui.checkbox(&mut half, "half resolution").changed() {
+        ao.resolution = Resolution::from_half_res(half);
+    }
+    ui.checkbox(&mut ao.temporal.enabled, "temporal accumulation");
+    egui::ComboBox::from_label("foveation").selected_text(ao.foveation.name()).show_ui(ui, |ui| {
+        for level in Foveation::ALL {
+            ui.selectable_value(&mut ao.foveation, level, level.name());
+        }
+    });
+}
+
+/// The SSDO settings: bounce strength and form, and depth peeling (disabled for the
+/// techniques that do not use them).
+fn bounce_ui(ui: &mut egui::Ui, ao: &mut AoSettings) {
+    let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
+    let bounce = ao.technique == Technique::SsdoBounce;
+    ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
+    let mut patch = ao.bounce_form == BounceForm::Patch;
+    if ui.add_enabled(bounce, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches")).changed() {
+        ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
+    }
+    ui.add_enabled(ssdo, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (SSDO)"));
+}
+
+/// The display mode and the buffer view shown of each eye.
+fn display_ui(ui: &mut egui::Ui, panel: &mut PanelState) {
+    ui.label("display");
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut panel.mode, DisplayMode::Mirror, "mirror");
+        ui.radio_value(&mut panel.mode, DisplayMode::SinglePass, "single-pass");
+    });
+    egui::ComboBox::from_label("show (each eye)").selected_text(buffer_label(panel.show)).show_ui(ui, |ui| {
+        for &view in <BufferView as clap::ValueEnum>::value_variants() {
+            ui.selectable_value(&mut panel.show, view, buffer_label(view));
+        }
+    });
+    if panel.show != BufferView::Eyes && panel.show.resource(&panel.settings).is_none() {
+        ui.small("no AO buffer: the technique is none");
+    }
+}
+
+/// What OpenXR reported, or the simulated headset's frame rates and latency.
+fn frame_rates_ui(ui: &mut egui::Ui, rates: [f64; 3], info: &PanelInfo, counters: &FrameCounters) {
+    match &info.openxr {
+        // OpenXR does not say what its compositor presented or reprojected.
+        Some(x) => ui.label(format!(
+            "OpenXR: {} layers submitted, {} not to render, {} display periods missed; period {:.2} ms",
+            x.layers_submitted, x.not_rendered, x.missed_display_periods, x.display_period_ms
+        )),
+        None => {
+            let [presented, reprojected, dropped] = rates;
+            ui.label(format!(
+                "per second: {presented:.0} presented, {reprojected:.0} reprojected, {dropped:.1} dropped\nlatency: median {:.1} ms, p95 {:.1} ms",
+                counters.latency_median_ms, counters.latency_p95_ms
+            ))
+        }
+    };
+}
+
+/// The governor's level and its latest changes, or that it is off.
+fn governor_ui(ui: &mut egui::Ui, governor: Option<&Governor>) {
+    match governor {
+        Some(governor) => {
+            ui.label(format!(
+                "governor: level {} of {}: {}",
+                governor.level(),
+                governor.frontier().top(),
+                governor.current().setting
+            ));
+            for change in governor.changes().iter().rev().take(4) {
+                ui.small(format!("frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason));
+            }
+        }
+        None => {
+            ui.label("governor: off");
+        }
+    }
 }
 
 /// The panel's name of a buffer view.

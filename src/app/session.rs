@@ -6,13 +6,14 @@ use crate::app::governor::{Frontier, Governor, GovernorConfig};
 use crate::app::window::{run_window, WindowOptions};
 use crate::app::{open_headset, BufferView, FrameLoop, HeadsetChoice, HeadsetError, RunSummary};
 use crate::render::error::{Error, Result};
-use crate::render::gpu::BackendChoice;
-use crate::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
+use crate::render::gpu::{BackendChoice, Gpu};
+use crate::render::renderer::{Renderer, DEFAULT_FRAMES_IN_FLIGHT};
 use crate::render::scene::Scene;
 use crate::render::settings::{DisplayMode, Settings};
 use crate::xr::simulated::motion::HeadMotion;
 use crate::xr::simulated::reproject::ReprojectionMode;
 use crate::xr::simulated::{SimulatedOptions, TimeMode};
+use crate::xr::Headset;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -143,6 +144,30 @@ pub fn run_session(
     interrupt: Arc<AtomicBool>,
 ) -> std::result::Result<RunSummary, SessionError> {
     let (settings, size) = session_settings(settings, options)?;
+    check_options(options)?;
+    let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };
+    let frames = options.frames.or((options.display == DisplayMode::None).then_some(600));
+    let simulated = simulated_options(scene, &settings, options, frames);
+    let (mut headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
+    log::info!("headset: {message}");
+    let renderer = match renderer_unless_interrupted(&gpu, scene, &settings, headset.as_ref(), &interrupt) {
+        Err(Error::Interrupted) => return end_before_frames(headset.as_mut(), &gpu, &settings, options),
+        renderer => renderer?,
+    };
+    let mut frame_loop = FrameLoop::with_renderer(gpu, renderer, headset);
+    frame_loop.frame_limit = frames;
+    frame_loop.exit_requested = interrupt;
+    frame_loop.renderer.set_frames_in_flight(options.frames_in_flight);
+    if let Some(governor) = governor {
+        log_governor(&governor);
+        frame_loop.set_governor(governor)?;
+    }
+    run_frames(frame_loop, scene, options)
+}
+
+/// Refuses the options that cannot go together or are out of range: a buffer view or a
+/// screenshot without a window, a frame count, a virtual render time.
+fn check_options(options: &RunOptions) -> std::result::Result<(), SessionError> {
     if options.display == DisplayMode::None && options.show != BufferView::Eyes {
         return Err(SessionError::ViewNeedsWindow(options.show));
     }
@@ -155,9 +180,18 @@ pub fn run_session(
     if !options.virtual_time.is_empty() {
         crate::xr::simulated::check_virtual_render_ms(&options.virtual_time).map_err(SessionError::VirtualTime)?;
     }
-    let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };
-    let frames = options.frames.or((options.display == DisplayMode::None).then_some(600));
-    let simulated = SimulatedOptions {
+    Ok(())
+}
+
+/// The simulated headset's options (used when it stands in for OpenXR), stopping after
+/// `frames` if given.
+fn simulated_options(
+    scene: &Scene,
+    settings: &Settings,
+    options: &RunOptions,
+    frames: Option<u64>,
+) -> SimulatedOptions {
+    SimulatedOptions {
         profile: settings.profile,
         near: settings.near,
         path: scene.head.clone(),
@@ -170,42 +204,61 @@ pub fn run_session(
         reprojection: options.reprojection,
         compose: options.display == DisplayMode::Mirror,
         frames,
-    };
-    let (mut headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
-    log::info!("headset: {message}");
+    }
+}
+
+/// The session's renderer, or [`Error::Interrupted`] when `interrupt` is set before or
+/// while it is built.
+fn renderer_unless_interrupted(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    settings: &Settings,
+    headset: &dyn Headset,
+    interrupt: &Arc<AtomicBool>,
+) -> Result<Renderer> {
     // Interrupted while the headset opened, or while the renderer compiled its pipelines
     // (up to 2 s on a CPU adapter; the interrupt cuts that short): end the session now.
     gpu.cancel_builds_on(interrupt.clone());
-    let renderer = if interrupt.load(Ordering::Relaxed) {
+    if interrupt.load(Ordering::Relaxed) {
         Err(Error::Interrupted)
     } else {
-        FrameLoop::renderer_for(&gpu, scene, &settings, headset.as_ref())
-    };
-    let renderer = match renderer {
-        Err(Error::Interrupted) => {
-            let state = headset.session_state();
-            headset.request_exit();
-            while headset.wait_frame(&gpu)?.is_some_and(|request| headset.submit(&gpu, &request, None).is_ok()) {}
-            headset.end(&gpu)?;
-            return Ok(RunSummary::before_frames(headset.as_ref(), &gpu, &settings, state, options.frames_in_flight));
-        }
-        renderer => renderer?,
-    };
-    let mut frame_loop = FrameLoop::with_renderer(gpu, renderer, headset);
-    frame_loop.frame_limit = frames;
-    frame_loop.exit_requested = interrupt;
-    frame_loop.renderer.set_frames_in_flight(options.frames_in_flight);
-    if let Some(governor) = governor {
-        let frontier = governor.frontier();
-        log::info!(
-            "governor: on, {} levels from {} to {}; starting at {}",
-            frontier.len(),
-            frontier.levels()[0].setting,
-            frontier.levels()[frontier.top()].setting,
-            governor.current().setting
-        );
-        frame_loop.set_governor(governor)?;
+        FrameLoop::renderer_for(gpu, scene, settings, headset)
     }
+}
+
+/// Ends an interrupted session before its first frame: asks the headset to exit, submits
+/// empty frames until it does, and returns the summary of the state it was in.
+fn end_before_frames(
+    headset: &mut dyn Headset,
+    gpu: &Arc<Gpu>,
+    settings: &Settings,
+    options: &RunOptions,
+) -> std::result::Result<RunSummary, SessionError> {
+    let state = headset.session_state();
+    headset.request_exit();
+    while headset.wait_frame(gpu)?.is_some_and(|request| headset.submit(gpu, &request, None).is_ok()) {}
+    headset.end(gpu)?;
+    Ok(RunSummary::before_frames(headset, gpu, settings, state, options.frames_in_flight))
+}
+
+/// Logs the governor's frontier and starting level.
+fn log_governor(governor: &Governor) {
+    let frontier = governor.frontier();
+    log::info!(
+        "governor: on, {} levels from {} to {}; starting at {}",
+        frontier.len(),
+        frontier.levels()[0].setting,
+        frontier.levels()[frontier.top()].setting,
+        governor.current().setting
+    );
+}
+
+/// Runs the frame loop to its end: headless, or in the desktop window.
+fn run_frames(
+    mut frame_loop: FrameLoop,
+    scene: &Scene,
+    options: &RunOptions,
+) -> std::result::Result<RunSummary, SessionError> {
     if options.display == DisplayMode::None {
         while frame_loop.step()?.is_some() {}
         frame_loop.end()?;

@@ -15,9 +15,9 @@
 //! f32.
 
 use crate::render::error::{Error, Result};
-use crate::render::scene::{AlphaMode, Interpolation, Light, Scene, Texture, Track};
+use crate::render::scene::{AlphaMode, Interpolation, Light, Mesh, Scene, Texture, Track};
 use crate::render::stereo::HeadPose;
-use glam::{DMat4, DQuat, DVec3, Vec3};
+use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -90,6 +90,7 @@ impl Default for WriteOptions {
 }
 
 /// The binary buffer being filled, and the JSON arrays that point into it.
+#[derive(Default)]
 struct Builder {
     bin: Vec<u8>,
     views: Vec<Value>,
@@ -118,8 +119,80 @@ impl Builder {
         self.accessors.len() - 1
     }
 
+    /// Appends an f32 accessor over `values` and returns its index.
     fn floats(&mut self, values: &[f32], kind: &str, count: usize, extra: Value) -> usize {
         self.accessor(bytemuck::cast_slice(values), FLOAT, kind, count, extra)
+    }
+
+    /// A primitive's `attributes`: positions with their bounds, normals if asked for, and
+    /// texture coordinates for a textured material.
+    fn attributes(&mut self, v: &MeshVertices, textured: bool, options: &WriteOptions) -> Value {
+        let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        v.positions.iter().for_each(|p| {
+            min = min.min(*p);
+            max = max.max(*p);
+        });
+        let flat: Vec<f32> = v.positions.iter().flat_map(|p| p.to_array()).collect();
+        let count = v.positions.len();
+        let mut attributes = json!({
+            "POSITION": self.floats(&flat, "VEC3", count, json!({ "min": min.to_array(), "max": max.to_array() }))
+        });
+        if options.normals {
+            let flat: Vec<f32> = v.normals.iter().flat_map(|n| n.to_array()).collect();
+            attributes["NORMAL"] = json!(self.floats(&flat, "VEC3", count, json!({})));
+        }
+        if textured && v.uvs.len() == count {
+            attributes["TEXCOORD_0"] = json!(self.texcoords(&v.uvs, options.texcoords));
+        }
+        attributes
+    }
+
+    /// Appends an accessor over texture coordinates stored as `storage` and returns its index.
+    fn texcoords(&mut self, uvs: &[Vec2], storage: TexcoordType) -> usize {
+        let count = uvs.len();
+        match storage {
+            TexcoordType::F32 => {
+                let flat: Vec<f32> = uvs.iter().flat_map(|t| t.to_array()).collect();
+                self.floats(&flat, "VEC2", count, json!({}))
+            }
+            TexcoordType::U8Normalized => {
+                let q: Vec<u8> =
+                    uvs.iter().flat_map(|t| t.to_array()).map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8).collect();
+                // Each element padded to 4 bytes, as the spec requires of vertex attributes.
+                let padded: Vec<u8> = q.chunks_exact(2).flat_map(|c| [c[0], c[1], 0, 0]).collect();
+                let view = self.view(&padded);
+                self.views[view]["byteStride"] = json!(4);
+                self.accessors.push(json!({ "bufferView": view, "componentType": UNSIGNED_BYTE, "type": "VEC2", "count": count, "normalized": true }));
+                self.accessors.len() - 1
+            }
+            TexcoordType::U16Normalized => {
+                let q: Vec<u16> = uvs
+                    .iter()
+                    .flat_map(|t| t.to_array())
+                    .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16)
+                    .collect();
+                self.accessor(bytemuck::cast_slice(&q), UNSIGNED_SHORT, "VEC2", count, json!({ "normalized": true }))
+            }
+        }
+    }
+
+    /// Appends an accessor over `indices` stored as `t` (U8, U16 or U32) and returns its index.
+    fn indices(&mut self, indices: &[u32], t: IndexType) -> usize {
+        let n = indices.len();
+        match t {
+            IndexType::U8 => self.accessor(
+                &indices.iter().map(|&i| i as u8).collect::<Vec<_>>(),
+                UNSIGNED_BYTE,
+                "SCALAR",
+                n,
+                json!({}),
+            ),
+            IndexType::U16 => {
+                let v: Vec<u16> = indices.iter().map(|&i| i as u16).collect();
+                self.accessor(bytemuck::cast_slice(&v), UNSIGNED_SHORT, "SCALAR", n, json!({}))
+            }
+            _ => self.accessor(bytemuck::cast_slice(indices), UNSIGNED_INT, "SCALAR", n, json!({})),
+        }
     }
 }
 
@@ -132,318 +205,394 @@ const UNSIGNED_INT: u32 = 5125;
 pub fn write(scene: &Scene, path: &Path, options: &WriteOptions) -> Result<()> {
     let glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let directory = path.parent().unwrap_or(Path::new(""));
-    let output =
-        |file: &Path, e: &dyn std::fmt::Display| Error::Output { path: file.to_path_buf(), message: e.to_string() };
-    let mut b = Builder { bin: Vec::new(), views: Vec::new(), accessors: Vec::new() };
-    let mut extensions_used: Vec<&str> = Vec::new();
+    let files = SideFiles { path, directory: path.parent().unwrap_or(Path::new("")), stem };
+    let mut d = Document::default();
+    d.add_materials(scene, options.images, &files)?;
+    let trs_of = d.add_nodes(scene);
+    for mesh in &scene.meshes {
+        d.add_mesh(scene, mesh, options, &trs_of)?;
+    }
+    d.add_animation(scene, &trs_of);
+    d.add_lights(scene);
+    d.add_camera(options.camera);
+    let buffer = d.buffer_json(glb, options.buffers, &files)?;
+    let bin = std::mem::take(&mut d.b.bin);
+    let root = validated(d.into_json(&scene.name, buffer))?;
+    let bytes = file_bytes(&root, glb, bin, path)?;
+    std::fs::write(path, bytes).map_err(|e| output(path, &e))
+}
 
-    // Materials and their images.
-    let mut images = Vec::new();
-    let mut materials = Vec::new();
-    for (i, m) in scene.materials.iter().enumerate() {
-        let mut pbr = json!({
-            "baseColorFactor": [m.diffuse.x, m.diffuse.y, m.diffuse.z, m.alpha],
-            "metallicFactor": 0.0,
-            "roughnessFactor": 1.0,
-        });
-        if let Some(texture) = &m.diffuse_texture {
-            let png = encode_png(texture).map_err(|e| output(path, &e))?;
-            let image = match options.images {
-                Storage::Embedded => json!({ "bufferView": b.view(&png), "mimeType": "image/png" }),
-                Storage::DataUri => json!({ "uri": format!("data:image/png;base64,{}", encode_base64(&png)) }),
-                Storage::External => {
-                    let name = format!("{stem}_image{i}.png");
-                    std::fs::write(directory.join(&name), &png).map_err(|e| output(&directory.join(&name), &e))?;
-                    json!({ "uri": name })
+/// The error of a file that could not be written.
+fn output(file: &Path, e: &dyn std::fmt::Display) -> Error {
+    Error::Output { path: file.to_path_buf(), message: e.to_string() }
+}
+
+/// Where the asset goes: its path, and the folder and stem of the files written beside it.
+struct SideFiles<'a> {
+    path: &'a Path,
+    directory: &'a Path,
+    stem: String,
+}
+
+impl SideFiles<'_> {
+    /// Writes `bytes` as the side file `name` beside the asset.
+    fn write(&self, name: &str, bytes: &[u8]) -> Result<()> {
+        std::fs::write(self.directory.join(name), bytes).map_err(|e| output(&self.directory.join(name), &e))
+    }
+}
+
+/// A mesh's vertex data as written: f32 world positions, and with
+/// [`IndexType::NonIndexed`] three vertices per triangle.
+struct MeshVertices {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    indices: Vec<u32>,
+}
+
+/// The document's JSON arrays as they are filled, and the buffer they point into.
+#[derive(Default)]
+struct Document {
+    b: Builder,
+    extensions_used: Vec<&'static str>,
+    images: Vec<Value>,
+    materials: Vec<Value>,
+    nodes: Vec<Value>,
+    roots: Vec<usize>,
+    meshes: Vec<Value>,
+    channels: Vec<Value>,
+    samplers: Vec<Value>,
+    lights: Vec<Value>,
+    cameras: Vec<Value>,
+}
+
+impl Document {
+    /// Appends `node` under glTF node `parent` (a scene root without one) and returns its index.
+    fn add_node(&mut self, node: Value, parent: Option<usize>) -> usize {
+        self.nodes.push(node);
+        let child = self.nodes.len() - 1;
+        match parent {
+            Some(p) => {
+                let children = self.nodes[p].as_object_mut().map(|o| o.entry("children").or_insert(json!([])));
+                if let Some(Value::Array(c)) = children {
+                    c.push(json!(child));
                 }
-            };
-            images.push(image);
-            pbr["baseColorTexture"] = json!({ "index": images.len() - 1 });
+            }
+            None => self.roots.push(child),
         }
-        let mut material = json!({ "name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": true });
-        let peak = m.emissive.max_element();
+        child
+    }
+
+    /// Adds every material, and the images of those with a texture.
+    fn add_materials(&mut self, scene: &Scene, images: Storage, files: &SideFiles) -> Result<()> {
+        for (i, m) in scene.materials.iter().enumerate() {
+            let mut pbr = json!({
+                "baseColorFactor": [m.diffuse.x, m.diffuse.y, m.diffuse.z, m.alpha],
+                "metallicFactor": 0.0,
+                "roughnessFactor": 1.0,
+            });
+            if let Some(texture) = &m.diffuse_texture {
+                let image = self.image_json(texture, i, images, files)?;
+                self.images.push(image);
+                pbr["baseColorTexture"] = json!({ "index": self.images.len() - 1 });
+            }
+            let mut material = json!({ "name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": true });
+            self.set_emission(&mut material, m.emissive);
+            set_alpha_mode(&mut material, m.alpha_mode);
+            self.materials.push(material);
+        }
+        Ok(())
+    }
+
+    /// Material `i`'s texture as an image, stored where `storage` says.
+    fn image_json(&mut self, texture: &Texture, i: usize, storage: Storage, files: &SideFiles) -> Result<Value> {
+        let png = encode_png(texture).map_err(|e| output(files.path, &e))?;
+        Ok(match storage {
+            Storage::Embedded => json!({ "bufferView": self.b.view(&png), "mimeType": "image/png" }),
+            Storage::DataUri => json!({ "uri": format!("data:image/png;base64,{}", encode_base64(&png)) }),
+            Storage::External => {
+                let name = format!("{}_image{i}.png", files.stem);
+                files.write(&name, &png)?;
+                json!({ "uri": name })
+            }
+        })
+    }
+
+    /// Sets `material`'s emission, with the strength extension where it exceeds 1.
+    fn set_emission(&mut self, material: &mut Value, emissive: Vec3) {
+        let peak = emissive.max_element();
         if peak > 0.0 {
             // emissiveFactor is limited to [0, 1]: the rest goes into the strength.
             let strength = peak.max(1.0);
-            let factor = m.emissive / strength;
+            let factor = emissive / strength;
             material["emissiveFactor"] = json!([factor.x, factor.y, factor.z]);
             if strength > 1.0 {
                 material["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": strength } });
-                extensions_used.push("KHR_materials_emissive_strength");
+                self.extensions_used.push("KHR_materials_emissive_strength");
             }
         }
-        match m.alpha_mode {
-            AlphaMode::Opaque => material["alphaMode"] = json!("OPAQUE"),
-            AlphaMode::Mask { cutoff } => {
-                material["alphaMode"] = json!("MASK");
-                material["alphaCutoff"] = json!(cutoff);
-            }
-            AlphaMode::Blend => material["alphaMode"] = json!("BLEND"),
-        }
-        materials.push(material);
-    }
-    let textures: Vec<Value> = (0..images.len()).map(|i| json!({ "source": i })).collect();
-
-    // Nodes: vrao node k is glTF node trs[k] (under a matrix node when it has a base).
-    let mut nodes: Vec<Value> = Vec::new();
-    let mut roots: Vec<usize> = Vec::new();
-    let mut trs_of = Vec::with_capacity(scene.nodes.len());
-    let add_child = |nodes: &mut Vec<Value>, parent: Option<usize>, child: usize, roots: &mut Vec<usize>| match parent {
-        Some(p) => {
-            let children = nodes[p].as_object_mut().map(|o| o.entry("children").or_insert(json!([])));
-            if let Some(Value::Array(c)) = children {
-                c.push(json!(child));
-            }
-        }
-        None => roots.push(child),
-    };
-    for node in &scene.nodes {
-        let parent = node.parent.and_then(|p| trs_of.get(p).copied());
-        let mut attach = parent;
-        if node.base != DMat4::IDENTITY {
-            nodes.push(json!({ "name": format!("{} base", node.name), "matrix": node.base.as_mat4().to_cols_array() }));
-            let child = nodes.len() - 1;
-            add_child(&mut nodes, attach, child, &mut roots);
-            attach = Some(nodes.len() - 1);
-        }
-        let r = node.rest;
-        nodes.push(json!({
-            "name": node.name,
-            "translation": r.translation.as_vec3().to_array(),
-            "rotation": r.rotation.as_quat().normalize().to_array(),
-            "scale": r.scale.as_vec3().to_array(),
-        }));
-        let child = nodes.len() - 1;
-        add_child(&mut nodes, attach, child, &mut roots);
-        trs_of.push(nodes.len() - 1);
     }
 
-    // Meshes: one glTF mesh with one primitive each, on a node of its own.
-    let mut meshes = Vec::new();
-    for mesh in &scene.meshes {
-        let material = &scene.materials.get(mesh.material);
-        let textured = material.is_some_and(|m| m.diffuse_texture.is_some());
-        let mut positions = world_f32(mesh.origin, &mesh.positions);
-        let mut normals = mesh.normals.clone();
-        let mut uvs = mesh.uvs.clone();
-        let mut indices = mesh.indices.clone();
-        if options.indices == IndexType::NonIndexed {
-            positions = indices.iter().map(|&i| positions[i as usize]).collect();
-            normals = indices.iter().map(|&i| normals[i as usize]).collect();
-            uvs = indices.iter().map(|&i| uvs[i as usize]).collect();
-            indices = (0..positions.len() as u32).collect();
-        }
-        let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        positions.iter().for_each(|p| {
-            min = min.min(*p);
-            max = max.max(*p);
-        });
-        let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
-        let count = positions.len();
-        let mut attributes = json!({
-            "POSITION": b.floats(&flat, "VEC3", count, json!({ "min": min.to_array(), "max": max.to_array() }))
-        });
-        if options.normals {
-            let flat: Vec<f32> = normals.iter().flat_map(|n| n.to_array()).collect();
-            attributes["NORMAL"] = json!(b.floats(&flat, "VEC3", count, json!({})));
-        }
-        if textured && uvs.len() == count {
-            attributes["TEXCOORD_0"] = json!(match options.texcoords {
-                TexcoordType::F32 => {
-                    let flat: Vec<f32> = uvs.iter().flat_map(|t| t.to_array()).collect();
-                    b.floats(&flat, "VEC2", count, json!({}))
-                }
-                TexcoordType::U8Normalized => {
-                    let q: Vec<u8> = uvs
-                        .iter()
-                        .flat_map(|t| t.to_array())
-                        .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
-                        .collect();
-                    // Each element padded to 4 bytes, as the spec requires of vertex attributes.
-                    let padded: Vec<u8> = q.chunks_exact(2).flat_map(|c| [c[0], c[1], 0, 0]).collect();
-                    let view = b.view(&padded);
-                    b.views[view]["byteStride"] = json!(4);
-                    b.accessors.push(json!({ "bufferView": view, "componentType": UNSIGNED_BYTE, "type": "VEC2", "count": count, "normalized": true }));
-                    b.accessors.len() - 1
-                }
-                TexcoordType::U16Normalized => {
-                    let q: Vec<u16> = uvs
-                        .iter()
-                        .flat_map(|t| t.to_array())
-                        .map(|c| (c.clamp(0.0, 1.0) * 65535.0).round() as u16)
-                        .collect();
-                    b.accessor(bytemuck::cast_slice(&q), UNSIGNED_SHORT, "VEC2", count, json!({ "normalized": true }))
-                }
+    /// Adds the node hierarchy and returns the glTF TRS node of each vrao node.
+    fn add_nodes(&mut self, scene: &Scene) -> Vec<usize> {
+        // Nodes: vrao node k is glTF node trs[k] (under a matrix node when it has a base).
+        let mut trs_of = Vec::with_capacity(scene.nodes.len());
+        for node in &scene.nodes {
+            let mut attach = node.parent.and_then(|p| trs_of.get(p).copied());
+            if node.base != DMat4::IDENTITY {
+                let base =
+                    json!({ "name": format!("{} base", node.name), "matrix": node.base.as_mat4().to_cols_array() });
+                attach = Some(self.add_node(base, attach));
+            }
+            let r = node.rest;
+            let trs = json!({
+                "name": node.name,
+                "translation": r.translation.as_vec3().to_array(),
+                "rotation": r.rotation.as_quat().normalize().to_array(),
+                "scale": r.scale.as_vec3().to_array(),
             });
+            trs_of.push(self.add_node(trs, attach));
         }
+        trs_of
+    }
+
+    /// Adds `mesh` as one glTF mesh with one primitive, on a node of its own.
+    fn add_mesh(&mut self, scene: &Scene, mesh: &Mesh, options: &WriteOptions, trs_of: &[usize]) -> Result<()> {
+        let textured = scene.materials.get(mesh.material).is_some_and(|m| m.diffuse_texture.is_some());
+        let v = mesh_vertices(mesh, options.indices);
+        let count = v.positions.len();
+        let attributes = self.b.attributes(&v, textured, options);
         let mut primitive = json!({ "attributes": attributes, "mode": 4, "material": mesh.material });
-        let index_type = match options.indices {
-            IndexType::NonIndexed => None,
-            IndexType::Smallest if count <= 256 => Some(IndexType::U8),
-            IndexType::Smallest if count <= 65536 => Some(IndexType::U16),
-            IndexType::Smallest => Some(IndexType::U32),
-            other => Some(other),
-        };
-        if let Some(t) = index_type {
-            let fits = match t {
-                IndexType::U8 => count <= 256,
-                IndexType::U16 => count <= 65536,
-                _ => true,
-            };
-            if !fits {
+        if let Some(t) = index_type(options.indices, count) {
+            if !index_fits(t, count) {
                 return Err(Error::input(format!("mesh '{}': {count} vertices do not fit {t:?} indices", mesh.name)));
             }
-            let n = indices.len();
-            primitive["indices"] = json!(match t {
-                IndexType::U8 => b.accessor(
-                    &indices.iter().map(|&i| i as u8).collect::<Vec<_>>(),
-                    UNSIGNED_BYTE,
-                    "SCALAR",
-                    n,
-                    json!({})
-                ),
-                IndexType::U16 => {
-                    let v: Vec<u16> = indices.iter().map(|&i| i as u16).collect();
-                    b.accessor(bytemuck::cast_slice(&v), UNSIGNED_SHORT, "SCALAR", n, json!({}))
-                }
-                _ => b.accessor(bytemuck::cast_slice(&indices), UNSIGNED_INT, "SCALAR", n, json!({})),
-            });
+            primitive["indices"] = json!(self.b.indices(&v.indices, t));
         }
-        meshes.push(json!({ "name": mesh.name, "primitives": [primitive] }));
-        nodes.push(json!({ "name": mesh.name, "mesh": meshes.len() - 1 }));
+        self.meshes.push(json!({ "name": mesh.name, "primitives": [primitive] }));
         let parent = mesh.node.and_then(|k| trs_of.get(k).copied());
-        let child = nodes.len() - 1;
-        add_child(&mut nodes, parent, child, &mut roots);
+        self.add_node(json!({ "name": mesh.name, "mesh": self.meshes.len() - 1 }), parent);
+        Ok(())
     }
 
-    // Animation: one channel per animated property.
-    let mut channels = Vec::new();
-    let mut samplers = Vec::new();
-    for (k, node) in scene.nodes.iter().enumerate() {
-        let target = trs_of[k];
-        if let Some(t) = &node.tracks.translation {
-            let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
-            samplers.push(sampler(&mut b, t, &values, "VEC3"));
-            channels
-                .push(json!({ "sampler": samplers.len() - 1, "target": { "node": target, "path": "translation" } }));
-        }
-        if let Some(t) = &node.tracks.rotation {
-            let values: Vec<f32> = t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
-            samplers.push(sampler(&mut b, t, &values, "VEC4"));
-            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": target, "path": "rotation" } }));
-        }
-        if let Some(t) = &node.tracks.scale {
-            let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
-            samplers.push(sampler(&mut b, t, &values, "VEC3"));
-            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": target, "path": "scale" } }));
-        }
-    }
-
-    // Lights shine along their node's −Z.
-    let mut lights = Vec::new();
-    for light in &scene.lights {
-        let (kind, position, direction, color, intensity) = match *light {
-            Light::Directional { direction, color, intensity } => {
-                ("directional", DVec3::ZERO, direction, color, intensity)
+    /// Adds the animation: one channel per animated property.
+    fn add_animation(&mut self, scene: &Scene, trs_of: &[usize]) {
+        for (k, node) in scene.nodes.iter().enumerate() {
+            let target = trs_of[k];
+            if let Some(t) = &node.tracks.translation {
+                let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+                self.add_channel(Channel {
+                    track: t,
+                    values: &values,
+                    kind: "VEC3",
+                    node: target,
+                    path: "translation",
+                });
             }
-            Light::Point { position, color, intensity } => ("point", position, Vec3::NEG_Z, color, intensity),
-            Light::Spot { position, direction, color, intensity, .. } => {
-                ("spot", position, direction, color, intensity)
+            if let Some(t) = &node.tracks.rotation {
+                let values: Vec<f32> = t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
+                self.add_channel(Channel { track: t, values: &values, kind: "VEC4", node: target, path: "rotation" });
             }
-        };
-        let mut entry = json!({ "type": kind, "color": color.to_array(), "intensity": intensity });
-        if let Light::Spot { inner_cone, outer_cone, .. } = *light {
-            entry["spot"] = json!({ "innerConeAngle": inner_cone, "outerConeAngle": outer_cone });
+            if let Some(t) = &node.tracks.scale {
+                let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+                self.add_channel(Channel { track: t, values: &values, kind: "VEC3", node: target, path: "scale" });
+            }
         }
-        lights.push(entry);
-        let rotation = DQuat::from_rotation_arc(DVec3::NEG_Z, direction.as_dvec3().normalize_or(DVec3::NEG_Z));
-        nodes.push(json!({
-            "name": format!("light {}", lights.len() - 1),
-            "translation": position.as_vec3().to_array(),
-            "rotation": rotation.as_quat().normalize().to_array(),
-            "extensions": { "KHR_lights_punctual": { "light": lights.len() - 1 } },
-        }));
-        roots.push(nodes.len() - 1);
-    }
-    if !lights.is_empty() {
-        extensions_used.push("KHR_lights_punctual");
     }
 
-    let mut cameras = Vec::new();
-    if let Some(pose) = options.camera {
-        cameras.push(json!({ "type": "perspective", "perspective": { "yfov": 1.6, "znear": 0.05 } }));
-        nodes.push(json!({
-            "name": "camera",
-            "camera": 0,
-            "translation": pose.position.as_vec3().to_array(),
-            "rotation": pose.orientation.as_quat().normalize().to_array(),
-        }));
-        roots.push(nodes.len() - 1);
+    /// Adds one animation channel and its sampler.
+    fn add_channel<T>(&mut self, c: Channel<T>) {
+        self.samplers.push(sampler(&mut self.b, c.track, c.values, c.kind));
+        self.channels.push(json!({ "sampler": self.samplers.len() - 1, "target": { "node": c.node, "path": c.path } }));
     }
 
-    while !b.bin.len().is_multiple_of(4) {
-        b.bin.push(0);
-    }
-    let buffer = match (glb, options.buffers) {
-        (true, _) => json!({ "byteLength": b.bin.len() }),
-        (false, Storage::External) => {
-            let name = format!("{stem}.bin");
-            std::fs::write(directory.join(&name), &b.bin).map_err(|e| output(&directory.join(&name), &e))?;
-            json!({ "byteLength": b.bin.len(), "uri": name })
+    /// Adds every light (`KHR_lights_punctual`), each on a root node of its own.
+    fn add_lights(&mut self, scene: &Scene) {
+        for light in &scene.lights {
+            let (entry, position, direction) = light_json(light);
+            self.lights.push(entry);
+            // Lights shine along their node's −Z.
+            let rotation = DQuat::from_rotation_arc(DVec3::NEG_Z, direction.as_dvec3().normalize_or(DVec3::NEG_Z));
+            let node = json!({
+                "name": format!("light {}", self.lights.len() - 1),
+                "translation": position.as_vec3().to_array(),
+                "rotation": rotation.as_quat().normalize().to_array(),
+                "extensions": { "KHR_lights_punctual": { "light": self.lights.len() - 1 } },
+            });
+            self.add_node(node, None);
         }
-        (false, _) => json!({
-            "byteLength": b.bin.len(),
-            "uri": format!("data:application/octet-stream;base64,{}", encode_base64(&b.bin)),
-        }),
+        if !self.lights.is_empty() {
+            self.extensions_used.push("KHR_lights_punctual");
+        }
+    }
+
+    /// Adds a camera at `pose`, if any, on a root node of its own.
+    fn add_camera(&mut self, pose: Option<HeadPose>) {
+        if let Some(pose) = pose {
+            self.cameras.push(json!({ "type": "perspective", "perspective": { "yfov": 1.6, "znear": 0.05 } }));
+            let node = json!({
+                "name": "camera",
+                "camera": 0,
+                "translation": pose.position.as_vec3().to_array(),
+                "rotation": pose.orientation.as_quat().normalize().to_array(),
+            });
+            self.add_node(node, None);
+        }
+    }
+
+    /// Pads the binary buffer to 4 bytes and returns its JSON, writing it as a side file
+    /// or encoding it as a data URI where a `.gltf` asks for it.
+    fn buffer_json(&mut self, glb: bool, storage: Storage, files: &SideFiles) -> Result<Value> {
+        let bin = &mut self.b.bin;
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        Ok(match (glb, storage) {
+            (true, _) => json!({ "byteLength": bin.len() }),
+            (false, Storage::External) => {
+                let name = format!("{}.bin", files.stem);
+                files.write(&name, bin)?;
+                json!({ "byteLength": bin.len(), "uri": name })
+            }
+            (false, _) => json!({
+                "byteLength": bin.len(),
+                "uri": format!("data:application/octet-stream;base64,{}", encode_base64(bin)),
+            }),
+        })
+    }
+
+    /// The whole glTF JSON document, with `buffer` as its one buffer; lists that would be
+    /// empty are left out.
+    fn into_json(mut self, scene_name: &str, buffer: Value) -> Value {
+        let textures: Vec<Value> = (0..self.images.len()).map(|i| json!({ "source": i })).collect();
+        let mut document = json!({
+            "asset": { "version": "2.0", "generator": "vrao" },
+            "scene": 0,
+            "scenes": [{ "name": scene_name, "nodes": self.roots }],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "accessors": self.b.accessors,
+            "bufferViews": self.b.views,
+            "buffers": [buffer],
+        });
+        let object = document.as_object_mut().expect("an object");
+        for (key, list) in [("images", self.images), ("textures", textures), ("cameras", self.cameras)] {
+            if !list.is_empty() {
+                object.insert(key.into(), Value::Array(list));
+            }
+        }
+        if !self.channels.is_empty() {
+            let animation = json!({ "name": "motion", "channels": self.channels, "samplers": self.samplers });
+            object.insert("animations".into(), json!([animation]));
+        }
+        if !self.lights.is_empty() {
+            object.insert("extensions".into(), json!({ "KHR_lights_punctual": { "lights": self.lights } }));
+        }
+        if !self.extensions_used.is_empty() {
+            self.extensions_used.dedup();
+            object.insert("extensionsUsed".into(), json!(self.extensions_used));
+        }
+        document
+    }
+}
+
+/// One animated property of one node, for [`Document::add_channel`].
+struct Channel<'a, T> {
+    track: &'a Track<T>,
+    /// The track's values, flattened to f32.
+    values: &'a [f32],
+    /// The accessor type of one value.
+    kind: &'a str,
+    /// The glTF node it animates.
+    node: usize,
+    /// The property it animates.
+    path: &'a str,
+}
+
+/// Sets `material`'s alpha mode, and its cutoff for a mask.
+fn set_alpha_mode(material: &mut Value, mode: AlphaMode) {
+    match mode {
+        AlphaMode::Opaque => material["alphaMode"] = json!("OPAQUE"),
+        AlphaMode::Mask { cutoff } => {
+            material["alphaMode"] = json!("MASK");
+            material["alphaCutoff"] = json!(cutoff);
+        }
+        AlphaMode::Blend => material["alphaMode"] = json!("BLEND"),
+    }
+}
+
+/// `mesh`'s vertices in f32 world space, repeated per triangle for non-indexed storage.
+fn mesh_vertices(mesh: &Mesh, index_type: IndexType) -> MeshVertices {
+    let mut positions = world_f32(mesh.origin, &mesh.positions);
+    let mut normals = mesh.normals.clone();
+    let mut uvs = mesh.uvs.clone();
+    let mut indices = mesh.indices.clone();
+    if index_type == IndexType::NonIndexed {
+        positions = indices.iter().map(|&i| positions[i as usize]).collect();
+        normals = indices.iter().map(|&i| normals[i as usize]).collect();
+        uvs = indices.iter().map(|&i| uvs[i as usize]).collect();
+        indices = (0..positions.len() as u32).collect();
+    }
+    MeshVertices { positions, normals, uvs, indices }
+}
+
+/// The index type a mesh of `count` vertices is written with (`None`: non-indexed).
+fn index_type(asked: IndexType, count: usize) -> Option<IndexType> {
+    match asked {
+        IndexType::NonIndexed => None,
+        IndexType::Smallest if count <= 256 => Some(IndexType::U8),
+        IndexType::Smallest if count <= 65536 => Some(IndexType::U16),
+        IndexType::Smallest => Some(IndexType::U32),
+        other => Some(other),
+    }
+}
+
+/// Whether indices of type `t` can address `count` vertices.
+fn index_fits(t: IndexType, count: usize) -> bool {
+    match t {
+        IndexType::U8 => count <= 256,
+        IndexType::U16 => count <= 65536,
+        _ => true,
+    }
+}
+
+/// A light's `KHR_lights_punctual` entry, with the position and direction of its node.
+fn light_json(light: &Light) -> (Value, DVec3, Vec3) {
+    let (kind, position, direction, color, intensity) = match *light {
+        Light::Directional { direction, color, intensity } => ("directional", DVec3::ZERO, direction, color, intensity),
+        Light::Point { position, color, intensity } => ("point", position, Vec3::NEG_Z, color, intensity),
+        Light::Spot { position, direction, color, intensity, .. } => ("spot", position, direction, color, intensity),
     };
+    let mut entry = json!({ "type": kind, "color": color.to_array(), "intensity": intensity });
+    if let Light::Spot { inner_cone, outer_cone, .. } = *light {
+        entry["spot"] = json!({ "innerConeAngle": inner_cone, "outerConeAngle": outer_cone });
+    }
+    (entry, position, direction)
+}
 
-    let mut document = json!({
-        "asset": { "version": "2.0", "generator": "vrao" },
-        "scene": 0,
-        "scenes": [{ "name": scene.name, "nodes": roots }],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": materials,
-        "accessors": b.accessors,
-        "bufferViews": b.views,
-        "buffers": [buffer],
-    });
-    let object = document.as_object_mut().expect("an object");
-    for (key, list) in [("images", images), ("textures", textures), ("cameras", cameras)] {
-        if !list.is_empty() {
-            object.insert(key.into(), Value::Array(list));
-        }
-    }
-    if !channels.is_empty() {
-        object.insert("animations".into(), json!([{ "name": "motion", "channels": channels, "samplers": samplers }]));
-    }
-    if !lights.is_empty() {
-        object.insert("extensions".into(), json!({ "KHR_lights_punctual": { "lights": lights } }));
-    }
-    if !extensions_used.is_empty() {
-        extensions_used.dedup();
-        object.insert("extensionsUsed".into(), json!(extensions_used));
-    }
-
-    // Through gltf::json and its validation: the writer's output is glTF the loader reads.
+/// `document` through `gltf::json` and its validation: the writer's output is glTF the
+/// loader reads.
+fn validated(document: Value) -> Result<::gltf::json::Root> {
     let root: ::gltf::json::Root =
         serde_json::from_value(document).map_err(|e| Error::input(format!("glTF writer built invalid JSON: {e}")))?;
-    let root = ::gltf::Document::from_json(root)
+    Ok(::gltf::Document::from_json(root)
         .map_err(|e| Error::input(format!("glTF writer built an invalid document: {e}")))?
-        .into_json();
-    let text = ::gltf::json::serialize::to_vec(&root).map_err(|e| output(path, &e))?;
-    let bytes = if glb {
-        let glb = ::gltf::binary::Glb {
-            header: ::gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
-            json: text.into(),
-            bin: Some(b.bin.into()),
-        };
-        glb.to_vec().map_err(|e| output(path, &e))?
-    } else {
-        text
+        .into_json())
+}
+
+/// The file's bytes: the serialised JSON, or a `.glb` of it and `bin`.
+fn file_bytes(root: &::gltf::json::Root, glb: bool, bin: Vec<u8>, path: &Path) -> Result<Vec<u8>> {
+    let text = ::gltf::json::serialize::to_vec(root).map_err(|e| output(path, &e))?;
+    if !glb {
+        return Ok(text);
+    }
+    let glb = ::gltf::binary::Glb {
+        header: ::gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
+        json: text.into(),
+        bin: Some(bin.into()),
     };
-    std::fs::write(path, bytes).map_err(|e| output(path, &e))
+    glb.to_vec().map_err(|e| output(path, &e))
 }
 
 /// World positions as f32 that the loaders' recentring (on the centre of their bounds)

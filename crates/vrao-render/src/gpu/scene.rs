@@ -10,7 +10,7 @@
 
 use super::kernel::{wgsl, Shader};
 use super::Gpu;
-use crate::scene::{Environment, Scene};
+use crate::scene::{Environment, Material, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
 use wgpu::util::DeviceExt;
@@ -186,128 +186,23 @@ impl GpuScene {
     pub fn upload(gpu: &Gpu, scene: &Scene) -> GpuScene {
         let bounds = scene.bounds();
         let anchor = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
-        let mut vertices = Vec::new();
-        let mut indices = Vec::new();
-        // (indices, material, object) of each draw; bind groups are made below.
-        let mut runs = Vec::new();
-        // Object slot 0 is static geometry; each animated node a mesh hangs from gets one.
-        let mut object_nodes: Vec<usize> = Vec::new();
-        for mesh in &scene.meshes {
-            let base = vertices.len() as u32;
-            let (offset, object) = match mesh.node {
-                // In the node's local frame; the object transform adds the anchor.
-                Some(node) => {
-                    let slot = object_nodes.iter().position(|&n| n == node).unwrap_or_else(|| {
-                        object_nodes.push(node);
-                        object_nodes.len() - 1
-                    });
-                    (mesh.origin.as_vec3(), slot + 1)
-                }
-                None => ((mesh.origin - anchor).as_vec3(), 0),
-            };
-            for i in 0..mesh.positions.len() {
-                vertices.push(Vertex {
-                    position: (mesh.positions[i] + offset).to_array(),
-                    normal: mesh.normals[i].to_array(),
-                    uv: mesh.uvs.get(i).copied().unwrap_or_default().to_array(),
-                });
-            }
-            let start = indices.len() as u32;
-            indices.extend(mesh.indices.iter().map(|i| i + base));
-            runs.push((start..indices.len() as u32, mesh.material, object));
-        }
-        // wgpu rejects empty buffers; an empty scene draws nothing from a dummy vertex.
-        if vertices.is_empty() {
-            vertices.push(Vertex::zeroed());
-            indices.extend([0, 0, 0]);
-        }
+        let geometry = Geometry::gather(scene, anchor);
         let device = &gpu.device;
-        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene indices"),
-            contents: bytemuck::cast_slice(&indices),
-            usage: wgpu::BufferUsages::INDEX,
-        });
+        let vertex_buffer =
+            buffer_init(device, "scene vertices", bytemuck::cast_slice(&geometry.vertices), wgpu::BufferUsages::VERTEX);
+        let index_buffer =
+            buffer_init(device, "scene indices", bytemuck::cast_slice(&geometry.indices), wgpu::BufferUsages::INDEX);
         // Each material's alpha-test cutoff, found once (it scans the texture's alpha).
         let cutoffs: Vec<Option<f32>> = scene.materials.iter().map(|m| m.alpha_cutoff()).collect();
-        let materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .zip(&cutoffs)
-            .map(|(m, cutoff)| {
-                let (texture, has_texture) = match &m.diffuse_texture {
-                    Some(t) => (rgba8_texture(gpu, &m.name, t.width, t.height, &t.rgba8), true),
-                    None => (rgba8_texture(gpu, "white", 1, 1, &[255; 4]), false),
-                };
-                let uniform = MaterialUniform {
-                    diffuse: [m.diffuse.x, m.diffuse.y, m.diffuse.z, if has_texture { 1.0 } else { 0.0 }],
-                    emission: [m.emissive.x, m.emissive.y, m.emissive.z, 0.0],
-                    alpha: [m.alpha, cutoff.unwrap_or(-1.0), 0.0, 0.0],
-                };
-                GpuMaterial {
-                    uniform: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(&m.name),
-                        contents: bytemuck::bytes_of(&uniform),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    }),
-                    texture,
-                    has_texture,
-                }
-            })
-            .collect();
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("linear repeat"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
-            ..Default::default()
-        });
-        let material_layout = material_layout(device);
-        // Every slot starts at the identity (static geometry, and moving objects until
-        // the first `set_time`) with no motion.
-        let identity = object_uniform(anchor, DMat4::from_translation(anchor), DMat4::from_translation(anchor));
-        let slots: Vec<u8> = (0..=object_nodes.len())
-            .flat_map(|_| {
-                let mut slot = bytemuck::bytes_of(&identity).to_vec();
-                slot.resize(OBJECT_STRIDE as usize, 0);
-                slot
-            })
-            .collect();
-        let objects = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene objects"),
-            contents: &slots,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        let draws = runs
-            .into_iter()
-            .map(|(range, material, object)| {
-                let m = &materials[material];
-                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("material and object"),
-                    layout: &material_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
-                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&sampler) },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                                buffer: &objects,
-                                offset: object as u64 * OBJECT_STRIDE,
-                                size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
-                            }),
-                        },
-                    ],
-                });
-                Draw { indices: range, material, object, alpha_tested: cutoffs[material].is_some(), group }
-            })
-            .collect::<Vec<_>>();
+        let materials: Vec<GpuMaterial> =
+            scene.materials.iter().zip(&cutoffs).map(|(m, &cutoff)| upload_material(gpu, m, cutoff)).collect();
+        let bindings = DrawBindings {
+            sampler: diffuse_sampler(device),
+            layout: material_layout(device),
+            objects: object_buffer(device, anchor, geometry.object_nodes.len()),
+        };
+        let draws: Vec<Draw> =
+            geometry.runs.into_iter().map(|run| bindings.draw(device, run, &materials, &cutoffs)).collect();
         let alpha_tested = draws.iter().any(|d| d.alpha_tested);
         GpuScene {
             anchor,
@@ -315,14 +210,155 @@ impl GpuScene {
             indices: index_buffer,
             draws,
             materials,
-            material_layout,
-            objects,
-            object_nodes,
+            material_layout: bindings.layout,
+            objects: bindings.objects,
+            object_nodes: geometry.object_nodes,
             alpha_tested,
             environment: environment_texture(gpu, scene.environment.as_ref()),
-            sampler,
+            sampler: bindings.sampler,
         }
     }
+}
+
+/// The indices one draw covers, with its material and object slot (bind groups come later).
+struct Run {
+    indices: std::ops::Range<u32>,
+    material: usize,
+    object: usize,
+}
+
+/// Every mesh's vertices and indices concatenated, the draws over them, and the node each
+/// moving object slot follows.
+struct Geometry {
+    vertices: Vec<Vertex>,
+    indices: Vec<u32>,
+    runs: Vec<Run>,
+    object_nodes: Vec<usize>,
+}
+
+impl Geometry {
+    /// Gathers `scene`'s meshes: static ones relative to `anchor`, moving ones in their
+    /// node's local frame.
+    fn gather(scene: &Scene, anchor: DVec3) -> Geometry {
+        let mut g = Geometry { vertices: Vec::new(), indices: Vec::new(), runs: Vec::new(), object_nodes: Vec::new() };
+        for mesh in &scene.meshes {
+            let base = g.vertices.len() as u32;
+            let (offset, object) = match mesh.node {
+                // In the node's local frame; the object transform adds the anchor.
+                Some(node) => (mesh.origin.as_vec3(), g.object_slot(node)),
+                None => ((mesh.origin - anchor).as_vec3(), 0),
+            };
+            for i in 0..mesh.positions.len() {
+                g.vertices.push(Vertex {
+                    position: (mesh.positions[i] + offset).to_array(),
+                    normal: mesh.normals[i].to_array(),
+                    uv: mesh.uvs.get(i).copied().unwrap_or_default().to_array(),
+                });
+            }
+            let start = g.indices.len() as u32;
+            g.indices.extend(mesh.indices.iter().map(|i| i + base));
+            g.runs.push(Run { indices: start..g.indices.len() as u32, material: mesh.material, object });
+        }
+        // wgpu rejects empty buffers; an empty scene draws nothing from a dummy vertex.
+        if g.vertices.is_empty() {
+            g.vertices.push(Vertex::zeroed());
+            g.indices.extend([0, 0, 0]);
+        }
+        g
+    }
+
+    /// The object slot of animated `node`, given one at its first mesh.
+    fn object_slot(&mut self, node: usize) -> usize {
+        // Object slot 0 is static geometry; each animated node a mesh hangs from gets one.
+        let slot = self.object_nodes.iter().position(|&n| n == node).unwrap_or_else(|| {
+            self.object_nodes.push(node);
+            self.object_nodes.len() - 1
+        });
+        slot + 1
+    }
+}
+
+/// What every draw's bind group binds besides its material: the layout, the diffuse
+/// sampler and the object buffer.
+struct DrawBindings {
+    sampler: wgpu::Sampler,
+    layout: wgpu::BindGroupLayout,
+    objects: wgpu::Buffer,
+}
+
+impl DrawBindings {
+    /// The draw of `run`, with the bind group of its material and object slot.
+    fn draw(&self, device: &wgpu::Device, run: Run, materials: &[GpuMaterial], cutoffs: &[Option<f32>]) -> Draw {
+        let m = &materials[run.material];
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("material and object"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.objects,
+                        offset: run.object as u64 * OBJECT_STRIDE,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
+                    }),
+                },
+            ],
+        });
+        let alpha_tested = cutoffs[run.material].is_some();
+        Draw { indices: run.indices, material: run.material, object: run.object, alpha_tested, group }
+    }
+}
+
+/// A buffer created with `contents`.
+fn buffer_init(device: &wgpu::Device, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+}
+
+/// Material `m` on the GPU: its uniform (with its alpha-test `cutoff`) and its diffuse
+/// texture, or the white placeholder.
+fn upload_material(gpu: &Gpu, m: &Material, cutoff: Option<f32>) -> GpuMaterial {
+    let (texture, has_texture) = match &m.diffuse_texture {
+        Some(t) => (rgba8_texture(gpu, &m.name, t.width, t.height, &t.rgba8), true),
+        None => (rgba8_texture(gpu, "white", 1, 1, &[255; 4]), false),
+    };
+    let uniform = MaterialUniform {
+        diffuse: [m.diffuse.x, m.diffuse.y, m.diffuse.z, if has_texture { 1.0 } else { 0.0 }],
+        emission: [m.emissive.x, m.emissive.y, m.emissive.z, 0.0],
+        alpha: [m.alpha, cutoff.unwrap_or(-1.0), 0.0, 0.0],
+    };
+    let uniform = buffer_init(&gpu.device, &m.name, bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
+    GpuMaterial { uniform, texture, has_texture }
+}
+
+/// The sampler of the materials' diffuse textures.
+fn diffuse_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("linear repeat"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+        ..Default::default()
+    })
+}
+
+/// The object buffer: slot 0 for static geometry and one per moving object, `OBJECT_STRIDE` apart.
+fn object_buffer(device: &wgpu::Device, anchor: DVec3, moving: usize) -> wgpu::Buffer {
+    // Every slot starts at the identity (static geometry, and moving objects until
+    // the first `set_time`) with no motion.
+    let identity = object_uniform(anchor, DMat4::from_translation(anchor), DMat4::from_translation(anchor));
+    let slots: Vec<u8> = (0..=moving)
+        .flat_map(|_| {
+            let mut slot = bytemuck::bytes_of(&identity).to_vec();
+            slot.resize(OBJECT_STRIDE as usize, 0);
+            slot
+        })
+        .collect();
+    buffer_init(device, "scene objects", &slots, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
 }
 
 /// An object's uniform: `world_from_local` now and in the previous frame, made relative
@@ -339,6 +375,7 @@ fn object_uniform(anchor: DVec3, world_from_local: DMat4, previous_world_from_lo
     }
 }
 
+/// An sRGB RGBA8 texture of `rgba8`, as a view.
 fn rgba8_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8]) -> wgpu::TextureView {
     let texture = gpu.device.create_texture_with_data(
         &gpu.queue,
