@@ -23,7 +23,8 @@ use std::time::{Duration, Instant};
 
 /// How long each scene's first row renders before it is measured (when the run warms up
 /// at all), and at most how many frames that takes. A GPU that idled has clocked down:
-/// on an H200 the first row's warm-up of 3 rounds left its frame at 3× every later row's.
+/// a warm-up of a few rounds left the first row far slower than every later one
+/// (docs/measurements-in-code.md, table-settle-time).
 const SETTLE_TIME: Duration = Duration::from_millis(1500);
 const SETTLE_MAX_ROUNDS: u32 = 500;
 

@@ -355,9 +355,10 @@ fn plane_offset_of(plane: TapPlane, distance: f32, k: f32) -> f32 {
 // occlusion probes compute from depth), y = its outgoing radiance in the shared-exponent
 // RGB9E5 form (9-bit mantissas, one 5-bit exponent: 0.1 % of the brightest channel,
 // up to MAX_RGB9E5). So the bounce's occluder probe is one fetch that also brings the
-// sender's light, instead of a depth fetch plus a sender fetch. At 1080×1200 the texel's
-// size decides how much of the texture stays in cache: the earlier 16-byte texel cost
-// the bounce +35 % over SSDO against +20 % at a quarter of the pixels.
+// sender's light, instead of a depth fetch plus a sender fetch. At headset sizes the
+// texel's size decides how much of the texture stays in cache: the earlier 16-byte
+// texel made the bounce relatively costlier at full size than at a quarter of the
+// pixels (docs/measurements-in-code.md, direct-texel).
 const MAX_RGB9E5: f32 = 65408.0;
 
 fn pack_rgb9e5(c: vec3<f32>) -> u32 {

@@ -25,6 +25,8 @@ pub mod stats;
 pub mod stereo;
 pub mod technique;
 
-pub use ao::{AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostMotion, HostNormals, ViewMatrices};
+pub use ao::{
+    AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostMotion, HostNormals, ViewMatrices,
+};
 pub use error::{Error, Result};
 pub use settings::{AoSettings, Technique};

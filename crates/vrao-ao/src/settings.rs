@@ -287,9 +287,9 @@ impl Foveation {
             Foveation::Low => FoveationMap { full_rate_deg: 25.0, edge_deg: 40.0, edge_rate: 0.5 },
             // Half, not less: a marching technique's half is one of its two slices with
             // every step (unbiased: the slices turn with the noise tile); a third took
-            // steps too, which lightened the edges (GTAO N = 24 half, furnished and
-            // Sibenik at 540×600: FLIP 1.05–1.14× of off against 1.01–1.04× at a half)
-            // and saved little more, the per-pixel set-up and denoise staying the same.
+            // steps too, which lightened the edges and saved little more, the per-pixel
+            // set-up and denoise staying the same (docs/measurements-in-code.md,
+            // foveation-high).
             Foveation::High => FoveationMap { full_rate_deg: 15.0, edge_deg: 30.0, edge_rate: 0.5 },
         }
     }

@@ -45,7 +45,7 @@ fn anchored_normal(v: VertexIn) -> vec3<f32> {
 
 // The material's albedo at `uv`, in 0..1. Call it in uniform control flow, every
 // fragment (untextured materials bind a white texel): sampling inside a branch made
-// lavapipe 22.3 leak ~0.4 MB per draw.
+// lavapipe 22.3 leak memory at every draw (docs/measurements-in-code.md, mesh-albedo-leak).
 fn material_albedo(uv: vec2<f32>) -> vec3<f32> {
     let texel = textureSample(diffuse_texture, diffuse_sampler, uv).rgb;
     let albedo = material.diffuse.rgb * select(vec3<f32>(1.0), texel, material.diffuse.w > 0.5);

@@ -180,9 +180,9 @@ impl SimulatedHeadset {
                 self.clock.wait_until(t);
             } else {
                 // Naps between non-blocking polls. Lavapipe makes polls and timed waits
-                // costly: polling every 0.5 ms (or a blocking wait with a timeout)
-                // tripled its frame time (192x216, 33 -> 91 ms); a finish is seen at
-                // most this late.
+                // costly: polling often (or a blocking wait with a timeout) slowed its
+                // frames several-fold (docs/measurements-in-code.md, completion-poll); a
+                // finish is seen at most this late.
                 self.clock.wait_until(t.min(now + COMPLETION_POLL_S));
             }
         }

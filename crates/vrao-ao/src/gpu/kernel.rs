@@ -323,7 +323,7 @@ fn compute_pipeline(
 
 impl Kernel {
     /// Compiles `entry` of the WGSL `files` (concatenated) into a compute kernel binding
-    /// `binds`. A shader file that cannot be read is recorded for [`take_shader_error`]
+    /// `binds`. A shader file that cannot be read is recorded for [`Gpu::take_shader_error`]
     /// ([`shader_module`]).
     pub fn new(gpu: &Gpu, label: &str, files: &[Shader], entry: &str, binds: &[Bind]) -> Kernel {
         Self::with_constants(gpu, label, files, entry, binds, &[])

@@ -216,12 +216,11 @@ impl FrameUniforms {
         };
         // With temporal accumulation each frame of the window takes its own part of a
         // longer Halton kernel, so the accumulated samples are as stratified as one
-        // kernel of window × N. Measured (room, SSAO N = 8, 270×300, noise against the
-        // converged estimator after 8 frames): golden-angle turns of one kernel 0.0122,
-        // parts plus turns 0.0125, parts alone 0.0078 — turning a part breaks the
-        // stratification between parts. So the hemisphere techniques change their pattern
-        // by parts and only the marching techniques (HBAO, GTAO), whose directions are not
-        // a Halton kernel, turn.
+        // kernel of window × N. Parts alone leave less noise after the window than
+        // golden-angle turns of one kernel or parts plus turns — turning a part breaks the
+        // stratification between parts (docs/measurements-in-code.md, kernel-parts). So
+        // the hemisphere techniques change their pattern by parts and only the marching
+        // techniques (HBAO, GTAO), whose directions are not a Halton kernel, turn.
         let part = if ao.temporal.enabled { (frame_index % ao.temporal.max_frames as u64) as u32 } else { 0 };
         let turns = ao.temporal.enabled && entry.samples == SamplePattern::Directions;
         let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
@@ -305,9 +304,9 @@ fn other_from_view(views: &[Eye], index: usize) -> Mat4 {
 }
 
 /// HBAO's turn of its directions this frame (radians): the golden angle (137.5°) per frame.
-/// Lin's NCTU thesis turns it 10° per frame; measured on the room (SSAO N = 8, 135×150 per
-/// eye), 10° steps leave successive patterns so alike that 8 frames cut the noise only from
-/// 0.037 to 0.029, while golden-angle steps reach 0.012 (the 1/√8 of independent ones).
+/// Lin's NCTU thesis turns it 10° per frame, which leaves successive patterns so alike that
+/// accumulating frames cuts the noise far less than golden-angle steps do
+/// (docs/measurements-in-code.md, temporal-angle).
 pub fn temporal_angle(frame_index: u64) -> f32 {
     ((frame_index as f64 * 137.507_764f64).rem_euclid(360.0)).to_radians() as f32
 }

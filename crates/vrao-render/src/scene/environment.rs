@@ -134,9 +134,9 @@ impl Environment {
     /// bands (weights 1, 0.75, 0: band 1 as a three-band Hann window has it, band 2
     /// dropped): the pre-filtered environment SSDO reads once per sample direction
     /// (Ritschel et al. 2009 ask for a pre-smoothed map). A linear function of the direction, so SSDO
-    /// sums it from the directions' first moments alone (the band-2 moments cost SSDO
-    /// ≈ 8 % of its time on lavapipe at N = 12; the window gave band 2 only a quarter
-    /// weight anyway). Evaluate with [`sh9_basis`] and clamp at 0.
+    /// sums it from the directions' first moments alone (the band-2 moments cost SSDO a
+    /// noticeable share of its time, docs/measurements-in-code.md, sh-band-2; the window
+    /// gave band 2 only a quarter weight anyway). Evaluate with [`sh9_basis`] and clamp at 0.
     pub fn radiance_sh_prefiltered(&self) -> [Vec3; 9] {
         const WINDOW_OVER_KERNEL: [f32; 9] =
             [1.0 / PI, 0.75 * 3.0 / TAU, 0.75 * 3.0 / TAU, 0.75 * 3.0 / TAU, 0.0, 0.0, 0.0, 0.0, 0.0];

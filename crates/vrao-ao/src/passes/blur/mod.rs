@@ -125,16 +125,13 @@ impl Pass for BlurPass {
             Denoise::Bilateral => ((w, h, layers), (w, h)),
         };
         // At half resolution only, and only for SSDO: there each eye upsamples from its
-        // own grid and the eyes drifted apart (furnished, 540×600: 2.0 % of the points both
-        // see differ by more than 0.02; 1.3 % with this reuse). For the AO-only techniques
-        // the upsampling reuses the left eye's final AO where it sees the same point
-        // (upsample::reuses_left_eye_upsample), which makes this reuse redundant: without
-        // it, 0.24–0.66 % of the points differ against 0.21–0.65 % with it (gtao and ssao,
-        // furnished and Sibenik, three radii), and on an H200 its extra right-eye dispatch
-        // cost the stereo denoise 1.76× the left eye's against 1.50× (docs/gpu-table-h200.md).
-        // At full resolution the eyes already agree (Sibenik 1080×1200: 0.5 %) and the
-        // reuse's lookups cost a fifth of the denoise (80–101 against 64–84 ms per eye,
-        // lavapipe).
+        // own grid and the eyes drifted apart, which this reuse reduces. For the AO-only
+        // techniques the upsampling reuses the left eye's final AO where it sees the same
+        // point (upsample::reuses_left_eye_upsample), which makes this reuse redundant:
+        // it barely changes how many points differ, and its extra right-eye dispatch makes
+        // the stereo denoise costlier. At full resolution the eyes already agree and the
+        // reuse's lookups add to the denoise's cost (docs/measurements-in-code.md,
+        // blur-stereo-reuse).
         let reuse = ao.stereo_reuse
             && ao.resolution.is_half()
             && layers == 2

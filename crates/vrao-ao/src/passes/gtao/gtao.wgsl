@@ -51,8 +51,8 @@ override RIGHT_EYE: bool = false;
 // normal w, gbuffer.wgsl) is a card — a leaf, a grille, a fence — with no depth behind
 // it: instead of a slab it blocks its footprint on the card's plane (`add_sample`).
 // As a slab `thickness` × r deep, a grille 25 cm over a floor read as a half-metre block
-// (floor AO 0.39 under its holes against the reference's 0.69). Off, no pixel pays the
-// normal's fetch.
+// (the floor under its holes far darker than the reference's; docs/measurements-in-code.md,
+// gtao-thin-cards). Off, no pixel pays the normal's fetch.
 override THIN_CARDS: bool = false;
 // AoRaw's and AoGeometry's left-eye layers in the right eye's dispatch (any array
 // textures otherwise).
@@ -221,8 +221,8 @@ struct SampleLimits {
 fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
     let t = (f32(i) + jitter) / f32(steps);
     // t ((2 − P) + (P − 1) t): between even (P = 1) and quadratic (P = 2); two
-    // multiply-adds, where t^P cost a pow per sample (12 % of the pass on lavapipe) and
-    // measured no better (P = 1.5 on four scenes: equal RMSE within 0.001).
+    // multiply-adds, where t^P cost a pow per sample and was no more accurate
+    // (docs/measurements-in-code.md, gtao-step-power).
     return max(t * mix(1.0, t, gtao.step_power - 1.0) * march_px, f32(i) + 1.0);
 }
 

@@ -27,8 +27,8 @@ pub struct GtaoSettings {
     /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
     /// radius (thin objects stop occluding behind themselves).
     // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
-    // fewer halos (pixels beside depth edges too dark by > 0.1 on the furnished room:
-    // 11.1 % at 1.0, 9.5 % at 0.75, 5.9 % at 0.5 for +0.003 RMSE).
+    // fewer halos (pixels beside depth edges too dark by > 0.1); 0.5 leaves fewer still
+    // but costs RMSE (docs/measurements-in-code.md, gtao-thickness).
     pub thickness: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
     /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
@@ -91,9 +91,8 @@ struct GtaoUniform {
 /// (slices × 2 × steps ≈ samples): 12 → 2×3, 24 → 2×6, 36 → 2×9, 64 → 2×16. Steps before
 /// slices: the 4×4 noise tile turns each pixel's slices, so the denoise averages 16 × 2
 /// directions anyway, while the occluders a sparse march steps over stay missed (a
-/// bias, not noise). Measured at N = 24, half resolution, 540×600 (furnished, Sibenik,
-/// Cornell): 3×4 gave RMSE 0.052 / 0.064 / 0.044 and bias where the reference is below
-/// 0.8 of +0.11 / +0.15 / +0.06; 2×6 gave 0.047 / 0.059 / 0.037 and +0.08 / +0.12 / +0.04.
+/// bias, not noise): at N = 24, 2×6 gave less error and bias than 3×4
+/// (docs/measurements-in-code.md, gtao-slices-steps).
 pub fn gtao_slices_steps(samples: u32) -> (u32, u32) {
     let slices = if samples < 128 { 2 } else { 4 };
     (slices, (samples / (2 * slices)).max(1))

@@ -5,8 +5,8 @@
 // (joint_upsample.wgsl `right_eye_quad`), its output bound as a one-layer view beside
 // the left eye's layer. It computes the right eye's own upsample at every quad, where
 // the composite does so only at the quads the left eye does not fully see (its
-// FALLBACK dispatch): the values are the same, this pass costs more (Sibenik 1080×1200,
-// lavapipe: 33 against 25 ms per eye with independent eyes).
+// FALLBACK dispatch): the values are the same, this pass costs more than with
+// independent eyes (docs/measurements-in-code.md, upsample-right-eye).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;

@@ -16,8 +16,8 @@
 // outer side, disocclusions: a small share) is listed instead, and a second, indirect
 // dispatch (FALLBACK) over exactly those quads upsamples their own occlusion too. Done
 // in one dispatch, every quad paid for both on lavapipe, which runs an untaken branch
-// anyway (frame upsample 21 against 10 ms per eye, Sibenik 1080×1200), and on a GPU
-// every warp holding one such quad would.
+// anyway (docs/measurements-in-code.md, composite-fallback), and on a GPU every warp
+// holding one such quad would.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -40,7 +40,7 @@
 
 override HALF_RES: bool = false;
 // A pipeline constant, not a uniform: lavapipe pays for the upsample code even when a
-// uniform skips it (composite 122 → 213 ms at 1080×1200 on Sibenik).
+// uniform skips it (docs/measurements-in-code.md, composite-constant).
 override RSM: bool = false;
 override RIGHT_EYE: bool = false;
 // The right eye's second dispatch, over the listed quads (implies RIGHT_EYE).
