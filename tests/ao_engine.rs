@@ -331,6 +331,28 @@ fn host_motion_vectors_reach_temporal_accumulation() {
     assert!(e.to_string().contains("motion") && e.to_string().contains("does not match"), "{e}");
 }
 
+/// One frame of the host's reversed-Z prepass and the engine after it, submitted; the
+/// engine's output texture.
+fn reversed_z_frame(
+    gpu: &vrao::Gpu,
+    engine: &mut AoEngine,
+    prepass: &DepthPrepass,
+    views: &[ViewMatrices],
+) -> wgpu::Texture {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    prepass.record(&gpu.device, &mut encoder, views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views,
+        motion: None,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    gpu.queue.submit([encoder.finish()]);
+    texture
+}
+
 #[test]
 fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_resize() {
     let (gpu, _lock) = common::gpu();
@@ -339,18 +361,8 @@ fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_
     let views = host_views(&eyes(), depth);
     let frame_at = |engine: &mut AoEngine, (width, height): (u32, u32)| -> f32 {
         let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (width, height));
-        let mut encoder = device.create_command_encoder(&Default::default());
-        prepass.record(device, &mut encoder, &views);
-        let frame = AoFrame {
-            depth: &prepass.depth,
-            depth_convention: DepthConvention::REVERSED_INFINITE,
-            normals: None,
-            views: &views,
-            motion: None,
-        };
-        let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+        let texture = reversed_z_frame(&gpu, engine, &prepass, &views);
         assert_eq!((texture.width(), texture.height()), (width, height), "the AO has the engine's size");
-        queue.submit([encoder.finish()]);
         let alpha = host::read_alpha(device, queue, &texture, 0);
         alpha.iter().sum::<f32>() / alpha.len() as f32
     };
@@ -414,18 +426,8 @@ fn the_single_channel_outputs_hold_the_visibility_the_default_output_holds() {
     let mut engine = AoEngine::new(device, queue, &config).unwrap();
     let mut visibility = |format: AoOutputFormat| {
         engine.set_output_format(format);
-        let mut encoder = device.create_command_encoder(&Default::default());
-        prepass.record(device, &mut encoder, &views);
-        let frame = AoFrame {
-            depth: &prepass.depth,
-            depth_convention: DepthConvention::REVERSED_INFINITE,
-            normals: None,
-            views: &views,
-            motion: None,
-        };
-        let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+        let texture = reversed_z_frame(&gpu, &mut engine, &prepass, &views);
         assert_eq!(texture.format(), format.texture_format());
-        queue.submit([encoder.finish()]);
         (0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect::<Vec<_>>()
     };
     let rgba = visibility(AoOutputFormat::Rgba16Float);

@@ -134,34 +134,61 @@ impl ScatterPlot {
             .map_err(|e| Error::Output { path: path.to_path_buf(), message: format!("writing the plot: {e}") })
     }
 
+    /// Draws the whole plot into `buffer` (RGB, `width × height`): axes, budget line,
+    /// front, points, their labels and the legend, in that order.
     fn draw(&self, buffer: &mut [u8], width: u32, height: u32) -> Result<Drawn> {
-        let err = drawing_failed;
         let root = Backend::new(buffer, (width, height)).into_drawing_area();
         // Sizes follow the image: 1280×800 gets 14 px tick labels and 12 px point labels.
-        let unit = (width.min(height) as f64 / 800.0).max(0.5);
-        let px = |v: f64| (v * unit).round().max(1.0) as u32;
-        let font = |size: f64| (FONT, size * unit).into_font();
-        let text_style = font(16.0).color(&TEXT);
-        let label_style = font(12.0).color(&LABEL_TEXT);
+        let scale = Scale::of(width, height);
+        let label_style = scale.font(12.0).color(&LABEL_TEXT);
 
         // The legend sits right of the plot, out of the data's way.
-        let legend_w = self
-            .series
-            .iter()
-            .map(|s| root.estimate_text_size(&s.label, &label_style).map_or(0, |(w, _)| w))
-            .max()
-            .map_or(0, |w| w + px(48.0))
-            .min(width / 3);
+        let legend_w = self.legend_width(&root, &label_style, scale, width);
         let (plot_area, legend_area) = root.split_horizontally(width - legend_w);
 
+        let mut chart = self.draw_axes(&plot_area, scale)?;
+        let (ax, ay) = chart.plotting_area().get_pixel_range();
+        let mut drawn = Drawn { area: (ax.start, ay.start, ax.end, ay.end), ..Drawn::default() };
+
+        // Budget line under the data.
+        let budget = self.draw_budget_line(&mut chart, &root, scale, ay.end)?;
+        drawn.vertical_line = budget.map(|(lx, _)| lx);
+        let budget_box = budget.map(|(_, label_box)| label_box);
+
+        let radius = scale.px(5.0) as i32;
+        drawn.points = self.draw_front_and_points(&mut chart, scale.px(2.0), radius)?;
+
+        // Labels after every point, so a label avoids the points drawn after its own.
+        drawn.labels = self.draw_labels(&root, &drawn, &label_style, radius, budget_box)?;
+
+        self.draw_legend(&legend_area, &label_style, scale, ay.start, radius)?;
+        root.present().map_err(|e| drawing_failed(&e))?;
+        Ok(drawn)
+    }
+
+    /// The legend's width: the widest series name plus room for its dot, at most a third
+    /// of the image (0 without series).
+    fn legend_width(&self, root: &Area<'_>, label_style: &TextStyle, scale: Scale, width: u32) -> u32 {
+        self.series
+            .iter()
+            .map(|s| root.estimate_text_size(&s.label, label_style).map_or(0, |(w, _)| w))
+            .max()
+            .map_or(0, |w| w + scale.px(48.0))
+            .min(width / 3)
+    }
+
+    /// Builds the chart on `plot_area` with its caption and draws the axes, grid and
+    /// their labels.
+    fn draw_axes<'b>(&self, plot_area: &Area<'b>, scale: Scale) -> Result<Chart<'_, 'b>> {
+        let font = |size: f64| scale.font(size);
         let (x_range, y_range) = self.ranges();
-        let mut chart = ChartBuilder::on(&plot_area)
+        let mut chart = ChartBuilder::on(plot_area)
             .caption(&self.title, font(18.0).color(&TEXT))
-            .margin(px(12.0))
-            .x_label_area_size(px(50.0))
-            .y_label_area_size(px(70.0))
+            .margin(scale.px(12.0))
+            .x_label_area_size(scale.px(50.0))
+            .y_label_area_size(scale.px(70.0))
             .build_cartesian_2d(x_range, y_range)
-            .map_err(|e| err(&e))?;
+            .map_err(|e| drawing_failed(&e))?;
         chart
             .configure_mesh()
             .light_line_style(WHITE)
@@ -169,52 +196,79 @@ impl ScatterPlot {
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
             .label_style(font(14.0).color(&TEXT))
-            .axis_desc_style(text_style.clone())
+            .axis_desc_style(font(16.0).color(&TEXT))
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
             .draw()
-            .map_err(|e| err(&e))?;
-        let (ax, ay) = chart.plotting_area().get_pixel_range();
-        let mut drawn = Drawn { area: (ax.start, ay.start, ax.end, ay.end), ..Drawn::default() };
+            .map_err(|e| drawing_failed(&e))?;
+        Ok(chart)
+    }
 
-        // Budget line under the data.
-        let mut budget_box = None;
-        if let Some((x, label)) = self.vertical_line.as_ref().filter(|(x, _)| x.is_finite()) {
-            let (y0, y1) = (chart.y_range().start, chart.y_range().end);
-            let style = ShapeStyle::from(rgb(BUDGET_COLOR)).stroke_width(px(2.0));
-            chart
-                .draw_series(DashedLineSeries::new([(*x, y0), (*x, y1)], px(9.0), px(5.0), style))
-                .map_err(|e| err(&e))?;
-            let (lx, _) = chart.backend_coord(&(*x, y1));
-            drawn.vertical_line = Some(lx);
-            // The label sits at the foot of the line: errors near 0 are rare, so the data
-            // stays clear, and point labels avoid its box (`budget_box`).
-            let style = font(14.0).color(&rgb(BUDGET_COLOR));
-            let foot = (lx + px(6.0) as i32, ay.end - px(6.0) as i32);
-            let (x0, y0, x1, _) = draw_lines_above(&root, label, &style, foot, px(17.0) as i32)?;
-            budget_box = Some((x0, y0, x1, ay.end));
-        }
+    /// Draws the dashed budget line (when there is a finite one) and its label at its foot
+    /// (`bottom` is the plotting area's); returns the line's column and the label's box.
+    fn draw_budget_line(
+        &self,
+        chart: &mut Chart<'_, '_>,
+        root: &Area<'_>,
+        scale: Scale,
+        bottom: i32,
+    ) -> Result<Option<(i32, LabelBox)>> {
+        let Some((x, label)) = self.vertical_line.as_ref().filter(|(x, _)| x.is_finite()) else {
+            return Ok(None);
+        };
+        let px = |v: f64| scale.px(v);
+        let (y0, y1) = (chart.y_range().start, chart.y_range().end);
+        let style = ShapeStyle::from(rgb(BUDGET_COLOR)).stroke_width(px(2.0));
+        chart
+            .draw_series(DashedLineSeries::new([(*x, y0), (*x, y1)], px(9.0), px(5.0), style))
+            .map_err(|e| drawing_failed(&e))?;
+        let (lx, _) = chart.backend_coord(&(*x, y1));
+        // The label sits at the foot of the line: errors near 0 are rare, so the data
+        // stays clear, and point labels avoid its box (`budget_box`).
+        let style = scale.font(14.0).color(&rgb(BUDGET_COLOR));
+        let foot = (lx + px(6.0) as i32, bottom - px(6.0) as i32);
+        let (x0, y0, x1, _) = draw_lines_above(root, label, &style, foot, px(17.0) as i32)?;
+        Ok(Some((lx, (x0, y0, x1, bottom))))
+    }
 
-        let radius = px(5.0) as i32;
-        drawn.points = self.draw_front_and_points(&mut chart, px(2.0), radius)?;
-
-        // Labels after every point, so a label avoids the points drawn after its own.
+    /// Draws every drawn point's label clear of the points (dots of `radius` px) and of
+    /// the budget label's box; returns the labels' boxes.
+    fn draw_labels(
+        &self,
+        root: &Area<'_>,
+        drawn: &Drawn,
+        label_style: &TextStyle,
+        radius: i32,
+        budget_box: Option<LabelBox>,
+    ) -> Result<Vec<LabelBox>> {
         let texts = self.series.iter().flat_map(|s| &s.points).filter(|p| p.x.is_finite() && p.y.is_finite());
         let labelled: Vec<(&str, (i32, i32))> = texts.map(|p| p.label.as_str()).zip(drawn.points.clone()).collect();
         let mut taken: Vec<LabelBox> =
             drawn.points.iter().map(|&(x, y)| (x - radius, y - radius, x + radius, y + radius)).collect();
         taken.extend(budget_box);
-        drawn.labels = draw_point_labels(&root, &labelled, &label_style, radius, taken, drawn.area)?;
+        draw_point_labels(root, &labelled, label_style, radius, taken, drawn.area)
+    }
 
-        // Legend: a dot and the series name per row.
+    /// Draws the legend: a dot of `radius` px and the series name per row, from `top` down.
+    fn draw_legend(
+        &self,
+        legend_area: &Area<'_>,
+        label_style: &TextStyle,
+        scale: Scale,
+        top: i32,
+        radius: i32,
+    ) -> Result<()> {
+        let px = |v: f64| scale.px(v);
         let row = px(22.0) as i32;
         for (i, s) in self.series.iter().enumerate() {
-            let y = ay.start + row / 2 + i as i32 * row;
-            legend_area.draw(&Circle::new((px(12.0) as i32, y), radius, rgb(s.color).filled())).map_err(|e| err(&e))?;
-            legend_area.draw_text(&s.label, &label_style, (px(24.0) as i32, y - row / 3)).map_err(|e| err(&e))?;
+            let y = top + row / 2 + i as i32 * row;
+            let dot = Circle::new((px(12.0) as i32, y), radius, rgb(s.color).filled());
+            legend_area.draw(&dot).map_err(|e| drawing_failed(&e))?;
+            legend_area
+                .draw_text(&s.label, label_style, (px(24.0) as i32, y - row / 3))
+                .map_err(|e| drawing_failed(&e))?;
         }
-        root.present().map_err(|e| err(&e))?;
-        Ok(drawn)
+        Ok(())
     }
 
     /// Draws the Pareto front (a line `stroke` px wide) and every series' points as dots
@@ -237,6 +291,32 @@ impl ScatterPlot {
         Ok(drawn)
     }
 }
+
+/// Sizes that follow the image, in pixels: `unit` scales sizes given for 1280×800.
+#[derive(Clone, Copy, Debug)]
+struct Scale {
+    unit: f64,
+}
+
+impl Scale {
+    /// The scale of a `width × height` image (never below half of 1280×800's).
+    fn of(width: u32, height: u32) -> Scale {
+        Scale { unit: (width.min(height) as f64 / 800.0).max(0.5) }
+    }
+
+    /// `v` px at 1280×800, in this image's whole pixels (at least 1).
+    fn px(self, v: f64) -> u32 {
+        (v * self.unit).round().max(1.0) as u32
+    }
+
+    /// The plot's font at `size` px at 1280×800.
+    fn font(self, size: f64) -> FontDesc<'static> {
+        (FONT, size * self.unit).into_font()
+    }
+}
+
+/// A drawing area in pixels on vrao's text-drawing backend.
+type Area<'b> = DrawingArea<Backend<'b>, plotters::coord::Shift>;
 
 /// The plot's chart: f64 axes on vrao's text-drawing backend.
 type Chart<'a, 'b> = ChartContext<

@@ -81,6 +81,21 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
     h.bytes(MAGIC);
     h.u32(FORMAT_VERSION);
     h.u32(super::TRACER_VERSION);
+    hash_meshes(&mut h, scene);
+    hash_materials(&mut h, scene);
+    hash_lights(&mut h, scene);
+    hash_environment(&mut h, scene);
+    hash_eyes(&mut h, eyes);
+    h.u32(size.0);
+    h.u32(size.1);
+    h.f64s(&[settings.radius, settings.near]);
+    h.u32(settings.rays_per_pixel);
+    h.u32(settings.stride);
+    h.finish()
+}
+
+/// Hashes the meshes' count and each one's origin, vertices, indices and material index.
+fn hash_meshes(h: &mut Fnv64, scene: &Scene) {
     h.u64(scene.meshes.len() as u64);
     for m in &scene.meshes {
         h.f64s(&m.origin.to_array());
@@ -91,6 +106,10 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
         h.bytes(bytemuck::cast_slice(&m.indices));
         h.u64(m.material as u64);
     }
+}
+
+/// Hashes the materials' count and each one's colours, texture and (when alpha-tested) alpha.
+fn hash_materials(h: &mut Fnv64, scene: &Scene) {
     h.u64(scene.materials.len() as u64);
     for m in &scene.materials {
         h.f32s(&m.diffuse.to_array());
@@ -111,6 +130,10 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
             h.f32s(&[m.alpha, cutoff]);
         }
     }
+}
+
+/// Hashes the lights' count and each one's kind and parameters.
+fn hash_lights(h: &mut Fnv64, scene: &Scene) {
     h.u64(scene.lights.len() as u64);
     for light in &scene.lights {
         match *light {
@@ -135,6 +158,10 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
             }
         }
     }
+}
+
+/// Hashes whether there is an environment and, if so, its size, intensity and texels.
+fn hash_environment(h: &mut Fnv64, scene: &Scene) {
     match &scene.environment {
         Some(env) => {
             h.u32(1);
@@ -145,18 +172,16 @@ pub fn cache_key(scene: &Scene, eyes: &[Eye], size: (u32, u32), settings: &Refer
         }
         None => h.u32(0),
     }
+}
+
+/// Hashes the eyes' count and each one's pose and field of view.
+fn hash_eyes(h: &mut Fnv64, eyes: &[Eye]) {
     h.u64(eyes.len() as u64);
     for eye in eyes {
         h.f64s(&eye.pose.position.to_array());
         h.f64s(&eye.pose.orientation.to_array());
         h.f32s(&[eye.fov.left, eye.fov.right, eye.fov.up, eye.fov.down]);
     }
-    h.u32(size.0);
-    h.u32(size.1);
-    h.f64s(&[settings.radius, settings.near]);
-    h.u32(settings.rays_per_pixel);
-    h.u32(settings.stride);
-    h.finish()
 }
 
 /// The file in `cache_dir` that holds the result for `key`.

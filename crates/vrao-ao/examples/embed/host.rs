@@ -165,88 +165,11 @@ impl DepthPrepass {
         (width, height): (u32, u32),
         layers: u32,
     ) -> Self {
-        let mut vertices: Vec<[f32; 6]> = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
-        for mesh in meshes {
-            let base = vertices.len() as u32;
-            vertices.extend(mesh.positions.iter().zip(&mesh.normals).map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z]));
-            indices.extend(mesh.indices.iter().map(|i| base + i));
-        }
-        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("host vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("host indices"),
-            contents: bytemuck::cast_slice(&indices),
-            usage: wgpu::BufferUsages::INDEX,
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("host view"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("host prepass"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("host prepass"),
-            source: wgpu::ShaderSource::Wgsl(PREPASS_WGSL.into()),
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("host prepass"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 24,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
-                })],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: depth_kind.format(),
-                depth_write_enabled: Some(true),
-                depth_compare: Some(depth_kind.compare()),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::TextureFormat::Rgba16Float.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let target = |label, format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-        };
+        let (vertices, indices) = merge_meshes(meshes);
+        let (vertex_buffer, index_buffer) = upload_geometry(device, &vertices, &indices);
+        let layout = view_layout(device);
+        let pipeline = prepass_pipeline(device, &layout, depth_kind);
+        let target = |label, format| layered_target(device, label, format, (width, height), layers);
         DepthPrepass {
             pipeline,
             layout,
@@ -315,6 +238,119 @@ impl DepthPrepass {
             pass.draw_indexed(0..self.index_count, 0, 0..1);
         }
     }
+}
+
+/// All meshes as one vertex list (position, normal) and one index list into it.
+fn merge_meshes(meshes: &[HostMesh]) -> (Vec<[f32; 6]>, Vec<u32>) {
+    let mut vertices: Vec<[f32; 6]> = Vec::new();
+    let mut indices: Vec<u32> = Vec::new();
+    for mesh in meshes {
+        let base = vertices.len() as u32;
+        vertices.extend(mesh.positions.iter().zip(&mesh.normals).map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z]));
+        indices.extend(mesh.indices.iter().map(|i| base + i));
+    }
+    (vertices, indices)
+}
+
+/// Uploads the merged vertices and indices into a vertex and an index buffer.
+fn upload_geometry(device: &wgpu::Device, vertices: &[[f32; 6]], indices: &[u32]) -> (wgpu::Buffer, wgpu::Buffer) {
+    let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host vertices"),
+        contents: bytemuck::cast_slice(vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host indices"),
+        contents: bytemuck::cast_slice(indices),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    (vertex_buffer, index_buffer)
+}
+
+/// The bind group layout of the per-view uniform (binding 0, vertex stage).
+fn view_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("host view"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }],
+    })
+}
+
+/// The prepass pipeline: back-face culled meshes into `depth_kind`'s depth and
+/// `Rgba16Float` view-space normals.
+fn prepass_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    depth_kind: HostDepth,
+) -> wgpu::RenderPipeline {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("host prepass"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host prepass"),
+        source: wgpu::ShaderSource::Wgsl(PREPASS_WGSL.into()),
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host prepass"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 24,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+            })],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: depth_kind.format(),
+            depth_write_enabled: Some(true),
+            depth_compare: Some(depth_kind.compare()),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::TextureFormat::Rgba16Float.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A render target of `format` with `layers` layers of `width` × `height`, also sampled.
+fn layered_target(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    (width, height): (u32, u32),
+    layers: u32,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
 }
 
 /// Copies layer `layer` of an `Rgba16Float` texture back and returns its alpha channel

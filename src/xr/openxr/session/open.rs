@@ -12,73 +12,14 @@ impl OpenXrHeadset {
     pub fn open(options: OpenXrOptions) -> std::result::Result<(OpenXrHeadset, Arc<Gpu>), Unavailable> {
         let entry = load_entry()?;
         let slot = InstanceSlot::take()?;
-        let available = entry.enumerate_extensions().map_err(|e| {
-            super::super::no_runtime(&super::super::xr_call_failed("xrEnumerateInstanceExtensionProperties", e))
-        })?;
-        if !available.khr_vulkan_enable2 {
-            return Err(Unavailable::Unsupported("no XR_KHR_vulkan_enable2".into()));
-        }
-        let mut extensions = xr::ExtensionSet::default();
-        extensions.khr_vulkan_enable2 = true;
-        extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
-        extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
-        extensions.fb_display_refresh_rate = available.fb_display_refresh_rate;
-        let instance = entry
-            .create_instance(&application_info(), &extensions, &[], &())
-            .map_err(|e| super::super::no_runtime(&super::super::xr_call_failed("xrCreateInstance", e)))?;
-        let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
-        let runtime = format!("{} {}", props.runtime_name, props.runtime_version);
-        let system = instance
-            .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)
-            .map_err(|e| Unavailable::NoHeadset(format!("{runtime}: xrGetSystem(HEAD_MOUNTED_DISPLAY): {e}")))?;
-        let system_name =
-            instance.system_properties(system).map(|p| p.system_name).unwrap_or_else(|_| "unnamed system".into());
-        let view_types =
-            instance.enumerate_view_configurations(system).map_err(failed("xrEnumerateViewConfigurations"))?;
-        if !view_types.contains(&VIEW_TYPE) {
-            return Err(Unavailable::Unsupported(format!("{system_name} has no PRIMARY_STEREO view configuration")));
-        }
-        let views = instance
-            .enumerate_view_configuration_views(system, VIEW_TYPE)
-            .map_err(failed("xrEnumerateViewConfigurationViews"))?;
-        if views.len() != 2 {
-            return Err(Unavailable::Unsupported(format!("PRIMARY_STEREO has {} views", views.len())));
-        }
-        // One size for both eyes (vrao renders them as two layers of one target).
-        let recommended = (
-            views.iter().map(|v| v.recommended_image_rect_width).max().unwrap_or(0).max(1),
-            views.iter().map(|v| v.recommended_image_rect_height).max().unwrap_or(0).max(1),
-        );
-        let max = (
-            views.iter().map(|v| v.max_image_rect_width).min().unwrap_or(0).max(1),
-            views.iter().map(|v| v.max_image_rect_height).min().unwrap_or(0).max(1),
-        );
-        let wanted = options.size.unwrap_or(recommended);
-        let size = (wanted.0.clamp(1, max.0), wanted.1.clamp(1, max.1));
-        let blend_mode = instance
-            .enumerate_environment_blend_modes(system, VIEW_TYPE)
-            .ok()
-            .and_then(|modes| modes.first().copied())
-            .unwrap_or(xr::EnvironmentBlendMode::OPAQUE);
+        let (instance, extensions) = create_instance(&entry)?;
+        let system = HeadsetSystem::find(&instance)?;
+        let views = stereo_views(&instance, &system)?;
+        let (recommended, size) = eye_sizes(&views, options.size);
+        let blend_mode = blend_mode(&instance, system.id);
 
-        let (gpu, binding) = vulkan::create_gpu(&instance, system)?;
-        let gpu = Arc::new(gpu);
-        // SAFETY: the binding names the instance, physical device and device the runtime
-        // created for this system, and one queue of the family the device was made with;
-        // wgpu and the runtime only use that queue from this thread.
-        let (session, frame_waiter, frame_stream) =
-            unsafe { instance.create_session::<xr::Vulkan>(system, &binding.session_create_info()) }
-                .map_err(failed("xrCreateSession"))?;
-        let space = session
-            .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
-            .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
-        let (refresh_rates_hz, refresh_hz) = if extensions.fb_display_refresh_rate {
-            display_refresh_rate(&session, options.preferred_refresh_hz)
-        } else {
-            (Vec::new(), None)
-        };
-        let swapchains =
-            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)?;
+        let SessionParts { gpu, session, frame_waiter, frame_stream, space, refresh_rates_hz, refresh_hz, swapchains } =
+            SessionParts::create(&instance, system.id, size, &extensions, &options)?;
         let swapchain_text = swapchains.describe();
         let depth = swapchains.has_depth();
         let xr = Xr {
@@ -97,8 +38,8 @@ impl OpenXrHeadset {
             gpu: gpu.clone(),
             options,
             xr: Some(xr),
-            runtime,
-            system: system_name,
+            runtime: system.runtime,
+            system: system.name,
             recommended,
             size,
             depth,
@@ -119,6 +60,139 @@ impl OpenXrHeadset {
             display_period_ms: 0.0,
         };
         Ok((headset, gpu))
+    }
+}
+
+/// Creates the OpenXR instance with XR_KHR_vulkan_enable2 and the optional extensions
+/// the runtime offers; returns it and the extensions it was created with.
+fn create_instance(entry: &xr::Entry) -> std::result::Result<(xr::Instance, xr::ExtensionSet), Unavailable> {
+    let available = entry.enumerate_extensions().map_err(|e| {
+        super::super::no_runtime(&super::super::xr_call_failed("xrEnumerateInstanceExtensionProperties", e))
+    })?;
+    if !available.khr_vulkan_enable2 {
+        return Err(Unavailable::Unsupported("no XR_KHR_vulkan_enable2".into()));
+    }
+    let mut extensions = xr::ExtensionSet::default();
+    extensions.khr_vulkan_enable2 = true;
+    extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
+    extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
+    extensions.fb_display_refresh_rate = available.fb_display_refresh_rate;
+    let instance = entry
+        .create_instance(&application_info(), &extensions, &[], &())
+        .map_err(|e| super::super::no_runtime(&super::super::xr_call_failed("xrCreateInstance", e)))?;
+    Ok((instance, extensions))
+}
+
+/// The head-mounted display of an instance, with the names the headset reports.
+struct HeadsetSystem {
+    id: xr::SystemId,
+    /// The runtime's name and version.
+    runtime: String,
+    /// The system's name ("unnamed system" when the runtime gives none).
+    name: String,
+}
+
+impl HeadsetSystem {
+    /// Names the runtime and finds its head-mounted display.
+    fn find(instance: &xr::Instance) -> std::result::Result<HeadsetSystem, Unavailable> {
+        let props = instance.properties().map_err(|e| Unavailable::NoRuntime(e.to_string()))?;
+        let runtime = format!("{} {}", props.runtime_name, props.runtime_version);
+        let system = instance
+            .system(xr::FormFactor::HEAD_MOUNTED_DISPLAY)
+            .map_err(|e| Unavailable::NoHeadset(format!("{runtime}: xrGetSystem(HEAD_MOUNTED_DISPLAY): {e}")))?;
+        let system_name =
+            instance.system_properties(system).map(|p| p.system_name).unwrap_or_else(|_| "unnamed system".into());
+        Ok(HeadsetSystem { id: system, runtime, name: system_name })
+    }
+}
+
+/// The two views of the system's PRIMARY_STEREO view configuration; refuses a system
+/// without it.
+fn stereo_views(
+    instance: &xr::Instance,
+    system: &HeadsetSystem,
+) -> std::result::Result<Vec<xr::ViewConfigurationView>, Unavailable> {
+    let view_types =
+        instance.enumerate_view_configurations(system.id).map_err(failed("xrEnumerateViewConfigurations"))?;
+    if !view_types.contains(&VIEW_TYPE) {
+        return Err(Unavailable::Unsupported(format!("{} has no PRIMARY_STEREO view configuration", system.name)));
+    }
+    let views = instance
+        .enumerate_view_configuration_views(system.id, VIEW_TYPE)
+        .map_err(failed("xrEnumerateViewConfigurationViews"))?;
+    if views.len() != 2 {
+        return Err(Unavailable::Unsupported(format!("PRIMARY_STEREO has {} views", views.len())));
+    }
+    Ok(views)
+}
+
+/// The per-eye size the views recommend and the one to render at: `wanted` (else the
+/// recommended one) within the views' maximum.
+fn eye_sizes(views: &[xr::ViewConfigurationView], wanted: Option<(u32, u32)>) -> ((u32, u32), (u32, u32)) {
+    // One size for both eyes (vrao renders them as two layers of one target).
+    let recommended = (
+        views.iter().map(|v| v.recommended_image_rect_width).max().unwrap_or(0).max(1),
+        views.iter().map(|v| v.recommended_image_rect_height).max().unwrap_or(0).max(1),
+    );
+    let max = (
+        views.iter().map(|v| v.max_image_rect_width).min().unwrap_or(0).max(1),
+        views.iter().map(|v| v.max_image_rect_height).min().unwrap_or(0).max(1),
+    );
+    let wanted = wanted.unwrap_or(recommended);
+    let size = (wanted.0.clamp(1, max.0), wanted.1.clamp(1, max.1));
+    (recommended, size)
+}
+
+/// The runtime's first environment blend mode for PRIMARY_STEREO, else OPAQUE.
+fn blend_mode(instance: &xr::Instance, system: xr::SystemId) -> xr::EnvironmentBlendMode {
+    instance
+        .enumerate_environment_blend_modes(system, VIEW_TYPE)
+        .ok()
+        .and_then(|modes| modes.first().copied())
+        .unwrap_or(xr::EnvironmentBlendMode::OPAQUE)
+}
+
+/// The GPU, the session and what is made with it, before they join `Xr`.
+struct SessionParts {
+    gpu: Arc<Gpu>,
+    session: xr::Session<xr::Vulkan>,
+    frame_waiter: xr::FrameWaiter,
+    frame_stream: xr::FrameStream<xr::Vulkan>,
+    space: xr::Space,
+    refresh_rates_hz: Vec<f32>,
+    refresh_hz: Option<f32>,
+    swapchains: EyeSwapchains,
+}
+
+impl SessionParts {
+    /// Has the runtime create the `Gpu`, then creates the session on it, the LOCAL
+    /// reference space, the display refresh rate (when offered) and the swapchains.
+    fn create(
+        instance: &xr::Instance,
+        system: xr::SystemId,
+        size: (u32, u32),
+        extensions: &xr::ExtensionSet,
+        options: &OpenXrOptions,
+    ) -> std::result::Result<SessionParts, Unavailable> {
+        let (gpu, binding) = vulkan::create_gpu(instance, system)?;
+        let gpu = Arc::new(gpu);
+        // SAFETY: the binding names the instance, physical device and device the runtime
+        // created for this system, and one queue of the family the device was made with;
+        // wgpu and the runtime only use that queue from this thread.
+        let (session, frame_waiter, frame_stream) =
+            unsafe { instance.create_session::<xr::Vulkan>(system, &binding.session_create_info()) }
+                .map_err(failed("xrCreateSession"))?;
+        let space = session
+            .create_reference_space(xr::ReferenceSpaceType::LOCAL, xr::Posef::IDENTITY)
+            .map_err(failed("xrCreateReferenceSpace(LOCAL)"))?;
+        let (refresh_rates_hz, refresh_hz) = if extensions.fb_display_refresh_rate {
+            display_refresh_rate(&session, options.preferred_refresh_hz)
+        } else {
+            (Vec::new(), None)
+        };
+        let swapchains =
+            EyeSwapchains::create(&gpu, &session, size, extensions.khr_composition_layer_depth, options.layout)?;
+        Ok(SessionParts { gpu, session, frame_waiter, frame_stream, space, refresh_rates_hz, refresh_hz, swapchains })
     }
 }
 
