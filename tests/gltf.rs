@@ -480,12 +480,6 @@ fn bad_input_is_one_line_naming_the_file_and_the_problem() {
         load_error(&dir, "badimage.gltf", textured(&format!("data:image/png;base64,{}", encode_base64(b"not a png"))));
     assert!(e.contains("image 0: cannot decode"), "{e}");
 
-    // Unsupported primitive modes name the mesh.
-    let mut lines: serde_json::Value = serde_json::from_str(&valid).unwrap();
-    lines["meshes"][0]["primitives"][0]["mode"] = json!(1);
-    let e = load_error(&dir, "lines.gltf", lines.to_string());
-    assert!(e.contains("mesh 'tri' primitive 0: mode Lines is not supported"), "{e}");
-
     // Indices out of range, or not whole triangles.
     let mut bytes = triangle_bytes();
     bytes.extend([0u8, 1, 3, 0]);
@@ -784,4 +778,51 @@ fn a_spot_light_lights_its_cone_with_gltfs_falloff_on_the_gpu() {
         .abs()
             < 1e-6
     );
+}
+
+#[test]
+fn strips_and_fans_become_triangles_and_points_and_lines_are_skipped() {
+    let dir = common::temp_dir("gltf-modes");
+    // A unit quad in z = 0 as a strip (0 1 2 3: two triangles) and as a fan (0 1 3 2),
+    // each facing +z, and the same vertices as lines and as points.
+    let p: [f32; 12] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0];
+    let fan_order: [u16; 4] = [0, 1, 3, 2];
+    let mut bin: Vec<u8> = bytemuck::cast_slice(&p).to_vec();
+    bin.extend(bytemuck::cast_slice(&fan_order));
+    let primitive = |mode: u32, indices: Option<u32>| {
+        let mut p = json!({ "attributes": { "POSITION": 0 }, "mode": mode });
+        if let Some(i) = indices {
+            p["indices"] = json!(i);
+        }
+        p
+    };
+    let body = json!({
+        "scene": 0,
+        "scenes": [{ "nodes": [0, 1] }],
+        "nodes": [{ "mesh": 0 }, { "mesh": 1, "translation": [2, 0, 0] }],
+        "meshes": [
+            { "name": "strip", "primitives": [primitive(5, None), primitive(1, None), primitive(0, None)] },
+            { "name": "fan", "primitives": [primitive(6, Some(1)), primitive(3, None)] },
+        ],
+        "accessors": [
+            { "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
+            { "bufferView": 1, "componentType": 5123, "count": 4, "type": "SCALAR" },
+        ],
+        "bufferViews": [{ "buffer": 0, "byteLength": 48 }, { "buffer": 0, "byteOffset": 48, "byteLength": 8 }],
+    });
+    let path = write_file(&dir, "modes.gltf", gltf_text(&bin, body));
+    let scene = Scene::load(path.to_str().unwrap()).unwrap();
+    // The lines and points primitives are gone; the strip and the fan are two triangles each.
+    assert_eq!(scene.meshes.len(), 2, "{:?}", scene.meshes.iter().map(|m| &m.name).collect::<Vec<_>>());
+    for mesh in &scene.meshes {
+        assert_eq!(mesh.indices.len(), 6, "{}", mesh.name);
+        let mut area = 0.0;
+        for t in mesh.indices.chunks(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[t[k] as usize]);
+            let normal = (b - a).cross(c - a);
+            assert!(normal.z > 0.0, "{}: triangle {t:?} faces {normal}", mesh.name);
+            area += normal.length() / 2.0;
+        }
+        assert!((area - 1.0).abs() < 1e-6, "{}: the triangles cover {area}, not the unit quad", mesh.name);
+    }
 }

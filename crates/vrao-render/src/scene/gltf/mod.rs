@@ -10,8 +10,8 @@
 //! one [`Error::Input`] line naming the file and the element.
 //!
 //! What is read: the default scene (else the first; else every root node) with its
-//! TRS and matrix transforms; triangle primitives (indexed u8/u16/u32 or not; other modes
-//! are an error); POSITION, NORMAL (computed as for OBJ when missing), TEXCOORD_0 (float
+//! TRS and matrix transforms; triangle primitives (indexed u8/u16/u32 or not; strips and
+//! fans become triangle lists; points and lines are skipped with one warning); POSITION, NORMAL (computed as for OBJ when missing), TEXCOORD_0 (float
 //! or normalised integers); the base-colour factor and texture; `alphaMode`
 //! OPAQUE / MASK (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]); the
 //! emissive factor × `KHR_materials_emissive_strength`, so emitters become lights as in
@@ -38,6 +38,7 @@ use crate::error::{Error, Result};
 use crate::stereo::HeadPose;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::json;
+use ::gltf::mesh::Mode;
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3};
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
@@ -608,10 +609,12 @@ impl Loader<'_> {
         let mut out = Vec::new();
         for primitive in mesh.primitives() {
             let what = format!("{mesh_name} primitive {}", primitive.index());
-            if primitive.mode() != ::gltf::mesh::Mode::Triangles {
-                let message =
-                    format!("{what}: mode {:?} is not supported (vrao draws triangles only)", primitive.mode());
-                return Err(self.error(message));
+            let mode = primitive.mode();
+            if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+                // Points and lines have no surface to occlude or be occluded: the rest of
+                // the file is drawn.
+                self.warnings.ignored.insert("points and lines primitives (vrao draws triangles)");
+                continue;
             }
             if primitive.morph_targets().next().is_some() {
                 self.warnings.ignored.insert("morph targets (drawn in the bind pose)");
@@ -626,6 +629,7 @@ impl Loader<'_> {
                 Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
                 None => (0..count as u32).collect(),
             };
+            let indices = triangle_list(mode, indices);
             if !indices.len().is_multiple_of(3) {
                 return Err(self.error(format!("{what}: {} indices, not a whole number of triangles", indices.len())));
             }
@@ -1073,6 +1077,23 @@ fn bake_static(name: &str, g: &Geometry, world: &DMat4, material: usize) -> Mesh
         normals::repair_normals(&positions, &mut normals, &indices);
     }
     Mesh { name: name.to_string(), origin, positions, normals, uvs: g.uvs.clone(), indices, material, node: None }
+}
+
+/// A primitive's vertex order as a triangle list: a strip's triangle i is (i, i+1, i+2)
+/// for even i and (i, i+2, i+1) for odd i, a fan's (i+1, i+2, 0), as glTF 2.0 §3.7.2.1
+/// orders them, so every triangle keeps the strip's or fan's winding.
+fn triangle_list(mode: Mode, indices: Vec<u32>) -> Vec<u32> {
+    let triangles = indices.len().saturating_sub(2);
+    match mode {
+        Mode::TriangleStrip => (0..triangles)
+            .flat_map(|i| {
+                let (a, b) = if i % 2 == 0 { (i + 1, i + 2) } else { (i + 2, i + 1) };
+                [indices[i], indices[a], indices[b]]
+            })
+            .collect(),
+        Mode::TriangleFan => (0..triangles).flat_map(|i| [indices[i + 1], indices[i + 2], indices[0]]).collect(),
+        _ => indices,
+    }
 }
 
 #[cfg(test)]
