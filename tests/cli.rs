@@ -673,3 +673,34 @@ fn a_bad_gltf_exits_2_with_one_line_and_writes_nothing() {
         assert!(!out_dir.exists() || std::fs::read_dir(&out_dir).unwrap().next().is_none(), "nothing written: {t}");
     }
 }
+
+#[test]
+fn negative_numbers_are_values_refused_by_their_range_and_the_bench_refuses_duplicates() {
+    let dir = temp_dir("negative");
+    let out_dir = dir.join("out");
+    let out = vrao(&["render", "--time", "-1", "--width", "8", "--height", "8", "--out", out_dir.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("-1 s is not within"), "{stderr}");
+    let out = vrao(&["run", "--refresh", "-90", "--headset", "simulated", "--display", "none", "--frames", "1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(!stderr.contains("unexpected argument") && stderr.contains("-90"), "{stderr}");
+    let out = vrao(&[
+        "bench",
+        "--techniques",
+        "ssao,ssao",
+        "--no-reference",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--frames",
+        "1",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("techniques name ssao twice"), "{stderr}");
+}

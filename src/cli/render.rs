@@ -54,7 +54,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Scene time in seconds (0 to 1e6): where animated objects and a scripted head are.
-    #[arg(long, default_value_t = 0.0, value_parser = super::parse_scene_time)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0, value_parser = super::parse_scene_time)]
     time: f64,
     /// Reinhard white point (smallest exposed luminance shown as white).
     #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_WHITE_POINT)]

@@ -43,7 +43,7 @@ pub struct RunArgs {
     profile: String,
     /// Refresh rate in Hz of the simulated headset, 10..=500 (default: the profile's).
     /// With OpenXR the runtime's display period sets the frame budget, frame by frame.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     refresh: Option<f64>,
     /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).

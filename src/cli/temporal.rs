@@ -21,7 +21,7 @@ pub struct TemporalArgs {
     #[arg(long)]
     motion: bool,
     /// With --motion: scene time of the sequence's first frame, 0 to 1e6 s.
-    #[arg(long, default_value_t = 0.5, value_parser = super::parse_scene_time)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5, value_parser = super::parse_scene_time)]
     start: f64,
     /// With --motion: frames scored (each traces a reference), 1 to 64.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
