@@ -118,17 +118,10 @@ pub struct Renderer {
     gpu: Arc<Gpu>,
     scene: Scene,
     settings: Settings,
-    /// What the engine's chain reads of `settings`.
-    chain_settings: ChainSettings,
-    multiview: bool,
     gpu_scene: GpuScene,
-    /// The passes before the AO chain (G-buffer, lights), [`passes::scene_passes`].
-    scene_passes: Vec<Box<dyn Pass>>,
-    /// The engine's AO chain ([`passes::ao_chain`]) over the G-buffer's depth and
-    /// normals, with the renderer's SSDO among its techniques.
-    ao_chain: Vec<Box<dyn Pass>>,
-    /// The passes after the AO chain (composite, tone mapping), [`passes::output_passes`].
-    output_passes: Vec<Box<dyn Pass>>,
+    /// What the passes consult each frame besides the driver's state.
+    inputs: FrameInputs,
+    passes: RendererPasses,
     /// The engine's frame driver: plan cache, targets, uniforms, record loop, timer.
     driver: GraphDriver<Settings>,
     timing: Timing,
@@ -137,8 +130,6 @@ pub struct Renderer {
     previous_scene_time: Option<f64>,
     /// Each moving object's node and its meshes' bounds in the node's frame.
     mover_bounds: Vec<(usize, Aabb)>,
-    /// What moves in the frame being rendered.
-    motion: FrameMotion,
     /// Submitted frames the GPU has not been seen to finish, oldest first.
     in_flight: VecDeque<InFlight>,
     frames_in_flight: usize,
@@ -179,9 +170,11 @@ impl Renderer {
         };
         let gpu_scene = GpuScene::upload(&gpu, scene);
         let driver = GraphDriver::new(&gpu, scene.lights.len(), PassTimer::new(&gpu)?);
-        let scene_passes = passes::scene_passes(&gpu, scene, &gpu_scene, driver.uniforms());
-        let ao_chain = passes::ao_chain(&gpu, vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]);
-        let output_passes = passes::output_passes(&gpu);
+        let passes = RendererPasses {
+            scene: passes::scene_passes(&gpu, scene, &gpu_scene, driver.uniforms()),
+            ao_chain: passes::ao_chain(&gpu, vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]),
+            output: passes::output_passes(&gpu),
+        };
         if gpu.builds_cancelled() {
             return Err(Error::Interrupted);
         }
@@ -189,23 +182,26 @@ impl Renderer {
         gpu.take_shader_error()?;
         gpu.take_error()?;
         let mover_bounds = mover_bounds(scene, &gpu_scene);
-        let motion = FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL };
+        let inputs = FrameInputs {
+            settings: chain_settings(settings),
+            // The scene is fixed for the renderer's life, so are its materials.
+            alpha_cards: scene.has_alpha_test(),
+            anchor: gpu_scene.anchor,
+            multiview,
+            motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },
+        };
         Ok(Renderer {
             gpu,
             scene: scene.clone(),
             settings: settings.clone(),
-            chain_settings: chain_settings(settings),
-            multiview,
             gpu_scene,
-            scene_passes,
-            ao_chain,
-            output_passes,
+            inputs,
+            passes,
             driver,
             timing: Timing::Pipelined,
             scene_time: 0.0,
             previous_scene_time: None,
             mover_bounds,
-            motion,
             in_flight: VecDeque::new(),
             frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
             frames_in_flight_max: 0,
@@ -255,7 +251,7 @@ impl Renderer {
             self.driver.reset_history();
         }
         self.settings = settings.clone();
-        self.chain_settings = chain_settings(settings);
+        self.inputs.settings = chain_settings(settings);
         Ok(())
     }
 
@@ -277,35 +273,13 @@ impl Renderer {
 
     /// Whether the G-buffer draws both eyes in one multiview pass.
     pub fn uses_multiview(&self) -> bool {
-        self.multiview
-    }
-
-    /// Every pass in execution order: the scene's, the AO engine's chain, the outputs'.
-    fn passes(&self) -> Vec<&dyn Pass> {
-        let scene = self.scene_passes.iter().map(|p| p.as_ref());
-        let chain = self.ao_chain.iter().map(|p| p.as_ref());
-        let output = self.output_passes.iter().map(|p| p.as_ref());
-        scene.chain(chain).chain(output).collect()
-    }
-
-    /// What the passes consult this frame, besides the driver's frame number and history;
-    /// the renderer's own passes find the scene, the uploaded scene and the settings in
-    /// `extensions`.
-    fn params<'a>(&'a self, extensions: &'a [&'a dyn std::any::Any]) -> FrameParams<'a> {
-        FrameParams {
-            settings: &self.chain_settings,
-            extensions,
-            alpha_cards: self.scene.has_alpha_test(),
-            anchor: self.gpu_scene.anchor,
-            multiview: self.multiview,
-            motion: &self.motion,
-        }
+        self.inputs.multiview
     }
 
     /// The plan for a frame of `views` layers that must produce `outputs`.
     pub fn plan(&self, views: u32, outputs: &[Resource]) -> Result<Plan> {
         let extensions: [&dyn std::any::Any; 3] = [&self.scene, &self.gpu_scene, &self.settings];
-        self.driver.plan_uncached(&self.passes(), &self.params(&extensions), views, outputs, &[])
+        self.driver.plan_uncached(&self.passes.all(), &self.inputs.params(&extensions), views, outputs, &[])
     }
 
     /// Renders one frame for `views` (two eyes, or one mono view) producing `outputs`
@@ -404,19 +378,10 @@ impl Renderer {
         self.update_motion(layers);
         // Borrowed field by field: the driver is changed while the passes and what they
         // consult are read.
-        let Renderer { gpu, scene, gpu_scene, settings, driver, scene_passes, ao_chain, output_passes, .. } = self;
+        let Renderer { gpu, scene, gpu_scene, settings, driver, inputs, passes, .. } = self;
         let extensions: [&dyn std::any::Any; 3] = [&*scene, &*gpu_scene, &*settings];
-        let params = FrameParams {
-            settings: &self.chain_settings,
-            extensions: &extensions,
-            alpha_cards: scene.has_alpha_test(),
-            anchor: gpu_scene.anchor,
-            multiview: self.multiview,
-            motion: &self.motion,
-        };
-        let passes: Vec<&dyn Pass> =
-            scene_passes.iter().chain(ao_chain.iter()).chain(output_passes.iter()).map(|p| p.as_ref()).collect();
-        let plan = driver.plan(settings, &passes, &params, layers, outputs, &[])?;
+        let params = inputs.params(&extensions);
+        let plan = driver.plan(settings, &passes.all(), &params, layers, outputs, &[])?;
         let lighting = ViewLighting::new(scene, gpu_scene.anchor, views, settings);
         driver.prepare(gpu, &plan, &params, &lighting.frame_lighting(), views);
         Ok(plan)
@@ -433,13 +398,13 @@ impl Renderer {
         wait_each_pass: bool,
     ) -> Result<(f64, Vec<(String, f64)>)> {
         let extensions: [&dyn std::any::Any; 3] = [&self.scene, &self.gpu_scene, &self.settings];
-        let params = self.params(&extensions);
+        let params = self.inputs.params(&extensions);
         let submission = match self.timing {
             Timing::Pipelined => Submission::OneEncoder,
             Timing::Serial => Submission::PerPass { wait: wait_each_pass },
         };
         let environment = Some((&self.gpu_scene.environment, &self.gpu_scene.sampler));
-        let passes = self.passes();
+        let passes = self.passes.all();
         let recorded =
             self.driver.record(&self.gpu, encoder, &passes, plan, &params, views, environment, None, submission)?;
         let resolve_start = Instant::now();
@@ -494,7 +459,7 @@ impl Renderer {
                 movers.push(MoverBox::of((local.min, local.max), &transforms[*node], anchor));
             }
         }
-        self.motion.movers = movers;
+        self.inputs.motion.movers = movers;
     }
 
     /// The plan of the last frame, if one was rendered.
@@ -512,7 +477,7 @@ impl Renderer {
     /// A target a pass keeps itself from frame to frame (the temporal history), or one
     /// the graph allocated ([`Renderer::target`]).
     pub fn kept_target(&self, r: Resource) -> Option<LayeredTarget> {
-        self.target(r).cloned().or_else(|| self.passes().iter().find_map(|p| p.kept_target(r)))
+        self.target(r).cloned().or_else(|| self.passes.all().iter().find_map(|p| p.kept_target(r)))
     }
 
     /// Raw bytes per layer of a resource the last frame produced.
@@ -548,6 +513,53 @@ fn mover_bounds(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, Aabb)> {
             (node, bounds)
         })
         .collect()
+}
+
+/// The renderer's passes in their three groups.
+struct RendererPasses {
+    /// Before the AO chain (G-buffer, lights): [`passes::scene_passes`].
+    scene: Vec<Box<dyn Pass>>,
+    /// The engine's AO chain ([`passes::ao_chain`]) over the G-buffer's depth and normals,
+    /// with the renderer's SSDO among its techniques.
+    ao_chain: Vec<Box<dyn Pass>>,
+    /// After the AO chain (composite, tone mapping): [`passes::output_passes`].
+    output: Vec<Box<dyn Pass>>,
+}
+
+impl RendererPasses {
+    /// Every pass in execution order: the scene's, the AO chain, the outputs'.
+    fn all(&self) -> Vec<&dyn Pass> {
+        self.scene.iter().chain(&self.ao_chain).chain(&self.output).map(|p| p.as_ref()).collect()
+    }
+}
+
+/// What the passes consult each frame besides the driver's frame number and history.
+struct FrameInputs {
+    /// What the engine's chain reads of the renderer's settings.
+    settings: ChainSettings,
+    /// Whether the scene has alpha-tested materials (GTAO's cards).
+    alpha_cards: bool,
+    /// Where the scene's geometry was uploaded relative to.
+    anchor: DVec3,
+    /// Whether the G-buffer draws both eyes in one multiview pass.
+    multiview: bool,
+    /// What moves in the frame being rendered.
+    motion: FrameMotion,
+}
+
+impl FrameInputs {
+    /// The frame's parameters; the renderer's own passes find the scene, the uploaded
+    /// scene and the settings in `extensions`.
+    fn params<'a>(&'a self, extensions: &'a [&'a dyn std::any::Any]) -> FrameParams<'a> {
+        FrameParams {
+            settings: &self.settings,
+            extensions,
+            alpha_cards: self.alpha_cards,
+            anchor: self.anchor,
+            multiview: self.multiview,
+            motion: &self.motion,
+        }
+    }
 }
 
 /// What the engine's chain reads of the renderer's settings.
