@@ -38,6 +38,11 @@ pub fn check_frames(warmup: u32, frames: u32) -> Result<()> {
     Ok(())
 }
 
+/// The first value a sweep's list names twice (its rows would be measured twice), if any.
+pub fn named_twice<T: PartialEq>(list: &[T]) -> Option<&T> {
+    list.iter().enumerate().find(|(i, v)| list[..*i].contains(v)).map(|(_, v)| v)
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -110,8 +110,8 @@ fn check_list<T: PartialEq + std::fmt::Debug>(what: &str, list: &[T]) -> Result<
     if list.is_empty() {
         return Err(Error::input(format!("the table needs at least one of its {what}")));
     }
-    match list.iter().enumerate().find(|(i, v)| list[..*i].contains(v)) {
-        Some((_, v)) => Err(Error::input(format!("{what} name {} twice", format!("{v:?}").to_lowercase()))),
+    match crate::measure::named_twice(list) {
+        Some(v) => Err(Error::input(format!("{what} name {} twice", format!("{v:?}").to_lowercase()))),
         None => Ok(()),
     }
 }

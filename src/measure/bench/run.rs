@@ -178,9 +178,9 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
 /// occlusion technique, and reflective-shadow-map rows need a directional light and a
 /// VPL count within 1..=1024.
 /// Refuses a list of the bench's options that names a value twice, naming it.
-fn named_once(what: &str, names: &[String]) -> Result<()> {
-    match names.iter().enumerate().find(|(i, name)| names[..*i].contains(name)) {
-        Some((_, name)) => Err(Error::input(format!("the bench's {what} name {name} twice"))),
+fn named_once<T: PartialEq + std::fmt::Display>(what: &str, list: &[T]) -> Result<()> {
+    match crate::measure::named_twice(list) {
+        Some(value) => Err(Error::input(format!("the bench's {what} name {value} twice"))),
         None => Ok(()),
     }
 }
@@ -188,11 +188,11 @@ fn named_once(what: &str, names: &[String]) -> Result<()> {
 fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: &[BenchCase]) -> Result<()> {
     crate::measure::check_frames(options.warmup, options.frames)?;
     // A value named twice would measure the same rows twice (the table refuses it too).
-    named_once("techniques", &options.techniques.iter().map(|t| t.name().to_string()).collect::<Vec<_>>())?;
-    named_once("sample counts", &options.samples.iter().map(|n| n.to_string()).collect::<Vec<_>>())?;
-    named_once("radii", &options.radii.iter().map(|r| r.to_string()).collect::<Vec<_>>())?;
-    named_once("foveation levels", &options.foveation.iter().map(|f| f.name().to_string()).collect::<Vec<_>>())?;
-    named_once("RSM sample counts", &options.rsm_samples.iter().map(|n| n.to_string()).collect::<Vec<_>>())?;
+    named_once("techniques", &options.techniques)?;
+    named_once("sample counts", &options.samples)?;
+    named_once("radii", &options.radii)?;
+    named_once("foveation levels", &options.foveation)?;
+    named_once("RSM sample counts", &options.rsm_samples)?;
     for case in cases {
         let mut s = base.clone();
         (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.resolution, s.ao.depth_peeling) = (
