@@ -45,6 +45,9 @@ pub(crate) struct PackPass {
     layer_uniforms: [wgpu::Buffer; 2],
     /// The output target and the format it was made for.
     target: Option<(AoOutputFormat, LayeredTarget)>,
+    /// Each layer's bind group and the final AO view they read: made again only when the
+    /// chain's targets change.
+    bind_groups: Option<(wgpu::TextureView, Vec<wgpu::BindGroup>)>,
 }
 
 impl PackPass {
@@ -89,6 +92,7 @@ impl PackPass {
             pipelines: [pipeline(AoOutputFormat::R16Float), pipeline(AoOutputFormat::R8Unorm)],
             layer_uniforms: [layer_uniform(0), layer_uniform(1)],
             target: None,
+            bind_groups: None,
         }
     }
 
@@ -108,20 +112,27 @@ impl PackPass {
             let target = LayeredTarget::new(&gpu.device, "ao output", format.texture_format(), extent, usage);
             self.target = Some((format, target));
         }
+        if self.bind_groups.as_ref().is_none_or(|(view, _)| *view != final_ao.array_view) {
+            let bind_group = |uniform: &wgpu::Buffer| {
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("pack"),
+                    layout: &self.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&final_ao.array_view),
+                        },
+                        wgpu::BindGroupEntry { binding: 1, resource: uniform.as_entire_binding() },
+                    ],
+                })
+            };
+            let groups = self.layer_uniforms.iter().map(bind_group).collect();
+            self.bind_groups = Some((final_ao.array_view.clone(), groups));
+        }
         let (_, target) = self.target.as_ref().expect("made above");
+        let (_, bind_groups) = self.bind_groups.as_ref().expect("made above");
         let pipeline = &self.pipelines.iter().find(|(f, _)| *f == format).expect("a single-channel format").1;
-        for (layer, view) in target.layer_views.iter().enumerate() {
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pack"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&final_ao.array_view),
-                    },
-                    wgpu::BindGroupEntry { binding: 1, resource: self.layer_uniforms[layer].as_entire_binding() },
-                ],
-            });
+        for (view, bind_group) in target.layer_views.iter().zip(bind_groups) {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("pack"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -136,7 +147,7 @@ impl PackPass {
                 ..Default::default()
             });
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(0, bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
         target
