@@ -5,7 +5,8 @@
 //! Folders with a dependency rule (checked by `tests/layout.rs`): `xr` (headsets) imports
 //! only the renderer; `app` (the frame loop, governor and window) and `measure`
 //! (reference, metrics, bench, studies) import the renderer and `xr` but not each other;
-//! `formats` (the bench file, still images, writers) and `test_assets` are shared. The
+//! `formats` (the bench file, still images, writers), `test_assets` and `stats` (the one
+//! definition of a quantile) are shared. The
 //! CLI (`src/cli/`) is the binary's. [`render`] is the renderer crate under the name these
 //! modules use.
 //!
@@ -21,6 +22,7 @@ pub mod formats;
 #[cfg(feature = "app")]
 pub mod measure;
 pub mod render;
+pub mod stats;
 pub mod test_assets;
 #[cfg(feature = "app")]
 pub mod xr;

@@ -1,8 +1,9 @@
 //! The dependency rule between the application library's folders (see `src/lib.rs`):
-//! `render` (the renderer crate under the name the others use) and the shared `formats`
-//! and `test_assets` import only the renderer and each other's formats, `xr` only
-//! `render`, `app` and `measure` use `render`, `xr` and `formats` but not each other, and
-//! nothing in the library reaches the CLI. Cargo enforces the rule between the crates.
+//! `render` (the renderer crate under the name the others use) imports nothing else;
+//! the shared `formats` and `test_assets` import only the renderer (and `stats`, the one
+//! quantile definition, a leaf); `xr` only `render` and `stats`; `app` and `measure` use
+//! `render`, `xr`, `formats` and `stats` but not each other; and nothing in the library
+//! reaches the CLI. Cargo enforces the rule between the crates.
 
 use std::path::{Path, PathBuf};
 
@@ -43,11 +44,11 @@ fn each_folder_imports_only_what_the_rule_allows() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let allowed: [(&str, &[&str]); 6] = [
         ("render", &["render"]),
-        ("formats", &["render", "formats"]),
+        ("formats", &["render", "formats", "stats"]),
         ("test_assets", &["render", "test_assets"]),
-        ("xr", &["render", "xr"]),
-        ("app", &["render", "xr", "app", "formats"]),
-        ("measure", &["render", "xr", "measure", "formats"]),
+        ("xr", &["render", "xr", "stats"]),
+        ("app", &["render", "xr", "app", "formats", "stats"]),
+        ("measure", &["render", "xr", "measure", "formats", "stats"]),
     ];
     let mut violations = Vec::new();
     let mut files_checked = 0;

@@ -5,7 +5,7 @@ use crate::app::{FrameLoop, SERIAL_EVERY};
 use crate::formats::output::significant;
 use crate::formats::spans::summarize;
 use crate::render::settings::AoSettings;
-use crate::render::stats;
+use crate::stats;
 use std::sync::atomic::Ordering;
 
 /// What a run did (`vrao run --report`): frames rendered and in flight, the frame budget
@@ -38,7 +38,7 @@ pub struct RunSummary {
     pub over_budget_frames: u64,
     /// Frames whose GPU time came back.
     pub timed_frames: u64,
-    /// Medians over the run ([`crate::render::stats`]; 0 when no frame was timed): GPU
+    /// Medians over the run ([`crate::stats`]; 0 when no frame was timed): GPU
     /// time per frame (both eyes), CPU encode time per frame, and their ratio.
     pub gpu_frame_ms_median: f64,
     /// Median CPU encode time per frame (ms).

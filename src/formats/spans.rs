@@ -1,6 +1,6 @@
 //! Median and spread of GPU and CPU spans over many frames, for reports.
 
-use crate::render::stats::Sorted;
+use crate::stats::Sorted;
 
 /// One span's times over many frames.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -22,7 +22,7 @@ pub struct SpanSummary {
 }
 
 /// Median and spread of every span over frames, in the order spans first appear
-/// (quantiles as [`crate::render::stats`] defines them).
+/// (quantiles as [`crate::stats`] defines them).
 pub fn summarize(frames: &[Vec<(String, f64)>]) -> Vec<SpanSummary> {
     let mut labels: Vec<&str> = Vec::new();
     for frame in frames {

@@ -13,7 +13,7 @@ use crate::render::graph::FINAL_AO;
 use crate::render::renderer::Renderer;
 use crate::render::scene::Scene;
 use crate::render::settings::Settings;
-use crate::render::stats;
+use crate::stats;
 use crate::xr::simulated::motion::HeadMotion;
 use serde::Serialize;
 use std::path::Path;

@@ -66,10 +66,10 @@ pub struct FrameCounters {
 
 impl FrameCounters {
     /// Sets the latency median and 95th percentile from the latency samples (ms), by
-    /// [`crate::render::stats`]'s one definition whichever headset measured them; with
+    /// [`crate::stats`]'s one definition whichever headset measured them; with
     /// no samples both stay as they are (0 before any frame was shown).
     pub fn set_latency(&mut self, samples_ms: &[f64]) {
-        let sorted = crate::render::stats::Sorted::new(samples_ms.iter().copied());
+        let sorted = crate::stats::Sorted::new(samples_ms.iter().copied());
         if let (Some(median), Some(p95)) = (sorted.median(), sorted.quantile(0.95)) {
             (self.latency_median_ms, self.latency_p95_ms) = (median, p95);
         }

@@ -21,7 +21,6 @@ pub mod graph_targets;
 pub mod passes;
 pub mod sampling;
 pub mod settings;
-pub mod stats;
 pub mod stereo;
 pub mod technique;
 

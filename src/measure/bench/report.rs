@@ -513,7 +513,7 @@ pub fn plot(file: &BenchFile, radius_m: f32, budget_ms_per_eye: f64) -> ScatterP
     let pareto: Vec<(f64, f64)> =
         rows.iter().filter(|r| r.pareto).map(|r| (r.occlusion_ms_per_eye, r.ao_rmse.unwrap_or(f64::NAN))).collect();
     let other: Vec<f64> = rows.iter().filter_map(|r| r.other_ms_per_eye).collect();
-    let line = match crate::render::stats::median(&other) {
+    let line = match crate::stats::median(&other) {
         Some(other) => {
             let share = (budget_ms_per_eye - other).max(0.0);
             let label = format!(
