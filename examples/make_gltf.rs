@@ -78,6 +78,8 @@ fn run(out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let world: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     let (origin, offsets) = Mesh::recentre(&world);
     let mesh = Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: "terrain".into(),
         origin,
         positions: offsets,
@@ -109,6 +111,8 @@ fn plain_scene(name: &str, meshes: Vec<Mesh>, materials: Vec<Material>) -> Scene
 fn quad(name: &str, y: f64, size: f32, material: usize) -> Mesh {
     let h = size / 2.0;
     Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: name.into(),
         origin: DVec3::new(0.0, y, 0.0),
         positions: vec![Vec3::new(-h, 0.0, h), Vec3::new(h, 0.0, h), Vec3::new(h, 0.0, -h), Vec3::new(-h, 0.0, -h)],
@@ -137,7 +141,8 @@ fn grille_scene() -> Scene {
         })
         .collect();
     let mut grille = Material::plain("grille", Vec3::new(0.7, 0.6, 0.5));
-    grille.diffuse_texture = Some(Texture { width: CHECKER, height: CHECKER, rgba8, source: None });
+    grille.diffuse_texture =
+        Some(Texture { sampling: Default::default(), width: CHECKER, height: CHECKER, rgba8, source: None });
     grille.alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
     let materials = vec![Material::plain("floor", Vec3::splat(0.7)), grille];
     let meshes = vec![quad("floor", 0.0, 4.0, 0), quad("grille", 0.5, 2.0, 1)];

@@ -57,6 +57,8 @@ fn scene() -> vrao::Scene {
         .into_iter()
         .enumerate()
         .map(|(i, m)| Mesh {
+            colors: Vec::new(),
+            tangents: Vec::new(),
             name: format!("mesh{i}"),
             origin: DVec3::ZERO,
             uvs: vec![glam::Vec2::ZERO; m.positions.len()],

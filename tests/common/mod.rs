@@ -46,6 +46,8 @@ pub fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
 pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Mesh {
     let h = size * 0.5;
     Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: name.into(),
         origin: center,
         node: None,
@@ -74,6 +76,8 @@ pub fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Me
     }
     let n = positions.len();
     Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: name.into(),
         origin: center,
         node: None,
@@ -123,7 +127,18 @@ pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize
         }
     }
     let uvs = vec![glam::Vec2::ZERO; positions.len()];
-    Mesh { name: name.into(), origin: center, positions, normals, uvs, indices, material, node: None }
+    Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
+        name: name.into(),
+        origin: center,
+        positions,
+        normals,
+        uvs,
+        indices,
+        material,
+        node: None,
+    }
 }
 
 /// The world position of every pixel of a depth readback (reversed-Z, one layer per eye,

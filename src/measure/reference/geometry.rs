@@ -366,6 +366,8 @@ mod tests {
         Scene {
             name: "quad".into(),
             meshes: vec![Mesh {
+                colors: Vec::new(),
+                tangents: Vec::new(),
                 name: "quad".into(),
                 origin,
                 normals: vec![Vec3::Z; 4],
@@ -446,7 +448,7 @@ mod tests {
         assert!((srgb_to_linear(188) - 0.5).abs() < 0.01);
         // 2×2: top row black/white, bottom row red/green.
         let rgba8 = vec![0, 0, 0, 255, 255, 255, 255, 255, 255, 0, 0, 255, 0, 255, 0, 255];
-        let t = Texture { width: 2, height: 2, rgba8, source: None };
+        let t = Texture { sampling: Default::default(), width: 2, height: 2, rgba8, source: None };
         assert_eq!(sample_texture(&t, Vec2::new(0.25, 0.25)), Vec3::ZERO);
         assert_eq!(sample_texture(&t, Vec2::new(0.75, 0.25)), Vec3::ONE);
         assert_eq!(sample_texture(&t, Vec2::new(0.25, 0.75)), Vec3::X);

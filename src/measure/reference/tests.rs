@@ -138,7 +138,18 @@ fn sphere_mesh(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
         }
     }
     let uvs = vec![Vec2::ZERO; positions.len()];
-    Mesh { name: "ball".into(), origin: centre, positions, normals, uvs, indices, material: 0, node: None }
+    Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
+        name: "ball".into(),
+        origin: centre,
+        positions,
+        normals,
+        uvs,
+        indices,
+        material: 0,
+        node: None,
+    }
 }
 
 fn floor_mesh(half: f32) -> Mesh {
@@ -149,6 +160,8 @@ fn floor_mesh(half: f32) -> Mesh {
         Vec3::new(half, 0.0, -half),
     ];
     Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: "floor".into(),
         origin: DVec3::ZERO,
         normals: vec![Vec3::Y; 4],

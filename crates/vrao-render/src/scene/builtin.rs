@@ -298,6 +298,8 @@ impl Builder {
     pub fn finish(self, name: &str, material: usize) -> Mesh {
         let (origin, positions) = Mesh::recentre(&self.positions);
         Mesh {
+            colors: Vec::new(),
+            tangents: Vec::new(),
             name: name.into(),
             origin,
             node: None,

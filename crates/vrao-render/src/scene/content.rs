@@ -43,7 +43,7 @@ fn checker_texture() -> Texture {
             rgba8.extend([200, 200, 200, if solid { 255 } else { 0 }]);
         }
     }
-    Texture { width: side, height: side, rgba8, source: None }
+    Texture { sampling: Default::default(), width: side, height: side, rgba8, source: None }
 }
 
 /// A two-sided horizontal quad at height `y` over x, z in ±`h`, with uvs as
@@ -55,6 +55,8 @@ fn plate(y: f64, h: f64, material: usize) -> Mesh {
     let uvs =
         corners.iter().map(|&(x, z)| Vec2::new(((x + h) / (2.0 * h)) as f32, ((z + h) / (2.0 * h)) as f32)).collect();
     Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: "grille".into(),
         origin,
         positions,

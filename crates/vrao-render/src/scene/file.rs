@@ -319,7 +319,7 @@ fn load_mesh_entry(
         _ => {
             return Err(Failure::Here(
                 "a [[mesh]] needs exactly one of obj = \"file.obj\", gltf = \"file.glb\" or builtin = \"name\"".into(),
-            ))
+            ));
         }
     };
     let placement = transform.as_ref().map_or(DMat4::IDENTITY, Transform::matrix);
@@ -375,7 +375,7 @@ fn animation_tracks(animation: &AnimationEntry) -> std::result::Result<NodeTrack
         "linear" => Interpolation::Linear,
         "step" => Interpolation::Step,
         other => {
-            return Err(Failure::Here(format!("animation interpolation '{other}': expected \"linear\" or \"step\"")))
+            return Err(Failure::Here(format!("animation interpolation '{other}': expected \"linear\" or \"step\"")));
         }
     };
     let keys = &animation.keys;
@@ -701,7 +701,10 @@ path = [{ t = 0, eye = [0, 1.6, 3], look_at = [0, 1, 0] }, { t = 2.5, eye = [1, 
             ("[[mesh]]\n", "needs exactly one of obj"),
             ("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n", "light intensity -1.0 must be"),
             ("[[light]]\ntype = \"directional\"\ndirection = [0, 0, 0]\nintensity = 1\n", "has no length"),
-            ("[head]\neye = [1, 2, 3]\nlook_at = [1, 2, 3]\n", "scene.toml:1: eye [1.0, 2.0, 3.0] and look_at [1.0, 2.0, 3.0] coincide"),
+            (
+                "[head]\neye = [1, 2, 3]\nlook_at = [1, 2, 3]\n",
+                "scene.toml:1: eye [1.0, 2.0, 3.0] and look_at [1.0, 2.0, 3.0] coincide",
+            ),
             ("[head]\neye = [1, 2, 3]\n", "[head] needs eye and look_at"),
             (
                 "[head]\npath = [{ t = 1, eye = [0, 0, 1], look_at = [0, 0, 0] }, { t = 1, eye = [0, 0, 2], look_at = [0, 0, 0] }]\n",

@@ -113,6 +113,7 @@ mod tests {
         let mut scene = crate::scene::builtin::load("plane").unwrap();
         let mut material = Material::plain("wide", Vec3::ONE);
         let texture = Texture {
+            sampling: Default::default(),
             width: 17,
             height: 1,
             rgba8: vec![255; 17 * 4],

@@ -17,14 +17,16 @@ pub mod gltf;
 pub mod limits;
 pub mod normals;
 pub mod obj;
+pub mod texture;
 
 use crate::error::{Error, Result};
 use crate::stereo::HeadPose;
-use glam::{DMat4, DVec3, Vec2, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 
 pub use animation::{Interpolation, Node, NodeTracks, Track, Trs};
 pub use environment::Environment;
+pub use texture::{Filter, Sampling, Texture, Wrap};
 
 /// A triangle mesh. Positions are stored relative to `origin` (f64) so that a scene
 /// placed far from the world origin keeps full f32 precision near the camera.
@@ -41,6 +43,12 @@ pub struct Mesh {
     /// Texture coordinates, one per position (zero when the source has none). v = 0 is the
     /// top row of the texture (OBJ's bottom-up v is flipped at load).
     pub uvs: Vec<Vec2>,
+    /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position, multiplying the
+    /// material's base colour and alpha; empty when the source has none (white).
+    pub colors: Vec<Vec4>,
+    /// Tangents for the normal texture (glTF `TANGENT`: xyz along +u, w the bitangent's
+    /// sign), one per position; empty when the material has no normal texture.
+    pub tangents: Vec<Vec4>,
     /// Triangle list into the vertex arrays.
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
@@ -60,20 +68,6 @@ impl Mesh {
         let origin = if bounds.is_empty() { DVec3::ZERO } else { bounds.center() };
         (origin, world.iter().map(|&p| (p - origin).as_vec3()).collect())
     }
-}
-
-/// An RGBA8 texture in sRGB encoding, row-major from the top-left texel.
-#[derive(Clone, Debug)]
-pub struct Texture {
-    /// Width in texels.
-    pub width: u32,
-    /// Height in texels.
-    pub height: u32,
-    /// `width × height` texels, four bytes each.
-    pub rgba8: Vec<u8>,
-    /// The image file it was decoded from (`None` when it came from no file of its own),
-    /// named when the device cannot take the texture.
-    pub source: Option<PathBuf>,
 }
 
 /// What a material's alpha (its `alpha` factor times the texture's alpha) does.
@@ -119,6 +113,15 @@ pub struct Material {
     /// Diffuse texture (MTL `map_Kd`), multiplied with `diffuse`; its alpha channel
     /// multiplies `alpha`.
     pub diffuse_texture: Option<Texture>,
+    /// Emission texture (glTF `emissiveTexture`, sRGB), multiplied with `emissive`.
+    pub emissive_texture: Option<Texture>,
+    /// Tangent-space normal texture (glTF `normalTexture`, linear), with its `scale`
+    /// (how far the texture tilts the normal: x and y scaled).
+    pub normal_texture: Option<(Texture, f32)>,
+    /// Baked ambient occlusion (glTF `occlusionTexture`, red channel, linear), with its
+    /// `strength` (1 + strength × (texel − 1)); combined with the screen-space AO in the
+    /// lighting by taking the smaller of the two (`composite.wgsl`).
+    pub occlusion_texture: Option<(Texture, f32)>,
     /// Alpha factor (MTL `d`, glTF `baseColorFactor.a`), in [0, 1].
     pub alpha: f32,
     /// What alpha does (opaque, alpha-tested or blended).
@@ -133,6 +136,9 @@ impl Material {
             diffuse,
             emissive: Vec3::ZERO,
             diffuse_texture: None,
+            emissive_texture: None,
+            normal_texture: None,
+            occlusion_texture: None,
             alpha: 1.0,
             alpha_mode: AlphaMode::Opaque,
         }
@@ -488,6 +494,8 @@ fn bake(mesh: &Mesh, world: &DMat4) -> Mesh {
         indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
     }
     Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: mesh.name.clone(),
         origin,
         positions,

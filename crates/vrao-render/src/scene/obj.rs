@@ -362,6 +362,9 @@ impl MtlMaterial {
             None => super::AlphaMode::Opaque,
         };
         Ok(Material {
+            emissive_texture: None,
+            normal_texture: None,
+            occlusion_texture: None,
             name: self.name,
             diffuse: self.diffuse.unwrap_or(Vec3::splat(DEFAULT_DIFFUSE)).clamp(Vec3::ZERO, Vec3::ONE),
             emissive: self.emissive,
@@ -472,7 +475,13 @@ fn load_texture(path: &Path) -> Result<Texture> {
     let cannot = |e: &dyn std::fmt::Display| Error::in_file(path, format!("cannot decode texture: {e}"));
     let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
     let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?.into_rgba8();
-    Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw(), source: Some(path.into()) })
+    Ok(Texture {
+        sampling: Default::default(),
+        width: image.width(),
+        height: image.height(),
+        rgba8: image.into_raw(),
+        source: Some(path.into()),
+    })
 }
 
 /// An alpha map (MTL `map_d`): its alpha channel when the image has one, else its grey
@@ -495,6 +504,7 @@ fn load_alpha(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
 /// texel when the sizes differ.
 fn with_alpha(diffuse: Option<Texture>, width: u32, height: u32, coverage: &[u8]) -> Texture {
     let mut texture = diffuse.unwrap_or_else(|| Texture {
+        sampling: Default::default(),
         width,
         height,
         rgba8: vec![255; 4 * width as usize * height as usize],
@@ -537,6 +547,8 @@ fn convert(model: tobj::Model, material: usize) -> Option<Mesh> {
         normals::compute_normals(&positions, &uvs, &source.indices, normals::DEFAULT_CREASE_DEG)
     };
     Some(Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
         name: model.name,
         origin,
         node: None,
@@ -597,6 +609,8 @@ mod tests {
     fn emitter_becomes_a_point_light_below_it() {
         // A 2 m × 1 m quad at y = 3 facing down, emitting (4, 2, 0).
         let mesh = Mesh {
+            colors: Vec::new(),
+            tangents: Vec::new(),
             name: "lamp".into(),
             origin: DVec3::new(0.0, 3.0, 0.0),
             positions: vec![Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 0.0)],

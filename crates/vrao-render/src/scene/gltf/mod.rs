@@ -450,6 +450,8 @@ impl Loader<'_> {
                     let points: Vec<DVec3> = g.positions.iter().map(|p| p.as_dvec3()).collect();
                     let (origin, positions) = Mesh::recentre(&points);
                     Mesh {
+                        colors: Vec::new(),
+                        tangents: Vec::new(),
                         name: primitive.name.clone(),
                         origin,
                         positions,
@@ -573,6 +575,9 @@ impl Loader<'_> {
             None => None,
         };
         self.materials.push(Material {
+            emissive_texture: None,
+            normal_texture: None,
+            occlusion_texture: None,
             name,
             diffuse: Vec3::new(factor[0], factor[1], factor[2]).clamp(Vec3::ZERO, Vec3::ONE),
             emissive,
@@ -760,7 +765,13 @@ fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, Problem> {
         return Err(Problem(format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}")));
     }
     let image = image::load_from_memory(bytes).map_err(|e| format!("cannot decode: {e}"))?.into_rgba8();
-    Ok(Texture { width: image.width(), height: image.height(), rgba8: image.into_raw(), source: None })
+    Ok(Texture {
+        sampling: Default::default(),
+        width: image.width(),
+        height: image.height(),
+        rgba8: image.into_raw(),
+        source: None,
+    })
 }
 
 /// Normals as [`normals::repair_normals`] leaves them, except that a normal already of
@@ -799,7 +810,18 @@ fn bake_static(name: &str, g: &Geometry, world: &DMat4, material: usize) -> Mesh
         // A singular transform flattens the mesh; its normals then come from the faces.
         normals::repair_normals(&positions, &mut normals, &indices);
     }
-    Mesh { name: name.to_string(), origin, positions, normals, uvs: g.uvs.clone(), indices, material, node: None }
+    Mesh {
+        colors: Vec::new(),
+        tangents: Vec::new(),
+        name: name.to_string(),
+        origin,
+        positions,
+        normals,
+        uvs: g.uvs.clone(),
+        indices,
+        material,
+        node: None,
+    }
 }
 
 /// A primitive's vertex order as a triangle list: a strip's triangle i is (i, i+1, i+2)

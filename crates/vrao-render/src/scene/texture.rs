@@ -1,0 +1,117 @@
+//! Textures as materials use them: the decoded image and how it is sampled (wrap per
+//! axis, filters, mipmaps, and `KHR_texture_transform`'s placement), read by the G-buffer
+//! and the reference tracer alike.
+
+use glam::{Affine2, Vec2};
+use std::path::PathBuf;
+
+/// An RGBA8 texture in sRGB encoding, row-major from the top-left texel.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// `width × height` texels, four bytes each.
+    pub rgba8: Vec<u8>,
+    /// The image file it was decoded from (`None` when it came from no file of its own),
+    /// named when the device cannot take the texture.
+    pub source: Option<PathBuf>,
+    /// How it is sampled.
+    pub sampling: Sampling,
+}
+
+/// What happens to a texture coordinate outside [0, 1] on one axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    /// The texture tiles (glTF's default, and OBJ's).
+    Repeat,
+    /// The texture tiles, mirrored every other repeat.
+    MirroredRepeat,
+    /// The edge texel extends.
+    ClampToEdge,
+}
+
+impl Wrap {
+    /// Texel index `i` of a row of `n` brought into 0..n as this mode addresses it.
+    pub fn texel(self, i: i64, n: i64) -> i64 {
+        match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::MirroredRepeat => {
+                let k = i.rem_euclid(2 * n);
+                if k < n {
+                    k
+                } else {
+                    2 * n - 1 - k
+                }
+            }
+            Wrap::ClampToEdge => i.clamp(0, n - 1),
+        }
+    }
+}
+
+/// Texel filtering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Filter {
+    /// The nearest texel.
+    Nearest,
+    /// Bilinear between the four nearest texels.
+    Linear,
+}
+
+/// How a material samples one texture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampling {
+    /// Wrap along u (glTF `wrapS`).
+    pub wrap_u: Wrap,
+    /// Wrap along v (glTF `wrapT`).
+    pub wrap_v: Wrap,
+    /// Filter when a texel covers more than a pixel (glTF `magFilter`).
+    pub magnify: Filter,
+    /// Filter within a mip level when a texel covers less than a pixel (glTF `minFilter`).
+    pub minify: Filter,
+    /// Filter between mip levels; `None` samples the full-size level only (glTF's
+    /// `NEAREST`/`LINEAR` minification filters).
+    pub mipmaps: Option<Filter>,
+    /// From the mesh's texture coordinates to where the texture is read
+    /// (`KHR_texture_transform`: translation · rotation · scale).
+    pub transform: Affine2,
+}
+
+impl Default for Sampling {
+    /// glTF's default sampler (repeat on both axes) with the filters engines pick when
+    /// the file names none: trilinear.
+    fn default() -> Self {
+        Sampling {
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+            magnify: Filter::Linear,
+            minify: Filter::Linear,
+            mipmaps: Some(Filter::Linear),
+            transform: Affine2::IDENTITY,
+        }
+    }
+}
+
+impl Sampling {
+    /// `uv` as the mesh gives it, moved by [`Sampling::transform`].
+    pub fn place(&self, uv: Vec2) -> Vec2 {
+        self.transform.transform_point2(uv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap_modes_address_texels_as_the_gpu_does() {
+        assert_eq!(Wrap::Repeat.texel(-1, 4), 3);
+        assert_eq!(Wrap::Repeat.texel(9, 4), 1);
+        assert_eq!(Wrap::MirroredRepeat.texel(4, 4), 3);
+        assert_eq!(Wrap::MirroredRepeat.texel(-1, 4), 0);
+        assert_eq!(Wrap::MirroredRepeat.texel(8, 4), 0);
+        assert_eq!(Wrap::ClampToEdge.texel(9, 4), 3);
+        assert_eq!(Wrap::ClampToEdge.texel(-2, 4), 0);
+    }
+}
