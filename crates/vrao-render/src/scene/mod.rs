@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 
 pub use animation::{Interpolation, Node, NodeTracks, Track, Trs};
 pub use environment::Environment;
-pub use texture::{Filter, Sampling, Texture, Wrap};
+pub use texture::{uv_transform, uv_transform_parts, Filter, Sampling, Texture, Wrap};
 
 /// A triangle mesh. Positions are stored relative to `origin` (f64) so that a scene
 /// placed far from the world origin keeps full f32 precision near the camera.

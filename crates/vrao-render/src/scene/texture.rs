@@ -100,6 +100,24 @@ impl Sampling {
     }
 }
 
+/// `KHR_texture_transform`'s matrix: offset · rotation · scale, the rotation as the
+/// Khronos sample viewer applies it (u' = cos·u + sin·v, v' = −sin·u + cos·v: the UVs
+/// turn counter-clockwise as the texture is drawn, v pointing down).
+pub fn uv_transform(offset: Vec2, rotation: f32, scale: Vec2) -> Affine2 {
+    let (sin, cos) = rotation.sin_cos();
+    let rotate = glam::Mat2::from_cols(Vec2::new(cos, -sin), Vec2::new(sin, cos));
+    Affine2::from_mat2_translation(rotate * glam::Mat2::from_diagonal(scale), offset)
+}
+
+/// The offset, rotation and scale that [`uv_transform`] makes `transform` from (a
+/// transform with shear has none; this gives the nearest).
+pub fn uv_transform_parts(transform: &Affine2) -> (Vec2, f32, Vec2) {
+    let (u, v) = (transform.matrix2.x_axis, transform.matrix2.y_axis);
+    let rotation = (-u.y).atan2(u.x);
+    let flip = if transform.matrix2.determinant() < 0.0 { -1.0 } else { 1.0 };
+    (transform.translation, rotation, Vec2::new(u.length(), flip * v.length()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,5 +131,20 @@ mod tests {
         assert_eq!(Wrap::MirroredRepeat.texel(8, 4), 0);
         assert_eq!(Wrap::ClampToEdge.texel(9, 4), 3);
         assert_eq!(Wrap::ClampToEdge.texel(-2, 4), 0);
+    }
+
+    #[test]
+    fn uv_transform_turns_uvs_as_the_sample_viewer_and_splits_back_into_its_parts() {
+        let quarter = uv_transform(Vec2::ZERO, std::f32::consts::FRAC_PI_2, Vec2::ONE);
+        // u' = cos·u + sin·v, v' = −sin·u + cos·v.
+        assert!(quarter.transform_point2(Vec2::X).abs_diff_eq(Vec2::new(0.0, -1.0), 1e-6));
+        assert!(quarter.transform_point2(Vec2::Y).abs_diff_eq(Vec2::new(1.0, 0.0), 1e-6));
+        let (offset, rotation, scale) = (Vec2::new(0.5, -0.25), 0.392699, Vec2::new(1.5, 2.0));
+        let t = uv_transform(offset, rotation, scale);
+        // Scale first, then rotate, then offset.
+        let expected = offset + Vec2::new(0.392699f32.cos() * 1.5, -0.392699f32.sin() * 1.5);
+        assert!(t.transform_point2(Vec2::X).abs_diff_eq(expected, 1e-6));
+        let (o, r, s) = uv_transform_parts(&t);
+        assert!(o.abs_diff_eq(offset, 1e-6) && (r - rotation).abs() < 1e-6 && s.abs_diff_eq(scale, 1e-5));
     }
 }
