@@ -6,3 +6,4 @@ pub use vrao_ao::gpu::*;
 pub mod kernel;
 pub mod raster;
 pub mod scene;
+pub mod textures;

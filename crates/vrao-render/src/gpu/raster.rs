@@ -5,9 +5,10 @@
 use super::scene::Vertex;
 pub use vrao_ao::gpu::raster::*;
 
-/// The scene's vertices (position, normal, uv) as the raster passes read them.
-pub const MESH_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+/// The scene's vertices (position, normal, uv, colour, tangent) as the raster passes read them.
+pub const MESH_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Unorm8x4, 4 => Snorm16x4
+];
 
 /// One vertex buffer of [`Vertex`] with the given attributes (all, or the position only).
 pub fn mesh_vertex_buffer(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexBufferLayout<'_> {

@@ -9,8 +9,9 @@
 //! previous frame's beside it (the G-buffer's motion vectors), so nothing is re-uploaded.
 
 use super::kernel::{wgsl, Shader};
+use super::textures::{self, Encoding, Samplers};
 use super::Gpu;
-use crate::scene::{Environment, Material, Scene};
+use crate::scene::{Environment, Material, Scene, Texture};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
 use wgpu::util::DeviceExt;
@@ -27,21 +28,46 @@ pub struct Vertex {
     pub position: [f32; 3],
     /// Unit surface normal in world space.
     pub normal: [f32; 3],
-    /// Texture coordinates of the diffuse texture.
+    /// Texture coordinates (set 0, which every texture reads).
     pub uv: [f32; 2],
+    /// Linear RGBA vertex colour (unorm8; white without one).
+    pub color: [u8; 4],
+    /// Tangent along +u and the bitangent's sign in w (snorm16); zero without one, when
+    /// the shader finds the tangent frame from screen-space derivatives.
+    pub tangent: [i16; 4],
 }
 
-/// One material's constants (`Material` uniform of the G-buffer shader).
+/// One material's constants (`Material` of mesh.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct MaterialUniform {
     /// Diffuse albedo in rgb; w is 1 when a diffuse texture multiplies it, else 0.
     pub diffuse: [f32; 4],
-    /// Emitted radiance in rgb; w unused.
+    /// Emitted radiance in rgb (the emissive texture multiplies it); w unused.
     pub emission: [f32; 4],
-    /// x: alpha factor; y: the alpha-test cutoff (−1 for a solid material); zw unused.
+    /// x: alpha factor; y: the alpha-test cutoff (−1 for a solid material); z: the normal
+    /// texture's scale (0 without one); w: the occlusion texture's strength (0 without one).
     pub alpha: [f32; 4],
+    /// Each texture's placement (`KHR_texture_transform`) in [`MaterialTexture`] order, two
+    /// rows each: (the 2×2 matrix's columns), (the offset, 0, 0).
+    pub placements: [[f32; 4]; 8],
 }
+
+/// The textures a material binds, in binding order (mesh.wgsl: texture at 1 + 2k…).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialTexture {
+    /// Base colour (sRGB; white without one).
+    Diffuse = 0,
+    /// Emission (sRGB; white without one).
+    Emissive = 1,
+    /// Tangent-space normals (linear; unused without one: the scale is 0).
+    Normal = 2,
+    /// Baked occlusion in red (linear; white without one).
+    Occlusion = 3,
+}
+
+/// The binding of each [`MaterialTexture`]'s texture (its sampler follows it).
+const TEXTURE_BINDINGS: [u32; 4] = [1, 4, 6, 8];
 
 /// One object's transforms (`Object` of mesh.wgsl).
 #[repr(C)]
@@ -71,13 +97,13 @@ pub enum DrawSet {
     AlphaTested,
 }
 
-/// One material on the GPU: its uniform and diffuse texture.
+/// One material on the GPU: its uniform, and its textures with their samplers.
 pub struct GpuMaterial {
     /// The [`MaterialUniform`].
     pub uniform: wgpu::Buffer,
-    /// The diffuse texture, or a 1×1 white placeholder without one.
-    pub texture: wgpu::TextureView,
-    /// Whether `texture` is the material's own texture rather than the placeholder.
+    /// Its textures in [`MaterialTexture`] order, a 1×1 placeholder where it has none.
+    pub textures: [(wgpu::TextureView, wgpu::Sampler); 4],
+    /// Whether it has its own diffuse texture (rather than the placeholder).
     pub has_texture: bool,
 }
 
@@ -121,7 +147,7 @@ pub struct GpuScene {
     pub alpha_tested: bool,
     /// The environment as a filterable equirectangular texture (1×1 black without one).
     pub environment: wgpu::TextureView,
-    /// Sampler of the materials' diffuse textures.
+    /// Sampler of the environment (repeats around, clamps at the poles).
     pub sampler: wgpu::Sampler,
 }
 
@@ -194,10 +220,16 @@ impl GpuScene {
             buffer_init(device, "scene indices", bytemuck::cast_slice(&geometry.indices), wgpu::BufferUsages::INDEX);
         // Each material's alpha-test cutoff, found once (it scans the texture's alpha).
         let cutoffs: Vec<Option<f32>> = scene.materials.iter().map(|m| m.alpha_cutoff()).collect();
-        let materials: Vec<GpuMaterial> =
-            scene.materials.iter().zip(&cutoffs).map(|(m, &cutoff)| upload_material(gpu, m, cutoff)).collect();
+        let mut samplers = Samplers::default();
+        let placeholders = Placeholders::new(gpu);
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .zip(&cutoffs)
+            .map(|(m, &cutoff)| upload_material(gpu, m, cutoff, &mut samplers, &placeholders))
+            .collect();
         let bindings = DrawBindings {
-            sampler: diffuse_sampler(device),
+            sampler: environment_sampler(device),
             layout: material_layout(device),
             objects: object_buffer(device, anchor, geometry.object_nodes.len()),
         };
@@ -249,10 +281,16 @@ impl Geometry {
                 None => ((mesh.origin - anchor).as_vec3(), 0),
             };
             for i in 0..mesh.positions.len() {
+                let color = mesh.colors.get(i).copied().unwrap_or(glam::Vec4::ONE);
+                let tangent = mesh.tangents.get(i).copied().unwrap_or(glam::Vec4::ZERO);
                 g.vertices.push(Vertex {
                     position: (mesh.positions[i] + offset).to_array(),
                     normal: mesh.normals[i].to_array(),
                     uv: mesh.uvs.get(i).copied().unwrap_or_default().to_array(),
+                    color: color.to_array().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
+                    tangent: tangent
+                        .to_array()
+                        .map(|c| (if c.is_finite() { c.clamp(-1.0, 1.0) } else { 0.0 } * 32767.0).round() as i16),
                 });
             }
             let start = g.indices.len() as u32;
@@ -295,8 +333,6 @@ impl DrawBindings {
             layout: &self.layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: m.uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.texture) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
@@ -305,6 +341,14 @@ impl DrawBindings {
                         size: wgpu::BufferSize::new(std::mem::size_of::<ObjectUniform>() as u64),
                     }),
                 },
+                texture_entry(m, MaterialTexture::Diffuse),
+                sampler_entry(m, MaterialTexture::Diffuse),
+                texture_entry(m, MaterialTexture::Emissive),
+                sampler_entry(m, MaterialTexture::Emissive),
+                texture_entry(m, MaterialTexture::Normal),
+                sampler_entry(m, MaterialTexture::Normal),
+                texture_entry(m, MaterialTexture::Occlusion),
+                sampler_entry(m, MaterialTexture::Occlusion),
             ],
         });
         let alpha_tested = cutoffs[run.material].is_some();
@@ -317,26 +361,82 @@ fn buffer_init(device: &wgpu::Device, label: &str, contents: &[u8], usage: wgpu:
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
 }
 
-/// Material `m` on the GPU: its uniform (with its alpha-test `cutoff`) and its diffuse
-/// texture, or the white placeholder.
-fn upload_material(gpu: &Gpu, m: &Material, cutoff: Option<f32>) -> GpuMaterial {
-    let (texture, has_texture) = match &m.diffuse_texture {
-        Some(t) => (rgba8_texture(gpu, &m.name, t.width, t.height, &t.rgba8), true),
-        None => (rgba8_texture(gpu, "white", 1, 1, &[255; 4]), false),
+fn texture_entry(m: &GpuMaterial, kind: MaterialTexture) -> wgpu::BindGroupEntry<'_> {
+    let binding = TEXTURE_BINDINGS[kind as usize];
+    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(&m.textures[kind as usize].0) }
+}
+
+fn sampler_entry(m: &GpuMaterial, kind: MaterialTexture) -> wgpu::BindGroupEntry<'_> {
+    let binding = TEXTURE_BINDINGS[kind as usize] + 1;
+    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::Sampler(&m.textures[kind as usize].1) }
+}
+
+/// The 1×1 textures bound where a material has none: white (diffuse, emission,
+/// occlusion multiply by 1) and a flat normal.
+struct Placeholders {
+    white_srgb: wgpu::TextureView,
+    white_linear: wgpu::TextureView,
+    flat_normal: wgpu::TextureView,
+}
+
+impl Placeholders {
+    fn new(gpu: &Gpu) -> Self {
+        Placeholders {
+            white_srgb: textures::placeholder(gpu, "white", [255; 4], Encoding::Srgb),
+            white_linear: textures::placeholder(gpu, "white (linear)", [255; 4], Encoding::Linear),
+            flat_normal: textures::placeholder(gpu, "flat normal", [128, 128, 255, 255], Encoding::Linear),
+        }
+    }
+}
+
+/// Material `m` on the GPU: its uniform (with its alpha-test `cutoff`) and its textures,
+/// placeholders where it has none.
+fn upload_material(
+    gpu: &Gpu,
+    m: &Material,
+    cutoff: Option<f32>,
+    samplers: &mut Samplers,
+    placeholders: &Placeholders,
+) -> GpuMaterial {
+    let mut upload = |texture: Option<&Texture>, kind: &str, encoding: Encoding, placeholder: &wgpu::TextureView| {
+        let sampling = texture.map(|t| t.sampling).unwrap_or_default();
+        let view = match texture {
+            Some(t) => textures::upload(gpu, &format!("{} {kind}", m.name), t, encoding),
+            None => placeholder.clone(),
+        };
+        (view, samplers.get(&gpu.device, &sampling), sampling.transform)
     };
+    let normal = m.normal_texture.as_ref();
+    let occlusion = m.occlusion_texture.as_ref();
+    let uploaded = [
+        upload(m.diffuse_texture.as_ref(), "diffuse", Encoding::Srgb, &placeholders.white_srgb),
+        upload(m.emissive_texture.as_ref(), "emissive", Encoding::Srgb, &placeholders.white_srgb),
+        upload(normal.map(|(t, _)| t), "normal", Encoding::Linear, &placeholders.flat_normal),
+        upload(occlusion.map(|(t, _)| t), "occlusion", Encoding::Linear, &placeholders.white_linear),
+    ];
+    let mut placements = [[0.0; 4]; 8];
+    for (k, (_, _, transform)) in uploaded.iter().enumerate() {
+        let (x, y) = (transform.matrix2.x_axis, transform.matrix2.y_axis);
+        placements[2 * k] = [x.x, x.y, y.x, y.y];
+        placements[2 * k + 1] = [transform.translation.x, transform.translation.y, 0.0, 0.0];
+    }
+    let has_texture = m.diffuse_texture.is_some();
     let uniform = MaterialUniform {
         diffuse: [m.diffuse.x, m.diffuse.y, m.diffuse.z, if has_texture { 1.0 } else { 0.0 }],
         emission: [m.emissive.x, m.emissive.y, m.emissive.z, 0.0],
-        alpha: [m.alpha, cutoff.unwrap_or(-1.0), 0.0, 0.0],
+        alpha: [m.alpha, cutoff.unwrap_or(-1.0), normal.map_or(0.0, |n| n.1), occlusion.map_or(0.0, |o| o.1)],
+        placements,
     };
     let uniform = buffer_init(&gpu.device, &m.name, bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
-    GpuMaterial { uniform, texture, has_texture }
+    let textures = uploaded.map(|(view, sampler, _)| (view, sampler));
+    GpuMaterial { uniform, textures, has_texture }
 }
 
-/// The sampler of the materials' diffuse textures.
-fn diffuse_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+/// The environment's sampler: the equirectangular map repeats around the horizon and
+/// clamps at the poles.
+fn environment_sampler(device: &wgpu::Device) -> wgpu::Sampler {
     device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("linear repeat"),
+        label: Some("environment"),
         address_mode_u: wgpu::AddressMode::Repeat,
         address_mode_v: wgpu::AddressMode::ClampToEdge,
         mag_filter: wgpu::FilterMode::Linear,
@@ -373,26 +473,6 @@ fn object_uniform(anchor: DVec3, world_from_local: DMat4, previous_world_from_lo
         previous_anchored_from_local: (anchored * previous_world_from_local).as_mat4().to_cols_array_2d(),
         normal_from_local: normal.as_mat4().to_cols_array_2d(),
     }
-}
-
-/// An sRGB RGBA8 texture of `rgba8`, as a view.
-fn rgba8_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8]) -> wgpu::TextureView {
-    let texture = gpu.device.create_texture_with_data(
-        &gpu.queue,
-        &wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8UnormSrgb,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        rgba8,
-    );
-    texture.create_view(&Default::default())
 }
 
 /// `v` as f16 bits, saturated to ±65504 and NaN as 0: `half` alone would give Inf or
@@ -446,22 +526,6 @@ fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 count: None,
             },
             wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: fragment,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: fragment,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
                 binding: 3,
                 visibility: wgpu::ShaderStages::VERTEX,
                 ty: wgpu::BindingType::Buffer {
@@ -471,8 +535,38 @@ fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 },
                 count: None,
             },
+            texture_layout(TEXTURE_BINDINGS[0]),
+            sampler_layout(TEXTURE_BINDINGS[0] + 1),
+            texture_layout(TEXTURE_BINDINGS[1]),
+            sampler_layout(TEXTURE_BINDINGS[1] + 1),
+            texture_layout(TEXTURE_BINDINGS[2]),
+            sampler_layout(TEXTURE_BINDINGS[2] + 1),
+            texture_layout(TEXTURE_BINDINGS[3]),
+            sampler_layout(TEXTURE_BINDINGS[3] + 1),
         ],
     })
+}
+
+fn texture_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn sampler_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
 }
 
 #[cfg(test)]

@@ -454,15 +454,30 @@ impl Scene {
 
     /// Loads `builtin:NAME`, a `.toml` scene file, a bare `.obj`, or a `.gltf`/`.glb`.
     pub fn load(spec: &str) -> Result<Scene> {
-        if let Some(name) = spec.strip_prefix("builtin:") {
-            return builtin::load(name);
+        let (scene, file) = match spec.strip_prefix("builtin:") {
+            Some(name) => (builtin::load(name)?, None),
+            None => {
+                let path = Path::new(spec);
+                // Says what is there when it is not a regular file (a folder, a FIFO, a
+                // device), and why a path `exists()` calls missing (a symlink loop) is unreadable.
+                crate::files::check_regular_file(path)?;
+                (Self::load_file(path)?, Some(path))
+            }
+        };
+        // What each loader checked part by part, for the whole scene: motion that carries a
+        // mesh beyond the far bound, a camera beyond it, the triangle and vertex budget.
+        let trouble = limits::motion_trouble(&scene.meshes, &scene.nodes)
+            .or_else(|| limits::head_trouble(&scene.head))
+            .or_else(|| limits::GeometryBudget::of(&scene.meshes).trouble());
+        match (trouble, file) {
+            (None, _) => Ok(scene),
+            (Some(trouble), Some(path)) => Err(Error::in_file(path, trouble)),
+            (Some(trouble), None) => Err(Error::input(format!("{spec}: {trouble}"))),
         }
-        let path = Path::new(spec);
-        // `exists()` says false for a symlink loop or an unreadable directory too: say why.
-        if let Err(e) = std::fs::metadata(path) {
-            let why = if e.kind() == std::io::ErrorKind::NotFound { "no such file".into() } else { e.to_string() };
-            return Err(Error::in_file(path, why));
-        }
+    }
+
+    /// Loads a `.toml` scene file, a bare `.obj`, or a `.gltf`/`.glb` by its extension.
+    fn load_file(path: &Path) -> Result<Scene> {
         match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
             Some(ext) if ext == "toml" => file::load(path),
             Some(ext) if ext == "obj" => obj::load_bare(path),
@@ -494,8 +509,8 @@ fn bake(mesh: &Mesh, world: &DMat4) -> Mesh {
         indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
     }
     Mesh {
-        colors: Vec::new(),
-        tangents: Vec::new(),
+        colors: mesh.colors.clone(),
+        tangents: transform_tangents(&mesh.tangents, glam::DMat3::from_mat4(*world)),
         name: mesh.name.clone(),
         origin,
         positions,
@@ -505,6 +520,16 @@ fn bake(mesh: &Mesh, world: &DMat4) -> Mesh {
         material: mesh.material,
         node: None,
     }
+}
+
+/// Tangents moved by the linear part of a transform: the direction along +u follows the
+/// surface, and a mirroring transform flips the bitangent's sign.
+pub fn transform_tangents(tangents: &[Vec4], linear: glam::DMat3) -> Vec<Vec4> {
+    let flip = if linear.determinant() < 0.0 { -1.0 } else { 1.0 };
+    tangents
+        .iter()
+        .map(|t| (linear * t.truncate().as_dvec3()).normalize_or_zero().as_vec3().extend(t.w * flip))
+        .collect()
 }
 
 /// The refusal of a glTF by a vrao built without the `gltf` feature.

@@ -47,6 +47,17 @@ fn triangles(positions: &[Vec3], indices: &[u32]) -> Vec<([u32; 3], Vec3)> {
 /// position, normal and uv per output vertex (vertices are duplicated where a crease
 /// splits them). Zero-area triangles are kept in the index list but carry no weight.
 pub fn compute_normals(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], crease_angle_deg: f32) -> Geometry {
+    compute_normals_with_sources(positions, uvs, indices, crease_angle_deg).0
+}
+
+/// [`compute_normals`], with the input vertex each output vertex was made from (so that
+/// further per-vertex data, such as colours, can follow the split).
+pub fn compute_normals_with_sources(
+    positions: &[Vec3],
+    uvs: &[Vec2],
+    indices: &[u32],
+    crease_angle_deg: f32,
+) -> (Geometry, Vec<u32>) {
     let crease = if crease_angle_deg.is_finite() { crease_angle_deg } else { DEFAULT_CREASE_DEG };
     let cos_crease = crease.clamp(0.0, 180.0).to_radians().cos();
     let tris = triangles(positions, indices);
@@ -103,6 +114,7 @@ pub fn compute_normals(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], crease
 
     // One output vertex per (input vertex, normal): corners that agree share a vertex.
     let mut out = Geometry::default();
+    let mut sources = Vec::new();
     let mut output_of: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
     for (f, (corners, _)) in tris.iter().enumerate() {
         for &v in corners {
@@ -112,12 +124,13 @@ pub fn compute_normals(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], crease
                 out.positions.push(positions[v as usize]);
                 out.normals.push(normal);
                 out.uvs.push(uvs.get(v as usize).copied().unwrap_or(Vec2::ZERO));
+                sources.push(v);
                 (out.positions.len() - 1) as u32
             });
             out.indices.push(index);
         }
     }
-    out
+    (out, sources)
 }
 
 /// Makes normals read from a file unit length. A zero-length or non-finite normal is

@@ -22,7 +22,7 @@ pub struct Texture {
 }
 
 /// What happens to a texture coordinate outside [0, 1] on one axis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Wrap {
     /// The texture tiles (glTF's default, and OBJ's).
     Repeat,
@@ -51,7 +51,7 @@ impl Wrap {
 }
 
 /// Texel filtering.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Filter {
     /// The nearest texel.
     Nearest,

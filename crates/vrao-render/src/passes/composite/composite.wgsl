@@ -71,15 +71,25 @@ fn shade(pixel: vec2<u32>, layer: u32, eye: Eye, depth: f32, n: vec3<f32>, occlu
         let dir = (eye.world_from_view * vec4<f32>(view_ray(pixel_uv(pixel, frame.size), eye.tangents), 0.0)).xyz;
         return environment_radiance(environment, environment_sampler, dir);
     }
-    let albedo = textureLoad(albedo_layers, p, i32(layer), 0).rgb;
+    let surface = textureLoad(albedo_layers, p, i32(layer), 0);
+    let albedo = surface.rgb;
+    // The material's baked occlusion (1 without an occlusion texture). Baked and
+    // screen-space AO estimate the same visibility, so the smaller one holds: multiplying
+    // would darken twice where both see the same crease.
+    let baked = surface.a;
     var ambient = vec3<f32>(0.0);
     if (frame.has_environment != 0u) {
         ambient = environment_irradiance(layer, n);
     }
     if (ao.technique == COMPOSITE_SCALAR_AO) {
-        ambient *= saturate_ao(occlusion.a);
+        ambient *= min(saturate_ao(occlusion.a), baked);
     } else if (ao.technique == COMPOSITE_DIRECTIONAL) {
-        ambient = max(occlusion.rgb, vec3<f32>(0.0));
+        // SSDO's irradiance already holds its visibility (a): the baked one lowers it
+        // only where it is smaller.
+        let visibility = saturate_ao(occlusion.a);
+        ambient = max(occlusion.rgb, vec3<f32>(0.0)) * select(1.0, baked / visibility, baked < visibility);
+    } else {
+        ambient *= baked;
     }
     return direct_radiance(textureLoad(direct_layers, p, i32(layer), 0)) + albedo / PI * (ambient + bounce);
 }

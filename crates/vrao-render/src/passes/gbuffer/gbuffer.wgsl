@@ -19,6 +19,8 @@ struct VertexOut {
     @location(0) view_position: vec3<f32>,
     @location(1) view_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    @location(3) color: vec4<f32>,
+    @location(4) view_tangent: vec4<f32>,
 };
 
 // VertexOut and where the point was in the previous frame.
@@ -27,9 +29,11 @@ struct MotionVertexOut {
     @location(0) view_position: vec3<f32>,
     @location(1) view_normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
-    @location(3) previous_clip: vec4<f32>,
+    @location(3) color: vec4<f32>,
+    @location(4) view_tangent: vec4<f32>,
+    @location(5) previous_clip: vec4<f32>,
     // Distance along the previous view's −z.
-    @location(4) previous_distance: f32,
+    @location(6) previous_distance: f32,
 };
 
 fn transform_vertex(v: VertexIn, eye: u32) -> VertexOut {
@@ -40,6 +44,9 @@ fn transform_vertex(v: VertexIn, eye: u32) -> VertexOut {
     out.view_position = (e.view_from_anchored * anchored).xyz;
     out.view_normal = (e.view_from_anchored * vec4<f32>(anchored_normal(v), 0.0)).xyz;
     out.uv = v.uv;
+    out.color = v.color;
+    let tangent = anchored_tangent(v);
+    out.view_tangent = vec4<f32>((e.view_from_anchored * vec4<f32>(tangent.xyz, 0.0)).xyz, tangent.w);
     return out;
 }
 
@@ -51,6 +58,8 @@ fn transform_vertex_with_motion(v: VertexIn, eye: u32) -> MotionVertexOut {
     out.view_position = now.view_position;
     out.view_normal = now.view_normal;
     out.uv = now.uv;
+    out.color = now.color;
+    out.view_tangent = now.view_tangent;
     out.previous_clip = previous.clip_from_anchored[eye] * before;
     out.previous_distance = -(previous.view_from_anchored[eye] * before).z;
     return out;
@@ -71,36 +80,38 @@ struct GBufferMotionOut {
     @location(3) motion: vec4<f32>,
 };
 
-fn shade(view_position: vec3<f32>, view_normal: vec3<f32>, uv: vec2<f32>) -> GBufferOut {
-    alpha_test(uv);
-    var n = view_normal;
+fn shade(in: VertexOut) -> GBufferOut {
+    alpha_test(in.uv, in.color.a);
+    var n = in.view_normal;
     let len2 = dot(n, n);
     // A zero or NaN interpolated normal falls back to the geometric one.
-    let geometric = normalize(cross(dpdx(view_position), dpdy(view_position)));
+    let geometric = normalize(cross(dpdx(in.view_position), dpdy(in.view_position)));
     n = select(geometric, n * inverseSqrt(len2), len2 > 1e-20 && len2 == len2);
     // Surfaces are seen from the front: flip normals that face away from the eye, so
-    // OBJ files with inconsistent winding still shade correctly.
-    if (dot(n, -view_position) < 0.0) {
-        n = -n;
-    }
-    let albedo = material_albedo(uv);
+    // OBJ files with inconsistent winding still shade correctly. The normal texture
+    // tilts the normal in the frame of the side the eye sees.
+    let facing = select(1.0, -1.0, dot(n, -in.view_position) < 0.0);
+    let tangent = vec4<f32>(in.view_tangent.xyz * facing, in.view_tangent.w);
+    n = mapped_normal(n * facing, tangent, in.view_position, in.uv);
+    let albedo = material_albedo(in.uv, in.color);
     var out: GBufferOut;
     // w marks alpha-tested surfaces (cards: leaves, grilles, fences), which GTAO takes as
     // thin occluders (gtao.wgsl `THIN_CARDS`).
     out.normal = vec4<f32>(finite_or_zero3(n), select(0.0, 1.0, ALPHA_TEST));
-    out.albedo = vec4<f32>(albedo, 1.0);
-    out.emission = vec4<f32>(finite_or_zero3(material.emission.rgb), 0.0);
+    // Alpha carries the baked occlusion, which the composite combines with the AO.
+    out.albedo = vec4<f32>(albedo, material_occlusion(in.uv));
+    out.emission = vec4<f32>(finite_or_zero3(material_emission(in.uv)), 0.0);
     return out;
 }
 
 @fragment
 fn fs_main(in: VertexOut) -> GBufferOut {
-    return shade(in.view_position, in.view_normal, in.uv);
+    return shade(in);
 }
 
 @fragment
 fn fs_motion(in: MotionVertexOut) -> GBufferMotionOut {
-    let g = shade(in.view_position, in.view_normal, in.uv);
+    let g = shade(VertexOut(in.clip, in.view_position, in.view_normal, in.uv, in.color, in.view_tangent));
     var out: GBufferMotionOut;
     out.normal = g.normal;
     out.albedo = g.albedo;

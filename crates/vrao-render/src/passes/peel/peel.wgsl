@@ -23,6 +23,7 @@ override PEEL_GAP: f32 = 1e-3;
 struct PeelVertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
+    @location(1) vertex_alpha: f32,
 };
 
 // The G-buffer's transform (gbuffer.wgsl `transform_vertex`), position and uv.
@@ -31,12 +32,13 @@ fn vs_peel(v: VertexIn) -> PeelVertexOut {
     var out: PeelVertexOut;
     out.clip = frame.eyes[peel_eye.index].clip_from_anchored * anchored_position(v);
     out.uv = v.uv;
+    out.vertex_alpha = v.color.a;
     return out;
 }
 
 @fragment
 fn fs_peel(in: PeelVertexOut) {
-    alpha_test(in.uv);
+    alpha_test(in.uv, in.vertex_alpha);
     let p = in.clip;
     // Reversed Z with an infinite far plane: distance = near / depth, so "farther than
     // the first layer by the gap" is depth × (1 + gap) < first depth. On the sky (first

@@ -12,6 +12,7 @@ struct VertexOut {
     // Normal in light view (+z towards the light).
     @location(0) normal: vec3<f32>,
     @location(1) uv: vec2<f32>,
+    @location(2) color: vec4<f32>,
 };
 
 @vertex
@@ -20,6 +21,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.clip = light.clip_from_anchored * anchored_position(v);
     out.normal = (light.view_from_anchored * vec4<f32>(anchored_normal(v), 0.0)).xyz;
     out.uv = v.uv;
+    out.color = v.color;
     return out;
 }
 
@@ -35,19 +37,19 @@ struct RsmOut {
 // The depth-only map of alpha-tested materials: holes let the light through.
 @fragment
 fn fs_alpha(in: VertexOut) {
-    alpha_test(in.uv);
+    alpha_test(in.uv, in.color.a);
 }
 
 @fragment
 fn fs_rsm(in: VertexOut) -> RsmOut {
-    alpha_test(in.uv);
+    alpha_test(in.uv, in.color.a);
     var n = in.normal;
     let len2 = dot(n, n);
     n = select(vec3<f32>(0.0, 0.0, 1.0), n * inverseSqrt(len2), len2 > 1e-20 && len2 == len2);
     if (n.z < 0.0) {
         n = -n;
     }
-    let albedo = material_albedo(in.uv);
+    let albedo = material_albedo(in.uv, in.color);
     var out: RsmOut;
     out.normal = vec4<f32>(finite_or_zero3(n), 0.0);
     out.flux = vec4<f32>(finite_or_zero3(albedo * light.radiance.rgb), 0.0);

@@ -6,13 +6,16 @@
 //! container, each buffer's bytes, every accessor's byte range against its buffer view and
 //! buffer, finite numbers, indices against vertex counts, node cycles, key times, and a
 //! bound on every count ([`MAX_FILE_BYTES`], [`MAX_TRIANGLES`], ...). Accessors are decoded
-//! here rather than by the crate's readers, which assume valid ranges. Anything wrong is
-//! one [`Error::Input`] line naming the file and the element.
+//! here rather than by the crate's readers, which assume valid ranges: dense or sparse
+//! (substituted over their view or over zeros), in the component types glTF allows for each
+//! use, `KHR_mesh_quantization`'s included (`accessors.rs` holds the table); a quantized
+//! mesh's node transform dequantizes it. Anything wrong is one [`Error::Input`] line naming
+//! the file and the element.
 //!
 //! What is read: the default scene (else the first; else every root node) with its
 //! TRS and matrix transforms; triangle primitives (indexed u8/u16/u32 or not; strips and
-//! fans become triangle lists; points and lines are skipped with one warning); POSITION, NORMAL (computed as for OBJ when missing), TEXCOORD_0 (float
-//! or normalised integers); the base-colour factor and texture; `alphaMode`
+//! fans become triangle lists; points and lines are skipped with one warning); POSITION, NORMAL (computed as for OBJ when missing), TEXCOORD_0 (float,
+//! or integers normalised or not); the base-colour factor and texture; `alphaMode`
 //! OPAQUE / MASK (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]); the
 //! emissive factor × `KHR_materials_emissive_strength`, so emitters become lights as in
 //! OBJ when the file has no punctual light; `KHR_lights_punctual` directional, point and
@@ -42,24 +45,25 @@ use crate::stereo::HeadPose;
 use ::gltf::json;
 use ::gltf::mesh::Mode;
 use files::{load_buffers, read_bounded, resolve_uri, split_glb};
-use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3};
+use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
 
 pub use files::decode_base64;
 
-/// The largest `.gltf`/`.glb`, external buffer or image file read (1 GiB).
-pub const MAX_FILE_BYTES: u64 = 1 << 30;
-/// The most triangles over every drawn mesh instance (20 million).
-pub const MAX_TRIANGLES: usize = 20_000_000;
-/// The most vertices over every drawn mesh instance (20 million).
-pub const MAX_VERTICES: usize = 20_000_000;
+/// The largest `.gltf`/`.glb`, external buffer or image file read (1 GiB, as every model file).
+pub const MAX_FILE_BYTES: u64 = crate::files::MAX_FILE_BYTES;
+/// The most triangles over every drawn mesh instance: the scene's budget
+/// ([`super::limits::MAX_TRIANGLES`], 20 million).
+pub const MAX_TRIANGLES: usize = super::limits::MAX_TRIANGLES;
+/// The most vertices over every drawn mesh instance ([`super::limits::MAX_VERTICES`], 20 million).
+pub const MAX_VERTICES: usize = super::limits::MAX_VERTICES;
 /// The most nodes a file may declare.
 pub const MAX_NODES: usize = 100_000;
 /// The most animation keys over all channels (10 million).
 pub const MAX_KEYS: usize = 10_000_000;
-/// The largest texture side in texels.
-pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+/// The largest texture side in texels ([`super::limits::MAX_TEXTURE_SIDE`]).
+pub const MAX_TEXTURE_SIDE: u32 = super::limits::MAX_TEXTURE_SIDE;
 /// The most elements one accessor may declare (more than any bound above needs).
 const MAX_ACCESSOR_COUNT: usize = 3 * MAX_TRIANGLES;
 
@@ -197,11 +201,22 @@ impl From<String> for Problem {
 }
 
 /// What the crate's validation leaves out and its accessors would panic on (found by
-/// fuzzing, gltf-json 1.4.1): animation channel targets (node index and path), a spot
-/// light without its cone, and a primitive's POSITION accessor that does not exist (the
-/// crate's own primitive check indexes the accessors with it before checking it).
+/// fuzzing and by reading gltf 1.4.1): animation channel targets (node index and path), a
+/// spot light without its cone, a primitive's POSITION accessor that does not exist (the
+/// crate's own primitive check indexes the accessors with it before checking it), and an
+/// image without the source `Image::source` unwraps (a bufferView needs a mimeType, as
+/// glTF requires; otherwise a uri). The rest of the accessor, sparse, image, texture and
+/// sampler getters unwrap only what the crate's validation has checked (indices in range,
+/// enumerations valid, a texture's source present).
 fn precheck(root: &json::Root) -> std::result::Result<(), Problem> {
     use json::validation::Checked;
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.uri, &image.buffer_view, &image.mime_type) {
+            (_, Some(_), None) => return Err(Problem(format!("image {i}: has a bufferView but no mimeType"))),
+            (None, None, _) => return Err(Problem(format!("image {i}: has neither a uri nor a bufferView"))),
+            _ => {}
+        }
+    }
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             for (semantic, accessor) in &primitive.attributes {
@@ -279,6 +294,10 @@ impl Warnings {
 struct LocalPrimitive {
     name: String,
     geometry: Geometry,
+    /// COLOR_0, one per vertex of `geometry`, or empty.
+    colors: Vec<Vec4>,
+    /// TANGENT, one per vertex of `geometry`, or empty.
+    tangents: Vec<Vec4>,
     /// Index into the loaded materials (before the offset).
     material: usize,
 }
@@ -399,7 +418,10 @@ impl Loader<'_> {
         Ok(content)
     }
 
-    /// A node's local transform, checked finite.
+    /// A node's local transform, checked finite and within the bounds static values have
+    /// (`limits.rs`): a translation beyond 10⁶ m or a scale above 10⁶ is refused naming the
+    /// node. A scale below 10⁻⁶ (0 included: glTF content hides nodes so) is kept: what
+    /// hangs below collapses and is not drawn, and [`Loader::warn_hidden_nodes`] says so.
     fn local_transform(&self, node: &::gltf::Node) -> Result<Local> {
         let local = match node.transform() {
             ::gltf::scene::Transform::Matrix { matrix } => {
@@ -421,7 +443,68 @@ impl Loader<'_> {
         if !local.matrix().is_finite() {
             return Err(self.error(format!("node {}: transform is not finite", node.index())));
         }
-        Ok(local)
+        let (translation, scale) = match local {
+            Local::Trs(trs) => (trs.translation, trs.scale.abs()),
+            Local::Matrix(m) => (m.w_axis.truncate(), matrix_scale(&m)),
+        };
+        use super::limits::{coordinate_trouble, SCALE_MAX};
+        let far = translation.to_array().into_iter().find_map(|t| coordinate_trouble("translation", t));
+        let large = (scale.max_element() > SCALE_MAX)
+            .then(|| format!("scale {:e} is larger than {SCALE_MAX:e}", scale.max_element()));
+        match far.or(large) {
+            Some(trouble) => Err(self.error(format!("node {}: {trouble}", node.index()))),
+            None => Ok(local),
+        }
+    }
+
+    /// One warning line naming the nodes whose scale is below [`super::limits::SCALE_MIN`] (0 included)
+    /// with meshes at or below them and no scale animation: those meshes collapse and are
+    /// not drawn (glTF content hides nodes with scale 0, so the file is not refused).
+    fn warn_hidden_nodes(&self, tracks: &HashMap<usize, NodeTracks>) {
+        use super::limits::SCALE_MIN;
+        let nodes: Vec<::gltf::Node> = self.document.nodes().collect();
+        let tiny = |node: &::gltf::Node| {
+            let scale = match node.transform() {
+                ::gltf::scene::Transform::Matrix { matrix } => {
+                    matrix_scale(&DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))))
+                }
+                ::gltf::scene::Transform::Decomposed { scale, .. } => DVec3::from(scale.map(f64::from)).abs(),
+            };
+            scale.min_element() < SCALE_MIN && !tracks.get(&node.index()).is_some_and(|t| t.scale.is_some())
+        };
+        let hidden: Vec<usize> = nodes.iter().filter(|n| tiny(n)).map(|n| n.index()).collect();
+        if hidden.is_empty() {
+            return;
+        }
+        // Whether some mesh hangs at or below each node (post-order; a cycle, refused
+        // later, ends the walk).
+        let mut below = vec![false; nodes.len()];
+        let mut state = vec![0u8; nodes.len()];
+        for &start in &hidden {
+            let mut stack = vec![(start, false)];
+            while let Some((i, done)) = stack.pop() {
+                if done {
+                    below[i] = nodes[i].mesh().is_some() || nodes[i].children().any(|c| below[c.index()]);
+                    state[i] = 2;
+                } else if state[i] == 0 {
+                    state[i] = 1;
+                    stack.push((i, true));
+                    stack.extend(nodes[i].children().map(|c| (c.index(), false)).filter(|&(c, _)| state[c] == 0));
+                }
+            }
+        }
+        let named: Vec<String> = hidden.iter().filter(|&&i| below[i]).map(|i| i.to_string()).collect();
+        if named.is_empty() {
+            return;
+        }
+        let more = if named.len() > 8 { format!(" and {} more", named.len() - 8) } else { String::new() };
+        log::warn!(
+            "{}: node{} {}{more} scaled below {SCALE_MIN:e}: the meshes below {} are not drawn",
+            self.path.display(),
+            if named.len() == 1 { "" } else { "s" },
+            named[..named.len().min(8)].join(", "),
+            if named.len() == 1 { "it" } else { "them" }
+        );
     }
 
     /// The mesh's primitives placed by `at`: baked into world space when static, in the
@@ -450,8 +533,8 @@ impl Loader<'_> {
                     let points: Vec<DVec3> = g.positions.iter().map(|p| p.as_dvec3()).collect();
                     let (origin, positions) = Mesh::recentre(&points);
                     Mesh {
-                        colors: Vec::new(),
-                        tangents: Vec::new(),
+                        colors: primitive.colors.clone(),
+                        tangents: primitive.tangents.clone(),
                         name: primitive.name.clone(),
                         origin,
                         positions,
@@ -462,7 +545,7 @@ impl Loader<'_> {
                         node: Some(node),
                     }
                 }
-                None => bake_static(&primitive.name, g, &at.world, material),
+                None => bake_static(primitive, &at.world, material),
             });
         }
         Ok(())
@@ -510,7 +593,20 @@ impl Loader<'_> {
             if primitive.get(&::gltf::Semantic::TexCoords(1)).is_some() {
                 self.warnings.ignored.insert("texture coordinate sets other than 0");
             }
-            let geometry = match primitive.get(&::gltf::Semantic::Normals) {
+            let colors = match primitive.get(&::gltf::Semantic::Colors(0)) {
+                Some(accessor) => self.read_colors(&accessor, &format!("{what} COLOR_0"), count)?,
+                None => Vec::new(),
+            };
+            let tangents: Vec<Vec4> = match primitive.get(&::gltf::Semantic::Tangents) {
+                Some(accessor) => {
+                    let label = format!("{what} TANGENT");
+                    let tangents = self.read_vectors::<4>(&accessor, &label)?;
+                    self.same_count(tangents.len(), count, &label)?;
+                    tangents.into_iter().map(Vec4::from).collect()
+                }
+                None => Vec::new(),
+            };
+            let (geometry, colors, tangents) = match primitive.get(&::gltf::Semantic::Normals) {
                 Some(accessor) => {
                     let label = format!("{what} NORMAL");
                     let mut normals: Vec<Vec3> =
@@ -518,18 +614,42 @@ impl Loader<'_> {
                     self.same_count(normals.len(), count, &label)?;
                     keep_unit_repair_others(&positions, &mut normals, &indices);
                     let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
-                    Geometry { positions, normals, uvs, indices }
+                    (Geometry { positions, normals, uvs, indices }, colors, tangents)
                 }
-                None => normals::compute_normals(&positions, &uvs, &indices, normals::DEFAULT_CREASE_DEG),
+                None => {
+                    // Computed normals split vertices at creases: colours and tangents follow.
+                    let (geometry, sources) =
+                        normals::compute_normals_with_sources(&positions, &uvs, &indices, normals::DEFAULT_CREASE_DEG);
+                    let follow = |values: &[Vec4]| -> Vec<Vec4> {
+                        if values.is_empty() {
+                            return Vec::new();
+                        }
+                        sources.iter().map(|&v| values[v as usize]).collect()
+                    };
+                    (geometry, follow(&colors), follow(&tangents))
+                }
             };
             let material = self.material(&primitive.material())?;
             let name = match mesh.primitives().len() {
                 1 => mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string),
                 _ => format!("{}.{}", mesh.name().unwrap_or("mesh"), primitive.index()),
             };
-            out.push(LocalPrimitive { name, geometry, material });
+            out.push(LocalPrimitive { name, geometry, colors, tangents, material });
         }
         Ok(out)
+    }
+
+    /// COLOR_0 as linear RGBA (VEC3 gets alpha 1), one per vertex.
+    fn read_colors(&self, accessor: &::gltf::Accessor, what: &str, count: usize) -> Result<Vec<Vec4>> {
+        let colors: Vec<Vec4> = match accessor.dimensions() {
+            ::gltf::accessor::Dimensions::Vec3 => {
+                self.read_vectors::<3>(accessor, what)?.into_iter().map(|c| Vec3::from(c).extend(1.0)).collect()
+            }
+            _ => self.read_vectors::<4>(accessor, what)?.into_iter().map(Vec4::from).collect(),
+        };
+        self.same_count(colors.len(), count, what)?;
+        // Colours are reflectance factors: outside [0, 1] they would add light.
+        Ok(colors.into_iter().map(|c| c.clamp(Vec4::ZERO, Vec4::ONE)).collect())
     }
 
     fn same_count(&self, found: usize, expected: usize, what: &str) -> Result<()> {
@@ -566,28 +686,81 @@ impl Loader<'_> {
             ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
         let diffuse_texture = match pbr.base_color_texture() {
-            Some(info) => {
-                if info.tex_coord() != 0 {
-                    self.warnings.ignored.insert("texture coordinate sets other than 0");
+            Some(info) => Some(self.texture(&info.texture(), placement_of_info(&info), &name)?),
+            None => None,
+        };
+        let emissive_texture = match material.emissive_texture() {
+            Some(info) => Some(self.texture(&info.texture(), placement_of_info(&info), &name)?),
+            None => None,
+        };
+        let normal_texture = match material.normal_texture() {
+            Some(normal) => {
+                let placement = placement_of_extension(
+                    normal.extension_value("KHR_texture_transform"),
+                    normal.tex_coord(),
+                    &name,
+                )
+                .map_err(|m| self.error(m))?;
+                let scale = normal.scale();
+                if !scale.is_finite() {
+                    return Err(self.error(format!("material '{name}': normalTexture scale {scale} is not finite")));
                 }
-                Some(self.image(&info.texture().source())?)
+                Some((self.texture(&normal.texture(), Ok(placement), &name)?, scale))
+            }
+            None => None,
+        };
+        let occlusion_texture = match material.occlusion_texture() {
+            Some(occlusion) => {
+                let placement = placement_of_extension(
+                    occlusion.extension_value("KHR_texture_transform"),
+                    occlusion.tex_coord(),
+                    &name,
+                )
+                .map_err(|m| self.error(m))?;
+                let strength = occlusion.strength();
+                if !(0.0..=1.0).contains(&strength) {
+                    return Err(self.error(format!(
+                        "material '{name}': occlusionTexture strength {strength} is not in [0, 1]"
+                    )));
+                }
+                Some((self.texture(&occlusion.texture(), Ok(placement), &name)?, strength))
             }
             None => None,
         };
         self.materials.push(Material {
-            emissive_texture: None,
-            normal_texture: None,
-            occlusion_texture: None,
             name,
             diffuse: Vec3::new(factor[0], factor[1], factor[2]).clamp(Vec3::ZERO, Vec3::ONE),
             emissive,
             diffuse_texture,
+            emissive_texture,
+            normal_texture,
+            occlusion_texture,
             alpha: factor[3].clamp(0.0, 1.0),
             alpha_mode,
         });
         let i = self.materials.len() - 1;
         self.material_of.insert(material.index(), i);
         Ok(i)
+    }
+
+    /// A material's texture: its image (decoded once), its sampler and where it is placed
+    /// (`KHR_texture_transform`).
+    fn texture(
+        &mut self,
+        texture: &::gltf::Texture,
+        placement: std::result::Result<Placement, String>,
+        material: &str,
+    ) -> Result<Texture> {
+        let placement = placement.map_err(|m| self.error(m))?;
+        if placement.tex_coord != 0 {
+            self.warnings.ignored.insert("texture coordinate sets other than 0");
+        }
+        let mut image = self.image(&texture.source())?;
+        image.sampling = sampling_of(&texture.sampler(), placement.transform);
+        if !image.sampling.transform.is_finite() {
+            return Err(self.error(format!("material '{material}': KHR_texture_transform is not finite")));
+        }
+        Ok(image)
     }
 
     /// A decoded image (PNG, JPEG, ... by content), once per image.
@@ -598,14 +771,9 @@ impl Loader<'_> {
         }
         let what = format!("image {index}");
         let bytes: Vec<u8> = match image.source() {
-            ::gltf::image::Source::View { view, .. } => {
-                let buffer = &self.buffers[view.buffer().index()];
-                let range = view.offset()..view.offset().saturating_add(view.length());
-                buffer
-                    .get(range)
-                    .ok_or_else(|| self.error(format!("{what}: buffer view {} runs past its buffer", view.index())))?
-                    .to_vec()
-            }
+            // Checked against its buffer in checked arithmetic (a byteOffset near 2⁶⁴ is
+            // refused, not wrapped); `precheck` saw to the mimeType the crate unwraps.
+            ::gltf::image::Source::View { view, .. } => self.view_bytes(&view, &what)?.to_vec(),
             ::gltf::image::Source::Uri { uri, .. } => {
                 resolve_uri(self.path, uri).map_err(|m| self.error(format!("{what}: {m}")))?
             }
@@ -712,9 +880,13 @@ impl Loader<'_> {
                         if values.len() != expected {
                             return Err(Error::in_file(self.path, mismatch(values.len())));
                         }
-                        let values = values.into_iter().map(|v| Vec3::from(v).as_dvec3()).collect();
+                        let values: Vec<DVec3> = values.into_iter().map(|v| Vec3::from(v).as_dvec3()).collect();
+                        let translation = property == ::gltf::animation::Property::Translation;
+                        if let Some(trouble) = key_trouble(&values, stride, translation) {
+                            return Err(self.error(format!("{label}: {trouble}")));
+                        }
                         let track = Track { interpolation, times, values };
-                        if property == ::gltf::animation::Property::Translation {
+                        if translation {
                             node.translation.get_or_insert(track);
                         } else {
                             node.scale.get_or_insert(track);
@@ -724,8 +896,41 @@ impl Loader<'_> {
             }
         }
         tracks.retain(|_, t| !t.is_empty());
+        self.warn_hidden_nodes(&tracks);
         Ok(tracks)
     }
+}
+
+/// The size of each axis of a matrix's linear part (its columns' lengths).
+fn matrix_scale(m: &DMat4) -> DVec3 {
+    DVec3::new(m.x_axis.truncate().length(), m.y_axis.truncate().length(), m.z_axis.truncate().length())
+}
+
+/// One-line trouble for the first translation or scale key (or cubic-spline tangent) of an
+/// animation output beyond the bounds static values have (`limits.rs`): a translation
+/// beyond 10⁶ m, a scale above 10⁶, or a scale key below 10⁻⁶ that is not 0 (a key of 0
+/// hides the node while it holds). `stride` is 3 for cubic splines (in-tangent, value,
+/// out-tangent), else 1.
+fn key_trouble(values: &[DVec3], stride: usize, translation: bool) -> Option<String> {
+    use super::limits::{coordinate_trouble, key_scale_trouble, SCALE_MAX};
+    values.iter().enumerate().find_map(|(i, v)| {
+        let (key, role) = (i / stride + 1, i % stride);
+        let tangent = stride == 3 && role != 1;
+        let what = match (tangent, role) {
+            (false, _) => format!("key {key}"),
+            (true, 0) => format!("key {key} in-tangent"),
+            (true, _) => format!("key {key} out-tangent"),
+        };
+        v.to_array().into_iter().find_map(|c| {
+            if translation {
+                coordinate_trouble(&format!("{what} translation"), c)
+            } else if tangent {
+                (c.abs() > SCALE_MAX).then(|| format!("{what} scale {c:e} is larger than {SCALE_MAX:e}"))
+            } else {
+                key_scale_trouble(&format!("{what} scale"), c)
+            }
+        })
+    })
 }
 
 /// A node's local transform as the file gives it.
@@ -755,6 +960,82 @@ impl Local {
     }
 }
 
+/// Where a texture reads the mesh's texture coordinates: which set and through which
+/// `KHR_texture_transform`.
+struct Placement {
+    tex_coord: u32,
+    transform: glam::Affine2,
+}
+
+/// A base-colour or emissive texture's placement (`textureInfo`).
+fn placement_of_info(info: &::gltf::texture::Info) -> std::result::Result<Placement, String> {
+    Ok(match info.texture_transform() {
+        Some(t) => Placement {
+            tex_coord: t.tex_coord().unwrap_or(info.tex_coord()),
+            transform: super::uv_transform(t.offset().into(), t.rotation(), t.scale().into()),
+        },
+        None => Placement { tex_coord: info.tex_coord(), transform: glam::Affine2::IDENTITY },
+    })
+}
+
+/// A normal or occlusion texture's placement: the crate exposes their
+/// `KHR_texture_transform` only as JSON.
+fn placement_of_extension(
+    extension: Option<&json::Value>,
+    tex_coord: u32,
+    material: &str,
+) -> std::result::Result<Placement, String> {
+    let Some(extension) = extension else {
+        return Ok(Placement { tex_coord, transform: glam::Affine2::IDENTITY });
+    };
+    let bad = || format!("material '{material}': KHR_texture_transform {extension} is not offset/rotation/scale numbers");
+    let pair = |key: &str, default: [f32; 2]| -> std::result::Result<glam::Vec2, String> {
+        match extension.get(key) {
+            None => Ok(default.into()),
+            Some(json::Value::Array(v)) if v.len() == 2 => {
+                let c: Vec<f32> = v.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect();
+                if c.len() == 2 { Ok(glam::Vec2::new(c[0], c[1])) } else { Err(bad()) }
+            }
+            _ => Err(bad()),
+        }
+    };
+    let rotation = match extension.get("rotation") {
+        None => 0.0,
+        Some(r) => r.as_f64().ok_or_else(bad)? as f32,
+    };
+    let tex_coord = match extension.get("texCoord") {
+        None => tex_coord,
+        Some(t) => t.as_u64().and_then(|t| u32::try_from(t).ok()).ok_or_else(bad)?,
+    };
+    let transform = super::uv_transform(pair("offset", [0.0, 0.0])?, rotation, pair("scale", [1.0, 1.0])?);
+    Ok(Placement { tex_coord, transform })
+}
+
+/// glTF's sampler as vrao's: wrap per axis (repeat when unset), filters (linear when
+/// unset, with linear mipmaps, as engines pick).
+fn sampling_of(sampler: &::gltf::texture::Sampler, transform: glam::Affine2) -> super::Sampling {
+    use ::gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    use super::{Filter, Wrap};
+    let wrap = |mode| match mode {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    };
+    let magnify = match sampler.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        _ => Filter::Linear,
+    };
+    let (minify, mipmaps) = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, None),
+        Some(MinFilter::Linear) => (Filter::Linear, None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Some(Filter::Nearest)),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Some(Filter::Nearest)),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Some(Filter::Linear)),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Some(Filter::Linear)),
+    };
+    super::Sampling { wrap_u: wrap(sampler.wrap_s()), wrap_v: wrap(sampler.wrap_t()), magnify, minify, mipmaps, transform }
+}
+
 /// Decodes an image to RGBA8, refusing sides over [`MAX_TEXTURE_SIDE`] before decoding.
 fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, Problem> {
     let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
@@ -764,7 +1045,7 @@ fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, Problem> {
     if width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE || width == 0 || height == 0 {
         return Err(Problem(format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}")));
     }
-    let image = image::load_from_memory(bytes).map_err(|e| format!("cannot decode: {e}"))?.into_rgba8();
+    let image = super::limits::decode_texture(bytes).map_err(|e| format!("cannot decode: {e}"))?.into_rgba8();
     Ok(Texture {
         sampling: Default::default(),
         width: image.width(),
@@ -794,16 +1075,19 @@ fn keep_unit_repair_others(positions: &[Vec3], normals: &mut [Vec3], indices: &[
 /// A static primitive in world space: positions through `world` in f64 and recentred as
 /// the OBJ loader does (so the identity gives the OBJ loader's mesh), normals by the
 /// inverse transpose, winding reversed by a mirroring transform.
-fn bake_static(name: &str, g: &Geometry, world: &DMat4, material: usize) -> Mesh {
+fn bake_static(primitive: &LocalPrimitive, world: &DMat4, material: usize) -> Mesh {
+    let g = &primitive.geometry;
     let identity = *world == DMat4::IDENTITY;
     let points: Vec<DVec3> = g.positions.iter().map(|p| world.transform_point3(p.as_dvec3())).collect();
     let (origin, positions) = Mesh::recentre(&points);
     let mut indices = g.indices.clone();
     let mut normals = g.normals.clone();
+    let mut tangents = primitive.tangents.clone();
     if !identity {
         let linear = DMat3::from_mat4(*world);
         let normal_matrix = linear.inverse().transpose();
         normals = normals.iter().map(|n| (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()).collect();
+        tangents = super::transform_tangents(&tangents, linear);
         if linear.determinant() < 0.0 {
             indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
         }
@@ -811,13 +1095,13 @@ fn bake_static(name: &str, g: &Geometry, world: &DMat4, material: usize) -> Mesh
         normals::repair_normals(&positions, &mut normals, &indices);
     }
     Mesh {
-        colors: Vec::new(),
-        tangents: Vec::new(),
-        name: name.to_string(),
+        name: primitive.name.clone(),
         origin,
         positions,
         normals,
         uvs: g.uvs.clone(),
+        colors: primitive.colors.clone(),
+        tangents,
         indices,
         material,
         node: None,
