@@ -73,14 +73,18 @@ pub fn read_layers(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<u8>>> {
     Ok(layers)
 }
 
-/// Every layer as f32 values (channels interleaved), for float and depth formats.
+/// Every layer as f32 values (channels interleaved), for float, depth and 8-bit formats.
 pub fn read_layers_f32(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<f32>>> {
     let raw = read_layers(gpu, target)?;
     let half = matches!(target.format, wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::R16Float);
+    let unorm8 = matches!(target.format, wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Rgba8UnormSrgb);
     Ok(raw
         .into_iter()
         .map(|bytes| {
-            if half {
+            if unorm8 {
+                // Each byte / 255: for an sRGB format, the encoded value.
+                bytes.iter().map(|&b| b as f32 / 255.0).collect()
+            } else if half {
                 bytes.chunks_exact(2).map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32()).collect()
             } else {
                 bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()

@@ -219,7 +219,7 @@ impl GpuScene {
         let index_buffer =
             buffer_init(device, "scene indices", bytemuck::cast_slice(&geometry.indices), wgpu::BufferUsages::INDEX);
         // Each material's alpha-test cutoff, found once (it scans the texture's alpha).
-        let cutoffs: Vec<Option<f32>> = scene.materials.iter().map(|m| m.alpha_cutoff()).collect();
+        let cutoffs = scene.alpha_cutoffs();
         let mut samplers = Samplers::default();
         let placeholders = Placeholders::new(gpu);
         let materials: Vec<GpuMaterial> = scene

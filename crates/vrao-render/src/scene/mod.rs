@@ -147,10 +147,16 @@ impl Material {
     /// The alpha below which this material is a hole, or `None` when it is solid
     /// everywhere (opaque, or an alpha test that nothing can fail).
     pub fn alpha_cutoff(&self) -> Option<f32> {
+        self.alpha_cutoff_with_vertex_alpha(1.0)
+    }
+
+    /// [`Material::alpha_cutoff`] on meshes whose vertex colours' alpha (which multiplies
+    /// the material's) goes down to `vertex_alpha_min`.
+    pub fn alpha_cutoff_with_vertex_alpha(&self, vertex_alpha_min: f32) -> Option<f32> {
         let cutoff = self.alpha_mode.cutoff()?;
         let texture_alpha_min =
             self.diffuse_texture.as_ref().map_or(255, |t| t.rgba8.chunks_exact(4).map(|c| c[3]).min().unwrap_or(255));
-        let lowest = self.alpha * texture_alpha_min as f32 / 255.0;
+        let lowest = self.alpha * vertex_alpha_min * texture_alpha_min as f32 / 255.0;
         (lowest < cutoff).then_some(cutoff)
     }
 }
@@ -389,7 +395,19 @@ impl Scene {
 
     /// Whether some material is alpha-tested (or blended) and can actually fail the test.
     pub fn has_alpha_test(&self) -> bool {
-        self.materials.iter().any(|m| m.alpha_cutoff().is_some())
+        self.alpha_cutoffs().iter().any(Option::is_some)
+    }
+
+    /// Each material's alpha-test cutoff ([`Material::alpha_cutoff`]), the vertex colours'
+    /// alpha of the meshes drawn with it included.
+    pub fn alpha_cutoffs(&self) -> Vec<Option<f32>> {
+        let mut vertex_alpha_min = vec![1.0f32; self.materials.len()];
+        for mesh in &self.meshes {
+            if let Some(lowest) = vertex_alpha_min.get_mut(mesh.material) {
+                *lowest = mesh.colors.iter().map(|c| c.w).fold(*lowest, f32::min);
+            }
+        }
+        self.materials.iter().zip(vertex_alpha_min).map(|(m, v)| m.alpha_cutoff_with_vertex_alpha(v)).collect()
     }
 
     /// The loop period of the animation: the last key time over every track (0 when

@@ -23,7 +23,8 @@ pub const NAME: &str = "gbuffer";
 /// The depth, normals and motion the G-buffer writes are the textures the AO engine
 /// reads.
 pub use vrao_ao::passes::inputs::{DEPTH, MOTION, NORMALS};
-/// Diffuse albedo (sRGB-encoded, reads back linear).
+/// Diffuse albedo in rgb (sRGB-encoded, sampled back linear); in alpha the material's baked
+/// occlusion (glTF `occlusionTexture`, 1 without one), which the composite combines with the AO.
 pub const ALBEDO: Resource = Resource::attachment("albedo", Size::Full, wgpu::TextureFormat::Rgba8UnormSrgb);
 /// Emitted radiance.
 pub const EMISSION: Resource = Resource::attachment("emission", Size::Full, wgpu::TextureFormat::Rgba16Float);
