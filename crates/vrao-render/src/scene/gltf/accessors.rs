@@ -28,8 +28,6 @@ pub(super) enum Use {
     KeyVectors,
     /// An animation sampler's rotation output (VEC4).
     Rotation,
-    /// Anything else read as vectors: float or normalised integers.
-    Other,
 }
 
 impl Use {
@@ -45,7 +43,7 @@ impl Use {
             Use::Position | Use::TexCoord => (ANY, ANY),
             Use::Normal | Use::Tangent => (SIGNED, &[]),
             Use::Color => (UNSIGNED, &[]),
-            Use::Rotation | Use::Other => (ANY, &[]),
+            Use::Rotation => (ANY, &[]),
             Use::KeyTimes | Use::KeyVectors => (&[], &[]),
         }
     }
@@ -56,16 +54,15 @@ impl Use {
         data_type == DataType::F32 || if normalized { normalised } else { plain }.contains(&data_type)
     }
 
-    /// The accessor types allowed for this use (`None`: any with the reader's components).
-    fn dimensions(self) -> Option<&'static [Dimensions]> {
-        Some(match self {
+    /// The accessor types allowed for this use.
+    fn dimensions(self) -> &'static [Dimensions] {
+        match self {
             Use::Position | Use::Normal | Use::KeyVectors => &[Dimensions::Vec3],
             Use::Tangent | Use::Rotation => &[Dimensions::Vec4],
             Use::TexCoord => &[Dimensions::Vec2],
             Use::Color => &[Dimensions::Vec3, Dimensions::Vec4],
             Use::KeyTimes => &[Dimensions::Scalar],
-            Use::Other => return None,
-        })
+        }
     }
 
     fn name(self) -> &'static str {
@@ -78,7 +75,6 @@ impl Use {
             Use::KeyTimes => "an animation input",
             Use::KeyVectors => "a translation or scale output",
             Use::Rotation => "a rotation output",
-            Use::Other => "this accessor",
         }
     }
 
@@ -101,24 +97,6 @@ impl Use {
             text.push_str(" (KHR_mesh_quantization)");
         }
         text
-    }
-
-    /// The use a reader's label names by its last word: a mesh attribute's glTF name
-    /// (`... POSITION`, `... TEXCOORD_0`, `... COLOR_0`), or an animation sampler's
-    /// `input` or `output` (a rotation's when it has four components). Any other label
-    /// reads float or normalised integers ([`Use::Other`]).
-    pub(super) fn from_label(what: &str, components: usize) -> Use {
-        match what.rsplit(' ').next().unwrap_or("") {
-            "POSITION" => Use::Position,
-            "NORMAL" => Use::Normal,
-            "TANGENT" => Use::Tangent,
-            s if s.starts_with("TEXCOORD_") => Use::TexCoord,
-            s if s.starts_with("COLOR_") => Use::Color,
-            "input" => Use::KeyTimes,
-            "output" if components == 4 => Use::Rotation,
-            "output" if components == 3 => Use::KeyVectors,
-            _ => Use::Other,
-        }
     }
 }
 
@@ -288,18 +266,8 @@ impl Loader<'_> {
         Ok(elements)
     }
 
-    /// An accessor of N-component float vectors: float, or the integers glTF allows for
-    /// the use the label names ([`Use::from_label`], [`Use::integers`]), every value finite.
-    pub(super) fn read_vectors<const N: usize>(
-        &self,
-        accessor: &::gltf::Accessor,
-        what: &str,
-    ) -> Result<Vec<[f32; N]>> {
-        self.read_as::<N>(accessor, Use::from_label(what, N), what)
-    }
-
-    /// An accessor of N-component float vectors read as `usage` allows (its accessor
-    /// type and component type checked against [`Use`]'s table), every value finite.
+    /// An accessor of N-component vectors for `usage`: float, or the integers glTF allows
+    /// for that use ([`Use::integers`]), every value finite.
     pub(super) fn read_as<const N: usize>(
         &self,
         accessor: &::gltf::Accessor,
@@ -311,7 +279,8 @@ impl Loader<'_> {
         if dimensions.multiplicity() != N || matches!(dimensions, Dimensions::Mat2) {
             return Err(self.error(format!("{what}: accessor {index} is {dimensions:?}, expected {N} components")));
         }
-        if let Some(allowed) = usage.dimensions().filter(|allowed| !allowed.contains(&dimensions)) {
+        let allowed = usage.dimensions();
+        if !allowed.contains(&dimensions) {
             let names: Vec<String> = allowed.iter().map(|d| format!("{d:?}").to_uppercase()).collect();
             return Err(self.error(format!(
                 "{what}: accessor {index} is {}, {} takes {}",

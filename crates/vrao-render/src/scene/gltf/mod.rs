@@ -44,6 +44,7 @@ use crate::error::{Error, Result};
 use crate::stereo::HeadPose;
 use ::gltf::json;
 use ::gltf::mesh::Mode;
+use accessors::Use;
 use files::{load_buffers, read_bounded, resolve_uri, split_glb};
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use std::collections::{BTreeSet, HashMap};
@@ -447,10 +448,10 @@ impl Loader<'_> {
             Local::Trs(trs) => (trs.translation, trs.scale.abs()),
             Local::Matrix(m) => (m.w_axis.truncate(), matrix_scale(&m)),
         };
-        use super::limits::{coordinate_trouble, SCALE_MAX};
+        use super::limits::{coordinate_trouble, shortest, SCALE_MAX};
         let far = translation.to_array().into_iter().find_map(|t| coordinate_trouble("translation", t));
         let large = (scale.max_element() > SCALE_MAX)
-            .then(|| format!("scale {:e} is larger than {SCALE_MAX:e}", scale.max_element()));
+            .then(|| format!("scale {} is larger than {SCALE_MAX:e}", shortest(scale.max_element())));
         match far.or(large) {
             Some(trouble) => Err(self.error(format!("node {}: {trouble}", node.index()))),
             None => Ok(local),
@@ -571,7 +572,7 @@ impl Loader<'_> {
                 .get(&::gltf::Semantic::Positions)
                 .ok_or_else(|| self.error(format!("{what} has no POSITION attribute")))?;
             let positions: Vec<Vec3> =
-                self.read_vectors::<3>(&position, &format!("{what} POSITION"))?.into_iter().map(Vec3::from).collect();
+                self.read_as::<3>(&position, Use::Position, &format!("{what} POSITION"))?.into_iter().map(Vec3::from).collect();
             let count = positions.len();
             let indices: Vec<u32> = match primitive.indices() {
                 Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
@@ -584,7 +585,7 @@ impl Loader<'_> {
             let uvs: Vec<Vec2> = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
                 Some(accessor) => {
                     let label = format!("{what} TEXCOORD_0");
-                    let uvs = self.read_vectors::<2>(&accessor, &label)?;
+                    let uvs = self.read_as::<2>(&accessor, Use::TexCoord, &label)?;
                     self.same_count(uvs.len(), count, &label)?;
                     uvs.into_iter().map(Vec2::from).collect()
                 }
@@ -600,7 +601,7 @@ impl Loader<'_> {
             let tangents: Vec<Vec4> = match primitive.get(&::gltf::Semantic::Tangents) {
                 Some(accessor) => {
                     let label = format!("{what} TANGENT");
-                    let tangents = self.read_vectors::<4>(&accessor, &label)?;
+                    let tangents = self.read_as::<4>(&accessor, Use::Tangent, &label)?;
                     self.same_count(tangents.len(), count, &label)?;
                     tangents.into_iter().map(Vec4::from).collect()
                 }
@@ -610,7 +611,7 @@ impl Loader<'_> {
                 Some(accessor) => {
                     let label = format!("{what} NORMAL");
                     let mut normals: Vec<Vec3> =
-                        self.read_vectors::<3>(&accessor, &label)?.into_iter().map(Vec3::from).collect();
+                        self.read_as::<3>(&accessor, Use::Normal, &label)?.into_iter().map(Vec3::from).collect();
                     self.same_count(normals.len(), count, &label)?;
                     keep_unit_repair_others(&positions, &mut normals, &indices);
                     let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
@@ -643,9 +644,9 @@ impl Loader<'_> {
     fn read_colors(&self, accessor: &::gltf::Accessor, what: &str, count: usize) -> Result<Vec<Vec4>> {
         let colors: Vec<Vec4> = match accessor.dimensions() {
             ::gltf::accessor::Dimensions::Vec3 => {
-                self.read_vectors::<3>(accessor, what)?.into_iter().map(|c| Vec3::from(c).extend(1.0)).collect()
+                self.read_as::<3>(accessor, Use::Color, what)?.into_iter().map(|c| Vec3::from(c).extend(1.0)).collect()
             }
-            _ => self.read_vectors::<4>(accessor, what)?.into_iter().map(Vec4::from).collect(),
+            _ => self.read_as::<4>(accessor, Use::Color, what)?.into_iter().map(Vec4::from).collect(),
         };
         self.same_count(colors.len(), count, what)?;
         // Colours are reflectance factors: outside [0, 1] they would add light.
@@ -695,12 +696,9 @@ impl Loader<'_> {
         };
         let normal_texture = match material.normal_texture() {
             Some(normal) => {
-                let placement = placement_of_extension(
-                    normal.extension_value("KHR_texture_transform"),
-                    normal.tex_coord(),
-                    &name,
-                )
-                .map_err(|m| self.error(m))?;
+                let placement =
+                    placement_of_extension(normal.extension_value("KHR_texture_transform"), normal.tex_coord(), &name)
+                        .map_err(|m| self.error(m))?;
                 let scale = normal.scale();
                 if !scale.is_finite() {
                     return Err(self.error(format!("material '{name}': normalTexture scale {scale} is not finite")));
@@ -719,9 +717,9 @@ impl Loader<'_> {
                 .map_err(|m| self.error(m))?;
                 let strength = occlusion.strength();
                 if !(0.0..=1.0).contains(&strength) {
-                    return Err(self.error(format!(
-                        "material '{name}': occlusionTexture strength {strength} is not in [0, 1]"
-                    )));
+                    return Err(
+                        self.error(format!("material '{name}': occlusionTexture strength {strength} is not in [0, 1]"))
+                    );
                 }
                 Some((self.texture(&occlusion.texture(), Ok(placement), &name)?, strength))
             }
@@ -865,7 +863,7 @@ impl Loader<'_> {
                     |found: usize| format!("{label}: {found} values for {} keys (expected {expected})", times.len());
                 match property {
                     ::gltf::animation::Property::Rotation => {
-                        let values = self.read_vectors::<4>(&output, &label)?;
+                        let values = self.read_as::<4>(&output, Use::Rotation, &label)?;
                         if values.len() != expected {
                             return Err(Error::in_file(self.path, mismatch(values.len())));
                         }
@@ -876,7 +874,7 @@ impl Loader<'_> {
                         node.rotation.get_or_insert(Track { interpolation, times, values });
                     }
                     _ => {
-                        let values = self.read_vectors::<3>(&output, &label)?;
+                        let values = self.read_as::<3>(&output, Use::KeyVectors, &label)?;
                         if values.len() != expected {
                             return Err(Error::in_file(self.path, mismatch(values.len())));
                         }
@@ -912,7 +910,7 @@ fn matrix_scale(m: &DMat4) -> DVec3 {
 /// hides the node while it holds). `stride` is 3 for cubic splines (in-tangent, value,
 /// out-tangent), else 1.
 fn key_trouble(values: &[DVec3], stride: usize, translation: bool) -> Option<String> {
-    use super::limits::{coordinate_trouble, key_scale_trouble, SCALE_MAX};
+    use super::limits::{coordinate_trouble, key_scale_trouble, shortest, SCALE_MAX};
     values.iter().enumerate().find_map(|(i, v)| {
         let (key, role) = (i / stride + 1, i % stride);
         let tangent = stride == 3 && role != 1;
@@ -925,7 +923,7 @@ fn key_trouble(values: &[DVec3], stride: usize, translation: bool) -> Option<Str
             if translation {
                 coordinate_trouble(&format!("{what} translation"), c)
             } else if tangent {
-                (c.abs() > SCALE_MAX).then(|| format!("{what} scale {c:e} is larger than {SCALE_MAX:e}"))
+                (c.abs() > SCALE_MAX).then(|| format!("{what} scale {} is larger than {SCALE_MAX:e}", shortest(c)))
             } else {
                 key_scale_trouble(&format!("{what} scale"), c)
             }
@@ -988,13 +986,18 @@ fn placement_of_extension(
     let Some(extension) = extension else {
         return Ok(Placement { tex_coord, transform: glam::Affine2::IDENTITY });
     };
-    let bad = || format!("material '{material}': KHR_texture_transform {extension} is not offset/rotation/scale numbers");
+    let bad =
+        || format!("material '{material}': KHR_texture_transform {extension} is not offset/rotation/scale numbers");
     let pair = |key: &str, default: [f32; 2]| -> std::result::Result<glam::Vec2, String> {
         match extension.get(key) {
             None => Ok(default.into()),
             Some(json::Value::Array(v)) if v.len() == 2 => {
                 let c: Vec<f32> = v.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect();
-                if c.len() == 2 { Ok(glam::Vec2::new(c[0], c[1])) } else { Err(bad()) }
+                if c.len() == 2 {
+                    Ok(glam::Vec2::new(c[0], c[1]))
+                } else {
+                    Err(bad())
+                }
             }
             _ => Err(bad()),
         }
@@ -1014,8 +1017,8 @@ fn placement_of_extension(
 /// glTF's sampler as vrao's: wrap per axis (repeat when unset), filters (linear when
 /// unset, with linear mipmaps, as engines pick).
 fn sampling_of(sampler: &::gltf::texture::Sampler, transform: glam::Affine2) -> super::Sampling {
-    use ::gltf::texture::{MagFilter, MinFilter, WrappingMode};
     use super::{Filter, Wrap};
+    use ::gltf::texture::{MagFilter, MinFilter, WrappingMode};
     let wrap = |mode| match mode {
         WrappingMode::ClampToEdge => Wrap::ClampToEdge,
         WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
@@ -1033,7 +1036,14 @@ fn sampling_of(sampler: &::gltf::texture::Sampler, transform: glam::Affine2) -> 
         Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Some(Filter::Linear)),
         Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Some(Filter::Linear)),
     };
-    super::Sampling { wrap_u: wrap(sampler.wrap_s()), wrap_v: wrap(sampler.wrap_t()), magnify, minify, mipmaps, transform }
+    super::Sampling {
+        wrap_u: wrap(sampler.wrap_s()),
+        wrap_v: wrap(sampler.wrap_t()),
+        magnify,
+        minify,
+        mipmaps,
+        transform,
+    }
 }
 
 /// Decodes an image to RGBA8, refusing sides over [`MAX_TEXTURE_SIDE`] before decoding.
