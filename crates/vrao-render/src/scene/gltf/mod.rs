@@ -14,19 +14,23 @@
 //!
 //! What is read: the default scene (else the first; else every root node) with its
 //! TRS and matrix transforms; triangle primitives (indexed u8/u16/u32 or not; strips and
-//! fans become triangle lists; points and lines are skipped with one warning); POSITION, NORMAL (computed as for OBJ when missing), TEXCOORD_0 (float,
-//! or integers normalised or not); the base-colour factor and texture; `alphaMode`
-//! OPAQUE / MASK (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]); the
-//! emissive factor × `KHR_materials_emissive_strength`, so emitters become lights as in
-//! OBJ when the file has no punctual light; `KHR_lights_punctual` directional, point and
-//! spot lights (intensities taken as vrao's units: lux as irradiance, candela as radiant
-//! intensity; `range` ignored); the first camera's node as the head pose; translation,
-//! rotation and scale animation channels (STEP, LINEAR, CUBICSPLINE).
+//! fans become triangle lists; points and lines are skipped with one warning); POSITION,
+//! NORMAL (computed as for OBJ when missing), TEXCOORD_0, TANGENT, COLOR_0 (times the base
+//! colour and alpha); the base-colour factor and texture; `alphaMode` OPAQUE / MASK
+//! (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]); the emissive factor ×
+//! texture × `KHR_materials_emissive_strength`, so emitters become lights as in OBJ when
+//! the file has no punctual light; normal textures (scale) and occlusion textures
+//! (strength); each texture's sampler (wrap, filters, mipmaps) and `KHR_texture_transform`;
+//! `KHR_lights_punctual` directional, point and spot lights (intensities taken as vrao's
+//! units: lux as irradiance, candela as radiant intensity); the first camera's node as
+//! the head pose; translation, rotation and scale animation channels (STEP, LINEAR,
+//! CUBICSPLINE).
 //!
-//! Not read: `doubleSided` (vrao draws every face from both sides, as for OBJ), metallic,
-//! roughness, normal, occlusion and emissive textures, samplers, texture sets other than 0,
-//! skins and morph targets (drawn in the bind pose, one warning), weight animations.
-//! Lights hang where their nodes are at time 0 (they do not move).
+//! Not read, one warning line per file ([`Warnings`]): points and lines, skins and morph
+//! targets (drawn in the bind pose), weight animations, texture sets other than 0,
+//! metallic-roughness, light `range`, unknown optional extensions. `doubleSided` is moot
+//! (vrao draws every face from both sides, as for OBJ). Lights hang where their nodes are
+//! at time 0 (they do not move).
 //!
 //! Motion: only meshes below an animated node keep a [`Node`]; static geometry is baked
 //! into world space (f64 transform, then [`Mesh::recentre`], exactly as the OBJ loader
@@ -399,6 +403,9 @@ impl Loader<'_> {
                 self.place_mesh(&mesh, &here, &mut content.meshes)?;
             }
             if let Some(light) = node.light() {
+                if light.range().is_some() {
+                    self.warnings.ignored.insert("light range (inverse-square falloff everywhere)");
+                }
                 content.lights.push(self.light(&light, &world_at_rest)?);
             }
             if node.camera().is_some() && content.camera.is_none() {
@@ -670,6 +677,9 @@ impl Loader<'_> {
             None => "default".to_string(),
         };
         let pbr = material.pbr_metallic_roughness();
+        if pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some() {
+            self.warnings.ignored.insert("metallic-roughness (vrao shades the base colour as diffuse)");
+        }
         let factor = pbr.base_color_factor();
         let emissive = Vec3::from(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
         if !factor.iter().all(|c| c.is_finite()) || !emissive.is_finite() || emissive.min_element() < 0.0 {
