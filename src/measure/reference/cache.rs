@@ -1,8 +1,8 @@
 //! A disk cache for reference images.
 //!
 //! A file is named by a 64-bit FNV-1a hash of everything that determines the result:
-//! the scene's content (vertex positions, normals, uvs and indices with their mesh origins,
-//! materials with their texels, lights, the environment's texels and intensity), the eyes'
+//! the scene's content (vertex positions, normals, uvs, colours, tangents and indices with
+//! their mesh origins, materials with their textures' texels and sampling, lights, the environment's texels and intensity), the eyes'
 //! poses and fields of view, the image size, the settings, [`super::TRACER_VERSION`] and
 //! [`FORMAT_VERSION`]. Names (of the scene, meshes, materials) and the head path do not
 //! change the result and are left out. Floats are hashed by their bits.
@@ -23,7 +23,7 @@
 
 use super::{grid_size, trace, Progress, ReferenceImage, ReferencePixel, ReferenceSettings, ReferenceStats};
 use crate::render::error::{Error, Result};
-use crate::render::scene::{Light, Scene};
+use crate::render::scene::{Filter, Light, Scene, Texture, Wrap};
 use crate::render::stereo::Eye;
 use std::path::{Path, PathBuf};
 
@@ -102,34 +102,54 @@ fn hash_meshes(h: &mut Fnv64, scene: &Scene) {
         h.f32s(bytemuck::cast_slice(&m.positions));
         h.f32s(bytemuck::cast_slice(&m.normals));
         h.f32s(bytemuck::cast_slice(&m.uvs));
+        h.f32s(bytemuck::cast_slice(&m.colors));
+        h.f32s(bytemuck::cast_slice(&m.tangents));
         h.u64(m.indices.len() as u64);
         h.bytes(bytemuck::cast_slice(&m.indices));
         h.u64(m.material as u64);
     }
 }
 
-/// Hashes the materials' count and each one's colours, texture and (when alpha-tested) alpha.
+/// Hashes the materials' count and each one's colours, the textures the tracer reads
+/// (base colour, emission, normal with its scale), alpha and alpha mode. The occlusion
+/// texture is not part of the reference and is left out.
 fn hash_materials(h: &mut Fnv64, scene: &Scene) {
     h.u64(scene.materials.len() as u64);
     for m in &scene.materials {
         h.f32s(&m.diffuse.to_array());
         h.f32s(&m.emissive.to_array());
-        match &m.diffuse_texture {
-            Some(t) => {
-                h.u32(1);
-                h.u32(t.width);
-                h.u32(t.height);
-                h.u64(t.rgba8.len() as u64);
-                h.bytes(&t.rgba8);
-            }
-            None => h.u32(0),
-        }
-        // Only alpha-tested materials hash their alpha, so keys of solid scenes stay as they were.
-        if let Some(cutoff) = m.alpha_cutoff() {
-            h.u32(2);
-            h.f32s(&[m.alpha, cutoff]);
-        }
+        hash_texture(h, m.diffuse_texture.as_ref());
+        hash_texture(h, m.emissive_texture.as_ref());
+        hash_texture(h, m.normal_texture.as_ref().map(|(t, _)| t));
+        h.f32s(&[m.normal_texture.as_ref().map_or(0.0, |&(_, scale)| scale)]);
+        // Whether a material is alpha-tested may depend on its meshes' vertex colours,
+        // which are hashed with the meshes: its alpha and mode are hashed whatever they are.
+        h.f32s(&[m.alpha, m.alpha_mode.cutoff().unwrap_or(-1.0)]);
     }
+}
+
+/// Hashes whether there is a texture and, if so, its size, texels and what of its
+/// sampling the tracer reads (transform, wrap per axis, magnification filter; it never
+/// minifies).
+fn hash_texture(h: &mut Fnv64, texture: Option<&Texture>) {
+    let Some(t) = texture else { return h.u32(0) };
+    h.u32(1);
+    h.u32(t.width);
+    h.u32(t.height);
+    h.u64(t.rgba8.len() as u64);
+    h.bytes(&t.rgba8);
+    let s = &t.sampling;
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => 0,
+        Wrap::MirroredRepeat => 1,
+        Wrap::ClampToEdge => 2,
+    };
+    let filter = |f: Filter| match f {
+        Filter::Nearest => 0,
+        Filter::Linear => 1,
+    };
+    h.u32(wrap(s.wrap_u) | wrap(s.wrap_v) << 2 | filter(s.magnify) << 4);
+    h.f32s(&s.transform.to_cols_array());
 }
 
 /// Hashes the lights' count and each one's kind and parameters.

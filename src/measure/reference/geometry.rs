@@ -1,10 +1,18 @@
 //! The scene as the tracer sees it: every triangle in f32 relative to an f64 anchor, in
 //! an obvhs compressed wide BVH (CWBVH8), with a watertight ray–triangle test and the
-//! attributes the shading needs (vertex normals, uvs, material).
+//! attributes the shading needs (vertex normals, uvs, vertex colours, tangents, material).
+//!
+//! Textures are read as the G-buffer reads them: the mesh's uv moved by the texture's
+//! `KHR_texture_transform` ([`Sampling::place`]), then wrapped per axis (repeat, mirrored
+//! repeat or clamp) and filtered with its magnification filter (nearest or bilinear) at the
+//! full-size level. The tracer has no pixel footprint (a bounce ray's hit has none, and a
+//! primary ray's is one pixel of whatever size), so it never minifies or picks a mip level:
+//! where the GPU minifies, its mip average and the tracer's full-size texel differ as the
+//! texture's detail does.
 
 use crate::render::error::{Error, Result};
-use crate::render::scene::{Scene, Texture};
-use glam::{DVec3, Vec2, Vec3, Vec3A};
+use crate::render::scene::{Filter, Material, Mesh, Sampling, Scene, Texture};
+use glam::{DVec3, Vec2, Vec3, Vec3A, Vec4};
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
@@ -26,25 +34,73 @@ struct TriAttributes {
     /// Unit normal of the winding, (v1 − v0) × (v2 − v0).
     geometric: Vec3,
     material: u32,
+    /// Index into [`SceneGeometry::extras`], or [`NO_EXTRAS`] for a triangle of a mesh
+    /// with neither vertex colours nor tangents (white, no normal texture).
+    extras: u32,
 }
 
-/// A material with its texture ready for sampling.
+/// [`TriAttributes::extras`] of a triangle with none.
+const NO_EXTRAS: u32 = u32::MAX;
+
+/// The per-vertex attributes few meshes have, kept beside the rest so that the triangles
+/// of meshes without them cost nothing more.
+#[derive(Clone, Copy, Debug)]
+struct TriExtras {
+    /// Linear RGBA vertex colours (white where the mesh has none).
+    colors: [Vec4; 3],
+    /// Tangents with the bitangent's sign in w (zero where the mesh has none or its
+    /// material no normal texture).
+    tangents: [Vec4; 3],
+}
+
+/// A material with its textures ready for sampling.
 #[derive(Clone, Debug)]
 pub(crate) struct SurfaceMaterial {
     pub diffuse: Vec3,
     pub emissive: Vec3,
+    /// The base colour texture (sRGB; alpha linear).
     pub texture: Option<Texture>,
+    /// The emission texture (sRGB), multiplying `emissive`.
+    pub emissive_texture: Option<Texture>,
+    /// The tangent-space normal texture (linear) and its scale.
+    pub normal_texture: Option<(Texture, f32)>,
     /// Alpha factor and alpha-test cutoff: rays pass through texels whose alpha (factor
-    /// × the texture's, filtered as the GPU filters it) is below the cutoff.
+    /// × the texture's, filtered as the GPU filters it, × the vertex colours') is below
+    /// the cutoff.
     pub alpha: f32,
     pub cutoff: Option<f32>,
 }
 
 impl SurfaceMaterial {
-    /// Whether a ray passes through this material at `uv` (an alpha-tested hole).
-    fn is_hole(&self, uv: Vec2) -> bool {
+    /// `material` as the tracer reads it; textures whose texels do not match their size
+    /// are left out, as if absent. `lowest_vertex_alpha` is the smallest vertex colour
+    /// alpha of the meshes that use it (1 without vertex colours).
+    fn new(material: &Material, lowest_vertex_alpha: f32) -> SurfaceMaterial {
+        let usable =
+            |t: &Texture| t.width > 0 && t.height > 0 && t.rgba8.len() as u64 == 4 * t.width as u64 * t.height as u64;
+        // A material is alpha-tested where some texel or vertex can fall below its
+        // cutoff (`Material::alpha_cutoff` with the vertex colours' alpha as well).
+        let texture_alpha_min = material
+            .diffuse_texture
+            .as_ref()
+            .map_or(255, |t| t.rgba8.chunks_exact(4).map(|c| c[3]).min().unwrap_or(255));
+        let lowest = material.alpha * texture_alpha_min as f32 / 255.0 * lowest_vertex_alpha;
+        SurfaceMaterial {
+            diffuse: material.diffuse,
+            emissive: material.emissive,
+            texture: material.diffuse_texture.clone().filter(usable),
+            emissive_texture: material.emissive_texture.clone().filter(usable),
+            normal_texture: material.normal_texture.clone().filter(|(t, _)| usable(t)),
+            alpha: material.alpha,
+            cutoff: material.alpha_mode.cutoff().filter(|&cutoff| lowest < cutoff),
+        }
+    }
+
+    /// Whether a ray passes through this material at `uv` with vertex colour alpha
+    /// `vertex_alpha` (an alpha-tested hole).
+    fn is_hole(&self, uv: Vec2, vertex_alpha: f32) -> bool {
         let Some(cutoff) = self.cutoff else { return false };
-        let alpha = self.alpha * self.texture.as_ref().map_or(1.0, |t| sample_alpha(t, uv));
+        let alpha = self.alpha * vertex_alpha * self.texture.as_ref().map_or(1.0, |t| sample_alpha(t, uv));
         alpha < cutoff
     }
 }
@@ -68,6 +124,11 @@ pub(crate) struct Surface {
     /// Interpolated vertex normal, normalised; the geometric normal when that is not usable.
     pub shading: Vec3,
     pub uv: Vec2,
+    /// Interpolated linear RGBA vertex colour (white without vertex colours).
+    pub color: Vec4,
+    /// Barycentric weights of v1 and v2 (for the attributes looked up only when needed).
+    pub b1: f32,
+    pub b2: f32,
     pub material: usize,
     /// Largest absolute coordinate of the triangle's vertices (the scale of f32 rounding there).
     pub magnitude: f32,
@@ -79,6 +140,8 @@ pub(crate) struct SceneGeometry {
     /// In BVH leaf order, so that a leaf's primitive id indexes these directly.
     tris: Vec<Tri>,
     attributes: Vec<TriAttributes>,
+    /// Vertex colours and tangents of the triangles that have them.
+    extras: Vec<TriExtras>,
     pub materials: Vec<SurfaceMaterial>,
     /// Whether some material is alpha-tested (rays then test each hit's alpha).
     has_holes: bool,
@@ -100,6 +163,7 @@ impl SceneGeometry {
         };
         let mut tris = Vec::with_capacity(scene.triangle_count());
         let mut attributes = Vec::with_capacity(scene.triangle_count());
+        let mut extras = Vec::new();
         for mesh in &scene.meshes {
             if mesh.material >= scene.materials.len() {
                 return Err(Error::input(format!(
@@ -113,6 +177,9 @@ impl SceneGeometry {
             let count = mesh.positions.len();
             let has_normals = mesh.normals.len() == count;
             let has_uvs = mesh.uvs.len() == count;
+            let has_colors = mesh.colors.len() == count;
+            let normal_mapped = scene.materials[mesh.material].normal_texture.is_some();
+            let has_tangents = normal_mapped && mesh.tangents.len() == count;
             for t in mesh.indices.chunks_exact(3) {
                 let idx = [t[0] as usize, t[1] as usize, t[2] as usize];
                 if idx.iter().any(|&i| i >= count) {
@@ -128,11 +195,21 @@ impl SceneGeometry {
                     continue;
                 }
                 tris.push(Tri { p: p.map(|v| v.to_array()) });
+                let extra = if has_colors || has_tangents {
+                    extras.push(TriExtras {
+                        colors: idx.map(|i| if has_colors { mesh.colors[i] } else { Vec4::ONE }),
+                        tangents: idx.map(|i| if has_tangents { mesh.tangents[i] } else { Vec4::ZERO }),
+                    });
+                    (extras.len() - 1) as u32
+                } else {
+                    NO_EXTRAS
+                };
                 attributes.push(TriAttributes {
                     normals: idx.map(|i| if has_normals { mesh.normals[i] } else { Vec3::ZERO }),
                     uvs: idx.map(|i| if has_uvs { mesh.uvs[i] } else { Vec2::ZERO }),
                     geometric: geometric / length,
                     material: mesh.material as u32,
+                    extras: extra,
                 });
             }
         }
@@ -154,18 +231,11 @@ impl SceneGeometry {
         let materials: Vec<SurfaceMaterial> = scene
             .materials
             .iter()
-            .map(|m| SurfaceMaterial {
-                diffuse: m.diffuse,
-                emissive: m.emissive,
-                texture: m.diffuse_texture.clone().filter(|t| {
-                    t.width > 0 && t.height > 0 && t.rgba8.len() as u64 == 4 * t.width as u64 * t.height as u64
-                }),
-                alpha: m.alpha,
-                cutoff: m.alpha_cutoff(),
-            })
+            .enumerate()
+            .map(|(i, m)| SurfaceMaterial::new(m, lowest_vertex_alpha(&scene.meshes, i)))
             .collect();
         let has_holes = materials.iter().any(|m| m.cutoff.is_some());
-        Ok(SceneGeometry { bvh, tris, attributes, materials, has_holes })
+        Ok(SceneGeometry { bvh, tris, attributes, extras, materials, has_holes })
     }
 
     #[cfg(test)]
@@ -177,6 +247,18 @@ impl SceneGeometry {
     fn uv_at(&self, prim: usize, b1: f32, b2: f32) -> Vec2 {
         let a = &self.attributes[prim];
         a.uvs[0] * (1.0 - b1 - b2) + a.uvs[1] * b1 + a.uvs[2] * b2
+    }
+
+    /// The interpolated vertex colour at barycentrics (b1, b2) of leaf-order triangle
+    /// `prim` (white without vertex colours).
+    fn color_at(&self, prim: usize, b1: f32, b2: f32) -> Vec4 {
+        match self.attributes[prim].extras {
+            NO_EXTRAS => Vec4::ONE,
+            i => {
+                let c = &self.extras[i as usize].colors;
+                c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2
+            }
+        }
     }
 
     /// The closest hit with t in (`tmin`, `tmax`) along unit `dir` from `origin`, ignoring
@@ -212,7 +294,7 @@ impl SceneGeometry {
     /// Whether the hit at (b1, b2) of `prim` falls in an alpha-tested hole.
     fn is_hole(&self, prim: usize, b1: f32, b2: f32) -> bool {
         let material = &self.materials[self.attributes[prim].material as usize];
-        material.cutoff.is_some() && material.is_hole(self.uv_at(prim, b1, b2))
+        material.cutoff.is_some() && material.is_hole(self.uv_at(prim, b1, b2), self.color_at(prim, b1, b2).w)
     }
 
     /// The attributes at `hit`.
@@ -233,10 +315,54 @@ impl SceneGeometry {
             geometric: a.geometric,
             shading,
             uv,
+            color: self.color_at(hit.prim as usize, b1, b2),
+            b1,
+            b2,
             material: a.material as usize,
             magnitude,
         }
     }
+
+    /// The normal that lights `surface`: its material's normal texture applied in the
+    /// frame of the interpolated vertex normal and tangent (glTF's convention: n =
+    /// normalize(T·x + B·y + N·z) with (x, y, z) = 2·texel − 1, x and y times the scale,
+    /// B = (N × T)·w), or the interpolated vertex normal without a normal texture, without
+    /// tangents or where the frame degenerates. Only the direct light of a bounce's sender
+    /// reads it (as the direct pass lights the G-buffer's normal-mapped normal); the
+    /// occlusion and the environment stay on the vertex normal.
+    pub fn lighting_normal(&self, surface: &Surface) -> Vec3 {
+        let n = surface.shading;
+        let Some((texture, scale)) = &self.materials[surface.material].normal_texture else { return n };
+        let a = &self.attributes[surface.prim as usize];
+        if a.extras == NO_EXTRAS {
+            return n;
+        }
+        let t = &self.extras[a.extras as usize].tangents;
+        let (b1, b2) = (surface.b1, surface.b2);
+        let tangent = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
+        let Some(tangent) = (tangent.truncate() - n * n.dot(tangent.truncate())).try_normalize() else { return n };
+        let sign = if tangent_sign(t, b1, b2) < 0.0 { -1.0 } else { 1.0 };
+        let bitangent = n.cross(tangent) * sign;
+        let texel = sample_linear(texture, surface.uv) * 2.0 - Vec3::ONE;
+        let (x, y) = (texel.x * scale, texel.y * scale);
+        (tangent * x + bitangent * y + n * texel.z).try_normalize().unwrap_or(n)
+    }
+}
+
+/// The bitangent sign at (b1, b2) of a triangle's tangents: interpolated, as the G-buffer
+/// receives it.
+fn tangent_sign(t: &[Vec4; 3], b1: f32, b2: f32) -> f32 {
+    t[0].w * (1.0 - b1 - b2) + t[1].w * b1 + t[2].w * b2
+}
+
+/// The smallest vertex colour alpha over the meshes that use material `material` (1 where
+/// none has vertex colours).
+fn lowest_vertex_alpha(meshes: &[Mesh], material: usize) -> f32 {
+    meshes
+        .iter()
+        .filter(|m| m.material == material && m.colors.len() == m.positions.len())
+        .flat_map(|m| m.colors.iter().map(|c| c.w))
+        .fold(1.0, f32::min)
 }
 
 /// Per-ray constants of the watertight ray–triangle test (Woop, Benthin and Wald 2013,
@@ -320,38 +446,60 @@ fn srgb_to_linear(byte: u8) -> f32 {
     })[byte as usize]
 }
 
-/// Bilinear filtering of `texture` at `uv`, repeating in u and clamping in v; v = 0 is the
-/// top row ([`crate::render::scene::Mesh::uvs`]). `texel` reads the texel at a byte offset
-/// into `rgba8`; `lerp` blends two of them.
-fn bilinear<T: Copy>(texture: &Texture, uv: Vec2, texel: impl Fn(usize) -> T, lerp: impl Fn(T, T, f32) -> T) -> T {
+/// Texel coordinates beyond this (in texels) are held there: f32 coordinates that large
+/// have no fraction left, and the integer arithmetic after them stays far from overflow.
+const TEXEL_LIMIT: f64 = (1u64 << 40) as f64;
+
+/// `texture` at `uv` as its [`Sampling`] says: `uv` moved by the transform, then wrapped
+/// per axis and filtered with the magnification filter, at the full-size level (see the
+/// module docs); v = 0 is the top row ([`crate::render::scene::Mesh::uvs`]). `texel` reads
+/// the texel at a byte offset into `rgba8`; `lerp` blends two of them.
+fn filtered<T: Copy>(texture: &Texture, uv: Vec2, texel: impl Fn(usize) -> T, lerp: impl Fn(T, T, f32) -> T) -> T {
+    let Sampling { wrap_u, wrap_v, magnify, .. } = texture.sampling;
     let (w, h) = (texture.width as i64, texture.height as i64);
-    let uv = if uv.is_finite() { uv } else { Vec2::ZERO };
-    let x = uv.x as f64 * w as f64 - 0.5;
-    let y = (uv.y as f64 * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let at = |x: i64, y: i64| texel(4 * (y.clamp(0, h - 1) * w + x.rem_euclid(w)) as usize);
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let top = lerp(at(x0, y0), at(x0 + 1, y0), fx);
-    let bottom = lerp(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
-    lerp(top, bottom, fy)
+    let placed = texture.sampling.place(uv);
+    let uv = if placed.is_finite() { placed } else { Vec2::ZERO };
+    let x = (uv.x as f64 * w as f64).clamp(-TEXEL_LIMIT, TEXEL_LIMIT);
+    let y = (uv.y as f64 * h as f64).clamp(-TEXEL_LIMIT, TEXEL_LIMIT);
+    let at = |x: i64, y: i64| texel(4 * (wrap_v.texel(y, h) * w + wrap_u.texel(x, w)) as usize);
+    match magnify {
+        Filter::Nearest => at(x.floor() as i64, y.floor() as i64),
+        Filter::Linear => {
+            let (x, y) = (x - 0.5, y - 0.5);
+            let (x0, y0) = (x.floor(), y.floor());
+            let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let top = lerp(at(x0, y0), at(x0 + 1, y0), fx);
+            let bottom = lerp(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
+            lerp(top, bottom, fy)
+        }
+    }
 }
 
-/// Bilinear lookup of an sRGB texture (decoded to linear before filtering, as an sRGB
-/// texture format does), addressed as [`bilinear`] says.
+/// Lookup of an sRGB texture's colour (decoded to linear before filtering, as an sRGB
+/// texture format does), as [`filtered`] says.
 pub(crate) fn sample_texture(texture: &Texture, uv: Vec2) -> Vec3 {
     let texel = |i: usize| {
         let b = &texture.rgba8[i..i + 3];
         Vec3::new(srgb_to_linear(b[0]), srgb_to_linear(b[1]), srgb_to_linear(b[2]))
     };
-    bilinear(texture, uv, texel, Vec3::lerp)
+    filtered(texture, uv, texel, Vec3::lerp)
 }
 
-/// Bilinear lookup of a texture's alpha (linear bytes, as the GPU filters them),
-/// addressed as [`bilinear`] says.
+/// Lookup of a linear texture's colour (a normal texture: bytes / 255, filtered as they
+/// are), as [`filtered`] says.
+pub(crate) fn sample_linear(texture: &Texture, uv: Vec2) -> Vec3 {
+    let texel = |i: usize| {
+        let b = &texture.rgba8[i..i + 3];
+        Vec3::new(b[0] as f32, b[1] as f32, b[2] as f32) / 255.0
+    };
+    filtered(texture, uv, texel, Vec3::lerp)
+}
+
+/// Lookup of a texture's alpha (linear bytes, as the GPU filters them), as [`filtered`] says.
 pub(crate) fn sample_alpha(texture: &Texture, uv: Vec2) -> f32 {
     let texel = |i: usize| texture.rgba8[i + 3] as f32 / 255.0;
-    bilinear(texture, uv, texel, |a, b, t| a + (b - a) * t)
+    filtered(texture, uv, texel, |a, b, t| a + (b - a) * t)
 }
 
 #[cfg(test)]
@@ -456,5 +604,126 @@ mod tests {
         assert!((sample_texture(&t, Vec2::new(0.5, 0.25)) - Vec3::splat(0.5)).abs().max_element() < 1e-6);
         assert!((sample_texture(&t, Vec2::new(0.0, 0.25)) - Vec3::splat(0.5)).abs().max_element() < 1e-6);
         assert!(sample_texture(&t, Vec2::new(f32::NAN, 7.0)).is_finite());
+    }
+}
+
+#[cfg(test)]
+mod sampling_tests {
+    //! Texture lookups as the GPU's sampler makes them: wrap per axis, nearest or linear,
+    //! the texture transform first.
+    use super::*;
+    use crate::render::scene::texture::uv_transform;
+    use crate::render::scene::Wrap;
+    use glam::Affine2;
+
+    /// A 2×2 texture whose texel (x, y) has alpha (10 + 10x + 20y) / 255 (10, 20 on the
+    /// top row, 30, 40 below), sampled as `sampling` says.
+    fn two_by_two(sampling: Sampling) -> Texture {
+        let rgba8 = [10u8, 20, 30, 40].iter().flat_map(|&a| [a, a, a, a]).collect();
+        Texture { width: 2, height: 2, rgba8, source: None, sampling }
+    }
+
+    /// The texel (x, y) of [`two_by_two`] that an alpha value names.
+    fn texel_of(alpha: f32) -> (i64, i64) {
+        let a = (alpha * 255.0).round() as i64;
+        assert!([10, 20, 30, 40].contains(&a), "alpha {a} is a blend, not one texel");
+        ((a / 10 - 1) % 2, (a / 10 - 1) / 2)
+    }
+
+    fn nearest(wrap_u: Wrap, wrap_v: Wrap) -> Sampling {
+        Sampling { wrap_u, wrap_v, magnify: Filter::Nearest, ..Sampling::default() }
+    }
+
+    #[test]
+    fn each_wrap_mode_addresses_texels_outside_the_unit_square_on_each_axis() {
+        // Coordinate → texel column of a 2-texel row, for repeat, mirrored repeat, clamp.
+        let cases: [(f32, [i64; 3]); 8] = [
+            (-1.25, [1, 1, 0]),
+            (-0.75, [0, 1, 0]),
+            (-0.25, [1, 0, 0]),
+            (0.25, [0, 0, 0]),
+            (1.25, [0, 1, 1]),
+            (1.75, [1, 0, 1]),
+            (2.25, [0, 0, 1]),
+            (3.75, [1, 0, 1]),
+        ];
+        let modes = [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge];
+        for (c, expected) in cases {
+            for (mode, want) in modes.into_iter().zip(expected) {
+                // The other axis is inside the texture, its mode one that differs.
+                let other = if mode == Wrap::ClampToEdge { Wrap::Repeat } else { Wrap::ClampToEdge };
+                let along_u = two_by_two(nearest(mode, other));
+                assert_eq!(texel_of(sample_alpha(&along_u, Vec2::new(c, 0.25))), (want, 0), "u = {c}, {mode:?}");
+                let along_v = two_by_two(nearest(other, mode));
+                assert_eq!(texel_of(sample_alpha(&along_v, Vec2::new(0.25, c))), (0, want), "v = {c}, {mode:?}");
+            }
+        }
+        // Both axes at once, each with its own mode (the floor: v clamped while u
+        // repeated drew one stripe down where glTF's default repeats both).
+        let t = two_by_two(nearest(Wrap::Repeat, Wrap::MirroredRepeat));
+        assert_eq!(texel_of(sample_alpha(&t, Vec2::new(1.25, 1.25))), (0, 1));
+        assert_eq!(texel_of(sample_alpha(&t, Vec2::new(-0.25, 2.75))), (1, 1));
+        let default = two_by_two(Sampling { magnify: Filter::Nearest, ..Sampling::default() });
+        for k in -3..4 {
+            let (u, v) = (k as f32 + 0.25, k as f32 + 0.75);
+            assert_eq!(texel_of(sample_alpha(&default, Vec2::new(u, v))), (0, 1), "repeat both at ({u}, {v})");
+        }
+    }
+
+    #[test]
+    fn linear_filtering_blends_across_the_wrapped_edge_and_nearest_does_not() {
+        let alpha = |s: Sampling, u: f32, v: f32| sample_alpha(&two_by_two(s), Vec2::new(u, v)) * 255.0;
+        let linear = |wrap_u, wrap_v| Sampling { wrap_u, wrap_v, ..Sampling::default() };
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-3;
+        // Between the two top texels: linear blends them, nearest takes the right one.
+        assert!(close(alpha(linear(Wrap::Repeat, Wrap::Repeat), 0.5, 0.25), 15.0));
+        assert!(close(alpha(nearest(Wrap::Repeat, Wrap::Repeat), 0.5, 0.25), 20.0));
+        assert!(close(alpha(nearest(Wrap::Repeat, Wrap::Repeat), 0.49, 0.25), 10.0));
+        // At u = 1 the bilinear footprint straddles the edge: repeat blends the last
+        // column with the first, mirrored repeat and clamp with itself.
+        assert!(close(alpha(linear(Wrap::Repeat, Wrap::Repeat), 1.0, 0.25), 15.0));
+        assert!(close(alpha(linear(Wrap::MirroredRepeat, Wrap::Repeat), 1.0, 0.25), 20.0));
+        assert!(close(alpha(linear(Wrap::ClampToEdge, Wrap::Repeat), 1.0, 0.25), 20.0));
+        // The same down v: repeat blends the bottom row with the top one.
+        assert!(close(alpha(linear(Wrap::ClampToEdge, Wrap::Repeat), 0.25, 1.0), 20.0));
+        assert!(close(alpha(linear(Wrap::ClampToEdge, Wrap::ClampToEdge), 0.25, 1.0), 30.0));
+        // A quarter texel in from the centre of texel (0, 0) towards (1, 1).
+        let c = alpha(linear(Wrap::Repeat, Wrap::Repeat), 0.375, 0.375);
+        assert!(close(c, 10.0 + 0.25 * 10.0 + 0.25 * 20.0), "{c}");
+        // Colour is decoded from sRGB before it is blended, as an sRGB format does.
+        let mut t = two_by_two(Sampling::default());
+        t.rgba8 = [0u8, 255, 0, 255].iter().flat_map(|&c| [c, c, c, 255]).collect();
+        assert!((sample_texture(&t, Vec2::new(0.5, 0.25)) - Vec3::splat(0.5)).abs().max_element() < 1e-6);
+        t.sampling.magnify = Filter::Nearest;
+        assert_eq!(sample_texture(&t, Vec2::new(0.5, 0.25)), Vec3::ONE);
+    }
+
+    #[test]
+    fn the_texture_transform_moves_uvs_before_they_wrap() {
+        let with = |transform: Affine2| two_by_two(Sampling { transform, ..nearest(Wrap::Repeat, Wrap::Repeat) });
+        let at = |t: &Texture, u: f32, v: f32| texel_of(sample_alpha(t, Vec2::new(u, v)));
+        // Offset by half the texture in u: texel (0, 0)'s uvs read texel (1, 0).
+        let offset = with(uv_transform(Vec2::new(0.5, 0.0), 0.0, Vec2::ONE));
+        assert_eq!(at(&offset, 0.25, 0.25), (1, 0));
+        assert_eq!(at(&offset, 0.75, 0.25), (0, 0), "and wraps");
+        // Scaled by 2: the texture repeats twice across the unit square.
+        let scaled = with(uv_transform(Vec2::ZERO, 0.0, Vec2::splat(2.0)));
+        assert_eq!(at(&scaled, 0.3, 0.3), (1, 1));
+        assert_eq!(at(&scaled, 0.55, 0.8), (0, 1));
+        // Rotated a quarter turn: (u, v) is read at (v, −u).
+        let rotated = with(uv_transform(Vec2::ZERO, std::f32::consts::FRAC_PI_2, Vec2::ONE));
+        assert_eq!(rotated.sampling.place(Vec2::new(0.25, 0.75)).round(), Vec2::new(1.0, 0.0));
+        assert_eq!(at(&rotated, 0.25, 0.75), (1, 1));
+        assert_eq!(at(&rotated, 0.75, 0.25), (0, 0));
+        // All three: translation · rotation · scale, applied in that order to the uv.
+        let all = with(uv_transform(Vec2::new(0.5, 0.5), std::f32::consts::PI, Vec2::splat(0.5)));
+        let placed = all.sampling.place(Vec2::new(0.2, 0.6));
+        assert!((placed - Vec2::new(0.4, 0.2)).length() < 1e-6, "{placed}");
+        assert_eq!(at(&all, 0.2, 0.6), (0, 0));
+        // A transform that sends uvs to infinity reads a texel, never out of bounds.
+        let huge = with(Affine2::from_scale(Vec2::splat(f32::MAX)));
+        assert!(sample_alpha(&huge, Vec2::new(3.0, -7.0)).is_finite());
+        let far = two_by_two(Sampling::default());
+        assert!(sample_alpha(&far, Vec2::new(1e30, -3e38)).is_finite());
     }
 }

@@ -11,7 +11,9 @@
 //!   map ([`Environment::sample`](crate::render::scene::Environment::sample)), what SSDO approximates;
 //! - `bounce`: ∫ [hit within r] L_direct(hit, towards the receiver) cos θ dω, one bounce of
 //!   the direct model of `src/render/passes/direct/direct.wgsl` (albedo/π · Σ light irradiance + emission, at
-//!   the hit triangle's interpolated normal and albedo; zero on a back face), directional
+//!   the hit triangle's interpolated albedo (base colour × texture × vertex colour), its
+//!   normal-mapped normal (the interpolated vertex normal without a normal texture) and
+//!   its emission (× emission texture); zero on a back face), directional
 //!   lights shadowed by a shadow ray from the hit (the truth the GPU's shadow maps
 //!   approximate; with `--shadows off` on the GPU the difference shows up as error);
 //! - `unoccluded`: the environment's SH9 irradiance E(n) the GPU uses (0 without one).
@@ -23,7 +25,12 @@
 //! open plane gives exactly 1). A direction about the shading normal that points below the
 //! geometric surface (possible where vertex normals bend away from the faces) counts as
 //! occluded at distance 0 (weight 1, no environment, no bounce): the surface itself blocks
-//! it. Texture v = 0 is the top row of the image, as [`crate::render::scene::Mesh::uvs`] says.
+//! it. Texture v = 0 is the top row of the image, as [`crate::render::scene::Mesh::uvs`] says;
+//! textures are sampled as their sampler says (transform, wrap per axis, magnification
+//! filter) at their full-size level (`geometry.rs`). The normal texture tilts only the
+//! light a bounce's sender reflects: the AO, like every estimate's hemisphere, is of the
+//! geometry (the interpolated vertex normal), and the occlusion texture is no part of the
+//! reference (the bench scores the screen-space AO).
 //!
 //! Sampling: a jittered ⌊√M⌋² grid (plus uniform points for the rest of M) mapped onto
 //! the disk by the concentric map and lifted to the hemisphere, from a PCG32 stream seeded
@@ -71,8 +78,10 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 /// Bumped whenever the tracer's results change for the same inputs (it is part of the
-/// cache key, so older cache files are recomputed).
-pub const TRACER_VERSION: u32 = 2;
+/// cache key, so older cache files are recomputed). 3: textures wrap per axis as their
+/// sampler says (v repeated, not clamped, by default), filter nearest or linear, move by
+/// `KHR_texture_transform`; vertex colours, emission and normal textures.
+pub const TRACER_VERSION: u32 = 3;
 
 /// Most rays per pixel accepted.
 pub const MAX_RAYS_PER_PIXEL: u32 = 65_536;

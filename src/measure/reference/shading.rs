@@ -1,7 +1,9 @@
 //! The estimators at one surface point: stratified cosine-weighted directions, one ray
 //! each, and the direct-light model of `src/render/passes/direct/direct.wgsl` at the points they hit,
 //! with directional light shadowed by a shadow ray (what the GPU's shadow maps
-//! approximate).
+//! approximate). A sender's albedo is its base colour × texture × vertex colour, its
+//! emission the emissive factor × emission texture, its direct light taken about its
+//! normal-mapped normal; the receiver's hemisphere is about its vertex normal.
 
 use super::geometry::{sample_texture, SceneGeometry, Surface};
 use crate::render::scene::{Environment, Light, Scene};
@@ -152,12 +154,13 @@ impl<'a> Lighting<'a> {
     }
 
     /// Irradiance from the lights at `surface` as the direct pass computes it with shadows
-    /// on: each directional light that faces the surface counts only when a shadow ray
-    /// towards it (leaving along the geometric normal on the light's side, past the
-    /// surface's own triangle) hits nothing. Point lights have no shadow maps on the GPU
-    /// and none here either.
+    /// on, about the surface's lighting normal ([`SceneGeometry::lighting_normal`]: the
+    /// normal texture's where it has one): each directional light that faces that normal
+    /// counts only when a shadow ray towards it (leaving along the geometric normal on the
+    /// light's side, past the surface's own triangle) hits nothing. Point lights have no
+    /// shadow maps on the GPU and none here either.
     pub fn shadowed_irradiance(&self, geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
-        let n = surface.shading;
+        let n = geometry.lighting_normal(surface);
         let offset = OFFSET_ULPS * surface.magnitude.max(f32::MIN_POSITIVE);
         let mut e = Vec3::ZERO;
         for light in &self.lights {
@@ -189,11 +192,11 @@ impl<'a> Lighting<'a> {
     }
 }
 
-/// Linear albedo at a surface: the material's diffuse times its texture, clamped to [0, 1]
-/// as the G-buffer stores it.
+/// Linear albedo at a surface: the material's diffuse times its texture times the
+/// interpolated vertex colour, clamped to [0, 1] as the G-buffer stores it.
 pub(crate) fn albedo(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
     let m = &geometry.materials[surface.material];
-    let mut a = m.diffuse;
+    let mut a = m.diffuse * surface.color.truncate();
     if let Some(t) = &m.texture {
         a *= sample_texture(t, surface.uv);
     }
@@ -202,6 +205,17 @@ pub(crate) fn albedo(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
         a
     } else {
         Vec3::ZERO
+    }
+}
+
+/// Emitted radiance at a surface: the material's emission times its emission texture
+/// (glTF `emissiveTexture`, sRGB). Vertex colours do not tint it (glTF's `COLOR_0`
+/// multiplies the base colour only).
+pub(crate) fn emission(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
+    let m = &geometry.materials[surface.material];
+    match &m.emissive_texture {
+        Some(t) if m.emissive != Vec3::ZERO => m.emissive * sample_texture(t, surface.uv),
+        _ => m.emissive,
     }
 }
 
@@ -215,8 +229,7 @@ pub(crate) fn direct_out(geometry: &SceneGeometry, lighting: &Lighting, surface:
         return Vec3::ZERO;
     }
     let irradiance = lighting.shadowed_irradiance(geometry, surface);
-    let emission = geometry.materials[surface.material].emissive;
-    let l = albedo(geometry, surface) / std::f32::consts::PI * irradiance + emission;
+    let l = albedo(geometry, surface) / std::f32::consts::PI * irradiance + emission(geometry, surface);
     if l.is_finite() {
         l
     } else {

@@ -6,7 +6,7 @@ use super::shading::{Estimator, Lighting, Rng};
 use super::*;
 use crate::measure::analytic::{crease_visibility, crease_visibility_falloff};
 use crate::render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
-use crate::render::scene::{Environment, HeadPath, Light, Material, Mesh};
+use crate::render::scene::{Environment, HeadPath, Light, Material, Mesh, Texture};
 use crate::render::stereo::{HeadPose, HeadsetProfile};
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -527,4 +527,137 @@ fn extreme_radii_stay_finite_and_in_range() {
             assert!(rgb.copied().all(f32::is_finite), "r = {r}: {p:?}");
         }
     }
+}
+
+/// [`floor_mesh`] with u running from 0 at x = −half to 1 at x = half, and v likewise along z.
+fn floor_with_uvs(half: f32) -> Mesh {
+    let mut floor = floor_mesh(half);
+    floor.uvs = floor.positions.iter().map(|p| Vec2::new(p.x / (2.0 * half) + 0.5, p.z / (2.0 * half) + 0.5)).collect();
+    floor
+}
+
+/// The surface straight below (x, 1, z), if a ray from there meets one.
+fn surface_below(g: &SceneGeometry, x: f32, z: f32) -> Option<super::geometry::Surface> {
+    g.closest(Vec3::new(x, 1.0, z), -Vec3::Y, 0.0, 10.0, u32::MAX).map(|hit| g.surface(&hit))
+}
+
+#[test]
+fn vertex_colours_interpolate_tint_the_albedo_and_cut_alpha_tested_holes() {
+    use crate::render::scene::AlphaMode;
+    use glam::Vec4;
+    let mut floor = floor_mesh(1.0);
+    // Corners (x, z): (−1, −1) red, (−1, 1) green, (1, 1) blue, (1, −1) black.
+    floor.colors =
+        vec![Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 1.0, 0.0, 1.0), Vec4::new(0.0, 0.0, 1.0, 1.0), Vec4::W];
+    let grey = Material::plain("grey", Vec3::splat(0.8));
+    let scene = custom_scene(vec![floor.clone()], vec![grey.clone()], vec![], None);
+    let g = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    // (−0.5, 0.5) weighs red ¼, green ½, blue ¼ in its triangle (0, 1, 2).
+    let s = surface_below(&g, -0.5, 0.5).unwrap();
+    assert!((s.color - Vec4::new(0.25, 0.5, 0.25, 1.0)).abs().max_element() < 1e-6, "{}", s.color);
+    let albedo = super::shading::albedo(&g, &s);
+    assert!((albedo - Vec3::new(0.2, 0.4, 0.2)).abs().max_element() < 1e-6, "{albedo}");
+    // (0.5, −0.5) in triangle (0, 2, 3): red ¼, blue ¼, black ½.
+    let s = surface_below(&g, 0.5, -0.5).unwrap();
+    assert!((s.color - Vec4::new(0.25, 0.0, 0.25, 1.0)).abs().max_element() < 1e-6, "{}", s.color);
+
+    // Alpha from the vertex colours alone (0 at x = −1, 1 at x = 1) under an alpha test
+    // at ½: a hole for x < 0, solid beyond, though neither factor nor texture is below it.
+    floor.colors.iter_mut().zip([0.0, 0.0, 1.0, 1.0]).for_each(|(c, a)| c.w = a);
+    let masked = Material { alpha_mode: AlphaMode::Mask { cutoff: 0.5 }, ..grey };
+    let scene = custom_scene(vec![floor], vec![masked], vec![], None);
+    let g = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    for x in [-0.9, -0.5, -0.1] {
+        assert!(surface_below(&g, x, 0.3).is_none(), "a hole at x = {x}");
+    }
+    for x in [0.1, 0.5, 0.9] {
+        assert!(surface_below(&g, x, 0.3).is_some(), "solid at x = {x}");
+    }
+}
+
+/// A texture of one row of sRGB grey levels, sampled nearest.
+fn grey_row(levels: &[u8]) -> Texture {
+    use crate::render::scene::{Filter, Sampling};
+    Texture {
+        width: levels.len() as u32,
+        height: 1,
+        rgba8: levels.iter().flat_map(|&l| [l, l, l, 255]).collect(),
+        source: None,
+        sampling: Sampling { magnify: Filter::Nearest, ..Sampling::default() },
+    }
+}
+
+#[test]
+fn the_emission_texture_limits_the_emissive_factor_and_vertex_colours_do_not_tint_it() {
+    use glam::Vec4;
+    let mut floor = floor_with_uvs(1.0);
+    floor.colors = vec![Vec4::new(0.0, 1.0, 0.0, 1.0); 4];
+    let mut glow = Material::plain("glow", Vec3::splat(0.5));
+    glow.emissive = Vec3::new(2.0, 1.0, 0.5);
+    // Dark on the left half of u, full on the right.
+    glow.emissive_texture = Some(grey_row(&[0, 255]));
+    let scene = custom_scene(vec![floor], vec![glow], vec![], None);
+    let g = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    let lighting = Lighting::new(&scene, DVec3::ZERO);
+    let out = |x: f32| super::shading::direct_out(&g, &lighting, &surface_below(&g, x, 0.2).unwrap(), -Vec3::Y);
+    assert_eq!(out(-0.5), Vec3::ZERO);
+    assert_eq!(out(0.5), Vec3::new(2.0, 1.0, 0.5));
+    // It repeats as its sampler says: u = 1.25 is u = 0.25 again.
+    let s = surface_below(&g, 0.5, 0.2).unwrap();
+    let shifted = super::geometry::Surface { uv: Vec2::new(1.25, s.uv.y), ..s };
+    assert_eq!(super::shading::emission(&g, &shifted), Vec3::ZERO);
+}
+
+#[test]
+fn a_normal_texture_tilts_the_light_a_sender_reflects_but_not_its_occlusion() {
+    use glam::Vec4;
+    let mut floor = floor_with_uvs(20.0);
+    // +u is +x; the bitangent's sign flips with w.
+    floor.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
+    let texel = |rgb: [u8; 3]| Texture { rgba8: vec![rgb[0], rgb[1], rgb[2], 255], ..grey_row(&[0]) };
+    let mut bumpy = Material::plain("bumpy", Vec3::splat(0.5));
+    // Tilted all the way towards +u.
+    bumpy.normal_texture = Some((texel([255, 128, 128]), 1.0));
+    // A sun grazing the floor from +x: the flat floor gets none of it.
+    let sun = Light::Directional { direction: -Vec3::X, color: Vec3::ONE, intensity: 2.0 };
+    let scene = custom_scene(vec![floor.clone()], vec![bumpy.clone()], vec![sun.clone()], None);
+    let g = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    let s = surface_below(&g, 0.3, 0.4).unwrap();
+    assert_eq!(s.shading, Vec3::Y);
+    let n = g.lighting_normal(&s);
+    assert!((n - Vec3::X).length() < 0.01, "{n}");
+    let e = Lighting::new(&scene, DVec3::ZERO).shadowed_irradiance(&g, &s);
+    assert!((e - Vec3::splat(2.0)).abs().max_element() < 0.01, "{e}");
+
+    // Scale 0 leaves the vertex normal; green tilts along the bitangent, (N × T)·w.
+    for (rgb, scale, w, expected) in [
+        ([255, 128, 128], 0.0, 1.0, Vec3::Y),
+        ([128, 255, 128], 1.0, 1.0, -Vec3::Z),
+        ([128, 255, 128], 1.0, -1.0, Vec3::Z),
+    ] {
+        let mut floor = floor.clone();
+        floor.tangents.iter_mut().for_each(|t| t.w = w);
+        let material = Material { normal_texture: Some((texel(rgb), scale)), ..bumpy.clone() };
+        let scene = custom_scene(vec![floor], vec![material], vec![], None);
+        let g = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+        let n = g.lighting_normal(&surface_below(&g, 0.3, 0.4).unwrap());
+        assert!((n - expected).length() < 0.01, "{rgb:?} × {scale}, w = {w}: {n}");
+    }
+    // Without tangents the vertex normal lights it.
+    let mut bare = floor.clone();
+    bare.tangents.clear();
+    let scene = custom_scene(vec![bare], vec![bumpy.clone()], vec![], None);
+    let g = SceneGeometry::build(&scene, DVec3::ZERO).unwrap();
+    assert_eq!(g.lighting_normal(&surface_below(&g, 0.3, 0.4).unwrap()), Vec3::Y);
+
+    // The occlusion stays the geometry's: the open floor is unoccluded everywhere though
+    // its normal texture tilts every normal by 90°.
+    let scene = custom_scene(vec![floor], vec![bumpy], vec![sun], None);
+    let (eyes, image) = run(&scene, (16, 18), &settings(1.0, 16));
+    let mut hits = 0;
+    for (p, px) in hit_cells(&eyes, &image) {
+        assert_eq!((px.ao, px.ao_falloff), (1.0, 1.0), "at {p}");
+        hits += 1;
+    }
+    assert!(hits > 100);
 }
