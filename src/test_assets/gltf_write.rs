@@ -1,9 +1,13 @@
 //! Writes a [`Scene`] as glTF 2.0 (`.glb` or `.gltf`): the project's own test assets and
 //! converted scenes (`examples/make_gltf.rs`, `tests/gltf.rs`).
 //!
-//! Written: every mesh (static meshes in world space, moving ones under their node),
-//! materials (base colour and alpha factor, texture as PNG, alpha mode and cutoff,
-//! emission with `KHR_materials_emissive_strength` above 1, `doubleSided: true`), the node
+//! Written: every mesh (static meshes in world space, moving ones under their node; vertex
+//! colours as `COLOR_0`, VEC3 when every alpha is 1 and VEC4 otherwise; tangents as
+//! `TANGENT` with the normals), materials (base colour and alpha factor, alpha mode and
+//! cutoff, emission with `KHR_materials_emissive_strength` above 1, `doubleSided: true`;
+//! base colour, emission, normal (with its scale) and occlusion (with its strength)
+//! textures as PNG, each with its sampler unless that is glTF's default, and with
+//! `KHR_texture_transform` on its texture reference unless the transform is the identity), the node
 //! hierarchy with its tracks (a node's `base` becomes a matrix parent of its TRS node),
 //! lights (`KHR_lights_punctual`), and an optional camera. [`WriteOptions`] picks how
 //! indices, texture coordinates, buffers and images are stored, so that tests reach every
@@ -15,9 +19,12 @@
 //! f32.
 
 use crate::render::error::{Error, Result};
-use crate::render::scene::{AlphaMode, Interpolation, Light, Mesh, Scene, Texture, Track};
+use crate::render::scene::texture::{uv_transform, uv_transform_parts};
+use crate::render::scene::{
+    AlphaMode, Filter, Interpolation, Light, Material, Mesh, Sampling, Scene, Texture, Track, Wrap,
+};
 use crate::render::stereo::HeadPose;
-use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
+use glam::{Affine2, DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -124,8 +131,9 @@ impl Builder {
         self.accessor(bytemuck::cast_slice(values), FLOAT, kind, count, extra)
     }
 
-    /// A primitive's `attributes`: positions with their bounds, normals if asked for, and
-    /// texture coordinates for a textured material.
+    /// A primitive's `attributes`: positions with their bounds, normals if asked for (and
+    /// tangents with them where the mesh has some), texture coordinates for a textured
+    /// material and vertex colours where the mesh has some.
     fn attributes(&mut self, v: &MeshVertices, textured: bool, options: &WriteOptions) -> Value {
         let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         v.positions.iter().for_each(|p| {
@@ -140,9 +148,22 @@ impl Builder {
         if options.normals {
             let flat: Vec<f32> = v.normals.iter().flat_map(|n| n.to_array()).collect();
             attributes["NORMAL"] = json!(self.floats(&flat, "VEC3", count, json!({})));
+            // Tangents without normals are ignored by the specification: written with them only.
+            if count > 0 && v.tangents.len() == count {
+                let flat: Vec<f32> = v.tangents.iter().flat_map(|t| t.to_array()).collect();
+                attributes["TANGENT"] = json!(self.floats(&flat, "VEC4", count, json!({})));
+            }
         }
         if textured && v.uvs.len() == count {
             attributes["TEXCOORD_0"] = json!(self.texcoords(&v.uvs, options.texcoords));
+        }
+        if count > 0 && v.colors.len() == count {
+            let (flat, kind): (Vec<f32>, _) = if v.colors.iter().all(|c| c.w == 1.0) {
+                (v.colors.iter().flat_map(|c| c.truncate().to_array()).collect(), "VEC3")
+            } else {
+                (v.colors.iter().flat_map(|c| c.to_array()).collect(), "VEC4")
+            };
+            attributes["COLOR_0"] = json!(self.floats(&flat, kind, count, json!({})));
         }
         attributes
     }
@@ -247,6 +268,8 @@ struct MeshVertices {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     uvs: Vec<Vec2>,
+    colors: Vec<Vec4>,
+    tangents: Vec<Vec4>,
     indices: Vec<u32>,
 }
 
@@ -256,6 +279,9 @@ struct Document {
     b: Builder,
     extensions_used: Vec<&'static str>,
     images: Vec<Value>,
+    textures: Vec<Value>,
+    /// Texture samplers (the animation's samplers are [`Document::samplers`]).
+    texture_samplers: Vec<Value>,
     materials: Vec<Value>,
     nodes: Vec<Value>,
     roots: Vec<usize>,
@@ -283,7 +309,7 @@ impl Document {
         child
     }
 
-    /// Adds every material, and the images of those with a texture.
+    /// Adds every material, and the images and textures of its textures.
     fn add_materials(&mut self, scene: &Scene, images: Storage, files: &SideFiles) -> Result<()> {
         for (i, m) in scene.materials.iter().enumerate() {
             let mut pbr = json!({
@@ -291,27 +317,90 @@ impl Document {
                 "metallicFactor": 0.0,
                 "roughnessFactor": 1.0,
             });
+            let image = |kind: &str| ImageName { material: i, kind: kind.to_string(), storage: images };
             if let Some(texture) = &m.diffuse_texture {
-                let image = self.image_json(texture, i, images, files)?;
-                self.images.push(image);
-                pbr["baseColorTexture"] = json!({ "index": self.images.len() - 1 });
+                pbr["baseColorTexture"] = self.add_texture(texture, &image(""), files, m)?;
             }
             let mut material = json!({ "name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": true });
             self.set_emission(&mut material, m.emissive);
+            if let Some(texture) = &m.emissive_texture {
+                material["emissiveTexture"] = self.add_texture(texture, &image("_emissive"), files, m)?;
+            }
+            if let Some((texture, scale)) = &m.normal_texture {
+                let mut info = self.add_texture(texture, &image("_normal"), files, m)?;
+                info["scale"] = json!(scale);
+                material["normalTexture"] = info;
+            }
+            if let Some((texture, strength)) = &m.occlusion_texture {
+                let mut info = self.add_texture(texture, &image("_occlusion"), files, m)?;
+                info["strength"] = json!(strength);
+                material["occlusionTexture"] = info;
+            }
             set_alpha_mode(&mut material, m.alpha_mode);
             self.materials.push(material);
         }
         Ok(())
     }
 
-    /// Material `i`'s texture as an image, stored where `storage` says.
-    fn image_json(&mut self, texture: &Texture, i: usize, storage: Storage, files: &SideFiles) -> Result<Value> {
+    /// Adds `texture` of material `m` as an image and a texture with its sampler (none for
+    /// glTF's default), and returns the material's reference to it (a textureInfo, with
+    /// `KHR_texture_transform` unless the transform is the identity).
+    fn add_texture(&mut self, texture: &Texture, name: &ImageName, files: &SideFiles, m: &Material) -> Result<Value> {
+        let image = self.image_json(texture, name, files)?;
+        self.images.push(image);
+        let mut entry = json!({ "source": self.images.len() - 1 });
+        if texture.sampling != Sampling::default() {
+            entry["sampler"] = json!(self.sampler(&texture.sampling));
+        }
+        self.textures.push(entry);
+        let mut info = json!({ "index": self.textures.len() - 1 });
+        let transform = texture.sampling.transform;
+        if transform != Affine2::IDENTITY {
+            let (offset, rotation, scale) = uv_transform_parts(&transform);
+            let rebuilt = uv_transform(offset, rotation, scale);
+            let size = transform.to_cols_array().iter().fold(1f32, |a, c| a.max(c.abs()));
+            if !rebuilt.abs_diff_eq(transform, 1e-5 * size) {
+                return Err(Error::input(format!(
+                    "material '{}': the texture transform {transform:?} shears, which KHR_texture_transform cannot say",
+                    m.name
+                )));
+            }
+            info["extensions"] = json!({ "KHR_texture_transform": {
+                "offset": offset.to_array(), "rotation": rotation, "scale": scale.to_array()
+            } });
+            self.use_extension("KHR_texture_transform");
+        }
+        Ok(info)
+    }
+
+    /// The index of a texture sampler for `sampling` (its wrap and filters), one per
+    /// distinct sampler. Every field is written: a missing filter is the reader's choice.
+    fn sampler(&mut self, sampling: &Sampling) -> usize {
+        let entry = sampler_json(sampling);
+        match self.texture_samplers.iter().position(|s| *s == entry) {
+            Some(i) => i,
+            None => {
+                self.texture_samplers.push(entry);
+                self.texture_samplers.len() - 1
+            }
+        }
+    }
+
+    /// Records that the document uses extension `name`.
+    fn use_extension(&mut self, name: &'static str) {
+        if !self.extensions_used.contains(&name) {
+            self.extensions_used.push(name);
+        }
+    }
+
+    /// An image's JSON, its PNG stored where `name` says.
+    fn image_json(&mut self, texture: &Texture, name: &ImageName, files: &SideFiles) -> Result<Value> {
         let png = encode_png(texture).map_err(|e| output(files.path, &e))?;
-        Ok(match storage {
+        Ok(match name.storage {
             Storage::Embedded => json!({ "bufferView": self.b.view(&png), "mimeType": "image/png" }),
             Storage::DataUri => json!({ "uri": format!("data:image/png;base64,{}", encode_base64(&png)) }),
             Storage::External => {
-                let name = format!("{}_image{i}.png", files.stem);
+                let name = format!("{}_image{}{}.png", files.stem, name.material, name.kind);
                 files.write(&name, &png)?;
                 json!({ "uri": name })
             }
@@ -328,7 +417,7 @@ impl Document {
             material["emissiveFactor"] = json!([factor.x, factor.y, factor.z]);
             if strength > 1.0 {
                 material["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": strength } });
-                self.extensions_used.push("KHR_materials_emissive_strength");
+                self.use_extension("KHR_materials_emissive_strength");
             }
         }
     }
@@ -358,7 +447,12 @@ impl Document {
 
     /// Adds `mesh` as one glTF mesh with one primitive, on a node of its own.
     fn add_mesh(&mut self, scene: &Scene, mesh: &Mesh, options: &WriteOptions, trs_of: &[usize]) -> Result<()> {
-        let textured = scene.materials.get(mesh.material).is_some_and(|m| m.diffuse_texture.is_some());
+        let textured = scene.materials.get(mesh.material).is_some_and(|m| {
+            m.diffuse_texture.is_some()
+                || m.emissive_texture.is_some()
+                || m.normal_texture.is_some()
+                || m.occlusion_texture.is_some()
+        });
         let v = mesh_vertices(mesh, options.indices);
         let count = v.positions.len();
         let attributes = self.b.attributes(&v, textured, options);
@@ -422,7 +516,7 @@ impl Document {
             self.add_node(node, None);
         }
         if !self.lights.is_empty() {
-            self.extensions_used.push("KHR_lights_punctual");
+            self.use_extension("KHR_lights_punctual");
         }
     }
 
@@ -463,8 +557,7 @@ impl Document {
 
     /// The whole glTF JSON document, with `buffer` as its one buffer; lists that would be
     /// empty are left out.
-    fn into_json(mut self, scene_name: &str, buffer: Value) -> Value {
-        let textures: Vec<Value> = (0..self.images.len()).map(|i| json!({ "source": i })).collect();
+    fn into_json(self, scene_name: &str, buffer: Value) -> Value {
         let mut document = json!({
             "asset": { "version": "2.0", "generator": "vrao" },
             "scene": 0,
@@ -477,7 +570,12 @@ impl Document {
             "buffers": [buffer],
         });
         let object = document.as_object_mut().expect("an object");
-        for (key, list) in [("images", self.images), ("textures", textures), ("cameras", self.cameras)] {
+        for (key, list) in [
+            ("images", self.images),
+            ("samplers", self.texture_samplers),
+            ("textures", self.textures),
+            ("cameras", self.cameras),
+        ] {
             if !list.is_empty() {
                 object.insert(key.into(), Value::Array(list));
             }
@@ -490,7 +588,6 @@ impl Document {
             object.insert("extensions".into(), json!({ "KHR_lights_punctual": { "lights": self.lights } }));
         }
         if !self.extensions_used.is_empty() {
-            self.extensions_used.dedup();
             object.insert("extensionsUsed".into(), json!(self.extensions_used));
         }
         document
@@ -510,6 +607,47 @@ struct Channel<'a, T> {
     path: &'a str,
 }
 
+/// Where one image goes and what it is called as a side file: `STEM_imageM.png` for
+/// material M's base colour, `STEM_imageM_KIND.png` for its other textures.
+struct ImageName {
+    material: usize,
+    /// "" for the base colour, else `_emissive`, `_normal` or `_occlusion`.
+    kind: String,
+    storage: Storage,
+}
+
+/// A texture sampler's JSON: its wrap per axis and both filters.
+fn sampler_json(sampling: &Sampling) -> Value {
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => REPEAT,
+        Wrap::MirroredRepeat => MIRRORED_REPEAT,
+        Wrap::ClampToEdge => CLAMP_TO_EDGE,
+    };
+    let magnify = match sampling.magnify {
+        Filter::Nearest => NEAREST,
+        Filter::Linear => LINEAR,
+    };
+    let minify = match (sampling.minify, sampling.mipmaps) {
+        (Filter::Nearest, None) => NEAREST,
+        (Filter::Linear, None) => LINEAR,
+        (Filter::Nearest, Some(Filter::Nearest)) => NEAREST_MIPMAP_NEAREST,
+        (Filter::Linear, Some(Filter::Nearest)) => LINEAR_MIPMAP_NEAREST,
+        (Filter::Nearest, Some(Filter::Linear)) => NEAREST_MIPMAP_LINEAR,
+        (Filter::Linear, Some(Filter::Linear)) => LINEAR_MIPMAP_LINEAR,
+    };
+    json!({ "magFilter": magnify, "minFilter": minify, "wrapS": wrap(sampling.wrap_u), "wrapT": wrap(sampling.wrap_v) })
+}
+
+const NEAREST: u32 = 9728;
+const LINEAR: u32 = 9729;
+const NEAREST_MIPMAP_NEAREST: u32 = 9984;
+const LINEAR_MIPMAP_NEAREST: u32 = 9985;
+const NEAREST_MIPMAP_LINEAR: u32 = 9986;
+const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+const CLAMP_TO_EDGE: u32 = 33071;
+const MIRRORED_REPEAT: u32 = 33648;
+const REPEAT: u32 = 10497;
+
 /// Sets `material`'s alpha mode, and its cutoff for a mask.
 fn set_alpha_mode(material: &mut Value, mode: AlphaMode) {
     match mode {
@@ -527,14 +665,22 @@ fn mesh_vertices(mesh: &Mesh, index_type: IndexType) -> MeshVertices {
     let mut positions = world_f32(mesh.origin, &mesh.positions);
     let mut normals = mesh.normals.clone();
     let mut uvs = mesh.uvs.clone();
+    let mut colors = mesh.colors.clone();
+    let mut tangents = mesh.tangents.clone();
     let mut indices = mesh.indices.clone();
     if index_type == IndexType::NonIndexed {
         positions = indices.iter().map(|&i| positions[i as usize]).collect();
         normals = indices.iter().map(|&i| normals[i as usize]).collect();
         uvs = indices.iter().map(|&i| uvs[i as usize]).collect();
+        if !colors.is_empty() {
+            colors = indices.iter().map(|&i| colors[i as usize]).collect();
+        }
+        if !tangents.is_empty() {
+            tangents = indices.iter().map(|&i| tangents[i as usize]).collect();
+        }
         indices = (0..positions.len() as u32).collect();
     }
-    MeshVertices { positions, normals, uvs, indices }
+    MeshVertices { positions, normals, uvs, colors, tangents, indices }
 }
 
 /// The index type a mesh of `count` vertices is written with (`None`: non-indexed).
@@ -678,6 +824,189 @@ pub fn encode_base64(bytes: &[u8]) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::render::scene::HeadPath;
+    use serde_json::Value;
+
+    /// A 2×2 RGBA texture sampled as `sampling`.
+    fn texture(sampling: Sampling) -> Texture {
+        Texture { width: 2, height: 2, rgba8: (0..16).map(|i| i * 16).collect(), source: None, sampling }
+    }
+
+    /// A unit quad in z = 0 with `colors` and `tangents` (each empty or one per corner).
+    fn quad(name: &str, material: usize, colors: Vec<Vec4>, tangents: Vec<Vec4>) -> Mesh {
+        Mesh {
+            name: name.into(),
+            origin: DVec3::ZERO,
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            normals: vec![Vec3::Z; 4],
+            uvs: vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y],
+            colors,
+            tangents,
+            indices: vec![0, 1, 2, 0, 2, 3],
+            material,
+            node: None,
+        }
+    }
+
+    fn scene(meshes: Vec<Mesh>, materials: Vec<Material>) -> Scene {
+        Scene {
+            name: "materials".into(),
+            meshes,
+            materials,
+            lights: vec![],
+            environment: None,
+            head: HeadPath::fixed(HeadPose::IDENTITY),
+            nodes: Vec::new(),
+        }
+    }
+
+    /// Every kind of texture and vertex attribute the writer knows: material 0 has a
+    /// tiled, transformed, nearest base colour, an emission texture with the default
+    /// sampler, a normal texture and an occlusion texture sampled as the base colour.
+    fn everything() -> Scene {
+        let tiled = Sampling {
+            wrap_u: Wrap::MirroredRepeat,
+            wrap_v: Wrap::ClampToEdge,
+            magnify: Filter::Nearest,
+            minify: Filter::Linear,
+            mipmaps: None,
+            transform: uv_transform(Vec2::new(0.25, -0.5), 0.3, Vec2::new(2.0, 3.0)),
+        };
+        let mut m = Material::plain("everything", Vec3::new(0.5, 0.6, 0.7));
+        m.emissive = Vec3::new(0.2, 0.1, 0.0);
+        m.diffuse_texture = Some(texture(tiled));
+        m.emissive_texture = Some(texture(Sampling::default()));
+        m.normal_texture = Some((texture(Sampling { mipmaps: Some(Filter::Nearest), ..Sampling::default() }), 0.7));
+        m.occlusion_texture = Some((texture(tiled), 0.4));
+        let translucent = vec![Vec4::new(1.0, 0.0, 0.0, 0.5), Vec4::ONE, Vec4::new(0.0, 0.0, 1.0, 1.0), Vec4::W];
+        let tangents = vec![Vec4::new(1.0, 0.0, 0.0, -1.0); 4];
+        let opaque = vec![Vec4::new(0.0, 1.0, 0.0, 1.0); 4];
+        scene(
+            vec![quad("translucent", 0, translucent, tangents), quad("opaque", 1, opaque, vec![])],
+            vec![m, Material::plain("plain", Vec3::ONE)],
+        )
+    }
+
+    /// `scene` written to a `.gltf` named `name` with `options`, read back as JSON.
+    fn written(scene: &Scene, name: &str, options: &WriteOptions) -> (Value, std::path::PathBuf) {
+        let dir = std::env::temp_dir().join(format!("vrao-gltf-write-{}-{name}", std::process::id()));
+        std::fs::remove_dir_all(&dir).ok();
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!("{name}.gltf"));
+        write(scene, &path, options).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        ::gltf::Gltf::from_slice(&bytes).expect("the gltf crate reads what was written");
+        (serde_json::from_slice(&bytes).unwrap(), dir)
+    }
+
+    /// The accessor type of attribute `name` of mesh `mesh`'s primitive, if written.
+    fn attribute_type<'a>(doc: &'a Value, mesh: usize, name: &str) -> Option<&'a str> {
+        let accessor = doc["meshes"][mesh]["primitives"][0]["attributes"][name].as_u64()?;
+        doc["accessors"][accessor as usize]["type"].as_str()
+    }
+
+    #[test]
+    fn samplers_texture_transforms_and_every_texture_are_written() {
+        let options = WriteOptions { buffers: Storage::DataUri, images: Storage::DataUri, ..Default::default() };
+        let (doc, dir) = written(&everything(), "everything", &options);
+        let material = &doc["materials"][0];
+        let base = &material["pbrMetallicRoughness"]["baseColorTexture"];
+        let texture = |info: &Value| doc["textures"][info["index"].as_u64().unwrap() as usize].clone();
+        // One sampler, shared by the base colour and occlusion textures; none (glTF's
+        // default) for the emission texture; the normal texture's differs in its mipmaps.
+        let samplers = doc["samplers"].as_array().unwrap();
+        assert_eq!(samplers.len(), 2, "{samplers:?}");
+        let tiled = &samplers[texture(base)["sampler"].as_u64().unwrap() as usize];
+        assert_eq!(tiled, &json!({ "magFilter": 9728, "minFilter": 9729, "wrapS": 33648, "wrapT": 33071 }));
+        assert_eq!(texture(&material["occlusionTexture"])["sampler"], texture(base)["sampler"]);
+        assert!(texture(&material["emissiveTexture"]).get("sampler").is_none());
+        let normal = &samplers[texture(&material["normalTexture"])["sampler"].as_u64().unwrap() as usize];
+        assert_eq!(normal, &json!({ "magFilter": 9729, "minFilter": 9985, "wrapS": 10497, "wrapT": 10497 }));
+        // The transform as offset, rotation and scale, on the base colour and occlusion
+        // references only; rebuilt, it is the transform that was written.
+        let t = &base["extensions"]["KHR_texture_transform"];
+        let f = |v: &Value| v.as_f64().unwrap() as f32;
+        let (offset, rotation, scale) = (
+            Vec2::new(f(&t["offset"][0]), f(&t["offset"][1])),
+            f(&t["rotation"]),
+            Vec2::new(f(&t["scale"][0]), f(&t["scale"][1])),
+        );
+        assert!((offset - Vec2::new(0.25, -0.5)).length() < 1e-6 && (rotation - 0.3).abs() < 1e-6, "{t}");
+        assert!((scale - Vec2::new(2.0, 3.0)).length() < 1e-5, "{t}");
+        let original = everything().materials[0].diffuse_texture.as_ref().unwrap().sampling.transform;
+        assert!(uv_transform(offset, rotation, scale).abs_diff_eq(original, 1e-5));
+        assert!(material["occlusionTexture"]["extensions"]["KHR_texture_transform"].is_object());
+        assert!(material["emissiveTexture"].get("extensions").is_none());
+        assert_eq!(doc["extensionsUsed"], json!(["KHR_texture_transform"]));
+        // Scale and strength beside their textures.
+        assert_eq!(f(&material["normalTexture"]["scale"]), 0.7);
+        assert_eq!(f(&material["occlusionTexture"]["strength"]), 0.4);
+        assert_eq!(doc["images"].as_array().unwrap().len(), 4);
+        // Colours with an alpha below 1 as VEC4, opaque ones as VEC3; tangents where the
+        // mesh has them.
+        assert_eq!(attribute_type(&doc, 0, "COLOR_0"), Some("VEC4"));
+        assert_eq!(attribute_type(&doc, 0, "TANGENT"), Some("VEC4"));
+        assert_eq!(attribute_type(&doc, 1, "COLOR_0"), Some("VEC3"));
+        assert_eq!(attribute_type(&doc, 1, "TANGENT"), None);
+        assert_eq!(attribute_type(&doc, 1, "TEXCOORD_0"), None, "material 1 has no texture");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn vertex_colours_and_tangents_follow_the_vertices_they_belong_to() {
+        // Non-indexed: repeated per triangle corner, as the positions are.
+        let options = WriteOptions {
+            buffers: Storage::External,
+            images: Storage::External,
+            indices: IndexType::NonIndexed,
+            ..Default::default()
+        };
+        let scene = everything();
+        let (doc, dir) = written(&scene, "nonindexed", &options);
+        let bin = std::fs::read(dir.join("nonindexed.bin")).unwrap();
+        let floats = |attribute: &str| -> Vec<f32> {
+            let accessor = &doc["accessors"]
+                [doc["meshes"][0]["primitives"][0]["attributes"][attribute].as_u64().unwrap() as usize];
+            let view = &doc["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+            let (start, length) =
+                (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+            bytemuck::pod_collect_to_vec(&bin[start..start + length])
+        };
+        let mesh = &scene.meshes[0];
+        let expected =
+            |v: &[Vec4]| -> Vec<f32> { mesh.indices.iter().flat_map(|&i| v[i as usize].to_array()).collect() };
+        assert_eq!(floats("COLOR_0"), expected(&mesh.colors));
+        assert_eq!(floats("TANGENT"), expected(&mesh.tangents));
+        // External images: the base colour keeps its name, the others say what they are.
+        for name in ["_image0.png", "_image0_emissive.png", "_image0_normal.png", "_image0_occlusion.png"] {
+            assert!(dir.join(format!("nonindexed{name}")).is_file(), "{name}");
+        }
+        // Without normals, tangents are not written (the specification ignores them).
+        let (doc, _) = written(&scene, "nonormals", &WriteOptions { normals: false, ..Default::default() });
+        assert_eq!(attribute_type(&doc, 0, "TANGENT"), None);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn default_samplers_and_identity_transforms_write_nothing_and_a_shear_is_refused() {
+        let mut m = Material::plain("default", Vec3::ONE);
+        m.diffuse_texture = Some(texture(Sampling::default()));
+        let (doc, dir) =
+            written(&scene(vec![quad("q", 0, vec![], vec![])], vec![m.clone()]), "default", &Default::default());
+        assert!(doc.get("samplers").is_none() && doc.get("extensionsUsed").is_none(), "{doc}");
+        assert_eq!(doc["textures"], json!([{ "source": 0 }]));
+        assert!(doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"].get("extensions").is_none());
+        assert_eq!(attribute_type(&doc, 0, "COLOR_0"), None);
+        std::fs::remove_dir_all(&dir).ok();
+        // A transform with shear has no offset, rotation and scale: refused, naming the material.
+        let sheared = Affine2::from_cols_array(&[1.0, 0.0, 0.5, 1.0, 0.0, 0.0]);
+        m.diffuse_texture = Some(texture(Sampling { transform: sheared, ..Sampling::default() }));
+        let path = std::env::temp_dir().join(format!("vrao-gltf-write-{}-sheared.gltf", std::process::id()));
+        let e = write(&scene(vec![quad("q", 0, vec![], vec![])], vec![m]), &path, &Default::default()).unwrap_err();
+        assert!(e.to_string().contains("'default'") && e.to_string().contains("shear"), "{e}");
+    }
+
     #[test]
     fn base64_round_trips() {
         for n in 0..10 {
