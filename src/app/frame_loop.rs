@@ -41,16 +41,21 @@ pub struct FrameLoop {
     pub frames: u64,
     /// Stop after this many rendered frames.
     pub frame_limit: Option<u64>,
-    /// The display period the frame must fit (ms): the headset's latest
-    /// ([`FrameRequest::display_period_ms`]), the profile's until it says.
+    /// The display's refresh period, which the frame must fit (ms): the headset's latest
+    /// ([`FrameRequest::refresh_period_ms`]), never a predicted period the runtime
+    /// stretched because frames were late; the profile's until the headset knows it.
     pub budget_ms: f64,
-    /// The shortest and longest display period seen (ms).
+    /// The shortest and longest refresh period seen (ms).
     pub budget_range_ms: (f64, f64),
-    /// How often the display period changed during the run.
+    /// How often the refresh period changed during the run.
     pub budget_changes: u64,
+    /// Frames the headset predicted a display period for that spans more than one
+    /// refresh ([`crate::xr::missed_refreshes`]): an OpenXR runtime stretches its period
+    /// when frames are late, each one a missed refresh or more.
+    pub stretched_frames: u64,
     /// The session state the run was interrupted in (Ctrl-C), once the loop saw it.
     pub interrupted_in: Option<String>,
-    /// Whether the headset has given a display period yet.
+    /// Whether the headset has given a refresh period yet.
     display_period_seen: bool,
     /// Frames whose GPU time exceeded `budget_ms`, and all frames whose time came back.
     pub over_budget_frames: u64,
@@ -84,8 +89,12 @@ pub struct FrameLoop {
 /// What the loop keeps of a submitted frame until its GPU times come back.
 struct InFlight {
     frame: u64,
-    /// The display period the frame was rendered for: its GPU time is judged against it.
+    /// The display's refresh period when the frame was rendered: its GPU time is judged
+    /// against it.
     budget_ms: f64,
+    /// The display period the headset predicted for the frame (the governor lowers on
+    /// one stretched over several refreshes).
+    predicted_period_ms: Option<f64>,
     serial: bool,
     occlusion_passes: Vec<&'static str>,
 }
@@ -118,6 +127,11 @@ impl FrameLoop {
     /// A loop drawing with `renderer` (made by [`FrameLoop::renderer_for`]) for `headset`.
     pub fn with_renderer(gpu: Arc<Gpu>, renderer: Renderer, headset: Box<dyn Headset>) -> FrameLoop {
         let settings = renderer.settings().clone();
+        // A rate the headset already knows (an OpenXR runtime's reported refresh rate)
+        // is the budget from the start; otherwise the profile's until the first frame.
+        let budget_ms = headset.refresh_period_ms().filter(|ms| ms.is_finite() && *ms > 0.0);
+        let display_period_seen = budget_ms.is_some();
+        let budget_ms = budget_ms.unwrap_or(settings.profile.budget_ms());
         let cpu_adapter = gpu.info.device_type == wgpu::DeviceType::Cpu;
         FrameLoop {
             cpu_adapter,
@@ -132,11 +146,12 @@ impl FrameLoop {
             history: PassHistory::new(120),
             frames: 0,
             frame_limit: None,
-            budget_ms: settings.profile.budget_ms(),
-            budget_range_ms: (settings.profile.budget_ms(), settings.profile.budget_ms()),
+            budget_ms,
+            budget_range_ms: (budget_ms, budget_ms),
             budget_changes: 0,
+            stretched_frames: 0,
             interrupted_in: None,
-            display_period_seen: false,
+            display_period_seen,
             over_budget_frames: 0,
             timed_frames: 0,
             gpu_frame_ms: Vec::new(),
@@ -166,8 +181,13 @@ impl FrameLoop {
             self.headset.request_exit();
         }
         let Some(request) = self.headset.wait_frame(&self.gpu)? else { return Ok(None) };
-        if let Some(period_ms) = request.display_period_ms {
-            self.follow_display_period(period_ms);
+        if let Some(refresh_ms) = request.refresh_period_ms.or(request.display_period_ms) {
+            self.follow_display_period(refresh_ms);
+        }
+        if let Some(predicted_ms) = request.display_period_ms {
+            if crate::xr::missed_refreshes(predicted_ms, self.budget_ms) > 0 {
+                self.stretched_frames += 1;
+            }
         }
         if !request.should_render {
             self.headset.submit(&self.gpu, &request, None)?;
@@ -191,6 +211,7 @@ impl FrameLoop {
         self.in_flight.push_back(InFlight {
             frame: report.frame,
             budget_ms: self.budget_ms,
+            predicted_period_ms: request.display_period_ms,
             serial,
             occlusion_passes: report.plan.occlusion_passes(),
         });
@@ -213,8 +234,10 @@ impl FrameLoop {
         })
     }
 
-    /// Takes the display period the headset gives this frame as the budget, and hands it
-    /// to the governor, so that both follow the display from this frame on.
+    /// Takes the display's refresh period the headset gives this frame as the budget, and
+    /// hands it to the governor, so that both follow the display from this frame on (a
+    /// runtime changing its rate). Never give it a predicted period the runtime stretched
+    /// because frames were late ([`FrameRequest::refresh_period_ms`]).
     pub fn follow_display_period(&mut self, period_ms: f64) {
         if !(period_ms.is_finite() && period_ms > 0.0) {
             return;
@@ -223,7 +246,7 @@ impl FrameLoop {
         if !std::mem::replace(&mut self.display_period_seen, true) {
             self.budget_range_ms = (period_ms, period_ms);
         } else if period_ms != self.budget_ms {
-            log::info!("display period {:.2} ms -> {period_ms:.2} ms: the budget follows", self.budget_ms);
+            log::info!("display refresh period {:.2} ms -> {period_ms:.2} ms: the budget follows", self.budget_ms);
             self.budget_changes += 1;
         }
         self.budget_ms = period_ms;
@@ -242,6 +265,7 @@ impl FrameLoop {
             let sent = self.in_flight.front().filter(|f| f.frame == timing.frame);
             timing.serial = sent.is_some_and(|f| f.serial);
             let budget_ms = sent.map_or(self.budget_ms, |f| f.budget_ms);
+            let predicted_ms = sent.and_then(|f| f.predicted_period_ms);
             let passes = sent.map(|f| f.occlusion_passes.clone());
             let ao_ms = passes.and_then(|passes| self.occlusion_ms(&timing, &passes));
             self.timed_frames += 1;
@@ -249,7 +273,7 @@ impl FrameLoop {
                 self.over_budget_frames += 1;
             }
             self.gpu_frame_ms.push(timing.total_ms);
-            self.govern(&timing, ao_ms);
+            self.govern(&timing, ao_ms, predicted_ms);
             self.history.push(timing);
         }
     }
@@ -269,13 +293,11 @@ impl FrameLoop {
         }
     }
 
-    /// Feeds a frame's times to the governor and applies the level it picks.
-    fn govern(&mut self, timing: &FrameTiming, ao_ms: Option<f64>) {
+    /// Feeds a frame's times and the display period the headset predicted for it to the
+    /// governor and applies the level it picks.
+    fn govern(&mut self, timing: &FrameTiming, ao_ms: Option<f64>, predicted_ms: Option<f64>) {
         let Some(governor) = &mut self.governor else { return };
-        let change = match ao_ms {
-            Some(ao_ms) => governor.observe_with_ao(timing.frame, timing.total_ms, ao_ms),
-            None => governor.observe(timing.frame, timing.total_ms),
-        };
+        let change = governor.observe_paced(timing.frame, timing.total_ms, ao_ms, predicted_ms);
         let Some(change) = change else { return };
         log::debug!("governor, frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason);
         let mut settings = self.renderer.settings().clone();

@@ -9,6 +9,16 @@
 //! 70 %, and only when the next level's predicted time stays under 90 % — so a steady
 //! load settles on one level instead of oscillating.
 //!
+//! ## The display's rate
+//! The period is the display's refresh period (an OpenXR runtime's refresh rate, else the
+//! shortest display period it predicted: [`crate::xr::DisplayRate`]), never the period a
+//! runtime predicts for a frame: that one stretches to whole refreshes when frames are late
+//! (Monado predicts 100 ms on a 50 ms display), and a raise judged against it would
+//! predict a frame slower than one refresh and keep the application at half rate. A frame
+//! whose predicted period spans more than one refresh ([`Governor::observe_paced`]) missed
+//! refreshes: it is a reason to drop (once the frames after a change had time to reach the
+//! runtime's pacing) and never counts as calm.
+//!
 //! ## Prediction model
 //! A frame's GPU time is T = R + A: the AO passes A and everything else R. At level i
 //! the AO costs are taken to scale with the frontier's per-eye cost c (measured by
@@ -199,6 +209,10 @@ pub struct GovernorConfig {
     /// This GPU's AO ms per frontier ms, for the AO estimate when no AO time is measured
     /// (1: the frontier was benched on this device).
     pub frontier_scale: f64,
+    /// Frames after a change's frame whose stretched display period is no reason to drop
+    /// again: their GPU times come one to three frames late, and the runtime's predicted
+    /// period follows the application's frame times a frame or more after that.
+    pub stretch_settle_frames: u64,
 }
 
 impl Default for GovernorConfig {
@@ -220,6 +234,7 @@ impl GovernorConfig {
             raise_step: 1,
             settle_frames: 2,
             frontier_scale: 1.0,
+            stretch_settle_frames: 8,
         }
     }
 
@@ -267,6 +282,11 @@ pub struct GovernorChange {
     pub to: String,
     /// The measured or predicted time and the threshold it crossed.
     pub reason: String,
+    /// The display's refresh period (ms) the change was judged against.
+    pub period_ms: f64,
+    /// A raise's predicted frame time at the new level (ms, with the level's correction);
+    /// `None` for a drop.
+    pub predicted_ms: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -274,6 +294,15 @@ struct Sample {
     frame: u64,
     gpu_ms: f64,
     ao_ms: Option<f64>,
+    /// The display period the headset predicted for the frame (ms), if it said.
+    predicted_period_ms: Option<f64>,
+}
+
+impl Sample {
+    /// Refreshes of a display of period `refresh_ms` the frame's predicted period missed.
+    fn missed(&self, refresh_ms: f64) -> u64 {
+        self.predicted_period_ms.map_or(0, |p| crate::xr::missed_refreshes(p, refresh_ms))
+    }
 }
 
 /// Frames a rising trend is fitted over.
@@ -345,9 +374,10 @@ impl Governor {
         &self.config
     }
 
-    /// Follows the display: from now on frames are judged against `period_ms` (the
-    /// runtime's predicted display period, which may change at any frame: a Quest
-    /// switching between 72, 90 and 120 Hz, a runtime lowering the rate under load).
+    /// Follows the display: from now on frames are judged against `period_ms`, the
+    /// display's refresh period (which may change at any frame: a Quest switching between
+    /// 72, 90 and 120 Hz). Never a period the runtime predicted for a frame and stretched
+    /// because frames were late: give that to [`Governor::observe_paced`].
     /// The frames measured so far stay: a shorter period drops on the next frame over
     /// it, a longer one raises as soon as the calm frames fit. A non-positive or
     /// non-finite period is ignored (returns false); returns whether the period changed.
@@ -365,14 +395,31 @@ impl Governor {
     /// `settle_frames` frames after a change's `frame` are ignored, so a loop whose times
     /// arrive later than that must raise it.
     pub fn observe(&mut self, frame: u64, gpu_ms: f64) -> Option<GovernorChange> {
-        self.observe_sample(Sample { frame, gpu_ms, ao_ms: None })
+        self.observe_paced(frame, gpu_ms, None, None)
     }
 
     /// [`Governor::observe`] with the AO passes' measured share of `gpu_ms`, which makes
     /// the raise prediction exact where the AO cost follows the frontier's ratios.
     pub fn observe_with_ao(&mut self, frame: u64, gpu_ms: f64, ao_ms: f64) -> Option<GovernorChange> {
-        let ao_ms = ao_ms.is_finite().then_some(ao_ms.clamp(0.0, gpu_ms.max(0.0)));
-        self.observe_sample(Sample { frame, gpu_ms, ao_ms })
+        self.observe_paced(frame, gpu_ms, Some(ao_ms), None)
+    }
+
+    /// [`Governor::observe`] with the AO share when measured, and the display period the
+    /// headset predicted for the frame (OpenXR's predictedDisplayPeriod). A predicted
+    /// period spanning more than one refresh of the display ([`crate::xr::missed_refreshes`]
+    /// against the governor's period) means frames were late: the frame drops like one
+    /// over 90 % (unless within [`GovernorConfig::stretch_settle_frames`] of a change) and
+    /// never counts as calm.
+    pub fn observe_paced(
+        &mut self,
+        frame: u64,
+        gpu_ms: f64,
+        ao_ms: Option<f64>,
+        predicted_period_ms: Option<f64>,
+    ) -> Option<GovernorChange> {
+        let ao_ms = ao_ms.filter(|ms| ms.is_finite()).map(|ms| ms.clamp(0.0, gpu_ms.max(0.0)));
+        let predicted_period_ms = predicted_period_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
+        self.observe_sample(Sample { frame, gpu_ms, ao_ms, predicted_period_ms })
     }
 
     /// The frame time predicted at level `to` from a frame `s` measured at the current
@@ -401,18 +448,35 @@ impl Governor {
         let c = &self.config;
         let (period, drop_ms, calm_ms) = (c.period_ms, c.drop_above * c.period_ms, c.raise_below * c.period_ms);
         if self.level > 0 {
+            let to = self.level.saturating_sub(c.drop_step);
             if s.gpu_ms > drop_ms {
                 let reason = format!("frame {:.2} ms > {:.0} % of {:.2} ms", s.gpu_ms, c.drop_above * 100.0, period);
-                return Some(self.change(s.frame, self.level.saturating_sub(c.drop_step), reason));
+                return Some(self.change(s.frame, to, reason, None));
+            }
+            let missed = s.missed(period);
+            let settled = self.last_change_frame.is_none_or(|f| s.frame > f + c.stretch_settle_frames);
+            if let (true, Some(predicted)) = (missed > 0 && settled, s.predicted_period_ms) {
+                let reason = format!(
+                    "display period {predicted:.2} ms stretched over {} refreshes of {period:.2} ms ({missed} missed)",
+                    missed + 1
+                );
+                return Some(self.change(s.frame, to, reason, None));
             }
             if let Some(reason) = self.trend_overrun() {
-                return Some(self.change(s.frame, self.level.saturating_sub(c.drop_step), reason));
+                return Some(self.change(s.frame, to, reason, None));
             }
         }
         let c = &self.config;
         let to = (self.level + c.raise_step).min(self.frontier.top());
+        // Calm: under 70 % of the display's period, and shown at the display's rate (a
+        // stretched period means refreshes were missed, whatever the GPU time).
         let calm = self.recent.len() >= c.calm_frames_to_raise
-            && self.recent.iter().rev().take(c.calm_frames_to_raise).all(|r| r.gpu_ms < calm_ms);
+            && self
+                .recent
+                .iter()
+                .rev()
+                .take(c.calm_frames_to_raise)
+                .all(|r| r.gpu_ms < calm_ms && r.missed(period) == 0);
         let spaced = self.last_change_frame.is_none_or(|f| s.frame >= f + c.min_frames_between_raises);
         if to == self.level || !calm || !spaced {
             return None;
@@ -436,7 +500,7 @@ impl Governor {
             c.drop_above * 100.0,
             period
         );
-        let change = self.change(s.frame, to, reason);
+        let change = self.change(s.frame, to, reason, Some(corrected));
         self.raise_check = Some(predicted);
         Some(change)
     }
@@ -463,12 +527,14 @@ impl Governor {
         })
     }
 
-    fn change(&mut self, frame: u64, to: usize, reason: String) -> GovernorChange {
+    fn change(&mut self, frame: u64, to: usize, reason: String, predicted_ms: Option<f64>) -> GovernorChange {
         let change = GovernorChange {
             frame,
             from: self.frontier.levels[self.level].setting.clone(),
             to: self.frontier.levels[to].setting.clone(),
             reason,
+            period_ms: self.config.period_ms,
+            predicted_ms,
         };
         self.level = to;
         self.last_change_frame = Some(frame);

@@ -16,5 +16,5 @@ pub use buffer_view::BufferView;
 pub use frame_loop::{FrameLoop, Step, SERIAL_EVERY};
 pub use headset::{open_headset, HeadsetChoice, HeadsetError};
 pub use history::PassHistory;
-pub use session::{run_session, RunOptions, SessionError, RUN_FRAMES_MAX};
+pub use session::{refresh_with_openxr, refused_summary, run_session, RunOptions, SessionError, RUN_FRAMES_MAX};
 pub use summary::RunSummary;

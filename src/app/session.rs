@@ -3,7 +3,7 @@
 //! the caller's interrupt flag is set.
 
 use crate::app::governor::{Frontier, Governor, GovernorConfig};
-use crate::app::window::{run_window, WindowOptions};
+use crate::app::window::{open_event_loop, run_window, WindowOptions};
 use crate::app::{open_headset, BufferView, FrameLoop, HeadsetChoice, HeadsetError, RunSummary};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::{BackendChoice, Gpu};
@@ -109,6 +109,13 @@ pub enum SessionError {
     /// [`RunOptions::virtual_time`] has a render time out of range.
     #[error("{0}")]
     VirtualTime(Error),
+    /// [`RunOptions::governor_frontier`] cannot be read or governed with.
+    #[error("{0}")]
+    Frontier(Error),
+    /// A window display mode and no desktop display to open it on (checked before the
+    /// headset opens).
+    #[error("{0}")]
+    NoWindow(Error),
     /// The headset (OpenXR asked for and unavailable, or the simulated one).
     #[error(transparent)]
     Headset(#[from] HeadsetError),
@@ -124,10 +131,28 @@ impl From<SessionError> for Error {
             SessionError::ViewNeedsWindow(_) | SessionError::ScreenshotNeedsWindow | SessionError::Frames(_) => {
                 Error::input(error.to_string())
             }
-            SessionError::VirtualTime(e) => e,
+            SessionError::VirtualTime(e) | SessionError::Frontier(e) | SessionError::NoWindow(e) => e,
             SessionError::Headset(e) => e.into(),
         }
     }
+}
+
+impl SessionError {
+    /// Whether the session was refused before any frame (its options, its frontier, no
+    /// display for its window, no headset), rather than failing while it ran.
+    pub fn is_refusal(&self) -> bool {
+        !matches!(self, SessionError::Other(_))
+    }
+}
+
+/// The report of a session refused with `why` (one line) before it opened anything:
+/// the budget of the profile `options` name (at its `--refresh`), where they name one.
+pub fn refused_summary(options: &RunOptions, why: &str) -> RunSummary {
+    let profile = crate::xr::profiles::by_name(&options.profile).ok().map(|p| match options.refresh {
+        Some(hz) => p.with_refresh(hz).unwrap_or(p),
+        None => p,
+    });
+    RunSummary::refused(profile.as_ref(), why)
 }
 
 /// Runs a headset session on `scene` with `settings` (their profile is replaced by the
@@ -145,11 +170,24 @@ pub fn run_session(
 ) -> std::result::Result<RunSummary, SessionError> {
     let (settings, size) = session_settings(settings, options)?;
     check_options(options)?;
-    let governor = if options.governor { Some(governor_for(options, &settings)?) } else { None };
+    let governor = match options.governor {
+        true => Some(governor_for(options, &settings).map_err(SessionError::Frontier)?),
+        false => None,
+    };
+    // The window's display before the headset: a machine without one is refused before
+    // a runtime, session, swapchains and pipelines are made for nothing.
+    let event_loop = match options.display {
+        DisplayMode::None => None,
+        _ => Some(open_event_loop().map_err(SessionError::NoWindow)?),
+    };
     let frames = options.frames.or((options.display == DisplayMode::None).then_some(600));
     let simulated = simulated_options(scene, &settings, options, frames);
     let (mut headset, gpu, message) = open_headset(options.headset, simulated, size, options.backend, &interrupt)?;
     log::info!("headset: {message}");
+    if let (Some(hz), Some(report)) = (options.refresh, headset.openxr_report()) {
+        let (level, line) = refresh_with_openxr(hz, &report.display_refresh_rates_hz, report.display_refresh_rate_hz);
+        log::log!(level, "{line}");
+    }
     let renderer = match renderer_unless_interrupted(&gpu, scene, &settings, headset.as_ref(), &interrupt) {
         Err(Error::Interrupted) => return end_before_frames(headset.as_mut(), &gpu, &settings, options),
         renderer => renderer?,
@@ -162,7 +200,32 @@ pub fn run_session(
         log_governor(&governor);
         frame_loop.set_governor(governor)?;
     }
-    run_frames(frame_loop, scene, options)
+    run_frames(frame_loop, event_loop, scene, options)
+}
+
+/// What `--refresh hz` did with an OpenXR headset, in one line and at the level to log it
+/// at: the rate is the simulated headset's; a runtime is only asked for it where it
+/// offers that rate (XR_FB_display_refresh_rate, `offered`; `current` the rate it runs
+/// at), and its display's rate sets the budget either way.
+pub fn refresh_with_openxr(hz: f64, offered: &[f32], current: Option<f32>) -> (log::Level, String) {
+    let near = |rate: f32| (f64::from(rate) - hz).abs() < 0.5;
+    if offered.iter().copied().any(near) && current.is_some_and(near) {
+        return (log::Level::Info, format!("--refresh {hz} Hz: asked of the OpenXR runtime, which offers it"));
+    }
+    let runs_at = match current {
+        Some(rate) => format!("the runtime's display runs at {rate} Hz"),
+        None => "the runtime's display rate".into(),
+    };
+    let offers = if offered.is_empty() {
+        "it offers no rate to choose (no XR_FB_display_refresh_rate)".to_string()
+    } else {
+        let rates: Vec<String> = offered.iter().map(|r| format!("{r}")).collect();
+        format!("it offers {} Hz", rates.join(", "))
+    };
+    (
+        log::Level::Warn,
+        format!("--refresh {hz} Hz is the simulated headset's and is not used with OpenXR: {runs_at} and sets the budget ({offers})"),
+    )
 }
 
 /// Refuses the options that cannot go together or are out of range: a buffer view or a
@@ -253,24 +316,28 @@ fn log_governor(governor: &Governor) {
     );
 }
 
-/// Runs the frame loop to its end: headless, or in the desktop window.
+/// Runs the frame loop to its end: headless, or in the desktop window on `event_loop`.
 fn run_frames(
     mut frame_loop: FrameLoop,
+    event_loop: Option<winit::event_loop::EventLoop<()>>,
     scene: &Scene,
     options: &RunOptions,
 ) -> std::result::Result<RunSummary, SessionError> {
-    if options.display == DisplayMode::None {
-        while frame_loop.step()?.is_some() {}
-        frame_loop.end()?;
-        Ok(RunSummary::of(&frame_loop))
-    } else {
-        let window = WindowOptions {
-            mode: options.display,
-            size: options.window,
-            screenshot: options.screenshot.clone(),
-            show: options.show,
-        };
-        Ok(run_window(frame_loop, scene, window)?)
+    match event_loop {
+        None => {
+            while frame_loop.step()?.is_some() {}
+            frame_loop.end()?;
+            Ok(RunSummary::of(&frame_loop))
+        }
+        Some(event_loop) => {
+            let window = WindowOptions {
+                mode: options.display,
+                size: options.window,
+                screenshot: options.screenshot.clone(),
+                show: options.show,
+            };
+            Ok(run_window(event_loop, frame_loop, scene, window)?)
+        }
     }
 }
 
@@ -321,4 +388,38 @@ fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
         .unwrap_or(frontier.top());
     let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
     Governor::new(frontier, config, start)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refresh_with_openxr_says_it_is_the_simulated_headsets_unless_the_runtime_took_it() {
+        // Monado's null compositor: 20 Hz alone.
+        let (level, line) = refresh_with_openxr(90.0, &[20.0], Some(20.0));
+        assert_eq!(level, log::Level::Warn);
+        assert!(line.starts_with("--refresh 90 Hz is the simulated headset's"), "{line}");
+        assert!(line.contains("runs at 20 Hz") && line.contains("offers 20 Hz") && !line.contains('\n'), "{line}");
+        // No XR_FB_display_refresh_rate.
+        let (level, line) = refresh_with_openxr(72.0, &[], None);
+        assert_eq!(level, log::Level::Warn);
+        assert!(line.contains("no XR_FB_display_refresh_rate"), "{line}");
+        // A runtime offering the rate was asked for it: said at the info level.
+        let (level, line) = refresh_with_openxr(72.0, &[72.0, 90.0, 120.0], Some(72.0));
+        assert_eq!(level, log::Level::Info);
+        assert!(line.contains("asked of the OpenXR runtime"), "{line}");
+    }
+
+    #[test]
+    fn a_refused_session_reports_why_with_its_profiles_budget() {
+        let options = RunOptions { profile: "index".into(), refresh: Some(144.0), ..RunOptions::default() };
+        let summary = refused_summary(&options, "cannot open a desktop window");
+        assert_eq!(summary.refused.as_deref(), Some("cannot open a desktop window"));
+        assert!((summary.budget_ms - 1000.0 / 144.0).abs() < 1e-9, "{}", summary.budget_ms);
+        assert!(summary.budget_source.contains("refused before a headset opened"), "{}", summary.budget_source);
+        assert_eq!((summary.frames_rendered, summary.interrupted), (0, false));
+        let unknown = RunOptions { profile: "nope".into(), ..RunOptions::default() };
+        assert_eq!(refused_summary(&unknown, "no profile").budget_ms, 0.0);
+    }
 }

@@ -22,18 +22,23 @@ pub struct RunSummary {
     pub frames_in_flight_max: usize,
     /// The renderer's limit on frames in flight.
     pub frames_in_flight_limit: usize,
-    /// The display period (ms) at the end of the run: the frame budget each frame's GPU
-    /// time is judged against (the period the frame was rendered for).
+    /// The display's refresh period (ms) at the end of the run: the frame budget each
+    /// frame's GPU time is judged against (the period when the frame was rendered).
     pub budget_ms: f64,
     /// Which rate governed the budget and where it came from: the OpenXR runtime's
-    /// predicted display period, or the simulated headset's refresh rate.
+    /// refresh rate (XR_FB_display_refresh_rate) or shortest predicted display period,
+    /// the simulated headset's refresh rate, or the profile's while no frame came.
     pub budget_source: String,
-    /// The shortest and longest display period of the run (ms).
+    /// The shortest refresh period of the run (ms).
     pub budget_ms_min: f64,
-    /// The longest display period of the run (ms).
+    /// The longest refresh period of the run (ms).
     pub budget_ms_max: f64,
-    /// How often the display period changed during the run.
+    /// How often the refresh period changed during the run.
     pub budget_changes: u64,
+    /// Frames the headset predicted a display period for spanning more than one refresh
+    /// (an OpenXR runtime stretches it when frames are late): each missed a refresh or
+    /// more, and each is a reason for the governor to lower, never to raise.
+    pub stretched_frames: u64,
     /// Timed frames whose GPU time exceeded `budget_ms`.
     pub over_budget_frames: u64,
     /// Frames whose GPU time came back.
@@ -69,6 +74,9 @@ pub struct RunSummary {
     pub final_ao_setting: String,
     /// The OpenXR session's states, layers and loss reason (OpenXR headsets only).
     pub openxr: Option<crate::xr::openxr::OpenXrReport>,
+    /// Why the run was refused before its headset or window opened (the command exits
+    /// 2): the report is written anyway when one was asked for. `None` for a run.
+    pub refused: Option<String>,
 }
 
 impl RunSummary {
@@ -97,6 +105,7 @@ impl RunSummary {
             budget_ms_min: frame_loop.budget_range_ms.0,
             budget_ms_max: frame_loop.budget_range_ms.1,
             budget_changes: frame_loop.budget_changes,
+            stretched_frames: frame_loop.stretched_frames,
             over_budget_frames: frame_loop.over_budget_frames,
             timed_frames: frame_loop.timed_frames,
             gpu_frame_ms_median,
@@ -119,6 +128,7 @@ impl RunSummary {
             governor_changes: frame_loop.governor.as_ref().map(|g| g.changes().to_vec()).unwrap_or_default(),
             final_ao_setting: ao_setting(&frame_loop.renderer.settings().ao),
             openxr,
+            refused: None,
         }
     }
 
@@ -132,8 +142,10 @@ impl RunSummary {
         frames_in_flight: usize,
     ) -> RunSummary {
         let openxr = headset.openxr_report();
-        let budget_ms = openxr.as_ref().map_or(0.0, |r| r.display_period_ms);
-        let budget_ms = if budget_ms > 0.0 { budget_ms } else { settings.profile.budget_ms() };
+        // The display's rate where the headset knows it (an OpenXR runtime's reported
+        // rate); otherwise the profile's, and the source says so.
+        let budget_ms = headset.refresh_period_ms().filter(|ms| ms.is_finite() && *ms > 0.0);
+        let budget_ms = budget_ms.unwrap_or(settings.profile.budget_ms());
         RunSummary {
             headset: headset.describe(),
             adapter: gpu.info.name.clone(),
@@ -145,6 +157,7 @@ impl RunSummary {
             budget_ms_min: budget_ms,
             budget_ms_max: budget_ms,
             budget_changes: 0,
+            stretched_frames: 0,
             over_budget_frames: 0,
             timed_frames: 0,
             gpu_frame_ms_median: 0.0,
@@ -159,6 +172,48 @@ impl RunSummary {
             governor_changes: Vec::new(),
             final_ao_setting: ao_setting(&settings.ao),
             openxr,
+            refused: None,
+        }
+    }
+
+    /// The report of a run refused before its headset or window opened, for `why` (one
+    /// line): nothing was rendered; the budget is the profile's (`profile`, with the
+    /// `--refresh` given) where it names one, 0 otherwise.
+    pub fn refused(profile: Option<&crate::render::stereo::HeadsetProfile>, why: &str) -> RunSummary {
+        let budget_ms = profile.map_or(0.0, |p| p.budget_ms());
+        RunSummary {
+            headset: "none (the run was refused before a headset opened)".into(),
+            adapter: "none".into(),
+            frames_rendered: 0,
+            frames_in_flight_max: 0,
+            frames_in_flight_limit: 0,
+            budget_ms,
+            budget_source: match profile {
+                Some(p) => format!(
+                    "the '{}' profile's {} Hz (the run was refused before a headset opened)",
+                    p.name, p.refresh_hz
+                ),
+                None => "none (the run was refused before a headset opened)".into(),
+            },
+            budget_ms_min: budget_ms,
+            budget_ms_max: budget_ms,
+            budget_changes: 0,
+            stretched_frames: 0,
+            over_budget_frames: 0,
+            timed_frames: 0,
+            gpu_frame_ms_median: 0.0,
+            cpu_encode_ms_median: 0.0,
+            cpu_encode_share_of_gpu: 0.0,
+            timing: "no frame was rendered".into(),
+            counters: None,
+            pass_medians_ms: Vec::new(),
+            interrupted: false,
+            interrupted_in: None,
+            governor: "not started".into(),
+            governor_changes: Vec::new(),
+            final_ao_setting: String::new(),
+            openxr: None,
+            refused: Some(why.to_string()),
         }
     }
 
@@ -181,6 +236,11 @@ impl RunSummary {
                 c.submitted, c.presented, c.reprojected, c.dropped, c.latency_median_ms, c.latency_p95_ms
             );
         }
+        let stretched = if self.stretched_frames > 0 {
+            format!("; {} frames at a display period stretched over missed refreshes", self.stretched_frames)
+        } else {
+            String::new()
+        };
         let budget = if self.budget_changes > 0 {
             format!(
                 "a {:.2} ms budget ({:.2}..{:.2} ms, {} changes) from {}",
@@ -194,7 +254,7 @@ impl RunSummary {
             _ => String::new(),
         };
         format!(
-            "governor {}: {} changes, AO setting at the end: {}\n{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
+            "governor {}: {} changes, AO setting at the end: {}\n{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
             self.governor_changes.len(),
             self.final_ao_setting,

@@ -46,15 +46,28 @@ fn without_source_location(message: String) -> String {
     }
 }
 
-/// Opens the window and runs the session until the headset ends it or the window closes.
-pub fn run_window(mut frame_loop: FrameLoop, scene: &Scene, options: WindowOptions) -> Result<RunSummary> {
-    frame_loop.buffer_view = options.show;
-    let event_loop = EventLoop::new().map_err(|e| {
+/// Connects to the desktop's display (winit's event loop, once per process): the check
+/// a session makes before it opens its headset, so that a machine without a display is
+/// refused at once (`Error::Unavailable`, one line), not after the runtime, session and
+/// pipelines were made.
+pub fn open_event_loop() -> Result<EventLoop<()>> {
+    EventLoop::new().map_err(|e| {
         Error::Unavailable(format!(
             "cannot open a desktop window ({}); without a display, run with --display none",
             without_source_location(e.to_string())
         ))
-    })?;
+    })
+}
+
+/// Opens the window on `event_loop` ([`open_event_loop`]) and runs the session until the
+/// headset ends it or the window closes.
+pub fn run_window(
+    event_loop: EventLoop<()>,
+    mut frame_loop: FrameLoop,
+    scene: &Scene,
+    options: WindowOptions,
+) -> Result<RunSummary> {
+    frame_loop.buffer_view = options.show;
     let mut app = WindowApp { frame_loop, scene: scene.clone(), options, window: None, error: None, finished: false };
     event_loop.run_app(&mut app).map_err(|e| {
         Error::Unavailable(format!("the window's event loop failed: {}", without_source_location(e.to_string())))

@@ -10,6 +10,29 @@ pub mod run;
 pub mod table;
 pub mod temporal;
 
+/// A flag that the first Ctrl-C (SIGINT) or SIGTERM sets, saying `first` on stderr, for
+/// the command to end cleanly; a second one runs `second` (its last cleaning up) and stops
+/// the process at once (130, as a shell reports an interrupted command).
+pub fn interrupt_on_signals(
+    first: &'static str,
+    second: impl Fn() + Send + 'static,
+) -> std::sync::Arc<std::sync::atomic::AtomicBool> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let interrupt = std::sync::Arc::new(AtomicBool::new(false));
+    let flag = interrupt.clone();
+    let installed = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            second();
+            std::process::exit(vrao::render::error::EXIT_INTERRUPTED);
+        }
+        eprintln!("interrupted: {first} (again to stop at once)");
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: Ctrl-C will stop vrao at once, without cleaning up: {e}");
+    }
+    interrupt
+}
+
 /// A clap value parser for a setting chosen by name ([`Choice`]): the engine and the
 /// renderer have no command line, so the CLI offers their settings' names itself.
 pub fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {

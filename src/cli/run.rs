@@ -3,9 +3,11 @@
 use super::{choice, AoArgs, OnOff, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-use vrao::app::{run_session, BufferView, HeadsetChoice, HeadsetError, RunOptions, SessionError, RUN_FRAMES_MAX};
+use vrao::app::{
+    refused_summary, run_session, BufferView, HeadsetChoice, HeadsetError, RunOptions, SessionError, RUN_FRAMES_MAX,
+};
 use vrao::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
 use vrao::render::settings::DisplayMode;
 use vrao::xr::simulated::motion::HeadMotion;
@@ -42,7 +44,9 @@ pub struct RunArgs {
     #[arg(long, default_value = "vive")]
     profile: String,
     /// Refresh rate in Hz of the simulated headset, 10..=500 (default: the profile's).
-    /// With OpenXR the runtime's display period sets the frame budget, frame by frame.
+    /// With OpenXR the display's rate sets the frame budget; the rate is asked of the
+    /// runtime only where it offers it (XR_FB_display_refresh_rate), else a warning says
+    /// it is not used.
     #[arg(long, allow_negative_numbers = true)]
     refresh: Option<f64>,
     /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
@@ -74,7 +78,8 @@ pub struct RunArgs {
     /// filter), depth or normals; the panel can change it.
     #[arg(long, default_value = "eyes", hide_possible_values = true)]
     show: BufferView,
-    /// Write the frame counters and per-pass medians to this JSON file.
+    /// Write the frame counters and per-pass medians to this JSON file (also when the
+    /// run is refused before it starts: `refused` then says why).
     #[arg(long)]
     report: Option<PathBuf>,
     #[command(flatten)]
@@ -111,7 +116,21 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         screenshot: args.screenshot,
         show: args.show,
     };
-    let summary = run_session(&scene, &settings, &options, interrupt).map_err(name_the_option)?;
+    let summary = match run_session(&scene, &settings, &options, interrupt) {
+        Ok(summary) => summary,
+        Err(error) => {
+            let refusal = error.is_refusal();
+            let error = name_the_option(error);
+            // A refused run still leaves its report, saying why, for whoever reads it.
+            if let (true, Some(path)) = (refusal, &args.report) {
+                let report = refused_summary(&options, &error.to_string());
+                if let Err(e) = vrao::formats::output::write_json(path, &report) {
+                    log::warn!("{e}");
+                }
+            }
+            return Err(error);
+        }
+    };
     println!("{}", summary.to_text());
     match &args.report {
         Some(path) => vrao::formats::output::write_json(path, &summary),
@@ -123,18 +142,7 @@ pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
 /// in whatever state it is (the summary and report are still written); a second one
 /// while it ends stops the process (130, as a shell reports an interrupted command).
 fn interrupt_on_ctrl_c() -> Arc<AtomicBool> {
-    let interrupt = Arc::new(AtomicBool::new(false));
-    let flag = interrupt.clone();
-    let installed = ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::Relaxed) {
-            std::process::exit(vrao::render::error::EXIT_INTERRUPTED);
-        }
-        eprintln!("interrupted: ending the session (again to stop at once)");
-    });
-    if let Err(e) = installed {
-        eprintln!("warning: Ctrl-C will stop vrao at once, without a summary: {e}");
-    }
-    interrupt
+    super::interrupt_on_signals("ending the session", || {})
 }
 
 /// The session's error with the command-line option that caused it named.

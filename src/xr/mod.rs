@@ -27,10 +27,104 @@ pub struct FrameRequest {
     /// False when the headset will not show this frame (OpenXR's shouldRender): the
     /// application submits without rendering.
     pub should_render: bool,
-    /// The display period this frame must fit (ms): OpenXR's predicted display period,
-    /// the simulated headset's refresh interval. The frame budget follows it frame by
-    /// frame; `None` while the headset has not said (the profile's rate stands).
+    /// The display period the headset predicts for this frame (ms): OpenXR's
+    /// predictedDisplayPeriod, the simulated headset's refresh interval. A runtime
+    /// stretches it to whole refreshes when the application's frames are late (Monado:
+    /// 100 ms on a 50 ms display), so it is not the budget: a period longer than
+    /// `refresh_period_ms` means missed refreshes. `None` while the headset has not said.
     pub display_period_ms: Option<f64>,
+    /// The display's refresh period (ms), the frame budget: the runtime's refresh rate
+    /// (XR_FB_display_refresh_rate) where it offers one, else the shortest predicted
+    /// display period so far ([`DisplayRate`]); the simulated headset's refresh interval.
+    /// `None` while unknown (the profile's rate stands).
+    pub refresh_period_ms: Option<f64>,
+}
+
+/// Refreshes of a display with period `refresh_ms` that a frame period of `period_ms`
+/// skips: the whole refreshes it spans beyond the first, rounded (a 100 ms period on a
+/// 50 ms display misses 1, 150 ms misses 2, 70 ms none: jitter, not a miss). 0 when
+/// either is not a positive finite number.
+pub fn missed_refreshes(period_ms: f64, refresh_ms: f64) -> u64 {
+    if !(period_ms.is_finite() && refresh_ms.is_finite() && period_ms > 0.0 && refresh_ms > 0.0) {
+        return 0;
+    }
+    ((period_ms / refresh_ms).round() as u64).saturating_sub(1)
+}
+
+/// The display's refresh period as a runtime tells it, and the refreshes missed between
+/// the frames it hands out. The refresh rate the runtime reports (XR_FB_display_refresh_rate)
+/// wins; without one, the shortest predicted display period seen so far stands for it,
+/// never a longer one (a runtime stretches its predicted period when frames are late).
+/// Pure bookkeeping: the OpenXR headset feeds it each frame's predicted display time and
+/// period.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DisplayRate {
+    /// The rate the runtime reports (Hz), when it has the extension.
+    reported_hz: Option<f64>,
+    /// The shortest predicted display period seen (ms).
+    shortest_ms: Option<f64>,
+    /// The previous frame's predicted display time (ns).
+    last_display_ns: Option<i64>,
+    /// Refreshes missed so far.
+    missed: u64,
+}
+
+impl DisplayRate {
+    /// No rate reported, no frame seen.
+    pub fn new() -> DisplayRate {
+        DisplayRate::default()
+    }
+
+    /// The refresh rate the runtime reports (at the start, and at each change event); a
+    /// rate that is not a positive finite number is ignored.
+    pub fn set_reported_hz(&mut self, hz: Option<f32>) {
+        if let Some(hz) = hz.map(f64::from).filter(|hz| hz.is_finite() && *hz > 0.0) {
+            self.reported_hz = Some(hz);
+        }
+    }
+
+    /// One frame the runtime handed out: its predicted display time and period (ns).
+    /// Returns the refreshes missed since the previous frame (the gap between their
+    /// display times in refreshes, beyond one).
+    pub fn frame(&mut self, display_time_ns: i64, predicted_period_ns: i64) -> u64 {
+        if predicted_period_ns > 0 {
+            let ms = predicted_period_ns as f64 / 1e6;
+            self.shortest_ms = Some(self.shortest_ms.map_or(ms, |s| s.min(ms)));
+        }
+        let missed = match (self.last_display_ns, self.period_ms()) {
+            (Some(last), Some(refresh_ms)) if display_time_ns > last => {
+                missed_refreshes((display_time_ns - last) as f64 / 1e6, refresh_ms)
+            }
+            _ => 0,
+        };
+        self.last_display_ns = Some(display_time_ns);
+        self.missed += missed;
+        missed
+    }
+
+    /// The display's refresh period (ms): the reported rate's, else the shortest
+    /// predicted period seen; `None` before either.
+    pub fn period_ms(&self) -> Option<f64> {
+        self.reported_hz.map(|hz| 1000.0 / hz).or(self.shortest_ms)
+    }
+
+    /// Refreshes missed between the frames seen so far.
+    pub fn missed(&self) -> u64 {
+        self.missed
+    }
+
+    /// Where [`DisplayRate::period_ms`] comes from, in words; `None` before it is known.
+    pub fn source(&self) -> Option<String> {
+        match (self.reported_hz, self.shortest_ms) {
+            (Some(hz), _) => Some(format!("the display's refresh rate, {hz} Hz (XR_FB_display_refresh_rate)")),
+            (None, Some(_)) => Some(
+                "the shortest display period the runtime predicted (xrWaitFrame; it offers no \
+                 XR_FB_display_refresh_rate)"
+                    .into(),
+            ),
+            (None, None) => None,
+        }
+    }
 }
 
 /// What the application hands to the headset: both eyes' colour and depth (2-layer
@@ -116,9 +210,15 @@ pub trait Headset {
     fn session_state(&self) -> String {
         "running".into()
     }
-    /// Where the display period of [`FrameRequest::display_period_ms`] comes from, for
-    /// the report (which rate governed the budget).
+    /// Where the budget, the display's refresh period ([`FrameRequest::refresh_period_ms`],
+    /// [`Headset::refresh_period_ms`]), comes from, for the report. Before the headset
+    /// knows it (an OpenXR runtime without XR_FB_display_refresh_rate before its first
+    /// frame) it says so: the profile's rate stands then.
     fn display_rate_source(&self) -> String;
+    /// The display's refresh period (ms) as far as the headset knows it now: an OpenXR
+    /// runtime's reported rate or shortest predicted period, the simulated headset's
+    /// refresh interval; `None` before it knows.
+    fn refresh_period_ms(&self) -> Option<f64>;
     /// What the OpenXR session did (`None` for headsets that are not OpenXR). An
     /// OpenXR headset that fell back to the simulated one still reports, with the loss.
     fn openxr_report(&self) -> Option<crate::xr::openxr::OpenXrReport> {
@@ -131,6 +231,50 @@ pub trait Headset {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn missed_refreshes_count_refreshes_of_the_display() {
+        assert_eq!(missed_refreshes(100.0, 50.0), 1, "a 100 ms period on a 50 ms display");
+        assert_eq!(missed_refreshes(150.0, 50.0), 2);
+        assert_eq!(missed_refreshes(50.0, 50.0), 0);
+        assert_eq!(missed_refreshes(70.0, 50.0), 0, "jitter rounds to none");
+        assert_eq!(missed_refreshes(16.0, 50.0), 0, "shorter than a refresh");
+        assert_eq!(missed_refreshes(f64::NAN, 50.0), 0);
+        assert_eq!(missed_refreshes(100.0, 0.0), 0);
+    }
+
+    #[test]
+    fn the_display_rate_is_the_reported_one_else_the_shortest_period_never_a_stretched_one() {
+        const MS: i64 = 1_000_000;
+        // Without XR_FB_display_refresh_rate: Monado-like, 50 ms, then stretched to 100 ms.
+        let mut rate = DisplayRate::new();
+        assert_eq!((rate.period_ms(), rate.source()), (None, None), "nothing before the first frame");
+        assert_eq!(rate.frame(1000 * MS, 50 * MS), 0);
+        assert_eq!(rate.period_ms(), Some(50.0));
+        assert_eq!(rate.frame(1050 * MS, 50 * MS), 0);
+        // Frames late: the runtime predicts 100 ms and displays 100 ms apart.
+        assert_eq!(rate.frame(1150 * MS, 100 * MS), 1, "100 ms on a 50 ms display: one refresh missed");
+        assert_eq!(rate.frame(1250 * MS, 100 * MS), 1);
+        assert_eq!(rate.frame(1400 * MS, 150 * MS), 2);
+        assert_eq!(rate.period_ms(), Some(50.0), "the stretched period never becomes the display's");
+        assert_eq!(rate.missed(), 4);
+        assert!(rate.source().unwrap().contains("shortest"), "{:?}", rate.source());
+        // A repeated or earlier display time misses nothing.
+        assert_eq!(rate.frame(1400 * MS, 50 * MS), 0);
+        // With the extension: its rate wins over a shorter predicted period (Monado's
+        // 16 ms before its first frames) and over a stretched one.
+        let mut rate = DisplayRate::new();
+        rate.set_reported_hz(Some(20.0));
+        assert_eq!(rate.period_ms(), Some(50.0), "known before the first frame");
+        assert_eq!(rate.frame(0, 16 * MS), 0);
+        assert_eq!(rate.frame(100 * MS, 100 * MS), 1);
+        assert_eq!(rate.period_ms(), Some(50.0));
+        assert!(rate.source().unwrap().contains("20 Hz (XR_FB_display_refresh_rate)"), "{:?}", rate.source());
+        rate.set_reported_hz(Some(0.0));
+        assert_eq!(rate.period_ms(), Some(50.0), "a rate of 0 is ignored");
+        rate.set_reported_hz(Some(40.0));
+        assert_eq!(rate.period_ms(), Some(25.0), "a change event moves it");
+    }
 
     #[test]
     fn latency_percentiles_interpolate_between_ranks() {

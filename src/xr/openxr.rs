@@ -160,12 +160,19 @@ pub struct OpenXrReport {
     pub empty_frames: u64,
     /// Frames the runtime told vrao not to render (shouldRender false).
     pub not_rendered: u64,
-    /// Display periods the runtime skipped between the frames it handed out, from the
-    /// gaps between successive predicted display times (OpenXR says nothing more about
-    /// late or dropped frames: the compositor's own counts are not visible to vrao).
+    /// Refreshes of the display the runtime skipped between the frames it handed out:
+    /// the gaps between successive predicted display times in refreshes of the display
+    /// (`refresh_period_ms`), beyond one; a 100 ms gap on a 50 ms display is 1 (OpenXR
+    /// says nothing more about late or dropped frames: the compositor's own counts are
+    /// not visible to vrao).
     pub missed_display_periods: u64,
-    /// The runtime's latest predicted display period (ms): the frame budget.
+    /// The runtime's latest predicted display period (ms). Not the budget: the runtime
+    /// stretches it to whole refreshes when frames are late.
     pub display_period_ms: f64,
+    /// The display's refresh period (ms), the frame budget: from the refresh rate the
+    /// runtime reports (XR_FB_display_refresh_rate), else the shortest predicted display
+    /// period seen; `None` before either.
+    pub refresh_period_ms: Option<f64>,
     /// The session state the run was interrupted in (Ctrl-C), if it was.
     pub interrupted_in: Option<String>,
     /// The display refresh rates the runtime offers (XR_FB_display_refresh_rate; empty
@@ -192,7 +199,8 @@ pub struct OpenXrOptions {
     /// starts where the scene's head pose is, facing its way.
     pub origin: HeadPose,
     /// Per-eye render and swapchain size; `None` takes the runtime's recommended size.
-    /// Clamped to the runtime's maximum.
+    /// A size above the runtime's maximum is scaled down to it with its aspect kept
+    /// ([`fit_within`]), with a warning naming both.
     pub size: Option<(u32, u32)>,
     /// End the session after this many rendered frames (submitted with an image):
     /// xrRequestExitSession, then STOPPING → xrEndSession → EXITING, and `wait_frame`
@@ -235,6 +243,21 @@ impl OpenXrOptions {
             interrupt: None,
         }
     }
+}
+
+/// `wanted` scaled down to fit within `max` with its aspect kept (each side rounded, at
+/// least 1); a size that fits is returned as it is. 4000×3000 within 1920×1080 is
+/// 1440×1080.
+pub fn fit_within(wanted: (u32, u32), max: (u32, u32)) -> (u32, u32) {
+    let (w, h) = (u64::from(wanted.0.max(1)), u64::from(wanted.1.max(1)));
+    let (max_w, max_h) = (u64::from(max.0.max(1)), u64::from(max.1.max(1)));
+    if w <= max_w && h <= max_h {
+        return (w as u32, h as u32);
+    }
+    // Whichever side is tighter sets the scale: w / max_w against h / max_h.
+    let (w, h) =
+        if w * max_h >= h * max_w { (max_w, (h * max_w + w / 2) / w) } else { ((w * max_h + h / 2) / h, max_h) };
+    (w.clamp(1, max_w) as u32, h.clamp(1, max_h) as u32)
 }
 
 /// `pose` with its pitch and roll removed (yaw about +Y kept).
@@ -461,6 +484,18 @@ mod tests {
             assert!(!t.contains('\n') && !t.contains("GPU"), "{t}");
         }
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_size_above_the_maximum_is_scaled_down_with_its_aspect_kept() {
+        assert_eq!(fit_within((4000, 3000), (1920, 1080)), (1440, 1080), "4:3 stays 4:3");
+        assert_eq!(fit_within((4000, 1000), (1920, 1080)), (1920, 480), "the width is the tighter side");
+        assert_eq!(fit_within((1920, 1080), (1920, 1080)), (1920, 1080));
+        assert_eq!(fit_within((320, 240), (1920, 1080)), (320, 240), "a size that fits is kept");
+        assert_eq!(fit_within((8192, 1), (1920, 1080)), (1920, 1), "never below one pixel");
+        assert_eq!(fit_within((3000, 3000), (1920, 1080)), (1080, 1080));
+        // Each side rounded: 2000 × 1080 / 1333 = 1620.4.
+        assert_eq!(fit_within((2000, 1333), (1920, 1080)), (1620, 1080));
     }
 
     #[test]

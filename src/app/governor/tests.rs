@@ -480,3 +480,106 @@ fn the_budget_and_the_level_follow_a_changing_display_period_within_one_frame() 
     assert!(!governor.set_period_ms(0.0) && !governor.set_period_ms(f64::NAN));
     assert_eq!(governor.config().period_ms, 1000.0 / 120.0);
 }
+
+/// A runtime that paces the application as Monado does: its predicted display period is
+/// the display's (`refresh_ms`) stretched to whole refreshes over the application's recent
+/// frame times (here the slowest of the last `window` frames that have finished, two
+/// frames back: a stretch outlasts the slow frames that caused it).
+fn stretched_period(refresh_ms: f64, frame_ms: &[f64], window: usize) -> f64 {
+    let done = frame_ms.len().saturating_sub(2);
+    let slowest = frame_ms[done.saturating_sub(window)..done].iter().copied().fold(0.0, f64::max);
+    refresh_ms * (slowest / refresh_ms).ceil().max(1.0)
+}
+
+/// A 20 Hz session (50 ms refreshes, as Monado's null compositor) on a device where the
+/// synthetic levels cost 32, 36.8, 43.2, 52.8 and 72 ms, starting at 36.8 ms, with two
+/// three-frame spikes (×1.6) in the first 200 frames and a steady load after them. The
+/// governor is fed each frame's GPU time two frames late. `follow_stretched`: the budget
+/// follows the runtime's predicted period, as it did before (the failure being tested);
+/// otherwise it is the display's 50 ms and the predicted period goes with each frame.
+fn paced_session(follow_stretched: bool) -> (Vec<GovernorChange>, Vec<usize>, Vec<f64>) {
+    const REFRESH_MS: f64 = 50.0;
+    let frontier = synthetic();
+    let script = Script { other_ms: 24.0, device_scale: 8.0, load: &|_| 1.0, ao_factor: &as_benched };
+    let mut governor = Governor::new(frontier.clone(), GovernorConfig::for_refresh_hz(20.0), 1).unwrap();
+    let (mut levels, mut frame_ms, mut periods) = (Vec::new(), Vec::new(), Vec::new());
+    let mut ao = Vec::new();
+    for frame in 0..600u64 {
+        if frame >= 2 {
+            let f = frame as usize - 2;
+            if follow_stretched {
+                governor.observe_with_ao(f as u64, frame_ms[f], ao[f]);
+            } else {
+                governor.observe_paced(f as u64, frame_ms[f], Some(ao[f]), Some(periods[f]));
+            }
+        }
+        let period = stretched_period(REFRESH_MS, &frame_ms, 48);
+        if follow_stretched {
+            governor.set_period_ms(period);
+        } else {
+            governor.set_period_ms(REFRESH_MS);
+        }
+        let spike = if (50..53).contains(&frame) || (150..153).contains(&frame) { 1.6 } else { 1.0 };
+        let (ms, ao_ms) = script.cost(&frontier, governor.level(), spike);
+        levels.push(governor.level());
+        frame_ms.push(ms);
+        ao.push(ao_ms);
+        periods.push(period);
+    }
+    (governor.changes().to_vec(), levels, frame_ms)
+}
+
+#[test]
+fn stretched_periods_never_let_a_raise_through_whose_prediction_exceeds_the_displays_period() {
+    // Before: judged against the 100 ms the runtime predicted once frames were late, the
+    // governor raised into 52.8 and 72 ms levels, slower than one 50 ms refresh, which
+    // kept the period stretched for good: the application at half rate (issue 39).
+    let (before, levels, _) = paced_session(true);
+    let over: Vec<&GovernorChange> = before.iter().filter(|c| c.predicted_ms.is_some_and(|p| p > 50.0)).collect();
+    assert!(!over.is_empty(), "the failure this test guards against: {before:#?}");
+    assert_eq!(*levels.last().unwrap(), 4, "stuck at 72 ms a frame: {before:#?}");
+    // Judged against the display's 50 ms: no raise predicts more than 90 % of it, each
+    // change says which period it was judged against, and the steady load settles.
+    let (changes, levels, frame_ms) = paced_session(false);
+    for change in &changes {
+        assert_eq!(change.period_ms, 50.0, "{change:?}");
+        if let Some(predicted) = change.predicted_ms {
+            assert!(predicted < 0.9 * 50.0, "a raise predicting {predicted} ms: {changes:#?}");
+        }
+    }
+    let raises = changes.iter().filter(|c| c.predicted_ms.is_some()).count();
+    assert!(raises >= 2, "it raises again after each spike: {changes:#?}");
+    assert!(changes.iter().all(|c| c.frame < 400), "no change in the last 200 frames: {changes:#?}");
+    assert!(levels[400..].iter().all(|&l| l == 1), "settled on the 36.8 ms level: {:?}", &levels[400..]);
+    assert!(frame_ms[400..].iter().all(|&ms| ms < 45.0), "every steady frame fits a refresh");
+}
+
+#[test]
+fn a_stretched_period_lowers_and_is_never_calm() {
+    let frontier = synthetic();
+    let top = frontier.top();
+    let config = GovernorConfig::for_refresh_hz(20.0);
+    let settle = config.stretch_settle_frames;
+    let mut g = Governor::new(frontier, config, top).unwrap();
+    // GPU times far under the 50 ms refresh, but the runtime predicts 100 ms: frames late.
+    let drop = g.observe_paced(0, 20.0, None, Some(100.0)).expect("a stretched period lowers");
+    assert_eq!(g.level(), top - 2);
+    assert_eq!(drop.reason, "display period 100.00 ms stretched over 2 refreshes of 50.00 ms (1 missed)");
+    assert_eq!((drop.period_ms, drop.predicted_ms), (50.0, None));
+    // Not again while the change has had no time to reach the runtime's pacing …
+    for frame in 1..=settle {
+        assert_eq!(g.observe_paced(frame, 20.0, None, Some(100.0)), None, "frame {frame}");
+    }
+    // … then again, while it stays stretched.
+    let again = g.observe_paced(settle + 1, 20.0, None, Some(150.0)).expect("still stretched: lower again");
+    assert!(again.reason.contains("over 3 refreshes of 50.00 ms (2 missed)"), "{}", again.reason);
+    assert_eq!(g.level(), 0);
+    // Calm GPU times at a stretched period never raise.
+    for frame in settle + 2..settle + 60 {
+        assert_eq!(g.observe_paced(frame, 10.0, None, Some(100.0)), None, "frame {frame}");
+    }
+    // Jitter (70 ms: 1.4 refreshes) is no missed refresh: the calm frames raise.
+    let raise = (settle + 60..settle + 80).find_map(|frame| g.observe_paced(frame, 10.0, None, Some(70.0)));
+    let raise = raise.expect("calm frames at the display's rate raise");
+    assert!(raise.predicted_ms.is_some_and(|p| p < 45.0), "{raise:?}");
+}

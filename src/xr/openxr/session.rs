@@ -27,7 +27,7 @@ use crate::render::error::{Error, Result};
 use crate::render::gpu::Gpu;
 use crate::render::stereo::{Eye, EyePair, EyeSide, Fov, HeadPose};
 use crate::xr::simulated::SimulatedHeadset;
-use crate::xr::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
+use crate::xr::{DisplayRate, FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use glam::{DQuat, DVec3, Quat, Vec3};
 use layer::{end_frame, Layer};
 use openxr as xr;
@@ -55,9 +55,10 @@ pub struct OpenXrStats {
     pub layers_with_depth: u64,
     /// Frames ended without a layer (not rendered, or run while the session stopped).
     pub empty_frames: u64,
-    /// Display periods the runtime skipped between frames it handed out: each gap
-    /// between successive predicted display times beyond one predicted display period
-    /// (rounded to whole periods). A missed frame of the application, as far as OpenXR
+    /// Refreshes of the display the runtime skipped between frames it handed out: each
+    /// gap between successive predicted display times beyond one refresh of the display
+    /// ([`DisplayRate`]: the reported refresh rate, else the shortest predicted period),
+    /// rounded to whole refreshes. A missed frame of the application, as far as OpenXR
     /// shows it; the compositor's own late or dropped frames are not visible.
     pub missed_display_periods: u64,
 }
@@ -111,8 +112,8 @@ pub struct OpenXrHeadset {
     tracking: Tracking,
     opened: Instant,
     fallback: Option<SimulatedHeadset>,
-    /// The previous frame's predicted display time, for the missed display periods.
-    last_display_time: Option<xr::Time>,
+    /// The display's refresh period (the budget) and the refreshes missed between frames.
+    display: DisplayRate,
     /// The runtime's latest predicted display period (ms), 0 before the first frame.
     display_period_ms: f64,
     /// XR_FB_display_refresh_rate: the rates offered and the latest one reported.
@@ -169,6 +170,7 @@ impl OpenXrHeadset {
             not_rendered: self.stats.not_rendered,
             missed_display_periods: self.stats.missed_display_periods,
             display_period_ms: self.display_period_ms,
+            refresh_period_ms: self.display.period_ms(),
             interrupted_in: self.machine.interrupted_in(),
             display_refresh_rates_hz: self.refresh_rates_hz.clone(),
             display_refresh_rate_hz: self.refresh_hz,
@@ -281,6 +283,7 @@ impl OpenXrHeadset {
         for (from, to) in refresh_changes {
             self.note(&format!("display refresh rate {from} Hz -> {to} Hz"));
             self.refresh_hz = Some(to);
+            self.display.set_reported_hz(Some(to));
         }
         for event in events {
             if let Event::State(phase) = &event {
@@ -319,12 +322,10 @@ impl OpenXrHeadset {
         let period_ns = state.predicted_display_period.as_nanos();
         if period_ns > 0 {
             self.display_period_ms = period_ns as f64 / 1e6;
-            if let Some(last) = self.last_display_time {
-                let gap_ns = state.predicted_display_time.as_nanos() - last.as_nanos();
-                self.stats.missed_display_periods += missed_periods(gap_ns, period_ns);
-            }
         }
-        self.last_display_time = Some(state.predicted_display_time);
+        // Missed refreshes of the display, not of the period the runtime predicts: that
+        // one stretches when frames are late (Monado: 100 ms on a 50 ms display).
+        self.stats.missed_display_periods += self.display.frame(state.predicted_display_time.as_nanos(), period_ns);
         if !render {
             // Leaving: until the runtime says STOPPING the session still runs frames;
             // they show nothing new.
@@ -361,8 +362,10 @@ impl OpenXrHeadset {
         Ok(Some(FrameRequest {
             index,
             display_time: state.predicted_display_time.as_nanos() as f64 / 1e9,
-            // The runtime's period is the budget; before it gives one, the profile's.
+            // The display's refresh period is the budget (before it is known, the
+            // profile's); the predicted period says whether frames were late.
             display_period_ms: (self.display_period_ms > 0.0).then_some(self.display_period_ms),
+            refresh_period_ms: self.display.period_ms(),
             eyes: self.eye_pair(&views),
             size: self.recommended_size(),
             should_render: state.should_render,
@@ -470,17 +473,6 @@ impl OpenXrHeadset {
             log::warn!("OpenXR: ending the session: {why}");
         }
     }
-}
-
-/// Display periods skipped between two successive frames whose predicted display times
-/// are `gap_ns` apart, at a predicted display period of `period_ns`: the whole periods
-/// beyond the first (a gap of 1.4 periods rounds to none missed, 2.6 to two).
-pub(crate) fn missed_periods(gap_ns: i64, period_ns: i64) -> u64 {
-    if gap_ns <= 0 || period_ns <= 0 {
-        return 0;
-    }
-    let periods = (gap_ns as f64 / period_ns as f64).round() as u64;
-    periods.saturating_sub(1)
 }
 
 /// The session state an XrSessionState names (`None`: one OpenXR 1.0 does not define).
@@ -611,9 +603,25 @@ impl Headset for OpenXrHeadset {
     }
 
     fn display_rate_source(&self) -> String {
+        match (&self.fallback, self.display.source()) {
+            (Some(simulated), _) => format!("{} (after the OpenXR session was lost)", simulated.display_rate_source()),
+            (None, Some(source)) => format!("the OpenXR runtime: {source}"),
+            (None, None) => {
+                let profile = self.options.fallback.as_ref().map(|s| &s.profile);
+                let rate = match (profile, self.options.preferred_refresh_hz) {
+                    (Some(p), _) => format!("the '{}' profile's {} Hz", p.name, p.refresh_hz),
+                    (None, Some(hz)) => format!("the profile's {hz} Hz"),
+                    (None, None) => "the profile's rate".into(),
+                };
+                format!("{rate} (no frame from the runtime yet, and it reports no refresh rate)")
+            }
+        }
+    }
+
+    fn refresh_period_ms(&self) -> Option<f64> {
         match &self.fallback {
-            Some(simulated) => format!("{} (after the OpenXR session was lost)", simulated.display_rate_source()),
-            None => "the OpenXR runtime's predicted display period (xrWaitFrame), frame by frame".into(),
+            Some(simulated) => simulated.refresh_period_ms(),
+            None => self.display.period_ms(),
         }
     }
 

@@ -351,6 +351,7 @@ impl Headset for SimulatedHeadset {
             size: self.recommended_size(),
             should_render: true,
             display_period_ms: Some(self.options.profile.budget_ms()),
+            refresh_period_ms: Some(self.options.profile.budget_ms()),
         };
         self.next_frame += 1;
         Ok(Some(request))
@@ -418,6 +419,10 @@ impl Headset for SimulatedHeadset {
     fn display_rate_source(&self) -> String {
         let p = &self.options.profile;
         format!("the simulated headset's refresh rate ({} Hz, profile '{}' or --refresh)", p.refresh_hz, p.name)
+    }
+
+    fn refresh_period_ms(&self) -> Option<f64> {
+        Some(self.options.profile.budget_ms())
     }
 
     fn request_exit(&mut self) {

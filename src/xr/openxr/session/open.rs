@@ -54,7 +54,11 @@ impl OpenXrHeadset {
             tracking: Tracking::default(),
             opened: Instant::now(),
             fallback: None,
-            last_display_time: None,
+            display: {
+                let mut display = crate::xr::DisplayRate::new();
+                display.set_reported_hz(refresh_hz);
+                display
+            },
             refresh_rates_hz,
             refresh_hz,
             display_period_ms: 0.0,
@@ -127,7 +131,8 @@ fn stereo_views(
 }
 
 /// The per-eye size the views recommend and the one to render at: `wanted` (else the
-/// recommended one) within the views' maximum.
+/// recommended one), scaled down to the views' maximum with its aspect kept (one warning
+/// line naming the request and the limit).
 fn eye_sizes(views: &[xr::ViewConfigurationView], wanted: Option<(u32, u32)>) -> ((u32, u32), (u32, u32)) {
     // One size for both eyes (vrao renders them as two layers of one target).
     let recommended = (
@@ -139,7 +144,18 @@ fn eye_sizes(views: &[xr::ViewConfigurationView], wanted: Option<(u32, u32)>) ->
         views.iter().map(|v| v.max_image_rect_height).min().unwrap_or(0).max(1),
     );
     let wanted = wanted.unwrap_or(recommended);
-    let size = (wanted.0.clamp(1, max.0), wanted.1.clamp(1, max.1));
+    let size = super::super::fit_within(wanted, max);
+    if size != wanted {
+        log::warn!(
+            "OpenXR: {}x{} per eye is above the runtime's maximum {}x{}: rendering at {}x{} (aspect kept)",
+            wanted.0,
+            wanted.1,
+            max.0,
+            max.1,
+            size.0,
+            size.1
+        );
+    }
     (recommended, size)
 }
 

@@ -105,18 +105,6 @@ fn tracking_before_any_valid_pose_uses_the_default_views() {
 }
 
 #[test]
-fn missed_display_periods_come_from_gaps_between_predicted_display_times() {
-    let period = 11_111_111;
-    assert_eq!(missed_periods(period, period), 0, "the next period: none missed");
-    assert_eq!(missed_periods(period * 14 / 10, period), 0, "jitter rounds to none");
-    assert_eq!(missed_periods(period * 2, period), 1);
-    assert_eq!(missed_periods(period * 26 / 10, period), 2);
-    assert_eq!(missed_periods(0, period), 0, "a repeated time");
-    assert_eq!(missed_periods(-period, period), 0, "a time going back");
-    assert_eq!(missed_periods(period, 0), 0, "no period given");
-}
-
-#[test]
 fn failed_calls_name_the_call_and_the_xr_result() {
     let text = crate::xr::openxr::xr_call_failed("xrReleaseSwapchainImage", xr::sys::Result::ERROR_INSTANCE_LOST);
     assert!(text.starts_with("xrReleaseSwapchainImage: XR_ERROR_INSTANCE_LOST ("), "{text}");
