@@ -704,3 +704,124 @@ fn negative_numbers_are_values_refused_by_their_range_and_the_bench_refuses_dupl
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("techniques name ssao twice"), "{stderr}");
 }
+
+#[test]
+fn a_window_without_a_display_is_refused_before_the_headset_opens_and_the_report_says_why() {
+    // Issue 39: refused only after the runtime, session, swapchains and pipelines were
+    // made (2.2 s), and no report written.
+    let dir = temp_dir("no-display");
+    for headset in ["simulated", "openxr"] {
+        let report = dir.join(format!("{headset}.json"));
+        let started = std::time::Instant::now();
+        let out = Command::new(env!("CARGO_BIN_EXE_vrao"))
+            .args([
+                "run",
+                "--headset",
+                headset,
+                "--display",
+                "mirror",
+                "--frames",
+                "2",
+                "--width",
+                "8",
+                "--height",
+                "8",
+            ])
+            .args(["--report", report.to_str().unwrap()])
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("WAYLAND_SOCKET")
+            // No runtime either: the window is what is named, so it was checked first.
+            .env("XR_RUNTIME_JSON", dir.join("no-runtime.json"))
+            .output()
+            .unwrap();
+        let t = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{headset}: {t}");
+        let errors = error_lines(&out);
+        assert_eq!(errors.len(), 1, "{headset}: {t}");
+        assert!(errors[0].contains("cannot open a desktop window") && errors[0].contains("--display none"), "{t}");
+        assert!(!t.contains("headset:") && !t.contains("OpenXR"), "{headset}: nothing was opened first: {t}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(10), "{headset}: {:?}", started.elapsed());
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert!(json["refused"].as_str().unwrap().contains("cannot open a desktop window"), "{json}");
+        assert_eq!(json["frames_rendered"], 0, "{json}");
+        assert!((json["budget_ms"].as_f64().unwrap() - 1000.0 / 90.0).abs() < 1e-9, "the vive profile's: {json}");
+    }
+    // A run that starts writes no `refused`.
+    let report = dir.join("ran.json");
+    let out = vrao(&[
+        "run",
+        "--headset",
+        "simulated",
+        "--display",
+        "none",
+        "--frames",
+        "2",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(json["refused"].is_null() && json["stretched_frames"] == 0, "{json}");
+    assert!(json["budget_source"].as_str().unwrap().contains("simulated headset"), "{json}");
+}
+
+#[test]
+fn an_interrupted_render_leaves_nothing_behind() {
+    // Issue 39: a render interrupted by Ctrl-C left an empty output folder.
+    let dir = temp_dir("render-interrupted");
+    for (signal, after_ms) in [("INT", 1500), ("TERM", 4000), ("INT", 6000)] {
+        let out_dir = dir.join(format!("{signal}-{after_ms}")).join("nested");
+        let child = Command::new(env!("CARGO_BIN_EXE_vrao"))
+            .args(["render", "--width", "64", "--height", "64", "--frames", "100000", "--debug"])
+            .args(["--out", out_dir.to_str().unwrap()])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(after_ms));
+        let sent = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+        assert!(sent.success());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(130), "SIG{signal} at {after_ms} ms: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(!out_dir.parent().unwrap().exists(), "SIG{signal} at {after_ms} ms left {}", out_dir.display());
+    }
+    // While the files are written: once the first file appears, one signal (the render
+    // stops and removes what it wrote) or two (the second removes it and exits at once).
+    for signals in [1, 2] {
+        let out_dir = dir.join(format!("writing-{signals}")).join("nested");
+        let child = Command::new(env!("CARGO_BIN_EXE_vrao"))
+            .args(["render", "--width", "768", "--height", "768", "--debug"])
+            .args(["--out", out_dir.to_str().unwrap()])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = std::time::Instant::now();
+        while !out_dir.join("left.png").exists() && started.elapsed() < std::time::Duration::from_secs(120) {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        for _ in 0..signals {
+            Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        if out.status.code() == Some(0) {
+            // Done before the signal landed: then every file is whole.
+            eprintln!("{signals} signal(s) came after the render finished: {stderr}");
+            assert!(image::open(out_dir.join("albedo_right.png")).is_ok());
+            std::fs::remove_dir_all(out_dir.parent().unwrap()).unwrap();
+            continue;
+        }
+        assert_eq!(out.status.code(), Some(130), "{signals} signal(s) while writing: {stderr}");
+        assert!(!out_dir.parent().unwrap().exists(), "{signals} signal(s) while writing left {}", out_dir.display());
+    }
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing in {}", dir.display());
+}

@@ -4,6 +4,7 @@ use super::{choice, parse_vec3, AoArgs, SCENE_HELP};
 use clap::Args;
 use glam::DVec3;
 use std::path::PathBuf;
+use vrao::formats::output::OutputTrail;
 use vrao::formats::still::{render_still, StillOptions};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::HeadPath;
@@ -88,6 +89,11 @@ pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         scene.head = HeadPath::fixed(pose);
     }
     let settings = args.settings(&scene);
+    // Ctrl-C or SIGTERM stops the render and takes away what it wrote (a second one
+    // while it does so removes it at once): an interrupted render leaves nothing behind.
+    let trail = OutputTrail::new();
+    let cleanup = trail.clone();
+    let interrupt = super::interrupt_on_signals("stopping; what was written is removed", move || cleanup.remove_all());
     let options = StillOptions {
         backend,
         timing: args.timing,
@@ -95,6 +101,7 @@ pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         debug: args.debug,
         out: args.out,
         time: args.time,
+        trail: trail.interruptible(interrupt),
     };
     let still = render_still(&scene, &settings, &options)?;
     println!("{}", still.summary);

@@ -8,6 +8,8 @@ use crate::render::passes::tonemap::COLOR;
 use crate::render::renderer::Renderer;
 use crate::render::settings::{Settings, Technique};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// File-name parts of layer 0 and layer 1, in that order.
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
@@ -83,19 +85,135 @@ pub fn outputs(settings: &Settings, debug: bool) -> Vec<Resource> {
     outputs
 }
 
+/// What a command has put on disk for its output so far (the folders it created, the
+/// files it wrote), so that an interrupted command can take it all away again and leave
+/// nothing behind. Clones share one trail: a Ctrl-C handler holds one while the writer
+/// records into another.
+#[derive(Clone, Debug, Default)]
+pub struct OutputTrail {
+    inner: Arc<Mutex<Trail>>,
+    /// The caller's cancellation token: once set, nothing more is made.
+    interrupt: Option<Arc<AtomicBool>>,
+}
+
+#[derive(Debug, Default)]
+struct Trail {
+    /// Folders created and files written, in order.
+    made: Vec<PathBuf>,
+    /// Removed: nothing more may be written.
+    closed: bool,
+}
+
+impl OutputTrail {
+    /// A trail with nothing on it.
+    pub fn new() -> OutputTrail {
+        OutputTrail::default()
+    }
+
+    /// A trail that makes nothing more (`Error::Interrupted`) once `interrupt` is set.
+    pub fn interrupted_by(interrupt: Arc<AtomicBool>) -> OutputTrail {
+        OutputTrail::new().interruptible(interrupt)
+    }
+
+    /// This trail (its clones share what it records) with `interrupt` as its
+    /// cancellation token.
+    pub fn interruptible(self, interrupt: Arc<AtomicBool>) -> OutputTrail {
+        OutputTrail { interrupt: Some(interrupt), ..self }
+    }
+
+    /// The trail's cancellation token, if it has one.
+    pub fn interrupt_flag(&self) -> Option<Arc<AtomicBool>> {
+        self.interrupt.clone()
+    }
+
+    /// Whether the trail's cancellation token is set.
+    pub fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(|flag| flag.load(Ordering::Relaxed))
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Trail> {
+        self.inner.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// The trail, locked, unless it is closed or interrupted.
+    fn open(&self) -> Result<MutexGuard<'_, Trail>> {
+        let trail = self.lock();
+        if trail.closed || self.interrupted() {
+            return Err(Error::Interrupted);
+        }
+        Ok(trail)
+    }
+
+    /// Creates the folder `dir` and its missing parents, recording each one created.
+    pub fn create_dir_all(&self, dir: &Path) -> Result<()> {
+        let mut trail = self.open()?;
+        let mut missing = Vec::new();
+        let mut next = Some(dir);
+        while let Some(d) = next.filter(|d| !d.as_os_str().is_empty() && std::fs::symlink_metadata(d).is_err()) {
+            missing.push(d.to_path_buf());
+            next = d.parent();
+        }
+        for d in missing.into_iter().rev() {
+            match std::fs::create_dir(&d) {
+                Ok(()) => trail.made.push(d),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && d.is_dir() => {}
+                Err(e) => return Err(Error::Output { path: d, message: format!("cannot create this directory: {e}") }),
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the file `path` with `write`, recorded before it is made and with the
+    /// trail held meanwhile, so that [`OutputTrail::remove_all`] never misses a file
+    /// half written. After `remove_all`, or once interrupted, nothing is written
+    /// (`Error::Interrupted`).
+    pub fn write_file(&self, path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+        let mut trail = self.open()?;
+        trail.made.push(path.to_path_buf());
+        write(path)
+    }
+
+    /// Removes every file written and folder created, newest first (a folder only once
+    /// empty: what others put there stays), and closes the trail to further writes.
+    /// Waits for a file being written to be done first.
+    pub fn remove_all(&self) {
+        let mut trail = self.lock();
+        trail.closed = true;
+        for path in std::mem::take(&mut trail.made).into_iter().rev() {
+            match std::fs::symlink_metadata(&path) {
+                Ok(meta) if meta.is_dir() => drop(std::fs::remove_dir(&path)),
+                Ok(_) => drop(std::fs::remove_file(&path)),
+                Err(_) => {}
+            }
+        }
+    }
+
+    /// What is on the trail, in the order it was made.
+    pub fn made(&self) -> Vec<PathBuf> {
+        self.lock().made.clone()
+    }
+}
+
 /// Writes `left.png` and `right.png` (or `mono.png` for one view) and, when a technique
 /// ran, the final AO as grey beside them (`ao_left.png`, `ao_right.png`): the picture of
 /// what the technique adds. With `debug` also the depth, normals, albedo and raw AO of
-/// each view. Returns the files written.
-pub fn write_images(renderer: &Renderer, out: &Path, views: usize, debug: bool) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::Output { path: out.into(), message: e.to_string() })?;
+/// each view. Returns the files written. `trail` records the folder it creates and each
+/// file, so that an interrupted command can remove them again.
+pub fn write_images(
+    renderer: &Renderer,
+    out: &Path,
+    views: usize,
+    debug: bool,
+    trail: &OutputTrail,
+) -> Result<Vec<PathBuf>> {
+    trail.create_dir_all(out)?;
     let settings = renderer.settings();
     let (w, h) = (settings.profile.width, settings.profile.height);
     let names: &[&str] = if views == 2 { &EYE_NAMES } else { &["mono"] };
     let mut written = Vec::new();
     let mut save_sized = |name: String, (w, h): (u32, u32), rgba: Vec<u8>| -> Result<()> {
         let path = out.join(name);
-        save_rgba(&path, w, h, rgba)?;
+        trail.write_file(&path, |path| save_rgba(path, w, h, rgba))?;
         written.push(path);
         Ok(())
     };
@@ -197,5 +315,46 @@ pub fn significant(x: f64, digits: i32) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_output_trail_removes_what_it_made_and_nothing_else() {
+        let root = std::env::temp_dir().join(format!("vrao-trail-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        std::fs::create_dir_all(&root).unwrap();
+        std::fs::write(root.join("theirs.txt"), "kept").unwrap();
+        let trail = OutputTrail::new();
+        let out = root.join("a/b");
+        trail.create_dir_all(&out).unwrap();
+        trail.create_dir_all(&out).unwrap();
+        for name in ["left.png", "right.png"] {
+            trail
+                .write_file(&out.join(name), |p| std::fs::write(p, "x").map_err(|e| Error::Gpu(e.to_string())))
+                .unwrap();
+        }
+        assert_eq!(trail.made(), [root.join("a"), out.clone(), out.join("left.png"), out.join("right.png")]);
+        // A clone (the Ctrl-C handler's) removes it all, newest first, and closes the trail.
+        trail.clone().remove_all();
+        assert!(!root.join("a").exists(), "the folders it created are gone");
+        assert!(root.join("theirs.txt").is_file(), "what was there before stays");
+        let late = trail.write_file(&root.join("late.png"), |_| panic!("nothing is written after removal"));
+        assert!(matches!(late, Err(Error::Interrupted)));
+        // A folder something else wrote into stays.
+        let trail = OutputTrail::new();
+        trail.create_dir_all(&root.join("c")).unwrap();
+        std::fs::write(root.join("c/other.txt"), "not the trail's").unwrap();
+        trail.remove_all();
+        assert!(root.join("c/other.txt").is_file());
+        // Interrupted: nothing is made at all.
+        let flag = Arc::new(AtomicBool::new(true));
+        let trail = OutputTrail::interrupted_by(flag);
+        assert!(matches!(trail.create_dir_all(&root.join("d")), Err(Error::Interrupted)));
+        assert!(!root.join("d").exists());
+        std::fs::remove_dir_all(&root).unwrap();
     }
 }

@@ -1,6 +1,7 @@
 //! One stereo frame written as PNG files, optionally rendered several times to time its
 //! passes: what `vrao render` does, reachable from the library.
 
+use crate::formats::output::OutputTrail;
 use crate::render::error::{Error, Result};
 use crate::render::gpu::{BackendChoice, Gpu};
 use crate::render::renderer::{Renderer, TimingChoice};
@@ -27,6 +28,11 @@ pub struct StillOptions {
     /// Scene time in seconds: where the head (on a scripted path) and the animated
     /// objects are.
     pub time: f64,
+    /// Records the folder and files written. When its cancellation token
+    /// ([`OutputTrail::interrupted_by`], the caller's Ctrl-C) is set, the render stops
+    /// (between frames, pipeline builds, files) and returns `Error::Interrupted` with
+    /// everything it wrote removed again.
+    pub trail: OutputTrail,
 }
 
 /// What [`render_still`] did.
@@ -41,18 +47,29 @@ pub struct Still {
 }
 
 /// Renders `scene` from its head pose at `options.time` and writes `left.png` and `right.png`
-/// (and with `debug` the buffers behind them) into `options.out`.
+/// (and with `debug` the buffers behind them) into `options.out`. The folder is made only
+/// once the frames are rendered; a failure or an interrupt removes whatever was written,
+/// so nothing is left behind.
 pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) -> Result<Still> {
+    let result = render_and_write(scene, settings, options);
+    if result.is_err() {
+        options.trail.remove_all();
+    }
+    result
+}
+
+fn render_and_write(scene: &Scene, settings: &Settings, options: &StillOptions) -> Result<Still> {
     settings.validate()?;
-    // An unwritable directory fails before the GPU starts; a refused adapter or scene
-    // (a texture too large for it) leaves no empty folder behind.
+    // An unwritable directory fails before the GPU starts.
     crate::formats::output::check_output_folder(&options.out)?;
+    let interrupted = || if options.trail.interrupted() { Err(Error::Interrupted) } else { Ok(()) };
     let gpu = Arc::new(Gpu::new(options.backend)?);
+    if let Some(flag) = options.trail.interrupt_flag() {
+        // An interrupt cuts the pipeline builds short (Renderer::new: Error::Interrupted).
+        gpu.cancel_builds_on(flag);
+    }
+    interrupted()?;
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
-    std::fs::create_dir_all(&options.out).map_err(|e| Error::Output {
-        path: options.out.clone(),
-        message: format!("cannot create this directory: {e}"),
-    })?;
     renderer.set_timing(options.timing.resolve(&gpu));
     renderer.set_scene_time(options.time);
     let eyes = settings.profile.eyes(&scene.head.pose_at(options.time), settings.near);
@@ -63,6 +80,7 @@ pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) 
     let mut timings = Vec::new();
     let mut report = None;
     for frame in 0..warmup + frames {
+        interrupted()?;
         let r = renderer.render_and_wait(&eyes.eyes, &outputs)?;
         if frame >= warmup {
             let mut spans = r.gpu_ms.clone();
@@ -73,7 +91,7 @@ pub fn render_still(scene: &Scene, settings: &Settings, options: &StillOptions) 
         report = Some(r);
     }
     let report = report.expect("at least one frame");
-    let written = crate::formats::output::write_images(&renderer, &options.out, 2, options.debug)?;
+    let written = crate::formats::output::write_images(&renderer, &options.out, 2, options.debug, &options.trail)?;
     let adapter = &gpu.info;
     let summary = format!(
         "rendered '{}' ({} triangles) on {}: {}x{} per eye, {} G-buffer, {} N={} r={} m{}",
