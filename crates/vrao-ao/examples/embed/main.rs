@@ -4,8 +4,12 @@
 //! both eyes and writes it as `OUT/embed_ao_left.png` and `OUT/embed_ao_right.png`.
 //!
 //! ```text
-//! cargo run --release --example embed [OUT] [--standard-depth] [--no-normals] [--time]
+//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--time] [--time-setup]
 //! ```
+//!
+//! The command line is handled like vrao's: `--help` prints the usage and exits 0; an
+//! unknown option or a second folder is one line naming it and exit 2, as is a folder
+//! that cannot be written (named); any other failure exits 1.
 //!
 //! `--standard-depth` stores depth as `Depth24Plus` with a finite far plane instead of
 //! reversed-Z `Depth32Float`; `--no-normals` lets the engine rebuild normals from depth.
@@ -25,26 +29,138 @@ use vrao_ao::settings::AoSettings;
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 360;
 
-fn main() -> std::process::ExitCode {
-    match run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            std::process::ExitCode::FAILURE
+const USAGE: &str = "\
+vrao's AO engine inside a host's own wgpu renderer: writes OUT/embed_ao_left.png and OUT/embed_ao_right.png
+
+Usage: embed [OUT] [OPTIONS]
+
+Arguments:
+  [OUT]             folder for the PNG files (default: out)
+
+Options:
+  --standard-depth  Depth24Plus with a finite far plane instead of reversed-Z Depth32Float
+  --no-normals      let the engine rebuild normals from depth
+  --time            also time whole frames at 1080x1200 per eye (host prepass alone and with the engine)
+  --time-setup      also time AoEngine::new, the first frame, a resize and the frame after it
+  -h, --help        print this and exit
+";
+
+/// What the command line asks for.
+#[derive(Clone, Debug, PartialEq)]
+struct Args {
+    out: std::path::PathBuf,
+    standard_depth: bool,
+    no_normals: bool,
+    time: bool,
+    time_setup: bool,
+}
+
+/// What [`parse_args`] found instead of a run.
+#[derive(Debug, PartialEq)]
+enum Parsed {
+    Run(Args),
+    Help,
+}
+
+/// Why the program stopped: a usage or output problem (exit 2, as vrao's command line
+/// exits on bad input) or a failure of the run (exit 1).
+#[derive(Debug)]
+enum Failure {
+    Usage(String),
+    Output { path: std::path::PathBuf, message: String },
+    Run(Box<dyn std::error::Error>),
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Failure::Usage(message) => write!(f, "{message} (see --help)"),
+            Failure::Output { path, message } => write!(f, "{}: {message}", path.display()),
+            Failure::Run(e) => write!(f, "{e}"),
         }
     }
 }
 
-fn run() -> Result<(), Box<dyn std::error::Error>> {
+impl<E: Into<Box<dyn std::error::Error>>> From<E> for Failure {
+    fn from(e: E) -> Failure {
+        Failure::Run(e.into())
+    }
+}
+
+/// The command line (without the program's name), or the one line that refuses it.
+fn parse_args(args: &[String]) -> Result<Parsed, String> {
+    let mut parsed =
+        Args { out: "out".into(), standard_depth: false, no_normals: false, time: false, time_setup: false };
+    let mut out: Option<&str> = None;
+    for arg in args {
+        match arg.as_str() {
+            "-h" | "--help" => return Ok(Parsed::Help),
+            "--standard-depth" => parsed.standard_depth = true,
+            "--no-normals" => parsed.no_normals = true,
+            "--time" => parsed.time = true,
+            "--time-setup" => parsed.time_setup = true,
+            // "--" ends the options: what follows is the folder.
+            flag if flag.starts_with('-') && flag != "-" => {
+                let name = flag.split_once('=').map_or(flag, |(name, _)| name);
+                return Err(match name {
+                    "--standard-depth" | "--no-normals" | "--time" | "--time-setup" => {
+                        format!("{name} takes no value: '{flag}'")
+                    }
+                    _ => format!("unknown option '{flag}'"),
+                });
+            }
+            "" => return Err("the output folder is an empty name".into()),
+            folder => match out {
+                None => out = Some(folder),
+                Some(first) => return Err(format!("a second output folder '{folder}' (the first is '{first}')")),
+            },
+        }
+    }
+    if let Some(out) = out {
+        parsed.out = out.into();
+    }
+    Ok(Parsed::Run(parsed))
+}
+
+fn main() -> std::process::ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let out = std::path::PathBuf::from(args.iter().find(|a| !a.starts_with("--")).map_or("out", |s| s.as_str()));
-    let depth_kind = if args.iter().any(|a| a == "--standard-depth") {
-        HostDepth::StandardFinite { far: 50.0 }
-    } else {
-        HostDepth::ReversedInfinite
+    let args = match parse_args(&args) {
+        Ok(Parsed::Run(args)) => args,
+        Ok(Parsed::Help) => {
+            print!("{USAGE}");
+            return std::process::ExitCode::SUCCESS;
+        }
+        Err(message) => return fail(Failure::Usage(message)),
     };
-    let with_normals = !args.iter().any(|a| a == "--no-normals");
-    std::fs::create_dir_all(&out)?;
+    match run(&args) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(failure) => fail(failure),
+    }
+}
+
+/// Prints the failure in one line and gives its exit code.
+fn fail(failure: Failure) -> std::process::ExitCode {
+    eprintln!("error: {failure}");
+    match failure {
+        Failure::Usage(_) | Failure::Output { .. } => std::process::ExitCode::from(2),
+        Failure::Run(_) => std::process::ExitCode::FAILURE,
+    }
+}
+
+/// Writes a grey PNG, naming `path` in its error.
+fn save_grey(path: &std::path::Path, width: u32, height: u32, pixels: Vec<u8>) -> Result<(), Failure> {
+    let output = |message: String| Failure::Output { path: path.to_path_buf(), message };
+    let image = image::GrayImage::from_raw(width, height, pixels).ok_or_else(|| output("image size".into()))?;
+    image.save(path).map_err(|e| output(format!("cannot write: {e}")))
+}
+
+fn run(args: &Args) -> Result<(), Failure> {
+    let out = &args.out;
+    let depth_kind =
+        if args.standard_depth { HostDepth::StandardFinite { far: 50.0 } } else { HostDepth::ReversedInfinite };
+    let with_normals = !args.no_normals;
+    std::fs::create_dir_all(out)
+        .map_err(|e| Failure::Output { path: out.clone(), message: format!("cannot create this folder: {e}") })?;
 
     // The host's own device: any adapter with Vulkan (or Metal, DX12) and compute.
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
@@ -86,10 +202,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
     let ao = engine.record(&mut encoder, &frame)?.texture.clone();
     queue.submit([encoder.finish()]);
-    if args.iter().any(|a| a == "--time") {
+    if args.time {
         time_frames(&device, &queue, depth_kind, convention)?;
     }
-    if args.iter().any(|a| a == "--time-setup") {
+    if args.time_setup {
         time_setup(&device, &queue, &prepass, &views, convention)?;
     }
     if let Some(plan) = engine.last_plan() {
@@ -107,7 +223,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         }
         let pixels: Vec<u8> = alpha.iter().map(|a| (a * 255.0).round() as u8).collect();
         let path = out.join(format!("embed_ao_{name}.png"));
-        image::GrayImage::from_raw(WIDTH, HEIGHT, pixels).ok_or("image size")?.save(&path)?;
+        save_grey(&path, WIDTH, HEIGHT, pixels)?;
         eprintln!("{name} eye: mean AO {mean:.3} -> {}", path.display());
     }
     Ok(())
@@ -220,4 +336,44 @@ fn time_frames(
         eprintln!("{label}: {:.2} ms per eye (median of {ROUNDS})", samples[ROUNDS / 2] / 2.0);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(line: &str) -> Result<Parsed, String> {
+        parse_args(&line.split_whitespace().map(String::from).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn the_command_line_is_handled_like_vraos() {
+        let Ok(Parsed::Run(args)) = parse("") else { panic!("no arguments run with the defaults") };
+        assert_eq!(args.out, std::path::PathBuf::from("out"));
+        let Ok(Parsed::Run(args)) = parse("dir --no-normals --standard-depth --time --time-setup") else { panic!() };
+        assert_eq!(
+            args,
+            Args { out: "dir".into(), standard_depth: true, no_normals: true, time: true, time_setup: true }
+        );
+        // --help anywhere prints the usage and renders nothing.
+        assert_eq!(parse("--help"), Ok(Parsed::Help));
+        assert_eq!(parse("dir -h --bogus"), Ok(Parsed::Help));
+        assert_eq!(parse("--bogus -h"), Err("unknown option '--bogus'".into()), "in order, as clap reads them");
+        // One line naming what is wrong.
+        assert_eq!(parse("--bogus"), Err("unknown option '--bogus'".into()));
+        assert_eq!(parse("-x"), Err("unknown option '-x'".into()));
+        assert_eq!(parse("--time=5"), Err("--time takes no value: '--time=5'".into()));
+        assert_eq!(parse("a b"), Err("a second output folder 'b' (the first is 'a')".into()));
+        assert!(USAGE.contains("--standard-depth") && USAGE.contains("--help"));
+    }
+
+    #[test]
+    fn a_write_error_names_the_path_and_exits_2() {
+        let path = std::path::Path::new("/proc/no-such-folder/embed_ao_left.png");
+        let failure = save_grey(path, 2, 2, vec![0; 4]).unwrap_err();
+        let line = failure.to_string();
+        assert!(line.starts_with("/proc/no-such-folder/embed_ao_left.png: cannot write"), "{line}");
+        assert!(matches!(failure, Failure::Output { .. }));
+        assert_eq!(fail(failure), std::process::ExitCode::from(2));
+    }
 }
