@@ -74,8 +74,8 @@ const MAX_ACCESSOR_COUNT: usize = 3 * MAX_TRIANGLES;
 
 /// Extensions whose meaning vrao honours; a file that requires any other is refused.
 /// (`KHR_mesh_quantization` only widens the accessor types, which are all decoded here.)
-pub const SUPPORTED_EXTENSIONS: [&str; 3] =
-    ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization"];
+pub const SUPPORTED_EXTENSIONS: [&str; 4] =
+    ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization", "KHR_texture_transform"];
 
 /// What a glTF file contributes to a scene: the scene-file loader places it, the bare
 /// loader ([`load`]) frames and lights it.

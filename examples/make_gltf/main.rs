@@ -5,13 +5,18 @@
 //! - `grille.obj` + `grille.mtl` + `grille_mask.png`: the same grille as OBJ, its holes
 //!   from `map_d`;
 //! - `sibenik.glb`: `$VRAO_SCENES/sibenik/sibenik.obj` converted (skipped without it);
-//! - `terrain.glb` and `terrain.obj`: the same 1,002,528-triangle height field.
+//! - `terrain.glb` and `terrain.obj`: the same 1,002,528-triangle height field;
+//! - the fidelity assets (`fidelity.rs`): `tiles.glb` (repeat, mirrored repeat, clamp),
+//!   `emissive.glb`, `vertex_colors.glb`, `normal_map.glb` and `normal_map_flat.glb`,
+//!   `modes.gltf` (strip, fan, list, lines, points), `quantized.gltf`, `sparse.gltf`.
 //!
 //! An example rather than a `vrao` subcommand: it is a generator for developers and tests,
 //! not something a user of the renderer needs, and it runs without the application
 //! features. Run: `cargo run --release --example make_gltf -- OUT_DIR`. The files are
 //! large (the terrain 81 MB as OBJ, 24 MB as .glb); keep them out of the repository.
 //! `make_gltf load FILE` loads a scene and prints its load time and peak memory.
+
+mod fidelity;
 
 use glam::{DVec3, Vec2, Vec3};
 use std::fmt::Write as _;
@@ -63,6 +68,7 @@ fn run(out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     write(&grille, &out.join("grille.glb"), &WriteOptions { camera: Some(camera), ..WriteOptions::default() })?;
     write_grille_obj(out)?;
     println!("wrote grille.glb, grille.obj, grille.mtl, grille_mask.png");
+    fidelity::write_all(out)?;
 
     match vrao::render::scene::shared_scenes_dir().map(|d| d.join("sibenik/sibenik.obj")).filter(|p| p.is_file()) {
         Some(obj) => {
