@@ -4,7 +4,7 @@
 //! and a texture transform (its holes where the sampler puts them), vertex colours tinting
 //! what a wall reflects, an emission texture limiting what it emits, and normal and
 //! occlusion textures, which leave the AO reference as it is.
-#![cfg(feature = "gltf")]
+#![cfg(all(feature = "app", feature = "gltf"))]
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
 use std::path::PathBuf;
