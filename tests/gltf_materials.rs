@@ -6,7 +6,7 @@
 mod common;
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
-use vrao::render::passes::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS};
+use vrao::render::passes::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS, SHADING_NORMALS};
 use vrao::render::scene::{uv_transform, AlphaMode, Filter, Sampling, Scene, Texture, Wrap};
 use vrao::render::stereo::HeadsetProfile;
 use vrao::{HeadPose, Renderer, Settings};
@@ -221,7 +221,7 @@ fn emissive_texture_limits_the_emission_and_occlusion_texture_reaches_the_albedo
 }
 
 #[test]
-fn normal_textures_tilt_the_normal_with_mesh_tangents_or_without_them() {
+fn normal_textures_tilt_the_lighting_normal_with_mesh_tangents_or_without_them_and_the_ao_keeps_the_surfaces() {
     // One texel tilting 30° towards +u (image right): (sin 30°, 0, cos 30°) encoded.
     let (s, c) = (30f32.to_radians().sin(), 30f32.to_radians().cos());
     let encode = |v: f32| ((v * 0.5 + 0.5) * 255.0).round() as u8;
@@ -242,7 +242,7 @@ fn normal_textures_tilt_the_normal_with_mesh_tangents_or_without_them() {
     {
         let mut material = vrao::render::scene::Material::plain("bumpy", Vec3::splat(0.5));
         material.normal_texture = Some((tilt.clone(), scale));
-        let frame = Frame::render(&scene_of(mesh, material), &[NORMALS]);
+        let frame = Frame::render(&scene_of(mesh, material), &[SHADING_NORMALS, NORMALS]);
         // The normal in view space: the eye looks down −z with +x to its right (it is
         // 32 mm left of the head, which turns it by a negligible angle at 2.2 m).
         let tilted = Vec3::new(s * scale, 0.0, c).normalize();
@@ -252,6 +252,10 @@ fn normal_textures_tilt_the_normal_with_mesh_tangents_or_without_them() {
             let world_to_view = frame.eyes.eyes[0].view_from_world();
             let expected = world_to_view.transform_vector3(tilted.as_dvec3()).as_vec3();
             assert!(got.abs_diff_eq(expected, 0.03), "{label} at {p}: normal {got}, expected {expected}");
+            // The AO keeps the surface's own normal.
+            let own = frame.at(1, p);
+            let flat = world_to_view.transform_vector3(DVec3::Z).as_vec3();
+            assert!(Vec3::new(own[0], own[1], own[2]).abs_diff_eq(flat, 1e-3), "{label} at {p}: AO normal {own:?}");
         }
     }
 }

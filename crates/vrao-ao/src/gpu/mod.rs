@@ -138,6 +138,9 @@ impl Gpu {
         limits.max_storage_textures_per_shader_stage = adapter_limits.max_storage_textures_per_shader_stage.min(8);
         limits.max_storage_buffers_per_shader_stage = adapter_limits.max_storage_buffers_per_shader_stage.min(8);
         limits.max_compute_workgroup_storage_size = adapter_limits.max_compute_workgroup_storage_size;
+        // A moving, normal-textured scene's G-buffer writes five targets (36 bytes a pixel).
+        limits.max_color_attachments = adapter_limits.max_color_attachments.min(8);
+        limits.max_color_attachment_bytes_per_sample = adapter_limits.max_color_attachment_bytes_per_sample.min(64);
         limits.max_buffer_size = adapter_limits.max_buffer_size;
         limits.max_storage_buffer_binding_size = adapter_limits.max_storage_buffer_binding_size;
         if multiview {

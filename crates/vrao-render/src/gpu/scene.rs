@@ -145,6 +145,9 @@ pub struct GpuScene {
     pub object_nodes: Vec<usize>,
     /// Whether some draw is alpha-tested (passes then build their alpha-tested pipelines).
     pub alpha_tested: bool,
+    /// Whether some material has a normal texture (the G-buffer then writes the lighting's
+    /// normals apart from the AO's).
+    pub normal_mapped: bool,
     /// The environment as a filterable equirectangular texture (1×1 black without one).
     pub environment: wgpu::TextureView,
     /// Sampler of the environment (repeats around, clamps at the poles).
@@ -236,6 +239,7 @@ impl GpuScene {
         let draws: Vec<Draw> =
             geometry.runs.into_iter().map(|run| bindings.draw(device, run, &materials, &cutoffs)).collect();
         let alpha_tested = draws.iter().any(|d| d.alpha_tested);
+        let normal_mapped = scene.materials.iter().any(|m| m.normal_texture.is_some());
         GpuScene {
             anchor,
             vertices: vertex_buffer,
@@ -246,6 +250,7 @@ impl GpuScene {
             objects: bindings.objects,
             object_nodes: geometry.object_nodes,
             alpha_tested,
+            normal_mapped,
             environment: environment_texture(gpu, scene.environment.as_ref()),
             sampler: bindings.sampler,
         }

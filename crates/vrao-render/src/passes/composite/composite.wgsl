@@ -37,6 +37,9 @@
 @group(0) @binding(12) var rsm_geometry: texture_2d_array<f32>;
 // The output's left-eye layer in the right eye's dispatch (any array texture otherwise).
 @group(0) @binding(13) var left_hdr: texture_2d_array<f32>;
+// The lighting's normals (the normal texture's where a material has one; `normal_layers`
+// are the surface's own, which the upsampling weighs by).
+@group(0) @binding(15) var lighting_normal_layers: texture_2d_array<f32>;
 
 override HALF_RES: bool = false;
 // A pipeline constant, not a uniform: lavapipe pays for the upsample code even when a
@@ -166,7 +169,8 @@ fn full_res_occlusion(px: UpsamplePixel, layer: u32) -> vec4<f32> {
 // bound output, unless it lies past an odd edge.
 fn shade_and_store(px: UpsamplePixel, layer: u32, out_layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) {
     if (all(px.pixel < frame.size)) {
-        let radiance = shade(px.pixel, layer, eye, px.depth, px.stored_normal, occlusion, bounce);
+        let n = textureLoad(lighting_normal_layers, vec2<i32>(px.pixel), i32(layer), 0).xyz;
+        let radiance = shade(px.pixel, layer, eye, px.depth, n, occlusion, bounce);
         let stored = vec4<f32>(finite_or_zero3(radiance), saturate_ao(occlusion.a));
         textureStore(hdr_out, vec2<i32>(px.pixel), i32(out_layer), stored);
     }

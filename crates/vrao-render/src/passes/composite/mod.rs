@@ -10,7 +10,7 @@
 //! listed on the GPU and composited by an indirect dispatch over just them.
 
 use super::direct::DIRECT;
-use super::gbuffer::{ALBEDO, DEPTH, NORMALS};
+use super::gbuffer::{ALBEDO, DEPTH, LIGHTING_NORMALS, NORMALS};
 use super::occlusion::AO_GEOMETRY;
 use super::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
 use super::shadow::rsm_active;
@@ -57,7 +57,7 @@ const FALLBACK_HEADER_BYTES: u64 = 16;
 /// occlusion, the environment, the HDR out, the occlusion's geometry, the RSM bounce and
 /// its geometry and, for the right eye's dispatches, the output's left-eye layer and the
 /// fallback list.
-const BINDINGS: [Bind; 15] = [
+const BINDINGS: [Bind; 16] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::Read(DEPTH),
@@ -73,6 +73,7 @@ const BINDINGS: [Bind; 15] = [
     Bind::Read(RSM_GEOMETRY),
     Bind::Own(Slot::Layers),
     Bind::Own(Slot::ReadWriteBuffer),
+    Bind::Read(LIGHTING_NORMALS),
 ];
 
 impl CompositePass {

@@ -7,6 +7,7 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var depth_layers: texture_depth_2d_array;
+// The lighting's normals (the normal texture's where a material has one).
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(4) var albedo_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var emission_layers: texture_2d_array<f32>;

@@ -3,7 +3,7 @@
 //! Directional lights are shadowed by their shadow maps (3×3 PCF, passes/shadow) when
 //! shadows are on.
 
-use super::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS};
+use super::gbuffer::{ALBEDO, DEPTH, EMISSION, LIGHTING_NORMALS};
 use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
 use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
@@ -26,7 +26,7 @@ const BINDINGS: [Bind; 10] = [
     Bind::Frame,
     Bind::Lights,
     Bind::Read(DEPTH),
-    Bind::Read(NORMALS),
+    Bind::Read(LIGHTING_NORMALS),
     Bind::Read(ALBEDO),
     Bind::Read(EMISSION),
     Bind::Write(DIRECT),

@@ -65,6 +65,18 @@ fn transform_vertex_with_motion(v: VertexIn, eye: u32) -> MotionVertexOut {
     return out;
 }
 
+// What a fragment writes, before it is spread over the targets a scene has.
+struct Surface {
+    // The surface's own normal (the AO's); w marks alpha-tested surfaces (cards: leaves,
+    // grilles, fences), which GTAO takes as thin occluders (gtao.wgsl `THIN_CARDS`).
+    normal: vec4<f32>,
+    // Albedo; alpha carries the baked occlusion, which the composite combines with the AO.
+    albedo: vec4<f32>,
+    emission: vec4<f32>,
+    // The normal texture's normal, for the lighting (the surface's own without one).
+    shading_normal: vec4<f32>,
+};
+
 struct GBufferOut {
     @location(0) normal: vec4<f32>,
     @location(1) albedo: vec4<f32>,
@@ -80,7 +92,22 @@ struct GBufferMotionOut {
     @location(3) motion: vec4<f32>,
 };
 
-fn shade(in: VertexOut) -> GBufferOut {
+struct GBufferMappedOut {
+    @location(0) normal: vec4<f32>,
+    @location(1) albedo: vec4<f32>,
+    @location(2) emission: vec4<f32>,
+    @location(4) shading_normal: vec4<f32>,
+};
+
+struct GBufferMotionMappedOut {
+    @location(0) normal: vec4<f32>,
+    @location(1) albedo: vec4<f32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) motion: vec4<f32>,
+    @location(4) shading_normal: vec4<f32>,
+};
+
+fn shade(in: VertexOut) -> Surface {
     alpha_test(in.uv, in.color.a);
     var n = in.view_normal;
     let len2 = dot(n, n);
@@ -91,31 +118,21 @@ fn shade(in: VertexOut) -> GBufferOut {
     // OBJ files with inconsistent winding still shade correctly. The normal texture
     // tilts the normal in the frame of the side the eye sees.
     let facing = select(1.0, -1.0, dot(n, -in.view_position) < 0.0);
+    n = n * facing;
     let tangent = vec4<f32>(in.view_tangent.xyz * facing, in.view_tangent.w);
-    n = mapped_normal(n * facing, tangent, in.view_position, in.uv);
-    let albedo = material_albedo(in.uv, in.color);
-    var out: GBufferOut;
-    // w marks alpha-tested surfaces (cards: leaves, grilles, fences), which GTAO takes as
-    // thin occluders (gtao.wgsl `THIN_CARDS`).
-    out.normal = vec4<f32>(finite_or_zero3(n), select(0.0, 1.0, ALPHA_TEST));
-    // Alpha carries the baked occlusion, which the composite combines with the AO.
-    out.albedo = vec4<f32>(albedo, material_occlusion(in.uv));
+    let mapped = mapped_normal(n, tangent, in.view_position, in.uv);
+    let card = select(0.0, 1.0, ALPHA_TEST);
+    var out: Surface;
+    out.normal = vec4<f32>(finite_or_zero3(n), card);
+    out.albedo = vec4<f32>(material_albedo(in.uv, in.color), material_occlusion(in.uv));
     out.emission = vec4<f32>(finite_or_zero3(material_emission(in.uv)), 0.0);
+    out.shading_normal = vec4<f32>(finite_or_zero3(mapped), card);
     return out;
 }
 
-@fragment
-fn fs_main(in: VertexOut) -> GBufferOut {
-    return shade(in);
-}
-
-@fragment
-fn fs_motion(in: MotionVertexOut) -> GBufferMotionOut {
-    let g = shade(VertexOut(in.clip, in.view_position, in.view_normal, in.uv, in.color, in.view_tangent));
-    var out: GBufferMotionOut;
-    out.normal = g.normal;
-    out.albedo = g.albedo;
-    out.emission = g.emission;
+// xy: previous uv − this uv (uv: 0..1 from the top left); z: the previous distance along
+// −z minus this one; w: 1, or 0 where the point was behind the previous eye.
+fn motion_of(in: MotionVertexOut) -> vec4<f32> {
     let uv = in.clip.xy / vec2<f32>(frame.size);
     var motion = vec4<f32>(0.0);
     if (in.previous_clip.w > 0.0) {
@@ -123,6 +140,33 @@ fn fs_motion(in: MotionVertexOut) -> GBufferMotionOut {
         let previous_uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
         motion = vec4<f32>(previous_uv - uv, in.previous_distance + in.view_position.z, 1.0);
     }
-    out.motion = select(vec4<f32>(0.0), motion, all(motion == motion) && all(abs(motion) < vec4<f32>(6.0e4)));
-    return out;
+    return select(vec4<f32>(0.0), motion, all(motion == motion) && all(abs(motion) < vec4<f32>(6.0e4)));
+}
+
+fn still(in: MotionVertexOut) -> VertexOut {
+    return VertexOut(in.clip, in.view_position, in.view_normal, in.uv, in.color, in.view_tangent);
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> GBufferOut {
+    let s = shade(in);
+    return GBufferOut(s.normal, s.albedo, s.emission);
+}
+
+@fragment
+fn fs_motion(in: MotionVertexOut) -> GBufferMotionOut {
+    let s = shade(still(in));
+    return GBufferMotionOut(s.normal, s.albedo, s.emission, motion_of(in));
+}
+
+@fragment
+fn fs_mapped(in: VertexOut) -> GBufferMappedOut {
+    let s = shade(in);
+    return GBufferMappedOut(s.normal, s.albedo, s.emission, s.shading_normal);
+}
+
+@fragment
+fn fs_motion_mapped(in: MotionVertexOut) -> GBufferMotionMappedOut {
+    let s = shade(still(in));
+    return GBufferMotionMappedOut(s.normal, s.albedo, s.emission, motion_of(in), s.shading_normal);
 }

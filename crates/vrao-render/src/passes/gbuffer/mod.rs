@@ -1,5 +1,7 @@
 //! The layered G-buffer: reversed-Z depth, view-space normals, albedo and emission for
-//! every eye layer, and in a scene that moves each pixel's motion ([`MOTION`]).
+//! every eye layer, in a scene that moves each pixel's motion ([`MOTION`]), and in a
+//! scene with normal textures the lighting's normals ([`SHADING_NORMALS`]) apart from the
+//! AO's.
 //! Multiview draws both eyes in one pass; otherwise one pass per eye. Both paths share the
 //! fragment shader and vertex transform, so they give equal pixels. Alpha-tested
 //! materials are drawn after the solid ones with a pipeline that discards their holes;
@@ -29,7 +31,21 @@ pub const ALBEDO: Resource = Resource::attachment("albedo", Size::Full, wgpu::Te
 /// Emitted radiance.
 pub const EMISSION: Resource = Resource::attachment("emission", Size::Full, wgpu::TextureFormat::Rgba16Float);
 
-const COLOR_TARGETS: [Resource; 4] = [NORMALS, ALBEDO, EMISSION, MOTION];
+/// The normals the lighting uses: the normal texture's where a material has one. The AO
+/// keeps the surface's own ([`NORMALS`]): against the reference, normal-textured normals
+/// tilt GTAO's hemisphere into the flat surface they decorate and raise its error several
+/// times (docs/measurements.md, "normal textures and the AO"). Written only in a scene
+/// with normal textures; otherwise [`LIGHTING_NORMALS`] is [`NORMALS`].
+pub const SHADING_NORMALS: Resource =
+    Resource::attachment("shading-normals", Size::Full, wgpu::TextureFormat::Rgba16Float);
+
+/// What the lighting passes (direct light, composite) read as normals: [`SHADING_NORMALS`]
+/// in a scene with normal textures, else [`NORMALS`].
+pub const LIGHTING_NORMALS: Resource =
+    Resource::alias("lighting-normals", wgpu::TextureFormat::Rgba16Float, None);
+
+/// Every colour target in location order; a scene writes those it needs.
+const COLOR_TARGETS: [Resource; 5] = [NORMALS, ALBEDO, EMISSION, MOTION, SHADING_NORMALS];
 
 /// gbuffer.wgsl: the vertex transform and fragment shader both paths share.
 const GBUFFER_WGSL: Shader = wgsl!("src/passes/gbuffer/gbuffer.wgsl");
@@ -67,6 +83,8 @@ pub struct GBufferPass {
     eye_select: [wgpu::BindGroup; 2],
     /// Whether the scene moves: the pipelines then write [`MOTION`].
     motion: bool,
+    /// Whether the scene has normal textures: the pipelines then write [`SHADING_NORMALS`].
+    mapped: bool,
     /// The previous frame's eyes (`PreviousEyes`).
     previous_eyes: wgpu::Buffer,
 }
@@ -97,8 +115,9 @@ impl GBufferPass {
             })
         });
         let motion = scene.has_moving_objects();
+        let mapped = scene.normal_mapped;
         let pipelines = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, mask: Option<NonZeroU32>| {
-            let make = |alpha_test: bool| pipeline(device, layout, module, mask, motion, alpha_test);
+            let make = |alpha_test: bool| pipeline(device, layout, module, mask, (motion, mapped), alpha_test);
             Pipelines { solid: make(false), alpha_tested: scene.alpha_tested.then(|| make(true)) }
         };
         let multiview = gpu.caps.multiview.then(|| {
@@ -139,16 +158,12 @@ impl GBufferPass {
                 wgpu::BindGroupEntry { binding: 1, resource: previous_eyes.as_entire_binding() },
             ],
         });
-        GBufferPass { frame_group, multiview, multipass, eye_select, motion, previous_eyes }
+        GBufferPass { frame_group, multiview, multipass, eye_select, motion, mapped, previous_eyes }
     }
 
-    /// The colour targets this scene's pipelines write.
-    fn color_targets(&self) -> &'static [Resource] {
-        if self.motion {
-            &COLOR_TARGETS
-        } else {
-            &COLOR_TARGETS[..3]
-        }
+    /// The colour targets this scene's pipelines write, by location (`None`: not written).
+    fn color_targets(&self) -> Vec<Option<Resource>> {
+        color_targets(self.motion, self.mapped)
     }
 
     /// Writes the previous frame's eyes (this frame's when there is none: then only
@@ -167,18 +182,38 @@ impl GBufferPass {
     }
 }
 
+/// The colour targets by location of a scene that moves (`motion`) or has normal
+/// textures (`mapped`); `None` where a location is not written.
+fn color_targets(motion: bool, mapped: bool) -> Vec<Option<Resource>> {
+    let mut targets: Vec<Option<Resource>> = COLOR_TARGETS[..3].iter().copied().map(Some).collect();
+    if motion || mapped {
+        targets.push(motion.then_some(MOTION));
+    }
+    if mapped {
+        targets.push(Some(SHADING_NORMALS));
+    }
+    targets
+}
+
 fn pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     multiview_mask: Option<NonZeroU32>,
-    motion: bool,
+    (motion, mapped): (bool, bool),
     alpha_test: bool,
 ) -> wgpu::RenderPipeline {
-    let count = if motion { 4 } else { 3 };
-    let targets: Vec<_> =
-        COLOR_TARGETS[..count].iter().map(|r| Some(wgpu::ColorTargetState::from(r.format()))).collect();
-    let (vertex, fragment) = if motion { ("vs_motion", "fs_motion") } else { ("vs_main", "fs_main") };
+    let targets: Vec<_> = color_targets(motion, mapped)
+        .into_iter()
+        .map(|r| r.map(|r| wgpu::ColorTargetState::from(r.format())))
+        .collect();
+    let vertex = if motion { "vs_motion" } else { "vs_main" };
+    let fragment = match (motion, mapped) {
+        (false, false) => "fs_main",
+        (true, false) => "fs_motion",
+        (false, true) => "fs_mapped",
+        (true, true) => "fs_motion_mapped",
+    };
     mesh_pipeline(
         device,
         MeshPipeline {
@@ -203,6 +238,11 @@ impl Pass for GBufferPass {
         } else {
             decl.note("motion vectors left out: nothing in the scene moves")
         };
+        decl = if self.mapped {
+            decl.write(SHADING_NORMALS).provide(LIGHTING_NORMALS, SHADING_NORMALS)
+        } else {
+            decl.provide(LIGHTING_NORMALS, NORMALS).note("shading normals left out: no material has a normal texture")
+        };
         if self.multipass.alpha_tested.is_none() {
             decl = decl.note("alpha test left out: no material has holes");
         }
@@ -214,7 +254,7 @@ impl Pass for GBufferPass {
         if self.motion {
             self.write_previous_eyes(ctx);
         }
-        let targets = self.color_targets();
+        let targets = &self.color_targets();
         let multiview = ctx.setup.multiview && ctx.setup.views == 2;
         if multiview {
             let pipelines = self.multiview.as_ref().expect("multiview requested without adapter support");
@@ -243,13 +283,14 @@ impl Pass for GBufferPass {
 /// 0 = invalid).
 fn begin<'e, 't>(
     encoder: &'e mut wgpu::CommandEncoder,
-    targets: &[Resource],
+    targets: &[Option<Resource>],
     views: impl Fn(Resource) -> &'t wgpu::TextureView,
     multiview_mask: Option<NonZeroU32>,
 ) -> wgpu::RenderPass<'e> {
     let color: Vec<_> = targets
         .iter()
         .map(|&r| {
+            let r = r?;
             Some(wgpu::RenderPassColorAttachment {
                 view: views(r),
                 depth_slice: None,
