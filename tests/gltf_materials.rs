@@ -259,3 +259,34 @@ fn normal_textures_tilt_the_lighting_normal_with_mesh_tangents_or_without_them_a
         }
     }
 }
+
+#[test]
+fn the_ambient_light_takes_the_smaller_of_the_baked_and_the_screen_space_occlusion() {
+    use vrao::render::graph::FINAL_AO;
+    use vrao::render::passes::composite::HDR;
+    // A floor under the sky alone (no lights): its radiance is albedo/π × the sky's
+    // irradiance × the occlusion the composite applies.
+    let lit = |baked: Option<f32>| {
+        let mut material = vrao::render::scene::Material::plain("floor", Vec3::splat(0.5));
+        material.occlusion_texture = baked.map(|b| {
+            let r = (b * 255.0).round() as u8;
+            (
+                Texture { width: 1, height: 1, rgba8: vec![r, r, r, 255], source: None, sampling: Sampling::default() },
+                1.0,
+            )
+        });
+        let mut scene = scene_of(quad(), material);
+        scene.environment = Some(vrao::render::scene::Environment::default_sky());
+        Frame::render(&scene, &[HDR, FINAL_AO])
+    };
+    let plain = lit(None);
+    let p = DVec3::new(2.0, 2.0, 0.0);
+    let ao = plain.at(1, p)[3];
+    assert!(ao > 0.6, "an open floor is mostly unoccluded ({ao})");
+    for baked in [0.2f32, 1.0] {
+        let with = lit(Some(baked));
+        let expected = baked.min(ao) / ao;
+        let ratio = with.at(0, p)[0] / plain.at(0, p)[0];
+        assert!((ratio - expected).abs() < 0.02, "baked {baked}, AO {ao}: radiance ratio {ratio}, expected {expected}");
+    }
+}
