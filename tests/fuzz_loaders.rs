@@ -7,7 +7,9 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
-use vrao::test_assets::fuzz::{load_bytes, Mutator, Target, VALID_GLTF, VALID_MTL, VALID_OBJ, VALID_SCENE};
+use vrao::test_assets::fuzz::{
+    load_bytes, Mutator, Target, VALID_GLTF, VALID_GLTF_FILES, VALID_MTL, VALID_OBJ, VALID_SCENE, VALID_SCENE_GLTF,
+};
 
 /// Time per target; `VRAO_FUZZ_SECONDS` overrides it for longer runs.
 fn budget() -> Duration {
@@ -33,8 +35,12 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
     match target {
         Target::Obj => seeds.extend(cornell("obj").and_then(|p| std::fs::read(p).ok())),
         Target::Mtl => seeds.extend(cornell("mtl").and_then(|p| std::fs::read(p).ok())),
-        Target::SceneFile => seeds.push(include_bytes!("../assets/scenes/cornell.toml").to_vec()),
+        Target::SceneFile => {
+            seeds.push(include_bytes!("../assets/scenes/cornell.toml").to_vec());
+            seeds.push(VALID_SCENE_GLTF.as_bytes().to_vec());
+        }
         Target::Gltf => {
+            seeds.push(VALID_GLTF_FILES.as_bytes().to_vec());
             // The same content as a .glb container, as vrao's writer makes it.
             let glb = scratch("glb-seed").join("seed.glb");
             let scene = vrao::render::scene::Scene::load("builtin:furnished").unwrap();
@@ -180,4 +186,50 @@ fn mutated_bench_files_are_refused_or_load_in_range_without_a_panic() {
     eprintln!("bench files: {runs} inputs, {accepted} accepted, {} panics", crashes.len());
     assert!(crashes.is_empty(), "bench files that panicked: {:?}", &crashes[..crashes.len().min(2)]);
     assert!(runs > 50 && accepted > 0, "{runs} inputs, {accepted} accepted: the mutations reach the records");
+}
+
+#[test]
+fn every_seed_loads() {
+    for target in Target::ALL {
+        let dir = scratch(&format!("seed-{}", target.extension()));
+        for (i, seed) in seeds(target).iter().enumerate() {
+            if let Err(e) = load_bytes(target, seed, &dir) {
+                panic!("{target:?} seed {i} is refused, so mutations start from a broken file: {e}");
+            }
+        }
+    }
+}
+
+/// The inputs the fuzzing tokens reach, each checked: a path that names a device, a FIFO,
+/// a folder or a file outside the glTF's folder is refused at once, naming what it is.
+#[test]
+fn special_files_named_by_any_loader_are_refused_at_once_naming_what_they_are() {
+    let dir = scratch("special");
+    let gltf_with = |uri: &str| VALID_GLTF_FILES.replace("\"uri\":\"fuzz.bin\"", &format!("\"uri\":\"{uri}\""));
+    let scene_with = |what: &str| VALID_SCENE.replace("obj = \"fuzz.obj\"", what);
+    let mut cases: Vec<(Target, String, &str)> = vec![
+        (Target::Gltf, gltf_with("zero.bin"), "buffer 0: file 'zero.bin' is a character device"),
+        (Target::Gltf, gltf_with("folder.png"), "buffer 0: file 'folder.png' is a directory"),
+        (Target::Gltf, gltf_with("../vrao-fuzz-outside.bin"), "buffer 0: URI '../vrao-fuzz-outside.bin' leaves the glTF's folder"),
+        (Target::Gltf, gltf_with("/dev/zero"), "buffer 0: URI '/dev/zero' leaves the glTF's folder"),
+        (Target::SceneFile, scene_with("obj = \"zero.bin\""), "mesh obj 'zero.bin' ("),
+        (Target::SceneFile, scene_with("gltf = \"folder.png\""), "is a directory, not a regular file"),
+        (Target::Mtl, "newmtl red\nmap_Kd zero.bin\n".into(), "texture file 'zero.bin' ("),
+    ];
+    if cfg!(unix) {
+        cases.push((
+            Target::Gltf,
+            gltf_with("link.bin"),
+            "buffer 0: URI 'link.bin' leaves the glTF's folder (a symlink",
+        ));
+        cases.push((Target::Gltf, gltf_with("pipe.bin"), "buffer 0: file 'pipe.bin' is a FIFO (named pipe)"));
+        cases.push((Target::SceneFile, scene_with("obj = \"pipe.bin\""), "is a FIFO (named pipe), not a regular file"));
+        cases.push((Target::Mtl, "newmtl red\nmap_Kd pipe.bin\n".into(), "is a FIFO (named pipe)"));
+    }
+    for (target, input, expected) in cases {
+        let started = Instant::now();
+        let e = load_bytes(target, input.as_bytes(), &dir).err().unwrap_or_else(|| panic!("{input} loads")).to_string();
+        assert!(e.contains(&format!("fuzz.{}", target.extension())) && e.contains(expected), "{target:?}: {e}");
+        assert!(started.elapsed() < Duration::from_secs(2), "{target:?} {expected}: {:?}", started.elapsed());
+    }
 }

@@ -370,7 +370,7 @@ fn session_settings(
 fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
     let frontier = match &options.governor_frontier {
         Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
+            let text = crate::render::files::read_regular_file_to_string(path, crate::render::files::MAX_TEXT_BYTES)?;
             Frontier::from_json(&text, path, settings.ao.radius)?
         }
         None => Frontier::builtin(),

@@ -1,10 +1,14 @@
 //! Entry points for fuzzing the loaders on bytes (the cargo-fuzz targets in `fuzz/` and
 //! the bounded mutation run in `tests/fuzz_loaders.rs` both use them).
 //!
-//! The loaders read files (an OBJ names its MTL, a scene file names its OBJ), so each
-//! input is written next to fixed, valid companions in a scratch directory and loaded
-//! through [`Scene::load`], the path users take. Any result is fine, `Ok` or `Err`;
-//! a panic, a hang or a NaN in a loaded scene is a bug.
+//! The loaders read files (an OBJ names its MTL, a scene file names its OBJ or glTF, a
+//! glTF its buffer), so each input is written next to fixed, valid companions in a
+//! scratch directory and loaded through [`Scene::load`], the path users take. Beside them
+//! lie what a path must never be read as: `zero.bin` (a symlink to `/dev/zero`),
+//! `pipe.bin` (a FIFO), `folder.png` (a directory) and, one level up, `vrao-fuzz-outside.bin`; the
+//! mutation tokens name them (and `../` and absolute paths), so mutated inputs reach them.
+//! Any result is fine, `Ok` or `Err`; a panic, a hang, a NaN or a value beyond the
+//! renderer's bounds in a loaded scene is a bug.
 
 use crate::render::error::Result;
 use crate::render::scene::Scene;
@@ -43,6 +47,15 @@ impl Target {
 pub const VALID_OBJ: &str = "mtllib fuzz.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nusemtl red\nf 1/1/1 2/2/1 3/3/1\nf 2 4 3\n";
 /// A valid MTL defining the material `red`.
 pub const VALID_MTL: &str = "newmtl red\nKd 0.8 0.1 0.1\nKe 0 0 0\n";
+/// A valid scene file placing `fuzz.gltf` three times, one of them moving (a scale key of
+/// 0 hides it while it holds).
+pub const VALID_SCENE_GLTF: &str = "[[mesh]]\ngltf = \"fuzz.gltf\"\n\n[[mesh]]\ngltf = \"fuzz.gltf\"\ntranslate = [2, 0, 0]\n\n[[mesh]]\ngltf = \"fuzz.gltf\"\nanimation = { keys = [{ t = 0, translate = [0, 0, 0], scale = 1 }, { t = 1, translate = [0, 1, 0], scale = 0 }] }\n\n[head]\neye = [0, 1, 4]\nlook_at = [0, 0, 0]\n";
+
+/// A valid `.gltf` whose buffer is the file `fuzz.bin` beside it (the bytes of
+/// [`VALID_GLTF`]'s data URI), with a second instance of its mesh under a node of scale 0
+/// (hidden, one warning) and a scale animation to 0.
+pub const VALID_GLTF_FILES: &str = "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,2]}],\"nodes\":[{\"translation\":[0,0,-1],\"children\":[1]},{\"mesh\":0,\"scale\":[2,2,2]},{\"mesh\":0,\"scale\":[0,0,0]}],\"meshes\":[{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6},{\"buffer\":0,\"byteOffset\":44,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":52,\"byteLength\":24}],\"buffers\":[{\"byteLength\":76,\"uri\":\"fuzz.bin\"}],\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"scale\"}}],\"samplers\":[{\"input\":2,\"output\":3,\"interpolation\":\"LINEAR\"}]}]}";
+
 /// A valid scene file placing `fuzz.obj`.
 pub const VALID_SCENE: &str = "name = \"fuzz\"\n\n[[mesh]]\nobj = \"fuzz.obj\"\ntranslate = [0, 0, -1]\nscale = 2\n\n[[light]]\ntype = \"directional\"\ndirection = [0, -1, -1]\nintensity = 2\n\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 5\n\n[environment]\nsky = \"default\"\n\n[head]\npath = [{ t = 0, eye = [0, 1, 2], look_at = [0, 0, 0] }, { t = 1, eye = [1, 1, 2], look_at = [0, 0, 0] }]\n";
 
@@ -59,9 +72,9 @@ pub fn load_bytes(target: Target, data: &[u8], dir: &Path) -> Result<Scene> {
     write("fuzz.obj", if target == Target::Obj { data } else { VALID_OBJ.as_bytes() })?;
     write("fuzz.mtl", if target == Target::Mtl { data } else { VALID_MTL.as_bytes() })?;
     write("fuzz.toml", if target == Target::SceneFile { data } else { VALID_SCENE.as_bytes() })?;
-    if target == Target::Gltf {
-        write("fuzz.gltf", data)?;
-    }
+    write("fuzz.gltf", if target == Target::Gltf { data } else { VALID_GLTF.as_bytes() })?;
+    write("fuzz.bin", &fuzz_bin())?;
+    special_companions(dir);
     let entry = match target {
         Target::SceneFile => "fuzz.toml",
         Target::Gltf => "fuzz.gltf",
@@ -70,6 +83,43 @@ pub fn load_bytes(target: Target, data: &[u8], dir: &Path) -> Result<Scene> {
     let scene = Scene::load(dir.join(entry).to_str().unwrap_or_default())?;
     check_finite(&scene);
     Ok(scene)
+}
+
+/// The bytes of [`VALID_GLTF`]'s buffer, for [`VALID_GLTF_FILES`]'s `fuzz.bin`.
+fn fuzz_bin() -> Vec<u8> {
+    let start = VALID_GLTF.find("base64,").map_or(0, |i| i + 7);
+    let end = VALID_GLTF[start..].find('"').map_or(start, |i| start + i);
+    #[cfg(feature = "gltf")]
+    return crate::render::scene::gltf::decode_base64(&VALID_GLTF[start..end]).unwrap_or_default();
+    #[cfg(not(feature = "gltf"))]
+    return VALID_GLTF[start..end].as_bytes().to_vec();
+}
+
+/// What a path named in an input must never be read as (made once per folder): a symlink
+/// to `/dev/zero`, a FIFO (opening it would block), a directory named like an image, and
+/// a file outside the input's folder.
+fn special_companions(dir: &Path) {
+    let _ = std::fs::create_dir_all(dir.join("folder.png"));
+    if let Some(parent) = dir.parent() {
+        if !parent.join("vrao-fuzz-outside.bin").exists() {
+            let _ = std::fs::write(parent.join("vrao-fuzz-outside.bin"), fuzz_bin());
+        }
+    }
+    #[cfg(unix)]
+    {
+        let zero = dir.join("zero.bin");
+        if std::fs::symlink_metadata(&zero).is_err() {
+            let _ = std::os::unix::fs::symlink("/dev/zero", &zero);
+        }
+        let link = dir.join("link.bin");
+        if std::fs::symlink_metadata(&link).is_err() {
+            let _ = std::os::unix::fs::symlink("../vrao-fuzz-outside.bin", &link);
+        }
+        let pipe = dir.join("pipe.bin");
+        if std::fs::symlink_metadata(&pipe).is_err() {
+            let _ = std::process::Command::new("mkfifo").arg(&pipe).status();
+        }
+    }
 }
 
 /// A loaded scene never holds a non-finite number: the loaders reject or drop them.
@@ -98,6 +148,11 @@ fn check_finite(scene: &Scene) {
     for t in [0.0, 0.5, 1e6] {
         assert!(scene.node_transforms(t).iter().all(|m| m.is_finite()), "a node transform is not finite at {t}");
     }
+    // Moving meshes and the head stay where static geometry may be; the scene within budget.
+    use crate::render::scene::limits;
+    assert_eq!(limits::motion_trouble(&scene.meshes, &scene.nodes), None, "a moving mesh is out of range");
+    assert_eq!(limits::head_trouble(&scene.head), None, "the head is out of range");
+    assert_eq!(limits::GeometryBudget::of(&scene.meshes).trouble(), None, "over the triangle budget");
 }
 
 /// Tokens a mutation inserts: what OBJ, MTL and TOML parsers trip over.
@@ -155,6 +210,31 @@ const TOKENS: &[&[u8]] = &[
     b"\"children\":[0]",
     b"\"matrix\":",
     b"\"CUBICSPLINE\"",
+    b"\"uri\":\"zero.bin\"",
+    b"\"uri\":\"pipe.bin\"",
+    b"\"uri\":\"folder.png\"",
+    b"\"uri\":\"link.bin\"",
+    b"\"uri\":\"../vrao-fuzz-outside.bin\"",
+    b"\"uri\":\"/dev/zero\"",
+    b"\"images\":[{\"uri\":\"pipe.bin\"}],",
+    b"\"scale\":[0,0,0]",
+    b"\"scale\":[1e-30,1e-30,1e-30]",
+    b"\"translation\":[1e30,0,0]",
+    b"\"matrix\":[0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1]",
+    b"1e30",
+    b"-3e38",
+    b"../",
+    b"zero.bin",
+    b"pipe.bin",
+    b"folder.png",
+    b"/dev/zero",
+    b"gltf = \"fuzz.gltf\"\n",
+    b"obj = \"pipe.bin\"\n",
+    b"mtllib zero.bin\n",
+    b"map_Kd pipe.bin\n",
+    b"[[mesh]]\ngltf = \"fuzz.gltf\"\n[[mesh]]\ngltf = \"fuzz.gltf\"\n[[mesh]]\ngltf = \"fuzz.gltf\"\n",
+    b"animation = { keys = [{ t = 0, scale = 0 }, { t = 1, translate = [1e30, 0, 0] }] }\n",
+    b"scale = 0",
     b"4294967295",
     b"1e300",
     b"[[mesh]]\n",

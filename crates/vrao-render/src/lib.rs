@@ -11,6 +11,7 @@
 //! …), with the renderer's own passes and GPU pieces beside the engine's in [`passes`]
 //! and [`gpu`].
 
+pub mod files;
 pub mod gpu;
 pub mod lighting;
 pub mod passes;

@@ -454,7 +454,7 @@ pub fn to_json(file: &BenchFile) -> String {
 
 /// Reads a bench JSON file (for `vrao budget --fit`).
 pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, e.to_string()))?;
+    let text = crate::render::files::read_regular_file_to_string(path, crate::render::files::MAX_TEXT_BYTES)?;
     BenchFile::from_json(&text, path)
 }
 

@@ -66,12 +66,17 @@ impl Environment {
         Ok(env)
     }
 
-    /// Loads a Radiance `.hdr` lat-long map.
+    /// Loads a Radiance `.hdr` lat-long map (a regular file of at most
+    /// [`crate::files::MAX_FILE_BYTES`], sides up to [`super::limits::MAX_TEXTURE_SIDE`]).
     pub fn load_hdr(path: &Path, intensity: f32) -> Result<Environment> {
-        let file =
-            std::fs::File::open(path).map_err(|e| Error::in_file(path, format!("cannot open HDR environment: {e}")))?;
-        let decoder = image::codecs::hdr::HdrDecoder::new(std::io::BufReader::new(file))
+        let bytes = crate::files::read_regular_file(path, crate::files::MAX_FILE_BYTES)?;
+        let decoder = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes))
             .map_err(|e| Error::in_file(path, format!("not a valid Radiance HDR file: {e}")))?;
+        // From the header, before the texels are allocated.
+        let (width, height) = image::ImageDecoder::dimensions(&decoder);
+        if let Some(trouble) = super::limits::texture_side_trouble(width, height) {
+            return Err(Error::in_file(path, format!("environment map of {trouble}")));
+        }
         let image = image::DynamicImage::from_decoder(decoder)
             .map_err(|e| Error::in_file(path, format!("cannot decode HDR environment: {e}")))?
             .into_rgb32f();

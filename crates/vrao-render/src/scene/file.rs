@@ -68,6 +68,7 @@ use crate::error::{Error, Result};
 use crate::stereo::HeadPose;
 use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
 use serde::Deserialize;
+use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
@@ -154,7 +155,7 @@ struct HeadKey {
 
 /// Loads a scene file; every error names the file and, where it can, the line.
 pub fn load(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::in_file(path, format!("cannot read: {e}")))?;
+    let text = crate::files::read_regular_file_to_string(path, crate::files::MAX_TEXT_BYTES)?;
     let scene = parse(path, &text)?;
     // Without a mesh there is nothing to occlude: say so rather than render the sky.
     if scene.meshes.is_empty() {
@@ -179,8 +180,9 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
     let at = |span: Range<usize>, message: String| Error::at_line(path, line_of(text, span.start), message);
 
     let (mut meshes, mut materials, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
+    let mut sources = Sources::new(&file.mesh, directory);
     for entry in &file.mesh {
-        let placed = load_mesh_entry(entry.get_ref(), directory, materials.len())
+        let placed = load_mesh_entry(entry.get_ref(), directory, materials.len(), &mut sources)
             .map_err(|f| f.place(|m| at(entry.span(), m)))?;
         // The entry's nodes count from 0; in the scene they follow those before them.
         let offset = nodes.len();
@@ -287,33 +289,116 @@ struct Placed {
     nodes: Vec<Node>,
 }
 
+/// The files a scene file's entries place, and the scene's triangle and vertex budget
+/// ([`limits::GeometryBudget`]) as they are added. A file placed by several entries is read
+/// once: its meshes are counted against the budget before each further copy is made (so
+/// that one file placed many times is refused before the memory is spent), and the copies
+/// share the first placement's materials.
+struct Sources {
+    /// How many entries still to come place each file (OBJ or glTF, as resolved).
+    uses: HashMap<(bool, PathBuf), usize>,
+    /// The files placed again later, as loaded (before any placement).
+    loaded: HashMap<(bool, PathBuf), Placed>,
+    budget: limits::GeometryBudget,
+}
+
+impl Sources {
+    fn new(entries: &[Spanned<MeshEntry>], directory: &Path) -> Sources {
+        let mut uses = HashMap::new();
+        for entry in entries.iter().map(Spanned::get_ref) {
+            if let Some(key) = entry.source(directory) {
+                *uses.entry(key).or_insert(0) += 1;
+            }
+        }
+        Sources { uses, loaded: HashMap::new(), budget: limits::GeometryBudget::default() }
+    }
+
+    /// The meshes, new materials and nodes of the file `key` (named `what` in errors),
+    /// read by `load` at its first placement, copied at the others.
+    fn place(
+        &mut self,
+        key: (bool, PathBuf),
+        what: &str,
+        load: impl FnOnce() -> std::result::Result<Placed, Failure>,
+    ) -> std::result::Result<Placed, Failure> {
+        let left = self.uses.get_mut(&key).map(|n| {
+            *n = n.saturating_sub(1);
+            *n
+        });
+        if let Some(cached) = self.loaded.get(&key) {
+            self.budget = self.budget.plus(limits::GeometryBudget::of(&cached.meshes), what)?;
+            let copy = match left {
+                Some(0) | None => self.loaded.remove(&key).expect("looked up above"),
+                Some(_) => Placed { meshes: cached.meshes.clone(), materials: Vec::new(), nodes: cached.nodes.clone() },
+            };
+            return Ok(copy);
+        }
+        let placed = load()?;
+        self.budget = self.budget.plus(limits::GeometryBudget::of(&placed.meshes), what)?;
+        if left.is_some_and(|n| n > 0) {
+            let again = Placed { meshes: placed.meshes.clone(), materials: Vec::new(), nodes: placed.nodes.clone() };
+            self.loaded.insert(key, again);
+        }
+        Ok(placed)
+    }
+}
+
+impl MeshEntry {
+    /// The file this entry places, as [`Sources`] keys it (`true` for a glTF); `None` for a
+    /// built-in set or an entry that names no single file.
+    fn source(&self, directory: &Path) -> Option<(bool, PathBuf)> {
+        match (&self.obj, &self.gltf, &self.builtin) {
+            (Some(obj), None, None) => resolve(directory, "mesh obj", obj).ok().map(|f| (false, f)),
+            (None, Some(gltf), None) => resolve(directory, "mesh gltf", gltf).ok().map(|f| (true, f)),
+            _ => None,
+        }
+    }
+}
+
+/// Refuses, as a problem of the entry, a `what` file `value` (looked for at `file`) that is
+/// missing or is not a regular file (a folder, a FIFO, a device), naming what it is.
+fn regular_file(file: &Path, what: &str, value: &str) -> std::result::Result<(), Failure> {
+    match crate::files::check_regular_file(file) {
+        Ok(_) => Ok(()),
+        Err(e) if matches!(e.problem, crate::files::FileProblem::Missing) => {
+            Err(Failure::Here(format!("{what} '{value}' not found (looked for {})", file.display())))
+        }
+        Err(e) => Err(Failure::Here(format!("{what} '{value}' ({}) {}", file.display(), e.problem))),
+    }
+}
+
 fn load_mesh_entry(
     entry: &MeshEntry,
     directory: &Path,
     material_offset: usize,
+    sources: &mut Sources,
 ) -> std::result::Result<Placed, Failure> {
     let transform = entry.transform()?;
     let (mut meshes, materials, mut nodes) = match (&entry.obj, &entry.gltf, &entry.builtin) {
         (Some(obj), None, None) => {
             let file = resolve(directory, "mesh obj", obj)?;
-            if !file.is_file() {
-                return Err(Failure::Here(format!("mesh obj '{obj}' not found (looked for {})", file.display())));
-            }
-            let (meshes, materials) = obj::load_obj(&file, material_offset).map_err(Failure::Elsewhere)?;
-            (meshes, materials, Vec::new())
+            regular_file(&file, "mesh obj", obj)?;
+            // The OBJ's faces are counted as they are read, on top of the scene so far.
+            let used = sources.budget;
+            let placed = sources.place((false, file.clone()), &format!("mesh obj '{obj}'"), || {
+                let (meshes, materials) =
+                    obj::load_obj_within(&file, material_offset, used).map_err(Failure::Elsewhere)?;
+                Ok(Placed { meshes, materials, nodes: Vec::new() })
+            })?;
+            (placed.meshes, placed.materials, placed.nodes)
         }
         (None, Some(gltf), None) => {
             let file = resolve(directory, "mesh gltf", gltf)?;
-            if !file.is_file() {
-                return Err(Failure::Here(format!("mesh gltf '{gltf}' not found (looked for {})", file.display())));
-            }
-            let placed = placed_gltf(&file, material_offset)?;
+            regular_file(&file, "mesh gltf", gltf)?;
+            let placed = sources
+                .place((true, file.clone()), &format!("mesh gltf '{gltf}'"), || placed_gltf(&file, material_offset))?;
             (placed.meshes, placed.materials, placed.nodes)
         }
         (None, None, Some(name)) => {
             let scene = builtin::load(name).map_err(|e| Failure::Here(e.to_string()))?;
             let mut meshes = scene.meshes;
             meshes.iter_mut().for_each(|m| m.material += material_offset);
+            sources.budget = sources.budget.plus(limits::GeometryBudget::of(&meshes), &format!("builtin '{name}'"))?;
             (meshes, scene.materials, scene.nodes)
         }
         _ => {
@@ -342,8 +427,12 @@ fn load_mesh_entry(
             }
         }
     }
-    // Each part may be in range and their product not (a large scale of a distant mesh).
+    // Each part may be in range and their product not (a large scale of a distant mesh,
+    // a far key of a large placement).
     if let Some(trouble) = meshes.iter().find_map(limits::mesh_trouble) {
+        return Err(Failure::Here(trouble));
+    }
+    if let Some(trouble) = limits::motion_trouble(&meshes, &nodes) {
         return Err(Failure::Here(trouble));
     }
     Ok(Placed { meshes, materials, nodes })
@@ -388,6 +477,25 @@ fn animation_tracks(animation: &AnimationEntry) -> std::result::Result<NodeTrack
     }
     if let Some(w) = times.windows(2).find(|w| w[1] <= w[0]) {
         return Err(Failure::Here(format!("animation key times {} then {} are not strictly increasing", w[0], w[1])));
+    }
+    // The bounds static values have (`limits.rs`): far translations and large scales are
+    // refused, and tiny scales unless exactly 0 (which hides the mesh while it holds).
+    for (k, key) in keys.iter().enumerate() {
+        let far = key
+            .translate
+            .iter()
+            .flatten()
+            .find_map(|&c| limits::coordinate_trouble(&format!("animation key {} translate", k + 1), c));
+        let scale = match key.scale {
+            None => Vec::new(),
+            Some(Scale::Uniform(s)) => vec![s],
+            Some(Scale::PerAxis(s)) => s.to_vec(),
+        };
+        let scale =
+            scale.into_iter().find_map(|c| limits::key_scale_trouble(&format!("animation key {} scale", k + 1), c));
+        if let Some(trouble) = far.or(scale) {
+            return Err(Failure::Here(trouble));
+        }
     }
     // Each property: present in every key or in none.
     fn track<T>(
@@ -561,12 +669,7 @@ fn environment_unchecked(entry: &EnvironmentEntry, directory: &Path) -> std::res
     match (&entry.hdr, entry.sky.as_deref()) {
         (Some(hdr), None) => {
             let file = resolve(directory, "environment hdr", hdr)?;
-            if !file.is_file() {
-                return Err(Failure::Here(format!(
-                    "environment hdr '{hdr}' not found (looked for {})",
-                    file.display()
-                )));
-            }
+            regular_file(&file, "environment hdr", hdr)?;
             Environment::load_hdr(&file, intensity).map_err(Failure::Elsewhere)
         }
         (None, Some("default")) => Ok(Environment { intensity, ..Environment::default_sky() }),
@@ -577,6 +680,12 @@ fn environment_unchecked(entry: &EnvironmentEntry, directory: &Path) -> std::res
 
 fn head_pose(eye: [f64; 3], look_at: [f64; 3]) -> std::result::Result<HeadPose, Failure> {
     let (eye, target) = (finite3("eye", eye)?, finite3("look_at", look_at)?);
+    // The head is where the frame is drawn from: as far as any vertex may be.
+    let far = eye.to_array().into_iter().find_map(|c| limits::coordinate_trouble("eye", c));
+    let far = far.or_else(|| target.to_array().into_iter().find_map(|c| limits::coordinate_trouble("look_at", c)));
+    if let Some(trouble) = far {
+        return Err(Failure::Here(trouble));
+    }
     HeadPose::look_at(eye, target)
         .ok_or_else(|| Failure::Here(format!("eye {:?} and look_at {:?} coincide", eye.to_array(), target.to_array())))
 }
@@ -717,6 +826,122 @@ path = [{ t = 0, eye = [0, 1.6, 3], look_at = [0, 1, 0] }, { t = 2.5, eye = [1, 
             let message = error(text);
             assert!(message.contains(expected), "{message:?} should contain {expected:?}");
         }
+    }
+
+    #[test]
+    fn far_keys_heads_and_motion_are_refused_and_scale_zero_keys_hide() {
+        let mesh = "[[mesh]]\nbuiltin = \"box\"\n";
+        let keys = |a: &str, b: &str| format!("{mesh}animation = {{ keys = [{{ t = 0, {a} }}, {{ t = 1, {b} }}] }}\n");
+        for (text, expected) in [
+            (keys("translate = [0, 0, 0]", "translate = [1e30, 0, 0]"), "scene.toml:1: animation key 2 translate 1e30 m is farther than 1e6 m"),
+            (keys("translate = [0, 0, 0]", "translate = [0, -3e38, 0]"), "animation key 2 translate -3e38 m is farther"),
+            (keys("scale = 1", "scale = 1e30"), "scene.toml:1: animation key 2 scale 1e30 is larger than 1e6"),
+            (keys("scale = [1, 1e-30, 1]", "scale = 1"), "animation key 1 scale 1e-30 is smaller than 1e-6 and not 0"),
+            // Each value in range, their product not.
+            (format!("{mesh}translate = [9e5, 0, 0]\nanimation = {{ keys = [{{ t = 0, translate = [0, 0, 0] }}, {{ t = 1, translate = [9e5, 0, 0] }}] }}\n"), "scene.toml:1: moving mesh"),
+            (format!("{mesh}[head]\neye = [1e30, 1, 0]\nlook_at = [0, 0, 0]\n"), "scene.toml:3: eye 1e30 m is farther than 1e6 m"),
+            (format!("{mesh}[head]\neye = [0, 1, 0]\nlook_at = [0, 0, -2e6]\n"), "look_at -2e6 m is farther"),
+            (format!("{mesh}[head]\npath = [{{ t = 0, eye = [0, 1, 2], look_at = [0, 0, 0] }}, {{ t = 1, eye = [0, 1, 3e38], look_at = [0, 0, 0] }}]\n"), "eye 3e38 m is farther"),
+        ] {
+            let message = error(&text);
+            assert!(message.contains(expected), "{message:?} should contain {expected:?}");
+        }
+        let moving = parse_str(&format!("{mesh}translate = [9e5, 0, 0]\nanimation = {{ keys = [{{ t = 0, translate = [0, 0, 0] }}, {{ t = 1, translate = [-1e5, 0, 0] }}] }}\n"));
+        assert!(moving.is_ok(), "{:?}", moving.err());
+        // A scale key of exactly 0 hides the box while it holds: loaded, every value finite.
+        let scene = parse_str(&keys("scale = 1", "scale = [0, 0, 0]")).unwrap();
+        for t in [0.0, 0.5, 1.0] {
+            let still = scene.at_time(t);
+            assert!(still
+                .meshes
+                .iter()
+                .all(|m| m.origin.is_finite() && m.positions.iter().chain(&m.normals).all(|v| v.is_finite())));
+        }
+        let bounds = scene.bounds();
+        assert!(bounds.min.is_finite() && bounds.max.is_finite());
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("vrao-scene-file-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_named_file_that_is_a_fifo_device_or_folder_is_named_as_what_it_is() {
+        let dir = scratch("special");
+        std::os::unix::fs::symlink("/dev/zero", dir.join("zero.obj")).unwrap();
+        std::fs::create_dir(dir.join("folder.glb")).unwrap();
+        let fifo = std::process::Command::new("mkfifo").arg(dir.join("pipe.hdr")).status().is_ok_and(|s| s.success());
+        let scene = dir.join("scene.toml");
+        let mut cases = vec![
+            (
+                "[[mesh]]\nobj = \"zero.obj\"\n",
+                "scene.toml:1: mesh obj 'zero.obj' (",
+                "zero.obj) is a character device, not a regular file",
+            ),
+            (
+                "[[mesh]]\ngltf = \"folder.glb\"\n",
+                "scene.toml:1: mesh gltf 'folder.glb' (",
+                "folder.glb) is a directory, not a regular file",
+            ),
+        ];
+        if fifo {
+            cases.push((
+                "[[mesh]]\nbuiltin = \"box\"\n[environment]\nhdr = \"pipe.hdr\"\n",
+                "scene.toml:3: environment hdr 'pipe.hdr' (",
+                "pipe.hdr) is a FIFO (named pipe), not a regular file",
+            ));
+        }
+        for (text, starts, ends) in cases {
+            std::fs::write(&scene, text).unwrap();
+            let e = load(&scene).unwrap_err().to_string();
+            assert!(e.contains(starts) && e.ends_with(ends), "{e}");
+        }
+    }
+
+    #[cfg(feature = "gltf")]
+    #[test]
+    fn a_file_placed_many_times_is_refused_at_the_placement_that_passes_the_scene_budget() {
+        // The sweep's case: one 2 M-triangle glTF (three vertices with their normals, one
+        // triangle's indices repeated) placed 30 times. Read once; refused at the 11th
+        // placement, before its copy is made, naming that entry's line.
+        let dir = scratch("budget");
+        let triangles = 2_000_000u32;
+        let corners = [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        let mut bin: Vec<u8> = corners.iter().flat_map(|f| f.to_le_bytes()).collect();
+        bin.extend((0..3 * triangles).flat_map(|i| ((i % 3) as u16).to_le_bytes()));
+        std::fs::write(dir.join("big.bin"), &bin).unwrap();
+        let gltf = format!(
+            r#"{{"asset":{{"version":"2.0"}},"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":2}},"indices":1}}]}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"bufferView":1,"componentType":5123,"count":{},"type":"SCALAR"}},{{"bufferView":2,"componentType":5126,"count":3,"type":"VEC3"}}],"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":72,"byteLength":{}}},{{"buffer":0,"byteOffset":36,"byteLength":36}}],"buffers":[{{"byteLength":{},"uri":"big.bin"}}]}}"#,
+            3 * triangles,
+            6 * triangles,
+            bin.len()
+        );
+        std::fs::write(dir.join("big.gltf"), gltf).unwrap();
+        let entries: String =
+            (0..30).map(|i| format!("[[mesh]]\ngltf = \"big.gltf\"\ntranslate = [{i}, 0, 0]\n")).collect();
+        let scene = dir.join("scene.toml");
+        std::fs::write(&scene, &entries).unwrap();
+        let started = std::time::Instant::now();
+        let e = load(&scene).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!(
+                "{}:31: mesh gltf 'big.gltf' brings the scene to 22000000 triangles",
+                scene.display()
+            )) && e.contains("more than vrao's limit of 20000000 triangles"),
+            "{e}"
+        );
+        assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+        // Ten placements fit, and share the first one's materials.
+        let ten: String = entries.lines().take(30).map(|l| format!("{l}\n")).collect();
+        std::fs::write(&scene, ten).unwrap();
+        let scene = load(&scene).unwrap();
+        assert_eq!(scene.triangle_count(), 20_000_000);
+        assert_eq!(scene.materials.len(), 1);
+        assert!((scene.meshes[9].origin.x - 9.0 - scene.meshes[0].origin.x).abs() < 1e-9);
     }
 
     #[test]

@@ -22,6 +22,65 @@ pub const COORDINATE_MAX_M: f64 = 1.0e6;
 /// collapse to a point.
 pub const SCALE_MIN: f64 = 1.0e-6;
 
+/// The largest scale an animation key may give: a metre-sized mesh at this scale already
+/// reaches [`COORDINATE_MAX_M`].
+pub const SCALE_MAX: f64 = 1.0e6;
+
+/// The most triangles a scene may hold, over every mesh instance of every file it places
+/// (20 million): the budget of a scene file, a glTF, an OBJ and a built-in scene alike.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// The most vertices a scene may hold, over every mesh instance (20 million).
+pub const MAX_VERTICES: usize = 20_000_000;
+
+/// The largest texture side in texels, for every image a scene names.
+pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+
+/// The triangles and vertices a scene holds so far, checked against [`MAX_TRIANGLES`] and
+/// [`MAX_VERTICES`] as each part is added (so that a file placed many times is refused
+/// before the memory for all of them is spent).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GeometryBudget {
+    /// Triangles so far.
+    pub triangles: usize,
+    /// Vertices so far.
+    pub vertices: usize,
+}
+
+impl GeometryBudget {
+    /// The triangles and vertices of `meshes`.
+    pub fn of(meshes: &[Mesh]) -> GeometryBudget {
+        meshes.iter().fold(GeometryBudget::default(), |b, m| GeometryBudget {
+            triangles: b.triangles + m.indices.len() / 3,
+            vertices: b.vertices + m.positions.len(),
+        })
+    }
+
+    /// This budget with `more` added, or one-line trouble (naming what `what` adds) when
+    /// the sum passes either limit.
+    pub fn plus(self, more: GeometryBudget, what: &str) -> std::result::Result<GeometryBudget, String> {
+        let sum = GeometryBudget {
+            triangles: self.triangles.saturating_add(more.triangles),
+            vertices: self.vertices.saturating_add(more.vertices),
+        };
+        match sum.trouble() {
+            Some(trouble) => Err(format!("{what} brings the scene to {trouble}")),
+            None => Ok(sum),
+        }
+    }
+
+    /// One-line trouble when these counts pass either limit.
+    pub fn trouble(self) -> Option<String> {
+        (self.triangles > MAX_TRIANGLES || self.vertices > MAX_VERTICES).then(|| {
+            format!(
+                "{} triangles and {} vertices, more than vrao's limit of {MAX_TRIANGLES} triangles and {MAX_VERTICES} \
+                 vertices over the whole scene",
+                self.triangles, self.vertices
+            )
+        })
+    }
+}
+
 /// `what` (a colour times its intensity, per channel) as one-line trouble when some
 /// channel is brighter than [`RADIANCE_MAX`].
 pub fn radiance_trouble(what: &str, brightest: f64) -> Option<String> {
@@ -42,7 +101,7 @@ pub fn coordinate_trouble(what: &str, value: f64) -> Option<String> {
 
 /// `value` in exponent form, as short as its precision allows: a value read as f32
 /// prints as the file wrote it (3e38, not 3.0000000054977558e38).
-fn shortest(value: f64) -> String {
+pub(crate) fn shortest(value: f64) -> String {
     let single = value as f32;
     if single.is_finite() && (single as f64 - value).abs() <= value.abs() * 1e-7 {
         format!("{single:e}")
@@ -57,6 +116,50 @@ pub fn scale_trouble(scale: f64) -> Option<String> {
         .then(|| format!("scale {} is smaller than {SCALE_MIN:e} (the mesh would vanish)", shortest(scale)))
 }
 
+/// One-line trouble for an animation key's scale factor: larger than [`SCALE_MAX`] in
+/// size, or smaller than [`SCALE_MIN`] but not 0 (a key of exactly 0 hides the object
+/// while it holds, as content does; the renderer draws nothing of it then).
+pub fn key_scale_trouble(what: &str, scale: f64) -> Option<String> {
+    if scale.abs() > SCALE_MAX {
+        return Some(format!("{what} {} is larger than {SCALE_MAX:e}", shortest(scale)));
+    }
+    (scale != 0.0 && scale.abs() < SCALE_MIN).then(|| {
+        format!("{what} {} is smaller than {SCALE_MIN:e} and not 0 (the mesh would collapse)", shortest(scale))
+    })
+}
+
+/// One-line trouble when a texture is wider or taller than [`MAX_TEXTURE_SIDE`] (or empty).
+pub fn texture_side_trouble(width: u32, height: u32) -> Option<String> {
+    (width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE || width == 0 || height == 0)
+        .then(|| format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}"))
+}
+
+/// The image decoder's limits for textures: sides up to [`MAX_TEXTURE_SIDE`], and memory
+/// for such a texture at 16 bits per channel (the image crate's own default, 512 MiB,
+/// would refuse a valid 16384 × 16384 RGBA8 texture, 1 GiB).
+pub fn texture_decoder_limits() -> image::Limits {
+    let side = MAX_TEXTURE_SIDE as u64;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(side * side * 8);
+    limits
+}
+
+/// Decodes an image file's bytes (PNG, JPEG, TGA, BMP, by content) under
+/// [`texture_decoder_limits`]: a side over [`MAX_TEXTURE_SIDE`] is refused from the header,
+/// before any texel is decoded.
+pub fn decode_texture(bytes: &[u8]) -> std::result::Result<image::DynamicImage, String> {
+    let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format();
+    let (width, height) = reader().map_err(|e| e.to_string())?.into_dimensions().map_err(|e| e.to_string())?;
+    if let Some(trouble) = texture_side_trouble(width, height) {
+        return Err(trouble);
+    }
+    let mut reader = reader().map_err(|e| e.to_string())?;
+    reader.limits(texture_decoder_limits());
+    reader.decode().map_err(|e| e.to_string())
+}
+
 /// One-line trouble when some vertex of `mesh` (static, in world space) lies beyond
 /// [`COORDINATE_MAX_M`]: the first such vertex, by its number in the mesh.
 pub fn mesh_trouble(mesh: &Mesh) -> Option<String> {
@@ -65,6 +168,62 @@ pub fn mesh_trouble(mesh: &Mesh) -> Option<String> {
         let farthest = world.abs().max_element();
         let trouble = coordinate_trouble(&format!("vertex {} of mesh '{}' lies at", i + 1, mesh.name), farthest);
         trouble.or_else(|| (!world.is_finite()).then(|| format!("mesh '{}' has a vertex at infinity", mesh.name)))
+    })
+}
+
+/// One-line trouble when a moving mesh (one that hangs from a node of `nodes`) reaches
+/// beyond [`COORDINATE_MAX_M`] over its animation: its local bounds' corners at 65 times
+/// over the loop (as [`Scene::swept_corners`] samples them for the scene's bounds), each
+/// key's value already in range but their product (a far key times a large scale, a large
+/// placement of a moving root) not.
+pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> {
+    const SAMPLES: usize = 64;
+    if !meshes.iter().any(|m| m.node.is_some()) {
+        return None;
+    }
+    let period = nodes.iter().map(|n| n.tracks.end()).fold(0.0, f64::max);
+    let times: Vec<f64> = (0..=SAMPLES).map(|k| period * k as f64 / SAMPLES as f64).collect();
+    let transforms: Vec<Vec<glam::DMat4>> =
+        times.iter().map(|&t| super::animation::world_transforms(nodes, t)).collect();
+    for mesh in meshes {
+        let Some(node) = mesh.node else { continue };
+        let mut local = super::Aabb::EMPTY;
+        mesh.positions.iter().filter(|p| p.is_finite()).for_each(|p| local.extend(mesh.origin + p.as_dvec3()));
+        if local.is_empty() {
+            continue;
+        }
+        for (world, t) in transforms.iter().zip(&times) {
+            let Some(world) = world.get(node) else { continue };
+            for corner in 0..8 {
+                let pick = |bit: usize, lo: f64, hi: f64| if corner & bit == 0 { lo } else { hi };
+                let c = glam::DVec3::new(
+                    pick(1, local.min.x, local.max.x),
+                    pick(2, local.min.y, local.max.y),
+                    pick(4, local.min.z, local.max.z),
+                );
+                let farthest = world.transform_point3(c).abs().max_element();
+                if !(farthest <= COORDINATE_MAX_M) {
+                    return Some(format!(
+                        "moving mesh '{}' reaches {} m from the origin at t = {t} s, farther than {COORDINATE_MAX_M:e} m",
+                        mesh.name,
+                        shortest(farthest)
+                    ));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// One-line trouble when a head pose of `head` (a scene file's head or path, a glTF's
+/// camera) lies beyond [`COORDINATE_MAX_M`].
+pub fn head_trouble(head: &super::HeadPath) -> Option<String> {
+    head.keys.iter().find_map(|(t, pose)| {
+        let what = match head.keys.len() {
+            1 => "the head (camera) position".to_string(),
+            _ => format!("the head (camera) position at t = {t} s"),
+        };
+        coordinate_trouble(&what, pose.position.abs().max_element())
     })
 }
 

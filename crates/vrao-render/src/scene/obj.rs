@@ -22,6 +22,7 @@
 //! are kept (they rasterise to nothing and keep triangle counts equal to the file's) but
 //! carry no weight in normals.
 
+use super::limits::GeometryBudget;
 use super::normals::{self, Geometry};
 use super::{Environment, HeadPath, Light, Material, Mesh, Scene, Texture};
 use crate::error::{Error, Result};
@@ -39,14 +40,32 @@ pub const DEFAULT_DIFFUSE: f32 = 0.8;
 /// already holds that many. A grey material is appended when some mesh names none (or
 /// names one no library defines). A missing library is a warning, not an error.
 pub fn load_obj(path: &Path, material_offset: usize) -> Result<(Vec<Mesh>, Vec<Material>)> {
+    load_obj_within(path, material_offset, GeometryBudget::default())
+}
+
+/// [`load_obj`] for a scene that already holds `used` triangles and vertices: the file is
+/// refused at the face (or vertex) that passes the scene's budget ([`super::limits`]),
+/// before the meshes are built.
+pub fn load_obj_within(
+    path: &Path,
+    material_offset: usize,
+    used: GeometryBudget,
+) -> Result<(Vec<Mesh>, Vec<Material>)> {
     let text = read_text(path)?;
-    let scan = scan_obj(path, &text)?;
+    let scan = scan_obj(path, &text, used)?;
     let mut libraries: HashMap<PathBuf, Vec<MtlMaterial>> = HashMap::new();
     for (library, line) in &scan.libraries {
-        if library.is_file() {
-            libraries.insert(library.clone(), scan_mtl(library)?);
-        } else {
-            log::warn!("{}:{line}: material library {} not found; using grey", path.display(), library.display());
+        match crate::files::check_regular_file(library) {
+            Ok(_) => {
+                libraries.insert(library.clone(), scan_mtl(library)?);
+            }
+            Err(e) => {
+                let what = match e.problem {
+                    crate::files::FileProblem::Missing => "not found".to_string(),
+                    problem => problem.to_string(),
+                };
+                log::warn!("{}:{line}: material library {} {what}; using grey", path.display(), library.display());
+            }
         }
     }
     for (name, line) in &scan.used_materials {
@@ -95,6 +114,8 @@ pub fn load_obj(path: &Path, material_offset: usize) -> Result<(Vec<Mesh>, Vec<M
     if meshes.is_empty() {
         return Err(Error::in_file(path, "contains no faces"));
     }
+    // tobj makes a vertex per distinct position/uv/normal triple: counted again, exactly.
+    used.plus(GeometryBudget::of(&meshes), "the file").map_err(|trouble| Error::in_file(path, trouble))?;
     Ok((meshes, materials))
 }
 
@@ -163,11 +184,14 @@ fn emitter_light(mesh: &Mesh, emissive: Vec3) -> Option<Light> {
     })
 }
 
-/// Reads a text file; bytes that are not UTF-8 (say, a Latin-1 comment) become U+FFFD
-/// rather than failing the load.
+/// Reads a text file (a regular file of at most [`crate::files::MAX_FILE_BYTES`]); bytes
+/// that are not UTF-8 (say, a Latin-1 comment) become U+FFFD rather than failing the load.
 fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::in_file(path, format!("cannot read: {e}")))?;
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
+    let bytes = crate::files::read_regular_file(path, crate::files::MAX_FILE_BYTES)?;
+    Ok(match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => String::from_utf8_lossy(e.as_bytes()).into_owned(),
+    })
 }
 
 /// The part of an OBJ or MTL line before its `#` comment.
@@ -204,11 +228,13 @@ struct Defined {
     normals: usize,
 }
 
-fn scan_obj(path: &Path, text: &str) -> Result<ObjScan> {
+fn scan_obj(path: &Path, text: &str, used: GeometryBudget) -> Result<ObjScan> {
     let directory = path.parent().unwrap_or(Path::new(""));
     let mut scan =
         ObjScan { clean: String::with_capacity(text.len()), libraries: Vec::new(), used_materials: Vec::new() };
     let mut defined = Defined::default();
+    // The scene so far plus this file's faces (fan-triangulated) and positions.
+    let mut counted = used;
     for (number, raw) in text.lines().enumerate() {
         let line = number + 1;
         let content = strip_comment(raw).trim();
@@ -244,6 +270,8 @@ fn scan_obj(path: &Path, text: &str) -> Result<ObjScan> {
                 }
                 out.push_str(&format!("v {} {} {}\n", xyz[0], xyz[1], xyz[2]));
                 defined.vertices += 1;
+                let one = GeometryBudget { triangles: 0, vertices: 1 };
+                counted = counted.plus(one, "this vertex").map_err(|trouble| Error::at_line(path, line, trouble))?;
             }
             "vt" => {
                 let uv = numbers("texture coordinate")?;
@@ -269,6 +297,8 @@ fn scan_obj(path: &Path, text: &str) -> Result<ObjScan> {
                 for word in &words {
                     check_face_vertex(word, &defined).map_err(|problem| Error::at_line(path, line, problem.0))?;
                 }
+                let face = GeometryBudget { triangles: words.len() - 2, vertices: 0 };
+                counted = counted.plus(face, "this face").map_err(|trouble| Error::at_line(path, line, trouble))?;
                 out.push_str(&format!("f {rest}\n"));
             }
             "mtllib" => {
@@ -453,8 +483,12 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
                     return Err(at(format!("{key} needs a texture file name")));
                 }
                 let texture = directory.join(name);
-                if !texture.is_file() {
-                    return Err(at(format!("texture file '{name}' not found (looked for {})", texture.display())));
+                match crate::files::check_regular_file(&texture) {
+                    Ok(_) => {}
+                    Err(e) if matches!(e.problem, crate::files::FileProblem::Missing) => {
+                        return Err(at(format!("texture file '{name}' not found (looked for {})", texture.display())));
+                    }
+                    Err(e) => return Err(at(format!("texture file '{name}' ({}) {}", texture.display(), e.problem))),
                 }
                 if let Some(m) = materials.last_mut() {
                     if key == "map_Kd" {
@@ -470,11 +504,17 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
     Ok(materials)
 }
 
+/// The image in a texture file (a regular file of at most [`crate::files::MAX_FILE_BYTES`]),
+/// decoded under the texture limits ([`super::limits::decode_texture`]: sides up to
+/// [`super::limits::MAX_TEXTURE_SIDE`]).
+fn read_image(path: &Path, what: &str) -> Result<image::DynamicImage> {
+    let bytes = crate::files::read_regular_file(path, crate::files::MAX_FILE_BYTES)?;
+    super::limits::decode_texture(&bytes).map_err(|e| Error::in_file(path, format!("cannot decode {what}: {e}")))
+}
+
 /// Decodes an image file into RGBA8 (PNG, JPEG, TGA or BMP, by content).
 fn load_texture(path: &Path) -> Result<Texture> {
-    let cannot = |e: &dyn std::fmt::Display| Error::in_file(path, format!("cannot decode texture: {e}"));
-    let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
-    let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?.into_rgba8();
+    let image = read_image(path, "texture")?.into_rgba8();
     Ok(Texture {
         sampling: Default::default(),
         width: image.width(),
@@ -487,9 +527,7 @@ fn load_texture(path: &Path) -> Result<Texture> {
 /// An alpha map (MTL `map_d`): its alpha channel when the image has one, else its grey
 /// level, as (width, height, one byte per texel).
 fn load_alpha(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
-    let cannot = |e: &dyn std::fmt::Display| Error::in_file(path, format!("cannot decode alpha texture: {e}"));
-    let reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
-    let image = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?;
+    let image = read_image(path, "alpha texture")?;
     let (width, height) = (image.width(), image.height());
     let coverage = if image.color().has_alpha() {
         image.into_rgba8().pixels().map(|p| p.0[3]).collect()
@@ -565,7 +603,7 @@ mod tests {
     use super::*;
 
     fn scan(text: &str) -> Result<ObjScan> {
-        scan_obj(Path::new("t.obj"), text)
+        scan_obj(Path::new("t.obj"), text, GeometryBudget::default())
     }
 
     #[test]
