@@ -139,10 +139,10 @@ mod tests {
         // u' = cos·u + sin·v, v' = −sin·u + cos·v.
         assert!(quarter.transform_point2(Vec2::X).abs_diff_eq(Vec2::new(0.0, -1.0), 1e-6));
         assert!(quarter.transform_point2(Vec2::Y).abs_diff_eq(Vec2::new(1.0, 0.0), 1e-6));
-        let (offset, rotation, scale) = (Vec2::new(0.5, -0.25), 0.392699, Vec2::new(1.5, 2.0));
+        let (offset, rotation, scale) = (Vec2::new(0.5, -0.25), 0.3f32, Vec2::new(1.5, 2.0));
         let t = uv_transform(offset, rotation, scale);
         // Scale first, then rotate, then offset.
-        let expected = offset + Vec2::new(0.392699f32.cos() * 1.5, -0.392699f32.sin() * 1.5);
+        let expected = offset + Vec2::new(0.3f32.cos() * 1.5, -0.3f32.sin() * 1.5);
         assert!(t.transform_point2(Vec2::X).abs_diff_eq(expected, 1e-6));
         let (o, r, s) = uv_transform_parts(&t);
         assert!(o.abs_diff_eq(offset, 1e-6) && (r - rotation).abs() < 1e-6 && s.abs_diff_eq(scale, 1e-5));
