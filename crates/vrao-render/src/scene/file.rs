@@ -25,7 +25,9 @@
 //! scale = 1.0                      # or [sx, sy, sz]; finite and nonzero (optional)
 //! # optional: moves the entry's meshes by keyframes (world = placement · TRS(t) · mesh);
 //! # each key gives the same properties, t in seconds strictly increasing (at most 10000 keys);
-//! # the animation loops over the longest track of the scene
+//! # the animation loops over the longest track of the scene; keys obey the bounds of
+//! # `limits.rs` (translate within 1e6 m, scale at most 1e6 and either 0, which hides the
+//! # mesh while it holds, or at least 1e-6), as eye and look_at do
 //! animation = { interpolation = "linear", keys = [        # or "step"
 //!     { t = 0.0, translate = [0, 0, 0], rotate_deg = [0, 0, 0], scale = 1.0 },
 //!     { t = 2.0, translate = [1, 0, 0], rotate_deg = [0, 90, 0], scale = 1.0 } ] }
@@ -54,7 +56,9 @@
 //! ```
 //!
 //! A glTF's static meshes are placed like an OBJ's; its moving nodes' roots take the
-//! placement into their `base` (so they move in the placed frame).
+//! placement into their `base` (so they move in the placed frame). A file placed by several
+//! entries is read once; every entry's meshes count against one triangle and vertex budget
+//! for the scene ([`limits::GeometryBudget`]), checked before each copy is made.
 //!
 //! Transforms are applied in f64 to each mesh's origin and in f32 to its (small) offsets;
 //! normals use the inverse transpose, and a mirroring scale reverses the winding so that
