@@ -26,7 +26,7 @@
 //! the head pose; translation, rotation and scale animation channels (STEP, LINEAR,
 //! CUBICSPLINE).
 //!
-//! Not read, one warning line per file ([`Warnings`]): points and lines, skins and morph
+//! Not read, one warning line per file (`Warnings`): points and lines, skins and morph
 //! targets (drawn in the bind pose), weight animations, texture sets other than 0,
 //! metallic-roughness, light `range`, unknown optional extensions. `doubleSided` is moot
 //! (vrao draws every face from both sides, as for OBJ). Lights hang where their nodes are
