@@ -128,10 +128,14 @@ pub fn key_scale_trouble(what: &str, scale: f64) -> Option<String> {
     })
 }
 
-/// One-line trouble when a texture is wider or taller than [`MAX_TEXTURE_SIDE`] (or empty).
+/// One-line trouble when a texture is wider or taller than [`MAX_TEXTURE_SIDE`] (or empty),
+/// worded as the device's own check ([`check_texture_sizes`]) words it.
 pub fn texture_side_trouble(width: u32, height: u32) -> Option<String> {
-    (width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE || width == 0 || height == 0)
-        .then(|| format!("{width}×{height} texels; vrao takes sides of 1 to {MAX_TEXTURE_SIDE}"))
+    if width == 0 || height == 0 {
+        return Some(format!("{width}x{height} texels: an empty image"));
+    }
+    (width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE)
+        .then(|| format!("{width}x{height} texels; vrao takes at most {MAX_TEXTURE_SIDE} per side (scale it down)"))
 }
 
 /// The image decoder's limits for textures: sides up to [`MAX_TEXTURE_SIDE`], and memory
