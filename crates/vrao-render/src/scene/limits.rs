@@ -272,6 +272,26 @@ mod tests {
     }
 
     #[test]
+    fn one_budget_for_the_scene_and_every_builtin_within_it() {
+        let most = GeometryBudget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES };
+        assert_eq!(most.trouble(), None);
+        let e = most.plus(GeometryBudget { triangles: 1, vertices: 0 }, "mesh obj 'a.obj'").unwrap_err();
+        assert_eq!(
+            e,
+            "mesh obj 'a.obj' brings the scene to 20000001 triangles and 20000000 vertices, more than vrao's limit \
+             of 20000000 triangles and 20000000 vertices over the whole scene"
+        );
+        for name in crate::scene::builtin::NAMES {
+            let scene = crate::scene::Scene::load(&format!("builtin:{name}")).unwrap();
+            assert_eq!(GeometryBudget::of(&scene.meshes).trouble(), None, "{name}");
+            assert_eq!(motion_trouble(&scene.meshes, &scene.nodes), None, "{name}");
+        }
+        assert!(key_scale_trouble("s", 0.0).is_none() && key_scale_trouble("s", 1e6).is_none());
+        assert!(key_scale_trouble("s", -1e-7).unwrap().contains("not 0"));
+        assert!(key_scale_trouble("s", 2e6).unwrap().contains("larger than 1e6"));
+    }
+
+    #[test]
     fn a_texture_over_the_device_limit_is_refused_naming_its_file_and_the_limit() {
         let mut scene = crate::scene::builtin::load("plane").unwrap();
         let mut material = Material::plain("wide", Vec3::ONE);

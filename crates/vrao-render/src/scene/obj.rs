@@ -607,6 +607,18 @@ mod tests {
     }
 
     #[test]
+    fn the_scene_budget_is_counted_face_by_face_on_top_of_the_scene_so_far() {
+        use super::super::limits::{MAX_TRIANGLES, MAX_VERTICES};
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+        let nearly = |triangles, vertices| GeometryBudget { triangles, vertices };
+        assert!(scan_obj(Path::new("t.obj"), text, nearly(MAX_TRIANGLES - 2, MAX_VERTICES - 4)).is_ok());
+        let e = scan_obj(Path::new("t.obj"), text, nearly(MAX_TRIANGLES - 1, 0)).unwrap_err().to_string();
+        assert!(e.starts_with("t.obj:6: this face brings the scene to 20000001 triangles and 4 vertices"), "{e}");
+        let e = scan_obj(Path::new("t.obj"), text, nearly(0, MAX_VERTICES - 2)).unwrap_err().to_string();
+        assert!(e.starts_with("t.obj:3: this vertex brings the scene to 0 triangles and 20000001 vertices"), "{e}");
+    }
+
+    #[test]
     fn face_indices_resolve_against_elements_defined_so_far() {
         let ok = "v 0 0 0\nv 1 0 0\nvt 0 0\nvn 0 1 0\nv 0 0 1\nf 1/1/1 -2/-1/-1 3//1\n";
         assert!(scan(ok).is_ok());

@@ -356,6 +356,24 @@ mod tests {
     }
 
     #[test]
+    fn a_camera_carried_beyond_the_far_bound_is_refused() {
+        // Each node in range, the chain not: the camera (the head) 1.8e6 m out.
+        let dir = scratch("far-camera");
+        let camera = r#""cameras":[{"type":"perspective","perspective":{"yfov":1,"znear":0.1}}],"asset""#;
+        let chain = |x: &str| {
+            triangle_gltf(&format!(r#""translation":[{x},0,0],"children":[1]"#), None)
+                .replace(r#"}],"meshes""#, &format!(r#"}},{{"camera":0,"translation":[{x},0,0]}}],"meshes""#))
+                .replace(r#""asset""#, camera)
+        };
+        assert!(load_text(&dir, "near.gltf", &chain("4e5")).is_ok());
+        let e = load_text(&dir, "far.gltf", &chain("9e5")).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(
+            e.ends_with("far.gltf: the head (camera) position 1.8e6 m is farther than 1e6 m from the origin"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn tiny_node_scales_hide_the_mesh_and_zero_scale_keys_keep_every_value_finite() {
         let dir = scratch("tiny");
         // A static node of scale 0, 1e-30, or a zero matrix: the file loads, its mesh
