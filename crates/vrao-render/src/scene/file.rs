@@ -301,8 +301,9 @@ struct Placed {
 struct Sources {
     /// How many entries still to come place each file (OBJ or glTF, as resolved).
     uses: HashMap<(bool, PathBuf), usize>,
-    /// The files placed again later, as loaded (before any placement).
-    loaded: HashMap<(bool, PathBuf), Placed>,
+    /// The files placed again later: their size, and their meshes and nodes as loaded
+    /// (before any placement) while another copy still fits the budget.
+    loaded: HashMap<(bool, PathBuf), (limits::GeometryBudget, Option<Placed>)>,
     budget: limits::GeometryBudget,
 }
 
@@ -318,7 +319,8 @@ impl Sources {
     }
 
     /// The meshes, new materials and nodes of the file `key` (named `what` in errors),
-    /// read by `load` at its first placement, copied at the others.
+    /// read by `load` at its first placement, copied at the others once the budget says
+    /// the copy fits.
     fn place(
         &mut self,
         key: (bool, PathBuf),
@@ -329,19 +331,30 @@ impl Sources {
             *n = n.saturating_sub(1);
             *n
         });
-        if let Some(cached) = self.loaded.get(&key) {
-            self.budget = self.budget.plus(limits::GeometryBudget::of(&cached.meshes), what)?;
-            let copy = match left {
-                Some(0) | None => self.loaded.remove(&key).expect("looked up above"),
-                Some(_) => Placed { meshes: cached.meshes.clone(), materials: Vec::new(), nodes: cached.nodes.clone() },
+        if let Some((size, kept)) = self.loaded.get(&key) {
+            self.budget = self.budget.plus(*size, what)?;
+            let copy = match (left, kept) {
+                (Some(0) | None, Some(_)) => self.loaded.remove(&key).and_then(|(_, kept)| kept),
+                (_, Some(kept)) => {
+                    Some(Placed { meshes: kept.meshes.clone(), materials: Vec::new(), nodes: kept.nodes.clone() })
+                }
+                (_, None) => None,
             };
-            return Ok(copy);
+            // (Not kept only when no further copy could fit, which the budget refused above.)
+            return copy.map_or_else(load, Ok);
         }
         let placed = load()?;
-        self.budget = self.budget.plus(limits::GeometryBudget::of(&placed.meshes), what)?;
+        let size = limits::GeometryBudget::of(&placed.meshes);
+        self.budget = self.budget.plus(size, what)?;
         if left.is_some_and(|n| n > 0) {
-            let again = Placed { meshes: placed.meshes.clone(), materials: Vec::new(), nodes: placed.nodes.clone() };
-            self.loaded.insert(key, again);
+            // A copy the budget will refuse is not kept: its size alone refuses it.
+            let fits = self.budget.plus(size, what).is_ok();
+            let kept = fits.then(|| Placed {
+                meshes: placed.meshes.clone(),
+                materials: Vec::new(),
+                nodes: placed.nodes.clone(),
+            });
+            self.loaded.insert(key, (size, kept));
         }
         Ok(placed)
     }
