@@ -210,7 +210,11 @@ fn special_files_named_by_any_loader_are_refused_at_once_naming_what_they_are() 
     let mut cases: Vec<(Target, String, &str)> = vec![
         (Target::Gltf, gltf_with("zero.bin"), "buffer 0: file 'zero.bin' is a character device"),
         (Target::Gltf, gltf_with("folder.png"), "buffer 0: file 'folder.png' is a directory"),
-        (Target::Gltf, gltf_with("../vrao-fuzz-outside.bin"), "buffer 0: URI '../vrao-fuzz-outside.bin' leaves the glTF's folder"),
+        (
+            Target::Gltf,
+            gltf_with("../vrao-fuzz-outside.bin"),
+            "buffer 0: URI '../vrao-fuzz-outside.bin' leaves the glTF's folder",
+        ),
         (Target::Gltf, gltf_with("/dev/zero"), "buffer 0: URI '/dev/zero' leaves the glTF's folder"),
         (Target::SceneFile, scene_with("obj = \"zero.bin\""), "mesh obj 'zero.bin' ("),
         (Target::SceneFile, scene_with("gltf = \"folder.png\""), "is a directory, not a regular file"),

@@ -206,7 +206,7 @@ pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> 
                     pick(4, local.min.z, local.max.z),
                 );
                 let farthest = world.transform_point3(c).abs().max_element();
-                if !(farthest <= COORDINATE_MAX_M) {
+                if farthest.is_nan() || farthest > COORDINATE_MAX_M {
                     return Some(format!(
                         "moving mesh '{}' reaches {} m from the origin at t = {t} s, farther than {COORDINATE_MAX_M:e} m",
                         mesh.name,

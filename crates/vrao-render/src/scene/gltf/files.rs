@@ -322,7 +322,8 @@ mod tests {
         assert!(
             load_text(&dir, "ok.gltf", &triangle_gltf("", Some(("translation", [[0.0; 3], [2.0, 0.0, 0.0]])))).is_ok()
         );
-        let cases: [(&str, Option<(&str, [[f32; 3]; 2])>, &str); 8] = [
+        type Case<'a> = (&'a str, Option<(&'a str, [[f32; 3]; 2])>, &'a str);
+        let cases: [Case; 8] = [
             (
                 "",
                 Some(("translation", [[0.0; 3], [1e30, 0.0, 0.0]])),

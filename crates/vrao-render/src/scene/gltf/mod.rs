@@ -478,7 +478,7 @@ impl Loader<'_> {
                 }
                 ::gltf::scene::Transform::Decomposed { scale, .. } => DVec3::from(scale.map(f64::from)).abs(),
             };
-            scale.min_element() < SCALE_MIN && !tracks.get(&node.index()).is_some_and(|t| t.scale.is_some())
+            scale.min_element() < SCALE_MIN && tracks.get(&node.index()).is_none_or(|t| t.scale.is_none())
         };
         let hidden: Vec<usize> = nodes.iter().filter(|n| tiny(n)).map(|n| n.index()).collect();
         if hidden.is_empty() {
