@@ -394,12 +394,12 @@ fn sparse() -> serde_json::Value {
     let mut bin = f32_bytes(&flat);
     let indices_at = bin.len();
     bin.extend(indices.iter().flat_map(|v| v.to_le_bytes()));
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let lifted_at = bin.len();
     bin.extend(lifted.iter().flat_map(|v| v.to_le_bytes()));
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let values_at = bin.len();

@@ -407,8 +407,11 @@ fn load_mesh_entry(
         (None, Some(gltf), None) => {
             let file = resolve(directory, "mesh gltf", gltf)?;
             regular_file(&file, "mesh gltf", gltf)?;
-            let placed = sources
-                .place((true, file.clone()), &format!("mesh gltf '{gltf}'"), || placed_gltf(&file, material_offset))?;
+            // The glTF's mesh instances are counted as they are made, on top of the scene so far.
+            let used = sources.budget;
+            let placed = sources.place((true, file.clone()), &format!("mesh gltf '{gltf}'"), || {
+                placed_gltf(&file, material_offset, used)
+            })?;
             (placed.meshes, placed.materials, placed.nodes)
         }
         (None, None, Some(name)) => {
@@ -457,8 +460,12 @@ fn load_mesh_entry(
 
 /// A glTF's meshes, materials and moving nodes for a `[[mesh]] gltf = …` entry.
 #[cfg(feature = "gltf")]
-fn placed_gltf(file: &Path, material_offset: usize) -> std::result::Result<Placed, Failure> {
-    let content = super::gltf::load_content(file, material_offset).map_err(Failure::Elsewhere)?;
+fn placed_gltf(
+    file: &Path,
+    material_offset: usize,
+    used: limits::GeometryBudget,
+) -> std::result::Result<Placed, Failure> {
+    let content = super::gltf::load_content_within(file, material_offset, used).map_err(Failure::Elsewhere)?;
     if !content.lights.is_empty() || content.camera.is_some() {
         log::warn!(
             "{}: its lights and camera are not used when a scene file places it (the scene file gives them)",
@@ -470,7 +477,7 @@ fn placed_gltf(file: &Path, material_offset: usize) -> std::result::Result<Place
 
 /// Without the `gltf` feature a scene file cannot place a glTF.
 #[cfg(not(feature = "gltf"))]
-fn placed_gltf(file: &Path, _: usize) -> std::result::Result<Placed, Failure> {
+fn placed_gltf(file: &Path, _: usize, _: limits::GeometryBudget) -> std::result::Result<Placed, Failure> {
     Err(Failure::Elsewhere(super::gltf_not_built(file)))
 }
 
@@ -626,6 +633,7 @@ impl Transform {
         mesh.origin = self.translate + self.linear * mesh.origin;
         mesh.positions.iter_mut().for_each(|p| *p = linear * *p);
         mesh.normals.iter_mut().for_each(|n| *n = (normal_matrix * *n).try_normalize().unwrap_or(*n));
+        mesh.tangents = super::transform_tangents(&mesh.tangents, self.linear);
         if self.linear.determinant() < 0.0 {
             mesh.indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
         }

@@ -119,6 +119,17 @@ pub fn load(path: &Path) -> Result<Scene> {
 
 /// Reads a `.gltf` or `.glb`. Material indices start at `material_offset`.
 pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
+    load_content_within(path, material_offset, super::limits::GeometryBudget::default())
+}
+
+/// [`load_content`] into a scene that already holds `used` triangles and vertices: the
+/// file's mesh instances are counted on top of them as they are made, so a file that
+/// would pass the scene's budget is refused before its geometry is all in memory.
+pub fn load_content_within(
+    path: &Path,
+    material_offset: usize,
+    used: super::limits::GeometryBudget,
+) -> Result<Content> {
     let bytes = read_bounded(path, path)?;
     let (json_bytes, bin) = if bytes.starts_with(b"glTF") {
         let (json, bin) = split_glb(path, &bytes)?;
@@ -161,8 +172,7 @@ pub fn load_content(path: &Path, material_offset: usize) -> Result<Content> {
         material_of: HashMap::new(),
         material_offset,
         primitives: HashMap::new(),
-        triangles: 0,
-        vertices: 0,
+        budget: used,
     };
     let content = loader.build()?;
     check_limits(path, &content)?;
@@ -322,8 +332,7 @@ struct Loader<'a> {
     /// Decoded primitives by glTF mesh index (a mesh drawn by several nodes is read once).
     primitives: HashMap<usize, Vec<LocalPrimitive>>,
     /// Drawn so far, over every instance (bounded).
-    triangles: usize,
-    vertices: usize,
+    budget: super::limits::GeometryBudget,
 }
 
 /// Where a node sits while the hierarchy is walked.
@@ -528,13 +537,8 @@ impl Loader<'_> {
             if g.indices.is_empty() {
                 continue;
             }
-            self.triangles += g.indices.len() / 3;
-            self.vertices += g.positions.len();
-            if self.triangles > MAX_TRIANGLES || self.vertices > MAX_VERTICES {
-                return Err(self.error(format!(
-                    "more than {MAX_TRIANGLES} triangles or {MAX_VERTICES} vertices over all mesh instances (vrao's limit)"
-                )));
-            }
+            let more = super::limits::GeometryBudget { triangles: g.indices.len() / 3, vertices: g.positions.len() };
+            self.budget = self.budget.plus(more, &format!("mesh '{}'", primitive.name)).map_err(|m| self.error(m))?;
             let material = self.material_offset + primitive.material;
             out.push(match at.node {
                 Some(node) => {
