@@ -642,6 +642,11 @@ fn obj_map_d_and_d_become_alpha() {
     let alphas: Vec<u8> = t.rgba8.chunks(4).map(|c| c[3]).collect();
     assert_eq!(alphas, [0, 0, 255, 255, 0, 0, 255, 255, 255, 255, 0, 0, 255, 255, 0, 0]);
     assert_eq!(&t.rgba8[..3], &[10, 20, 30], "colour kept");
+    // OBJ textures tile on both axes (V was clamped).
+    assert_eq!(
+        (t.sampling.wrap_u, t.sampling.wrap_v),
+        (vrao::render::scene::Wrap::Repeat, vrao::render::scene::Wrap::Repeat)
+    );
     let bare = material(&scene, "bare").diffuse_texture.as_ref().unwrap();
     assert_eq!((bare.width, bare.height, &bare.rgba8[..8]), (2, 2, &[255, 255, 255, 0, 255, 255, 255, 255][..]));
     assert_eq!((material(&scene, "glass").alpha, material(&scene, "glass").alpha_mode), (0.25, AlphaMode::Blend));

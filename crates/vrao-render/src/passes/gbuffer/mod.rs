@@ -41,8 +41,7 @@ pub const SHADING_NORMALS: Resource =
 
 /// What the lighting passes (direct light, composite) read as normals: [`SHADING_NORMALS`]
 /// in a scene with normal textures, else [`NORMALS`].
-pub const LIGHTING_NORMALS: Resource =
-    Resource::alias("lighting-normals", wgpu::TextureFormat::Rgba16Float, None);
+pub const LIGHTING_NORMALS: Resource = Resource::alias("lighting-normals", wgpu::TextureFormat::Rgba16Float, None);
 
 /// Every colour target in location order; a scene writes those it needs.
 const COLOR_TARGETS: [Resource; 5] = [NORMALS, ALBEDO, EMISSION, MOTION, SHADING_NORMALS];

@@ -582,8 +582,11 @@ impl Loader<'_> {
             let position = primitive
                 .get(&::gltf::Semantic::Positions)
                 .ok_or_else(|| self.error(format!("{what} has no POSITION attribute")))?;
-            let positions: Vec<Vec3> =
-                self.read_as::<3>(&position, Use::Position, &format!("{what} POSITION"))?.into_iter().map(Vec3::from).collect();
+            let positions: Vec<Vec3> = self
+                .read_as::<3>(&position, Use::Position, &format!("{what} POSITION"))?
+                .into_iter()
+                .map(Vec3::from)
+                .collect();
             let count = positions.len();
             let indices: Vec<u32> = match primitive.indices() {
                 Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
