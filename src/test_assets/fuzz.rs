@@ -92,7 +92,7 @@ fn fuzz_bin() -> Vec<u8> {
     #[cfg(feature = "gltf")]
     return crate::render::scene::gltf::decode_base64(&VALID_GLTF[start..end]).unwrap_or_default();
     #[cfg(not(feature = "gltf"))]
-    return VALID_GLTF[start..end].as_bytes().to_vec();
+    return VALID_GLTF.as_bytes()[start..end].to_vec();
 }
 
 /// What a path named in an input must never be read as (made once per folder): a symlink
