@@ -372,9 +372,10 @@ pub fn runtime_trouble(manifest: Option<&std::path::Path>, active: &[std::path::
         },
     };
     let shown = manifest.display();
-    let text = match std::fs::read_to_string(&manifest) {
+    let text = match crate::render::files::read_regular_file_to_string(&manifest, crate::render::files::MAX_TEXT_BYTES)
+    {
         Ok(text) => text,
-        Err(e) => return format!("{named_by} manifest {shown} cannot be read: {e}"),
+        Err(e) => return format!("{named_by} manifest {shown} cannot be read: {}", e.problem),
     };
     let json: serde_json::Value = match serde_json::from_str(&text) {
         Ok(json) => json,

@@ -258,7 +258,9 @@ pub fn write_cache(path: &Path, key: u64, image: &ReferenceImage) -> Result<()> 
 
 /// Reads the image stored under `key` at `path`; the error says why it is unusable.
 pub fn read_cache(path: &Path, key: u64) -> std::result::Result<ReferenceImage, UnusableCache> {
-    decode(&std::fs::read(path).map_err(|e| UnusableCache(e.to_string()))?, key)
+    let bytes = crate::render::files::read_regular_file(path, crate::render::files::MAX_FILE_BYTES)
+        .map_err(|e| UnusableCache(e.problem.to_string()))?;
+    decode(&bytes, key)
 }
 
 /// Why a reference cache file cannot be used (whoever wanted it traces again).

@@ -65,7 +65,7 @@ fn source_from(dir: Option<&Path>, files: &[Shader]) -> Result<String> {
         match dir {
             Some(dir) => {
                 let path = dir.join(file.path);
-                let text = std::fs::read_to_string(&path)
+                let text = read_shader(&path)
                     .map_err(|e| Error::in_file(&path, format!("cannot read this shader ({SHADER_DIR_VAR}): {e}")))?;
                 source.push_str(&text);
             }
@@ -74,6 +74,24 @@ fn source_from(dir: Option<&Path>, files: &[Shader]) -> Result<String> {
         source.push('\n');
     }
     Ok(source)
+}
+
+/// The most bytes a shader file from the shader directory may hold (16 MiB).
+const MAX_SHADER_BYTES: u64 = 16 << 20;
+
+/// A shader file's text: a regular file only (a FIFO would block the read, a device never
+/// ends), at most [`MAX_SHADER_BYTES`] read.
+fn read_shader(path: &Path) -> std::io::Result<String> {
+    use std::io::{Error, ErrorKind, Read};
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(Error::new(ErrorKind::InvalidInput, "not a regular file"));
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)?.take(MAX_SHADER_BYTES + 1).read_to_string(&mut text)?;
+    if text.len() as u64 > MAX_SHADER_BYTES {
+        return Err(Error::new(ErrorKind::InvalidData, format!("more than {MAX_SHADER_BYTES} bytes")));
+    }
+    Ok(text)
 }
 
 /// The first error kept until someone takes it (each `Gpu` has one for its shaders).
@@ -567,6 +585,22 @@ mod tests {
             other => panic!("not an input error naming the file: {other:?}"),
         }
         assert!(error.to_string().contains("no-such-file.wgsl") && error.to_string().contains(SHADER_DIR_VAR));
+    }
+
+    #[test]
+    fn a_shader_path_that_is_a_folder_or_a_fifo_is_refused_without_blocking() {
+        let dir = std::env::temp_dir().join(format!("vrao-shader-dir-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("a-folder.wgsl")).unwrap();
+        let folder = Shader { path: "a-folder.wgsl", source: "" };
+        let error = source_from(Some(&dir), &[folder]).unwrap_err().to_string();
+        assert!(error.contains("a-folder.wgsl") && error.contains("not a regular file"), "{error}");
+        let made_fifo = std::process::Command::new("mkfifo").arg(dir.join("a-fifo.wgsl")).status();
+        if made_fifo.is_ok_and(|s| s.success()) {
+            let fifo = Shader { path: "a-fifo.wgsl", source: "" };
+            let error = source_from(Some(&dir), &[fifo]).unwrap_err().to_string();
+            assert!(error.contains("not a regular file"), "{error}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
