@@ -147,54 +147,32 @@ impl RunSummary {
         let budget_ms = headset.refresh_period_ms().filter(|ms| ms.is_finite() && *ms > 0.0);
         let budget_ms = budget_ms.unwrap_or(settings.profile.budget_ms());
         RunSummary {
-            headset: headset.describe(),
-            adapter: gpu.info.name.clone(),
-            frames_rendered: 0,
-            frames_in_flight_max: 0,
             frames_in_flight_limit: frames_in_flight,
-            budget_ms,
-            budget_source: headset.display_rate_source(),
-            budget_ms_min: budget_ms,
-            budget_ms_max: budget_ms,
-            budget_changes: 0,
-            stretched_frames: 0,
-            over_budget_frames: 0,
-            timed_frames: 0,
-            gpu_frame_ms_median: 0.0,
-            cpu_encode_ms_median: 0.0,
-            cpu_encode_share_of_gpu: 0.0,
-            timing: "no frame was rendered".into(),
             counters: openxr.as_ref().is_none_or(|r| r.fell_back).then(|| headset.counters()),
-            pass_medians_ms: Vec::new(),
             interrupted: true,
             interrupted_in: Some(state),
-            governor: "not started".into(),
-            governor_changes: Vec::new(),
             final_ao_setting: ao_setting(&settings.ao),
             openxr,
-            refused: None,
+            ..RunSummary::nothing_rendered(
+                headset.describe(),
+                gpu.info.name.clone(),
+                budget_ms,
+                headset.display_rate_source(),
+            )
         }
     }
 
-    /// The report of a run refused before its headset or window opened, for `why` (one
-    /// line): nothing was rendered; the budget is the profile's (`profile`, with the
-    /// `--refresh` given) where it names one, 0 otherwise.
-    pub fn refused(profile: Option<&crate::render::stereo::HeadsetProfile>, why: &str) -> RunSummary {
-        let budget_ms = profile.map_or(0.0, |p| p.budget_ms());
+    /// What every run that rendered no frame reports alike: no frames, no timings, the
+    /// budget it would have had, the governor not started.
+    fn nothing_rendered(headset: String, adapter: String, budget_ms: f64, budget_source: String) -> RunSummary {
         RunSummary {
-            headset: "none (the run was refused before a headset opened)".into(),
-            adapter: "none".into(),
+            headset,
+            adapter,
             frames_rendered: 0,
             frames_in_flight_max: 0,
             frames_in_flight_limit: 0,
             budget_ms,
-            budget_source: match profile {
-                Some(p) => format!(
-                    "the '{}' profile's {} Hz (the run was refused before a headset opened)",
-                    p.name, p.refresh_hz
-                ),
-                None => "none (the run was refused before a headset opened)".into(),
-            },
+            budget_source,
             budget_ms_min: budget_ms,
             budget_ms_max: budget_ms,
             budget_changes: 0,
@@ -213,7 +191,29 @@ impl RunSummary {
             governor_changes: Vec::new(),
             final_ao_setting: String::new(),
             openxr: None,
+            refused: None,
+        }
+    }
+
+    /// The report of a run refused before its headset or window opened, for `why` (one
+    /// line): nothing was rendered; the budget is the profile's (`profile`, with the
+    /// `--refresh` given) where it names one, 0 otherwise.
+    pub fn refused(profile: Option<&crate::render::stereo::HeadsetProfile>, why: &str) -> RunSummary {
+        let budget_ms = profile.map_or(0.0, |p| p.budget_ms());
+        let budget_source = match profile {
+            Some(p) => {
+                format!("the '{}' profile's {} Hz (the run was refused before a headset opened)", p.name, p.refresh_hz)
+            }
+            None => "none (the run was refused before a headset opened)".into(),
+        };
+        RunSummary {
             refused: Some(why.to_string()),
+            ..RunSummary::nothing_rendered(
+                "none (the run was refused before a headset opened)".into(),
+                "none".into(),
+                budget_ms,
+                budget_source,
+            )
         }
     }
 
