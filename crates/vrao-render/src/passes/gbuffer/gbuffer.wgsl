@@ -115,12 +115,12 @@ fn shade(in: VertexOut) -> Surface {
     let geometric = normalize(cross(dpdx(in.view_position), dpdy(in.view_position)));
     n = select(geometric, n * inverseSqrt(len2), len2 > 1e-20 && len2 == len2);
     // Surfaces are seen from the front: flip normals that face away from the eye, so
-    // OBJ files with inconsistent winding still shade correctly. The normal texture
-    // tilts the normal in the frame of the side the eye sees.
+    // OBJ files with inconsistent winding still shade correctly. The normal texture tilts
+    // the stored normal in the mesh's own frame; seen from behind, the tilted normal is
+    // turned round with it (a bump on one side is a dent on the other).
     let facing = select(1.0, -1.0, dot(n, -in.view_position) < 0.0);
+    let mapped = mapped_normal(n, in.view_tangent, in.view_position, in.uv) * facing;
     n = n * facing;
-    let tangent = vec4<f32>(in.view_tangent.xyz * facing, in.view_tangent.w);
-    let mapped = mapped_normal(n, tangent, in.view_position, in.uv);
     let card = select(0.0, 1.0, ALPHA_TEST);
     var out: Surface;
     out.normal = vec4<f32>(finite_or_zero3(n), card);
