@@ -97,15 +97,19 @@ pub fn compute_normals_with_sources(
     // The normal of face `f`'s corner at welded vertex `w`: the weighted sum over the faces
     // around `w` within the crease angle of `f`. A degenerate face borrows the normal of
     // the largest face around `w`.
-    let corner_normal = |f: usize, w: usize| -> Vec3 {
-        let around = &faces_around[start[w]..start[w + 1]];
-        let own = units[f].or_else(|| {
+    // Face `f`'s unit normal, or for a degenerate face the largest face's of `around`.
+    let own_normal = |f: usize, around: &[usize]| -> Option<Vec3> {
+        units[f].or_else(|| {
             let largest = around
                 .iter()
                 .copied()
                 .max_by(|&a, &b| tris[a].1.length_squared().total_cmp(&tris[b].1.length_squared()))?;
             units[largest]
-        });
+        })
+    };
+    let corner_normal = |f: usize, w: usize| -> Vec3 {
+        let around = &faces_around[start[w]..start[w + 1]];
+        let own = own_normal(f, around);
         let Some(own) = own else { return FALLBACK_NORMAL };
         let sum: Vec3 =
             around.iter().filter(|&&g| units[g].is_some_and(|u| u.dot(own) >= cos_crease)).map(|&g| tris[g].1).sum();
@@ -134,13 +138,7 @@ pub fn compute_normals_with_sources(
             return normal;
         }
         let around = &faces_around[start[w]..start[w + 1]];
-        let own = units[f].or_else(|| {
-            let largest = around
-                .iter()
-                .copied()
-                .max_by(|&a, &b| tris[a].1.length_squared().total_cmp(&tris[b].1.length_squared()))?;
-            units[largest]
-        });
+        let own = own_normal(f, around);
         let normal = match own {
             None => FALLBACK_NORMAL,
             Some(own) => {
