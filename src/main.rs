@@ -38,6 +38,9 @@ enum Command {
     /// Headless per-eye budget test: per-pass medians against the frame budget; exit 0
     /// within budget, 3 over it.
     Budget(cli::budget::BudgetArgs),
+    /// The peer: Bevy 0.19's SSAO (peers/bevy) and vrao's GTAO on the same frames, both
+    /// eyes, scored by the same reference and timed in one run; a table and a plot.
+    Peer(cli::peer::PeerArgs),
     /// The GPU table: per-pass ms per eye of every technique × preset × AO resolution ×
     /// foveation and the stereo frame against the budget, per scene, in one Markdown file.
     Table(cli::table::TableArgs),
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => cli::render::run(backend, args),
         Some(Command::Bench(args)) => cli::bench::run(backend, args),
         Some(Command::Budget(args)) => cli::budget::run(backend, args),
+        Some(Command::Peer(args)) => cli::peer::run(backend, args),
         Some(Command::Table(args)) => cli::table::run(backend, args),
         Some(Command::Run(args)) => cli::run::run(backend, args),
         Some(Command::Temporal(args)) => cli::temporal::run(backend, args),

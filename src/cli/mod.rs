@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod budget;
 pub mod info;
+pub mod peer;
 pub mod render;
 pub mod reprojection;
 pub mod run;

@@ -10,6 +10,7 @@ pub mod analytic;
 pub mod bench;
 pub mod budget;
 pub mod metrics;
+pub mod peer;
 pub mod plot;
 pub mod reference;
 pub mod reprojection;

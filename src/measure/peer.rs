@@ -1,0 +1,696 @@
+//! `vrao peer`: Bevy's screen-space AO (the peer program in `peers/bevy`) and vrao's on
+//! the same frames, scored by the same reference and timed in one run.
+//!
+//! The scene is written as glTF for the peer, which renders it with one Bevy camera per
+//! eye whose view and projection are vrao's own matrices for that eye (the reference's
+//! pixels are the peer's pixels). Rounds alternate the peer (every Bevy preset, frame by
+//! frame) and vrao (every case, interleaved as `vrao bench --interleave` does); the
+//! medians of the rounds' medians are reported. Both families' AO is scored with the
+//! bench's [`score`] against one reference, with the screen-space limit of vrao's depth
+//! buffer beside.
+//!
+//! What each side's time is: vrao's occlusion chain as the bench reports it (technique,
+//! denoise, upsampling at half resolution; both eyes in one dispatch), Bevy's three AO
+//! passes (depth preprocess, main pass, spatial denoise) per camera, one camera per eye.
+//! With serial timing (lavapipe) both are wall clock around work submitted alone; with
+//! pipelined timing (a GPU) both are GPU timestamps.
+
+use crate::measure::bench::{
+    pixels_per_degree, score, sweep, BenchCase, BenchRow, ErrorFigures, Measurement, ReferenceOptions,
+};
+use crate::measure::plot::{Point, ScatterPlot, Series};
+use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
+use crate::measure::reference::{trace_cached, ProgressBar, ReferenceImage, ReferenceSettings};
+use crate::render::error::{Error, Result};
+use crate::render::gpu::{BackendChoice, Gpu};
+use crate::render::graph::FINAL_AO;
+use crate::render::passes::gbuffer::{DEPTH, NORMALS};
+use crate::render::renderer::{Renderer, Timing, TimingChoice};
+use crate::render::scene::Scene;
+use crate::render::settings::{Foveation, Settings, Technique};
+use crate::render::stereo::{reversed_z_projection, Eye, EyePair};
+use serde::Deserialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Bevy 0.19's own SSAO presets: (name, slices, samples per slice side).
+pub const BEVY_PRESETS: [(&str, u32, u32); 4] = [("low", 1, 2), ("medium", 2, 2), ("high", 3, 3), ("ultra", 9, 3)];
+/// The most rounds a comparison takes.
+pub const ROUNDS_MAX: u32 = 20;
+/// Where `cargo build --release` in `peers/bevy` puts the peer.
+pub const DEFAULT_PEER: &str = "peers/bevy/target/release/vrao-peer-bevy";
+
+/// What a comparison runs.
+#[derive(Clone, Debug)]
+pub struct PeerOptions {
+    /// The wgpu backend for vrao.
+    pub backend: BackendChoice,
+    /// The peer program.
+    pub peer: PathBuf,
+    /// Bevy's presets to run (names of [`BEVY_PRESETS`]).
+    pub presets: Vec<String>,
+    /// vrao's GTAO sample counts.
+    pub samples: Vec<u32>,
+    /// vrao's resolutions (`true`: half).
+    pub half_res: Vec<bool>,
+    /// Serial, pipelined or auto, for both sides.
+    pub timing: TimingChoice,
+    /// Frames discarded before timing, per case and round.
+    pub warmup: u32,
+    /// Frames timed per case and round.
+    pub frames: u32,
+    /// Rounds of peer and vrao, alternating which goes first.
+    pub rounds: u32,
+    /// The reference both are scored against.
+    pub reference: ReferenceOptions,
+    /// Output folder (the glTF, the peer's files, the table, the plot, the images).
+    pub out: PathBuf,
+}
+
+/// Which program a row measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    /// Bevy 0.19's `ScreenSpaceAmbientOcclusion`.
+    Bevy,
+    /// vrao's engine.
+    Vrao,
+}
+
+/// One row of the comparison.
+#[derive(Clone, Debug)]
+pub struct PeerRow {
+    /// Whose AO.
+    pub family: Family,
+    /// The setting, as that side names it ("high"; "gtao 24 half").
+    pub setting: String,
+    /// Median ms per eye (Bevy: the mean of its two cameras).
+    pub ms_per_eye: f64,
+    /// Median ms for both eyes (vrao: its stereo chain; Bevy: both cameras' chains).
+    pub ms_stereo: f64,
+    /// Error against the reference.
+    pub error: ErrorFigures,
+}
+
+/// A finished comparison.
+#[derive(Clone, Debug)]
+pub struct PeerRun {
+    /// The scene's name.
+    pub scene: String,
+    /// Per-eye size.
+    pub width: u32,
+    /// Per-eye size.
+    pub height: u32,
+    /// vrao's adapter, "name (backend, driver)".
+    pub adapter: String,
+    /// The peer's adapter as Bevy reports it.
+    pub peer_adapter: String,
+    /// How both sides were timed.
+    pub timing: Timing,
+    /// Warm-up, measured frames and rounds.
+    pub warmup: u32,
+    /// Measured frames per case and round.
+    pub frames: u32,
+    /// Rounds.
+    pub rounds: u32,
+    /// The reference's AO radius (m), rays per pixel and stride.
+    pub radius: f32,
+    /// Rays per traced pixel.
+    pub rays: u32,
+    /// Traced at every stride-th pixel.
+    pub stride: u32,
+    /// vrao's occlusion passes (what its time includes).
+    pub vrao_passes: Vec<String>,
+    /// Bevy's rows, then vrao's.
+    pub rows: Vec<PeerRow>,
+}
+
+/// The peer's `peer.json`.
+#[derive(Deserialize)]
+struct PeerFile {
+    adapter: String,
+    width: u32,
+    height: u32,
+    timestamps: bool,
+    presets: Vec<PeerPreset>,
+}
+
+#[derive(Deserialize)]
+struct PeerPreset {
+    name: String,
+    eyes: Vec<PeerEye>,
+}
+
+#[derive(Deserialize)]
+struct PeerEye {
+    eye: String,
+    ao: String,
+    median_wall_ms: Option<f64>,
+    median_gpu_ms: Option<f64>,
+}
+
+/// One round of the peer: per preset, per eye, (ms, AO image).
+type PeerRound = Vec<(String, Vec<(f64, Vec<f32>)>)>;
+
+/// Refuses options out of range before any work.
+pub fn check_options(options: &PeerOptions) -> Result<()> {
+    crate::measure::check_frames(options.warmup, options.frames)?;
+    if !(1..=ROUNDS_MAX).contains(&options.rounds) {
+        return Err(Error::input(format!("{} rounds is not within 1..={ROUNDS_MAX}", options.rounds)));
+    }
+    if options.presets.is_empty() && options.samples.is_empty() {
+        return Err(Error::input("nothing to compare: no Bevy preset and no vrao sample count"));
+    }
+    if let Some(p) = options.presets.iter().find(|p| !BEVY_PRESETS.iter().any(|(n, _, _)| n == p)) {
+        return Err(Error::input(format!("'{p}' is not a Bevy preset (low, medium, high, ultra)")));
+    }
+    if let Some(p) = crate::measure::named_twice(&options.presets) {
+        return Err(Error::input(format!("the Bevy presets name {p} twice")));
+    }
+    if let Some(n) = crate::measure::named_twice(&options.samples) {
+        return Err(Error::input(format!("the sample counts name {n} twice")));
+    }
+    if !options.presets.is_empty() && !options.peer.is_file() {
+        return Err(Error::input(format!(
+            "no peer program at {} (build it: cd peers/bevy && cargo build --release)",
+            options.peer.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The vrao cases: GTAO at every sample count and resolution, at the base radius.
+pub fn vrao_cases(base: &Settings, options: &PeerOptions) -> Vec<BenchCase> {
+    let mut cases = Vec::new();
+    for &half_res in &options.half_res {
+        for &samples in &options.samples {
+            cases.push(BenchCase {
+                technique: Technique::Gtao,
+                samples,
+                radius: base.ao.radius,
+                half_res,
+                depth_peeling: false,
+                temporal: false,
+                foveation: Foveation::Off,
+            });
+        }
+    }
+    cases
+}
+
+/// Runs the comparison: the glTF, the reference, the rounds, the scores. Logs progress.
+pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result<PeerRun> {
+    check_options(options)?;
+    let cases = vrao_cases(base, options);
+    for case in &cases {
+        let mut s = base.clone();
+        (s.ao.technique, s.ao.samples, s.ao.resolution) =
+            (case.technique, case.samples, crate::render::settings::Resolution::from_half_res(case.half_res));
+        s.validate()?;
+    }
+    let work = options.out.join("peer-work");
+    std::fs::create_dir_all(&work).map_err(|e| Error::Output { path: work.clone(), message: e.to_string() })?;
+    let gltf = work.join("scene.glb");
+    write_gltf(scene, &gltf)?;
+    let (width, height) = (base.profile.width, base.profile.height);
+    let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near);
+    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let timing = options.timing.resolve(&gpu);
+    let adapter = format!("{} ({:?}, {})", gpu.info.name, gpu.info.backend, gpu.info.driver_info);
+    let radius = base.ao.radius;
+    let reference = trace_reference(scene, base, &eyes, radius, &options.reference)?;
+    let references = vec![(radius, reference)];
+    let reference = &references[0].1;
+    let (limit, vrao_default) = limit_and_default(&gpu, scene, base, &eyes, reference)?;
+    let how = Measurement {
+        timing,
+        warmup: options.warmup,
+        frames: options.frames,
+        whole_frame: false,
+        interleave: cases.len().max(1),
+    };
+    let mut peer_rounds: Vec<PeerRound> = Vec::new();
+    let mut vrao_rounds: Vec<Vec<BenchRow>> = Vec::new();
+    let mut peer_adapter = String::new();
+    for round in 0..options.rounds {
+        let peer_first = round % 2 == 0;
+        for side in [peer_first, !peer_first] {
+            if side && !options.presets.is_empty() {
+                log::info!("peer: round {} of {}: Bevy, {} presets", round + 1, options.rounds, options.presets.len());
+                let dir = work.join(format!("round-{round}"));
+                let (adapter, result) = run_peer_round(options, &gltf, &dir, &eyes, (width, height), timing)?;
+                peer_adapter = adapter;
+                peer_rounds.push(result);
+            } else if !side && !cases.is_empty() {
+                log::info!("peer: round {} of {}: vrao, {} cases", round + 1, options.rounds, cases.len());
+                vrao_rounds.push(sweep(&gpu, scene, base, &cases, how, &references, |done, total, row| {
+                    log::info!(
+                        "[{done}/{total}] vrao {} {:.3} ms/eye",
+                        setting_name(&row.case),
+                        row.occlusion_ms_per_eye()
+                    )
+                })?);
+            }
+        }
+    }
+    let fovs: Vec<_> = eyes.eyes.iter().map(|e| e.fov).collect();
+    let ppd = eyes.eyes.iter().map(|e| pixels_per_degree(&e.fov, width)).sum::<f64>() / eyes.eyes.len() as f64;
+    let mut rows = Vec::new();
+    for (k, name) in options.presets.iter().enumerate() {
+        let per_eye: Vec<f64> =
+            (0..eyes.eyes.len()).map(|e| median(peer_rounds.iter().map(|r| r[k].1[e].0).collect())).collect();
+        let last = &peer_rounds.last().expect("a round ran")[k].1;
+        let occlusion: Vec<Vec<f32>> = last.iter().map(|(_, ao)| rgba_of(ao)).collect();
+        let error = score(Technique::Gtao, &occlusion, reference, Some(&limit), ppd, &fovs);
+        let stereo: f64 = per_eye.iter().sum();
+        rows.push(PeerRow {
+            family: Family::Bevy,
+            setting: name.clone(),
+            ms_per_eye: stereo / per_eye.len() as f64,
+            ms_stereo: stereo,
+            error,
+        });
+    }
+    let mut vrao_passes = Vec::new();
+    for (i, case) in cases.iter().enumerate() {
+        let per_eye = median(vrao_rounds.iter().map(|r| r[i].occlusion_ms_per_eye()).collect());
+        let last = &vrao_rounds.last().expect("a round ran")[i];
+        for pass in &last.occlusion_passes {
+            if !vrao_passes.iter().any(|p: &String| p == pass) {
+                vrao_passes.push(pass.to_string());
+            }
+        }
+        let error = last.error.clone().ok_or_else(|| Error::Gpu("a vrao row was not scored".into()))?;
+        rows.push(PeerRow {
+            family: Family::Vrao,
+            setting: setting_name(case),
+            ms_per_eye: per_eye,
+            ms_stereo: per_eye * last.views as f64,
+            error,
+        });
+    }
+    let run = PeerRun {
+        scene: scene.name.clone(),
+        width,
+        height,
+        adapter,
+        peer_adapter,
+        timing,
+        warmup: options.warmup,
+        frames: options.frames,
+        rounds: options.rounds,
+        radius,
+        rays: options.reference.rays_per_pixel,
+        stride: options.reference.stride,
+        vrao_passes,
+        rows,
+    };
+    write_side_by_side(&options.out, &run, &peer_rounds, options, &vrao_default, reference)?;
+    Ok(run)
+}
+
+/// "gtao 24 half": a vrao case as the table names it.
+fn setting_name(case: &BenchCase) -> String {
+    format!("{} {} {}", case.technique.name(), case.samples, if case.half_res { "half" } else { "full" })
+}
+
+/// The median (NaN of none).
+fn median(mut values: Vec<f64>) -> f64 {
+    values.retain(|v| v.is_finite());
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        (values[n / 2 - 1] + values[n / 2]) / 2.0
+    }
+}
+
+/// An AO image as the RGBA the bench scores (white, AO in alpha).
+fn rgba_of(ao: &[f32]) -> Vec<f32> {
+    ao.iter().flat_map(|&a| [1.0, 1.0, 1.0, a]).collect()
+}
+
+/// Writes `scene` as the glTF the peer loads.
+#[cfg(feature = "gltf")]
+fn write_gltf(scene: &Scene, path: &Path) -> Result<()> {
+    crate::test_assets::gltf_write::write(scene, path, &Default::default())
+}
+
+#[cfg(not(feature = "gltf"))]
+fn write_gltf(_scene: &Scene, _path: &Path) -> Result<()> {
+    Err(Error::input("the peer loads the scene as glTF: build vrao with the gltf feature"))
+}
+
+/// The reference at `radius` for both eyes (cached as the bench caches it).
+fn trace_reference(
+    scene: &Scene,
+    base: &Settings,
+    eyes: &EyePair,
+    radius: f32,
+    options: &ReferenceOptions,
+) -> Result<ReferenceImage> {
+    let settings = ReferenceSettings {
+        radius: radius as f64,
+        rays_per_pixel: options.rays_per_pixel,
+        stride: options.stride,
+        near: base.near,
+    };
+    let mut bar = ProgressBar::new("reference");
+    let size = (base.profile.width, base.profile.height);
+    let image = trace_cached(&options.cache, scene, &eyes.eyes, size, &settings, &mut |p| bar.update(p))?;
+    bar.finish();
+    Ok(image)
+}
+
+/// One frame of vrao's default AO setting (at the base size): the screen-space limit of
+/// its depth buffer (the same for every row: the same pixels) and its AO per eye.
+fn limit_and_default(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    base: &Settings,
+    eyes: &EyePair,
+    reference: &ReferenceImage,
+) -> Result<(ScreenLimit, Vec<Vec<f32>>)> {
+    let mut renderer = Renderer::new(gpu.clone(), scene, base)?;
+    renderer.render_and_wait(&eyes.eyes, &[FINAL_AO])?;
+    let depth = renderer.read_f32(DEPTH)?;
+    let normals = renderer.read_f32(NORMALS)?;
+    let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
+        .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: eyes.eyes[k].fov })
+        .collect();
+    let settings = LimitSettings::for_reference(reference, base.ao.radius as f64, eyes.near);
+    let limit = screen_space_limit(&buffers, (reference.width, reference.height), &settings)?;
+    let ao = renderer.read_f32(FINAL_AO)?.iter().map(|l| l.iter().skip(3).step_by(4).copied().collect()).collect();
+    Ok((limit, ao))
+}
+
+/// The eye's job line: its name, world-from-view and clip-from-view, column-major, as
+/// vrao builds them.
+fn eye_line(name: &str, eye: &Eye, near: f64) -> String {
+    let world_from_view = eye.pose.world_from_local().as_mat4();
+    let clip_from_view = reversed_z_projection(&eye.fov, near).as_mat4();
+    let numbers: Vec<String> = world_from_view
+        .to_cols_array()
+        .iter()
+        .chain(clip_from_view.to_cols_array().iter())
+        .map(|v| format!("{v:e}"))
+        .collect();
+    format!("eye {name} {}\n", numbers.join(" "))
+}
+
+/// The eyes' names, in layer order.
+const EYE_NAMES: [&str; 2] = ["left", "right"];
+
+/// Runs the peer once into `dir` and reads what it wrote: per preset, per eye, the
+/// median ms (wall clock for serial timing, timestamps for pipelined) and the AO.
+fn run_peer_round(
+    options: &PeerOptions,
+    gltf: &Path,
+    dir: &Path,
+    eyes: &EyePair,
+    (width, height): (u32, u32),
+    timing: Timing,
+) -> Result<(String, PeerRound)> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Output { path: dir.to_path_buf(), message: e.to_string() })?;
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let mut job = format!(
+        "scene {}\nsize {width} {height}\nwarmup {}\nframes {}\npresets {}\nout {}\n",
+        absolute(gltf).display(),
+        options.warmup,
+        options.frames,
+        options.presets.join(" "),
+        absolute(dir).display()
+    );
+    for (k, eye) in eyes.eyes.iter().enumerate() {
+        job += &eye_line(EYE_NAMES[k], eye, eyes.near);
+    }
+    let job_path = dir.join("job.txt");
+    let output = |path: &Path, e: std::io::Error| Error::Output { path: path.to_path_buf(), message: e.to_string() };
+    std::fs::write(&job_path, job).map_err(|e| output(&job_path, e))?;
+    let log_path = dir.join("peer.log");
+    let log = std::fs::File::create(&log_path).map_err(|e| output(&log_path, e))?;
+    let log2 = log.try_clone().map_err(|e| output(&log_path, e))?;
+    let status = std::process::Command::new(&options.peer)
+        .arg(&job_path)
+        .stdout(log)
+        .stderr(log2)
+        .status()
+        .map_err(|e| Error::input(format!("running the peer {}: {e}", options.peer.display())))?;
+    if !status.success() {
+        let text = std::fs::read_to_string(&log_path).unwrap_or_default();
+        let tail: Vec<&str> = text.lines().rev().take(3).collect();
+        return Err(Error::Gpu(format!(
+            "the peer failed ({status}): {}",
+            tail.into_iter().rev().collect::<Vec<_>>().join(" / ")
+        )));
+    }
+    let file_path = dir.join("peer.json");
+    let text = std::fs::read_to_string(&file_path).map_err(|e| output(&file_path, e))?;
+    let file: PeerFile =
+        serde_json::from_str(&text).map_err(|e| Error::Gpu(format!("the peer's peer.json does not read: {e}")))?;
+    if (file.width, file.height) != (width, height) || file.presets.len() != options.presets.len() {
+        return Err(Error::Gpu("the peer's peer.json does not match its job".into()));
+    }
+    if timing == Timing::Pipelined && !file.timestamps {
+        return Err(Error::Device("the peer's device has no timestamp queries; use serial timing".into()));
+    }
+    let mut round = Vec::new();
+    for preset in &file.presets {
+        let mut per_eye = Vec::new();
+        for (k, eye) in preset.eyes.iter().enumerate() {
+            if eye.eye != EYE_NAMES[k] {
+                return Err(Error::Gpu(format!("the peer's eye {k} is '{}'", eye.eye)));
+            }
+            let ms = match timing {
+                Timing::Serial => eye.median_wall_ms,
+                Timing::Pipelined => eye.median_gpu_ms,
+            }
+            .unwrap_or(f64::NAN);
+            let ao_path = dir.join(&eye.ao);
+            let bytes = std::fs::read(&ao_path).map_err(|e| output(&ao_path, e))?;
+            if bytes.len() != width as usize * height as usize * 4 {
+                return Err(Error::Gpu(format!("{} is not {width}x{height} f32 values", ao_path.display())));
+            }
+            let ao: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+            per_eye.push((ms, ao));
+        }
+        round.push((preset.name.clone(), per_eye));
+    }
+    Ok((file.adapter, round))
+}
+
+/// `side_by_side_left.png`: the left eye's AO from Bevy (High, or the last preset run),
+/// vrao's default setting and the reference (nearest cell), side by side.
+fn write_side_by_side(
+    out: &Path,
+    run: &PeerRun,
+    peer_rounds: &[PeerRound],
+    options: &PeerOptions,
+    vrao_default: &[Vec<f32>],
+    reference: &ReferenceImage,
+) -> Result<()> {
+    let (w, h) = (run.width as usize, run.height as usize);
+    let Some(last) = peer_rounds.last() else { return Ok(()) };
+    let bevy = options.presets.iter().position(|p| p == "high").unwrap_or(options.presets.len() - 1);
+    let panels: [Vec<f32>; 3] = [last[bevy].1[0].1.clone(), vrao_default[0].clone(), {
+        let (gw, gh) = reference.grid_size();
+        let mut image = vec![1.0f32; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let (i, j) = (
+                    (x as u32 / reference.stride.max(1)).min(gw - 1),
+                    (y as u32 / reference.stride.max(1)).min(gh - 1),
+                );
+                let p = reference.get(0, i, j);
+                image[y * w + x] = if p.hit { p.ao } else { 1.0 };
+            }
+        }
+        image
+    }];
+    let mut pixels = vec![0u8; 3 * w * h];
+    for (k, panel) in panels.iter().enumerate() {
+        for y in 0..h {
+            for x in 0..w {
+                let v = panel.get(y * w + x).copied().unwrap_or(1.0);
+                pixels[y * 3 * w + k * w + x] = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+            }
+        }
+    }
+    let path = out.join("side_by_side_left.png");
+    image::GrayImage::from_raw((3 * w) as u32, h as u32, pixels)
+        .expect("3w × h pixels")
+        .save_with_format(&path, image::ImageFormat::Png)
+        .map_err(|e| Error::Output { path, message: e.to_string() })
+}
+
+/// The row every ratio is taken against: Bevy's High, else its first preset, else the
+/// first row.
+fn baseline(run: &PeerRun) -> Option<&PeerRow> {
+    run.rows
+        .iter()
+        .find(|r| r.family == Family::Bevy && r.setting == "high")
+        .or_else(|| run.rows.iter().find(|r| r.family == Family::Bevy))
+        .or(run.rows.first())
+}
+
+/// The Markdown table with its header lines.
+pub fn markdown(run: &PeerRun) -> String {
+    let mut md = String::new();
+    let how = match run.timing {
+        Timing::Serial => "serial: wall clock around work submitted alone and waited for",
+        Timing::Pipelined => "pipelined: GPU timestamps",
+    };
+    let base = baseline(run);
+    let base_name = base.map_or(String::new(), |b| format!("{} {}", family_name(b.family), b.setting));
+    let _ = writeln!(
+        md,
+        "Scene `{}`, {}×{} per eye, both eyes; vrao on {}; Bevy on {}.",
+        run.scene, run.width, run.height, run.adapter, run.peer_adapter
+    );
+    let _ = writeln!(
+        md,
+        "Timing {how}; {} warm-up and {} measured frames per case and round, {} round(s) alternating Bevy and vrao; medians.",
+        run.warmup, run.frames, run.rounds
+    );
+    let _ = writeln!(
+        md,
+        "vrao's time: its occlusion chain ({}) for both eyes in one dispatch. Bevy's time: its three AO passes (depth preprocess, main pass, spatial denoise) of each eye's camera, the two cameras added.",
+        run.vrao_passes.join(" + ")
+    );
+    let _ = writeln!(
+        md,
+        "Error against the reference tracer (hard cut-off at r = {} m, {} rays per pixel at every {}th pixel), as `vrao bench` scores it; ratios against {base_name}.\n",
+        run.radius, run.rays, run.stride
+    );
+    md.push_str("| AO | setting | ms per eye | ms both eyes | × time | RMSE | × RMSE | bias | dark bias | FLIP | RMSE vs limit | limit RMSE |\n");
+    md.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let opt = |v: Option<f64>, signed: bool| match v {
+        Some(v) if signed => format!("{v:+.3}"),
+        Some(v) => format!("{v:.3}"),
+        None => "–".into(),
+    };
+    for row in &run.rows {
+        let (t, e) =
+            base.map_or((f64::NAN, f64::NAN), |b| (row.ms_stereo / b.ms_stereo, row.error.ao_rmse / b.error.ao_rmse));
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:+.3} | {} | {} | {} | {} |",
+            family_name(row.family),
+            row.setting,
+            row.ms_per_eye,
+            row.ms_stereo,
+            t,
+            row.error.ao_rmse,
+            e,
+            row.error.ao_bias,
+            opt(row.error.ao_bias_dark, true),
+            opt(row.error.flip_mean, false),
+            opt(row.error.ao_rmse_vs_limit, false),
+            opt(row.error.limit_rmse, false),
+        );
+    }
+    md
+}
+
+fn family_name(family: Family) -> &'static str {
+    match family {
+        Family::Bevy => "Bevy 0.19.1",
+        Family::Vrao => "vrao",
+    }
+}
+
+/// The plot: RMSE against ms for both eyes, one series per family.
+pub fn plot(run: &PeerRun) -> ScatterPlot {
+    let series = |family: Family, color: [u8; 3]| Series {
+        label: family_name(family).to_string(),
+        color,
+        points: run
+            .rows
+            .iter()
+            .filter(|r| r.family == family)
+            .map(|r| Point { x: r.ms_stereo, y: r.error.ao_rmse, label: r.setting.clone() })
+            .collect(),
+    };
+    ScatterPlot {
+        title: format!("{}: AO error against time, both eyes ({}×{} per eye)", run.scene, run.width, run.height),
+        x_label: match run.timing {
+            Timing::Serial => "ms for both eyes (serial wall clock)".into(),
+            Timing::Pipelined => "ms for both eyes (GPU timestamps)".into(),
+        },
+        y_label: "RMSE against the reference".into(),
+        series: vec![series(Family::Bevy, [200, 80, 40]), series(Family::Vrao, [40, 90, 200])],
+        pareto: Vec::new(),
+        vertical_line: None,
+    }
+}
+
+/// Writes `peer.md` and `peer.png` into `out` and returns the table.
+pub fn write_outputs(out: &Path, run: &PeerRun) -> Result<String> {
+    let md = markdown(run);
+    let path = out.join("peer.md");
+    std::fs::write(&path, &md).map_err(|e| Error::Output { path: path.clone(), message: e.to_string() })?;
+    plot(run).save_png(&out.join("peer.png"), 1200, 800)?;
+    Ok(md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options() -> PeerOptions {
+        PeerOptions {
+            backend: BackendChoice::Auto,
+            peer: PathBuf::from("/nonexistent/peer"),
+            presets: vec![],
+            samples: vec![12],
+            half_res: vec![true],
+            timing: TimingChoice::Auto,
+            warmup: 1,
+            frames: 1,
+            rounds: 1,
+            reference: ReferenceOptions { rays_per_pixel: 16, stride: 8, cache: PathBuf::from("/tmp") },
+            out: PathBuf::from("/tmp"),
+        }
+    }
+
+    #[test]
+    fn options_out_of_range_are_refused_naming_the_value() {
+        let mut o = options();
+        assert!(check_options(&o).is_ok());
+        o.rounds = 0;
+        assert!(check_options(&o).unwrap_err().to_string().contains("0 rounds"));
+        o.rounds = 1;
+        o.presets = vec!["extreme".into()];
+        assert!(check_options(&o).unwrap_err().to_string().contains("'extreme'"));
+        o.presets = vec!["high".into()];
+        assert!(check_options(&o).unwrap_err().to_string().contains("no peer program"));
+        o.presets = vec![];
+        o.samples = vec![12, 12];
+        assert!(check_options(&o).unwrap_err().to_string().contains("12 twice"));
+    }
+
+    #[test]
+    fn an_eye_line_carries_the_projection_vrao_renders_with() {
+        let profile = crate::HeadsetProfile::with_size("vive", 64, 80);
+        let eyes = profile.eyes(&crate::HeadPose::IDENTITY, 0.05);
+        let line = eye_line("left", &eyes.eyes[0], eyes.near);
+        let numbers: Vec<f32> = line.split_whitespace().skip(2).map(|s| s.parse().unwrap()).collect();
+        assert_eq!(numbers.len(), 32);
+        let projection = reversed_z_projection(&eyes.eyes[0].fov, eyes.near).as_mat4();
+        assert_eq!(&numbers[16..], &projection.to_cols_array()[..]);
+        // Reversed Z with the far plane at infinity: a point at the near plane lands at 1.
+        let clip = projection * glam::Vec4::new(0.0, 0.0, -(eyes.near as f32), 1.0);
+        assert!((clip.z / clip.w - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn medians_skip_what_was_not_measured() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, f64::NAN, 2.0, 3.0]), 2.5);
+        assert!(median(vec![]).is_nan());
+    }
+}
