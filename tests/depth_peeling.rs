@@ -25,7 +25,7 @@ fn settings(ao: AoSettings) -> Settings {
 }
 
 fn ssdo(depth_peeling: bool) -> AoSettings {
-    AoSettings { technique: Technique::Ssdo, samples: 36, radius: RADIUS, depth_peeling, ..AoSettings::default() }
+    AoSettings { technique: Technique::SsdoPoints, samples: 36, radius: RADIUS, depth_peeling, ..AoSettings::default() }
 }
 
 /// A 1.2 m × 1.2 m board, 2 cm thick, whose back face is `gap` metres in front of a
@@ -127,7 +127,7 @@ fn a_thin_board_far_in_front_of_a_wall_casts_a_halo_only_without_peeling() {
     for (peel, range_check) in [(false, false), (true, false), (true, true)] {
         let ao = render(&scene, &settings(AoSettings { range_check, ..ssdo(peel) }));
         let (ours, truth, n) = mean_over(&ao, &reference, &band);
-        let e = error_figures(Technique::Ssdo, &ao, &reference);
+        let e = error_figures(Technique::SsdoPoints, &ao, &reference);
         println!(
             "board 1 m in front, peel={peel} range check={range_check}: wall beside the board AO {ours:.3} \
              (reference {truth:.3}, {n} cells); AO RMSE {:.4}",
@@ -167,7 +167,7 @@ fn a_closed_box_still_occludes_the_floor_beside_it_with_peeling() {
         let ao = render(&scene, &settings(ssdo(peel)));
         let (beside, truth, n) = mean_over(&ao, &reference, floor(0.5, 0.75));
         let (open, _, _) = mean_over(&ao, &reference, floor(3.0, 6.0));
-        let e = error_figures(Technique::Ssdo, &ao, &reference);
+        let e = error_figures(Technique::SsdoPoints, &ao, &reference);
         println!(
             "box, peel={peel}: floor beside AO {beside:.3} (reference {truth:.3}, {n} cells), open floor {open:.3}; \
              AO RMSE {:.4}",
@@ -192,11 +192,11 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
     };
     let reason =
         |p: &vrao::render::graph::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
-    for technique in [Technique::Ssdo, Technique::SsdoBounce] {
+    for technique in [Technique::SsdoPoints, Technique::SsdoPointsBounce] {
         let on = plan(technique, true, &[COLOR]);
         assert!(on.runs("depth-peel"), "{on}");
         let order: Vec<_> =
-            on.names.iter().filter(|n| ["gbuffer", "depth-peel", "ssdo", "ssdo-bounce"].contains(n)).collect();
+            on.names.iter().filter(|n| ["gbuffer", "depth-peel", "ssdo-points", "ssdo-points-bounce"].contains(n)).collect();
         assert_eq!(order[..2], [&"gbuffer", &"depth-peel"], "{on}");
         assert!(on.resources.contains(&DEPTH_LAYER_2));
         let off = plan(technique, false, &[COLOR]);
@@ -206,7 +206,7 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
         let depth_only = plan(technique, true, &[DEPTH]);
         assert!(!depth_only.runs("depth-peel"), "{depth_only}");
     }
-    for technique in [Technique::None, Technique::Ssao, Technique::Hbao] {
+    for technique in [Technique::None, Technique::Ssao, Technique::Hbao, Technique::Ssdo] {
         let p = plan(technique, true, &[COLOR]);
         assert!(!p.runs("depth-peel"), "{p}");
         let why = reason(&p).unwrap();
@@ -217,7 +217,7 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
 #[test]
 fn peeling_at_half_resolution_with_the_bounce_stays_finite() {
     let scene = Scene::load("builtin:room").unwrap();
-    for technique in [Technique::Ssdo, Technique::SsdoBounce] {
+    for technique in [Technique::SsdoPoints, Technique::SsdoPointsBounce] {
         let s = settings(AoSettings {
             resolution: vrao::render::settings::Resolution::Half,
             ..AoSettings { technique, ..ssdo(true) }

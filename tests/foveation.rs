@@ -15,7 +15,8 @@ use vrao::render::settings::{AoSettings, Foveation, Technique};
 use vrao::render::stereo::{Fov, HeadsetProfile};
 use vrao::{Renderer, Resource, Settings};
 
-const TECHNIQUES: [Technique; 4] = [Technique::Gtao, Technique::Hbao, Technique::Ssao, Technique::Ssdo];
+const TECHNIQUES: [Technique; 5] =
+    [Technique::Gtao, Technique::Hbao, Technique::Ssao, Technique::Ssdo, Technique::SsdoPoints];
 const SIZE: (u32, u32) = (160, 180);
 
 /// The raw occlusion (AO in alpha) and the depth of one stereo frame of `scene`.

@@ -21,7 +21,8 @@ use vrao::render::stereo::{Fov, HeadPose};
 use vrao::xr::simulated::reproject::{output_target, ReprojectionMode, Reprojector};
 use vrao::{Gpu, HeadsetProfile, Renderer, Settings};
 
-const TECHNIQUES: [Technique; 4] = [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce];
+const TECHNIQUES: [Technique; 5] =
+    [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce, Technique::SsdoPointsBounce];
 
 /// What one frame produced, per resource and layer (RGBA values; depth is checked as it is read).
 struct Outputs {

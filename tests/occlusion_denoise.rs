@@ -113,7 +113,7 @@ fn half_resolution_stays_close_to_full_resolution() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:room").unwrap();
     let head = scene.head.pose_at(0.0);
-    for technique in [Technique::Ssao, Technique::Hbao, Technique::Ssdo] {
+    for technique in [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoPoints] {
         let full = settings(128, 144, ao(technique, 24, 1.0));
         let mut half = full.clone();
         half.ao.resolution = vrao::render::settings::Resolution::Half;
@@ -189,7 +189,7 @@ fn the_composite_upsamples_half_resolution_occlusion_inline() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:room").unwrap();
     let head = scene.head.pose_at(0.0);
-    for technique in [Technique::Ssao, Technique::Ssdo] {
+    for technique in [Technique::Ssao, Technique::Ssdo, Technique::SsdoPoints] {
         let base = AoSettings { technique, samples: 32, radius: 1.0, ..AoSettings::default() };
         let full = render(&gpu, &scene, &settings(128, 144, base.clone()), &head, &[HDR]);
         let half_settings = AoSettings { resolution: vrao::render::settings::Resolution::Half, ..base };

@@ -1,9 +1,9 @@
-//! SSAO and SSDO (with and without the bounce), the estimators that test sampled points
-//! against the depth buffer, on the GPU: on a 90° crease each matches its expected value
-//! (simulated on the CPU and in closed form, `vrao::measure::analytic`), SSDO also the
-//! falloff reference; SSDO shadows what faces away from a single light where SSAO
-//! cannot and gathers the unoccluded ambient on an open plane; a red wall bleeds red
-//! only with the bounce.
+//! SSAO and SSDO (with and without the bounce) on the GPU: on a 90° crease SSAO and the
+//! point-sampled SSDO (`ssdo-points`) match their expected values (simulated on the CPU
+//! and in closed form, `vrao::measure::analytic`), `ssdo-points` also the falloff
+//! reference, and SSDO on GTAO's bitmask (`ssdo`) has GTAO's occlusion exactly; both
+//! SSDOs shadow what faces away from a single light where SSAO cannot and gather the
+//! unoccluded ambient on an open plane; a red wall bleeds red only with the bounce.
 //!
 //! `cargo test --release --test occlusion_ssao_ssdo -- --nocapture` shows what the tests measure.
 
@@ -46,9 +46,37 @@ fn crease_ssao_matches_its_expected_value() {
 }
 
 #[test]
-fn crease_ssdo_matches_its_expected_value_and_the_falloff_reference() {
+fn ssdo_on_the_bitmask_has_gtao_s_occlusion_exactly() {
+    // The same march (gtao.wgsl) with the same noise: the visibility in AoRaw's alpha is
+    // GTAO's, bit for bit up to the f16 target, with and without the bounce, and the
+    // gathered light in rgb is finite and not negative.
     let (gpu, _guard) = common::gpu();
-    let bins = measure_crease(&gpu, Technique::Ssdo);
+    let scene = Scene::load("builtin:room").unwrap();
+    let head = scene.head.pose_at(0.0);
+    let alpha_and_rgb = |technique: Technique| {
+        let f = render(&gpu, &scene, &settings(96, 108, ao(technique, 24, 0.8)), &head, &[AO_RAW]);
+        let texels: Vec<f32> = f.outputs[&AO_RAW].iter().flatten().copied().collect();
+        texels
+    };
+    let gtao = alpha_and_rgb(Technique::Gtao);
+    for technique in [Technique::Ssdo, Technique::SsdoBounce] {
+        let ssdo = alpha_and_rgb(technique);
+        let worst = gtao.chunks(4).zip(ssdo.chunks(4)).map(|(g, s)| (g[3] - s[3]).abs()).fold(0f32, f32::max);
+        eprintln!("{}: largest AO difference from gtao {worst}", technique.name());
+        assert!(worst <= 1e-3, "{} AO differs from gtao's by {worst}", technique.name());
+        assert!(
+            ssdo.chunks(4).all(|t| t[..3].iter().all(|c| c.is_finite() && *c >= 0.0)),
+            "{}: gathered light not finite or negative",
+            technique.name()
+        );
+        assert!(ssdo.chunks(4).any(|t| t[0] > 0.0), "{}: no light gathered", technique.name());
+    }
+}
+
+#[test]
+fn crease_ssdo_points_matches_its_expected_value_and_the_falloff_reference() {
+    let (gpu, _guard) = common::gpu();
+    let bins = measure_crease(&gpu, Technique::SsdoPoints);
     assert_falls_towards_the_edge("ssdo", &bins);
     assert_bins("ssdo", "raw vs simulated", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.expected_raw));
     assert_bins("ssdo", "raw vs closed form", &bins, EXPECTATION_TOLERANCE, |b| (b.pixels, b.raw, b.closed_raw));
@@ -130,26 +158,33 @@ fn ssdo_shadows_the_side_away_from_a_single_light_where_ssao_cannot() {
         (mean(away), mean(lit))
     };
     let (ssao_away, ssao_lit) = luminance_of(Technique::Ssao);
-    let (ssdo_away, ssdo_lit) = luminance_of(Technique::Ssdo);
-    let (ssao_ratio, ssdo_ratio) = (ssao_away / ssao_lit, ssdo_away / ssdo_lit);
-    eprintln!(
-        "single light: floor luminance away from / towards the light: ssao {ssao_away:.4} / {ssao_lit:.4} \
-         (ratio {ssao_ratio:.3}), ssdo {ssdo_away:.4} / {ssdo_lit:.4} (ratio {ssdo_ratio:.3})"
-    );
+    let ssao_ratio = ssao_away / ssao_lit;
     // SSAO scales the unshadowed ambient irradiance by a direction-blind AO, so the two
     // sides, mirror images of each other for this eye, come out alike (within 5 %: the
     // eyes sit ±32 mm off the mirror plane and the rotation noise differs).
     assert!((ssao_ratio - 1.0).abs() < 0.05, "ssao differs between the sides: {ssao_away} vs {ssao_lit}");
-    // SSDO blocks the light's directions where the sphere stands between floor and light:
-    // the side away from the light is darker than the lit side by clearly more than
-    // under SSAO (comparing each technique with itself cancels any overall difference
-    // in how the two gather the unoccluded ambient) ...
-    assert!(
-        ssdo_ratio < ssao_ratio - 0.08,
-        "ssdo does not shadow the side away from the light: ratio {ssdo_ratio:.3} vs ssao {ssao_ratio:.3}"
-    );
-    // ... and that side is darker under SSDO than under SSAO.
-    assert!(ssdo_away < ssao_away, "the side away from the light is not darker under ssdo: {ssdo_away} vs {ssao_away}");
+    for technique in [Technique::Ssdo, Technique::SsdoPoints] {
+        let name = technique.name();
+        let (ssdo_away, ssdo_lit) = luminance_of(technique);
+        let ssdo_ratio = ssdo_away / ssdo_lit;
+        eprintln!(
+            "single light: floor luminance away from / towards the light: ssao {ssao_away:.4} / {ssao_lit:.4} \
+         (ratio {ssao_ratio:.3}), {name} {ssdo_away:.4} / {ssdo_lit:.4} (ratio {ssdo_ratio:.3})"
+        );
+        // SSDO blocks the light's directions where the sphere stands between floor and light:
+        // the side away from the light is darker than the lit side by clearly more than
+        // under SSAO (comparing each technique with itself cancels any overall difference
+        // in how the two gather the unoccluded ambient) ...
+        assert!(
+            ssdo_ratio < ssao_ratio - 0.08,
+            "{name} does not shadow the side away from the light: ratio {ssdo_ratio:.3} vs ssao {ssao_ratio:.3}"
+        );
+        // ... and that side is darker under SSDO than under SSAO.
+        assert!(
+            ssdo_away < ssao_away,
+            "the side away from the light is not darker under {name}: {ssdo_away} vs {ssao_away}"
+        );
+    }
 }
 
 #[test]
@@ -176,12 +211,15 @@ fn ssdo_on_an_open_plane_gathers_the_unoccluded_ambient() {
     let texels = vec![[1.0f32; 3]; 64 * 32];
     scene.environment = Some(Environment::from_texels(64, 32, texels, 1.0).unwrap());
     let unoccluded = floor_luminance(&scene, Technique::None, 24);
-    for samples in [12, 24, 36, 64] {
-        let ssdo = floor_luminance(&scene, Technique::Ssdo, samples);
-        let ratio = ssdo / unoccluded;
-        eprintln!("constant sky, N = {samples}: ssdo / unoccluded floor luminance = {ratio:.4}");
-        if (ratio - 1.0).abs() > 0.02 {
-            failures.push(format!("constant environment, N = {samples}: ssdo / unoccluded = {ratio:.3}"));
+    for technique in [Technique::Ssdo, Technique::SsdoPoints] {
+        for samples in [12, 24, 36, 64] {
+            let ssdo = floor_luminance(&scene, technique, samples);
+            let ratio = ssdo / unoccluded;
+            let name = technique.name();
+            eprintln!("constant sky, N = {samples}: {name} / unoccluded floor luminance = {ratio:.4}");
+            if (ratio - 1.0).abs() > 0.02 {
+                failures.push(format!("constant environment, N = {samples}: {name} / unoccluded = {ratio:.3}"));
+            }
         }
     }
     // The single bright patch of the shadow test: the irradiance of a floor that sees
@@ -189,11 +227,14 @@ fn ssdo_on_an_open_plane_gathers_the_unoccluded_ambient() {
     // 1 % once averaged over the floor's rotations; tolerance 5 %.
     scene.environment = Some(single_light_environment(Vec3::new(1.0, 1.0, 0.0), 30.0, 8.0));
     let unoccluded = floor_luminance(&scene, Technique::None, 64);
-    let ssdo = floor_luminance(&scene, Technique::Ssdo, 64);
-    let ratio = ssdo / unoccluded;
-    eprintln!("single light, N = 64: ssdo / unoccluded floor luminance = {ratio:.4}");
-    if (ratio - 1.0).abs() > 0.05 {
-        failures.push(format!("single bright patch, N = 64: ssdo / unoccluded = {ratio:.3}"));
+    for technique in [Technique::Ssdo, Technique::SsdoPoints] {
+        let ssdo = floor_luminance(&scene, technique, 64);
+        let ratio = ssdo / unoccluded;
+        let name = technique.name();
+        eprintln!("single light, N = 64: {name} / unoccluded floor luminance = {ratio:.4}");
+        if (ratio - 1.0).abs() > 0.05 {
+            failures.push(format!("single bright patch, N = 64: {name} / unoccluded = {ratio:.3}"));
+        }
     }
     assert!(failures.is_empty(), "ssdo does not reproduce the unoccluded ambient on an open plane: {failures:#?}");
 }
@@ -204,6 +245,12 @@ fn ssdo_on_an_open_plane_gathers_the_unoccluded_ambient() {
 #[test]
 fn red_wall_bleeds_red_only_with_the_bounce() {
     let (gpu, _guard) = common::gpu();
+    red_wall_bleeds(&gpu, Technique::Ssdo, Technique::SsdoBounce);
+    red_wall_bleeds(&gpu, Technique::SsdoPoints, Technique::SsdoPointsBounce);
+}
+
+fn red_wall_bleeds(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounce: Technique) {
+    eprintln!("{} and {}:", plain.name(), with_bounce.name());
     let scene = Scene::load("builtin:room").unwrap();
     // Looking down at the foot of the red (−X) wall, from the middle of the room.
     let head = HeadPose::look_at(DVec3::new(0.6, 1.6, -0.8), DVec3::new(ROOM_MIN.x + 0.3, 0.0, -2.6)).unwrap();
@@ -211,13 +258,14 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
         let mut a = ao(technique, 64, 1.0);
         a.bounce = bounce;
         a.bounce_form = form;
-        render(&gpu, &scene, &settings(128, 144, a), &head, &[HDR, AO_RAW])
+        render(gpu, &scene, &settings(128, 144, a), &head, &[HDR, AO_RAW])
     };
     let run = |technique: Technique, bounce: f32| run_form(technique, bounce, BounceForm::Direction);
-    let ssdo = run(Technique::Ssdo, 1.0);
-    let bounce = run(Technique::SsdoBounce, 1.0);
-    let bounce_off = run(Technique::SsdoBounce, 0.0);
-    let patch = run_form(Technique::SsdoBounce, 1.0, BounceForm::Patch);
+    let ssdo = run(plain, 1.0);
+    let bounce = run(with_bounce, 1.0);
+    let bounce_off = run(with_bounce, 0.0);
+    // The bounce form is the point-sampled SSDO's; the bitmask's senders have none.
+    let patch = run_form(with_bounce, 1.0, BounceForm::Patch);
     // Floor within 0.45 m of the red wall, away from the other walls.
     let near_red_wall =
         |p: DVec3| p.y.abs() < 1e-3 && p.x < ROOM_MIN.x + 0.45 && p.z < ROOM_MAX.z - 1.0 && p.z > ROOM_MIN.z + 0.5;
@@ -247,10 +295,12 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     // (tests/reference_error.rs compares both with the reference).
     let patch_gained: Vec<f64> = (0..3).map(|i| patch_raw[i] - ssdo_raw[i]).collect();
     eprintln!("bounce: patch form gained {patch_gained:.3?}");
-    assert!(
-        patch_gained[0] > 0.005 && patch_gained[0] > 3.0 * patch_gained[1].max(patch_gained[2]).max(0.0),
-        "the patch-form bounce is not red: {patch_gained:?}"
-    );
+    if with_bounce == Technique::SsdoPointsBounce {
+        assert!(
+            patch_gained[0] > 0.005 && patch_gained[0] > 3.0 * patch_gained[1].max(patch_gained[2]).max(0.0),
+            "the patch-form bounce is not red: {patch_gained:?}"
+        );
+    }
     eprintln!(
         "bounce: floor by the red wall, hdr r/g: ssdo {:.3}, ssdo-bounce {:.3}, bounce 0 {:.3}; \
          ao-raw rgb: ssdo {ssdo_raw:.3?}, ssdo-bounce {bounce_raw:.3?} (gained {gained:.3?}), bounce 0 {off_raw:.3?}",

@@ -226,6 +226,11 @@ impl FrameLoop {
         // Animated objects are where they are at the frame's display time.
         let origin = *self.scene_time_origin.get_or_insert(request.display_time);
         self.renderer.set_scene_time(request.display_time - origin);
+        // The lens's mask: the headset's from the first frame, and again whenever the
+        // runtime changes it.
+        if self.renderer.visibility_mask() != self.headset.visibility_mask() {
+            self.renderer.set_visibility_mask(self.headset.visibility_mask().cloned());
+        }
         let (headset, gpu) = (&mut self.headset, &self.gpu);
         self.renderer.render_with(&request.eyes.eyes, &outputs, |encoder, targets| {
             if let (Some(color), Some(depth)) = (targets.get(&COLOR), targets.get(&DEPTH)) {

@@ -144,14 +144,14 @@ fn ao_parameters_ui(ui: &mut egui::Ui, ao: &mut AoSettings, quality: &mut Option
 /// The SSDO settings: bounce strength and form, and depth peeling (disabled for the
 /// techniques that do not use them).
 fn bounce_ui(ui: &mut egui::Ui, ao: &mut AoSettings) {
-    let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
-    let bounce = ao.technique == Technique::SsdoBounce;
+    let points = matches!(ao.technique, Technique::SsdoPoints | Technique::SsdoPointsBounce);
+    let bounce = ao.technique.gathers_bounce();
     ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
     let mut patch = ao.bounce_form == BounceForm::Patch;
-    if ui.add_enabled(bounce, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches")).changed() {
+    if ui.add_enabled(bounce && points, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches")).changed() {
         ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
     }
-    ui.add_enabled(ssdo, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (SSDO)"));
+    ui.add_enabled(points, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (point-sampled SSDO)"));
 }
 
 /// The display mode and the buffer view shown of each eye.

@@ -77,6 +77,12 @@ pub struct RunSummary {
     /// Why the run was refused before its headset or window opened (the command exits
     /// 2): the report is written anyway when one was asked for. `None` for a run.
     pub refused: Option<String>,
+    /// The lens's visibility mask: where it comes from, and whether the passes skipped
+    /// it (`--mask`); "none" for a headset without one.
+    pub visibility_mask: String,
+    /// The share of each eye's pixels the mask hid in the last frame (left, right; empty
+    /// with `--mask off`, without a mask or without a frame).
+    pub hidden_share_per_eye: Vec<f64>,
 }
 
 impl RunSummary {
@@ -129,6 +135,11 @@ impl RunSummary {
             final_ao_setting: ao_setting(&frame_loop.renderer.settings().ao),
             openxr,
             refused: None,
+            visibility_mask: mask_description(
+                frame_loop.headset.visibility_mask(),
+                frame_loop.renderer.settings().ao.mask,
+            ),
+            hidden_share_per_eye: frame_loop.renderer.hidden_share().iter().copied().filter(|s| *s > 0.0).collect(),
         }
     }
 
@@ -192,6 +203,8 @@ impl RunSummary {
             final_ao_setting: String::new(),
             openxr: None,
             refused: None,
+            visibility_mask: "none".into(),
+            hidden_share_per_eye: Vec::new(),
         }
     }
 
@@ -249,12 +262,18 @@ impl RunSummary {
         } else {
             format!("a {:.2} ms budget from {}", self.budget_ms, self.budget_source)
         };
+        let mask = if self.hidden_share_per_eye.is_empty() {
+            format!("visibility mask {}\n", self.visibility_mask)
+        } else {
+            let shares: Vec<String> = self.hidden_share_per_eye.iter().map(|s| format!("{:.1} %", s * 100.0)).collect();
+            format!("visibility mask {}; hidden per eye: {}\n", self.visibility_mask, shares.join(", "))
+        };
         let interrupted = match &self.interrupted_in {
             Some(state) if self.interrupted => format!("\ninterrupted in {state}"),
             _ => String::new(),
         };
         format!(
-            "governor {}: {} changes, AO setting at the end: {}\n{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
+            "governor {}: {} changes, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
             self.governor_changes.len(),
             self.final_ao_setting,
@@ -267,6 +286,15 @@ impl RunSummary {
             passes.join(", ")
         )
     }
+}
+
+/// The mask's source in one line, and whether the passes skip it.
+fn mask_description(mask: Option<&crate::render::visibility::VisibilityMask>, on: bool) -> String {
+    let Some(mask) = mask else { return "none (the headset gives no visibility mask)".into() };
+    let sources: Vec<&str> = mask.views.iter().map(|v| v.source.as_str()).collect();
+    let source = if sources.windows(2).all(|w| w[0] == w[1]) { sources[..1].join("") } else { sources.join("; ") };
+    let applied = if on { "applied" } else { "not applied (--mask off)" };
+    format!("{applied}: {source}")
 }
 
 /// (pass, median GPU ms) over the recent frames; on a CPU adapter over the frames timed

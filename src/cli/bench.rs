@@ -213,7 +213,7 @@ mod tests {
         let args = Bench::try_parse_from(["bench"]).unwrap().args;
         assert_eq!(args.scene, RENDER_DEFAULT);
         use Technique::*;
-        assert_eq!(args.techniques, [Gtao, Ssao, Hbao, Ssdo, SsdoBounce]);
+        assert_eq!(args.techniques, [Gtao, Ssao, Hbao, Ssdo, SsdoBounce, SsdoPoints, SsdoPointsBounce]);
         assert_eq!(args.samples, [12, 24, 36, 64]);
         assert_eq!((args.denoise, args.blur), (AoSettings::default().denoise, AoSettings::default().blur_radius));
         assert_eq!((args.width, args.height), (1080, 1200));

@@ -155,8 +155,10 @@ pub struct AoArgs {
     #[command(flatten)]
     pub lights: LightArgs,
     /// Occlusion technique: none, ssao, hbao, gtao (the default: the most accurate per
-    /// millisecond), ssdo, ssdo-bounce or fetch-only (the benchmark baseline with SSAO's
-    /// depth taps and no occlusion arithmetic).
+    /// millisecond), ssdo and ssdo-bounce (GTAO's march gathering the environment and one
+    /// bounce), ssdo-points and ssdo-points-bounce (the seeds' point-sampled SSDO, a
+    /// baseline) or fetch-only (the benchmark baseline with SSAO's depth taps and no
+    /// occlusion arithmetic).
     #[arg(value_parser = choice::<Technique>(), long, default_value_t = AoSettings::default().technique, hide_possible_values = true)]
     technique: Technique,
     /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
@@ -173,10 +175,10 @@ pub struct AoArgs {
     /// Depth bias as a fraction of the radius.
     #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().bias)]
     bias: f32,
-    /// SSDO bounce strength (ssdo-bounce); 0 leaves the bounce out.
+    /// SSDO bounce strength (ssdo-bounce, ssdo-points-bounce); 0 leaves the bounce out.
     #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().bounce)]
     bounce: f32,
-    /// How the bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
+    /// How ssdo-points-bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
     /// the receiver cosine) or patch (Ritschel et al. 2009 eq. 2: area π r²/N, both
     /// cosines, 1/d²).
     #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
@@ -188,7 +190,12 @@ pub struct AoArgs {
     /// half the samples from 40°) or high (full within 15°, half from 30°).
     #[arg(value_parser = choice::<Foveation>(), long, default_value_t = AoSettings::default().foveation, hide_possible_values = true)]
     foveation: Foveation,
-    /// SSDO quality mode (Ritschel et al. 2009 §4): peel a second depth layer per eye; a
+    /// The headset's visibility mask: on (every pass skips the pixels the lens hides; they
+    /// stay black) or off (the whole rectangle is computed). The mask comes from the
+    /// OpenXR runtime or the simulated headset's profile.
+    #[arg(long, value_enum, default_value_t = OnOff::from(AoSettings::default().mask))]
+    mask: OnOff,
+    /// Point-sampled SSDO quality mode (Ritschel et al. 2009 §4): peel a second depth layer per eye; a
     /// sample then occludes only inside an object (between the layers), which removes the
     /// halos of thin objects in front of a background. Assumes closed geometry.
     #[arg(long)]
@@ -287,6 +294,7 @@ impl AoArgs {
             gtao: self.gtao.settings(),
             stereo_reuse: !self.gtao.independent_eyes,
             foveation: self.foveation,
+            mask: self.mask.on(),
         }
     }
 }

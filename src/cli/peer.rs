@@ -10,7 +10,7 @@ use vrao::measure::reference::default_cache_dir;
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
 use vrao::render::scene::RENDER_DEFAULT;
-use vrao::render::settings::Quality;
+use vrao::render::settings::{AoSettings, Quality};
 use vrao::{BackendChoice, HeadsetProfile, Result, Scene, Settings};
 
 #[derive(Args)]
@@ -38,6 +38,10 @@ pub struct PeerArgs {
     /// Rounds of Bevy and vrao, alternating which goes first, 1..=20.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=ROUNDS_MAX as i64))]
     rounds: u32,
+    /// AO radius in metres of vrao's cases and of the reference (Bevy's own is fixed: 0.73 m
+    /// with a falloff from 0.28 m).
+    #[arg(long, default_value_t = AoSettings::default().radius, value_parser = parse_radius)]
+    radius: f32,
     /// Per-eye width in pixels, 16..=8192.
     #[arg(long, default_value_t = HeadsetProfile::vive().width, value_parser = clap::value_parser!(u32).range(16..=8192))]
     width: u32,
@@ -66,7 +70,9 @@ pub struct PeerArgs {
 pub fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
     vrao::formats::output::check_output_folder(&args.out)?;
     let scene = Scene::load(&args.scene)?;
-    let base = Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
+    let mut base =
+        Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
+    base.ao.radius = args.radius;
     let options = PeerOptions {
         backend,
         peer: args.peer,
@@ -91,4 +97,14 @@ pub fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
     let run = run_peer(&scene, &base, &options)?;
     print!("{}", write_outputs(&args.out, &run)?);
     Ok(())
+}
+
+/// A radius within the engine's range (its settings check it again).
+fn parse_radius(text: &str) -> std::result::Result<f32, String> {
+    let r: f32 = text.parse().map_err(|_| format!("'{text}' is not a number"))?;
+    if r.is_finite() && r > 0.0 && r <= 100.0 {
+        Ok(r)
+    } else {
+        Err(format!("radius {r} m is not within (0, 100]"))
+    }
 }

@@ -257,7 +257,7 @@ impl CaseRun {
             Some(reference) if settings.ao.bounce_active() => {
                 let with = self.renderer.read_f32(output)?;
                 let mut without = settings.clone();
-                without.ao.technique = Technique::Ssdo;
+                without.ao.technique = settings.ao.technique.without_bounce();
                 self.renderer.set_settings(&without)?;
                 self.renderer.render(&self.eyes.eyes, &[output])?;
                 let difference: Vec<Vec<f32>> = with

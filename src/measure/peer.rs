@@ -334,10 +334,20 @@ fn rgba_of(ao: &[f32]) -> Vec<f32> {
     ao.iter().flat_map(|&a| [1.0, 1.0, 1.0, a]).collect()
 }
 
-/// Writes `scene` as the glTF the peer loads.
+/// Writes `scene` as the glTF the peer loads: its geometry and plain materials. AO reads
+/// depth and normals only, so textures are left out (the peer needs no image codecs); a
+/// material whose alpha comes from a texture is named in a warning, as the peer sees it
+/// solid where vrao cuts it out.
 #[cfg(feature = "gltf")]
 fn write_gltf(scene: &Scene, path: &Path) -> Result<()> {
-    crate::test_assets::gltf_write::write(scene, path, &Default::default())
+    let mut plain = scene.clone();
+    for m in &mut plain.materials {
+        if m.diffuse_texture.is_some() && m.alpha_mode != crate::render::scene::AlphaMode::Opaque {
+            log::warn!("peer: material '{}' is cut out by its texture in vrao, solid for the peer", m.name);
+        }
+        (m.diffuse_texture, m.emissive_texture, m.normal_texture, m.occlusion_texture) = (None, None, None, None);
+    }
+    crate::test_assets::gltf_write::write(&plain, path, &Default::default())
 }
 
 #[cfg(not(feature = "gltf"))]

@@ -224,6 +224,13 @@ pub trait Headset {
     fn openxr_report(&self) -> Option<crate::xr::openxr::OpenXrReport> {
         None
     }
+    /// The lens's visibility mask, one view mask per eye, or `None` where the headset has
+    /// none. An OpenXR runtime's may change during the session
+    /// (`XrEventDataVisibilityMaskChangedKHR`): the frame loop asks every frame and hands a
+    /// changed one to the renderer.
+    fn visibility_mask(&self) -> Option<&crate::render::visibility::VisibilityMask> {
+        None
+    }
     /// Ends the session cleanly.
     fn end(&mut self, gpu: &Gpu) -> Result<()>;
 }

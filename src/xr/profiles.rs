@@ -8,6 +8,7 @@
 
 use crate::render::error::{Error, Result};
 use crate::render::stereo::{Fov, HeadsetProfile, DEFAULT_IPD};
+use crate::render::visibility::{ViewMask, VisibilityMask};
 
 /// The names [`by_name`] knows, as the CLI spells them.
 pub const PROFILE_NAMES: [&str; 6] = ["vive", "vive-pro-2", "index", "quest-2", "quest-3", "pico-4"];
@@ -136,6 +137,64 @@ fn pico_4() -> HeadsetProfile {
         // per-eye dump with an outward/nasal split was found, so none is made up here.
         from_tangents(-1.279942, 1.279942, 1.279942, -1.279942),
     )
+}
+
+/// The share of each eye's render target a headset's own hidden-area mesh covers, where one
+/// is published: hmdq's "mesh area" of the left eye's HAM mesh in the HMD Geometry Database
+/// (<https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html>: 19.10 %;
+/// <https://risa2000.github.io/hmdgdb/hmd_cfgs/Quest2_Native_R72.html>: 9.13 %).
+fn published_hidden_share(name: &str) -> Option<f64> {
+    match name {
+        "vive" => Some(0.1910),
+        "quest-2" => Some(0.0913),
+        _ => None,
+    }
+}
+
+/// The visibility mask of a profile's eyes. Where the headset's hidden area is published
+/// ([`published_hidden_share`]) the lens shows a superellipse |x|ⁿ + |y|ⁿ ≤ 1 in each eye's
+/// rectangle (its four edges touched, the corners cut round, as the dumps' HAM meshes of
+/// four corner n-gons are), its n chosen so it hides that share; elsewhere (and for a
+/// size or frustum of no named headset) Monado's default for a device without a mask of
+/// its own: the four corners cut off from the field of view.
+pub fn visibility_mask(profile: &HeadsetProfile) -> VisibilityMask {
+    let eye = |fov: &Fov| match published_hidden_share(profile.name) {
+        Some(share) => ViewMask::superellipse(
+            fov.tangents(),
+            superellipse_exponent_hiding(share),
+            256,
+            format!("the {} lens: {:.1} % hidden as its published hidden-area mesh", profile.name, share * 100.0),
+        ),
+        None => ViewMask::corner_cut(fov.tangents()),
+    };
+    VisibilityMask { views: vec![eye(&profile.fov_left), eye(&profile.fov_right)] }
+}
+
+/// The exponent n whose superellipse |x|ⁿ + |y|ⁿ ≤ 1 leaves `share` of the square
+/// [−1, 1]² outside it (n ≥ 2: between the inscribed ellipse's 21.5 % and none).
+fn superellipse_exponent_hiding(share: f64) -> f64 {
+    // The area inside, by the midpoint rule on its quarter: ∫₀¹ (1 − xⁿ)^(1/n) dx.
+    let hidden = |n: f64| {
+        const STEPS: usize = 4096;
+        let quarter: f64 = (0..STEPS)
+            .map(|i| {
+                let x = (i as f64 + 0.5) / STEPS as f64;
+                (1.0 - x.powf(n)).max(0.0).powf(1.0 / n)
+            })
+            .sum::<f64>()
+            / STEPS as f64;
+        1.0 - quarter
+    };
+    let (mut lo, mut hi) = (2.0, 64.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if hidden(mid) > share {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 #[cfg(test)]
@@ -270,5 +329,20 @@ mod tests {
         let quest = by_name("quest-2").unwrap().with_refresh(120.0).unwrap();
         assert_eq!(quest.budget_ms(), 1000.0 / 120.0);
         assert_eq!(quest.fov_left, by_name("quest-2").unwrap().fov_left);
+    }
+
+    #[test]
+    fn profile_masks_hide_the_published_share_or_monados_corners() {
+        for name in PROFILE_NAMES {
+            let p = by_name(name).unwrap();
+            let mask = visibility_mask(&p);
+            assert_eq!(mask.views.len(), 2);
+            let (w, h) = (p.width / 8, p.height / 8);
+            for (view, fov) in mask.views.iter().zip([p.fov_left, p.fov_right]) {
+                let share = view.hidden_share(w, h, fov.tangents());
+                let expected = published_hidden_share(name).unwrap_or(0.03125);
+                assert!((share - expected).abs() < 0.006, "{name}: {share} hidden, expected {expected}");
+            }
+        }
     }
 }

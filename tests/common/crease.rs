@@ -96,10 +96,10 @@ pub fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
     // SSAO and SSDO by their depth-test simulation, HBAO by its march (None).
     let estimator = match technique {
         Technique::Ssao => Some((Estimator::Ssao, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Cosine))),
-        Technique::Ssdo | Technique::SsdoBounce => {
+        Technique::SsdoPoints | Technique::SsdoPointsBounce => {
             Some((Estimator::Ssdo, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Uniform)))
         }
-        Technique::Hbao | Technique::Gtao => None,
+        Technique::Hbao | Technique::Gtao | Technique::Ssdo | Technique::SsdoBounce => None,
         other => panic!("no crease expectation for {}", other.name()),
     };
     let (directions, steps) = hbao_directions_steps(CREASE_SAMPLES);

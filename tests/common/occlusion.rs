@@ -13,10 +13,17 @@ use vrao::render::stereo::HeadsetProfile;
 use vrao::{EyePair, FrameReport, Gpu, HeadPose, Renderer, Resource, Settings};
 
 /// The techniques that compute occlusion.
-pub const AO_TECHNIQUES: [Technique; 5] =
-    [Technique::Ssao, Technique::Hbao, Technique::Gtao, Technique::Ssdo, Technique::SsdoBounce];
+pub const AO_TECHNIQUES: [Technique; 7] = [
+    Technique::Ssao,
+    Technique::Hbao,
+    Technique::Gtao,
+    Technique::Ssdo,
+    Technique::SsdoBounce,
+    Technique::SsdoPoints,
+    Technique::SsdoPointsBounce,
+];
 /// Names of the passes that compute occlusion.
-pub const AO_PASSES: [&str; 5] = ["ssao", "hbao", "gtao", "ssdo", "ssdo-bounce"];
+pub const AO_PASSES: [&str; 7] = ["ssao", "hbao", "gtao", "ssdo", "ssdo-bounce", "ssdo-points", "ssdo-points-bounce"];
 
 pub fn settings(width: u32, height: u32, ao: AoSettings) -> Settings {
     Settings { profile: HeadsetProfile::with_size("test", width, height), ao, ..Settings::default() }

@@ -8,6 +8,7 @@
 use crate::error::Result;
 use crate::gpu::timing::{PassTimer, SpanRecorder};
 use crate::gpu::uniforms::{FrameLighting, FrameUniforms};
+use crate::gpu::visibility::VisibilityMaps;
 use crate::gpu::Gpu;
 use crate::graph::{self, Plan, Resource};
 use crate::graph_targets::GraphTargets;
@@ -33,6 +34,9 @@ pub struct FrameParams<'a> {
     pub multiview: bool,
     /// What moves this frame.
     pub motion: &'a FrameMotion,
+    /// The views' visibility mask (a headset's lens), applied when the settings' `mask`
+    /// is on and it has one mask per view.
+    pub mask: Option<&'a crate::visibility::VisibilityMask>,
 }
 
 /// How the passes of one frame reach the GPU.
@@ -78,6 +82,7 @@ struct PlanKey<K> {
 pub struct GraphDriver<K> {
     targets: GraphTargets,
     uniforms: FrameUniforms,
+    visibility: VisibilityMaps,
     timer: PassTimer,
     plan_cache: Option<(PlanKey<K>, Plan)>,
     frame_index: u64,
@@ -91,6 +96,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
         GraphDriver {
             targets: GraphTargets::default(),
             uniforms: FrameUniforms::new(&gpu.device, lights_per_view),
+            visibility: VisibilityMaps::new(gpu),
             timer,
             plan_cache: None,
             frame_index: 0,
@@ -116,6 +122,11 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
     /// The frame's uniform buffers (a raster pass binds them when it is made).
     pub fn uniforms(&self) -> &FrameUniforms {
         &self.uniforms
+    }
+
+    /// The visibility mask and foveation map of the last prepared frame.
+    pub fn visibility(&self) -> &VisibilityMaps {
+        &self.visibility
     }
 
     /// The targets, placeholders and imported textures.
@@ -206,6 +217,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
         self.targets = targets;
         self.uniforms.update(&gpu.queue, lighting, views, params.settings);
         self.uniforms.update_ao(&gpu.queue, params.settings, self.frame_index);
+        self.visibility.update(gpu, params.mask, params.settings, views);
     }
 
     /// Records the plan's passes into `encoder`, each in a span of `spans` (the driver's
@@ -236,6 +248,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
                 placeholders: &self.targets.placeholders,
                 decl: &plan.decls[step],
                 frame: &self.uniforms,
+                visibility: &self.visibility,
                 environment,
                 timer: spans,
                 setup: &setup,

@@ -23,6 +23,7 @@ pub mod sampling;
 pub mod settings;
 pub mod stereo;
 pub mod technique;
+pub mod visibility;
 
 pub use ao::{
     AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostMotion, HostNormals, ViewMatrices,

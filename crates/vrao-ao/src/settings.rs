@@ -357,6 +357,10 @@ pub struct AoSettings {
     pub stereo_reuse: bool,
     /// Fixed foveated occlusion: fewer samples towards each eye's image edges.
     pub foveation: Foveation,
+    /// Skip the pixels the headset's lens hides (its visibility mask, where the runtime,
+    /// the profile or the host gives one): every pass leaves them out and they stay
+    /// black. Off: every pixel of the rectangle is computed.
+    pub mask: bool,
 }
 
 /// How the temporal pass blends the new frame into the history.
@@ -451,6 +455,7 @@ impl Default for AoSettings {
             gtao: GtaoSettings::default(),
             stereo_reuse: true,
             foveation: Foveation::Off,
+            mask: true,
         }
     }
 }
@@ -500,13 +505,13 @@ impl AoSettings {
     /// bounce strength is above 0.
     pub fn pass_name(&self) -> &'static str {
         match self.technique {
-            Technique::SsdoBounce if !self.bounce_active() => Technique::Ssdo.name(),
+            technique if technique.gathers_bounce() && !self.bounce_active() => technique.without_bounce().name(),
             technique => technique.name(),
         }
     }
 
     /// True when the SSDO pass also gathers the bounce.
     pub fn bounce_active(&self) -> bool {
-        self.technique == Technique::SsdoBounce && self.bounce > 0.0
+        self.technique.gathers_bounce() && self.bounce > 0.0
     }
 }

@@ -6,7 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
-use crate::passes::{fetch_only, gtao, hbao, ssao, Pass};
+use crate::passes::{fetch_only, gtao, hbao, ssao, ssdo, Pass};
 
 /// The occlusion technique.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -22,10 +22,18 @@ pub enum Technique {
     /// millisecond.
     #[default]
     Gtao,
-    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1).
+    /// Screen-space directional occlusion of the environment (Ritschel et al. 2009 eq. 1)
+    /// on GTAO's slices and visibility bitmask: GTAO's occlusion, and the environment
+    /// light through the unoccluded sectors in rgb.
     Ssdo,
-    /// SSDO plus one indirect bounce in the same loop (Ritschel et al. 2009 eq. 2).
+    /// [`Technique::Ssdo`] plus one bounce of direct light from the senders of the newly
+    /// covered sectors (Ritschel et al. 2009 eq. 2 on sectors, Therrien et al. 2023).
     SsdoBounce,
+    /// The seeds' point-sampled SSDO (Ritschel et al. 2009 eq. 1, a hemisphere of sample
+    /// points), kept as a measured baseline; vrao's renderer supplies its pass.
+    SsdoPoints,
+    /// [`Technique::SsdoPoints`] plus the seeds' point-sampled bounce (eq. 2).
+    SsdoPointsBounce,
     /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
     FetchOnly,
 }
@@ -39,8 +47,8 @@ pub enum TechniqueKind {
     Hemisphere,
     /// Horizons or sectors found by marching depth along screen-space directions.
     HorizonMarch,
-    /// Occlusion and the light that arrives through the unblocked directions, in colour:
-    /// it needs a renderer's light (vrao-render's SSDO); the AO engine refuses it.
+    /// Occlusion and the light that arrives through the unblocked directions, in colour,
+    /// from the frame's environment and direct light (SSDO).
     LightGathering,
     /// A cost baseline that estimates nothing.
     Baseline,
@@ -110,7 +118,7 @@ pub struct TechniqueEntry {
 }
 
 /// Every technique, in the order the CLI and the bench list them.
-pub const TECHNIQUES: [TechniqueEntry; 7] = [
+pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::None,
         name: "none",
@@ -152,13 +160,31 @@ pub const TECHNIQUES: [TechniqueEntry; 7] = [
         name: "ssdo",
         kind: TechniqueKind::LightGathering,
         composite: CompositeMode::Directional,
+        samples: SamplePattern::Directions,
+        foveation: FoveationRule::DirectionsThenSteps,
+        pass: Some(|gpu| Box::new(ssdo::SsdoPass::new(gpu, Technique::Ssdo))),
+    },
+    TechniqueEntry {
+        technique: Technique::SsdoBounce,
+        name: "ssdo-bounce",
+        kind: TechniqueKind::LightGathering,
+        composite: CompositeMode::Directional,
+        samples: SamplePattern::Directions,
+        foveation: FoveationRule::DirectionsThenSteps,
+        pass: Some(|gpu| Box::new(ssdo::SsdoPass::new(gpu, Technique::SsdoBounce))),
+    },
+    TechniqueEntry {
+        technique: Technique::SsdoPoints,
+        name: "ssdo-points",
+        kind: TechniqueKind::LightGathering,
+        composite: CompositeMode::Directional,
         samples: SamplePattern::HemisphereUniform,
         foveation: FoveationRule::Samples,
         pass: None,
     },
     TechniqueEntry {
-        technique: Technique::SsdoBounce,
-        name: "ssdo-bounce",
+        technique: Technique::SsdoPointsBounce,
+        name: "ssdo-points-bounce",
         kind: TechniqueKind::LightGathering,
         composite: CompositeMode::Directional,
         samples: SamplePattern::HemisphereUniform,
@@ -203,6 +229,28 @@ impl Technique {
     /// so the denoise filters alpha alone for them.
     pub fn carries_light(self) -> bool {
         self.entry().kind == TechniqueKind::LightGathering
+    }
+
+    /// Whether the technique gathers a bounce of direct light (`ssdo-bounce`,
+    /// `ssdo-points-bounce`).
+    pub fn gathers_bounce(self) -> bool {
+        matches!(self, Technique::SsdoBounce | Technique::SsdoPointsBounce)
+    }
+
+    /// The same technique without its bounce (itself when it has none): what the bench
+    /// subtracts to see the bounce alone.
+    pub fn without_bounce(self) -> Technique {
+        match self {
+            Technique::SsdoBounce => Technique::Ssdo,
+            Technique::SsdoPointsBounce => Technique::SsdoPoints,
+            other => other,
+        }
+    }
+
+    /// Whether vrao's renderer supplies the technique's pass (the point-sampled SSDO,
+    /// which the AO engine does not run).
+    pub fn renderer_only(self) -> bool {
+        self.entry().pass.is_none() && self.entry().kind == TechniqueKind::LightGathering
     }
 
     /// Every technique, in the order the CLI and the bench list them ([`Technique::ALL`]).
@@ -253,6 +301,8 @@ mod tests {
             Technique::Gtao,
             Technique::Ssdo,
             Technique::SsdoBounce,
+            Technique::SsdoPoints,
+            Technique::SsdoPointsBounce,
             Technique::FetchOnly,
         ] {
             match t {
@@ -262,6 +312,8 @@ mod tests {
                 | Technique::Gtao
                 | Technique::Ssdo
                 | Technique::SsdoBounce
+                | Technique::SsdoPoints
+                | Technique::SsdoPointsBounce
                 | Technique::FetchOnly => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
             }
         }
@@ -279,11 +331,11 @@ mod tests {
                 "{}",
                 e.name
             );
-            // The engine builds a pass for every technique but `none` and the light
-            // gathering ones, which a renderer supplies.
-            let engine_pass = !matches!(e.kind, TechniqueKind::Off | TechniqueKind::LightGathering);
+            // The engine builds a pass for every technique but `none` and the point-sampled
+            // SSDO, which a renderer supplies.
+            let engine_pass = e.kind != TechniqueKind::Off && !e.name.starts_with("ssdo-points");
             assert_eq!(e.pass.is_some(), engine_pass, "{}", e.name);
-            let marches = e.kind == TechniqueKind::HorizonMarch;
+            let marches = e.kind == TechniqueKind::HorizonMarch || (e.kind == TechniqueKind::LightGathering && engine_pass);
             assert_eq!(marches, e.samples == SamplePattern::Directions, "{}", e.name);
             assert_eq!(marches, e.foveation == FoveationRule::DirectionsThenSteps, "{}", e.name);
         }

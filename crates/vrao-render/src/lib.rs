@@ -19,7 +19,7 @@ pub mod renderer;
 pub mod scene;
 pub mod settings;
 
-pub use vrao_ao::{ao, driver, error, graph, graph_targets, sampling, stereo, technique};
+pub use vrao_ao::{ao, driver, error, graph, graph_targets, sampling, stereo, technique, visibility};
 
 pub use error::{Error, Result};
 pub use gpu::{BackendChoice, Gpu};

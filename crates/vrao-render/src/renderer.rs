@@ -20,6 +20,7 @@ use crate::passes::{self, ChainSettings, FrameMotion, MoverBox, Pass};
 use crate::scene::{Aabb, Scene};
 use crate::settings::{Settings, StereoMode};
 use crate::stereo::Eye;
+use crate::visibility::VisibilityMask;
 use glam::DVec3;
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -189,6 +190,7 @@ impl Renderer {
             anchor: gpu_scene.anchor,
             multiview,
             motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },
+            mask: None,
         };
         Ok(Renderer {
             gpu,
@@ -253,6 +255,24 @@ impl Renderer {
         self.settings = settings.clone();
         self.inputs.settings = chain_settings(settings);
         Ok(())
+    }
+
+    /// The headset's visibility mask, one view mask per eye (the runtime's or the
+    /// profile's), or `None`. With the AO settings' `mask` on, the G-buffer draws it into
+    /// depth first and every pass leaves the hidden pixels out; they stay black.
+    pub fn set_visibility_mask(&mut self, mask: Option<VisibilityMask>) {
+        self.inputs.mask = mask;
+    }
+
+    /// The visibility mask given ([`Renderer::set_visibility_mask`]).
+    pub fn visibility_mask(&self) -> Option<&VisibilityMask> {
+        self.inputs.mask.as_ref()
+    }
+
+    /// The share of each view's pixels the mask hid in the last frame (zeros without
+    /// one, empty before the first frame).
+    pub fn hidden_share(&self) -> &[f64] {
+        self.driver.visibility().hidden_share()
     }
 
     /// The scene time (seconds) of the next frame: where animated objects are. The frame
@@ -545,6 +565,8 @@ struct FrameInputs {
     multiview: bool,
     /// What moves in the frame being rendered.
     motion: FrameMotion,
+    /// The headset's visibility mask ([`Renderer::set_visibility_mask`]).
+    mask: Option<VisibilityMask>,
 }
 
 impl FrameInputs {
@@ -558,6 +580,7 @@ impl FrameInputs {
             anchor: self.anchor,
             multiview: self.multiview,
             motion: &self.motion,
+            mask: self.mask.as_ref(),
         }
     }
 }

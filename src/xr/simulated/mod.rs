@@ -117,6 +117,8 @@ pub struct SimulatedHeadset {
     /// `request_exit` was called: no more frames.
     exit_requested: bool,
     ended: bool,
+    /// The profile's lens ([`crate::xr::profiles::visibility_mask`]).
+    mask: crate::render::visibility::VisibilityMask,
 }
 
 impl SimulatedHeadset {
@@ -131,6 +133,7 @@ impl SimulatedHeadset {
             TimeMode::Virtual { .. } => Clock::Virtual { now: 0.0 },
         };
         Ok(SimulatedHeadset {
+            mask: crate::xr::profiles::visibility_mask(&options.profile),
             rendering: VecDeque::new(),
             recorded: None,
             compositor: Compositor::new(options.profile.refresh_hz),
@@ -311,6 +314,10 @@ impl SimulatedHeadset {
 }
 
 impl Headset for SimulatedHeadset {
+    fn visibility_mask(&self) -> Option<&crate::render::visibility::VisibilityMask> {
+        Some(&self.mask)
+    }
+
     fn describe(&self) -> String {
         let p = &self.options.profile;
         let time = match &self.options.time {

@@ -57,6 +57,9 @@ pub struct Reprojector {
     sampler: wgpu::Sampler,
     /// Splatted target depths, one u32 per pixel and layer (grown on demand).
     splatted: Option<wgpu::Buffer>,
+    /// Group 1 every kernel has (the AO chain's visibility maps): the warp masks nothing,
+    /// the runtime's compositor having no lens of its own here.
+    visibility: crate::render::gpu::visibility::VisibilityMaps,
 }
 
 /// reproject.wgsl's bindings: the warp's uniform, the held depth and colour and their
@@ -95,6 +98,7 @@ impl Reprojector {
                 ..Default::default()
             }),
             splatted: None,
+            visibility: crate::render::gpu::visibility::VisibilityMaps::new(gpu),
         })
     }
 
@@ -149,11 +153,11 @@ impl Reprojector {
         ];
         let extent = (width, height, layers);
         match mode {
-            ReprojectionMode::Rotational => self.rotational.dispatch(&gpu.device, encoder, &resources, extent),
+            ReprojectionMode::Rotational => self.rotational.dispatch(&gpu.device, encoder, self.visibility.bind_group(), &resources, extent),
             ReprojectionMode::Depth => {
                 encoder.clear_buffer(splatted, 0, Some(bytes));
-                self.splat.dispatch(&gpu.device, encoder, &resources, extent);
-                self.positional.dispatch(&gpu.device, encoder, &resources, extent);
+                self.splat.dispatch(&gpu.device, encoder, self.visibility.bind_group(), &resources, extent);
+                self.positional.dispatch(&gpu.device, encoder, self.visibility.bind_group(), &resources, extent);
             }
         }
     }

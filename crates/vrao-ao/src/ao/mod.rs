@@ -160,6 +160,8 @@ pub struct AoEngine {
     output_format: AoOutputFormat,
     /// Whether this frame has the host's motion vectors.
     motion: FrameMotion,
+    /// The host's visibility mask, one per view ([`AoEngine::set_visibility_mask`]).
+    mask: Option<crate::visibility::VisibilityMask>,
 }
 
 impl AoEngine {
@@ -191,7 +193,20 @@ impl AoEngine {
             pack,
             output_format: AoOutputFormat::default(),
             motion: FrameMotion::STILL,
+            mask: None,
         })
+    }
+
+    /// The headset's visibility mask, one [`crate::visibility::ViewMask`] per view (from
+    /// `xrGetVisibilityMaskKHR`, say), or `None`. With [`AoSettings::mask`] on, every pass
+    /// leaves the hidden pixels out: their AO reads 1 and costs no fetches.
+    pub fn set_visibility_mask(&mut self, mask: Option<crate::visibility::VisibilityMask>) {
+        self.mask = mask;
+    }
+
+    /// The share of each view's pixels the mask hid in the last frame (empty before one).
+    pub fn hidden_share(&self) -> &[f64] {
+        self.driver.visibility().hidden_share()
     }
 
     /// Changes the AO settings (validated; a different technique or resolution
@@ -304,6 +319,7 @@ impl AoEngine {
             anchor: glam::DVec3::ZERO,
             multiview: false,
             motion: &self.motion,
+            mask: self.mask.as_ref(),
         };
         let passes: Vec<&dyn Pass> =
             std::iter::once(&self.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();

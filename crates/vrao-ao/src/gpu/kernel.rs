@@ -45,6 +45,14 @@ pub(crate) use wgsl;
 /// `common.wgsl`: the frame's uniforms and helpers every pass shares.
 pub const COMMON: Shader = wgsl!("shaders/common.wgsl");
 
+/// `irradiance.wgsl`: the environment's irradiance and radiance quadratics (SSDO, a
+/// renderer's composite).
+pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");
+
+/// `visibility.wgsl`: bind group 1 of every compute kernel, the visibility mask and
+/// foveation map (`tile_rate`, `pixel_shown`), for the kernels that read it.
+pub const VISIBILITY: Shader = wgsl!("shaders/visibility.wgsl");
+
 /// The environment variable that makes the application's shaders load from disk
 /// (`Gpu::new` reads it; [`Gpu::set_shader_dir`] sets a directory for one `Gpu`):
 /// `VRAO_SHADER_DIR=.` (the workspace root) runs an edited shader without rebuilding.
@@ -369,7 +377,7 @@ impl Kernel {
         // The files are read now, so an unreadable one is the error of whoever makes the
         // kernel (as for an eager one); only the compilation waits.
         let source = source_or_recorded(gpu, files);
-        let (layout, pipeline_layout, slots) = Self::layouts(&gpu.device, label, binds);
+        let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds);
         Kernel {
             label: label.to_string(),
             pipeline: OnceLock::new(),
@@ -399,7 +407,7 @@ impl Kernel {
         binds: &[Bind],
         constants: &[(&str, f64)],
     ) -> Kernel {
-        let (layout, pipeline_layout, slots) = Self::layouts(&gpu.device, label, binds);
+        let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds);
         let pipeline = compute_pipeline(&gpu.device, label, &pipeline_layout, module, entry, constants);
         gpu.pipeline_counter().fetch_add(1, Ordering::Relaxed);
         Kernel {
@@ -414,11 +422,8 @@ impl Kernel {
     }
 
     /// The bind group layout, the pipeline layout and the slots of `binds`.
-    fn layouts(
-        device: &wgpu::Device,
-        label: &str,
-        binds: &[Bind],
-    ) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout, Vec<Slot>) {
+    fn layouts(gpu: &Gpu, label: &str, binds: &[Bind]) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout, Vec<Slot>) {
+        let device = &gpu.device;
         let slots: Vec<Slot> = binds.iter().map(|b| b.slot()).collect();
         // The start-up check refuses adapters that cannot write these formats; a kernel
         // writing another would fail on them only at its first frame.
@@ -436,7 +441,8 @@ impl Kernel {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
-            bind_group_layouts: &[Some(&layout)],
+            // Group 1: the visibility mask and foveation map every kernel may read.
+            bind_group_layouts: &[Some(&layout), Some(&gpu.visibility_layout)],
             immediate_size: 0,
         });
         (layout, pipeline_layout, slots)
@@ -467,12 +473,13 @@ impl Kernel {
         })
     }
 
-    /// Binds `resources` (one per slot, in slot order) and dispatches over
-    /// `width × height × layers` invocations.
+    /// Binds `resources` (one per slot, in slot order) and the frame's `visibility` maps
+    /// (group 1) and dispatches over `width × height × layers` invocations.
     pub fn dispatch(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
+        visibility: &wgpu::BindGroup,
         resources: &[wgpu::BindingResource],
         (width, height, layers): (u32, u32, u32),
     ) {
@@ -481,6 +488,7 @@ impl Kernel {
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
         pass.set_pipeline(self.pipeline(device));
         pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(1, visibility, &[]);
         pass.dispatch_workgroups(width.div_ceil(TILE), height.div_ceil(TILE), layers);
     }
 
@@ -491,6 +499,7 @@ impl Kernel {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
+        visibility: &wgpu::BindGroup,
         resources: &[wgpu::BindingResource],
         args: &wgpu::Buffer,
         offset: u64,
@@ -500,6 +509,7 @@ impl Kernel {
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&self.label), timestamp_writes: None });
         pass.set_pipeline(self.pipeline(device));
         pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(1, visibility, &[]);
         pass.dispatch_workgroups_indirect(args, offset);
     }
 

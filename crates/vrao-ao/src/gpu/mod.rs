@@ -9,6 +9,7 @@ pub mod readback;
 pub mod support;
 pub mod timing;
 pub mod uniforms;
+pub mod visibility;
 
 use crate::error::{Error, Result};
 use std::fmt::Write as _;
@@ -82,6 +83,9 @@ pub struct Gpu {
     /// Bumped whenever targets are made or dropped: every kernel made on this `Gpu` then
     /// forgets its bind groups, which would otherwise keep dropped textures alive.
     pub(crate) bind_group_epoch: std::sync::Arc<std::sync::atomic::AtomicU64>,
+    /// Bind group 1 of every compute kernel: the visibility mask and foveation map
+    /// ([`visibility::bind_group_layout`]).
+    pub visibility_layout: wgpu::BindGroupLayout,
 }
 
 impl Gpu {
@@ -175,7 +179,9 @@ impl Gpu {
             slot.get_or_insert_with(|| e.to_string());
         }));
         let info = adapter.get_info();
+        let visibility_layout = visibility::bind_group_layout(&device);
         let mut gpu = Gpu {
+            visibility_layout,
             caps: Self::capabilities_of(&device),
             instance: Some(instance),
             adapter: Some(adapter),
@@ -205,6 +211,7 @@ impl Gpu {
         let info = device.adapter_info();
         refuse_missing(&info, support::missing_device_capabilities(&support::DeviceSupport::of(device)))?;
         Ok(Gpu {
+            visibility_layout: visibility::bind_group_layout(device),
             caps: Capabilities { multiview: false, ..Self::capabilities_of(device) },
             instance: None,
             adapter: None,

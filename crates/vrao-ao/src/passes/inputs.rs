@@ -12,3 +12,8 @@ pub const NORMALS: Resource = Resource::attachment("normals", Size::Full, wgpu::
 /// the view's −z minus this one, w 1 where valid (0: the point was behind the previous
 /// eye). Written only when the scene moves; a host hands its own to the AO engine.
 pub const MOTION: Resource = Resource::attachment("motion", Size::Full, wgpu::TextureFormat::Rgba16Float);
+/// The direct light leaving each pixel's surface (outgoing radiance, RGB) with its view
+/// distance, packed (common.wgsl `pack_direct`): what SSDO's bounce sends from each
+/// occluding sample. vrao's renderer writes it (its direct-light pass); the AO engine
+/// packs a host's radiance texture into it.
+pub const DIRECT_LIGHT: Resource = Resource::storage("direct", Size::Full, wgpu::TextureFormat::Rg32Uint);

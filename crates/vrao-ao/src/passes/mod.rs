@@ -13,6 +13,7 @@ pub mod hbao;
 pub mod inputs;
 pub mod occlusion;
 pub mod ssao;
+pub mod ssdo;
 pub mod temporal;
 pub mod upsample;
 
@@ -30,7 +31,7 @@ use std::collections::{BTreeMap, HashMap};
 
 /// The AO chain, in execution order: each technique of the table that has a pass (one
 /// runs; [`crate::technique::TECHNIQUES`]), then `light_gathering`
-/// (a renderer's light-gathering technique, such as vrao-render's SSDO), temporal
+/// (a renderer's light-gathering technique, such as vrao-render's point-sampled SSDO), temporal
 /// accumulation, the denoise and the upsampling to full resolution. It reads
 /// [`inputs::DEPTH`] and [`inputs::NORMALS`] and provides [`crate::graph::OCCLUSION`] and
 /// [`crate::graph::FINAL_AO`].
@@ -174,6 +175,8 @@ pub struct RecordContext<'a> {
     pub decl: &'a PassDecl,
     /// The frame's uniform and light buffers.
     pub frame: &'a FrameUniforms,
+    /// The visibility mask and foveation map (bind group 1 of every kernel).
+    pub visibility: &'a crate::gpu::visibility::VisibilityMaps,
     /// An environment map and its sampler for [`Bind::Environment`] and
     /// [`Bind::EnvironmentSampler`] (a renderer's; `None` in the AO engine).
     pub environment: Option<(&'a wgpu::TextureView, &'a wgpu::Sampler)>,

@@ -1,5 +1,5 @@
-//! The engine's kernel plumbing ([`vrao_ao::gpu::kernel`]) and the renderer's shared
-//! WGSL files.
+//! The engine's kernel plumbing ([`vrao_ao::gpu::kernel`], with the shared WGSL files
+//! `COMMON` and `IRRADIANCE`) and the renderer's `wgsl!` for its own.
 
 pub use vrao_ao::gpu::kernel::*;
 
@@ -16,5 +16,3 @@ macro_rules! wgsl {
 
 pub(crate) use wgsl;
 
-/// `irradiance.wgsl`: the environment's irradiance and radiance quadratics.
-pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");

@@ -20,6 +20,11 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
     let layer = layers.x;
     let eye = frame.eyes[layer];
     let p = vec2<i32>(id.xy);
+    if (tile_rate(id.xy, u32(layer), ao.scale) == 0.0) {
+        // Hidden by the lens (visibility.wgsl): unoccluded, as the sky.
+        textureStore(occlusion_out, p, layers.y, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
     let centre_value = textureLoad(occlusion_in, p, layer, 0);
     let centre = textureLoad(geometry_layers, p, layer, 0);
     if (!(centre.w > 0.0) || ao.blur_radius == 0u) {

@@ -38,6 +38,17 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
     let layer = layers.x;
     let eye = frame.eyes[layer];
     let limit = vec2<i32>(ao.ao_size) - vec2<i32>(1);
+    // A run lies in one 8×8 tile of the visibility map: where the lens hides it, the run
+    // is written as the sky is (unoccluded) and loads nothing.
+    if (tile_rate(vec2<u32>(first), u32(layer), ao.scale) == 0.0) {
+        for (var o = 0; o < RUN; o++) {
+            let p = first + axis * o;
+            if (all(p <= limit)) {
+                textureStore(occlusion_out, p, layers.y, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+            }
+        }
+        return;
+    }
     // The right eye's pixels the left eye sees (bit o for pixel o of the run, also set
     // past the edge): written here, skipped below; a run of only those loads no taps.
     var reused = 0u;

@@ -7,7 +7,7 @@
 use super::inputs::DEPTH;
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::settings::{Denoise, Technique};
@@ -60,7 +60,7 @@ struct DenoiseKernels {
 impl DenoiseKernels {
     /// `constants`: the shader's pipeline constants besides `RIGHT_EYE`.
     fn new(gpu: &Gpu, shader: Shader, horizontal: &str, vertical: &str, constants: &[(&str, f64)]) -> Self {
-        let files = [COMMON, wgsl!("src/passes/blur/denoise_stereo.wgsl"), shader];
+        let files = [COMMON, VISIBILITY, wgsl!("src/passes/blur/denoise_stereo.wgsl"), shader];
         let kernel = |entry: &str, binds: &[Bind], right_eye: bool| {
             let mut constants = constants.to_vec();
             constants.push(("RIGHT_EYE", f64::from(right_eye)));
@@ -140,17 +140,17 @@ impl Pass for BlurPass {
         // Binding 6 is unused before the right eye's vertical dispatch: the geometry stands in.
         let stand_in = [ctx.view(AO_GEOMETRY)];
         let horizontal = ctx.bind(&HORIZONTAL, &stand_in);
-        kernels.horizontal.dispatch(device, ctx.encoder, &horizontal, horizontal_grid);
+        kernels.horizontal.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &horizontal, horizontal_grid);
         // The vertical pass: both eyes alike, or the left eye and then the right eye
         // reusing it.
         let mut vertical = ctx.bind(&VERTICAL, &stand_in);
         let filtered_layers = if reuse { 1 } else { layers };
-        kernels.vertical.dispatch(device, ctx.encoder, &vertical, (vertical_grid.0, vertical_grid.1, filtered_layers));
+        kernels.vertical.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &vertical, (vertical_grid.0, vertical_grid.1, filtered_layers));
         if reuse {
             let (right, left) = (ctx.layer_view(AO_BLURRED, 1), ctx.layer_view(AO_BLURRED, 0));
             vertical[4] = wgpu::BindingResource::TextureView(&right);
             vertical[6] = wgpu::BindingResource::TextureView(&left);
-            kernels.right_eye_vertical.dispatch(device, ctx.encoder, &vertical, (vertical_grid.0, vertical_grid.1, 1));
+            kernels.right_eye_vertical.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &vertical, (vertical_grid.0, vertical_grid.1, 1));
         }
     }
 }

@@ -31,6 +31,11 @@
 // With two views and `stereo_reuse`, the right eye then runs as a third (RIGHT_EYE).
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
+// The light a march gathers besides the visibility (`begin_light`, `gather_sample` for
+// each sample's newly covered sectors, `end_slice`, `light_result`, `open_light`,
+// `reused_light`) comes from the file compiled after this one: gtao_light.wgsl for GTAO
+// (none: rgb 0, code the compiler drops), passes/ssdo/ssdo.wgsl for SSDO, which marches
+// the same slices and sectors.
 
 const SECTORS: f32 = 32.0;
 
@@ -343,7 +348,7 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
             r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
         );
         if (left.found) {
-            store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, left.value.a));
+            store_occlusion(id, vec4<f32>(reused_light(left.value), left.value.a));
             return;
         }
     }
@@ -357,7 +362,7 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let radius_px = radius / max(abs(pixel_tangent.x) * distance, 1e-30);
     if (!(radius_px >= 1.0)) {
         // The whole radius lies inside this pixel: nothing to find.
-        store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        store_occlusion(id, vec4<f32>(open_light(r), 1.0));
         return;
     }
     // Never march further than the image's diagonal.
@@ -370,7 +375,7 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let centre_px = vec2<f32>(r.pixel) + vec2<f32>(0.5);
     // Fewer slices, then steps, towards the image's edges with fixed foveation
     // (occlusion.wgsl).
-    let counts = foveated_march(max(gtao.slices, 1u), max(gtao.steps, 1u), foveation_rate(p), id.xy);
+    let counts = foveated_march(max(gtao.slices, 1u), max(gtao.steps, 1u), foveation_rate(id.xy, r.layer), id.xy);
     let slices = counts.x;
     let steps = counts.y;
     // Whether any step can leave the image through the inner border, the only one the
@@ -389,6 +394,9 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
     limits.sector_offset = fract(rotation_noise * 11.0 + 0.71875);
     var visible = 0.0;
     var total = 0.0;
+    // What a light-gathering march (SSDO, passes/ssdo) adds up besides the visibility;
+    // nothing for GTAO (gtao_light.wgsl).
+    var light = begin_light(rotation_noise);
     // Slice directions: the pixel's first, then turned by π / slices each (one sin/cos
     // pair per pixel and one per frame instead of one per slice).
     let phi0 = rotation_noise * PI / f32(slices) + ao.frame_angle;
@@ -467,7 +475,9 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
                         card.ray_b = view_position_from_distance(qb / size, 1.0, r.eye.tangents);
                     }
                 }
+                let covered = march.occluded;
                 add_sample(&march, slice, sign, p, select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0), card, limits);
+                gather_sample(&light, march.occluded & ~covered, pixel, r.layer, surface, p);
             }
             let towards_inner = near_inner_border && sign * omega.x * inner > 0.0;
             for (; towards_inner && i < steps; i++) {
@@ -484,11 +494,12 @@ fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
         let weight = projected_len * slice_total;
         visible += weight * visible_sectors(march, limits.sector_offset) / SECTORS;
         total += weight;
+        end_slice(&light, slice, march, limits.sector_offset, projected_len, weight, view);
     }
     var visibility = 1.0;
     if (total > 1e-12) {
         visibility = visible / total;
     }
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, result));
+    store_occlusion(id, vec4<f32>(light_result(light, r, visibility, total), result));
 }

@@ -7,7 +7,7 @@
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
 use super::{DeclareContext, Pass, RecordContext};
 use crate::error::{Error, Result};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::Technique;
@@ -69,9 +69,35 @@ impl GtaoSettings {
 
 /// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
 /// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`),
-/// and at 9 GTAO's own parameters.
-const BINDINGS: [Bind; 10] =
+/// and at 9 GTAO's own parameters. A march that gathers light (SSDO) binds more after
+/// these ([`March::binds`]).
+pub const BINDINGS: [Bind; 10] =
     occlusion::bindings_and([Bind::Own(Slot::Layers), Bind::Own(Slot::Layers), Bind::Own(Slot::Uniform)]);
+
+/// gtao.wgsl: the march over slices and sectors that GTAO and SSDO share.
+pub const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
+
+/// One technique built on gtao.wgsl's march: its name, its WGSL files (the march and,
+/// after it, the file of its light hooks: gtao_light.wgsl for GTAO), its bindings
+/// ([`BINDINGS`] and its own after them), its extra pipeline constants, and what it
+/// adds to its declaration.
+pub struct March {
+    /// The technique (its pass runs when it is chosen).
+    pub technique: Technique,
+    /// The pipelines' label.
+    pub label: &'static str,
+    /// The WGSL files, in order.
+    pub files: Vec<Shader>,
+    /// The bindings: [`BINDINGS`] first.
+    pub binds: &'static [Bind],
+    /// Extra `override` values.
+    pub constants: Vec<(&'static str, f64)>,
+    /// Adjusts the pass's declaration (the resources it leaves unbound, notes).
+    pub declare: fn(PassDecl, &DeclareContext) -> PassDecl,
+    /// Whether the pipelines without cards compile when the pass is made (GTAO, the
+    /// default) or at its first frame.
+    pub eager: bool,
+}
 
 /// `GtaoParams` of gtao.wgsl: what GTAO reads besides the shared `AoParams`.
 #[repr(C)]
@@ -115,25 +141,27 @@ struct Kernels {
 }
 
 impl Kernels {
-    fn new(gpu: &Gpu, thin_cards: bool) -> Self {
-        let files = [COMMON, OCCLUSION_WGSL, wgsl!("src/passes/gtao/gtao.wgsl")];
-        let label = Technique::Gtao.name();
+    fn new(gpu: &Gpu, march: &March, thin_cards: bool) -> Self {
         let kernel = |band: bool, right: bool| {
-            let constants = [
+            let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
                 ("RIGHT_EYE", f64::from(right)),
                 ("SINGLE_LAYER_OUTPUT", f64::from(right)),
                 ("THIN_CARDS", f64::from(thin_cards)),
             ];
-            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
+            constants.extend_from_slice(&march.constants);
+            Kernel::with_constants(gpu, march.label, &march.files, "main", march.binds, &constants)
         };
         Kernels { interior: kernel(false, false), inner_band: kernel(true, false), right_eye: kernel(false, true) }
     }
 }
 
-/// GTAO's pipelines and its parameters.
+/// GTAO's pipelines and its parameters; with another [`March`], a technique that
+/// marches the same slices (SSDO).
 pub struct GtaoPass {
-    solid: Kernels,
+    march: March,
+    /// Built when the pass is made for an eager [`March`], else on its first frame.
+    solid: std::sync::OnceLock<Kernels>,
     /// Built on the first frame of a scene with alpha-tested materials.
     thin_cards: std::sync::OnceLock<Kernels>,
     params: wgpu::Buffer,
@@ -142,19 +170,41 @@ pub struct GtaoPass {
 impl GtaoPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
+        Self::with_march(
+            gpu,
+            March {
+                technique: Technique::Gtao,
+                label: Technique::Gtao.name(),
+                files: vec![COMMON, VISIBILITY, OCCLUSION_WGSL, GTAO_WGSL, wgsl!("src/passes/gtao/gtao_light.wgsl")],
+                binds: &BINDINGS,
+                constants: Vec::new(),
+                declare: |decl, _| decl,
+                eager: true,
+            },
+        )
+    }
+
+    /// The pass of another technique on GTAO's march.
+    pub fn with_march(gpu: &Gpu, march: March) -> Self {
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("gtao params"),
             size: std::mem::size_of::<GtaoUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        GtaoPass { solid: Kernels::new(gpu, false), thin_cards: std::sync::OnceLock::new(), params }
+        let solid = std::sync::OnceLock::new();
+        if march.eager {
+            let _ = solid.set(Kernels::new(gpu, &march, false));
+        }
+        GtaoPass { march, solid, thin_cards: std::sync::OnceLock::new(), params }
     }
 }
 
 impl Pass for GtaoPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
-        let decl = technique_decl(Technique::Gtao.name(), &BINDINGS, &[Technique::Gtao], setup);
+        let technique = self.march.technique;
+        let decl = technique_decl(self.march.label, self.march.binds, &[technique], setup);
+        let decl = (self.march.declare)(decl, setup);
         if setup.alpha_cards {
             decl.note("alpha-tested samples are cards: each blocks its footprint on the card, not a slab")
         } else {
@@ -182,21 +232,24 @@ impl Pass for GtaoPass {
         // caller's interrupt cuts builds short, kernels built now would be stand-ins for
         // good: the last frames of an ending session take samples as solid instead.
         let cards = ctx.setup.alpha_cards;
+        let solid = || self.solid.get_or_init(|| Kernels::new(ctx.gpu, &self.march, false));
         let kernels = match self.thin_cards.get() {
             Some(kernels) if cards => kernels,
-            None if cards && !ctx.gpu.builds_cancelled() => self.thin_cards.get_or_init(|| Kernels::new(ctx.gpu, true)),
-            _ => &self.solid,
+            None if cards && !ctx.gpu.builds_cancelled() => {
+                self.thin_cards.get_or_init(|| Kernels::new(ctx.gpu, &self.march, true))
+            }
+            _ => solid(),
         };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
         // Bindings 7 and 8 are unused before the right eye's dispatch: the normals stand in.
         let normals = ctx.view(super::inputs::NORMALS);
-        let resources = ctx.bind(&BINDINGS, &[normals.clone(), normals, self.params.as_entire_binding()]);
+        let resources = ctx.bind(self.march.binds, &[normals.clone(), normals, self.params.as_entire_binding()]);
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        kernels.interior.dispatch(device, ctx.encoder, &resources, (width - band, height, marched_layers));
-        kernels.inner_band.dispatch(device, ctx.encoder, &resources, (band, height, marched_layers));
+        kernels.interior.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (width - band, height, marched_layers));
+        kernels.inner_band.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (band, height, marched_layers));
         if !reuse {
             return;
         }
@@ -206,11 +259,11 @@ impl Pass for GtaoPass {
         let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
         let view = wgpu::BindingResource::TextureView;
         let resources = ctx.bind_overriding(
-            &BINDINGS,
+            self.march.binds,
             &[view(&ao_left), view(&geometry_left), self.params.as_entire_binding()],
             &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))],
         );
-        kernels.right_eye.dispatch(device, ctx.encoder, &resources, (width, height, 1));
+        kernels.right_eye.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (width, height, 1));
     }
 }
 

@@ -20,7 +20,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let radius_px = ao.radius / max(metres_per_pixel, 1e-30);
     // Fewer directions, then steps, towards the image's edges with fixed foveation
     // (occlusion.wgsl).
-    let counts = foveated_march(max(ao.directions, 1u), max(ao.steps, 1u), foveation_rate(r.position), id.xy);
+    let counts = foveated_march(max(ao.directions, 1u), max(ao.steps, 1u), foveation_rate(id.xy, r.layer), id.xy);
     let directions = counts.x;
     let steps = counts.y;
     // Never further than the image's diagonal.

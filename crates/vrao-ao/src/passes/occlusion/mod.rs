@@ -5,7 +5,7 @@
 //! are passes of their own in their folders.
 
 use super::{DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::passes::inputs::{DEPTH, NORMALS};
@@ -78,7 +78,7 @@ pub struct TechniquePass {
 impl TechniquePass {
     /// The pass of `technique`, whose WGSL is `shader`.
     pub fn new(gpu: &Gpu, technique: Technique, shader: Shader) -> Self {
-        let files = [COMMON, OCCLUSION_WGSL, shader];
+        let files = [COMMON, VISIBILITY, OCCLUSION_WGSL, shader];
         TechniquePass { technique, kernel: Kernel::new(gpu, technique.name(), &files, "main", &BINDINGS) }
     }
 }
@@ -90,6 +90,6 @@ impl Pass for TechniquePass {
 
     fn record(&self, ctx: &mut RecordContext) {
         let resources = ctx.bind(&BINDINGS, &[]);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.ao_extent());
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.ao_extent());
     }
 }

@@ -41,7 +41,12 @@ fn begin_receiver(id: vec3<u32>) -> Receiver {
     r.layer = id.z;
     r.eye = frame.eyes[id.z];
     r.pixel = full_res_pixel(id.xy, ao.scale, frame.size);
-    let depth = textureLoad(depth_layers, vec2<i32>(r.pixel), i32(r.layer), 0);
+    // A tile the lens hides (visibility.wgsl) is written as the sky is, before any fetch;
+    // its hidden pixels in a tile the lens partly shows read as sky in depth already.
+    var depth = 0.0;
+    if (tile_rate(id.xy, id.z, ao.scale) > 0.0) {
+        depth = textureLoad(depth_layers, vec2<i32>(r.pixel), i32(r.layer), 0);
+    }
     if (depth <= 0.0) {
         store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
         textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(0.0));
@@ -271,18 +276,13 @@ fn bayer4(p: vec2<u32>) -> f32 {
     return (f32(index) + 0.5) / 16.0;
 }
 
-// Fixed foveation (settings::Foveation): the share of its full sample count the receiver
-// at view-space `position` spends, from the tangent of its angle off the eye's view axis
-// (1 within `foveation_full_rate_tan`, falling linearly in the tangent to
-// `foveation_edge_rate` at `foveation_edge_tan`). Off, the rate is 1 everywhere.
-fn foveation_rate(position: vec3<f32>) -> f32 {
-    if (ao.foveation_edge_rate >= 1.0) {
-        return 1.0;
-    }
-    let tan_off_axis = length(position.xy) / max(-position.z, 1e-30);
-    let span = max(ao.foveation_edge_tan - ao.foveation_full_rate_tan, 1e-6);
-    let t = clamp((tan_off_axis - ao.foveation_full_rate_tan) / span, 0.0, 1.0);
-    return mix(1.0, ao.foveation_edge_rate, t);
+// Fixed foveation (settings::Foveation): the share of its full sample count occlusion
+// pixel `p` spends, read from the visibility map (visibility.wgsl), which holds the rate
+// of each tile's centre, from the tangent of its angle off the eye's view axis (1 within
+// the map's full-rate angle, falling linearly in the tangent to its edge rate). Off, the
+// rate is 1 everywhere the lens shows.
+fn foveation_rate(p: vec2<u32>, layer: u32) -> f32 {
+    return tile_rate(p, layer, ao.scale);
 }
 
 // `full` samples (or steps, or slices) scaled by `rate` (a foveation rate), as a whole

@@ -16,7 +16,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = r.position + r.normal * bias;
     // Fewer samples towards the image's edges with fixed foveation (occlusion.wgsl): a
     // prefix of the low-discrepancy kernel.
-    let samples = foveated_count(max(ao.samples, 1u), foveation_rate(r.position), id.xy);
+    let samples = foveated_count(max(ao.samples, 1u), foveation_rate(id.xy, r.layer), id.xy);
     var occlusion = 0.0;
     for (var i = 0u; i < samples; i++) {
         let k = kernel[i];

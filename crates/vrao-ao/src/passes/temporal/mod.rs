@@ -6,7 +6,7 @@
 
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, MoverBox, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, VISIBILITY};
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION, PIXEL_MOTION};
@@ -93,7 +93,7 @@ pub struct TemporalPass {
 impl TemporalPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> TemporalPass {
-        let files = [COMMON, wgsl!("src/passes/temporal/temporal.wgsl")];
+        let files = [COMMON, VISIBILITY, wgsl!("src/passes/temporal/temporal.wgsl")];
         TemporalPass {
             kernel: Kernel::new(gpu, "temporal", &files, "main", &BINDINGS),
             uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -206,7 +206,7 @@ impl Pass for TemporalPass {
         ];
         // The history views live in `history` (clones of the pass's handles) until the dispatch.
         let resources = ctx.bind(&BINDINGS, &own);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, extent);
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, extent);
     }
 
     fn kept_target(&self, r: Resource) -> Option<LayeredTarget> {

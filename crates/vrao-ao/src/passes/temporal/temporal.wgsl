@@ -97,6 +97,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let p = vec2<i32>(id.xy);
     let layer = i32(id.z);
+    if (tile_rate(id.xy, id.z, ao.scale) == 0.0) {
+        // Hidden by the lens (visibility.wgsl): unoccluded, as the sky, and no history.
+        textureStore(accumulated_out, p, layer, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(history_value_out, p, layer, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(history_position_out, p, layer, vec4<f32>(0.0));
+        return;
+    }
     let current = textureLoad(current_layers, p, layer, 0);
     let geometry = textureLoad(geometry_layers, p, layer, 0);
     if (!(geometry.w > 0.0)) {

@@ -7,7 +7,7 @@
 use super::inputs::{DEPTH, NORMALS};
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
 use crate::passes::ChainSettings;
@@ -62,7 +62,7 @@ pub struct UpsamplePass {
 impl UpsamplePass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = [COMMON, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/upsample/upsample.wgsl")];
+        let files = [COMMON, VISIBILITY, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/upsample/upsample.wgsl")];
         let kernel = |label: &str, right_eye: bool| {
             Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &[("RIGHT_EYE", f64::from(right_eye))])
         };
@@ -88,7 +88,7 @@ impl Pass for UpsamplePass {
         let (w, h, layers) = ctx.quad_extent();
         let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
-        self.kernel.dispatch(device, ctx.encoder, &resources, (w, h, if reuse { 1 } else { layers }));
+        self.kernel.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, if reuse { 1 } else { layers }));
         if reuse {
             // The right eye writes layer 1 alone and reads the left eye's layer 0.
             let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));
@@ -97,7 +97,7 @@ impl Pass for UpsamplePass {
                 &[wgpu::BindingResource::TextureView(&left)],
                 &[(AO_FULL, wgpu::BindingResource::TextureView(&right))],
             );
-            self.right_eye.dispatch(device, ctx.encoder, &resources, (w, h, 1));
+            self.right_eye.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, 1));
         }
     }
 }

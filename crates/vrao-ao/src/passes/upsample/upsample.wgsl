@@ -29,6 +29,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let layer = select(id.z, 1u, RIGHT_EYE);
     let out_layer = select(id.z, 0u, RIGHT_EYE);
     let eye = frame.eyes[layer];
+    if (tile_rate(id.xy, layer, 2u) == 0.0) {
+        // A 16×16 tile the lens hides (visibility.wgsl): unoccluded, as the sky, unfetched.
+        for (var k = 0u; k < 4u; k++) {
+            let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
+            if (all(pixel < frame.size)) {
+                textureStore(occlusion_out, vec2<i32>(pixel), i32(out_layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+            }
+        }
+        return;
+    }
     let quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
     var values: array<vec4<f32>, 4>;
     if (RIGHT_EYE) {

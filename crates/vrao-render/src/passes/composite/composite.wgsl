@@ -118,6 +118,16 @@ fn main(
     let layer = select(id.z, 1u, RIGHT_EYE);
     let out_layer = select(id.z, 0u, RIGHT_EYE);
     let eye = frame.eyes[layer];
+    if (tile_rate(b, layer, 2u) == 0.0) {
+        // A 16×16 tile the lens hides (visibility.wgsl): black, unfetched.
+        for (var k = 0u; k < 4u; k++) {
+            let pixel = b * 2u + vec2<u32>(k & 1u, k >> 1u);
+            if (all(pixel < frame.size)) {
+                textureStore(hdr_out, vec2<i32>(pixel), i32(out_layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+            }
+        }
+        return;
+    }
     // The quad's depths and normals, for the joint bilateral weights and the shading.
     // Its arrays are indexed by constants only (joint_upsample.wgsl says why).
     let quad = quad_pixels(depth_layers, normal_layers, b, layer, eye);
@@ -169,6 +179,11 @@ fn full_res_occlusion(px: UpsamplePixel, layer: u32) -> vec4<f32> {
 // bound output, unless it lies past an odd edge.
 fn shade_and_store(px: UpsamplePixel, layer: u32, out_layer: u32, eye: Eye, occlusion: vec4<f32>, bounce: vec3<f32>) {
     if (all(px.pixel < frame.size)) {
+        // The G-buffer leaves the lens's hidden pixels as sky in depth: black, not sky.
+        if (px.depth <= 0.0 && !pixel_shown(px.pixel, layer)) {
+            textureStore(hdr_out, vec2<i32>(px.pixel), i32(out_layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+            return;
+        }
         let n = textureLoad(lighting_normal_layers, vec2<i32>(px.pixel), i32(layer), 0).xyz;
         let radiance = shade(px.pixel, layer, eye, px.depth, n, occlusion, bounce);
         let stored = vec4<f32>(finite_or_zero3(radiance), saturate_ao(occlusion.a));

@@ -38,7 +38,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let layer = id.z;
     let eye = frame.eyes[layer];
     let p = vec2<i32>(id.xy);
-    let depth = textureLoad(depth_layers, p, i32(layer), 0);
+    // A tile the lens hides (visibility.wgsl) lights nothing: read as the sky, unfetched.
+    var depth = 0.0;
+    if (tile_rate(id.xy, layer, 1u) > 0.0) {
+        depth = textureLoad(depth_layers, p, i32(layer), 0);
+    }
     var radiance = vec3<f32>(0.0);
     var n = vec3<f32>(0.0, 0.0, 1.0);
     var distance = 0.0;

@@ -6,9 +6,9 @@
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, LIGHTING_NORMALS};
 use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
 use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size};
+use crate::graph::{PassDecl, Resource};
 use std::sync::Arc;
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
@@ -18,7 +18,7 @@ pub const NAME: &str = "direct";
 /// Outgoing direct radiance (lights and emission) and the view distance, packed
 /// (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the composite's base, and
 /// the depth test plus sender radiance of SSDO's bounce in a single fetch.
-pub const DIRECT: Resource = Resource::storage("direct", Size::Full, wgpu::TextureFormat::Rg32Uint);
+pub const DIRECT: Resource = vrao_ao::passes::inputs::DIRECT_LIGHT;
 
 /// direct.wgsl's bindings: the G-buffer in, the direct light out, and the shadows
 /// (their `Shadows` uniform, every light's map, the comparison sampler).
@@ -44,7 +44,7 @@ pub struct DirectLightPass {
 impl DirectLightPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> Self {
-        let files = [COMMON, SHADOW_WGSL, wgsl!("src/passes/direct/direct.wgsl")];
+        let files = [COMMON, VISIBILITY, SHADOW_WGSL, wgsl!("src/passes/direct/direct.wgsl")];
         DirectLightPass { kernel: Kernel::new(gpu, "direct", &files, "main", &BINDINGS), light_space }
     }
 }
@@ -65,6 +65,6 @@ impl Pass for DirectLightPass {
         let shadows = if shadowed { &self.light_space.uniform } else { &self.light_space.none };
         let own = [shadows.as_entire_binding(), wgpu::BindingResource::Sampler(&self.light_space.comparison)];
         let resources = ctx.bind(&BINDINGS, &own);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.extent());
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.extent());
     }
 }

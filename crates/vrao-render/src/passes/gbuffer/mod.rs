@@ -7,7 +7,10 @@
 //! materials are drawn after the solid ones with a pipeline that discards their holes;
 //! a scene without them (or without motion) gets neither pipeline nor target.
 
+mod mask;
+
 use super::{gpu_scene_of, settings_of, DeclareContext, Pass, RecordContext};
+use mask::{MaskDepth, MaskStep};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
@@ -86,6 +89,8 @@ pub struct GBufferPass {
     mapped: bool,
     /// The previous frame's eyes (`PreviousEyes`).
     previous_eyes: wgpu::Buffer,
+    /// The visibility mask drawn into depth around the scene.
+    mask: MaskDepth,
 }
 
 impl GBufferPass {
@@ -157,7 +162,8 @@ impl GBufferPass {
                 wgpu::BindGroupEntry { binding: 1, resource: previous_eyes.as_entire_binding() },
             ],
         });
-        GBufferPass { frame_group, multiview, multipass, eye_select, motion, mapped, previous_eyes }
+        let mask = MaskDepth::new(gpu);
+        GBufferPass { frame_group, multiview, multipass, eye_select, motion, mapped, previous_eyes, mask }
     }
 
     /// The colour targets this scene's pipelines write, by location (`None`: not written).
@@ -254,11 +260,18 @@ impl Pass for GBufferPass {
             self.write_previous_eyes(ctx);
         }
         let targets = &self.color_targets();
+        // The lens's hidden pixels first, at the near plane: the scene's fragments there
+        // fail the depth test before they are shaded.
+        let masked = ctx.visibility.masked();
+        if masked {
+            self.mask.draw(ctx, MaskStep::Near);
+        }
+        let depth_load = if masked { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(0.0) };
         let multiview = ctx.setup.multiview && ctx.setup.views == 2;
         if multiview {
             let pipelines = self.multiview.as_ref().expect("multiview requested without adapter support");
             let views = |r: Resource| &ctx.targets[&r].array_view;
-            let mut pass = begin(ctx.encoder, targets, views, NonZeroU32::new(0b11));
+            let mut pass = begin(ctx.encoder, targets, views, depth_load, NonZeroU32::new(0b11));
             pass.set_bind_group(0, &self.frame_group, &[]);
             pipelines.draw(&mut pass, gpu_scene);
         } else {
@@ -267,7 +280,7 @@ impl Pass for GBufferPass {
                 let span = ctx.timer.begin(ctx.encoder, label);
                 {
                     let views = |r: Resource| &ctx.targets[&r].layer_views[layer];
-                    let mut pass = begin(ctx.encoder, targets, views, None);
+                    let mut pass = begin(ctx.encoder, targets, views, depth_load, None);
                     pass.set_bind_group(0, &self.frame_group, &[]);
                     pass.set_bind_group(2, &self.eye_select[layer], &[]);
                     self.multipass.draw(&mut pass, gpu_scene);
@@ -275,15 +288,21 @@ impl Pass for GBufferPass {
                 ctx.timer.end(ctx.encoder, span);
             }
         }
+        if masked {
+            // Then as sky: the compute passes find no surface on hidden pixels.
+            self.mask.draw(ctx, MaskStep::Far);
+        }
     }
 }
 
-/// A render pass clearing every G-buffer target (depth to 0 = infinitely far, motion to
-/// 0 = invalid).
+/// A render pass clearing every G-buffer colour target (motion to 0 = invalid) and
+/// loading depth with `depth_load` (a clear to 0 = infinitely far, or the visibility
+/// mask's depth drawn before).
 fn begin<'e, 't>(
     encoder: &'e mut wgpu::CommandEncoder,
     targets: &[Option<Resource>],
     views: impl Fn(Resource) -> &'t wgpu::TextureView,
+    depth_load: wgpu::LoadOp<f32>,
     multiview_mask: Option<NonZeroU32>,
 ) -> wgpu::RenderPass<'e> {
     let color: Vec<_> = targets
@@ -306,7 +325,7 @@ fn begin<'e, 't>(
         color_attachments: &color,
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: views(DEPTH),
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+            depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
             stencil_ops: None,
         }),
         timestamp_writes: None,

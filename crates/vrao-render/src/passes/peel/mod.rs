@@ -105,15 +105,18 @@ impl DepthPeelPass {
 impl Pass for DepthPeelPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &settings_of(setup).ao;
-        let ssdo = matches!(ao.technique, Technique::Ssdo | Technique::SsdoBounce);
+        let ssdo = matches!(ao.technique, Technique::SsdoPoints | Technique::SsdoPointsBounce);
         PassDecl::new(NAME)
             .read(DEPTH)
             .write(DEPTH_LAYER_2)
             .occlusion_cost()
-            .disabled_if(!ao.depth_peeling, "depth peeling is off (an SSDO quality mode)")
+            .disabled_if(!ao.depth_peeling, "depth peeling is off (a point-sampled SSDO quality mode)")
             .disabled_if(
                 !ssdo,
-                format!("technique is {}: only SSDO tests occluders against a second depth layer", ao.technique.name()),
+                format!(
+                    "technique is {}: only the point-sampled SSDO tests occluders against a second depth layer",
+                    ao.technique.name()
+                ),
             )
     }
 

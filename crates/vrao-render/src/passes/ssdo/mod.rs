@@ -1,5 +1,7 @@
-//! SSDO, with the optional bounce gathered in the same loop (Ritschel et al. 2009 eqs. 1–2,
-//! Belonogov 2018 §4.1–4.2). The technique itself is ssdo.wgsl on the shared occlusion
+//! The seeds' point-sampled SSDO (`ssdo-points`), with the optional bounce gathered in the
+//! same loop (`ssdo-points-bounce`; Ritschel et al. 2009 eqs. 1–2, Belonogov 2018 §4.1–4.2),
+//! kept as a measured baseline beside the engine's SSDO on GTAO's bitmask
+//! (vrao_ao::passes::ssdo). The technique itself is ssdo.wgsl on the shared occlusion
 //! layout; a bounce strength of 0 selects the pipeline compiled without bounce work,
 //! which also does not read the direct light, so the graph need not produce it for an
 //! occlusion-only frame.
@@ -8,7 +10,7 @@ use super::direct::DIRECT;
 use super::occlusion::{self, technique_decl, OCCLUSION_WGSL};
 use super::peel::DEPTH_LAYER_2;
 use super::{settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON, IRRADIANCE};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON, IRRADIANCE, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::{BounceForm, Technique};
@@ -27,10 +29,10 @@ pub struct SsdoPass {
 impl SsdoPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
-        let files = [COMMON, IRRADIANCE, OCCLUSION_WGSL, wgsl!("src/passes/ssdo/ssdo.wgsl")];
+        let files = [COMMON, VISIBILITY, IRRADIANCE, OCCLUSION_WGSL, wgsl!("src/passes/ssdo/ssdo.wgsl")];
         let labels = [
-            ["ssdo", "ssdo-bounce", "ssdo-bounce patch"],
-            ["ssdo peeled", "ssdo-bounce peeled", "ssdo-bounce patch peeled"],
+            ["ssdo-points", "ssdo-points-bounce", "ssdo-points-bounce patch"],
+            ["ssdo-points peeled", "ssdo-points-bounce peeled", "ssdo-points-bounce patch peeled"],
         ];
         let kernels = [0, 1].map(|peel| {
             [0, 1, 2].map(|bounce| {
@@ -49,11 +51,12 @@ impl SsdoPass {
 impl Pass for SsdoPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &settings_of(setup).ao;
-        let name = if ao.bounce_active() { "ssdo-bounce" } else { "ssdo" };
-        let mut decl = technique_decl(name, &BINDINGS, &[Technique::Ssdo, Technique::SsdoBounce], setup);
+        let runs_for = [Technique::SsdoPoints, Technique::SsdoPointsBounce];
+        let name = if ao.bounce_active() { Technique::SsdoPointsBounce.name() } else { Technique::SsdoPoints.name() };
+        let mut decl = technique_decl(name, &BINDINGS, &runs_for, setup);
         if !ao.bounce_active() {
             decl = decl.unbind(DIRECT);
-            if ao.technique == Technique::SsdoBounce {
+            if ao.technique == Technique::SsdoPointsBounce {
                 decl = decl.note("bounce left out: bounce strength is 0");
             }
         }
@@ -73,6 +76,6 @@ impl Pass for SsdoPass {
         };
         let kernel = &self.kernels[ao.depth_peeling as usize][form];
         let resources = ctx.bind(&BINDINGS, &[]);
-        kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.ao_extent());
+        kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.ao_extent());
     }
 }

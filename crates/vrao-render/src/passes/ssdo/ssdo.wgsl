@@ -90,7 +90,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = r.position + r.normal * bias;
     // Fewer samples towards the image's edges with fixed foveation (occlusion.wgsl): a
     // prefix of the low-discrepancy kernel.
-    let samples = foveated_count(max(ao.samples, 1u), foveation_rate(r.position), id.xy);
+    let samples = foveated_count(max(ao.samples, 1u), foveation_rate(id.xy, r.layer), id.xy);
     // Direction form: each direction covers 2π/N of the hemisphere. Patch form: each
     // sender is a patch of area π r_max² / N (Ritschel et al. 2009), seen as a disc of that
     // area facing the receiver, `disc_radius2` its radius².

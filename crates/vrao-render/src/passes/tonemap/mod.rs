@@ -35,6 +35,6 @@ impl Pass for TonemapPass {
 
     fn record(&self, ctx: &mut RecordContext) {
         let resources = ctx.bind(&BINDINGS, &[]);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, &resources, ctx.extent());
+        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.extent());
     }
 }

@@ -1,0 +1,20 @@
+// Bind group 1 of every compute kernel (gpu/visibility.rs): the visibility mask and the
+// foveation rate as one map. `visibility_rates` holds, per tile of 8×8 full-resolution
+// pixels (level 0) and of 16×16 (level 1), the share of the full sample count its pixels
+// spend: 0 where the lens hides the whole tile, the foveation rate of its centre elsewhere.
+// `visibility_pixels` is 1 on the pixels the lens shows and 0 on those it hides.
+
+@group(1) @binding(0) var visibility_rates: texture_2d_array<f32>;
+@group(1) @binding(1) var visibility_pixels: texture_2d_array<f32>;
+
+// The rate of the tile of 8·`scale` full-resolution pixels holding pixel `p` of a pass that
+// works at 1/`scale` of full resolution (1 or 2): every invocation of an 8×8 workgroup
+// reads the same texel, so a hidden tile's early return costs one fetch per workgroup.
+fn tile_rate(p: vec2<u32>, layer: u32, scale: u32) -> f32 {
+    return textureLoad(visibility_rates, vec2<i32>(p / 8u), i32(layer), i32(min(scale, 2u) - 1u)).r;
+}
+
+// Whether the lens shows full-resolution pixel `p`.
+fn pixel_shown(p: vec2<u32>, layer: u32) -> bool {
+    return textureLoad(visibility_pixels, vec2<i32>(p), i32(layer), 0).r > 0.5;
+}
