@@ -1,7 +1,7 @@
 //! `vrao bench`: sweep technique × samples × radius × resolution, timed and scored
 //! against the reference tracer.
 
-use super::{choice, parse_budget_ms, GtaoArgs, SCENE_HELP};
+use super::{choice, parse_budget_ms, GtaoArgs, OnOff, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
@@ -67,6 +67,12 @@ pub struct BenchArgs {
     /// gets its RMSE within 10° of each eye's view axis, where foveation keeps full rate).
     #[arg(value_parser = choice::<Foveation>(), long, value_delimiter = ',', default_values_t = [Foveation::Off], hide_possible_values = true)]
     foveation: Vec<Foveation>,
+    /// The visibility mask to sweep, comma-separated: off (the whole rectangle computed),
+    /// on (the passes skip what the profile's lens hides). Every row is scored on the
+    /// pixels the lens shows; rows with the mask off also over the whole rectangle
+    /// (ao_rmse_whole).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [OnOff::from(AoSettings::default().mask)])]
+    mask: Vec<OnOff>,
     /// Also measure reflective shadow maps (one bounce of the directional lights) with
     /// these VPL counts (each 1..=1024), comma-separated, gathering within each radius: rows "rsm", whose
     /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
@@ -163,6 +169,7 @@ pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
                 depth_peeling: args.depth_peeling.values(),
                 temporal: args.temporal.values(),
                 foveation: args.foveation.clone(),
+                mask: args.mask.iter().map(|m| m.on()).collect(),
                 rsm_samples: args.rsm_samples.clone(),
                 timing: args.timing,
                 warmup: args.warmup,

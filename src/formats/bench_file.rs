@@ -25,6 +25,15 @@ pub struct BenchRecord {
     /// Fixed foveation (`off`, `low` or `high`; `off` in files written before it existed).
     #[serde(default, with = "crate::formats::by_name")]
     pub foveation: Foveation,
+    /// Whether the passes skipped the pixels the lens hides (`false` in files written
+    /// before the mask existed, which computed and scored the whole rectangle).
+    #[serde(default)]
+    pub mask: bool,
+    /// RMSE over the whole rectangle, hidden pixels included, as files before the mask
+    /// scored every row (`ao_rmse` counts the pixels the lens shows); rows with the
+    /// mask off only.
+    #[serde(default)]
+    pub ao_rmse_whole: Option<f64>,
     /// Median GPU ms per eye of the technique's own pass.
     pub technique_ms_per_eye: f64,
     /// Median GPU ms per eye of the bilateral blur (0 when off).
@@ -81,7 +90,8 @@ pub struct BenchRecord {
     pub stereo_inconsistent_interior: Option<f64>,
     /// Mean SSIM of the AO against the reference (1 = identical).
     pub ao_ssim: Option<f64>,
-    /// RMSE of the ambient light's luminance relative to the reference's mean.
+    /// RMSE of the ambient light's luminance relative to the reference's mean, the
+    /// reference's noise taken out.
     pub ambient_rel_rmse: Option<f64>,
     /// On the Pareto front of AO RMSE against occlusion ms per eye.
     pub pareto: bool,
@@ -97,6 +107,24 @@ pub struct BenchRecord {
     /// Mean relative bias of the one-bounce irradiance against the reference's.
     #[serde(default)]
     pub bounce_rel_bias: Option<f64>,
+    /// [`Self::ambient_rel_rmse`] per colour channel (red, green, blue).
+    #[serde(default)]
+    pub ambient_rel_rmse_r: Option<f64>,
+    /// See [`Self::ambient_rel_rmse_r`].
+    #[serde(default)]
+    pub ambient_rel_rmse_g: Option<f64>,
+    /// See [`Self::ambient_rel_rmse_r`].
+    #[serde(default)]
+    pub ambient_rel_rmse_b: Option<f64>,
+    /// [`Self::bounce_rel_rmse`] per colour channel (red, green, blue).
+    #[serde(default)]
+    pub bounce_rel_rmse_r: Option<f64>,
+    /// See [`Self::bounce_rel_rmse_r`].
+    #[serde(default)]
+    pub bounce_rel_rmse_g: Option<f64>,
+    /// See [`Self::bounce_rel_rmse_r`].
+    #[serde(default)]
+    pub bounce_rel_rmse_b: Option<f64>,
     /// Temporal accumulation on; its pass is in `occlusion_ms_per_eye`.
     #[serde(default)]
     pub temporal: bool,

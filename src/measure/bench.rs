@@ -56,6 +56,8 @@ pub struct BenchCase {
     pub temporal: bool,
     /// Fixed foveated occlusion.
     pub foveation: Foveation,
+    /// The passes skip the pixels the profile's lens hides ([`crate::xr::profiles::visibility_mask`]).
+    pub mask: bool,
 }
 
 /// How each case is run: frames (after warm-up) and the timing mode.
@@ -124,6 +126,19 @@ impl BenchRow {
     }
 }
 
+/// Each eye's pixels the `mask` shows for `settings`' size (`None`: all of them).
+pub fn lens_coverage(
+    mask: &crate::render::visibility::VisibilityMask,
+    settings: &Settings,
+    eyes: &[crate::render::stereo::Eye],
+) -> Vec<Option<Vec<u8>>> {
+    let (w, h) = (settings.profile.width, settings.profile.height);
+    eyes.iter()
+        .zip(&mask.views)
+        .map(|(eye, view)| Some(view.coverage(w, h, eye.fov.tangents())).filter(|c| c.contains(&0)))
+        .collect()
+}
+
 /// Renders `warmup + frames` frames of `case` producing only the occlusion (the AO
 /// alone, as a budget test asks), and returns the per-pass medians; with a reference
 /// for the case's radius, also the last frame's error against it.
@@ -161,6 +176,8 @@ struct CaseRun {
     eyes: crate::render::stereo::EyePair,
     timing: Timing,
     timings: Vec<Vec<(String, f64)>>,
+    /// Each eye's pixels the profile's lens shows (0: hidden): rows are scored there.
+    coverage: Vec<Option<Vec<u8>>>,
 }
 
 impl CaseRun {
@@ -174,6 +191,7 @@ impl CaseRun {
         settings.ao.depth_peeling = case.depth_peeling;
         settings.ao.temporal.enabled = case.temporal;
         settings.ao.foveation = case.foveation;
+        settings.ao.mask = case.mask;
         if settings.ao.technique == Technique::None {
             return Err(Error::input("bench needs an occlusion technique"));
         }
@@ -186,12 +204,25 @@ impl CaseRun {
         }
         let mut renderer = Renderer::new(gpu.clone(), scene, &settings)?;
         renderer.set_timing(timing);
+        let mask = crate::xr::profiles::visibility_mask(&settings.profile);
+        renderer.set_visibility_mask(Some(mask.clone()));
         let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
         let mut outputs = vec![output];
         if how.whole_frame {
             outputs.push(HDR);
         }
-        Ok(CaseRun { case: case.clone(), settings, output, outputs, renderer, eyes, timing, timings: Vec::new() })
+        let coverage = lens_coverage(&mask, &settings, &eyes.eyes);
+        Ok(CaseRun {
+            case: case.clone(),
+            settings,
+            output,
+            outputs,
+            renderer,
+            eyes,
+            timing,
+            timings: Vec::new(),
+            coverage,
+        })
     }
 
     /// One frame, not measured (warm-up).
@@ -236,7 +267,16 @@ impl CaseRun {
         let occlusion = self.renderer.read_f32(output)?;
         let error = reference.map(|reference| {
             let fovs: Vec<_> = self.eyes.eyes.iter().map(|e| e.fov).collect();
-            score(self.case.technique, &occlusion, reference, limit, self.pixels_per_degree(), &fovs)
+            let ppd = self.pixels_per_degree();
+            // Scored where the eye can see; with the mask off also over the whole rectangle.
+            let visible = reference.visible_only(&self.coverage);
+            let mut figures = score(self.case.technique, &occlusion, &visible, limit, ppd, &fovs);
+            let traced_whole = reference.layers.iter().flatten().filter(|p| p.hit).count()
+                > visible.layers.iter().flatten().filter(|p| p.hit).count();
+            if !self.case.mask && traced_whole {
+                figures.ao_rmse_whole = Some(score(self.case.technique, &occlusion, reference, limit, ppd, &fovs).ao_rmse);
+            }
+            figures
         });
         let stereo = {
             let depth = self.renderer.read_f32(DEPTH)?;
@@ -349,6 +389,7 @@ pub fn measure_rsm(
         depth_peeling: false,
         temporal: false,
         foveation: Foveation::Off,
+        mask: settings.ao.mask,
     };
     Ok(BenchRow {
         case,
@@ -366,10 +407,15 @@ pub fn measure_rsm(
 /// the reference's hit pixels (both eyes), relative to the reference's mean.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BounceFigures {
-    /// RMSE / mean of the reference.
+    /// RMSE / mean of the reference, the reference's own noise (its per-pixel standard
+    /// errors) taken out in quadrature as for the AO.
     pub rel_rmse: f64,
     /// (mean of the estimate − mean of the reference) / mean of the reference.
     pub rel_bias: f64,
+    /// [`Self::rel_rmse`] per colour channel (r, g, b), each relative to its own mean
+    /// (NaN for a channel the reference has no bounce in).
+    #[serde(default)]
+    pub rel_rmse_rgb: [f64; 3],
 }
 
 /// Compares irradiance images (per layer, RGBA, `width` texels a row, each texel standing
@@ -382,7 +428,9 @@ pub fn bounce_figures(
     reference: &ReferenceImage,
 ) -> Option<BounceFigures> {
     let (gw, gh) = reference.grid_size();
-    let (mut n, mut sum_ref, mut sum_est, mut sum_sq) = (0usize, 0f64, 0f64, 0f64);
+    // Per channel r, g, b and luminance: sums of the reference, the estimate, the squared
+    // difference and the reference's variance.
+    let (mut n, mut sum_ref, mut sum_est, mut sum_sq, mut noise2) = (0usize, [0f64; 4], [0f64; 4], [0f64; 4], [0f64; 4]);
     for (layer, image) in estimate.iter().enumerate().take(reference.layers.len()) {
         let height = image.len() / 4 / width.max(1) as usize;
         for j in 0..gh {
@@ -394,18 +442,34 @@ pub fn bounce_figures(
                 let (x, y) = reference.pixel_of(i, j);
                 let (x, y) = (((x / scale) as usize).min(width as usize - 1), ((y / scale) as usize).min(height - 1));
                 let t = &image[(y * width as usize + x) * 4..][..3];
-                let (e, truth) = (luminance([t[0], t[1], t[2]]), luminance(r.bounce));
+                let e = [t[0] as f64, t[1] as f64, t[2] as f64, luminance([t[0], t[1], t[2]])];
+                let b = r.bounce;
+                let truth = [b[0] as f64, b[1] as f64, b[2] as f64, luminance(b)];
                 n += 1;
-                sum_ref += truth;
-                sum_est += e;
-                sum_sq += (e - truth) * (e - truth);
+                for k in 0..4 {
+                    sum_ref[k] += truth[k];
+                    sum_est[k] += e[k];
+                    sum_sq[k] += (e[k] - truth[k]) * (e[k] - truth[k]);
+                    noise2[k] += (r.bounce_std_error[k] as f64).powi(2);
+                }
             }
         }
     }
-    let mean = sum_ref / n.max(1) as f64;
+    let n_f = n.max(1) as f64;
+    let rel_rmse = |k: usize| {
+        let mean = sum_ref[k] / n_f;
+        let rmse = crate::measure::metrics::noise_corrected_rmse((sum_sq[k] / n_f).sqrt(), (noise2[k] / n_f).sqrt());
+        if mean > 1e-9 {
+            rmse / mean
+        } else {
+            f64::NAN
+        }
+    };
+    let mean = sum_ref[3] / n_f;
     (n > 0 && mean > 1e-9).then(|| BounceFigures {
-        rel_rmse: (sum_sq / n as f64).sqrt() / mean,
-        rel_bias: (sum_est - sum_ref) / n as f64 / mean,
+        rel_rmse: rel_rmse(3),
+        rel_bias: (sum_est[3] - sum_ref[3]) / n_f / mean,
+        rel_rmse_rgb: [0, 1, 2].map(rel_rmse),
     })
 }
 

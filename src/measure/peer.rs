@@ -192,6 +192,8 @@ pub fn vrao_cases(base: &Settings, options: &PeerOptions) -> Vec<BenchCase> {
                 depth_peeling: false,
                 temporal: false,
                 foveation: Foveation::Off,
+                // Bevy computes the whole rectangle: so does vrao here.
+                mask: false,
             });
         }
     }

@@ -6,8 +6,9 @@
 //! through XR_KHR_vulkan_enable2, with the runtime creating the VkInstance and VkDevice
 //! and wgpu wrapping them (`openxr/vulkan.rs`); colour and depth swapchains filled from
 //! the renderer's 2-layer targets (`openxr/swapchain.rs`); a projection layer with depth
-//! (XR_KHR_composition_layer_depth) so the runtime can reproject; and OpenXR's session
-//! state machine, falling back to the simulated headset if the session is lost.
+//! (XR_KHR_composition_layer_depth) so the runtime can reproject; the lens's visibility
+//! mask (XR_KHR_visibility_mask, `openxr/mask.rs`); and OpenXR's session state machine,
+//! falling back to the simulated headset if the session is lost.
 //!
 //! Only one OpenXR instance lives in a process at a time (runtimes are not required to
 //! allow more): [`probe_runtime`] and [`OpenXrHeadset::open`] share one slot.
@@ -16,6 +17,7 @@ use super::simulated::SimulatedOptions;
 use crate::render::stereo::HeadPose;
 use glam::{DQuat, DVec3};
 
+pub mod mask;
 #[cfg(feature = "xr")]
 mod session;
 pub mod state;
@@ -187,6 +189,12 @@ pub struct OpenXrReport {
     pub ending: Option<String>,
     /// Whether the run went on on the simulated headset after a loss.
     pub fell_back: bool,
+    /// Whether the runtime offers XR_KHR_visibility_mask (vrao then reads each view's mask
+    /// from it; otherwise the mask is Monado's default from each view's field of view).
+    pub visibility_mask_extension: bool,
+    /// The runtime's XrEventDataVisibilityMaskChangedKHR events followed (each view's mask
+    /// read again).
+    pub visibility_mask_changes: u64,
 }
 
 /// How `vrao run` (or a test) wants the OpenXR headset driven.

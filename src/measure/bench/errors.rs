@@ -28,9 +28,14 @@ pub struct ErrorFigures {
     pub ao_ssim: f64,
     /// RMSE of the ambient light's luminance (what the composite multiplies by albedo/π)
     /// relative to the reference's mean: environment light that gets through within r
-    /// plus one bounce of direct light from surfaces within r. Comparable across
-    /// techniques; `None` when the reference has no ambient light at all.
+    /// plus one bounce of direct light from surfaces within r, with the reference's own
+    /// noise taken out in quadrature (as for `ao_rmse`). Comparable across techniques;
+    /// `None` when the reference has no ambient light at all.
     pub ambient_rel_rmse: Option<f64>,
+    /// The same per colour channel (r, g, b), each relative to its own mean; `None` as
+    /// above.
+    #[serde(default)]
+    pub ambient_rel_rmse_rgb: Option<[f64; 3]>,
     /// Mean ꟻLIP of the AO against the reference AO ([`metrics::flip_mean`]) on the
     /// reference's grid, at the headset's pixels per degree over the grid's spacing.
     pub flip_mean: Option<f64>,
@@ -48,6 +53,11 @@ pub struct ErrorFigures {
     /// top or bottom border, where samples that leave the image count as open: with
     /// `ao_rmse`, what a guard band could win. `None` when no such pixel is covered.
     pub ao_rmse_outer_border: Option<f64>,
+    /// [`Self::ao_rmse`] over the whole rectangle, the pixels the lens hides included
+    /// (every figure else counts only those it shows): for continuity with the figures
+    /// before the mask, on rows with the mask off. Set by the bench, `None` otherwise.
+    #[serde(default)]
+    pub ao_rmse_whole: Option<f64>,
     /// Halos: the share (0..1) of the pixels beside a depth edge (`near_depth_edge`)
     /// that are too dark by more than [`HALO_DARKER`]. `None` when there is no edge.
     pub halo_share: Option<f64>,
@@ -130,6 +140,7 @@ pub fn score(
     let noise = (cells.iter().map(|c| c.noise2).sum::<f64>() / hits).sqrt();
     let (ao_rmse_vs_limit, limit_rmse, limit_bias) = limit_figures(&cells);
     ErrorFigures {
+        ao_rmse_whole: None,
         ao_rmse_outer_border: cells
             .iter()
             .any(|c| c.outer_border)
@@ -145,7 +156,11 @@ pub fn score(
         ao_bias_dark: mean_difference(&cells, |c| c.ao, |c| c.ref_ao, |c| c.hit && c.ref_ao < DARK_REFERENCE),
         ao_rmse_falloff: corrected_rmse(&cells, |c| c.ao, |c| c.ref_falloff, |c| c.hit, noise),
         ao_ssim: ssim_sum / reference.layers.len().max(1) as f64,
-        ambient_rel_rmse: ambient_rel_rmse(&cells, hits),
+        ambient_rel_rmse: ambient_rel_rmse(&cells, hits, 3),
+        ambient_rel_rmse_rgb: {
+            let rgb = [0, 1, 2].map(|k| ambient_rel_rmse(&cells, hits, k));
+            rgb.iter().all(Option::is_some).then(|| rgb.map(|v| v.unwrap_or(f64::NAN)))
+        },
         flip_mean: (flip_pixels > 0).then(|| flip_sum / flip_pixels as f64),
         ao_rmse_vs_limit,
         limit_rmse,
@@ -168,9 +183,11 @@ struct Cell {
     /// reference hit a surface.
     limit_ao: f32,
     limit_hit: bool,
-    /// The luminance of the frame's ambient light and of the reference's.
-    ambient: f32,
-    ref_ambient: f32,
+    /// The frame's ambient light and the reference's: r, g, b and luminance, and the
+    /// reference's variance of each.
+    ambient: [f32; 4],
+    ref_ambient: [f32; 4],
+    ambient_noise2: [f64; 4],
     /// A hit within [`BORDER_PX`] of the eye's outer, top or bottom border.
     outer_border: bool,
     /// A hit beside a depth edge ([`near_depth_edge`]).
@@ -226,8 +243,9 @@ fn eye_cells(
                 noise2: if r.hit { (r.ao_std_error as f64).powi(2) } else { 0.0 },
                 limit_ao: l.map_or(1.0, |l| l.ao),
                 limit_hit: r.hit && l.is_some_and(|l| l.hit),
-                ambient: luminance(ambient) as f32,
-                ref_ambient: luminance(truth) as f32,
+                ambient: [ambient[0], ambient[1], ambient[2], luminance(ambient) as f32],
+                ref_ambient: [truth[0], truth[1], truth[2], luminance(truth) as f32],
+                ambient_noise2: if r.hit { r.ambient_std_error.map(|e| (e as f64).powi(2)) } else { [0.0; 4] },
                 outer_border: r.hit && outer.min(y).min(h - 1 - y) < BORDER_PX as usize,
                 beside_edge: r.hit && near_depth_edge(pixels, (gw as usize, gh as usize), gx as usize, gy as usize),
                 central: r.hit && central(x, y),
@@ -275,11 +293,15 @@ fn mean_difference(cells: &[Cell], a: Value, b: Value, keep: Keep) -> Option<f64
     (!kept.is_empty()).then(|| sum / kept.len() as f64)
 }
 
-/// The ambient light's luminance RMSE relative to the reference's mean over the `hits`
-/// hit cells; `None` where the reference has no ambient light.
-fn ambient_rel_rmse(cells: &[Cell], hits: f64) -> Option<f64> {
-    let mean = cells.iter().filter(|c| c.hit).map(|c| c.ref_ambient as f64).sum::<f64>() / hits;
-    (mean > 1e-12).then(|| rmse(cells, |c| c.ambient, |c| c.ref_ambient, |c| c.hit).map(|e| e / mean)).flatten()
+/// The ambient light's RMSE in channel `k` (0–2 r, g, b; 3 luminance) relative to the
+/// reference's mean over the `hits` hit cells, the reference's noise taken out; `None`
+/// where the reference has no ambient light in that channel.
+fn ambient_rel_rmse(cells: &[Cell], hits: f64, k: usize) -> Option<f64> {
+    let kept = cells.iter().filter(|c| c.hit);
+    let mean = kept.clone().map(|c| c.ref_ambient[k] as f64).sum::<f64>() / hits;
+    let noise = (kept.clone().map(|c| c.ambient_noise2[k]).sum::<f64>() / hits).sqrt();
+    let sum2: f64 = kept.map(|c| (c.ambient[k] as f64 - c.ref_ambient[k] as f64).powi(2)).sum();
+    (mean > 1e-12).then(|| metrics::noise_corrected_rmse((sum2 / hits).sqrt(), noise) / mean)
 }
 
 /// (the frame against the screen-space limit, the limit's noise-corrected RMSE and its

@@ -20,6 +20,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 radius_m: c.radius,
                 resolution: Resolution::from_half_res(c.half_res),
                 foveation: c.foveation,
+                mask: c.mask,
+                ao_rmse_whole: row.error.as_ref().and_then(|e| e.ao_rmse_whole),
                 technique_ms_per_eye: per_eye(name),
                 blur_ms_per_eye: per_eye(blur::NAME),
                 upsample_ms_per_eye: per_eye(upsample::NAME),
@@ -46,6 +48,12 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 peel_ms_per_eye: per_eye(peel::NAME),
                 bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
                 bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
+                ambient_rel_rmse_r: row.error.as_ref().and_then(|e| e.ambient_rel_rmse_rgb).map(|c| c[0]),
+                ambient_rel_rmse_g: row.error.as_ref().and_then(|e| e.ambient_rel_rmse_rgb).map(|c| c[1]),
+                ambient_rel_rmse_b: row.error.as_ref().and_then(|e| e.ambient_rel_rmse_rgb).map(|c| c[2]),
+                bounce_rel_rmse_r: row.bounce.map(|b| b.rel_rmse_rgb[0]),
+                bounce_rel_rmse_g: row.bounce.map(|b| b.rel_rmse_rgb[1]),
+                bounce_rel_rmse_b: row.bounce.map(|b| b.rel_rmse_rgb[2]),
                 temporal: c.temporal,
                 composite_ms_per_eye: per_eye(composite::NAME),
                 frame_upsample_ms_per_eye: None,
@@ -68,12 +76,14 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
 /// The full-resolution record of the same technique and setting as `half`.
 fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -> Option<&'a BenchRecord> {
     records.iter().find(|f| {
-        f.resolution == Resolution::Full && f.foveation == half.foveation && sweep_case(f) == sweep_case(half)
+        f.resolution == Resolution::Full
+            && (f.foveation, f.mask) == (half.foveation, half.mask)
+            && sweep_case(f) == sweep_case(half)
     })
 }
 
-/// A record's sweep axes but its resolution and foveation, the two that the partner
-/// lookups (the same case at full resolution, the same case unfoveated) vary.
+/// A record's sweep axes but its resolution, foveation and mask, which the partner
+/// lookups (the same case at full resolution, the same case unfoveated and unmasked) vary.
 fn sweep_case(r: &BenchRecord) -> (&str, u32, f32, bool, bool) {
     (r.technique.as_str(), r.samples, r.radius_m, r.depth_peeling, r.temporal)
 }
@@ -183,6 +193,13 @@ const COLUMNS: &[Column] = &[
         optional: true,
     },
     Column {
+        name: "mask",
+        header: "mask",
+        csv: |r| if r.mask { "on" } else { "off" }.to_string(),
+        markdown: |r| if r.mask { "on" } else { "" }.to_string(),
+        optional: true,
+    },
+    Column {
         name: "occlusion_ms_per_eye",
         header: "ms/eye",
         csv: |r| format!("{:.3}", r.occlusion_ms_per_eye),
@@ -250,6 +267,12 @@ const COLUMNS: &[Column] = &[
     },
     figure_column!(bounce_rel_rmse, "bounce rel. RMSE", true),
     figure_column!(bounce_rel_bias, "bounce rel. bias", true),
+    figure_column!(ambient_rel_rmse_r, "ambient rel. RMSE r", true),
+    figure_column!(ambient_rel_rmse_g, "ambient rel. RMSE g", true),
+    figure_column!(ambient_rel_rmse_b, "ambient rel. RMSE b", true),
+    figure_column!(bounce_rel_rmse_r, "bounce rel. RMSE r", true),
+    figure_column!(bounce_rel_rmse_g, "bounce rel. RMSE g", true),
+    figure_column!(bounce_rel_rmse_b, "bounce rel. RMSE b", true),
     Column {
         name: "temporal",
         header: "temporal",
@@ -549,15 +572,15 @@ fn chain_ms_per_eye(r: &BenchRecord) -> f64 {
     }
 }
 
-/// Each foveated row against the same case with foveation off (empty without such
-/// pairs): the chain's cost ratio, the RMSE within the central 20° and over the whole
-/// image (the differences), and FLIP (the ratio).
+/// Each foveated or masked row against the same case with neither (empty without such
+/// pairs): the chain's cost ratio, the RMSE within the central 20° and over the pixels
+/// the lens shows (the differences), and FLIP (the ratio).
 fn foveation_markdown(records: &[BenchRecord]) -> String {
     let mut table = String::new();
-    for r in records.iter().filter(|r| r.foveation != Foveation::Off) {
-        let off = records
-            .iter()
-            .find(|b| b.foveation == Foveation::Off && b.resolution == r.resolution && sweep_case(b) == sweep_case(r));
+    for r in records.iter().filter(|r| r.foveation != Foveation::Off || r.mask) {
+        let off = records.iter().find(|b| {
+            b.foveation == Foveation::Off && !b.mask && b.resolution == r.resolution && sweep_case(b) == sweep_case(r)
+        });
         let Some(off) = off else { continue };
         let difference = |a: Option<f64>, b: Option<f64>| match (a, b) {
             (Some(a), Some(b)) => format!("{:+.4}", a - b),
@@ -569,12 +592,13 @@ fn foveation_markdown(records: &[BenchRecord]) -> String {
         };
         let _ = writeln!(
             table,
-            "| {} | {} | {} | {} | {} | {:.3} | {} | {} | {flip} |",
+            "| {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {flip} |",
             r.technique,
             r.samples,
             significant(r.radius_m as f64, 2),
             r.resolution,
             r.foveation.name(),
+            if r.mask { "on" } else { "off" },
             chain_ms_per_eye(r) / chain_ms_per_eye(off),
             difference(r.ao_rmse_central, off.ao_rmse_central),
             difference(r.ao_rmse, off.ao_rmse),
@@ -584,8 +608,8 @@ fn foveation_markdown(records: &[BenchRecord]) -> String {
         return table;
     }
     format!(
-        "\nFoveated against off, same case (chain: the occlusion passes per eye, with the frame's inline upsampling under --frame):\n\n\
-         | technique | samples | radius_m | resolution | foveation | chain ms ratio | Δ RMSE central 20° | Δ RMSE whole | FLIP ratio |\n\
-         |---|---|---|---|---|---|---|---|---|\n{table}"
+        "\nFoveated or masked against neither, same case (chain: the occlusion passes per eye, with the frame's inline upsampling under --frame; errors over the pixels the lens shows):\n\n\
+         | technique | samples | radius_m | resolution | foveation | mask | chain ms ratio | Δ RMSE central 20° | Δ RMSE visible | FLIP ratio |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n{table}"
     )
 }

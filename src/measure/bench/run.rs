@@ -5,7 +5,7 @@ use super::{
     estimate_seconds, mark_pareto, markdown_report, measure_rsm, pixels_per_degree, plot, read_json, records, sweep,
     to_csv, to_json, BenchCase, BenchFile, BenchRecord, BenchRow, LimitInfo, Measurement, ReferenceInfo, Resolution,
 };
-use crate::measure::reference::{trace_cached, ProgressBar, ReferenceImage, ReferenceSettings};
+use crate::measure::reference::{trace_cached_visible, ProgressBar, ReferenceImage, ReferenceSettings};
 use crate::render::error::{Error, Result};
 use crate::render::gpu::{BackendChoice, Gpu};
 use crate::render::renderer::TimingChoice;
@@ -36,6 +36,8 @@ pub struct BenchOptions {
     pub temporal: Vec<bool>,
     /// Foveation levels to sweep.
     pub foveation: Vec<Foveation>,
+    /// The visibility mask off (`false`) and on to sweep.
+    pub mask: Vec<bool>,
     /// VPL counts of reflective-shadow-map rows (empty: none).
     pub rsm_samples: Vec<u32>,
     /// Serial, pipelined or auto (decided once the adapter is known).
@@ -90,16 +92,19 @@ pub fn cases(options: &BenchOptions, radii: &[f32]) -> Vec<BenchCase> {
                             continue;
                         }
                         for &temporal in &options.temporal {
-                            for &foveation in &options.foveation {
-                                cases.push(BenchCase {
-                                    technique,
-                                    samples,
-                                    radius,
-                                    half_res,
-                                    depth_peeling,
-                                    temporal,
-                                    foveation,
-                                });
+                            for &mask in &options.mask {
+                                for &foveation in &options.foveation {
+                                    cases.push(BenchCase {
+                                        technique,
+                                        samples,
+                                        radius,
+                                        half_res,
+                                        depth_peeling,
+                                        temporal,
+                                        foveation,
+                                        mask,
+                                    });
+                                }
                             }
                         }
                     }
@@ -128,7 +133,16 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
     let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near);
     let (references, reference_info) = match &options.reference {
         Some(reference) => {
-            let (images, info) = trace_references(scene, base, &eyes.eyes, &radii, reference)?;
+            // Rows with the mask off are scored over the whole rectangle too; with every
+            // row masked the tracer leaves out what the lens hides.
+            let coverage = options.mask.iter().all(|&m| m).then(|| {
+                crate::measure::bench::lens_coverage(
+                    &crate::xr::profiles::visibility_mask(&base.profile),
+                    base,
+                    &eyes.eyes,
+                )
+            });
+            let (images, info) = trace_references(scene, base, &eyes.eyes, &radii, reference, coverage.as_deref())?;
             (images, Some(info))
         }
         None => (Vec::new(), None),
@@ -192,6 +206,7 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
     named_once("sample counts", &options.samples)?;
     named_once("radii", &options.radii)?;
     named_once("foveation levels", &options.foveation)?;
+    named_once("mask settings", &options.mask)?;
     named_once("RSM sample counts", &options.rsm_samples)?;
     for case in cases {
         let mut s = base.clone();
@@ -262,7 +277,7 @@ fn progress_line(done: usize, total: usize, row: &BenchRow, elapsed: f64) -> Str
             match row.case.foveation {
                 Foveation::Off => String::new(),
                 level => format!(" fov-{}", level.name()),
-            }
+            } + if row.case.mask { " mask" } else { "" }
         ),
         row.occlusion_ms_per_eye()
     )
@@ -298,6 +313,7 @@ fn trace_references(
     eyes: &[crate::render::stereo::Eye],
     radii: &[f32],
     options: &ReferenceOptions,
+    coverage: Option<&[Option<Vec<u8>>]>,
 ) -> Result<(Vec<(f32, ReferenceImage)>, ReferenceInfo)> {
     let (mut noise, mut rays, mut seconds) = (0.0f64, 0u64, 0.0f64);
     let mut references = Vec::new();
@@ -315,7 +331,8 @@ fn trace_references(
         );
         let mut bar = ProgressBar::new("reference");
         let size = (base.profile.width, base.profile.height);
-        let image = trace_cached(&options.cache, scene, eyes, size, &settings, &mut |p| bar.update(p))?;
+        let image =
+            trace_cached_visible(&options.cache, scene, eyes, size, &settings, coverage, &mut |p| bar.update(p))?;
         bar.finish();
         noise = noise.max(image.stats.noise);
         if !image.stats.from_cache {

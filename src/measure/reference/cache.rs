@@ -14,24 +14,25 @@
 //! width u32 | height u32 | stride u32 | layers u32 | grid width u32 | grid height u32
 //! rays u64 | seconds f64 | build seconds f64 | rays per second f64 | noise f64 | hit pixels u64
 //! per layer, per cell (row-major): hit u8, depth, ao, ao_falloff, ao_std_error f32,
-//!                                  environment_visible, bounce, unoccluded 3 × f32 each
+//!                                  environment_visible, bounce, unoccluded 3 × f32 each,
+//!                                  ambient_std_error, bounce_std_error 4 × f32 each
 //! FNV-1a 64 of every byte above, u64
 //! ```
 //!
 //! A file that is truncated, corrupt, of another version or for another key is ignored
 //! with a warning and traced again (and overwritten).
 
-use super::{grid_size, trace, Progress, ReferenceImage, ReferencePixel, ReferenceSettings, ReferenceStats};
+use super::{grid_size, Progress, ReferenceImage, ReferencePixel, ReferenceSettings, ReferenceStats};
 use crate::render::error::{Error, Result};
 use crate::render::scene::{Filter, Light, Scene, Texture, Wrap};
 use crate::render::stereo::Eye;
 use std::path::{Path, PathBuf};
 
 /// Version of the cache file layout.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"VRAOREF\0";
-const PIXEL_BYTES: usize = 1 + 13 * 4;
+const PIXEL_BYTES: usize = 1 + 21 * 4;
 const HEADER_BYTES: usize = 8 + 4 + 8 + 6 * 4 + 8 + 4 * 8 + 8;
 
 /// FNV-1a, 64 bit: stable across runs, platforms and Rust versions (unlike std's hasher).
@@ -221,8 +222,30 @@ pub fn trace_cached(
     settings: &ReferenceSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ReferenceImage> {
+    trace_cached_visible(cache_dir, scene, eyes, size, settings, None, progress)
+}
+
+/// [`trace_cached`] of only the pixels the lens shows ([`super::trace_visible`]); the
+/// coverage is part of the key.
+pub fn trace_cached_visible(
+    cache_dir: &Path,
+    scene: &Scene,
+    eyes: &[Eye],
+    size: (u32, u32),
+    settings: &ReferenceSettings,
+    coverage: Option<&[Option<Vec<u8>>]>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<ReferenceImage> {
     settings.validate()?;
-    let key = cache_key(scene, eyes, size, settings);
+    let mut key = cache_key(scene, eyes, size, settings);
+    if let Some(coverage) = coverage {
+        let mut h = Fnv64::default();
+        h.u64(key);
+        for layer in coverage {
+            h.bytes(layer.as_deref().unwrap_or(b"all shown"));
+        }
+        key = h.finish();
+    }
     let path = cache_file(cache_dir, key);
     if path.exists() {
         match read_cache(&path, key) {
@@ -235,7 +258,7 @@ pub fn trace_cached(
             Err(why) => log::warn!("{}: unusable reference cache file ({why}); tracing again", path.display()),
         }
     }
-    let image = trace(scene, eyes, size, settings, progress)?;
+    let image = super::trace_visible(scene, eyes, size, settings, coverage, progress)?;
     write_cache(&path, key, &image)?;
     Ok(image)
 }
@@ -299,7 +322,8 @@ fn encode(key: u64, image: &ReferenceImage) -> Vec<u8> {
     for p in image.layers.iter().flatten() {
         out.push(p.hit as u8);
         let scalars = [p.depth, p.ao, p.ao_falloff, p.ao_std_error];
-        for v in scalars.iter().chain(&p.environment_visible).chain(&p.bounce).chain(&p.unoccluded) {
+        let light = p.environment_visible.iter().chain(&p.bounce).chain(&p.unoccluded);
+        for v in scalars.iter().chain(light).chain(&p.ambient_std_error).chain(&p.bounce_std_error) {
             out.extend_from_slice(&v.to_le_bytes());
         }
     }
@@ -337,6 +361,9 @@ impl Reader<'_> {
     }
     fn f32x3(&mut self) -> std::result::Result<[f32; 3], UnusableCache> {
         Ok([self.f32()?, self.f32()?, self.f32()?])
+    }
+    fn f32x4(&mut self) -> std::result::Result<[f32; 4], UnusableCache> {
+        Ok([self.f32()?, self.f32()?, self.f32()?, self.f32()?])
     }
 }
 
@@ -391,6 +418,8 @@ fn decode(bytes: &[u8], key: u64) -> std::result::Result<ReferenceImage, Unusabl
                 environment_visible: r.f32x3()?,
                 bounce: r.f32x3()?,
                 unoccluded: r.f32x3()?,
+                ambient_std_error: r.f32x4()?,
+                bounce_std_error: r.f32x4()?,
             });
         }
         layers.push(layer);
@@ -435,6 +464,8 @@ mod tests {
             environment_visible: [1.0, 2.0, k as f32],
             bounce: [f32::MIN_POSITIVE, 0.0, -0.0],
             unoccluded: [3.0, 2.0, 1.0],
+            ambient_std_error: [0.1, 0.2, 0.3, k as f32],
+            bounce_std_error: [0.0, 0.5, 0.25, 0.125],
         };
         ReferenceImage {
             width: 5,

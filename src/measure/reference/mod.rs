@@ -64,7 +64,7 @@ mod shading;
 #[cfg(test)]
 mod tests;
 
-pub use cache::{cache_file, cache_key, default_cache_dir, read_cache, trace_cached, write_cache, FORMAT_VERSION};
+pub use cache::{cache_file, cache_key, default_cache_dir, read_cache, trace_cached, trace_cached_visible, write_cache, FORMAT_VERSION};
 pub use progress::ProgressBar;
 
 use crate::render::error::{Error, Result};
@@ -146,6 +146,12 @@ pub struct ReferencePixel {
     pub bounce: [f32; 3],
     /// Linear RGB irradiance of the whole environment (SH9), for normalising.
     pub unoccluded: [f32; 3],
+    /// Standard errors of the ambient light (`environment_visible` + `bounce`, from the
+    /// same rays) as estimated from its samples: r, g, b and luminance
+    /// (`metrics::luminance`); what the bench takes out of the ambient light's error.
+    pub ambient_std_error: [f32; 4],
+    /// The same for `bounce` alone.
+    pub bounce_std_error: [f32; 4],
 }
 
 impl ReferencePixel {
@@ -159,6 +165,8 @@ impl ReferencePixel {
         environment_visible: [0.0; 3],
         bounce: [0.0; 3],
         unoccluded: [0.0; 3],
+        ambient_std_error: [0.0; 4],
+        bounce_std_error: [0.0; 4],
     };
 }
 
@@ -214,6 +222,26 @@ impl ReferenceImage {
         let (gw, _) = self.grid_size();
         &self.layers[layer][(j * gw + i) as usize]
     }
+
+    /// This image with every cell whose pixel the lens hides turned to sky, so that the
+    /// scores count only what the eye can see. `coverage` holds each layer's pixels (0:
+    /// hidden; `None`: all shown), `width` × `height` row by row.
+    pub fn visible_only(&self, coverage: &[Option<Vec<u8>>]) -> ReferenceImage {
+        let mut image = self.clone();
+        let (gw, gh) = self.grid_size();
+        for (layer, cells) in image.layers.iter_mut().enumerate() {
+            let Some(Some(shown)) = coverage.get(layer) else { continue };
+            for j in 0..gh {
+                for i in 0..gw {
+                    let (x, y) = self.pixel_of(i, j);
+                    if shown[(y * self.width + x) as usize] == 0 {
+                        cells[(j * gw + i) as usize] = ReferencePixel::SKY;
+                    }
+                }
+            }
+        }
+        image
+    }
 }
 
 /// Progress of a trace, reported from the calling thread.
@@ -249,7 +277,25 @@ pub fn trace(
     settings: &ReferenceSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ReferenceImage> {
+    trace_visible(scene, eyes, size, settings, None, progress)
+}
+
+/// [`trace`] of only the pixels the lens shows: where `coverage` (each eye's pixels, 0
+/// hidden, as [`ReferenceImage::visible_only`] takes it) hides a cell's pixel, the cell is
+/// sky and no ray is traced. A coverage of the wrong size is `Error::Input`.
+pub fn trace_visible(
+    scene: &Scene,
+    eyes: &[Eye],
+    size: (u32, u32),
+    settings: &ReferenceSettings,
+    coverage: Option<&[Option<Vec<u8>>]>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<ReferenceImage> {
     check_trace(eyes, size, settings)?;
+    let pixels = size.0 as usize * size.1 as usize;
+    if let Some(c) = coverage.into_iter().flatten().flatten().find(|c| c.len() != pixels) {
+        return Err(Error::input(format!("a visibility coverage of {} pixels for a {}×{} image", c.len(), size.0, size.1)));
+    }
     let start = Instant::now();
     let anchor = eyes.iter().map(|e| e.pose.position).sum::<DVec3>() / eyes.len() as f64;
     let geometry = SceneGeometry::build(scene, anchor)?;
@@ -261,8 +307,15 @@ pub fn trace(
         radius: settings.radius,
         rays_per_pixel: settings.rays_per_pixel,
     };
-    let tracer =
-        RowTracer { eyes, anchor, size, settings, estimator: &estimator, grid: grid_size(size, settings.stride) };
+    let tracer = RowTracer {
+        eyes,
+        anchor,
+        size,
+        settings,
+        estimator: &estimator,
+        grid: grid_size(size, settings.stride),
+        coverage,
+    };
     let (gw, gh) = tracer.grid;
     let rows_total = eyes.len() * gh as usize;
     let rows_done = AtomicUsize::new(0);
@@ -348,6 +401,8 @@ struct RowTracer<'a> {
     estimator: &'a Estimator<'a>,
     /// Grid cells across and down.
     grid: (u32, u32),
+    /// Each eye's pixels the lens shows (0: hidden, traced as sky), or `None`.
+    coverage: Option<&'a [Option<Vec<u8>>]>,
 }
 
 impl RowTracer<'_> {
@@ -360,8 +415,12 @@ impl RowTracer<'_> {
         let mut rays = 0u64;
         let pixels = (0..gw)
             .map(|i| {
-                let (pixel, pixel_rays) =
-                    self.pixel(&eye, layer, pixel_of(self.size, self.settings.stride, i, j), &mut points);
+                let (x, y) = pixel_of(self.size, self.settings.stride, i, j);
+                let shown = self.coverage.and_then(|c| c.get(layer)).and_then(|c| c.as_ref());
+                if shown.is_some_and(|shown| shown[(y * self.size.0 + x) as usize] == 0) {
+                    return ReferencePixel::SKY;
+                }
+                let (pixel, pixel_rays) = self.pixel(&eye, layer, (x, y), &mut points);
                 rays += pixel_rays;
                 pixel
             })
@@ -401,6 +460,8 @@ impl RowTracer<'_> {
             environment_visible: rgb(e.environment_visible),
             bounce: rgb(e.bounce),
             unoccluded: rgb(e.unoccluded),
+            ambient_std_error: e.ambient_std_error.map(|v| if v.is_finite() { v as f32 } else { 0.0 }),
+            bounce_std_error: e.bounce_std_error.map(|v| if v.is_finite() { v as f32 } else { 0.0 }),
         };
         // The primary ray and the estimator's.
         (pixel, 1 + e.rays)

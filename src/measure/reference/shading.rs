@@ -246,6 +246,9 @@ pub(crate) struct PointEstimate {
     pub environment_visible: [f64; 3],
     pub bounce: [f64; 3],
     pub unoccluded: [f64; 3],
+    /// Standard errors of environment_visible + bounce and of bounce: r, g, b, luminance.
+    pub ambient_std_error: [f64; 4],
+    pub bounce_std_error: [f64; 4],
     /// Rays traced (directions below the surface need none).
     pub rays: u64,
 }
@@ -290,6 +293,12 @@ impl Estimator<'_> {
         let (mut occluded, mut attenuated, mut rays) = (0u64, 0f64, 0u64);
         let mut visible_env = DVec3::ZERO;
         let mut bounce = DVec3::ZERO;
+        // Sums of squares per ray (r, g, b, luminance) for the light's standard errors.
+        let (mut ambient2, mut bounce2) = ([0f64; 4], [0f64; 4]);
+        let squares = |c: DVec3| {
+            let lum = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+            [c.x * c.x, c.y * c.y, c.z * c.z, lum * lum]
+        };
         for &(u, v) in points.iter() {
             let (x, y) = concentric_disk(u, v);
             let z = (1.0 - x * x - y * y).max(0.0).sqrt();
@@ -306,11 +315,22 @@ impl Estimator<'_> {
                     occluded += 1;
                     attenuated += (1.0 - hit.t as f64 / self.radius).clamp(0.0, 1.0);
                     let sender = self.geometry.surface(&hit);
-                    bounce += direct_out(self.geometry, self.lighting, &sender, dir32).as_dvec3();
+                    let sent = direct_out(self.geometry, self.lighting, &sender, dir32).as_dvec3();
+                    bounce += sent;
+                    let sq = squares(sent);
+                    for k in 0..4 {
+                        ambient2[k] += sq[k];
+                        bounce2[k] += sq[k];
+                    }
                 }
                 None => {
                     if let Some(env) = self.lighting.environment {
-                        visible_env += env.sample(dir32).as_dvec3();
+                        let seen = env.sample(dir32).as_dvec3();
+                        visible_env += seen;
+                        let sq = squares(seen);
+                        for k in 0..4 {
+                            ambient2[k] += sq[k];
+                        }
                     }
                 }
             }
@@ -323,6 +343,18 @@ impl Estimator<'_> {
         // With the cosine-weighted pdf cos θ / π, ∫ f cos θ dω ≈ (π / M) Σ f.
         let scale = PI / m;
         let unoccluded = self.lighting.environment.map_or(Vec3::ZERO, |env| env.irradiance(ns.as_vec3()));
+        // The standard error of (π / M) Σ x from the rays' own spread (0 for one ray).
+        let std_error = |sum: DVec3, sum2: [f64; 4]| -> [f64; 4] {
+            let lum = 0.2126 * sum.x + 0.7152 * sum.y + 0.0722 * sum.z;
+            let sums = [sum.x, sum.y, sum.z, lum];
+            std::array::from_fn(|k| {
+                if self.rays_per_pixel < 2 {
+                    return 0.0;
+                }
+                let variance = ((sum2[k] - sums[k] * sums[k] / m) / (m - 1.0)).max(0.0);
+                PI * (variance / m).sqrt()
+            })
+        };
         PointEstimate {
             ao: 1.0 - p,
             ao_falloff: (1.0 - attenuated / m).clamp(0.0, 1.0),
@@ -330,6 +362,8 @@ impl Estimator<'_> {
             environment_visible: (visible_env * scale).to_array(),
             bounce: (bounce * scale).to_array(),
             unoccluded: unoccluded.as_dvec3().to_array(),
+            ambient_std_error: std_error(visible_env + bounce, ambient2),
+            bounce_std_error: std_error(bounce, bounce2),
             rays,
         }
     }

@@ -17,6 +17,7 @@
 //! compositor's business: it does not report them through OpenXR, so vrao's counters
 //! only say what was submitted.
 
+use super::mask::SessionMask;
 use super::state::{Action, Event, FrameBudget, SessionMachine, Turn};
 use super::swapchain::{EyeSwapchains, FillError, SubImage};
 use super::{
@@ -119,6 +120,9 @@ pub struct OpenXrHeadset {
     /// XR_FB_display_refresh_rate: the rates offered and the latest one reported.
     refresh_rates_hz: Vec<f32>,
     refresh_hz: Option<f32>,
+    /// The lens's visibility mask: the runtime's (XR_KHR_visibility_mask), following its
+    /// change events, else Monado's default from the views' fields of view.
+    mask: SessionMask,
 }
 
 fn failed(what: &str) -> impl Fn(xr::sys::Result) -> Unavailable + '_ {
@@ -177,6 +181,8 @@ impl OpenXrHeadset {
             loss_reason: self.machine.loss_reason().map(str::to_string),
             ending: self.machine.ending().map(str::to_string),
             fell_back: self.fallback.is_some(),
+            visibility_mask_extension: self.mask.from_the_runtime(),
+            visibility_mask_changes: self.mask.changes(),
         }
     }
 
@@ -251,11 +257,12 @@ impl OpenXrHeadset {
     }
 
     /// Feeds the queued events to the machine: session state changes and a pending
-    /// instance loss.
+    /// instance loss; a view's changed visibility mask is read again.
     fn poll_events(&mut self) {
         let Some(xr) = self.xr.as_ref() else { return };
         let mut events = Vec::new();
         let mut refresh_changes = Vec::new();
+        let mut mask_changes = Vec::new();
         let mut buffer = xr::EventDataBuffer::new();
         loop {
             match xr.instance.poll_event(&mut buffer) {
@@ -269,6 +276,9 @@ impl OpenXrHeadset {
                     let (from, to) = (change.from_display_refresh_rate(), change.to_display_refresh_rate());
                     refresh_changes.push((from, to));
                 }
+                Ok(Some(xr::Event::VisibilityMaskChangedKHR(change))) => {
+                    mask_changes.push((change.view_configuration_type() == VIEW_TYPE, change.view_index()));
+                }
                 Ok(Some(xr::Event::EventsLost(lost))) => {
                     log::warn!("OpenXR: {} events lost", lost.lost_event_count())
                 }
@@ -279,6 +289,14 @@ impl OpenXrHeadset {
                     break;
                 }
             }
+        }
+        // Read after the queue is drained: the event buffer is reused by each poll.
+        let mask_lines: Vec<String> = mask_changes
+            .into_iter()
+            .map(|(ours, view)| self.mask.changed(ours, view, || mask::read_view(&xr.session, view)))
+            .collect();
+        for line in mask_lines {
+            self.note(&line);
         }
         for (from, to) in refresh_changes {
             self.note(&format!("display refresh rate {from} Hz -> {to} Hz"));
@@ -339,6 +357,10 @@ impl OpenXrHeadset {
         let (views, warning) = self.tracking.merge(flags, &views);
         if let Some(warning) = warning {
             log::warn!("OpenXR: {warning}");
+        }
+        // Without XR_KHR_visibility_mask: Monado's default mask for the rendered views.
+        if self.mask.follow_fov([fov_from_xr(&views[0].fov), fov_from_xr(&views[1].fov)]) {
+            log::debug!("OpenXR: visibility mask from the views' fields of view");
         }
         if let Some(now) = sampled_at {
             let ms = (state.predicted_display_time.as_nanos() - now.as_nanos()) as f64 / 1e6;
@@ -602,6 +624,13 @@ impl Headset for OpenXrHeadset {
         Some(self.report())
     }
 
+    fn visibility_mask(&self) -> Option<&crate::render::visibility::VisibilityMask> {
+        match &self.fallback {
+            Some(simulated) => simulated.visibility_mask(),
+            None => self.mask.mask(),
+        }
+    }
+
     fn display_rate_source(&self) -> String {
         match (&self.fallback, self.display.source()) {
             (Some(simulated), _) => format!("{} (after the OpenXR session was lost)", simulated.display_rate_source()),
@@ -664,6 +693,7 @@ impl Drop for OpenXrHeadset {
 }
 
 mod layer;
+mod mask;
 mod open;
 #[cfg(test)]
 mod tests;

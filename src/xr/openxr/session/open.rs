@@ -4,11 +4,12 @@
 use super::*;
 
 impl OpenXrHeadset {
-    /// Creates the instance (with XR_KHR_vulkan_enable2, and XR_KHR_composition_layer_depth
-    /// and XR_KHR_convert_timespec_time when offered), finds the head-mounted display,
-    /// has the runtime create the Vulkan instance and device, wraps them as the `Gpu`,
-    /// and creates the session, a LOCAL reference space and the swapchains. The session
-    /// begins at its READY state, from `wait_frame`.
+    /// Creates the instance (with XR_KHR_vulkan_enable2, and XR_KHR_composition_layer_depth,
+    /// XR_KHR_convert_timespec_time and XR_KHR_visibility_mask when offered), finds the
+    /// head-mounted display, has the runtime create the Vulkan instance and device, wraps
+    /// them as the `Gpu`, and creates the session, a LOCAL reference space, the swapchains
+    /// and reads each view's visibility mask. The session begins at its READY state, from
+    /// `wait_frame`.
     pub fn open(options: OpenXrOptions) -> std::result::Result<(OpenXrHeadset, Arc<Gpu>), Unavailable> {
         let entry = load_entry()?;
         let slot = InstanceSlot::take()?;
@@ -20,6 +21,7 @@ impl OpenXrHeadset {
 
         let SessionParts { gpu, session, frame_waiter, frame_stream, space, refresh_rates_hz, refresh_hz, swapchains } =
             SessionParts::create(&instance, system.id, size, &extensions, &options)?;
+        let mask = mask::initial(&session, extensions.khr_visibility_mask);
         let swapchain_text = swapchains.describe();
         let depth = swapchains.has_depth();
         let xr = Xr {
@@ -62,6 +64,7 @@ impl OpenXrHeadset {
             refresh_rates_hz,
             refresh_hz,
             display_period_ms: 0.0,
+            mask,
         };
         Ok((headset, gpu))
     }
@@ -81,6 +84,7 @@ fn create_instance(entry: &xr::Entry) -> std::result::Result<(xr::Instance, xr::
     extensions.khr_composition_layer_depth = available.khr_composition_layer_depth;
     extensions.khr_convert_timespec_time = available.khr_convert_timespec_time;
     extensions.fb_display_refresh_rate = available.fb_display_refresh_rate;
+    extensions.khr_visibility_mask = available.khr_visibility_mask;
     let instance = entry
         .create_instance(&application_info(), &extensions, &[], &())
         .map_err(|e| super::super::no_runtime(&super::super::xr_call_failed("xrCreateInstance", e)))?;

@@ -1,0 +1,330 @@
+//! The lens's visibility mask as an OpenXR session keeps it, without the runtime calls
+//! (those are `session/mask.rs`): each view's mask read through XR_KHR_visibility_mask
+//! (its hidden triangle mesh, else its visible one), replaced when the runtime says a
+//! view's mask changed (`XrEventDataVisibilityMaskChangedKHR`), or, where the runtime
+//! offers no extension, Monado's default from each view's field of view (the four
+//! corners cut off) following the field of view the frames are rendered with. Pure
+//! bookkeeping, so the event path is tested without a runtime.
+
+use crate::render::stereo::Fov;
+use crate::render::visibility::{ViewMask, VisibilityMask, MAX_MASK_TRIANGLES};
+use glam::Vec2;
+
+/// Views of PRIMARY_STEREO: left, then right.
+pub const VIEWS: usize = 2;
+
+/// The source of a mask read from the runtime, for reports.
+pub const RUNTIME_SOURCE: &str = "the OpenXR runtime (XR_KHR_visibility_mask)";
+
+/// The most vertices or indices vrao takes from one of the runtime's meshes (three per
+/// triangle of [`MAX_MASK_TRIANGLES`]): a larger count is refused, not allocated.
+pub const MAX_MESH_ELEMENTS: usize = 3 * MAX_MASK_TRIANGLES;
+
+/// One mesh as `xrGetVisibilityMaskKHR` returned it: vertices on the view's image plane
+/// at z = −1 (the tangents of the view angles, x right, y up), three indices a triangle.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MaskMesh {
+    /// The vertices.
+    pub vertices: Vec<Vec2>,
+    /// The indices, three a triangle.
+    pub indices: Vec<u32>,
+}
+
+impl MaskMesh {
+    /// Whether the mesh has no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.indices.len() < 3
+    }
+}
+
+/// Refuses counts above [`MAX_MESH_ELEMENTS`] before anything is allocated for them.
+pub fn check_counts(vertices: u32, indices: u32) -> Result<(), String> {
+    let (v, i) = (vertices as usize, indices as usize);
+    if v > MAX_MESH_ELEMENTS || i > MAX_MESH_ELEMENTS {
+        return Err(format!("the mesh has {v} vertices and {i} indices (vrao takes at most {MAX_MESH_ELEMENTS} of each)"));
+    }
+    Ok(())
+}
+
+/// One view's mask from its hidden triangle mesh; an empty hidden mesh asks for the
+/// visible one (`visible`, called only then). A failed read, both meshes empty, or a
+/// mesh [`ViewMask`] refuses (indices out of range, a vertex that is not finite) is the
+/// reason there is no mask.
+pub fn view_mask(
+    hidden: Result<MaskMesh, String>,
+    visible: impl FnOnce() -> Result<MaskMesh, String>,
+) -> Result<ViewMask, String> {
+    let hidden = hidden.map_err(|e| format!("hidden triangle mesh: {e}"))?;
+    if !hidden.is_empty() {
+        return ViewMask::from_hidden_mesh(&hidden.vertices, &hidden.indices, format!("{RUNTIME_SOURCE}, hidden mesh"))
+            .map_err(|e| format!("hidden triangle mesh: {e}"));
+    }
+    let visible = visible().map_err(|e| format!("the hidden triangle mesh is empty; visible triangle mesh: {e}"))?;
+    if visible.is_empty() {
+        return Err("the hidden and the visible triangle meshes are both empty".into());
+    }
+    ViewMask::from_visible_mesh(&visible.vertices, &visible.indices, format!("{RUNTIME_SOURCE}, visible mesh"))
+        .map_err(|e| format!("visible triangle mesh: {e}"))
+}
+
+/// Where the session's mask comes from.
+#[derive(Clone, Debug, PartialEq)]
+enum Origin {
+    /// Read from the runtime (XR_KHR_visibility_mask), view by view.
+    Runtime,
+    /// The runtime has no XR_KHR_visibility_mask: Monado's default from the fields of
+    /// view of the frames (`None` before the first frame).
+    FieldOfView(Option<[Fov; VIEWS]>),
+}
+
+/// The session's visibility mask: one [`ViewMask`] per view, and the [`VisibilityMask`]
+/// the headset hands out once every view has one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SessionMask {
+    origin: Origin,
+    views: [Option<ViewMask>; VIEWS],
+    mask: Option<VisibilityMask>,
+    /// Change events followed (the runtime's `XrEventDataVisibilityMaskChangedKHR`).
+    changes: u64,
+}
+
+impl SessionMask {
+    /// The mask read from the runtime at the start of the session, one read per view.
+    /// Returns it and, when a view has no mask (the session then has none), one line
+    /// saying why for the log.
+    pub fn from_runtime(reads: [Result<ViewMask, String>; VIEWS]) -> (SessionMask, Option<String>) {
+        let mut problems = Vec::new();
+        let views = reads.map(|read| read.map_err(|e| problems.push(e)).ok());
+        let mut mask = SessionMask { origin: Origin::Runtime, views, mask: None, changes: 0 };
+        mask.compose();
+        let problem = (!problems.is_empty()).then(|| {
+            let which: Vec<String> = mask
+                .views
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_none())
+                .zip(&problems)
+                .map(|((i, _), why)| format!("view {i}: {why}"))
+                .collect();
+            format!("no visibility mask from the runtime ({}): every pixel is rendered", which.join("; "))
+        });
+        (mask, problem)
+    }
+
+    /// A runtime without XR_KHR_visibility_mask: Monado's default mask from each view's
+    /// field of view, built at the first frame ([`SessionMask::follow_fov`]).
+    pub fn from_field_of_view() -> SessionMask {
+        SessionMask { origin: Origin::FieldOfView(None), views: [None, None], mask: None, changes: 0 }
+    }
+
+    /// Whether the mask is read from the runtime (XR_KHR_visibility_mask).
+    pub fn from_the_runtime(&self) -> bool {
+        self.origin == Origin::Runtime
+    }
+
+    /// The fields of view a frame is rendered with. Without the extension the mask is
+    /// Monado's default for them: built at the first frame and again whenever they change
+    /// (by more than 1e-5 rad). Returns whether the mask changed. A mask read from the
+    /// runtime does not follow the field of view (it is the runtime's own).
+    pub fn follow_fov(&mut self, fovs: [Fov; VIEWS]) -> bool {
+        let Origin::FieldOfView(built_for) = &self.origin else { return false };
+        let same = |a: &Fov, b: &Fov| {
+            [(a.left, b.left), (a.right, b.right), (a.up, b.up), (a.down, b.down)]
+                .iter()
+                .all(|(x, y)| (x - y).abs() <= 1e-5)
+        };
+        if built_for.is_some_and(|built| built.iter().zip(&fovs).all(|(a, b)| same(a, b))) {
+            return false;
+        }
+        self.views = fovs.map(|fov| {
+            let mut view = ViewMask::corner_cut(fov.tangents());
+            view.source = format!(
+                "{} (the OpenXR runtime offers no XR_KHR_visibility_mask; built from the field of view it reports)",
+                view.source
+            );
+            Some(view)
+        });
+        self.origin = Origin::FieldOfView(Some(fovs));
+        self.compose();
+        true
+    }
+
+    /// The runtime's `XrEventDataVisibilityMaskChangedKHR` for view `view_index` of the
+    /// session's view configuration (`ours`: the event names PRIMARY_STEREO), with the
+    /// view's mask read again since (`read`, called only for an event that applies).
+    /// A fresh mask replaces the view's; a failed read leaves the view without one, and
+    /// the session without a mask (rendering pixels the lens hides is safe, hiding ones
+    /// it shows is not). Returns one line for the log.
+    pub fn changed(&mut self, ours: bool, view_index: u32, read: impl FnOnce() -> Result<ViewMask, String>) -> String {
+        if !ours {
+            return format!("visibility mask of view {view_index} of another view configuration changed: ignored");
+        }
+        if self.origin != Origin::Runtime {
+            return format!("visibility mask of view {view_index} changed, but XR_KHR_visibility_mask is not enabled: ignored");
+        }
+        let Some(slot) = self.views.get_mut(view_index as usize) else {
+            return format!("visibility mask of view {view_index} changed: PRIMARY_STEREO has {VIEWS} views, ignored");
+        };
+        self.changes += 1;
+        let line = match read() {
+            Ok(view) => {
+                *slot = Some(view);
+                format!("visibility mask of view {view_index} changed: read again")
+            }
+            Err(why) => {
+                *slot = None;
+                format!("visibility mask of view {view_index} changed but could not be read ({why}): no mask from now on")
+            }
+        };
+        self.compose();
+        line
+    }
+
+    /// The mask the headset hands out: every view's, or `None` while a view has none.
+    pub fn mask(&self) -> Option<&VisibilityMask> {
+        self.mask.as_ref()
+    }
+
+    /// Change events followed so far.
+    pub fn changes(&self) -> u64 {
+        self.changes
+    }
+
+    fn compose(&mut self) {
+        self.mask = self
+            .views
+            .iter()
+            .cloned()
+            .collect::<Option<Vec<ViewMask>>>()
+            .filter(|views| !views.iter().all(ViewMask::is_empty))
+            .map(|views| VisibilityMask { views });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Monado's default hidden mesh (`u_visibility_mask_get_default`) for a ±45° view:
+    /// the four corner triangles, twelve vertices indexed in order.
+    fn monado_hidden() -> MaskMesh {
+        let corners = [
+            (1.0, 0.75),
+            (1.0, 1.0),
+            (0.75, 1.0),
+            (-1.0, 1.0),
+            (-1.0, 0.75),
+            (-0.75, 1.0),
+            (-1.0, -0.75),
+            (-1.0, -1.0),
+            (-0.75, -1.0),
+            (0.75, -1.0),
+            (1.0, -1.0),
+            (1.0, -0.75),
+        ];
+        MaskMesh { vertices: corners.iter().map(|&(x, y)| Vec2::new(x, y)).collect(), indices: (0..12).collect() }
+    }
+
+    /// A visible mesh: the centre square of the ±1 rectangle (half its width and height).
+    fn centre_square() -> MaskMesh {
+        let v = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
+        MaskMesh { vertices: v.iter().map(|&(x, y)| Vec2::new(x, y)).collect(), indices: vec![0, 1, 2, 0, 2, 3] }
+    }
+
+    const SQUARE: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
+    const FOV45: Fov = Fov { left: -0.785_398_2, right: 0.785_398_2, up: 0.785_398_2, down: -0.785_398_2 };
+
+    fn read(mesh: MaskMesh) -> Result<ViewMask, String> {
+        view_mask(Ok(mesh), || panic!("the hidden mesh is not empty: no visible read"))
+    }
+
+    #[test]
+    fn the_hidden_mesh_is_taken_and_an_empty_one_asks_for_the_visible_one() {
+        let view = read(monado_hidden()).unwrap();
+        assert!(view.source.contains("XR_KHR_visibility_mask"), "{}", view.source);
+        let share = view.hidden_share(200, 200, SQUARE);
+        assert!((share - 0.03125).abs() < 0.002, "Monado's corners: {share}");
+
+        let view = view_mask(Ok(MaskMesh::default()), || Ok(centre_square())).unwrap();
+        assert!(view.source.contains("visible mesh"), "{}", view.source);
+        assert!((view.hidden_share(200, 200, SQUARE) - 0.75).abs() < 0.01);
+
+        let both_empty = view_mask(Ok(MaskMesh::default()), || Ok(MaskMesh::default()));
+        assert!(both_empty.unwrap_err().contains("both empty"));
+        let failed = view_mask(Err("xrGetVisibilityMaskKHR: XR_ERROR_RUNTIME_FAILURE".into()), || unreachable!());
+        assert!(failed.unwrap_err().contains("XR_ERROR_RUNTIME_FAILURE"));
+        let bad = MaskMesh { vertices: vec![Vec2::ZERO; 3], indices: vec![0, 1, 7] };
+        assert!(view_mask(Ok(bad), || unreachable!()).unwrap_err().contains("index 7"));
+        assert!(check_counts(12, 12).is_ok());
+        assert!(check_counts(u32::MAX, 12).is_err(), "a runtime's absurd count is refused before allocating");
+    }
+
+    #[test]
+    fn a_view_the_runtime_cannot_give_leaves_the_session_without_a_mask() {
+        let (mask, problem) = SessionMask::from_runtime([read(monado_hidden()), Ok(read(monado_hidden()).unwrap())]);
+        assert_eq!(problem, None);
+        assert_eq!(mask.mask().map(|m| m.views.len()), Some(2));
+        assert!(mask.from_the_runtime());
+
+        let (mask, problem) = SessionMask::from_runtime([read(monado_hidden()), Err("both empty".into())]);
+        assert_eq!(mask.mask(), None);
+        let problem = problem.unwrap();
+        assert!(problem.contains("view 1: both empty") && !problem.contains("view 0"), "{problem}");
+    }
+
+    #[test]
+    fn a_change_event_replaces_the_view_it_names_and_only_that_one() {
+        let (mut mask, _) = SessionMask::from_runtime([read(monado_hidden()), read(monado_hidden())]);
+        let before = mask.mask().cloned().unwrap();
+        // The runtime narrows the right eye's lens: its visible mesh is now the centre square.
+        let line = mask.changed(true, 1, || view_mask(Ok(MaskMesh::default()), || Ok(centre_square())));
+        assert!(line.contains("view 1 changed: read again"), "{line}");
+        let after = mask.mask().cloned().unwrap();
+        assert_eq!(after.views[0], before.views[0], "the left eye's mask is kept");
+        assert_ne!(after.views[1], before.views[1]);
+        assert!((after.views[1].hidden_share(100, 100, SQUARE) - 0.75).abs() < 0.02);
+        assert_eq!(mask.changes(), 1);
+
+        // Another view configuration's event, or a view PRIMARY_STEREO does not have: nothing read.
+        let unchanged = mask.mask().cloned();
+        assert!(mask.changed(false, 0, || unreachable!()).contains("ignored"));
+        assert!(mask.changed(true, 2, || unreachable!()).contains("ignored"));
+        assert_eq!(mask.mask().cloned(), unchanged);
+        assert_eq!(mask.changes(), 1);
+
+        // The new mask cannot be read: no mask (never the stale one), until a later event gives it.
+        let line = mask.changed(true, 0, || Err("xrGetVisibilityMaskKHR: XR_ERROR_SESSION_LOST".into()));
+        assert!(line.contains("could not be read"), "{line}");
+        assert_eq!(mask.mask(), None);
+        mask.changed(true, 0, || read(monado_hidden()));
+        assert_eq!(mask.mask().map(|m| m.views[0].clone()), Some(before.views[0].clone()));
+        assert_eq!(mask.changes(), 3);
+    }
+
+    #[test]
+    fn without_the_extension_the_mask_is_monados_default_following_the_field_of_view() {
+        let mut mask = SessionMask::from_field_of_view();
+        assert_eq!(mask.mask(), None, "nothing before the first frame's fields of view");
+        assert!(mask.follow_fov([FOV45, FOV45]));
+        let view = &mask.mask().unwrap().views[0];
+        assert!(view.source.contains("offers no XR_KHR_visibility_mask"), "{}", view.source);
+        // The same mask Monado's runtime gives for the same field of view.
+        assert_eq!(view.coverage(64, 64, SQUARE), read(monado_hidden()).unwrap().coverage(64, 64, SQUARE));
+        assert!(!mask.follow_fov([FOV45, FOV45]), "the same fields of view: unchanged");
+        let wider = Fov { left: -0.9, ..FOV45 };
+        assert!(mask.follow_fov([wider, FOV45]));
+        assert!((mask.mask().unwrap().views[0].hidden_share(100, 100, wider.tangents()) - 0.03125).abs() < 0.003);
+        // Change events do not apply to a mask the runtime did not give.
+        assert!(mask.changed(true, 0, || unreachable!()).contains("not enabled"));
+        // A mask read from the runtime does not follow the field of view.
+        let (mut runtime, _) = SessionMask::from_runtime([read(monado_hidden()), read(monado_hidden())]);
+        assert!(!runtime.follow_fov([wider, wider]));
+    }
+
+    #[test]
+    fn masks_hiding_nothing_are_no_mask() {
+        let nothing = || ViewMask::from_hidden_mesh(&[], &[], RUNTIME_SOURCE);
+        let (mask, problem) = SessionMask::from_runtime([nothing(), nothing()]);
+        assert_eq!((mask.mask(), problem), (None, None));
+    }
+}
