@@ -116,6 +116,10 @@ pub struct BenchRecord {
     /// See [`Self::ambient_rel_rmse_r`].
     #[serde(default)]
     pub ambient_rel_rmse_b: Option<f64>,
+    /// The bounce's screen-space limit's relative RMSE against the reference's bounce
+    /// (what a depth-buffer bounce can reach at best).
+    #[serde(default)]
+    pub bounce_limit_rel_rmse: Option<f64>,
     /// [`Self::bounce_rel_rmse`] per colour channel (red, green, blue).
     #[serde(default)]
     pub bounce_rel_rmse_r: Option<f64>,

@@ -244,10 +244,29 @@ impl CaseRun {
         let depth = self.renderer.read_f32(DEPTH)?;
         let normals = self.renderer.read_f32(NORMALS)?;
         let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
-            .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: self.eyes.eyes[k].fov })
+            .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: self.eyes.eyes[k].fov, direct: None })
             .collect();
         let settings = LimitSettings::for_reference(reference, self.case.radius as f64, self.eyes.near);
         screen_space_limit(&buffers, (reference.width, reference.height), &settings)
+    }
+
+    /// The bounce's screen-space limit of the last frame (the limit's march with this
+    /// frame's direct light), against the reference's bounce: its relative RMSE.
+    fn bounce_limit(&self, reference: &ReferenceImage) -> Result<Option<f64>> {
+        let depth = self.renderer.read_f32(DEPTH)?;
+        let normals = self.renderer.read_f32(NORMALS)?;
+        let direct = self.renderer.read_f32(crate::render::passes::direct::DIRECT)?;
+        let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()).min(direct.len()))
+            .map(|k| EyeBuffers {
+                depth: &depth[k],
+                normals: &normals[k],
+                fov: self.eyes.eyes[k].fov,
+                direct: Some(&direct[k]),
+            })
+            .collect();
+        let settings = LimitSettings::for_reference(reference, self.case.radius as f64, self.eyes.near);
+        let limit = screen_space_limit(&buffers, (reference.width, reference.height), &settings)?;
+        Ok(limit_bounce_rel_rmse(&limit, reference))
     }
 
     /// Pixels per degree of this case's eyes (the mean of both).
@@ -305,7 +324,9 @@ impl CaseRun {
                     .zip(self.renderer.read_f32(output)?)
                     .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a - b).collect())
                     .collect();
-                bounce_figures(&difference, settings.profile.width, 1, reference)
+                let figures = bounce_figures(&difference, settings.profile.width, 1, reference);
+                let limit = self.bounce_limit(reference)?;
+                figures.map(|f| BounceFigures { limit_rel_rmse: limit, ..f })
             }
             _ => None,
         };
@@ -416,6 +437,42 @@ pub struct BounceFigures {
     /// (NaN for a channel the reference has no bounce in).
     #[serde(default)]
     pub rel_rmse_rgb: [f64; 3],
+    /// The bounce's screen-space limit (a march of many rays over the frame's own depth
+    /// and direct light, `screen_limit`) against the reference's bounce: the
+    /// [`Self::rel_rmse`] no depth-buffer bounce can go below.
+    #[serde(default)]
+    pub limit_rel_rmse: Option<f64>,
+}
+
+/// The relative RMSE (luminance, the reference's noise taken out) of a screen-space
+/// limit's bounce against the reference's, on the reference's grid; `None` when the
+/// grids differ or the reference has no bounce.
+pub fn limit_bounce_rel_rmse(limit: &ScreenLimit, reference: &ReferenceImage) -> Option<f64> {
+    if limit.grid_size() != reference.grid_size() {
+        return None;
+    }
+    let (gw, gh) = reference.grid_size();
+    let (mut n, mut sum_ref, mut sum_sq, mut noise2) = (0usize, 0f64, 0f64, 0f64);
+    for layer in 0..reference.layers.len().min(limit.layers.len()) {
+        for j in 0..gh {
+            for i in 0..gw {
+                let r = reference.get(layer, i, j);
+                let l = limit.get(layer, i, j);
+                if !r.hit || !l.hit {
+                    continue;
+                }
+                let (e, truth) = (luminance(l.bounce), luminance(r.bounce));
+                n += 1;
+                sum_ref += truth;
+                sum_sq += (e - truth) * (e - truth);
+                noise2 += (r.bounce_std_error[3] as f64).powi(2);
+            }
+        }
+    }
+    let n_f = n.max(1) as f64;
+    let mean = sum_ref / n_f;
+    (n > 0 && mean > 1e-9)
+        .then(|| crate::measure::metrics::noise_corrected_rmse((sum_sq / n_f).sqrt(), (noise2 / n_f).sqrt()) / mean)
 }
 
 /// Compares irradiance images (per layer, RGBA, `width` texels a row, each texel standing
@@ -470,6 +527,7 @@ pub fn bounce_figures(
         rel_rmse: rel_rmse(3),
         rel_bias: (sum_est[3] - sum_ref[3]) / n_f / mean,
         rel_rmse_rgb: [0, 1, 2].map(rel_rmse),
+        limit_rel_rmse: None,
     })
 }
 

@@ -29,6 +29,11 @@
 //! open (the ray stops when it leaves the image: the image of a segment is a segment, and
 //! the image is convex). AO = unblocked rays / M, as the reference's 1 − (1/π)∫\[hit\]cos θ dω.
 //!
+//! The bounce's limit (with the frame's direct light, [`EyeBuffers::direct`]): each
+//! blocked ray brings the direct light leaving the surface S it was blocked by when S
+//! faces P (its normal towards P), (π / M) Σ L_direct(S), as the reference's one bounce
+//! from surfaces within r: what SSDO's bounce could reach from the same buffers.
+//!
 //! Thickness: the depth buffer cannot say how deep anything is. A step counts only within
 //! a finite thickness behind the visible surface, so an object in front of a far wall does
 //! not shadow the wall (the halo of infinite thickness) and a thin slab stops occluding a
@@ -119,6 +124,9 @@ pub struct EyeBuffers<'a> {
     pub normals: &'a [f32],
     /// The eye's field of view (to turn pixels into view rays).
     pub fov: Fov,
+    /// The direct light leaving each pixel's surface (RGBA, a unused), for the bounce's
+    /// limit; `None`: no bounce.
+    pub direct: Option<&'a [f32]>,
 }
 
 /// The limit at one grid pixel.
@@ -131,6 +139,9 @@ pub struct LimitPixel {
     /// Standard error of `ao` from its own rays (√(p(1 − p)/(M − 1)); conservative, as
     /// the reference's: stratification makes the real error smaller).
     pub std_error: f32,
+    /// The one-bounce irradiance from the blocking surfaces' direct light (linear RGB; 0
+    /// without the direct light).
+    pub bounce: [f32; 3],
 }
 
 /// The limit for every eye on a grid of `stride`, laid out as a reference image's.
@@ -165,7 +176,8 @@ pub fn screen_space_limit(eyes: &[EyeBuffers], size: (u32, u32), settings: &Limi
     settings.validate()?;
     let pixels = size.0 as usize * size.1 as usize;
     for (layer, eye) in eyes.iter().enumerate() {
-        if eye.depth.len() != pixels || eye.normals.len() != pixels * 4 {
+        if eye.depth.len() != pixels || eye.normals.len() != pixels * 4 || eye.direct.is_some_and(|d| d.len() != pixels * 4)
+        {
             return Err(Error::input(format!(
                 "screen-space limit: eye {layer} has {} depth and {} normal values for {}×{} pixels",
                 eye.depth.len(),
@@ -243,7 +255,7 @@ impl<'a> Marcher<'a> {
 
     fn pixel(&self, layer: u32, x: u32, y: u32, points: &mut Vec<(f64, f64)>) -> LimitPixel {
         let Some(d) = self.depth(x, y) else {
-            return LimitPixel { hit: false, ao: 1.0, std_error: 0.0 };
+            return LimitPixel { hit: false, ao: 1.0, std_error: 0.0, bounce: [0.0; 3] };
         };
         let s = self.settings;
         let p = self.position(x, y, d);
@@ -262,6 +274,7 @@ impl<'a> Marcher<'a> {
         stratified_points(s.rays_per_pixel, &mut rng, points);
         let tolerance = s.radius * TANGENT_PLANE_TOLERANCE_OF_RADIUS;
         let mut blocked = 0u32;
+        let mut bounce = DVec3::ZERO;
         for &(u, v) in points.iter() {
             let (dx, dy) = concentric_disk(u, v);
             let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
@@ -284,6 +297,15 @@ impl<'a> Marcher<'a> {
                     continue; // the receiver's own plane (or below it)
                 }
                 blocked += 1;
+                if let Some(direct) = self.eye.direct {
+                    // The blocking surface sends its direct light when it faces P.
+                    let k = (qy as usize * self.size.0 as usize + qx as usize) * 4;
+                    let normals = &self.eye.normals;
+                    let normal = DVec3::new(normals[k] as f64, normals[k + 1] as f64, normals[k + 2] as f64);
+                    if normal.dot(p - surface) > 0.0 {
+                        bounce += DVec3::new(direct[k] as f64, direct[k + 1] as f64, direct[k + 2] as f64);
+                    }
+                }
                 break;
             }
         }
@@ -291,7 +313,8 @@ impl<'a> Marcher<'a> {
         let occluded = blocked as f64 / m;
         let std_error =
             if s.rays_per_pixel > 1 { (occluded * (1.0 - occluded) / (m - 1.0)).max(0.0).sqrt() } else { 0.5 };
-        LimitPixel { hit: true, ao: (1.0 - occluded) as f32, std_error: std_error as f32 }
+        let bounce = (bounce * (std::f64::consts::PI / m)).as_vec3().to_array();
+        LimitPixel { hit: true, ao: (1.0 - occluded) as f32, std_error: std_error as f32, bounce }
     }
 }
 
@@ -342,7 +365,7 @@ mod tests {
 
     fn limit(rects: &[Rect], size: (u32, u32), settings: LimitSettings) -> (ScreenLimit, Vec<f32>) {
         let (depth, normals) = rasterise(rects, size);
-        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov() };
+        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None };
         (screen_space_limit(&[eye], size, &settings).unwrap(), depth)
     }
 
@@ -471,7 +494,7 @@ mod tests {
     fn the_sky_is_open_and_mismatched_buffers_are_refused() {
         let size = (8, 6);
         let (depth, normals) = (vec![0.0; 48], vec![0.0; 192]);
-        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov() };
+        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None };
         let limit = screen_space_limit(&[eye, eye], size, &LimitSettings::new(1.0, 1, NEAR)).unwrap();
         assert!(limit.layers.iter().flatten().all(|p| !p.hit && p.ao == 1.0));
         let short = EyeBuffers { depth: &depth[..40], ..eye };

@@ -28,8 +28,9 @@
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the one without).
 override BOUNCE: bool = false;
 
-// Directions per slice that weigh the environment's radiance.
-const LIGHT_DIRECTIONS: u32 = 8u;
+// Directions per slice that weigh the environment's radiance (jittered per pixel: the
+// denoise averages 16 pixels' offsets).
+const LIGHT_DIRECTIONS: u32 = 4u;
 
 struct GatheredLight {
     // Σ over slices of |projected normal| × the directions' cosine weights, and of the
@@ -91,6 +92,10 @@ fn end_slice(
     if (BOUNCE) {
         (*light).bounce += (*light).slice_bounce * (weight / SECTORS);
         (*light).slice_bounce = vec3<f32>(0.0);
+    }
+    if (frame.has_environment == 0u) {
+        // No environment: nothing to weigh (uniform across the dispatch).
+        return;
     }
     // Directions θ_j = θ_min + φ_j, φ_j = (j + jitter) Δ over the half circle; the slice's
     // cosine-weighted measure there is |sin θ| cos(θ − γ) = |sin θ| sin φ.
