@@ -108,6 +108,7 @@ fn engine_ao(gpu: &vrao::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: b
         normals: with_normals.then_some(normals),
         views: &views,
         motion: None,
+        light: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
@@ -191,6 +192,7 @@ fn a_mono_view_from_a_single_layer_depth_buffer_matches_the_renderer() {
         normals: Some(normals),
         views: &views,
         motion: None,
+        light: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
@@ -223,6 +225,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         normals: None,
         views: &views,
         motion: None,
+        light: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a depth buffer of another size");
     assert!(e.to_string().contains("depth") && e.to_string().contains("does not match"), "{e}");
@@ -234,6 +237,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         normals: None,
         views: &views,
         motion: None,
+        light: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a convention the projection contradicts");
     assert!(e.to_string().contains("view 0: projection"), "{e}");
@@ -246,6 +250,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         normals: None,
         views: &scaled,
         motion: None,
+        light: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a view matrix with scale");
     assert!(e.to_string().contains("view 1: view matrix"), "{e}");
@@ -298,6 +303,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
                 normals: None,
                 views: &views,
                 motion,
+                light: None,
             };
             texture = Some(engine.record(&mut encoder, &frame).unwrap().texture.clone());
             queue.submit([encoder.finish()]);
@@ -328,6 +334,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
         normals: None,
         views: &views,
         motion: Some(HostMotion { texture: &small, to_previous_uv: [1.0, 1.0] }),
+        light: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("motion of another size");
     assert!(e.to_string().contains("motion") && e.to_string().contains("does not match"), "{e}");
@@ -349,6 +356,7 @@ fn reversed_z_frame(
         normals: None,
         views,
         motion: None,
+        light: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     gpu.queue.submit([encoder.finish()]);

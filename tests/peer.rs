@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 use vrao::measure::bench::ReferenceOptions;
-use vrao::measure::peer::{run_peer, Family, PeerOptions};
+use vrao::measure::peer::{run_peer, scene_for_peer, Family, PeerOptions};
 use vrao::render::renderer::TimingChoice;
 use vrao::{BackendChoice, HeadsetProfile, Scene, Settings};
 
@@ -21,6 +21,9 @@ fn bevy_on_an_open_plane_reads_its_known_084_against_a_reference_of_1() {
     let out = std::env::temp_dir().join(format!("vrao-peer-plane-{}", std::process::id()));
     let scene = Scene::load("builtin:plane").unwrap();
     let base = Settings { profile: HeadsetProfile::with_size("vive", 96, 104), ..Settings::default() };
+    std::fs::create_dir_all(&out).unwrap();
+    let gltf = out.join("plane.glb");
+    vrao::test_assets::gltf_write::write(&scene_for_peer(&scene), &gltf, &Default::default()).unwrap();
     let options = PeerOptions {
         backend: BackendChoice::Auto,
         peer,
@@ -33,6 +36,7 @@ fn bevy_on_an_open_plane_reads_its_known_084_against_a_reference_of_1() {
         rounds: 1,
         reference: ReferenceOptions { rays_per_pixel: 64, stride: 4, cache: out.join("cache") },
         out: out.clone(),
+        gltf,
     };
     let run = run_peer(&scene, &base, &options).unwrap();
     let bevy = run.rows.iter().find(|r| r.family == Family::Bevy).unwrap();

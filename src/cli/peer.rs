@@ -5,7 +5,9 @@ use super::{choice, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::bench::ReferenceOptions;
-use vrao::measure::peer::{run_peer, write_outputs, PeerOptions, BEVY_PRESETS, DEFAULT_PEER, ROUNDS_MAX};
+use vrao::measure::peer::{
+    check_options, run_peer, scene_for_peer, write_outputs, PeerOptions, BEVY_PRESETS, DEFAULT_PEER, ROUNDS_MAX,
+};
 use vrao::measure::reference::default_cache_dir;
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::render::renderer::TimingChoice;
@@ -69,10 +71,7 @@ pub struct PeerArgs {
 
 pub fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
     vrao::formats::output::check_output_folder(&args.out)?;
-    let scene = Scene::load(&args.scene)?;
-    let mut base =
-        Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
-    base.ao.radius = args.radius;
+    let work = args.out.join("peer-work");
     let options = PeerOptions {
         backend,
         peer: args.peer,
@@ -93,7 +92,16 @@ pub fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
             cache: args.cache.unwrap_or_else(default_cache_dir),
         },
         out: args.out.clone(),
+        gltf: work.join("scene.glb"),
     };
+    check_options(&options)?;
+    let scene = Scene::load(&args.scene)?;
+    let mut base =
+        Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
+    base.ao.radius = args.radius;
+    // The scene as glTF for the peer, written into the output folder at run time.
+    std::fs::create_dir_all(&work).map_err(|e| vrao::Error::Output { path: work.clone(), message: e.to_string() })?;
+    vrao::test_assets::gltf_write::write(&scene_for_peer(&scene), &options.gltf, &Default::default())?;
     let run = run_peer(&scene, &base, &options)?;
     print!("{}", write_outputs(&args.out, &run)?);
     Ok(())

@@ -298,7 +298,13 @@ impl CaseRun {
             figures
         });
         let stereo = {
-            let depth = self.renderer.read_f32(DEPTH)?;
+            let mut depth = self.renderer.read_f32(DEPTH)?;
+            // Points the lens hides in either eye count as unseen (as sky), mask on or off.
+            for (layer, shown) in depth.iter_mut().zip(&self.coverage) {
+                if let Some(shown) = shown {
+                    layer.iter_mut().zip(shown).filter(|(_, &s)| s == 0).for_each(|(d, _)| *d = 0.0);
+                }
+            }
             let ao: Vec<Vec<f32>> = occlusion.iter().map(|l| l.iter().skip(3).step_by(4).copied().collect()).collect();
             let size = (settings.profile.width, settings.profile.height);
             (depth.len() == 2 && ao.len() == 2).then(|| {

@@ -64,8 +64,10 @@ pub struct PeerOptions {
     pub rounds: u32,
     /// The reference both are scored against.
     pub reference: ReferenceOptions,
-    /// Output folder (the glTF, the peer's files, the table, the plot, the images).
+    /// Output folder (the peer's files, the table, the plot, the images).
     pub out: PathBuf,
+    /// The scene as glTF for the peer ([`scene_for_peer`] written by the caller).
+    pub gltf: PathBuf,
 }
 
 /// Which program a row measured.
@@ -212,8 +214,10 @@ pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result
     }
     let work = options.out.join("peer-work");
     std::fs::create_dir_all(&work).map_err(|e| Error::Output { path: work.clone(), message: e.to_string() })?;
-    let gltf = work.join("scene.glb");
-    write_gltf(scene, &gltf)?;
+    let gltf = &options.gltf;
+    if !options.presets.is_empty() && !gltf.is_file() {
+        return Err(Error::input(format!("no glTF of the scene for the peer at {}", gltf.display())));
+    }
     let (width, height) = (base.profile.width, base.profile.height);
     let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near);
     let gpu = Arc::new(Gpu::new(options.backend)?);
@@ -240,7 +244,7 @@ pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result
             if side && !options.presets.is_empty() {
                 log::info!("peer: round {} of {}: Bevy, {} presets", round + 1, options.rounds, options.presets.len());
                 let dir = work.join(format!("round-{round}"));
-                let (adapter, result) = run_peer_round(options, &gltf, &dir, &eyes, (width, height), timing)?;
+                let (adapter, result) = run_peer_round(options, gltf, &dir, &eyes, (width, height), timing)?;
                 peer_adapter = adapter;
                 peer_rounds.push(result);
             } else if !side && !cases.is_empty() {
@@ -336,12 +340,12 @@ fn rgba_of(ao: &[f32]) -> Vec<f32> {
     ao.iter().flat_map(|&a| [1.0, 1.0, 1.0, a]).collect()
 }
 
-/// Writes `scene` as the glTF the peer loads: its geometry and plain materials. AO reads
-/// depth and normals only, so textures are left out (the peer needs no image codecs); a
-/// material whose alpha comes from a texture is named in a warning, as the peer sees it
-/// solid where vrao cuts it out.
-#[cfg(feature = "gltf")]
-fn write_gltf(scene: &Scene, path: &Path) -> Result<()> {
+/// `scene` as the peer is to load it (the caller writes it as glTF, e.g. with
+/// `test_assets::gltf_write`, and names the file in [`PeerOptions::gltf`]): its geometry
+/// and plain materials. AO reads depth and normals only, so textures are left out (the
+/// peer needs no image codecs); a material whose alpha comes from a texture is named in a
+/// warning, as the peer sees it solid where vrao cuts it out.
+pub fn scene_for_peer(scene: &Scene) -> Scene {
     let mut plain = scene.clone();
     for m in &mut plain.materials {
         if m.diffuse_texture.is_some() && m.alpha_mode != crate::render::scene::AlphaMode::Opaque {
@@ -349,12 +353,7 @@ fn write_gltf(scene: &Scene, path: &Path) -> Result<()> {
         }
         (m.diffuse_texture, m.emissive_texture, m.normal_texture, m.occlusion_texture) = (None, None, None, None);
     }
-    crate::test_assets::gltf_write::write(&plain, path, &Default::default())
-}
-
-#[cfg(not(feature = "gltf"))]
-fn write_gltf(_scene: &Scene, _path: &Path) -> Result<()> {
-    Err(Error::input("the peer loads the scene as glTF: build vrao with the gltf feature"))
+    plain
 }
 
 /// The reference at `radius` for both eyes (cached as the bench caches it).
@@ -666,6 +665,7 @@ mod tests {
             rounds: 1,
             reference: ReferenceOptions { rays_per_pixel: 16, stride: 8, cache: PathBuf::from("/tmp") },
             out: PathBuf::from("/tmp"),
+            gltf: PathBuf::from("/nonexistent/scene.glb"),
         }
     }
 

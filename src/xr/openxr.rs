@@ -189,9 +189,11 @@ pub struct OpenXrReport {
     pub ending: Option<String>,
     /// Whether the run went on on the simulated headset after a loss.
     pub fell_back: bool,
-    /// Whether the runtime offers XR_KHR_visibility_mask (vrao then reads each view's mask
-    /// from it; otherwise the mask is Monado's default from each view's field of view).
-    pub visibility_mask_extension: bool,
+    /// Whether each view's visibility mask was read from the runtime
+    /// (XR_KHR_visibility_mask); otherwise it is Monado's default from each view's field
+    /// of view (the runtime lacks the extension, or vrao does not call it: the run
+    /// report's `visibility_mask` says why).
+    pub visibility_mask_from_runtime: bool,
     /// The runtime's XrEventDataVisibilityMaskChangedKHR events followed (each view's mask
     /// read again).
     pub visibility_mask_changes: u64,

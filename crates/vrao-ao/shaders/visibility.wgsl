@@ -1,7 +1,8 @@
 // Bind group 1 of every compute kernel (gpu/visibility.rs): the visibility mask and the
 // foveation rate as one map. `visibility_rates` holds, per tile of 8×8 full-resolution
 // pixels (level 0) and of 16×16 (level 1), the share of the full sample count its pixels
-// spend: 0 where the lens hides the whole tile, the foveation rate of its centre elsewhere.
+// spend: 0 where the lens hides the whole tile, elsewhere the foveation rate of its point
+// nearest the view axis.
 // `visibility_pixels` is 1 on the pixels the lens shows and 0 on those it hides.
 
 @group(1) @binding(0) var visibility_rates: texture_2d_array<f32>;
@@ -18,3 +19,10 @@ fn tile_rate(p: vec2<u32>, layer: u32, scale: u32) -> f32 {
 fn pixel_shown(p: vec2<u32>, layer: u32) -> bool {
     return textureLoad(visibility_pixels, vec2<i32>(p), i32(layer), 0).r > 0.5;
 }
+
+// At and below this rate (the outer half of foveation's fall-off and beyond) the
+// upsampling thins as the technique's sampling does: at a depth edge it keeps the 2×2
+// low-res samples instead of widening to 3×3. (Thinning the denoise to one axis and the
+// upsampling to each quad's own sample cost more than they saved: the stereo-inconsistent
+// points rose from 0.8 % to 1.8 %, docs/measurements.md.)
+const THIN_BELOW_RATE: f32 = 0.75;

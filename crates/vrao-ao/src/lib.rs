@@ -21,12 +21,14 @@ pub mod graph_targets;
 pub mod passes;
 pub mod sampling;
 pub mod settings;
+pub mod sh;
 pub mod stereo;
 pub mod technique;
 pub mod visibility;
 
 pub use ao::{
-    AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostMotion, HostNormals, ViewMatrices,
+    AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostLight, HostMotion, HostNormals,
+    ViewMatrices,
 };
 pub use error::{Error, Result};
 pub use settings::{AoSettings, Technique};

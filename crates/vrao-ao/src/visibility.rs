@@ -224,6 +224,8 @@ impl RateMap {
             let t = ((tan - inner) / (outer - inner).max(1e-6)).clamp(0.0, 1.0);
             1.0 + (foveation.edge_rate - 1.0) * t
         };
+        // Where the view axis meets the image, in pixels (it may lie outside).
+        let axis = glam::DVec2::new(-left / (right - left) * width as f64, -up / (down - up) * height as f64);
         // Whether any pixel of the block at (x0, y0) of `size` pixels is shown.
         let shown = |x0: u32, y0: u32, size: u32| -> bool {
             let Some(coverage) = coverage else { return x0 < width && y0 < height };
@@ -238,9 +240,13 @@ impl RateMap {
                 for tx in 0..nx {
                     let (x0, y0) = (tx * tile, ty * tile);
                     out.push(if shown(x0, y0, tile) {
-                        let centre = rate_at(x0 as f64 + tile as f64 * 0.5, y0 as f64 + tile as f64 * 0.5);
+                        // The rate of the tile's point nearest the view axis: a pixel within
+                        // the full-rate cone keeps its full count whatever tile it lies in.
+                        let nearest_x = axis.x.clamp(x0 as f64, (x0 + tile) as f64);
+                        let nearest_y = axis.y.clamp(y0 as f64, (y0 + tile) as f64);
+                        let rate = rate_at(nearest_x, nearest_y);
                         // A shown tile never reads 0, whatever its rate rounds to.
-                        ((centre * 255.0).round() as u8).max(1)
+                        ((rate * 255.0).round() as u8).max(1)
                     } else {
                         0
                     });

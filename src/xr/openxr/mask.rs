@@ -5,6 +5,13 @@
 //! offers no extension, Monado's default from each view's field of view (the four
 //! corners cut off) following the field of view the frames are rendered with. Pure
 //! bookkeeping, so the event path is tested without a runtime.
+//!
+//! Monado 24's in-process runtime (at least 59c34e17b4d9, December 2024) crashes in
+//! `xrGetVisibilityMaskKHR` for a device without a mask of its own, its simulated HMD
+//! among them: its `xrt_device_get_visibility_mask` calls the device's function pointer
+//! without the NULL check it once had (dropped in "xrt: remove function pointer check",
+//! 1473430ee). vrao does not call it there ([`skip_runtime_mask`]) and takes the default
+//! Monado itself would give such a device; [`MASK_VAR`] overrides the choice.
 
 use crate::render::stereo::Fov;
 use crate::render::visibility::{ViewMask, VisibilityMask, MAX_MASK_TRIANGLES};
@@ -37,11 +44,35 @@ impl MaskMesh {
     }
 }
 
+/// The environment variable that overrides where the mask comes from when the runtime
+/// offers XR_KHR_visibility_mask: `runtime` reads it from the runtime whatever the
+/// runtime is, `fov` takes Monado's default from the field of view instead.
+pub const MASK_VAR: &str = "VRAO_OPENXR_VISIBILITY_MASK";
+
+/// Why vrao does not call `xrGetVisibilityMaskKHR` on a runtime that offers the extension
+/// (`None`: it does), from the runtime's name, its version's major number and the value
+/// of [`MASK_VAR`] (`runtime`, `fov`; anything else counts as unset). Monado up to 24
+/// is skipped: see the module comment.
+pub fn skip_runtime_mask(runtime_name: &str, major: u16, choice: Option<&str>) -> Option<String> {
+    match choice.map(str::trim) {
+        Some("runtime") => None,
+        Some("fov") => Some(format!("{MASK_VAR}=fov")),
+        _ if runtime_name.starts_with("Monado") && major <= 24 => Some(format!(
+            "not read from Monado {major}, whose in-process runtime crashes in xrGetVisibilityMaskKHR for a device \
+             without a mask of its own such as its simulated HMD; this is the mask Monado gives such a device \
+             ({MASK_VAR}=runtime reads it anyway)"
+        )),
+        _ => None,
+    }
+}
+
 /// Refuses counts above [`MAX_MESH_ELEMENTS`] before anything is allocated for them.
 pub fn check_counts(vertices: u32, indices: u32) -> Result<(), String> {
     let (v, i) = (vertices as usize, indices as usize);
     if v > MAX_MESH_ELEMENTS || i > MAX_MESH_ELEMENTS {
-        return Err(format!("the mesh has {v} vertices and {i} indices (vrao takes at most {MAX_MESH_ELEMENTS} of each)"));
+        return Err(format!(
+            "the mesh has {v} vertices and {i} indices (vrao takes at most {MAX_MESH_ELEMENTS} of each)"
+        ));
     }
     Ok(())
 }
@@ -72,9 +103,10 @@ pub fn view_mask(
 enum Origin {
     /// Read from the runtime (XR_KHR_visibility_mask), view by view.
     Runtime,
-    /// The runtime has no XR_KHR_visibility_mask: Monado's default from the fields of
-    /// view of the frames (`None` before the first frame).
-    FieldOfView(Option<[Fov; VIEWS]>),
+    /// Not from the runtime (`why`: it has no XR_KHR_visibility_mask, or vrao does not
+    /// call it): Monado's default from the fields of view of the frames (`None` before
+    /// the first frame).
+    FieldOfView { why: String, built_for: Option<[Fov; VIEWS]> },
 }
 
 /// The session's visibility mask: one [`ViewMask`] per view, and the [`VisibilityMask`]
@@ -111,10 +143,13 @@ impl SessionMask {
         (mask, problem)
     }
 
-    /// A runtime without XR_KHR_visibility_mask: Monado's default mask from each view's
-    /// field of view, built at the first frame ([`SessionMask::follow_fov`]).
-    pub fn from_field_of_view() -> SessionMask {
-        SessionMask { origin: Origin::FieldOfView(None), views: [None, None], mask: None, changes: 0 }
+    /// Not from the runtime (`why`, for the mask's source: the runtime has no
+    /// XR_KHR_visibility_mask, or [`skip_runtime_mask`]'s reason): Monado's default mask
+    /// from each view's field of view, built at the first frame
+    /// ([`SessionMask::follow_fov`]).
+    pub fn from_field_of_view(why: &str) -> SessionMask {
+        let origin = Origin::FieldOfView { why: why.to_string(), built_for: None };
+        SessionMask { origin, views: [None, None], mask: None, changes: 0 }
     }
 
     /// Whether the mask is read from the runtime (XR_KHR_visibility_mask).
@@ -127,7 +162,7 @@ impl SessionMask {
     /// (by more than 1e-5 rad). Returns whether the mask changed. A mask read from the
     /// runtime does not follow the field of view (it is the runtime's own).
     pub fn follow_fov(&mut self, fovs: [Fov; VIEWS]) -> bool {
-        let Origin::FieldOfView(built_for) = &self.origin else { return false };
+        let Origin::FieldOfView { why, built_for } = &mut self.origin else { return false };
         let same = |a: &Fov, b: &Fov| {
             [(a.left, b.left), (a.right, b.right), (a.up, b.up), (a.down, b.down)]
                 .iter()
@@ -136,15 +171,12 @@ impl SessionMask {
         if built_for.is_some_and(|built| built.iter().zip(&fovs).all(|(a, b)| same(a, b))) {
             return false;
         }
+        *built_for = Some(fovs);
         self.views = fovs.map(|fov| {
             let mut view = ViewMask::corner_cut(fov.tangents());
-            view.source = format!(
-                "{} (the OpenXR runtime offers no XR_KHR_visibility_mask; built from the field of view it reports)",
-                view.source
-            );
+            view.source = format!("{} of the views the OpenXR runtime locates ({why})", view.source);
             Some(view)
         });
-        self.origin = Origin::FieldOfView(Some(fovs));
         self.compose();
         true
     }
@@ -160,7 +192,9 @@ impl SessionMask {
             return format!("visibility mask of view {view_index} of another view configuration changed: ignored");
         }
         if self.origin != Origin::Runtime {
-            return format!("visibility mask of view {view_index} changed, but XR_KHR_visibility_mask is not enabled: ignored");
+            return format!(
+                "visibility mask of view {view_index} changed, but vrao does not read the runtime's: ignored"
+            );
         }
         let Some(slot) = self.views.get_mut(view_index as usize) else {
             return format!("visibility mask of view {view_index} changed: PRIMARY_STEREO has {VIEWS} views, ignored");
@@ -173,7 +207,9 @@ impl SessionMask {
             }
             Err(why) => {
                 *slot = None;
-                format!("visibility mask of view {view_index} changed but could not be read ({why}): no mask from now on")
+                format!(
+                    "visibility mask of view {view_index} changed but could not be read ({why}): no mask from now on"
+                )
             }
         };
         self.compose();
@@ -303,27 +339,50 @@ mod tests {
 
     #[test]
     fn without_the_extension_the_mask_is_monados_default_following_the_field_of_view() {
-        let mut mask = SessionMask::from_field_of_view();
+        let mut mask = SessionMask::from_field_of_view("the OpenXR runtime offers no XR_KHR_visibility_mask");
         assert_eq!(mask.mask(), None, "nothing before the first frame's fields of view");
         assert!(mask.follow_fov([FOV45, FOV45]));
         let view = &mask.mask().unwrap().views[0];
         assert!(view.source.contains("offers no XR_KHR_visibility_mask"), "{}", view.source);
         // The same mask Monado's runtime gives for the same field of view.
-        assert_eq!(view.coverage(64, 64, SQUARE), read(monado_hidden()).unwrap().coverage(64, 64, SQUARE));
+        // (Pixel centres on the diagonals may fall either way: tan 45° is not exactly 1 in f32.)
+        let (ours, monados) = (view.coverage(64, 64, SQUARE), read(monado_hidden()).unwrap().coverage(64, 64, SQUARE));
+        let differing = ours.iter().zip(&monados).filter(|(a, b)| a != b).count();
+        assert!(differing <= 16, "{differing} of 4096 pixels differ");
         assert!(!mask.follow_fov([FOV45, FOV45]), "the same fields of view: unchanged");
         let wider = Fov { left: -0.9, ..FOV45 };
         assert!(mask.follow_fov([wider, FOV45]));
         assert!((mask.mask().unwrap().views[0].hidden_share(100, 100, wider.tangents()) - 0.03125).abs() < 0.003);
         // Change events do not apply to a mask the runtime did not give.
-        assert!(mask.changed(true, 0, || unreachable!()).contains("not enabled"));
+        assert!(mask.changed(true, 0, || unreachable!()).contains("does not read"));
         // A mask read from the runtime does not follow the field of view.
         let (mut runtime, _) = SessionMask::from_runtime([read(monado_hidden()), read(monado_hidden())]);
         assert!(!runtime.follow_fov([wider, wider]));
     }
 
     #[test]
+    fn monado_24_is_not_asked_unless_the_variable_says_so() {
+        let monado = "Monado(XRT) by Collabora et al 'v24.0.0-2403-g59c34e17b'";
+        let why = skip_runtime_mask(monado, 24, None).unwrap();
+        assert!(why.contains("Monado 24") && why.contains(MASK_VAR), "{why}");
+        assert_eq!(skip_runtime_mask(monado, 24, Some("runtime")), None);
+        assert_eq!(skip_runtime_mask(monado, 25, None), None, "a later Monado is asked");
+        assert_eq!(skip_runtime_mask("SteamVR/OpenXR", 2, None), None);
+        assert_eq!(
+            skip_runtime_mask("SteamVR/OpenXR", 2, Some("fov")).as_deref(),
+            Some("VRAO_OPENXR_VISIBILITY_MASK=fov")
+        );
+        assert_eq!(skip_runtime_mask("SteamVR/OpenXR", 2, Some("sometimes")), None, "an unknown value is unset");
+        // The reason ends up in the mask's source.
+        let mut mask = SessionMask::from_field_of_view(&why);
+        mask.follow_fov([FOV45, FOV45]);
+        assert!(mask.mask().unwrap().views[1].source.contains("not read from Monado 24"));
+        assert!(!mask.from_the_runtime());
+    }
+
+    #[test]
     fn masks_hiding_nothing_are_no_mask() {
-        let nothing = || ViewMask::from_hidden_mesh(&[], &[], RUNTIME_SOURCE);
+        let nothing = || ViewMask::from_hidden_mesh(&[], &[], RUNTIME_SOURCE).map_err(|e| e.to_string());
         let (mask, problem) = SessionMask::from_runtime([nothing(), nothing()]);
         assert_eq!((mask.mask(), problem), (None, None));
     }

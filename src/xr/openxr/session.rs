@@ -181,7 +181,7 @@ impl OpenXrHeadset {
             loss_reason: self.machine.loss_reason().map(str::to_string),
             ending: self.machine.ending().map(str::to_string),
             fell_back: self.fallback.is_some(),
-            visibility_mask_extension: self.mask.from_the_runtime(),
+            visibility_mask_from_runtime: self.mask.from_the_runtime(),
             visibility_mask_changes: self.mask.changes(),
         }
     }

@@ -353,17 +353,28 @@ fn layered_target(
     })
 }
 
-/// Copies layer `layer` of an `Rgba16Float` texture back and returns its alpha channel
-/// (the engine's AO), row by row.
+/// One layer of the engine's output, read back: the visibility (alpha of `Rgba16Float`,
+/// red of the single-channel outputs), one value a pixel.
 pub fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
-    let size = texture.size();
-    // The visibility: alpha of Rgba16Float, red of the single-channel outputs.
     let (texel, value): (u32, fn(&[u8]) -> f32) = match texture.format() {
         wgpu::TextureFormat::Rgba16Float => (8, |t| half::f16::from_bits(u16::from_le_bytes([t[6], t[7]])).to_f32()),
         wgpu::TextureFormat::R16Float => (2, |t| half::f16::from_bits(u16::from_le_bytes([t[0], t[1]])).to_f32()),
         wgpu::TextureFormat::R8Unorm => (1, |t| f32::from(t[0]) / 255.0),
         other => panic!("the engine does not write {other:?}"),
     };
+    read_layer(device, queue, texture, layer, texel).chunks(texel as usize).map(value).collect()
+}
+
+/// One layer of an `Rgba16Float` output, read back: r, g, b, a per pixel.
+pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
+    assert_eq!(texture.format(), wgpu::TextureFormat::Rgba16Float, "the light is in the Rgba16Float output");
+    let half = |t: &[u8]| half::f16::from_bits(u16::from_le_bytes([t[0], t[1]])).to_f32();
+    read_layer(device, queue, texture, layer, 8).chunks(2).map(half).collect()
+}
+
+/// One layer's texels (`texel` bytes each), rows packed.
+fn read_layer(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32, texel: u32) -> Vec<u8> {
+    let size = texture.size();
     let row = (size.width * texel).div_ceil(256) * 256;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
@@ -390,11 +401,10 @@ pub fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Te
     slice.map_async(wgpu::MapMode::Read, |_| {});
     device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).expect("readback");
     let data = slice.get_mapped_range().expect("the readback buffer is mapped");
-    let mut alpha = Vec::with_capacity((size.width * size.height) as usize);
+    let mut bytes = Vec::with_capacity((size.width * size.height * texel) as usize);
     for y in 0..size.height {
         let start = (y * row) as usize;
-        let texels = &data[start..start + (size.width * texel) as usize];
-        alpha.extend(texels.chunks(texel as usize).map(value));
+        bytes.extend_from_slice(&data[start..start + (size.width * texel) as usize]);
     }
-    alpha
+    bytes
 }

@@ -2,6 +2,9 @@
 //! draws its own geometry with its own depth prepass (depth and view-space normals, both
 //! eyes in a 2-layer array), then asks vrao's [`AoEngine`] for the ambient occlusion of
 //! both eyes and writes it as `OUT/embed_ao_left.png` and `OUT/embed_ao_right.png`.
+//! Then it hands the engine its light as well (a sky as nine SH coefficients and a
+//! direct-light texture) and asks for SSDO with one bounce: the ambient light of both
+//! eyes, beside the AO, as `OUT/embed_ambient_left.png` and `OUT/embed_ambient_right.png`.
 //!
 //! ```text
 //! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--time] [--time-setup]
@@ -22,9 +25,9 @@ mod host;
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
 use vrao_ao::ao::AoOutputFormat;
 use vrao_ao::ao::{
-    AoConfig, AoEngine, AoFrame, DepthConvention, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
+    AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
 };
-use vrao_ao::settings::AoSettings;
+use vrao_ao::settings::{AoSettings, Technique};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 360;
@@ -199,6 +202,7 @@ fn run(args: &Args) -> Result<(), Failure> {
         views: &views,
         // The example's geometry stands still.
         motion: None,
+        light: None,
     };
     let ao = engine.record(&mut encoder, &frame)?.texture.clone();
     queue.submit([encoder.finish()]);
@@ -226,6 +230,73 @@ fn run(args: &Args) -> Result<(), Failure> {
         save_grey(&path, WIDTH, HEIGHT, pixels)?;
         eprintln!("{name} eye: mean AO {mean:.3} -> {}", path.display());
     }
+    ambient(&device, &queue, &mut engine, &frame, out)
+}
+
+/// SSDO with one bounce from the host's light: a sky (nine SH coefficients of its
+/// irradiance in the host's world, +Y up: 1.2 from the zenith, 0.4 from below, bluish) and
+/// the direct light leaving every surface (here a stand-in the host would compute from its
+/// lights: an even warm 0.3). Writes each eye's ambient irradiance (the output's rgb,
+/// what a lighting pass multiplies by albedo/π) and fails unless it is finite, within the
+/// unoccluded sky's and not all unoccluded.
+fn ambient(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    engine: &mut AoEngine,
+    frame: &AoFrame,
+    out: &std::path::Path,
+) -> Result<(), Failure> {
+    let direct = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host direct light"),
+        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let texel: [f32; 4] = [0.3, 0.27, 0.22, 1.0];
+    let bytes: Vec<u8> = (0..WIDTH * HEIGHT * 2).flat_map(|_| texel).flat_map(f32::to_le_bytes).collect();
+    queue.write_texture(
+        direct.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(WIDTH * 16), rows_per_image: Some(HEIGHT) },
+        direct.size(),
+    );
+    // E(n) = a + b n.y for a sky of 1.2 above and 0.4 below (per channel, bluish):
+    // c0 = a / Y0, c1 = b / Y1 (Y0 = 0.282095, Y1 = 0.488603 y).
+    let (above, below) = ([1.0f32, 1.1, 1.3], [0.3f32, 0.35, 0.4]);
+    let mut sh = [[0.0f32; 3]; 9];
+    for c in 0..3 {
+        sh[0][c] = 0.5 * (above[c] + below[c]) / 0.282_095;
+        sh[1][c] = 0.5 * (above[c] - below[c]) / 0.488_603;
+    }
+    let settings = AoSettings { technique: Technique::SsdoBounce, ..AoSettings::default() };
+    engine.set_settings(&settings)?;
+    let lit = AoFrame { light: Some(HostLight { direct: Some(&direct), environment_sh: Some(sh) }), ..*frame };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let output = engine.record(&mut encoder, &lit)?.texture.clone();
+    queue.submit([encoder.finish()]);
+    for (layer, name) in ["left", "right"].iter().enumerate() {
+        let rgba = host::read_rgba(device, queue, &output, layer as u32);
+        if let Some(bad) = rgba.iter().find(|v| !v.is_finite() || **v < 0.0 || **v > 10.0) {
+            return Err(format!("{name} eye: ambient value {bad} is not finite or out of range").into());
+        }
+        let green: Vec<f32> = rgba.chunks(4).map(|t| t[1]).collect();
+        let mean = green.iter().sum::<f32>() / green.len() as f32;
+        if !(mean > 0.05 && mean < above[1] + 0.3) {
+            return Err(format!("{name} eye: mean ambient (green) {mean:.3} is not a lit, occluded sky").into());
+        }
+        let pixels: Vec<u8> = rgba
+            .chunks(4)
+            .flat_map(|t| [t[0], t[1], t[2]].map(|c| ((c / 1.6).clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8))
+            .collect();
+        let path = out.join(format!("embed_ambient_{name}.png"));
+        image::save_buffer(&path, &pixels, WIDTH, HEIGHT, image::ExtendedColorType::Rgb8)
+            .map_err(|e| Failure::Output { path: path.clone(), message: e.to_string() })?;
+        eprintln!("{name} eye: ssdo-bounce mean ambient (green) {mean:.3} -> {}", path.display());
+    }
     Ok(())
 }
 
@@ -243,7 +314,7 @@ fn time_setup(
     let frame = |engine: &mut AoEngine, depth: &wgpu::Texture| -> Result<f64, Box<dyn std::error::Error>> {
         let started = std::time::Instant::now();
         let mut encoder = device.create_command_encoder(&Default::default());
-        let frame = AoFrame { depth, depth_convention: convention, normals: None, views, motion: None };
+        let frame = AoFrame { depth, depth_convention: convention, normals: None, views, motion: None, light: None };
         engine.record(&mut encoder, &frame)?;
         queue.submit([encoder.finish()]);
         device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None })?;
@@ -321,6 +392,7 @@ fn time_frames(
                     normals: (kind != 2).then_some(normals),
                     views: &views,
                     motion: None,
+                    light: None,
                 };
                 engine.record(&mut encoder, &frame)?;
             }

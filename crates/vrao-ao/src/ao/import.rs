@@ -132,7 +132,7 @@ impl ImportSource {
 }
 
 /// Refuses a texture of another size, too few layers, multisampled or not bindable.
-fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Result<()> {
+pub(crate) fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Result<()> {
     let size = texture.size();
     if (size.width, size.height) != (config.width, config.height) {
         return Err(Error::input(format!(

@@ -10,8 +10,11 @@
 //! reversed-Z infinite-far `Depth32Float`, and its normals, or normals rebuilt from the
 //! depth, into view space), the chosen technique, temporal accumulation, the denoise and
 //! the upsampling from half resolution, each left out when the settings do not need it.
-//! SSDO is not offered: it gathers light from the renderer's direct-light buffer and
-//! environment, which a host's renderer does not have in vrao's form.
+//! SSDO (`ssdo`, `ssdo-bounce`) gathers the host's light beside the AO when the frame
+//! gives it ([`AoFrame::light`]: the direct light per view, the environment's SH): the
+//! output's rgb is then the ambient irradiance (environment through the unoccluded
+//! directions plus one bounce) to multiply by albedo/π; without it SSDO is an AO
+//! technique. The point-sampled SSDO (`ssdo-points`) needs vrao's renderer.
 //!
 //! Conventions (what [`AoFrame`] must hold): right-handed view space (x right, y up,
 //! looking down −z, as glam's `camera::rh::view::look_at_mat4`); perspective projections with clip w = −z
@@ -19,8 +22,10 @@
 //! frame's [`DepthConvention`] says; one depth layer per view.
 
 pub mod import;
+pub mod light;
 mod pack;
 
+pub use light::HostLight;
 pub use pack::AoOutputFormat;
 
 use crate::driver::{FrameParams, GraphDriver, Submission};
@@ -122,6 +127,9 @@ pub struct AoFrame<'a> {
     /// The host's motion vectors, or `None`: temporal accumulation then reprojects by the
     /// views' motion alone (right for a still scene).
     pub motion: Option<HostMotion<'a>>,
+    /// The host's light for SSDO (its direct light and environment), or `None`: SSDO then
+    /// returns AO alone; the other techniques never read it.
+    pub light: Option<HostLight<'a>>,
 }
 
 /// What the engine is made for: the AO settings, the size of each view and their number.
@@ -154,7 +162,10 @@ pub struct AoEngine {
     config: AoConfig,
     import: ImportPass,
     chain: Vec<Box<dyn Pass>>,
-    driver: GraphDriver<(ChainSettings, bool)>,
+    /// Plans by settings, whether the host gave motion and whether it gave direct light.
+    driver: GraphDriver<(ChainSettings, bool, bool)>,
+    /// Packs the host's direct light for SSDO's bounce.
+    light_import: light::LightImportPass,
     /// The copy into a single-channel output, and the format chosen.
     pack: PackPass,
     output_format: AoOutputFormat,
@@ -178,6 +189,7 @@ impl AoEngine {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let chain = passes::ao_chain(&gpu, Vec::new());
         let import = ImportPass::new(&gpu);
+        let light_import = light::LightImportPass::new(&gpu);
         let pack = PackPass::new(&gpu);
         let driver = GraphDriver::new(&gpu, 0, PassTimer::disabled(&gpu)?);
         if let Some(error) = pollster::block_on(scope.pop()) {
@@ -188,6 +200,7 @@ impl AoEngine {
             gpu,
             config: config.clone(),
             import,
+            light_import,
             chain,
             driver,
             pack,
@@ -312,23 +325,52 @@ impl AoEngine {
             None => FrameMotion::STILL,
         };
         self.import.set_source(source);
+        // SSDO's light: the host's direct light (imported, then packed with the depth by
+        // the light import pass) and its environment's quadratics in each view.
+        let direct = frame.light.and_then(|l| l.direct);
+        if let Some(texture) = direct {
+            import::check_texture("direct light", texture, config)?;
+            if texture.format().sample_type(None, None) != Some(wgpu::TextureSampleType::Float { filterable: true })
+                && texture.format().sample_type(None, None) != Some(wgpu::TextureSampleType::Float { filterable: false })
+            {
+                return Err(Error::input(format!(
+                    "direct light: format {:?} is not float-sampled",
+                    texture.format()
+                )));
+            }
+            targets.import(&self.gpu, light::HOST_DIRECT, texture, wgpu::TextureAspect::All, layers);
+        }
+        let environment = frame.light.and_then(|l| l.environment_sh).map(|sh| {
+            let coefficients = sh.map(glam::Vec3::from_array);
+            let rotations: Vec<glam::Mat3> =
+                eyes.iter().map(|eye| glam::Mat3::from_quat(eye.pose.orientation.as_quat())).collect();
+            crate::sh::view_quadratics(&coefficients, &rotations)
+        });
+        if environment.is_some_and(|q| !q.iter().flatten().flatten().all(|v| v.is_finite())) {
+            return Err(Error::input("environment SH: a coefficient is not finite"));
+        }
+        let lighting = FrameLighting { environment: environment.as_ref(), ..FrameLighting::NONE };
+        let light_inputs = crate::passes::ssdo::LightInputs { direct: direct.is_some() };
         let params = FrameParams {
             settings: &settings,
-            extensions: &[],
+            extensions: &[&light_inputs],
             alpha_cards: false,
             anchor: glam::DVec3::ZERO,
             multiview: false,
             motion: &self.motion,
             mask: self.mask.as_ref(),
         };
-        let passes: Vec<&dyn Pass> =
-            std::iter::once(&self.import as &dyn Pass).chain(self.chain.iter().map(|p| p.as_ref())).collect();
+        let passes: Vec<&dyn Pass> = [&self.import as &dyn Pass, &self.light_import as &dyn Pass]
+            .into_iter()
+            .chain(self.chain.iter().map(|p| p.as_ref()))
+            .collect();
         let mut imported = vec![HOST_DEPTH];
         imported.extend(frame.normals.is_some().then_some(HOST_NORMALS));
         imported.extend(frame.motion.is_some().then_some(HOST_MOTION));
-        let key = (settings.clone(), frame.motion.is_some());
+        imported.extend(direct.is_some().then_some(light::HOST_DIRECT));
+        let key = (settings.clone(), frame.motion.is_some(), direct.is_some());
         let plan = self.driver.plan(&key, &passes, &params, layers, &[FINAL_AO], &imported)?;
-        self.driver.prepare(&self.gpu, &plan, &params, &FrameLighting::NONE, &eyes);
+        self.driver.prepare(&self.gpu, &plan, &params, &lighting, &eyes);
         // Kernels compile at their first frame: a device that cannot build one is refused
         // here, as a typed error, not through the host's uncaptured-error handler.
         let scope = self.gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -362,16 +404,17 @@ impl AoEngine {
 pub const MAX_SIDE: u32 = 8192;
 
 /// The renderer settings the engine's passes read: the host's AO settings, its size as
-/// the profile's, and its near plane. SSDO is refused (see the module's notes).
+/// the profile's, and its near plane. The point-sampled SSDO is refused (see the
+/// module's notes).
 fn host_settings(config: &AoConfig, near: f64) -> Result<ChainSettings> {
     if config.views == 0 || config.views > 2 {
         return Err(Error::input(format!("the AO engine renders 1 or 2 views, not {}", config.views)));
     }
-    if config.settings.technique.carries_light() {
+    if config.settings.technique.renderer_only() {
         return Err(Error::input(format!(
-            "technique {} gathers light from vrao's own direct-light buffer: the AO engine offers {}",
+            "technique {} samples vrao's renderer's own buffers: the AO engine offers {}",
             config.settings.technique.name(),
-            Technique::ALL.iter().filter(|t| !t.carries_light()).map(|t| t.name()).collect::<Vec<_>>().join(", ")
+            Technique::ALL.iter().filter(|t| !t.renderer_only()).map(|t| t.name()).collect::<Vec<_>>().join(", ")
         )));
     }
     if !(1..=MAX_SIDE).contains(&config.width) || !(1..=MAX_SIDE).contains(&config.height) {

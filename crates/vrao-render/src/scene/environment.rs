@@ -10,7 +10,7 @@
 //! usual HDRIs (Poly Haven, three.js examples) appear the right way round.
 
 use crate::error::{Error, Result};
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 use std::f32::consts::{PI, TAU};
 use std::path::Path;
 
@@ -143,10 +143,7 @@ impl Environment {
     /// noticeable share of its time, docs/measurements-in-code.md, sh-band-2; the window
     /// gave band 2 only a quarter weight anyway). Evaluate with [`sh9_basis`] and clamp at 0.
     pub fn radiance_sh_prefiltered(&self) -> [Vec3; 9] {
-        const WINDOW_OVER_KERNEL: [f32; 9] =
-            [1.0 / PI, 0.75 * 3.0 / TAU, 0.75 * 3.0 / TAU, 0.75 * 3.0 / TAU, 0.0, 0.0, 0.0, 0.0, 0.0];
-        let e = self.irradiance_sh_scaled();
-        std::array::from_fn(|k| e[k] * WINDOW_OVER_KERNEL[k])
+        vrao_ao::sh::prefiltered_radiance(&self.irradiance_sh_scaled())
     }
 
     /// The pre-filtered radiance of [`Environment::radiance_sh_prefiltered`] in the
@@ -220,63 +217,12 @@ pub fn sh9_basis(d: Vec3) -> [f32; 9] {
     ]
 }
 
-/// Nine SH coefficients as the quadratic polynomial in the unit direction ω = (x, y, z)
-/// that they are: f(ω) = a + b·ω + qxx x² + qyy y² + qzz z² + qxy xy + qxz xz + qyz yz,
-/// returned as [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz] (rgb each).
-pub fn sh9_quadratic(c: &[Vec3; 9]) -> [Vec3; 10] {
-    [
-        c[0] * 0.282_095 - c[6] * 0.315_392,
-        c[3] * 0.488_603,
-        c[1] * 0.488_603,
-        c[2] * 0.488_603,
-        c[8] * 0.546_274,
-        c[8] * -0.546_274,
-        c[6] * (3.0 * 0.315_392),
-        c[4] * 1.092_548,
-        c[7] * 1.092_548,
-        c[5] * 1.092_548,
-    ]
-}
-
-/// A quadratic of [`sh9_quadratic`]'s form in the world direction, re-expressed in the
-/// direction v of a view whose world direction is `world_from_view` · v:
-/// f(R v) = a + (Rᵀb)·v + vᵀ(RᵀQR)v. Done once per eye, so the shaders evaluate
-/// environment light in view space without turning each pixel's vectors into the world.
-pub fn quadratic_in_view(q: &[Vec3; 10], world_from_view: Mat3) -> [Vec3; 10] {
-    let mut out = [Vec3::ZERO; 10];
-    out[0] = q[0];
-    for channel in 0..3 {
-        let c = |k: usize| q[k][channel];
-        let linear = world_from_view.transpose() * Vec3::new(c(1), c(2), c(3));
-        // The symmetric matrix of the quadratic part: a cross term's coefficient is
-        // shared by its two off-diagonal entries.
-        let symmetric = Mat3::from_cols(
-            Vec3::new(c(4), 0.5 * c(7), 0.5 * c(8)),
-            Vec3::new(0.5 * c(7), c(5), 0.5 * c(9)),
-            Vec3::new(0.5 * c(8), 0.5 * c(9), c(6)),
-        );
-        let turned = world_from_view.transpose() * symmetric * world_from_view;
-        let coefficients = [
-            linear.x,
-            linear.y,
-            linear.z,
-            turned.x_axis.x,
-            turned.y_axis.y,
-            turned.z_axis.z,
-            2.0 * turned.y_axis.x,
-            2.0 * turned.z_axis.x,
-            2.0 * turned.z_axis.y,
-        ];
-        for (k, value) in coefficients.into_iter().enumerate() {
-            out[k + 1][channel] = value;
-        }
-    }
-    out
-}
+pub use vrao_ao::sh::{quadratic_in_view, sh9_quadratic};
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Mat3;
 
     fn uniform(width: u32, height: u32, radiance: f32) -> Environment {
         let texels = vec![[radiance; 3]; (width * height) as usize];

@@ -5,21 +5,32 @@
 
 use super::*;
 use crate::render::visibility::ViewMask;
-use crate::xr::openxr::mask::{check_counts, view_mask, MaskMesh, SessionMask, VIEWS};
+use crate::xr::openxr::mask::{check_counts, skip_runtime_mask, view_mask, MaskMesh, SessionMask, MASK_VAR, VIEWS};
 
 /// How often the two-call idiom is tried again when the mask grows between its calls.
 const READ_TRIES: usize = 3;
 
 /// The session's mask at its start: read from the runtime for every view when the
 /// extension is enabled (a view without one is logged and leaves the session without a
-/// mask), else Monado's default from the fields of view of the frames.
+/// mask), else, or where vrao does not call it (`skip_runtime_mask`), Monado's default
+/// from the fields of view of the frames.
 pub(super) fn initial(session: &xr::Session<xr::Vulkan>, enabled: bool) -> SessionMask {
-    if !enabled {
-        log::info!(
-            "OpenXR: the runtime offers no XR_KHR_visibility_mask: the mask is Monado's default from each view's \
-             field of view (the corners cut off)"
-        );
-        return SessionMask::from_field_of_view();
+    let choice = std::env::var(MASK_VAR).ok();
+    if let Some(value) = choice.as_deref().filter(|v| !matches!(v.trim(), "runtime" | "fov" | "")) {
+        log::warn!("OpenXR: {MASK_VAR}={value} is neither `runtime` nor `fov`: not used");
+    }
+    let skipped = match session.instance().properties() {
+        Ok(props) => skip_runtime_mask(&props.runtime_name, props.runtime_version.major(), choice.as_deref()),
+        Err(_) => None,
+    };
+    let why = match (enabled, skipped) {
+        (false, _) => "the OpenXR runtime offers no XR_KHR_visibility_mask".to_string(),
+        (true, Some(why)) => why,
+        (true, None) => String::new(),
+    };
+    if !why.is_empty() {
+        log::info!("OpenXR: visibility mask: Monado's default from each view's field of view ({why})");
+        return SessionMask::from_field_of_view(&why);
     }
     let reads: [std::result::Result<ViewMask, String>; VIEWS] = std::array::from_fn(|i| read_view(session, i as u32));
     let (mask, problem) = SessionMask::from_runtime(reads);

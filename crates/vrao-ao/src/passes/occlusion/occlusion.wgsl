@@ -277,10 +277,10 @@ fn bayer4(p: vec2<u32>) -> f32 {
 }
 
 // Fixed foveation (settings::Foveation): the share of its full sample count occlusion
-// pixel `p` spends, read from the visibility map (visibility.wgsl), which holds the rate
-// of each tile's centre, from the tangent of its angle off the eye's view axis (1 within
-// the map's full-rate angle, falling linearly in the tangent to its edge rate). Off, the
-// rate is 1 everywhere the lens shows.
+// pixel `p` spends, read from the visibility map (visibility.wgsl): per tile the rate of
+// its point nearest the eye's view axis, from the tangent of that angle (1 within the
+// full-rate angle, falling linearly in the tangent to the edge rate). Off, the rate is 1
+// everywhere the lens shows.
 fn foveation_rate(p: vec2<u32>, layer: u32) -> f32 {
     return tile_rate(p, layer, ao.scale);
 }

@@ -190,7 +190,9 @@ fn upsample_quad(
     pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 1), layer, tangents), vec2<i32>(1, 1), every);
     // Which pixels take the 3×3, decided before any of it is added.
     let edge = vec4<f32>(pixels[0].agree, pixels[1].agree, pixels[2].agree, pixels[3].agree) < vec4<f32>(EDGE_AGREEMENT);
-    if (any(edge)) {
+    // Foveated towards the edge (visibility.wgsl) a depth edge keeps the 2×2 samples: the
+    // five more fetches are spent where the eye looks.
+    if (any(edge) && tile_rate(vec2<u32>(b), layer, 2u) > THIN_BELOW_RATE) {
         for (var i = 0; i < 5; i++) {
             // (-1,-1) (0,-1) (1,-1) (-1,0) (-1,1): the rest of the 3×3.
             let offset = select(vec2<i32>(-1, i - 2), vec2<i32>(i - 1, -1), i < 3);
