@@ -54,6 +54,8 @@ pub(super) struct PanelInfo<'a> {
     /// What an OpenXR session said so far (`None` for the simulated headset, and after a
     /// lost session, whose simulated counters then apply).
     pub(super) openxr: Option<crate::xr::openxr::OpenXrReport>,
+    /// The share of each eye the visibility mask hid in the last frame (empty: none).
+    pub(super) hidden_share: &'a [f64],
 }
 
 /// Colour of pass `i` in the profiler graph.
@@ -84,6 +86,7 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
         display_ui(ui, panel);
         ui.separator();
         frame_rates_ui(ui, panel.rates, info, counters);
+        mask_ui(ui, info.hidden_share);
         ui.separator();
         governor_ui(ui, info.governor);
         ui.separator();
@@ -139,6 +142,17 @@ fn ao_parameters_ui(ui: &mut egui::Ui, ao: &mut AoSettings, quality: &mut Option
             ui.selectable_value(&mut ao.foveation, level, level.name());
         }
     });
+    ui.checkbox(&mut ao.mask, "skip what the lens hides (mask)");
+}
+
+/// What the visibility mask hides of each eye.
+fn mask_ui(ui: &mut egui::Ui, hidden_share: &[f64]) {
+    if hidden_share.iter().any(|&s| s > 0.0) {
+        let shares: Vec<String> = hidden_share.iter().map(|s| format!("{:.1} %", s * 100.0)).collect();
+        ui.label(format!("lens mask hides {} (left, right)", shares.join(", ")));
+    } else {
+        ui.label("lens mask: none applied");
+    }
 }
 
 /// The SSDO settings: bounce strength and form, and depth peeling (disabled for the

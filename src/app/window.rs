@@ -318,6 +318,7 @@ impl WindowState {
             budget_ms: frame_loop.budget_ms,
             governor: frame_loop.governor.as_ref(),
             openxr: frame_loop.headset.openxr_report().filter(|r| !r.fell_back),
+            hidden_share: frame_loop.renderer.hidden_share(),
         };
         let full_output = self.egui_ctx.run_ui(raw_input, |ui| {
             changed = panel_ui(ui, panel, &info, &counters);
