@@ -9,7 +9,8 @@ mod host;
 use glam::DVec3;
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
 use vrao::ao::{
-    AoConfig, AoEngine, AoFrame, DepthConvention, HostMotion, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
+    AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostMotion, HostNormals, NormalEncoding, NormalSpace,
+    ViewMatrices,
 };
 use vrao::render::graph::FINAL_AO;
 use vrao::render::scene::Mesh;
@@ -205,14 +206,14 @@ fn a_mono_view_from_a_single_layer_depth_buffer_matches_the_renderer() {
 fn bad_host_input_is_a_typed_error_naming_it() {
     let (gpu, _lock) = common::gpu();
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let ssdo = AoConfig {
-        settings: AoSettings { technique: Technique::Ssdo, ..AoSettings::default() },
+    let points = AoConfig {
+        settings: AoSettings { technique: Technique::SsdoPoints, ..AoSettings::default() },
         width: WIDTH,
         height: HEIGHT,
         views: 2,
     };
-    let e = AoEngine::new(device, queue, &ssdo).err().expect("SSDO is the renderer's");
-    assert!(matches!(e, Error::Input { .. }) && e.to_string().contains("ssdo"), "{e}");
+    let e = AoEngine::new(device, queue, &points).err().expect("the point-sampled SSDO is the renderer's");
+    assert!(matches!(e, Error::Input { .. }) && e.to_string().contains("ssdo-points"), "{e}");
 
     let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
     let mut engine = AoEngine::new(device, queue, &config).unwrap();
@@ -452,4 +453,83 @@ fn the_single_channel_outputs_hold_the_visibility_the_default_output_holds() {
     assert_eq!(AoOutputFormat::R8Unorm.bytes_per_pixel(), 1);
     assert_eq!(AoOutputFormat::R16Float.bytes_per_pixel(), 2);
     assert_eq!(AoOutputFormat::Rgba16Float.bytes_per_pixel(), 8);
+}
+
+/// SSDO in the engine: without the host's light it is GTAO's AO with no light; with a
+/// constant sky (nine SH coefficients) its light is the sky's irradiance π L times that
+/// AO, pixel by pixel; with the host's direct light as well the bounce only adds.
+#[test]
+fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let depth = HostDepth::ReversedInfinite;
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
+    let views = host_views(&eyes(), depth);
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let direct = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host direct light"),
+        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let bytes: Vec<u8> =
+        (0..WIDTH * HEIGHT * 2).flat_map(|_| [0.5f32, 0.1, 0.1, 1.0]).flat_map(f32::to_le_bytes).collect();
+    queue.write_texture(
+        direct.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(WIDTH * 16), rows_per_image: Some(HEIGHT) },
+        direct.size(),
+    );
+    // A constant sky of radiance L: E(n) = π L, c0 = π L / Y0.
+    let l = [0.4f32, 0.5, 0.6];
+    let mut sh = [[0.0f32; 3]; 9];
+    sh[0] = l.map(|c| std::f32::consts::PI * c / 0.282_095);
+    let run = |technique: Technique, light: Option<HostLight>| {
+        let settings = AoSettings { technique, ..AoSettings::default() };
+        let config = AoConfig { settings, width: WIDTH, height: HEIGHT, views: 2 };
+        let mut engine = AoEngine::new(device, queue, &config).unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        prepass.record(device, &mut encoder, &views);
+        let frame = AoFrame {
+            depth: &prepass.depth,
+            depth_convention: DepthConvention::REVERSED_INFINITE,
+            normals: Some(normals),
+            views: &views,
+            motion: None,
+            light,
+        };
+        let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+        queue.submit([encoder.finish()]);
+        (0..2).flat_map(|layer| host::read_rgba(device, queue, &texture, layer)).collect::<Vec<f32>>()
+    };
+    let gtao = run(Technique::Gtao, None);
+    let dark = run(Technique::Ssdo, None);
+    let sky = Some(HostLight { direct: None, environment_sh: Some(sh) });
+    let lit = run(Technique::Ssdo, sky);
+    let bounced = run(Technique::SsdoBounce, Some(HostLight { direct: Some(&direct), environment_sh: Some(sh) }));
+    let texels = |v: &[f32]| v.chunks(4).map(|t| [t[0], t[1], t[2], t[3]]).collect::<Vec<_>>();
+    let (gtao, dark, lit, bounced) = (texels(&gtao), texels(&dark), texels(&lit), texels(&bounced));
+    let worst_ao = gtao.iter().zip(&dark).map(|(g, s)| (g[3] - s[3]).abs()).fold(0f32, f32::max);
+    assert!(worst_ao <= 1e-3, "ssdo's AO differs from gtao's by {worst_ao}");
+    assert!(dark.iter().all(|t| t[..3] == [0.0; 3]), "light without the host's light");
+    let (mut worst_sky, mut gained) = (0f32, 0f64);
+    for ((s, b), g) in lit.iter().zip(&bounced).zip(&gtao) {
+        for c in 0..3 {
+            // Where the pixel is not the sky (AO 1 and no light there: the host's sky is
+            // its own business).
+            if s[3] < 1.0 || s[c] > 0.0 {
+                worst_sky = worst_sky.max((s[c] - std::f32::consts::PI * l[c] * g[3]).abs());
+            }
+            assert!(b[c] >= s[c] - 2e-3 * std::f32::consts::PI, "the bounce took light away: {b:?} vs {s:?}");
+            gained += f64::from(b[c] - s[c]);
+        }
+        assert!((b[3] - s[3]).abs() <= 1e-3, "the bounce changed the AO");
+    }
+    eprintln!("ssdo in the engine: largest |E - pi L AO| {worst_sky}, bounce gained {gained:.2} in all");
+    assert!(worst_sky <= 0.02, "the sky's light is not its irradiance times the AO: off by {worst_sky}");
+    assert!(gained > 1.0, "no bounce from the host's direct light");
 }

@@ -85,7 +85,8 @@ impl SsdoPass {
     /// The march this frame runs.
     fn march(&self, setup: &DeclareContext) -> &GtaoPass {
         match &self.bounce {
-            Some(bounce) if setup.settings.ao.bounce_active() => bounce,
+            // Left out, it is named for its technique.
+            Some(bounce) if setup.settings.ao.bounce_active() || setup.settings.ao.technique != self.technique => bounce,
             _ => &self.plain,
         }
     }
