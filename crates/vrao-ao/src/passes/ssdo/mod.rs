@@ -86,7 +86,9 @@ impl SsdoPass {
     fn march(&self, setup: &DeclareContext) -> &GtaoPass {
         match &self.bounce {
             // Left out, it is named for its technique.
-            Some(bounce) if setup.settings.ao.bounce_active() || setup.settings.ao.technique != self.technique => bounce,
+            Some(bounce) if setup.settings.ao.bounce_active() || setup.settings.ao.technique != self.technique => {
+                bounce
+            }
             _ => &self.plain,
         }
     }
