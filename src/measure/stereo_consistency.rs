@@ -139,7 +139,7 @@ fn direction(eyes: &[Eye; 2], images: &[EyeImages; 2], a: usize, size: (u32, u32
 
 /// Eye B's AO at view-space point `v` (its view space), blended from the pixels around
 /// it whose surface is `v`'s; `None` off the image or where B sees another surface.
-fn lookup(image: &EyeImages, v: DVec3, [l, r, u, d]: [f64; 4], size: (u32, u32), near: f64) -> Option<f32> {
+pub(crate) fn lookup(image: &EyeImages, v: DVec3, [l, r, u, d]: [f64; 4], size: (u32, u32), near: f64) -> Option<f32> {
     let distance = -v.z;
     if distance.is_nan() || distance < near {
         return None;

@@ -2,6 +2,7 @@
 //! and 16 frames, with a static head and with the head moving, next to the same
 //! per-frame settings without temporal reuse.
 
+pub mod flicker;
 pub mod motion;
 
 use crate::measure::bench::error_figures;

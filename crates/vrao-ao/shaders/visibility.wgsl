@@ -21,8 +21,7 @@ fn pixel_shown(p: vec2<u32>, layer: u32) -> bool {
 }
 
 // At and below this rate (the outer half of foveation's fall-off and beyond) the
-// upsampling thins as the technique's sampling does: at a depth edge it keeps the 2×2
-// low-res samples instead of widening to 3×3. (Thinning the denoise to one axis and the
-// upsampling to each quad's own sample cost more than they saved: the stereo-inconsistent
-// points rose from 0.8 % to 1.8 %, docs/measurements.md.)
+// upsampling thins as the technique's sampling does (joint_upsample.wgsl
+// `foveated_quad`). The denoise does not: filtering the periphery along one axis only
+// raised the stereo-inconsistent points from 0.8 % to 1.8 % (docs/measurements.md).
 const THIN_BELOW_RATE: f32 = 0.75;

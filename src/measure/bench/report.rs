@@ -209,6 +209,7 @@ const COLUMNS: &[Column] = &[
     },
     figure_column!(ao_rmse, "RMSE", false),
     figure_column!(ao_rmse_central, "RMSE central 20°", false),
+    figure_column!(ao_rmse_whole, "RMSE whole rectangle", true),
     figure_column!(ao_bias, "bias", false),
     figure_column!(ao_bias_dark, "bias (ref < 0.8)", false),
     figure_column!(ao_rmse_vs_limit, "RMSE vs limit", false),
@@ -334,7 +335,10 @@ pub const COLUMN_NOTES: &str = "\
 - **RMSE**, **bias**: the AO against the ray-traced reference's hard cut-off AO (cosine-weighted \
 visibility within r), the target every technique is scored against; bias is mean(estimate − \
 reference), > 0 too light; **bias (ref < 0.8)** over the pixels the reference finds occluded. \
-**RMSE falloff**: against the reference with HBAO's linear falloff 1 − d/r instead, for comparison.
+**RMSE falloff**: against the reference with HBAO's linear falloff 1 − d/r instead, for comparison. \
+Every figure counts only the pixels the profile's lens shows (its visibility mask); **RMSE whole \
+rectangle**, on rows with the mask off, counts every pixel, as figures before the mask did. \
+**mask** on: the passes skipped the hidden pixels.
 - **limit RMSE**, **limit bias**: the *screen-space limit* (a brute-force march over this frame's \
 own depth buffer: many rays of length r, a thickness, off-image open) against the reference: the \
 error of seeing one depth layer per eye, which no screen-space technique can remove. The same \

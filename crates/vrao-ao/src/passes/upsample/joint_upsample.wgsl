@@ -182,6 +182,9 @@ fn upsample_quad(
     layer: u32,
     tangents: vec4<f32>,
 ) -> array<vec4<f32>, 4> {
+    if (tile_rate(vec2<u32>(b), layer, 2u) <= THIN_BELOW_RATE) {
+        return foveated_quad(value_low, b, layer);
+    }
     let every = vec4<bool>(true);
     let nearest = low_res_sample(geometry_low, value_low, b, layer, tangents);
     var pixels = add_to_quad(quad, nearest, vec2<i32>(0, 0), every);
@@ -190,9 +193,7 @@ fn upsample_quad(
     pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 1), layer, tangents), vec2<i32>(1, 1), every);
     // Which pixels take the 3×3, decided before any of it is added.
     let edge = vec4<f32>(pixels[0].agree, pixels[1].agree, pixels[2].agree, pixels[3].agree) < vec4<f32>(EDGE_AGREEMENT);
-    // Foveated towards the edge (visibility.wgsl) a depth edge keeps the 2×2 samples: the
-    // five more fetches are spent where the eye looks.
-    if (any(edge) && tile_rate(vec2<u32>(b), layer, 2u) > THIN_BELOW_RATE) {
+    if (any(edge)) {
         for (var i = 0; i < 5; i++) {
             // (-1,-1) (0,-1) (1,-1) (-1,0) (-1,1): the rest of the 3×3.
             let offset = select(vec2<i32>(-1, i - 2), vec2<i32>(i - 1, -1), i < 3);
@@ -206,6 +207,37 @@ fn upsample_quad(
         upsampled(pixels[2], nearest.value),
         upsampled(pixels[3], nearest.value),
     );
+}
+
+// Foveated towards the image's edge (visibility.wgsl, THIN_BELOW_RATE), where the
+// technique marches fewer slices: the quad's values from the 2×2 low-res samples by
+// distance alone, four value fetches and no geometry, instead of four to nine samples of
+// both weighed by the surface. Smooth as the joint weights are, so the eyes still agree,
+// but an edge there may take a little of the other side's occlusion.
+fn foveated_quad(value_low: texture_2d_array<f32>, b: vec2<i32>, layer: u32) -> array<vec4<f32>, 4> {
+    let limit = vec2<i32>(textureDimensions(value_low)) - vec2<i32>(1);
+    let v00 = textureLoad(value_low, min(b, limit), i32(layer), 0);
+    let v10 = textureLoad(value_low, min(b + vec2<i32>(1, 0), limit), i32(layer), 0);
+    let v01 = textureLoad(value_low, min(b + vec2<i32>(0, 1), limit), i32(layer), 0);
+    let v11 = textureLoad(value_low, min(b + vec2<i32>(1, 1), limit), i32(layer), 0);
+    return array<vec4<f32>, 4>(
+        distance_weighted(v00, v10, v01, v11, 0),
+        distance_weighted(v00, v10, v01, v11, 1),
+        distance_weighted(v00, v10, v01, v11, 2),
+        distance_weighted(v00, v10, v01, v11, 3),
+    );
+}
+
+// Quad pixel `k`'s value from the 2×2 low-res samples by `spatial_weight` alone.
+fn distance_weighted(v00: vec4<f32>, v10: vec4<f32>, v01: vec4<f32>, v11: vec4<f32>, k: i32) -> vec4<f32> {
+    let w = vec4<f32>(
+        spatial_weight(vec2<i32>(0, 0), k),
+        spatial_weight(vec2<i32>(1, 0), k),
+        spatial_weight(vec2<i32>(0, 1), k),
+        spatial_weight(vec2<i32>(1, 1), k),
+    );
+    let v = (v00 * w.x + v10 * w.y + v01 * w.z + v11 * w.w) / (w.x + w.y + w.z + w.w);
+    return vec4<f32>(finite_or_zero3(v.rgb), saturate_ao(v.a));
 }
 
 // The stereo reuse of the upsampled occlusion (half resolution, AO-only techniques): a
