@@ -2,7 +2,7 @@
 //! the swapchain blit's colour encoding and depth copy, and — ignored unless run with
 //! `--ignored` against a runtime (`XR_RUNTIME_JSON`, e.g. Monado with
 //! `XRT_COMPOSITOR_NULL=1`, which runs headless on lavapipe) — a real session of a few
-//! hundred frames, `--frames`, and a lost session's fall back.
+//! hundred frames, `--frames`, each eye's visibility mask, and a lost session's fall back.
 //!
 //! A process may hold one OpenXR instance at a time, and these tests change
 //! `XR_RUNTIME_JSON`: every test holds the one GPU lock for its whole run.
@@ -470,10 +470,14 @@ fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
     let mut renderer = renderer_for(&headset, &gpu);
     let before = run_frames(&mut headset, &gpu, &mut renderer, 20);
     assert!(before > 0);
+    let runtime_mask = headset.visibility_mask().cloned();
     headset.simulate_loss("test: LOSS_PENDING");
     assert_eq!(headset.lost(), Some("test: LOSS_PENDING"));
     assert!(headset.describe().starts_with("simulated headset"), "{}", headset.describe());
     assert_eq!(headset.recommended_size(), (96, 80), "the fall back keeps the render size");
+    // The mask is the fall back's (its profile's lens) from now on.
+    let mask = headset.visibility_mask().expect("the simulated headset's profile has a mask");
+    assert_ne!(Some(mask), runtime_mask.as_ref());
     // The runtime's instance is gone; the GPU it made keeps rendering.
     probe_runtime().expect("the OpenXR instance was released");
     let after = run_frames(&mut headset, &gpu, &mut renderer, 10);
@@ -490,6 +494,52 @@ fn a_lost_session_continues_on_the_simulated_headset_with_the_same_gpu() {
     // The fall back takes the exit request.
     headset.request_exit();
     assert!(headset.wait_frame(&gpu).unwrap().is_none());
+    headset.end(&gpu).unwrap();
+}
+
+#[test]
+#[ignore = "needs an OpenXR runtime (e.g. Monado); run with --ignored"]
+fn the_runtime_gives_each_eye_a_visibility_mask() {
+    let _one_at_a_time = common::gpu_lock();
+    let runtime = require_runtime();
+    let (mut headset, gpu) = OpenXrHeadset::open(session_options(None)).expect("session");
+    // Read at the start (XR_KHR_visibility_mask), or built from the first frame's fields of
+    // view (Monado's default) where vrao does not read the runtime's.
+    let mut request = None;
+    for _ in 0..100 {
+        let Some(r) = headset.wait_frame(&gpu).expect("wait_frame") else { break };
+        headset.submit(&gpu, &r, None).expect("submit");
+        if r.should_render {
+            request = Some(r);
+            break;
+        }
+    }
+    let request = request.expect("a frame to render");
+    let mask = headset.visibility_mask().cloned().expect("a mask once the first frame is located");
+    let report = headset.openxr_report().unwrap();
+    assert_eq!(mask.views.len(), 2);
+    let (width, height) = headset.recommended_size();
+    for (view, eye) in mask.views.iter().zip(&request.eyes.eyes) {
+        let share = view.hidden_share(width, height, eye.fov.tangents());
+        eprintln!("{:?} eye: {:.4} hidden ({})", eye.side, share, view.source);
+        assert!(share > 0.0 && share < 0.5, "{share}");
+        assert_eq!(
+            view.source.contains("(XR_KHR_visibility_mask)"),
+            report.visibility_mask_from_runtime,
+            "{}",
+            view.source
+        );
+        if runtime.starts_with("Monado") {
+            // Monado's default for a device without its own (the simulated HMD): a corner cut
+            // an eighth of the width and height on its legs, 1/32 of the rectangle.
+            assert!((share - 0.03125).abs() < 0.003, "{share}");
+        }
+    }
+    assert_eq!(report.visibility_mask_changes, 0, "{report:?}");
+    headset.request_exit();
+    while let Some(r) = headset.wait_frame(&gpu).unwrap() {
+        headset.submit(&gpu, &r, None).unwrap();
+    }
     headset.end(&gpu).unwrap();
 }
 
