@@ -157,7 +157,7 @@ fn unit_to_tangent(u: Vec2, [left, right, up, down]: [f64; 4]) -> Vec2 {
 }
 
 fn triangles_of(vertices: &[Vec2], indices: &[u32]) -> Result<Vec<[Vec2; 3]>> {
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(Error::input(format!("visibility mask: {} indices, not a multiple of 3", indices.len())));
     }
     if indices.len() / 3 > MAX_MASK_TRIANGLES {
