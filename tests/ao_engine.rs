@@ -489,7 +489,9 @@ fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
     let mut sh = [[0.0f32; 3]; 9];
     sh[0] = l.map(|c| std::f32::consts::PI * c / 0.282_095);
     let run = |technique: Technique, light: Option<HostLight>| {
-        let settings = AoSettings { technique, ..AoSettings::default() };
+        // No denoise: it filters the light with normal edges the AO does not stop at, so
+        // only the raw values are E(n) × AO pixel by pixel.
+        let settings = AoSettings { technique, blur_radius: 0, ..AoSettings::default() };
         let config = AoConfig { settings, width: WIDTH, height: HEIGHT, views: 2 };
         let mut engine = AoEngine::new(device, queue, &config).unwrap();
         let mut encoder = device.create_command_encoder(&Default::default());

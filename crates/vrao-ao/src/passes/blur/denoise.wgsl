@@ -103,7 +103,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         var light_sum = vec3<f32>(0.0);
         var total = 0.0;
         var plain_sum = 0.0;
-        var plain_light_sum = vec3<f32>(0.0);
+        var light_total = 0.0;
         var plain_total = 0.0;
         for (var k = -2; k <= 2; k++) {
             let distance = geometry[o + k + 2].w;
@@ -115,8 +115,12 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
             plain_sum += occlusion[o + k + 2] * on_surface;
             plain_total += on_surface;
             if (CARRIES_LIGHT) {
-                light_sum += light[o + k + 2] * w;
-                plain_light_sum += light[o + k + 2] * on_surface;
+                // The light also stops at normal edges: the irradiance changes with the
+                // normal (a crease's floor and wall see different skies) where the AO
+                // need not. The centre weighs 1, so the total never vanishes.
+                let wl = w * normal_agreement(centre.xyz, geometry[o + k + 2].xyz);
+                light_sum += light[o + k + 2] * wl;
+                light_total += wl;
             }
         }
         // The centre alone weighs 1; below 2 the window's plain mean makes up the rest.
@@ -126,7 +130,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         let result = (sum + plain_sum * plain_weight) * normaliser;
         var light_result = vec3<f32>(0.0);
         if (CARRIES_LIGHT) {
-            light_result = finite_or_zero3((light_sum + plain_light_sum * plain_weight) * normaliser);
+            light_result = finite_or_zero3(light_sum / max(light_total, 1e-20));
         }
         textureStore(occlusion_out, p, layers.y, vec4<f32>(light_result, saturate_ao(result)));
     }
