@@ -34,6 +34,9 @@ pub struct FrameChange {
     pub compared: u64,
 }
 
+/// The last frame's eyes, then its AO, light and depth per eye.
+type PreviousFrame = (Vec<crate::render::stereo::Eye>, Vec<Vec<f32>>, Vec<Vec<f32>>, Vec<Vec<f32>>);
+
 /// Renders `frames` frames (after [`SETTLE_FRAMES`]) at 90 Hz of `scene` from its head
 /// turning about the vertical at `degrees_per_second`, and measures the change between
 /// consecutive frames.
@@ -48,7 +51,7 @@ pub fn frame_to_frame(
     let start = scene.head.pose_at(0.0);
     let light = settings.ao.technique.carries_light();
     let (w, h) = (settings.profile.width as usize, settings.profile.height as usize);
-    let mut previous: Option<(Vec<crate::render::stereo::Eye>, Vec<Vec<f32>>, Vec<Vec<f32>>, Vec<Vec<f32>>)> = None;
+    let mut previous: Option<PreviousFrame> = None;
     let (mut ao2, mut light2, mut light_sum, mut n) = (0f64, 0f64, 0f64, 0u64);
     for frame in 0..SETTLE_FRAMES + frames {
         let yaw = (degrees_per_second * frame as f64 / 90.0).to_radians();

@@ -268,7 +268,8 @@ mod tests {
     }
 
     const SQUARE: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
-    const FOV45: Fov = Fov { left: -0.785_398_2, right: 0.785_398_2, up: 0.785_398_2, down: -0.785_398_2 };
+    const Q: f32 = std::f32::consts::FRAC_PI_4;
+    const FOV45: Fov = Fov { left: -Q, right: Q, up: Q, down: -Q };
 
     fn read(mesh: MaskMesh) -> Result<ViewMask, String> {
         view_mask(Ok(mesh), || panic!("the hidden mesh is not empty: no visible read"))
