@@ -195,8 +195,11 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
     for technique in [Technique::SsdoPoints, Technique::SsdoPointsBounce] {
         let on = plan(technique, true, &[COLOR]);
         assert!(on.runs("depth-peel"), "{on}");
-        let order: Vec<_> =
-            on.names.iter().filter(|n| ["gbuffer", "depth-peel", "ssdo-points", "ssdo-points-bounce"].contains(n)).collect();
+        let order: Vec<_> = on
+            .names
+            .iter()
+            .filter(|n| ["gbuffer", "depth-peel", "ssdo-points", "ssdo-points-bounce"].contains(n))
+            .collect();
         assert_eq!(order[..2], [&"gbuffer", &"depth-peel"], "{on}");
         assert!(on.resources.contains(&DEPTH_LAYER_2));
         let off = plan(technique, false, &[COLOR]);

@@ -31,7 +31,8 @@ struct Frame {
 
 fn render(scene: &Scene, ao: &AoSettings, mask: Option<&VisibilityMask>) -> Frame {
     let (gpu, _guard) = common::gpu();
-    let s = Settings { profile: HeadsetProfile::with_size("vive", SIZE.0, SIZE.1), ao: ao.clone(), ..Settings::default() };
+    let s =
+        Settings { profile: HeadsetProfile::with_size("vive", SIZE.0, SIZE.1), ao: ao.clone(), ..Settings::default() };
     let mut renderer = Renderer::new(gpu.clone(), scene, &s).unwrap();
     renderer.set_visibility_mask(mask.cloned());
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
@@ -90,7 +91,11 @@ fn hidden_pixels_are_black_and_unoccluded_and_the_rest_is_untouched() {
         let what = format!("{} foveation {}", resolution.name(), foveation.name());
         for layer in 0..2 {
             let share = coverage[layer].iter().filter(|&&c| c == 0).count() as f64 / coverage[layer].len() as f64;
-            assert!((masked.hidden_share[layer] - share).abs() < 1e-9, "{what}: hidden share {:?}", masked.hidden_share);
+            assert!(
+                (masked.hidden_share[layer] - share).abs() < 1e-9,
+                "{what}: hidden share {:?}",
+                masked.hidden_share
+            );
             assert!((share - (1.0 - std::f64::consts::FRAC_PI_4)).abs() < 0.01, "{share}");
             let (mut hidden_on_geometry, mut compared, mut far) = (0, 0, 0);
             for i in 0..coverage[layer].len() {
@@ -102,7 +107,11 @@ fn hidden_pixels_are_black_and_unoccluded_and_the_rest_is_untouched() {
                     hidden_on_geometry += usize::from(open.depth[layer][i] > 0.0);
                     assert_eq!(masked.depth[layer][i], 0.0, "{what}: a hidden pixel kept a surface's depth");
                     assert_eq!(a_masked, 1.0, "{what}: a hidden pixel's AO is not the neutral 1");
-                    assert_eq!(&masked.color[layer][4 * i..4 * i + 3], &[0, 0, 0], "{what}: a hidden pixel is not black");
+                    assert_eq!(
+                        &masked.color[layer][4 * i..4 * i + 3],
+                        &[0, 0, 0],
+                        "{what}: a hidden pixel is not black"
+                    );
                 } else {
                     // Shown pixels keep their surface.
                     assert_eq!(masked.depth[layer][i], open.depth[layer][i], "{what}: depth changed at {i}");

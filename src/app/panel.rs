@@ -162,7 +162,10 @@ fn bounce_ui(ui: &mut egui::Ui, ao: &mut AoSettings) {
     let bounce = ao.technique.gathers_bounce();
     ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
     let mut patch = ao.bounce_form == BounceForm::Patch;
-    if ui.add_enabled(bounce && points, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches")).changed() {
+    if ui
+        .add_enabled(bounce && points, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches"))
+        .changed()
+    {
         ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
     }
     ui.add_enabled(points, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (point-sampled SSDO)"));

@@ -293,7 +293,8 @@ impl CaseRun {
             let traced_whole = reference.layers.iter().flatten().filter(|p| p.hit).count()
                 > visible.layers.iter().flatten().filter(|p| p.hit).count();
             if !self.case.mask && traced_whole {
-                figures.ao_rmse_whole = Some(score(self.case.technique, &occlusion, reference, limit, ppd, &fovs).ao_rmse);
+                figures.ao_rmse_whole =
+                    Some(score(self.case.technique, &occlusion, reference, limit, ppd, &fovs).ao_rmse);
             }
             figures
         });
@@ -493,7 +494,8 @@ pub fn bounce_figures(
     let (gw, gh) = reference.grid_size();
     // Per channel r, g, b and luminance: sums of the reference, the estimate, the squared
     // difference and the reference's variance.
-    let (mut n, mut sum_ref, mut sum_est, mut sum_sq, mut noise2) = (0usize, [0f64; 4], [0f64; 4], [0f64; 4], [0f64; 4]);
+    let (mut n, mut sum_ref, mut sum_est, mut sum_sq, mut noise2) =
+        (0usize, [0f64; 4], [0f64; 4], [0f64; 4], [0f64; 4]);
     for (layer, image) in estimate.iter().enumerate().take(reference.layers.len()) {
         let height = image.len() / 4 / width.max(1) as usize;
         for j in 0..gh {

@@ -335,7 +335,8 @@ mod tests {
             // SSDO, which a renderer supplies.
             let engine_pass = e.kind != TechniqueKind::Off && !e.name.starts_with("ssdo-points");
             assert_eq!(e.pass.is_some(), engine_pass, "{}", e.name);
-            let marches = e.kind == TechniqueKind::HorizonMarch || (e.kind == TechniqueKind::LightGathering && engine_pass);
+            let marches =
+                e.kind == TechniqueKind::HorizonMarch || (e.kind == TechniqueKind::LightGathering && engine_pass);
             assert_eq!(marches, e.samples == SamplePattern::Directions, "{}", e.name);
             assert_eq!(marches, e.foveation == FoveationRule::DirectionsThenSteps, "{}", e.name);
         }

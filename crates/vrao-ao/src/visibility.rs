@@ -62,7 +62,8 @@ impl ViewMask {
     pub fn corner_cut(tangents: [f64; 4]) -> ViewMask {
         // Corners in the rectangle's own coordinates (−1..1 on each axis).
         let corner = |sx: f32, sy: f32| {
-            [Vec2::new(sx, sy), Vec2::new(sx, sy * 0.75), Vec2::new(sx * 0.75, sy)].map(|c| unit_to_tangent(c, tangents))
+            [Vec2::new(sx, sy), Vec2::new(sx, sy * 0.75), Vec2::new(sx * 0.75, sy)]
+                .map(|c| unit_to_tangent(c, tangents))
         };
         ViewMask {
             covers: Covers::Hidden,
@@ -130,7 +131,8 @@ impl ViewMask {
                 for x in x0..=x1 as u32 {
                     let p = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
                     // Inside (edges included) whatever the triangle's winding.
-                    let inside = [(a, b), (b, c), (c, a)].iter().all(|&(e0, e1)| (e1 - e0).perp_dot(p - e0) * sign >= 0.0);
+                    let inside =
+                        [(a, b), (b, c), (c, a)].iter().all(|&(e0, e1)| (e1 - e0).perp_dot(p - e0) * sign >= 0.0);
                     if inside {
                         pixels[(y * width + x) as usize] = fill;
                     }

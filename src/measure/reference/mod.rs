@@ -64,7 +64,10 @@ mod shading;
 #[cfg(test)]
 mod tests;
 
-pub use cache::{cache_file, cache_key, default_cache_dir, read_cache, trace_cached, trace_cached_visible, write_cache, FORMAT_VERSION};
+pub use cache::{
+    cache_file, cache_key, default_cache_dir, read_cache, trace_cached, trace_cached_visible, write_cache,
+    FORMAT_VERSION,
+};
 pub use progress::ProgressBar;
 
 use crate::render::error::{Error, Result};
@@ -294,7 +297,12 @@ pub fn trace_visible(
     check_trace(eyes, size, settings)?;
     let pixels = size.0 as usize * size.1 as usize;
     if let Some(c) = coverage.into_iter().flatten().flatten().find(|c| c.len() != pixels) {
-        return Err(Error::input(format!("a visibility coverage of {} pixels for a {}×{} image", c.len(), size.0, size.1)));
+        return Err(Error::input(format!(
+            "a visibility coverage of {} pixels for a {}×{} image",
+            c.len(),
+            size.0,
+            size.1
+        )));
     }
     let start = Instant::now();
     let anchor = eyes.iter().map(|e| e.pose.position).sum::<DVec3>() / eyes.len() as f64;

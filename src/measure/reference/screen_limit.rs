@@ -176,7 +176,9 @@ pub fn screen_space_limit(eyes: &[EyeBuffers], size: (u32, u32), settings: &Limi
     settings.validate()?;
     let pixels = size.0 as usize * size.1 as usize;
     for (layer, eye) in eyes.iter().enumerate() {
-        if eye.depth.len() != pixels || eye.normals.len() != pixels * 4 || eye.direct.is_some_and(|d| d.len() != pixels * 4)
+        if eye.depth.len() != pixels
+            || eye.normals.len() != pixels * 4
+            || eye.direct.is_some_and(|d| d.len() != pixels * 4)
         {
             return Err(Error::input(format!(
                 "screen-space limit: eye {layer} has {} depth and {} normal values for {}×{} pixels",

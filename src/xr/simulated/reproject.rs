@@ -153,7 +153,9 @@ impl Reprojector {
         ];
         let extent = (width, height, layers);
         match mode {
-            ReprojectionMode::Rotational => self.rotational.dispatch(&gpu.device, encoder, self.visibility.bind_group(), &resources, extent),
+            ReprojectionMode::Rotational => {
+                self.rotational.dispatch(&gpu.device, encoder, self.visibility.bind_group(), &resources, extent)
+            }
             ReprojectionMode::Depth => {
                 encoder.clear_buffer(splatted, 0, Some(bytes));
                 self.splat.dispatch(&gpu.device, encoder, self.visibility.bind_group(), &resources, extent);

@@ -331,12 +331,10 @@ impl AoEngine {
         if let Some(texture) = direct {
             import::check_texture("direct light", texture, config)?;
             if texture.format().sample_type(None, None) != Some(wgpu::TextureSampleType::Float { filterable: true })
-                && texture.format().sample_type(None, None) != Some(wgpu::TextureSampleType::Float { filterable: false })
+                && texture.format().sample_type(None, None)
+                    != Some(wgpu::TextureSampleType::Float { filterable: false })
             {
-                return Err(Error::input(format!(
-                    "direct light: format {:?} is not float-sampled",
-                    texture.format()
-                )));
+                return Err(Error::input(format!("direct light: format {:?} is not float-sampled", texture.format())));
             }
             targets.import(&self.gpu, light::HOST_DIRECT, texture, wgpu::TextureAspect::All, layers);
         }

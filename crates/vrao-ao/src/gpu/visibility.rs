@@ -164,7 +164,14 @@ impl VisibilityMaps {
     }
 }
 
-fn textures(gpu: &Gpu, width: u32, height: u32, layers: u32, tiles_x: u32, tiles_y: u32) -> (wgpu::Texture, wgpu::Texture) {
+fn textures(
+    gpu: &Gpu,
+    width: u32,
+    height: u32,
+    layers: u32,
+    tiles_x: u32,
+    tiles_y: u32,
+) -> (wgpu::Texture, wgpu::Texture) {
     let texture = |label, width, height, mips| {
         gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),

@@ -15,4 +15,3 @@ macro_rules! wgsl {
 }
 
 pub(crate) use wgsl;
-

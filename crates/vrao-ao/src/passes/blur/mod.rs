@@ -145,12 +145,24 @@ impl Pass for BlurPass {
         // reusing it.
         let mut vertical = ctx.bind(&VERTICAL, &stand_in);
         let filtered_layers = if reuse { 1 } else { layers };
-        kernels.vertical.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &vertical, (vertical_grid.0, vertical_grid.1, filtered_layers));
+        kernels.vertical.dispatch(
+            device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &vertical,
+            (vertical_grid.0, vertical_grid.1, filtered_layers),
+        );
         if reuse {
             let (right, left) = (ctx.layer_view(AO_BLURRED, 1), ctx.layer_view(AO_BLURRED, 0));
             vertical[4] = wgpu::BindingResource::TextureView(&right);
             vertical[6] = wgpu::BindingResource::TextureView(&left);
-            kernels.right_eye_vertical.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &vertical, (vertical_grid.0, vertical_grid.1, 1));
+            kernels.right_eye_vertical.dispatch(
+                device,
+                ctx.encoder,
+                ctx.visibility.bind_group(),
+                &vertical,
+                (vertical_grid.0, vertical_grid.1, 1),
+            );
         }
     }
 }

@@ -248,8 +248,20 @@ impl Pass for GtaoPass {
         let resources = ctx.bind(self.march.binds, &[normals.clone(), normals, self.params.as_entire_binding()]);
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        kernels.interior.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (width - band, height, marched_layers));
-        kernels.inner_band.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (band, height, marched_layers));
+        kernels.interior.dispatch(
+            device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            (width - band, height, marched_layers),
+        );
+        kernels.inner_band.dispatch(
+            device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            (band, height, marched_layers),
+        );
         if !reuse {
             return;
         }

@@ -88,7 +88,13 @@ impl Pass for UpsamplePass {
         let (w, h, layers) = ctx.quad_extent();
         let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
-        self.kernel.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, if reuse { 1 } else { layers }));
+        self.kernel.dispatch(
+            device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            (w, h, if reuse { 1 } else { layers }),
+        );
         if reuse {
             // The right eye writes layer 1 alone and reads the left eye's layer 0.
             let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));

@@ -148,7 +148,13 @@ impl Pass for CompositePass {
         let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
         let kernel = &self.kernels[half_res as usize][rsm as usize];
-        kernel.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, if reuse { 1 } else { layers }));
+        kernel.dispatch(
+            device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            (w, h, if reuse { 1 } else { layers }),
+        );
         if reuse {
             let fallback = self.fallback_list(device, u64::from(w) * u64::from(h));
             ctx.encoder.copy_buffer_to_buffer(&self.fallback_header, 0, &fallback, 0, FALLBACK_HEADER_BYTES);
@@ -160,10 +166,23 @@ impl Pass for CompositePass {
                 &[wgpu::BindingResource::TextureView(&left), fallback.as_entire_binding()],
                 &[(HDR, wgpu::BindingResource::TextureView(&right))],
             );
-            self.right_eye[rsm as usize].dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, 1));
+            self.right_eye[rsm as usize].dispatch(
+                device,
+                ctx.encoder,
+                ctx.visibility.bind_group(),
+                &resources,
+                (w, h, 1),
+            );
             ctx.encoder.copy_buffer_to_buffer(&fallback, 0, &self.fallback_args, 0, 12);
             let args = &self.fallback_args;
-            self.right_eye_fallback[rsm as usize].dispatch_indirect(device, ctx.encoder, ctx.visibility.bind_group(), &resources, args, 0);
+            self.right_eye_fallback[rsm as usize].dispatch_indirect(
+                device,
+                ctx.encoder,
+                ctx.visibility.bind_group(),
+                &resources,
+                args,
+                0,
+            );
         }
     }
 }

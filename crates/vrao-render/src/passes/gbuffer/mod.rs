@@ -10,7 +10,6 @@
 mod mask;
 
 use super::{gpu_scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use mask::{MaskDepth, MaskStep};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
 use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
@@ -18,6 +17,7 @@ use crate::gpu::uniforms::FrameUniforms;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, PIXEL_MOTION};
 use bytemuck::{Pod, Zeroable};
+use mask::{MaskDepth, MaskStep};
 use std::num::NonZeroU32;
 use wgpu::util::DeviceExt;
 

@@ -104,6 +104,12 @@ impl Pass for RsmPass {
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let own = [self.light_space.uniform.as_entire_binding(), self.params.as_entire_binding()];
         let resources = ctx.bind(&BINDINGS, &own);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, ctx.setup.views));
+        self.kernel.dispatch(
+            &ctx.gpu.device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            (w, h, ctx.setup.views),
+        );
     }
 }
