@@ -152,7 +152,7 @@ fn published_hidden_share(name: &str) -> Option<f64> {
 }
 
 /// The visibility mask of a profile's eyes. Where the headset's hidden area is published
-/// ([`published_hidden_share`]) the lens shows a superellipse |x|ⁿ + |y|ⁿ ≤ 1 in each eye's
+/// (`published_hidden_share`) the lens shows a superellipse |x|ⁿ + |y|ⁿ ≤ 1 in each eye's
 /// rectangle (its four edges touched, the corners cut round, as the dumps' HAM meshes of
 /// four corner n-gons are), its n chosen so it hides that share; elsewhere (and for a
 /// size or frustum of no named headset) Monado's default for a device without a mask of

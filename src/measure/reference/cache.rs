@@ -210,7 +210,7 @@ pub fn cache_file(cache_dir: &Path, key: u64) -> PathBuf {
     cache_dir.join(format!("reference-{key:016x}.bin"))
 }
 
-/// As [`trace`], but reads the result from `cache_dir` when an intact file for the same
+/// As [`super::trace`], but reads the result from `cache_dir` when an intact file for the same
 /// inputs is there, and otherwise traces and writes one (creating the directory).
 /// A cache file that cannot be read is traced again with a warning; one that cannot be
 /// written is an [`Error::Output`] naming it.
