@@ -220,6 +220,8 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
             "hbao",
             "gtao",
             "ssdo",
+            "ssdo-bounce",
+            "ssdo-points",
             "fetch-only",
             "temporal",
             "blur",
