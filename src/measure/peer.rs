@@ -693,8 +693,8 @@ mod tests {
 
     #[test]
     fn an_eye_line_carries_the_projection_vrao_renders_with() {
-        let profile = crate::HeadsetProfile::with_size("vive", 64, 80);
-        let eyes = profile.eyes(&crate::HeadPose::IDENTITY, 0.05);
+        let profile = crate::render::stereo::HeadsetProfile::with_size("vive", 64, 80);
+        let eyes = profile.eyes(&crate::render::stereo::HeadPose::IDENTITY, 0.05);
         let line = eye_line("left", &eyes.eyes[0], eyes.near);
         let numbers: Vec<f32> = line.split_whitespace().skip(2).map(|s| s.parse().unwrap()).collect();
         assert_eq!(numbers.len(), 32);
