@@ -5,11 +5,11 @@ ray-traced reference over several scenes and radii, with `vrao bench`.
 For every combination of the grid it benches `gtao` on every scene at three radii (the
 scene's default radius × 0.5, 1, 2) and ranks the combinations by the mean over (scene,
 radius) of RMSE + |bias| against the hard cut-off reference. It writes the full table
-and the ranking as Markdown (default docs/gtao-tuning.md) and prints the winner; the
+and the ranking as Markdown (default docs/records/2026-11-29/gtao-tuning.md) and prints the winner; the
 winner goes into src/render/passes/gtao/mod.rs (GtaoSettings: its defaults).
 
 usage: python3 scripts/tune-gtao.py [--vrao target/release/vrao] [--size 270x300]
-       [--samples 24] [--scenes a,b,...] [--out docs/gtao-tuning.md]
+       [--samples 24] [--scenes a,b,...] [--out docs/records/2026-11-29/gtao-tuning.md]
 References are cached (~/.cache/vrao), so a second run only re-renders.
 """
 import argparse
@@ -56,7 +56,7 @@ def main():
     ap.add_argument("--size", default="270x300")
     ap.add_argument("--samples", type=int, default=24)
     ap.add_argument("--scenes", default=",".join(DEFAULT_SCENES))
-    ap.add_argument("--out", default="docs/gtao-tuning.md")
+    ap.add_argument("--out", default="docs/records/2026-11-29/gtao-tuning.md")
     args = ap.parse_args()
     scenes = args.scenes.split(",")
     combos = [dict(zip(GRID, values)) for values in itertools.product(*GRID.values())]

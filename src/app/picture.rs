@@ -1,6 +1,6 @@
 //! The window's picture pipelines: a full-screen triangle drawing one 2D view into a
 //! viewport — an eye image (filtered), or one of the buffers behind it texel for texel
-//! (mirror.wgsl).
+//! (shaders/mirror.wgsl).
 
 use crate::app::BufferView;
 use crate::render::error::Result;
@@ -58,7 +58,7 @@ impl Blit {
             &[(2, texture_binding(wgpu::TextureSampleType::Float { filterable: false }))],
         );
         let depth_layout = fragment_layout(gpu, "depth view", &[(3, texture_binding(wgpu::TextureSampleType::Depth))]);
-        let module = try_shader_module(gpu, "mirror", &[wgsl!("src/app/mirror.wgsl")])?;
+        let module = try_shader_module(gpu, "mirror", &[wgsl!("shaders/mirror.wgsl")])?;
         let pipeline = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(entry_point),

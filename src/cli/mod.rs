@@ -154,12 +154,7 @@ impl GtaoArgs {
 pub struct AoArgs {
     #[command(flatten)]
     pub lights: LightArgs,
-    /// Occlusion technique: none, ssao, hbao, gtao (the default: the most accurate per
-    /// millisecond), ssdo and ssdo-bounce (GTAO's march gathering the environment and one
-    /// bounce), ssdo-points and ssdo-points-bounce (the seeds' point-sampled SSDO, a
-    /// baseline) or fetch-only (the benchmark baseline with SSAO's depth taps and no
-    /// occlusion arithmetic).
-    #[arg(value_parser = choice::<Technique>(), long, default_value_t = AoSettings::default().technique, hide_possible_values = true)]
+    #[arg(value_parser = choice::<Technique>(), long, default_value_t = AoSettings::default().technique, hide_possible_values = true, help = technique_help())]
     technique: Technique,
     /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
     #[arg(value_parser = choice::<Quality>(), long, default_value_t = Quality::default(), hide_possible_values = true)]
@@ -242,6 +237,11 @@ pub struct AoArgs {
     /// (moving objects then leave their old AO behind: for comparison).
     #[arg(long)]
     temporal_eyes_only: bool,
+}
+
+/// `--technique`'s help: the techniques of the engine's table ([`Technique::help_list`]).
+fn technique_help() -> String {
+    format!("Occlusion technique: {}", Technique::help_list())
 }
 
 /// `--radius`'s help, with the library's figures for the default.

@@ -136,6 +136,18 @@ mod tests {
     }
 
     #[test]
+    fn the_technique_help_is_the_engines_table() {
+        use clap::CommandFactory;
+        let command = Render::command();
+        let technique = command.get_arguments().find(|a| a.get_id() == "technique").unwrap();
+        let help = technique.get_help().unwrap().to_string();
+        assert_eq!(help, format!("Occlusion technique: {}", vrao::render::settings::Technique::help_list()));
+        for t in vrao::render::settings::Technique::all() {
+            assert!(help.contains(t.name()), "{} missing from {help}", t.name());
+        }
+    }
+
+    #[test]
     fn render_options_reach_the_settings() {
         let line = "render --quality ultra --half-res --radius 0.25 --technique hbao --temporal";
         let args = Render::try_parse_from(line.split(' ')).unwrap().args;

@@ -253,17 +253,7 @@ pub fn ssim(
     // Statistics are taken of values relative to each image's mean over the valid pixels, so
     // E[x²] − μ² does not cancel catastrophically for images far from zero; means are shifted
     // back for the luminance term.
-    let (mut shift_a, mut shift_b, mut n_valid) = (0.0f64, 0.0f64, 0usize);
-    for i in (0..n).filter(|&i| valid(i)) {
-        shift_a += a[i] as f64;
-        shift_b += b[i] as f64;
-        n_valid += 1;
-    }
-    if n_valid == 0 {
-        return None;
-    }
-    shift_a /= n_valid as f64;
-    shift_b /= n_valid as f64;
+    let shift = valid_means(a, b, n, &valid)?;
 
     // Horizontally filtered rows of [w, w·a, w·b, w·a², w·b², w·a·b] in a ring of kh rows, so
     // memory stays at kh × ow entries however large the image is.
@@ -272,24 +262,10 @@ pub fn ssim(
     let mut filter_row = |y: usize, ring: &mut Vec<[f64; 6]>| {
         for (x, t) in row_terms.iter_mut().enumerate() {
             let i = y * width + x;
-            *t = if valid(i) {
-                let (p, q) = (a[i] as f64 - shift_a, b[i] as f64 - shift_b);
-                [1.0, p, q, p * p, q * q, p * q]
-            } else {
-                [0.0; 6]
-            };
+            *t = if valid(i) { centred_terms(a[i], b[i], shift) } else { [0.0; 6] };
         }
         let slot = (y % kh) * ow;
-        for ox in 0..ow {
-            let mut s = [0.0f64; 6];
-            for (k, g) in gx.iter().enumerate() {
-                let t = &row_terms[ox + k];
-                for c in 0..6 {
-                    s[c] += g * t[c];
-                }
-            }
-            ring[slot + ox] = s;
-        }
+        filter_horizontally(&row_terms, &gx, &mut ring[slot..slot + ow]);
     };
     for y in 0..kh - 1 {
         filter_row(y, &mut ring);
@@ -303,27 +279,11 @@ pub fn ssim(
             if !valid((oy + ry) * width + ox + rx) {
                 continue;
             }
-            let mut s = [0.0f64; 6];
-            for (k, g) in gy.iter().enumerate() {
-                let t = &ring[((oy + k) % kh) * ow + ox];
-                for c in 0..6 {
-                    s[c] += g * t[c];
-                }
-            }
-            let w = s[0];
-            if w < 0.5 * full_weight {
+            let s = filter_vertically(&ring, &gy, oy, ox, ow);
+            if s[0] < 0.5 * full_weight {
                 continue;
             }
-            let (da, db) = (s[1] / w, s[2] / w);
-            let var_a = (s[3] / w - da * da).max(0.0);
-            let var_b = (s[4] / w - db * db).max(0.0);
-            // Rounding may break |cov| ≤ σaσb (Cauchy–Schwarz); restore it.
-            let bound = (var_a * var_b).sqrt();
-            let cov = (s[5] / w - da * db).clamp(-bound, bound);
-            let (mu_a, mu_b) = (da + shift_a, db + shift_b);
-            let num = (2.0 * mu_a * mu_b + c1) * (2.0 * cov + c2);
-            let den = (mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2);
-            sum += num / den;
+            sum += window_ssim(&s, shift, c1, c2);
             count += 1;
         }
     }
@@ -333,6 +293,75 @@ pub fn ssim(
     let mean = sum / count as f64;
     // Rounding can leave identical images a hair above 1; SSIM is at most 1 by definition.
     mean.is_finite().then_some(mean.min(1.0))
+}
+
+/// The means of `a` and `b` over the first `n` pixels that are `valid`, or `None` when
+/// none is.
+fn valid_means(a: &[f32], b: &[f32], n: usize, valid: &impl Fn(usize) -> bool) -> Option<(f64, f64)> {
+    let (mut shift_a, mut shift_b, mut n_valid) = (0.0f64, 0.0f64, 0usize);
+    for i in (0..n).filter(|&i| valid(i)) {
+        shift_a += a[i] as f64;
+        shift_b += b[i] as f64;
+        n_valid += 1;
+    }
+    if n_valid == 0 {
+        return None;
+    }
+    shift_a /= n_valid as f64;
+    shift_b /= n_valid as f64;
+    Some((shift_a, shift_b))
+}
+
+/// One valid pixel's terms [1, p, q, p², q², p·q] of its values relative to each image's
+/// mean (`shift`).
+fn centred_terms(a: f32, b: f32, shift: (f64, f64)) -> [f64; 6] {
+    let (p, q) = (a as f64 - shift.0, b as f64 - shift.1);
+    [1.0, p, q, p * p, q * q, p * q]
+}
+
+/// A row's terms filtered by the horizontal Gaussian `gx`, one entry of `out` per window
+/// position ("valid" filtering: `out` is `gx.len() − 1` shorter than the row).
+fn filter_horizontally(row_terms: &[[f64; 6]], gx: &[f64], out: &mut [[f64; 6]]) {
+    for (ox, o) in out.iter_mut().enumerate() {
+        let mut s = [0.0f64; 6];
+        for (k, g) in gx.iter().enumerate() {
+            let t = &row_terms[ox + k];
+            for c in 0..6 {
+                s[c] += g * t[c];
+            }
+        }
+        *o = s;
+    }
+}
+
+/// The window at (`ox`, `oy`): the ring's horizontally filtered rows `oy..oy + kh`
+/// (`kh = gy.len()`, each `ow` entries) filtered by the vertical Gaussian `gy`.
+fn filter_vertically(ring: &[[f64; 6]], gy: &[f64], oy: usize, ox: usize, ow: usize) -> [f64; 6] {
+    let kh = gy.len();
+    let mut s = [0.0f64; 6];
+    for (k, g) in gy.iter().enumerate() {
+        let t = &ring[((oy + k) % kh) * ow + ox];
+        for c in 0..6 {
+            s[c] += g * t[c];
+        }
+    }
+    s
+}
+
+/// One window's SSIM from its weighted sums `s` (weight first, see [`centred_terms`]),
+/// the images' mean `shift` and the constants `c1`, `c2`.
+fn window_ssim(s: &[f64; 6], shift: (f64, f64), c1: f64, c2: f64) -> f64 {
+    let w = s[0];
+    let (da, db) = (s[1] / w, s[2] / w);
+    let var_a = (s[3] / w - da * da).max(0.0);
+    let var_b = (s[4] / w - db * db).max(0.0);
+    // Rounding may break |cov| ≤ σaσb (Cauchy–Schwarz); restore it.
+    let bound = (var_a * var_b).sqrt();
+    let cov = (s[5] / w - da * db).clamp(-bound, bound);
+    let (mu_a, mu_b) = (da + shift.0, db + shift.1);
+    let num = (2.0 * mu_a * mu_b + c1) * (2.0 * cov + c2);
+    let den = (mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2);
+    num / den
 }
 
 /// Mean ꟻLIP error (NVIDIA's LDR-ꟻLIP, Andersson et al. 2020, through the `nv-flip`

@@ -206,18 +206,9 @@ pub fn vrao_cases(base: &Settings, options: &PeerOptions) -> Vec<BenchCase> {
 pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result<PeerRun> {
     check_options(options)?;
     let cases = vrao_cases(base, options);
-    for case in &cases {
-        let mut s = base.clone();
-        (s.ao.technique, s.ao.samples, s.ao.resolution) =
-            (case.technique, case.samples, crate::render::settings::Resolution::from_half_res(case.half_res));
-        s.validate()?;
-    }
-    let work = options.out.join("peer-work");
-    std::fs::create_dir_all(&work).map_err(|e| Error::Output { path: work.clone(), message: e.to_string() })?;
+    check_cases(base, &cases)?;
+    let work = peer_work_dir(options)?;
     let gltf = &options.gltf;
-    if !options.presets.is_empty() && !gltf.is_file() {
-        return Err(Error::input(format!("no glTF of the scene for the peer at {}", gltf.display())));
-    }
     let (width, height) = (base.profile.width, base.profile.height);
     let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near);
     let gpu = Arc::new(Gpu::new(options.backend)?);
@@ -263,43 +254,10 @@ pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result
     let ppd = eyes.eyes.iter().map(|e| pixels_per_degree(&e.fov, width)).sum::<f64>() / eyes.eyes.len() as f64;
     let mask = crate::xr::profiles::visibility_mask(&base.profile);
     let visible = reference.visible_only(&crate::measure::bench::lens_coverage(&mask, base, &eyes.eyes));
-    let mut rows = Vec::new();
-    for (k, name) in options.presets.iter().enumerate() {
-        let per_eye: Vec<f64> =
-            (0..eyes.eyes.len()).map(|e| median(peer_rounds.iter().map(|r| r[k].1[e].0).collect())).collect();
-        let last = &peer_rounds.last().expect("a round ran")[k].1;
-        let occlusion: Vec<Vec<f32>> = last.iter().map(|(_, ao)| rgba_of(ao)).collect();
-        // Scored as the bench scores vrao's rows: on the pixels the lens shows, the
-        // whole rectangle beside.
-        let mut error = score(Technique::Gtao, &occlusion, &visible, Some(&limit), ppd, &fovs);
-        error.ao_rmse_whole = Some(score(Technique::Gtao, &occlusion, reference, Some(&limit), ppd, &fovs).ao_rmse);
-        let stereo: f64 = per_eye.iter().sum();
-        rows.push(PeerRow {
-            family: Family::Bevy,
-            setting: name.clone(),
-            ms_per_eye: stereo / per_eye.len() as f64,
-            ms_stereo: stereo,
-            error,
-        });
-    }
-    let mut vrao_passes = Vec::new();
-    for (i, case) in cases.iter().enumerate() {
-        let per_eye = median(vrao_rounds.iter().map(|r| r[i].occlusion_ms_per_eye()).collect());
-        let last = &vrao_rounds.last().expect("a round ran")[i];
-        for pass in &last.occlusion_passes {
-            if !vrao_passes.iter().any(|p: &String| p == pass) {
-                vrao_passes.push(pass.to_string());
-            }
-        }
-        let error = last.error.clone().ok_or_else(|| Error::Gpu("a vrao row was not scored".into()))?;
-        rows.push(PeerRow {
-            family: Family::Vrao,
-            setting: setting_name(case),
-            ms_per_eye: per_eye,
-            ms_stereo: per_eye * last.views as f64,
-            error,
-        });
-    }
+    let scoring = PeerScoring { reference, visible: &visible, limit: &limit, ppd, fovs: &fovs };
+    let mut rows = bevy_rows(&options.presets, &peer_rounds, eyes.eyes.len(), &scoring);
+    let (vrao_rows, vrao_passes) = vrao_rows(&cases, &vrao_rounds)?;
+    rows.extend(vrao_rows);
     let run = PeerRun {
         scene: scene.name.clone(),
         width,
@@ -318,6 +276,89 @@ pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result
     };
     write_side_by_side(&options.out, &run, &peer_rounds, options, &vrao_default, reference)?;
     Ok(run)
+}
+
+/// The folder the peer's rounds write into (made), once the glTF it reads is known to
+/// exist (when some Bevy preset runs).
+fn peer_work_dir(options: &PeerOptions) -> Result<PathBuf> {
+    let work = options.out.join("peer-work");
+    std::fs::create_dir_all(&work).map_err(|e| Error::Output { path: work.clone(), message: e.to_string() })?;
+    let gltf = &options.gltf;
+    if !options.presets.is_empty() && !gltf.is_file() {
+        return Err(Error::input(format!("no glTF of the scene for the peer at {}", gltf.display())));
+    }
+    Ok(work)
+}
+
+/// Validates each vrao case's settings before any work.
+fn check_cases(base: &Settings, cases: &[BenchCase]) -> Result<()> {
+    for case in cases {
+        let mut s = base.clone();
+        (s.ao.technique, s.ao.samples, s.ao.resolution) =
+            (case.technique, case.samples, crate::render::settings::Resolution::from_half_res(case.half_res));
+        s.validate()?;
+    }
+    Ok(())
+}
+
+/// What a peer's AO is scored against: the reference (whole and on the pixels the lens
+/// shows), the screen-space limit, and the views' pixel density and fields of view.
+struct PeerScoring<'a> {
+    reference: &'a ReferenceImage,
+    visible: &'a ReferenceImage,
+    limit: &'a ScreenLimit,
+    ppd: f64,
+    fovs: &'a [crate::render::stereo::Fov],
+}
+
+/// The Bevy rows, one per preset: the median time per eye over the rounds, and the last
+/// round's AO scored (over `views` eyes).
+fn bevy_rows(presets: &[String], peer_rounds: &[PeerRound], views: usize, scoring: &PeerScoring) -> Vec<PeerRow> {
+    let PeerScoring { reference, visible, limit, ppd, fovs } = *scoring;
+    let mut rows = Vec::new();
+    for (k, name) in presets.iter().enumerate() {
+        let per_eye: Vec<f64> = (0..views).map(|e| median(peer_rounds.iter().map(|r| r[k].1[e].0).collect())).collect();
+        let last = &peer_rounds.last().expect("a round ran")[k].1;
+        let occlusion: Vec<Vec<f32>> = last.iter().map(|(_, ao)| rgba_of(ao)).collect();
+        // Scored as the bench scores vrao's rows: on the pixels the lens shows, the
+        // whole rectangle beside.
+        let mut error = score(Technique::Gtao, &occlusion, visible, Some(limit), ppd, fovs);
+        error.ao_rmse_whole = Some(score(Technique::Gtao, &occlusion, reference, Some(limit), ppd, fovs).ao_rmse);
+        let stereo: f64 = per_eye.iter().sum();
+        rows.push(PeerRow {
+            family: Family::Bevy,
+            setting: name.clone(),
+            ms_per_eye: stereo / per_eye.len() as f64,
+            ms_stereo: stereo,
+            error,
+        });
+    }
+    rows
+}
+
+/// The vrao rows, one per case: the median time per eye over the rounds and the last
+/// round's score; with the passes the cases ran, each named once.
+fn vrao_rows(cases: &[BenchCase], vrao_rounds: &[Vec<BenchRow>]) -> Result<(Vec<PeerRow>, Vec<String>)> {
+    let mut rows = Vec::new();
+    let mut vrao_passes = Vec::new();
+    for (i, case) in cases.iter().enumerate() {
+        let per_eye = median(vrao_rounds.iter().map(|r| r[i].occlusion_ms_per_eye()).collect());
+        let last = &vrao_rounds.last().expect("a round ran")[i];
+        for pass in &last.occlusion_passes {
+            if !vrao_passes.iter().any(|p: &String| p == pass) {
+                vrao_passes.push(pass.to_string());
+            }
+        }
+        let error = last.error.clone().ok_or_else(|| Error::Gpu("a vrao row was not scored".into()))?;
+        rows.push(PeerRow {
+            family: Family::Vrao,
+            setting: setting_name(case),
+            ms_per_eye: per_eye,
+            ms_stereo: per_eye * last.views as f64,
+            error,
+        });
+    }
+    Ok((rows, vrao_passes))
 }
 
 /// "gtao 24 half": a vrao case as the table names it.

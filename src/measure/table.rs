@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 /// How long each scene's first row renders before it is measured (when the run warms up
 /// at all), and at most how many frames that takes. A GPU that idled has clocked down:
 /// a warm-up of a few rounds left the first row far slower than every later one
-/// (docs/measurements-in-code.md, table-settle-time).
+/// (docs/records/2026-11-29/measurements-in-code.md, table-settle-time).
 const SETTLE_TIME: Duration = Duration::from_millis(1500);
 const SETTLE_MAX_ROUNDS: u32 = 500;
 

@@ -112,12 +112,10 @@ struct AoParams {
     blur_plane_sigma: f32,
     // Sample-length scale this frame (temporal range jitter; 1 otherwise).
     range_scale: f32,
-    // Fixed foveation (settings::FoveationMap): the tangents of the angles off the view
-    // axis where the sample count starts to fall and where it reaches `foveation_edge_rate`
-    // of the full count (occlusion.wgsl `foveated_count`).
-    foveation_full_rate_tan: f32,
-    foveation_edge_tan: f32,
-    foveation_edge_rate: f32,
+    // Pads the struct to 80 bytes, a multiple of 16 (`padding` of AoParamsUniform).
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // The full-resolution G-buffer pixel that stands for occlusion pixel `p` (its top-left
@@ -358,7 +356,7 @@ fn plane_offset_of(plane: TapPlane, distance: f32, k: f32) -> f32 {
 // sender's light, instead of a depth fetch plus a sender fetch. At headset sizes the
 // texel's size decides how much of the texture stays in cache: the earlier 16-byte
 // texel made the bounce relatively costlier at full size than at a quarter of the
-// pixels (docs/measurements-in-code.md, direct-texel).
+// pixels (docs/records/2026-11-29/measurements-in-code.md, direct-texel).
 const MAX_RGB9E5: f32 = 65408.0;
 
 fn pack_rgb9e5(c: vec3<f32>) -> u32 {

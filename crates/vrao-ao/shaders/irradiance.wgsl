@@ -10,7 +10,7 @@ const RADIANCE: u32 = 2u;
 // `first` (IRRADIANCE or RADIANCE), in eye `layer`, from the moments m0 = Σc, m1 = Σcω and
 // Σcωωᵀ (diagonal, and off-diagonal as xy, xz, yz). Reads the uniform in place: with
 // the array copied by value into a local, SSDO ran slower on lavapipe
-// (docs/measurements-in-code.md, irradiance-in-place).
+// (docs/records/2026-11-29/measurements-in-code.md, irradiance-in-place).
 fn quadratic_sum(first: u32, layer: u32, m0: f32, m1: vec3<f32>, diag: vec3<f32>, off: vec3<f32>) -> vec3<f32> {
     let q = &frame.environment_quadratics[first + layer];
     return q[0].xyz * m0 + q[1].xyz * m1.x + q[2].xyz * m1.y + q[3].xyz * m1.z

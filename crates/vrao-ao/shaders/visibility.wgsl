@@ -23,5 +23,5 @@ fn pixel_shown(p: vec2<u32>, layer: u32) -> bool {
 // At and below this rate (the outer half of foveation's fall-off and beyond) the
 // upsampling thins as the technique's sampling does (joint_upsample.wgsl
 // `foveated_quad`). The denoise does not: filtering the periphery along one axis only
-// raised the stereo-inconsistent points from 0.8 % to 1.8 % (docs/measurements.md).
+// raised the stereo-inconsistent points from 0.8 % to 1.8 % (docs/records/2026-11-29/summary.md).
 const THIN_BELOW_RATE: f32 = 0.75;

@@ -288,7 +288,7 @@ impl Foveation {
             // Half, not less: a marching technique's half is one of its two slices with
             // every step (unbiased: the slices turn with the noise tile); a third took
             // steps too, which lightened the edges and saved little more, the per-pixel
-            // set-up and denoise staying the same (docs/measurements-in-code.md,
+            // set-up and denoise staying the same (docs/records/2026-11-29/measurements-in-code.md,
             // foveation-high).
             Foveation::High => FoveationMap { full_rate_deg: 15.0, edge_deg: 30.0, edge_rate: 0.5 },
         }

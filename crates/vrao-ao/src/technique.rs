@@ -104,6 +104,9 @@ pub struct TechniqueEntry {
     pub technique: Technique,
     /// Its command-line name, also its pass's name and the name in files and reports.
     pub name: &'static str,
+    /// What the command line's help says of it after its name ("": nothing);
+    /// [`Technique::help_list`].
+    pub help: &'static str,
     /// What kind of estimate it makes.
     pub kind: TechniqueKind,
     /// How the composite applies it.
@@ -122,6 +125,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::None,
         name: "none",
+        help: "",
         kind: TechniqueKind::Off,
         composite: CompositeMode::Unoccluded,
         samples: SamplePattern::Nothing,
@@ -131,6 +135,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::Ssao,
         name: "ssao",
+        help: "",
         kind: TechniqueKind::Hemisphere,
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::HemisphereCosine,
@@ -140,6 +145,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::Hbao,
         name: "hbao",
+        help: "",
         kind: TechniqueKind::HorizonMarch,
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::Directions,
@@ -149,6 +155,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::Gtao,
         name: "gtao",
+        help: "the most accurate per millisecond",
         kind: TechniqueKind::HorizonMarch,
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::Directions,
@@ -158,6 +165,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::Ssdo,
         name: "ssdo",
+        help: "GTAO's march gathering the environment",
         kind: TechniqueKind::LightGathering,
         composite: CompositeMode::Directional,
         samples: SamplePattern::Directions,
@@ -167,6 +175,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::SsdoBounce,
         name: "ssdo-bounce",
+        help: "ssdo and one bounce of direct light",
         kind: TechniqueKind::LightGathering,
         composite: CompositeMode::Directional,
         samples: SamplePattern::Directions,
@@ -176,6 +185,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::SsdoPoints,
         name: "ssdo-points",
+        help: "the seeds' point-sampled SSDO, a baseline",
         kind: TechniqueKind::LightGathering,
         composite: CompositeMode::Directional,
         samples: SamplePattern::HemisphereUniform,
@@ -185,6 +195,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::SsdoPointsBounce,
         name: "ssdo-points-bounce",
+        help: "ssdo-points and its point-sampled bounce",
         kind: TechniqueKind::LightGathering,
         composite: CompositeMode::Directional,
         samples: SamplePattern::HemisphereUniform,
@@ -194,6 +205,7 @@ pub const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::FetchOnly,
         name: "fetch-only",
+        help: "the benchmark baseline with SSAO's depth taps and no occlusion arithmetic",
         kind: TechniqueKind::Baseline,
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::HemisphereCosine,
@@ -217,6 +229,28 @@ impl Technique {
     /// The technique's line of [`TECHNIQUES`].
     pub fn entry(self) -> &'static TechniqueEntry {
         TECHNIQUES.iter().find(|e| e.technique == self).expect("every technique has a line (checked by a test)")
+    }
+
+    /// Every technique's name in [`TECHNIQUES`]' order with its help in brackets (the
+    /// default's marked), the last after "or": the list the command line's help shows.
+    pub fn help_list() -> String {
+        let items: Vec<String> = TECHNIQUES
+            .iter()
+            .map(|e| {
+                let default = e.technique == Technique::default();
+                match (default, e.help) {
+                    (false, "") => e.name.to_string(),
+                    (false, help) => format!("{} ({help})", e.name),
+                    (true, "") => format!("{} (the default)", e.name),
+                    (true, help) => format!("{} (the default: {help})", e.name),
+                }
+            })
+            .collect();
+        match items.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => String::new(),
+        }
     }
 
     /// The technique's command-line name (`ssao`, `hbao`, …), also used in file names and reports.
@@ -317,6 +351,17 @@ mod tests {
                 | Technique::FetchOnly => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
             }
         }
+    }
+
+    #[test]
+    fn the_help_list_names_every_technique_from_the_table() {
+        let list = Technique::help_list();
+        for e in &TECHNIQUES {
+            assert!(list.contains(e.name), "{} missing from {list}", e.name);
+        }
+        assert!(list.starts_with("none, ssao, hbao, gtao (the default: the most accurate"), "{list}");
+        assert!(list
+            .ends_with(" or fetch-only (the benchmark baseline with SSAO's depth taps and no occlusion arithmetic)"));
     }
 
     #[test]

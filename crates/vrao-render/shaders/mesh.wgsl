@@ -75,7 +75,7 @@ fn placed(k: u32, uv: vec2<f32>) -> vec2<f32> {
 // The material's albedo at `uv` times the vertex colour, in 0..1. Call it in uniform
 // control flow, every fragment (untextured materials bind a white texel): sampling inside
 // a branch made lavapipe 22.3 leak memory at every draw
-// (docs/measurements-in-code.md, mesh-albedo-leak).
+// (docs/records/2026-11-29/measurements-in-code.md, mesh-albedo-leak).
 fn material_albedo(uv: vec2<f32>, color: vec4<f32>) -> vec3<f32> {
     let texel = textureSample(diffuse_texture, diffuse_sampler, placed(DIFFUSE, uv)).rgb;
     let albedo = material.diffuse.rgb * select(vec3<f32>(1.0), texel, material.diffuse.w > 0.5) * color.rgb;

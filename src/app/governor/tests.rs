@@ -130,7 +130,7 @@ fn run(
 
 /// The two frontiers with a device for each: the synthetic one as benched; the
 /// built-in (benched on lavapipe) on a device 20× faster, with little else in the frame
-/// so that its close levels can be told apart (docs/measurements-in-code.md,
+/// so that its close levels can be told apart (docs/records/2026-11-29/measurements-in-code.md,
 /// governor-builtin-frontier).
 fn frontiers() -> Vec<(&'static str, Frontier, f64, f64)> {
     vec![("synthetic", synthetic(), 3.0, 1.0), ("built-in", Frontier::builtin(), 0.25, 0.05)]

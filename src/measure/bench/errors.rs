@@ -41,7 +41,7 @@ pub struct ErrorFigures {
     pub flip_mean: Option<f64>,
     /// RMSE against the screen-space limit (the march over this frame's depth buffer):
     /// the estimator's own error (the limit's small noise left in; see
-    /// docs/measurements-in-code.md, limit-noise).
+    /// docs/records/2026-11-29/measurements-in-code.md, limit-noise).
     pub ao_rmse_vs_limit: Option<f64>,
     /// The screen-space limit's RMSE against the reference (the reference's noise taken
     /// out, as for `ao_rmse`): the error no depth-buffer method can remove. The same for
@@ -310,7 +310,7 @@ fn ambient_rel_rmse(cells: &[Cell], hits: f64, k: usize) -> Option<f64> {
 /// The limit against the reference has the reference's noise taken out, as `ao_rmse`
 /// (so the two compare directly). The limit's own noise is not subtracted: its binomial
 /// bound ignores the stratification of its rays and is well above what they leave, so
-/// subtracting it would zero real error (docs/measurements-in-code.md, limit-bound).
+/// subtracting it would zero real error (docs/records/2026-11-29/measurements-in-code.md, limit-bound).
 fn limit_figures(cells: &[Cell]) -> (Option<f64>, Option<f64>, Option<f64>) {
     let both = cells.iter().filter(|c| c.limit_hit).count();
     if both == 0 {

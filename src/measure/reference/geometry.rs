@@ -147,6 +147,84 @@ pub(crate) struct SceneGeometry {
     has_holes: bool,
 }
 
+/// A scene's triangles as they are flattened, before the BVH puts them in leaf order.
+struct Flattened {
+    tris: Vec<Tri>,
+    attributes: Vec<TriAttributes>,
+    extras: Vec<TriExtras>,
+}
+
+impl Flattened {
+    /// Adds `mesh`'s triangles relative to `anchor`, leaving out those with a non-finite
+    /// vertex or no area; an index or material out of range is an input error.
+    fn add_mesh(&mut self, mesh: &Mesh, materials: &[Material], anchor: DVec3) -> Result<()> {
+        if mesh.material >= materials.len() {
+            return Err(Error::input(format!(
+                "mesh '{}' uses material {} of {}",
+                mesh.name,
+                mesh.material,
+                materials.len()
+            )));
+        }
+        let offset = mesh.origin - anchor;
+        let count = mesh.positions.len();
+        let has_normals = mesh.normals.len() == count;
+        let has_uvs = mesh.uvs.len() == count;
+        let has_colors = mesh.colors.len() == count;
+        let normal_mapped = materials[mesh.material].normal_texture.is_some();
+        let has_tangents = normal_mapped && mesh.tangents.len() == count;
+        for t in mesh.indices.chunks_exact(3) {
+            let idx = [t[0] as usize, t[1] as usize, t[2] as usize];
+            if idx.iter().any(|&i| i >= count) {
+                return Err(Error::input(format!(
+                    "mesh '{}' has a triangle index out of range ({:?} of {count} vertices)",
+                    mesh.name, idx
+                )));
+            }
+            let p = idx.map(|i| (offset + mesh.positions[i].as_dvec3()).as_vec3());
+            let geometric = (p[1] - p[0]).cross(p[2] - p[0]);
+            let length = geometric.length();
+            if !(p.iter().all(|v| v.is_finite()) && length > 0.0 && length.is_finite()) {
+                continue;
+            }
+            self.tris.push(Tri { p: p.map(|v| v.to_array()) });
+            let extra = if has_colors || has_tangents {
+                self.extras.push(TriExtras {
+                    colors: idx.map(|i| if has_colors { mesh.colors[i] } else { Vec4::ONE }),
+                    tangents: idx.map(|i| if has_tangents { mesh.tangents[i] } else { Vec4::ZERO }),
+                });
+                (self.extras.len() - 1) as u32
+            } else {
+                NO_EXTRAS
+            };
+            self.attributes.push(TriAttributes {
+                normals: idx.map(|i| if has_normals { mesh.normals[i] } else { Vec3::ZERO }),
+                uvs: idx.map(|i| if has_uvs { mesh.uvs[i] } else { Vec2::ZERO }),
+                geometric: geometric / length,
+                material: mesh.material as u32,
+                extras: extra,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The BVH over `tris` (`None` without triangles), with `tris` and `attributes` put in
+/// its leaf order so that a leaf's primitive id indexes them directly.
+fn leaf_ordered_bvh(tris: &mut Vec<Tri>, attributes: &mut Vec<TriAttributes>) -> Option<CwBvh> {
+    if tris.is_empty() {
+        return None;
+    }
+    let boxes: Vec<Triangle> =
+        tris.iter().map(|t| Triangle { v0: t.p[0].into(), v1: t.p[1].into(), v2: t.p[2].into() }).collect();
+    let bvh =
+        obvhs::cwbvh::builder::build_cwbvh_from_tris(&boxes, BvhBuildParams::medium_build(), &mut Duration::default());
+    // Store the triangles in leaf order (without pre-splits this is a permutation).
+    *tris = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+    *attributes = bvh.primitive_indices.iter().map(|&i| attributes[i as usize]).collect();
+    Some(bvh)
+}
+
 impl SceneGeometry {
     /// Flattens `scene` relative to `anchor` and builds the BVH. Triangles with a
     /// non-finite vertex or no area are left out (they rasterise to nothing); an index or
@@ -161,73 +239,16 @@ impl SceneGeometry {
             frozen = scene.at_time(0.0);
             &frozen
         };
-        let mut tris = Vec::with_capacity(scene.triangle_count());
-        let mut attributes = Vec::with_capacity(scene.triangle_count());
-        let mut extras = Vec::new();
-        for mesh in &scene.meshes {
-            if mesh.material >= scene.materials.len() {
-                return Err(Error::input(format!(
-                    "mesh '{}' uses material {} of {}",
-                    mesh.name,
-                    mesh.material,
-                    scene.materials.len()
-                )));
-            }
-            let offset = mesh.origin - anchor;
-            let count = mesh.positions.len();
-            let has_normals = mesh.normals.len() == count;
-            let has_uvs = mesh.uvs.len() == count;
-            let has_colors = mesh.colors.len() == count;
-            let normal_mapped = scene.materials[mesh.material].normal_texture.is_some();
-            let has_tangents = normal_mapped && mesh.tangents.len() == count;
-            for t in mesh.indices.chunks_exact(3) {
-                let idx = [t[0] as usize, t[1] as usize, t[2] as usize];
-                if idx.iter().any(|&i| i >= count) {
-                    return Err(Error::input(format!(
-                        "mesh '{}' has a triangle index out of range ({:?} of {count} vertices)",
-                        mesh.name, idx
-                    )));
-                }
-                let p = idx.map(|i| (offset + mesh.positions[i].as_dvec3()).as_vec3());
-                let geometric = (p[1] - p[0]).cross(p[2] - p[0]);
-                let length = geometric.length();
-                if !(p.iter().all(|v| v.is_finite()) && length > 0.0 && length.is_finite()) {
-                    continue;
-                }
-                tris.push(Tri { p: p.map(|v| v.to_array()) });
-                let extra = if has_colors || has_tangents {
-                    extras.push(TriExtras {
-                        colors: idx.map(|i| if has_colors { mesh.colors[i] } else { Vec4::ONE }),
-                        tangents: idx.map(|i| if has_tangents { mesh.tangents[i] } else { Vec4::ZERO }),
-                    });
-                    (extras.len() - 1) as u32
-                } else {
-                    NO_EXTRAS
-                };
-                attributes.push(TriAttributes {
-                    normals: idx.map(|i| if has_normals { mesh.normals[i] } else { Vec3::ZERO }),
-                    uvs: idx.map(|i| if has_uvs { mesh.uvs[i] } else { Vec2::ZERO }),
-                    geometric: geometric / length,
-                    material: mesh.material as u32,
-                    extras: extra,
-                });
-            }
-        }
-        let bvh = if tris.is_empty() {
-            None
-        } else {
-            let boxes: Vec<Triangle> =
-                tris.iter().map(|t| Triangle { v0: t.p[0].into(), v1: t.p[1].into(), v2: t.p[2].into() }).collect();
-            let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-                &boxes,
-                BvhBuildParams::medium_build(),
-                &mut Duration::default(),
-            );
-            // Store the triangles in leaf order (without pre-splits this is a permutation).
-            tris = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
-            attributes = bvh.primitive_indices.iter().map(|&i| attributes[i as usize]).collect();
-            Some(bvh)
+        let mut flat = Flattened {
+            tris: Vec::with_capacity(scene.triangle_count()),
+            attributes: Vec::with_capacity(scene.triangle_count()),
+            extras: Vec::new(),
         };
+        for mesh in &scene.meshes {
+            flat.add_mesh(mesh, &scene.materials, anchor)?;
+        }
+        let Flattened { mut tris, mut attributes, extras } = flat;
+        let bvh = leaf_ordered_bvh(&mut tris, &mut attributes);
         let materials: Vec<SurfaceMaterial> = scene
             .materials
             .iter()

@@ -49,7 +49,7 @@
 //! test (so ours is a watertight one, `geometry.rs`) and uses glam 0.34 itself. `bvh`
 //! (0.13) is built on nalgebra and hands out candidate primitives (a list, or an iterator
 //! in box order) with no ray extent, so a ray of length r cannot stop early. Both build
-//! about as fast, and obvhs traces far faster (docs/measurements-in-code.md,
+//! about as fast, and obvhs traces far faster (docs/records/2026-11-29/measurements-in-code.md,
 //! reference-bvh). Pixel rows are the work units of a rayon parallel iterator over all
 //! cores.
 //!

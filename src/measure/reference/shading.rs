@@ -275,6 +275,110 @@ impl Estimator<'_> {
         rng: &mut Rng,
         points: &mut Vec<(f64, f64)>,
     ) -> PointEstimate {
+        let frame = Hemisphere::at(surface, view_dir);
+        stratified_points(self.rays_per_pixel, rng, points);
+        let mut sums = RaySums::default();
+        for &(u, v) in points.iter() {
+            self.trace(surface, &frame, (u, v), &mut sums);
+        }
+        self.point_estimate(&sums, frame.ns)
+    }
+
+    /// Traces the ray of stratified point `(u, v)` (mapped cosine-weighted onto the
+    /// hemisphere) and adds what it found to `sums`: an occluder's direct light, or the
+    /// environment through an open direction.
+    fn trace(&self, surface: &Surface, frame: &Hemisphere, (u, v): (f64, f64), sums: &mut RaySums) {
+        let (t, b, ns, ng) = (frame.t, frame.b, frame.ns, frame.ng);
+        let (x, y) = concentric_disk(u, v);
+        let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+        let dir = (t * x + b * y + ns * z).normalize();
+        if dir.dot(ng) < BELOW_SURFACE {
+            sums.occluded += 1;
+            sums.attenuated += 1.0;
+            return;
+        }
+        let dir32 = dir.as_vec3();
+        sums.rays += 1;
+        match self.geometry.closest(frame.origin, dir32, 0.0, self.radius as f32, surface.prim) {
+            Some(hit) => {
+                sums.occluded += 1;
+                sums.attenuated += (1.0 - hit.t as f64 / self.radius).clamp(0.0, 1.0);
+                let sender = self.geometry.surface(&hit);
+                let sent = direct_out(self.geometry, self.lighting, &sender, dir32).as_dvec3();
+                sums.bounce += sent;
+                let sq = squares(sent);
+                for (k, s) in sq.into_iter().enumerate() {
+                    sums.ambient2[k] += s;
+                    sums.bounce2[k] += s;
+                }
+            }
+            None => {
+                if let Some(env) = self.lighting.environment {
+                    let seen = env.sample(dir32).as_dvec3();
+                    sums.visible_env += seen;
+                    let sq = squares(seen);
+                    for (sum, s) in sums.ambient2.iter_mut().zip(sq) {
+                        *sum += s;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The point's estimates from its rays' sums; `ns` is the shading normal the
+    /// hemisphere was taken about.
+    fn point_estimate(&self, sums: &RaySums, ns: DVec3) -> PointEstimate {
+        let m = self.rays_per_pixel as f64;
+        let p = sums.occluded as f64 / m;
+        // Sample standard deviation of the 0/1 occlusion indicator over √M. For one ray
+        // there is no spread to measure: state the largest a 0/1 variable can have.
+        let ao_std_error = if self.rays_per_pixel > 1 { (p * (1.0 - p) / (m - 1.0)).max(0.0).sqrt() } else { 0.5 };
+        // With the cosine-weighted pdf cos θ / π, ∫ f cos θ dω ≈ (π / M) Σ f.
+        let scale = PI / m;
+        let unoccluded = self.lighting.environment.map_or(Vec3::ZERO, |env| env.irradiance(ns.as_vec3()));
+        PointEstimate {
+            ao: 1.0 - p,
+            ao_falloff: (1.0 - sums.attenuated / m).clamp(0.0, 1.0),
+            ao_std_error,
+            environment_visible: (sums.visible_env * scale).to_array(),
+            bounce: (sums.bounce * scale).to_array(),
+            unoccluded: unoccluded.as_dvec3().to_array(),
+            ambient_std_error: self.std_error(sums.visible_env + sums.bounce, sums.ambient2),
+            bounce_std_error: self.std_error(sums.bounce, sums.bounce2),
+            rays: sums.rays,
+        }
+    }
+
+    /// The standard error of (π / M) Σ x from the rays' own spread (0 for one ray), per
+    /// channel and for luminance, from the sum of x and of its squares.
+    fn std_error(&self, sum: DVec3, sum2: [f64; 4]) -> [f64; 4] {
+        let m = self.rays_per_pixel as f64;
+        let lum = 0.2126 * sum.x + 0.7152 * sum.y + 0.0722 * sum.z;
+        let sums = [sum.x, sum.y, sum.z, lum];
+        std::array::from_fn(|k| {
+            if self.rays_per_pixel < 2 {
+                return 0.0;
+            }
+            let variance = ((sum2[k] - sums[k] * sums[k] / m) / (m - 1.0)).max(0.0);
+            PI * (variance / m).sqrt()
+        })
+    }
+}
+
+/// Where a surface point's rays leave from: the hemisphere about the shading normal `ns`
+/// (with tangents `t`, `b`), flipped to face the eye as the G-buffer does, and the ray
+/// origin pushed off the surface along the geometric normal `ng` on the eye's side.
+struct Hemisphere {
+    ng: DVec3,
+    ns: DVec3,
+    t: DVec3,
+    b: DVec3,
+    origin: Vec3,
+}
+
+impl Hemisphere {
+    /// The hemisphere at `surface`, seen along unit `view_dir` (from the eye towards it).
+    fn at(surface: &Surface, view_dir: Vec3) -> Hemisphere {
         let mut ng = surface.geometric.as_dvec3();
         if ng.dot(view_dir.as_dvec3()) > 0.0 {
             ng = -ng;
@@ -287,86 +391,32 @@ impl Estimator<'_> {
         let (t, b) = orthonormal_basis(ns);
         let offset = OFFSET_ULPS * surface.magnitude.max(f32::MIN_POSITIVE);
         let origin = surface.position + ng.as_vec3() * offset;
-        let radius = self.radius as f32;
-
-        stratified_points(self.rays_per_pixel, rng, points);
-        let (mut occluded, mut attenuated, mut rays) = (0u64, 0f64, 0u64);
-        let mut visible_env = DVec3::ZERO;
-        let mut bounce = DVec3::ZERO;
-        // Sums of squares per ray (r, g, b, luminance) for the light's standard errors.
-        let (mut ambient2, mut bounce2) = ([0f64; 4], [0f64; 4]);
-        let squares = |c: DVec3| {
-            let lum = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-            [c.x * c.x, c.y * c.y, c.z * c.z, lum * lum]
-        };
-        for &(u, v) in points.iter() {
-            let (x, y) = concentric_disk(u, v);
-            let z = (1.0 - x * x - y * y).max(0.0).sqrt();
-            let dir = (t * x + b * y + ns * z).normalize();
-            if dir.dot(ng) < BELOW_SURFACE {
-                occluded += 1;
-                attenuated += 1.0;
-                continue;
-            }
-            let dir32 = dir.as_vec3();
-            rays += 1;
-            match self.geometry.closest(origin, dir32, 0.0, radius, surface.prim) {
-                Some(hit) => {
-                    occluded += 1;
-                    attenuated += (1.0 - hit.t as f64 / self.radius).clamp(0.0, 1.0);
-                    let sender = self.geometry.surface(&hit);
-                    let sent = direct_out(self.geometry, self.lighting, &sender, dir32).as_dvec3();
-                    bounce += sent;
-                    let sq = squares(sent);
-                    for k in 0..4 {
-                        ambient2[k] += sq[k];
-                        bounce2[k] += sq[k];
-                    }
-                }
-                None => {
-                    if let Some(env) = self.lighting.environment {
-                        let seen = env.sample(dir32).as_dvec3();
-                        visible_env += seen;
-                        let sq = squares(seen);
-                        for k in 0..4 {
-                            ambient2[k] += sq[k];
-                        }
-                    }
-                }
-            }
-        }
-        let m = self.rays_per_pixel as f64;
-        let p = occluded as f64 / m;
-        // Sample standard deviation of the 0/1 occlusion indicator over √M. For one ray
-        // there is no spread to measure: state the largest a 0/1 variable can have.
-        let ao_std_error = if self.rays_per_pixel > 1 { (p * (1.0 - p) / (m - 1.0)).max(0.0).sqrt() } else { 0.5 };
-        // With the cosine-weighted pdf cos θ / π, ∫ f cos θ dω ≈ (π / M) Σ f.
-        let scale = PI / m;
-        let unoccluded = self.lighting.environment.map_or(Vec3::ZERO, |env| env.irradiance(ns.as_vec3()));
-        // The standard error of (π / M) Σ x from the rays' own spread (0 for one ray).
-        let std_error = |sum: DVec3, sum2: [f64; 4]| -> [f64; 4] {
-            let lum = 0.2126 * sum.x + 0.7152 * sum.y + 0.0722 * sum.z;
-            let sums = [sum.x, sum.y, sum.z, lum];
-            std::array::from_fn(|k| {
-                if self.rays_per_pixel < 2 {
-                    return 0.0;
-                }
-                let variance = ((sum2[k] - sums[k] * sums[k] / m) / (m - 1.0)).max(0.0);
-                PI * (variance / m).sqrt()
-            })
-        };
-        PointEstimate {
-            ao: 1.0 - p,
-            ao_falloff: (1.0 - attenuated / m).clamp(0.0, 1.0),
-            ao_std_error,
-            environment_visible: (visible_env * scale).to_array(),
-            bounce: (bounce * scale).to_array(),
-            unoccluded: unoccluded.as_dvec3().to_array(),
-            ambient_std_error: std_error(visible_env + bounce, ambient2),
-            bounce_std_error: std_error(bounce, bounce2),
-            rays,
-        }
+        Hemisphere { ng, ns, t, b, origin }
     }
+}
+
+/// What one point's rays found, summed as they are traced.
+#[derive(Default)]
+struct RaySums {
+    /// Directions blocked (below the surface or hitting within the radius).
+    occluded: u64,
+    /// Σ of each direction's occlusion with distance falloff (1 at the surface).
+    attenuated: f64,
+    /// Rays traced.
+    rays: u64,
+    /// The environment's radiance through the open directions.
+    visible_env: DVec3,
+    /// The occluders' outgoing direct light.
+    bounce: DVec3,
+    /// Sums of squares per ray (r, g, b, luminance) for the light's standard errors.
+    ambient2: [f64; 4],
+    bounce2: [f64; 4],
+}
+
+/// The squares of a ray's light (r, g, b and its luminance), for the standard errors.
+fn squares(c: DVec3) -> [f64; 4] {
+    let lum = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+    [c.x * c.x, c.y * c.y, c.z * c.z, lum * lum]
 }
 
 #[cfg(test)]

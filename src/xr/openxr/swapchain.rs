@@ -9,7 +9,7 @@
 //! plain copy into an sRGB swapchain would be byte-exact, but copies need the same
 //! channel order and leave the image in TRANSFER_DST layout, while OpenXR wants it back
 //! in COLOR_ATTACHMENT_OPTIMAL at release. So every format goes through a small render
-//! pass (xr_blit.wgsl) that decodes sRGB to linear and lets an sRGB swapchain
+//! pass (shaders/xr_blit.wgsl) that decodes sRGB to linear and lets an sRGB swapchain
 //! encode again (exact for 8 bits); a UNORM or float swapchain then holds linear values,
 //! which is how OpenXR runtimes read them. sRGB formats are preferred (8 bits per
 //! channel without banding), then float16, then UNORM. Depth goes through the same pass
@@ -210,7 +210,7 @@ impl EyeBlit {
     pub fn new(device: &wgpu::Device, color: wgpu::TextureFormat, depth: Option<wgpu::TextureFormat>) -> EyeBlit {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("openxr blit"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("xr_blit.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/xr_blit.wgsl").into()),
         });
         let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
             binding,

@@ -184,7 +184,7 @@ impl SimulatedHeadset {
             } else {
                 // Naps between non-blocking polls. Lavapipe makes polls and timed waits
                 // costly: polling often (or a blocking wait with a timeout) slowed its
-                // frames several-fold (docs/measurements-in-code.md, completion-poll); a
+                // frames several-fold (docs/records/2026-11-29/measurements-in-code.md, completion-poll); a
                 // finish is seen at most this late.
                 self.clock.wait_until(t.min(now + COMPLETION_POLL_S));
             }

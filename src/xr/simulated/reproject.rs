@@ -1,4 +1,4 @@
-//! The compositor's late warp (reproject.wgsl): a finished stereo frame is
+//! The compositor's late warp (shaders/reproject.wgsl): a finished stereo frame is
 //! re-presented at a newer head pose, rotationally (orientation only, a homography per
 //! eye) or positionally (the submitted depth forward-splatted into the new view).
 
@@ -35,7 +35,7 @@ impl ReprojectionMode {
     }
 }
 
-/// Mirrors `Reproject` in reproject.wgsl.
+/// Mirrors `Reproject` in shaders/reproject.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct ReprojectUniform {
@@ -62,7 +62,7 @@ pub struct Reprojector {
     visibility: crate::render::gpu::visibility::VisibilityMaps,
 }
 
-/// reproject.wgsl's bindings: the warp's uniform, the held depth and colour and their
+/// shaders/reproject.wgsl's bindings: the warp's uniform, the held depth and colour and their
 /// sampler, the splatted depths, the warped colour out (all the compositor's own).
 const BINDINGS: [Bind; 6] = [
     Bind::Own(Slot::Uniform),
@@ -77,7 +77,7 @@ impl Reprojector {
     /// Compiles the warp's kernels (splat, positional, rotational); a shader file that
     /// cannot be read (`VRAO_SHADER_DIR`) is the error.
     pub fn new(gpu: &Gpu) -> Result<Reprojector> {
-        let module = try_shader_module(gpu, "reproject", &[COMMON, wgsl!("src/xr/simulated/reproject.wgsl")])?;
+        let module = try_shader_module(gpu, "reproject", &[COMMON, wgsl!("shaders/reproject.wgsl")])?;
         let variant = |label, entry, positional: bool| {
             Kernel::from_module(gpu, label, &module, entry, &BINDINGS, &[("POSITIONAL", f64::from(positional))])
         };
@@ -174,4 +174,26 @@ pub fn output_target(gpu: &Gpu, (width, height, layers): (u32, u32, u32)) -> Lay
         (width, height, layers),
         wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
     )
+}
+
+/// The engine's test helper that checks the Rust mirrors of WGSL structs (naga is a
+/// dev-dependency of this crate for it).
+#[cfg(test)]
+#[path = "../../../crates/vrao-ao/src/gpu/layout_check.rs"]
+mod layout_check;
+
+#[cfg(test)]
+mod tests {
+    use super::layout_check::{self, mirror};
+    use super::*;
+
+    #[test]
+    fn the_reproject_uniform_matches_reproject_wgsl() {
+        // The files of `Reprojector::new`.
+        let files = [COMMON, wgsl!("shaders/reproject.wgsl")];
+        #[rustfmt::skip]
+        layout_check::check(&[
+            mirror!(ReprojectUniform, files, "Reproject", [source_from_target, target_from_source, source_tangents, target_tangents, size, layers, near]),
+        ]);
+    }
 }

@@ -408,3 +408,21 @@ fn read_layer(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Textur
     }
     bytes
 }
+
+/// The engine's test helper that checks the Rust mirrors of WGSL structs (the example
+/// builds as a test with the crate's: `test = true`).
+#[cfg(test)]
+#[path = "../../src/gpu/layout_check.rs"]
+mod layout_check;
+
+#[cfg(test)]
+mod tests {
+    use super::layout_check::{self, mirror};
+    use super::*;
+
+    #[test]
+    fn the_view_uniform_matches_the_prepass_wgsl() {
+        let prepass = [layout_check::Text { path: "examples/embed/host.rs PREPASS_WGSL", source: PREPASS_WGSL }];
+        layout_check::check(&[mirror!(ViewUniform, prepass, "View", [clip_from_world, view_from_world])]);
+    }
+}

@@ -266,3 +266,18 @@ impl Pass for ImportPass {
         }
     }
 }
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+    use crate::gpu::layout_check::{self, mirror};
+
+    #[test]
+    fn the_import_uniform_matches_import_wgsl() {
+        #[rustfmt::skip]
+        layout_check::check(&[
+            mirror!(ImportLayer, [IMPORT_WGSL], "ImportLayer", [view_from_world, tangents, depth_offset, depth_numerator, padding]),
+            mirror!(ImportParams, [IMPORT_WGSL], "ImportParams", [layers, size, near, reversed, host_normals, unsigned_normals, world_normals, padding]),
+        ]);
+    }
+}

@@ -307,6 +307,44 @@ impl AoEngine {
         let source = ImportSource::check(frame, config, &projections)?;
         let settings = host_settings(config, projections[0].near)?;
         let layers = config.views;
+        self.import_host_buffers(frame, layers);
+        self.import.set_source(source);
+        // SSDO's light: the host's direct light (imported, then packed with the depth by
+        // the light import pass) and its environment's quadratics in each view.
+        let direct = self.import_direct_light(frame, layers)?;
+        let environment = environment_quadratics(frame, &eyes)?;
+        let lighting = FrameLighting { environment: environment.as_ref(), ..FrameLighting::NONE };
+        let light_inputs = crate::passes::ssdo::LightInputs { direct: direct.is_some() };
+        let params = FrameParams {
+            settings: &settings,
+            extensions: &[&light_inputs],
+            alpha_cards: false,
+            anchor: glam::DVec3::ZERO,
+            multiview: false,
+            motion: &self.motion,
+            mask: self.mask.as_ref(),
+        };
+        let passes: Vec<&dyn Pass> = [&self.import as &dyn Pass, &self.light_import as &dyn Pass]
+            .into_iter()
+            .chain(self.chain.iter().map(|p| p.as_ref()))
+            .collect();
+        let imported = imported_resources(frame, direct.is_some());
+        let key = (settings.clone(), frame.motion.is_some(), direct.is_some());
+        let plan = self.driver.plan(&key, &passes, &params, layers, &[FINAL_AO], &imported)?;
+        self.driver.prepare(&self.gpu, &plan, &params, &lighting, &eyes);
+        // Kernels compile at their first frame: a device that cannot build one is refused
+        // here, as a typed error, not through the host's uncaptured-error handler.
+        let recorded = pipeline_errors_as_device(&self.gpu, || {
+            self.driver.record(&self.gpu, encoder, &passes, &plan, &params, &eyes, None, spans, Submission::OneEncoder)
+        })?;
+        recorded?;
+        self.driver.end_frame(&eyes);
+        self.output(encoder, &plan, spans)
+    }
+
+    /// Imports the host's depth, and its normals and motion vectors when given, as this
+    /// frame's graph inputs, and notes whether the frame has motion vectors.
+    fn import_host_buffers(&mut self, frame: &AoFrame, layers: u32) {
         let targets = self.driver.targets_mut();
         targets.import(&self.gpu, HOST_DEPTH, frame.depth, wgpu::TextureAspect::DepthOnly, layers);
         if let Some(normals) = &frame.normals {
@@ -324,61 +362,33 @@ impl AoEngine {
             }
             None => FrameMotion::STILL,
         };
-        self.import.set_source(source);
-        // SSDO's light: the host's direct light (imported, then packed with the depth by
-        // the light import pass) and its environment's quadratics in each view.
+    }
+
+    /// Checks and imports the host's direct light for SSDO, when the frame gives it: the
+    /// light import pass samples it as float, so an integer format is refused.
+    fn import_direct_light<'f>(&mut self, frame: &AoFrame<'f>, layers: u32) -> Result<Option<&'f wgpu::Texture>> {
         let direct = frame.light.and_then(|l| l.direct);
         if let Some(texture) = direct {
-            import::check_texture("direct light", texture, config)?;
+            import::check_texture("direct light", texture, &self.config)?;
             if texture.format().sample_type(None, None) != Some(wgpu::TextureSampleType::Float { filterable: true })
                 && texture.format().sample_type(None, None)
                     != Some(wgpu::TextureSampleType::Float { filterable: false })
             {
                 return Err(Error::input(format!("direct light: format {:?} is not float-sampled", texture.format())));
             }
-            targets.import(&self.gpu, light::HOST_DIRECT, texture, wgpu::TextureAspect::All, layers);
+            self.driver.targets_mut().import(&self.gpu, light::HOST_DIRECT, texture, wgpu::TextureAspect::All, layers);
         }
-        let environment = frame.light.and_then(|l| l.environment_sh).map(|sh| {
-            let coefficients = sh.map(glam::Vec3::from_array);
-            let rotations: Vec<glam::Mat3> =
-                eyes.iter().map(|eye| glam::Mat3::from_quat(eye.pose.orientation.as_quat())).collect();
-            crate::sh::view_quadratics(&coefficients, &rotations)
-        });
-        if environment.is_some_and(|q| !q.iter().flatten().flatten().all(|v| v.is_finite())) {
-            return Err(Error::input("environment SH: a coefficient is not finite"));
-        }
-        let lighting = FrameLighting { environment: environment.as_ref(), ..FrameLighting::NONE };
-        let light_inputs = crate::passes::ssdo::LightInputs { direct: direct.is_some() };
-        let params = FrameParams {
-            settings: &settings,
-            extensions: &[&light_inputs],
-            alpha_cards: false,
-            anchor: glam::DVec3::ZERO,
-            multiview: false,
-            motion: &self.motion,
-            mask: self.mask.as_ref(),
-        };
-        let passes: Vec<&dyn Pass> = [&self.import as &dyn Pass, &self.light_import as &dyn Pass]
-            .into_iter()
-            .chain(self.chain.iter().map(|p| p.as_ref()))
-            .collect();
-        let mut imported = vec![HOST_DEPTH];
-        imported.extend(frame.normals.is_some().then_some(HOST_NORMALS));
-        imported.extend(frame.motion.is_some().then_some(HOST_MOTION));
-        imported.extend(direct.is_some().then_some(light::HOST_DIRECT));
-        let key = (settings.clone(), frame.motion.is_some(), direct.is_some());
-        let plan = self.driver.plan(&key, &passes, &params, layers, &[FINAL_AO], &imported)?;
-        self.driver.prepare(&self.gpu, &plan, &params, &lighting, &eyes);
-        // Kernels compile at their first frame: a device that cannot build one is refused
-        // here, as a typed error, not through the host's uncaptured-error handler.
-        let scope = self.gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let recorded =
-            self.driver.record(&self.gpu, encoder, &passes, &plan, &params, &eyes, None, spans, Submission::OneEncoder);
-        if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
-        }
-        recorded?;
-        self.driver.end_frame(&eyes);
+        Ok(direct)
+    }
+
+    /// The final AO target the plan resolved, as the host asked for it: the chain's own
+    /// `Rgba16Float` texture, or its copy packed into a single-channel format.
+    fn output(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        plan: &Plan,
+        spans: Option<&dyn SpanRecorder>,
+    ) -> Result<AoOutput<'_>> {
         let output = plan.resolve(FINAL_AO).ok_or_else(|| Error::Plan("nothing provides the final AO".into()))?;
         let target = self
             .driver
@@ -396,6 +406,42 @@ impl AoEngine {
         }
         Ok(AoOutput { texture: &packed.texture, view: &packed.array_view })
     }
+}
+
+/// The host environment's SH turned into each view's quadratics (SSDO's ambient light),
+/// or `None` without one; a coefficient that is not finite is refused.
+fn environment_quadratics(frame: &AoFrame, eyes: &[Eye]) -> Result<Option<[[[f32; 4]; 10]; 4]>> {
+    let environment = frame.light.and_then(|l| l.environment_sh).map(|sh| {
+        let coefficients = sh.map(glam::Vec3::from_array);
+        let rotations: Vec<glam::Mat3> =
+            eyes.iter().map(|eye| glam::Mat3::from_quat(eye.pose.orientation.as_quat())).collect();
+        crate::sh::view_quadratics(&coefficients, &rotations)
+    });
+    if environment.is_some_and(|q| !q.iter().flatten().flatten().all(|v| v.is_finite())) {
+        return Err(Error::input("environment SH: a coefficient is not finite"));
+    }
+    Ok(environment)
+}
+
+/// The graph inputs this frame imports from the host: its depth always, and its normals,
+/// motion vectors and direct light when given.
+fn imported_resources(frame: &AoFrame, direct: bool) -> Vec<crate::graph::Resource> {
+    let mut imported = vec![HOST_DEPTH];
+    imported.extend(frame.normals.is_some().then_some(HOST_NORMALS));
+    imported.extend(frame.motion.is_some().then_some(HOST_MOTION));
+    imported.extend(direct.then_some(light::HOST_DIRECT));
+    imported
+}
+
+/// Runs `record` inside a validation error scope, so a kernel the device cannot build
+/// comes back as a typed `Error::Device` rather than through the host's handler.
+fn pipeline_errors_as_device<T>(gpu: &Gpu, record: impl FnOnce() -> T) -> Result<T> {
+    let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let recorded = record();
+    if let Some(error) = pollster::block_on(scope.pop()) {
+        return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
+    }
+    Ok(recorded)
 }
 
 /// The largest view side the engine takes, in pixels.

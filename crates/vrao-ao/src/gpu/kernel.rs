@@ -15,6 +15,48 @@ use std::sync::{Mutex, OnceLock};
 /// times; more means the resources change every frame).
 const MAX_CACHED_BIND_GROUPS: usize = 64;
 
+/// Compute pipelines a device keeps before it starts over (a frame uses a few dozen; a
+/// sweep over override constants makes more).
+const MAX_KEPT_PIPELINES: usize = 512;
+
+/// The compute pipelines compiled on one device ([`Gpu`]), by what they were compiled
+/// from: the shader's text, entry, override constants and bindings. A chain made again
+/// with settings seen before (the governor returning to a level, a bench's next round, a
+/// resize that rebuilds) binds the pipelines compiled the first time instead of compiling
+/// them again, which is a stall of milliseconds to a second per pipeline where the driver
+/// compiles with LLVM. Kernels whose build was cancelled are never kept.
+#[derive(Default)]
+pub(crate) struct CompiledPipelines(Mutex<HashMap<u64, wgpu::ComputePipeline>>);
+
+impl CompiledPipelines {
+    /// The pipeline kept under `key`, or the one `compile` makes, kept from now on.
+    fn get_or_compile(&self, key: u64, compile: impl FnOnce() -> wgpu::ComputePipeline) -> wgpu::ComputePipeline {
+        if let Some(pipeline) = self.0.lock().expect("compiled pipelines").get(&key) {
+            return pipeline.clone();
+        }
+        // Compiled outside the lock: two threads may compile the same pipeline once each.
+        let pipeline = compile();
+        let mut kept = self.0.lock().expect("compiled pipelines");
+        if kept.len() >= MAX_KEPT_PIPELINES {
+            kept.clear();
+        }
+        kept.insert(key, pipeline.clone());
+        pipeline
+    }
+}
+
+/// What a compute pipeline is compiled from, as the key of [`CompiledPipelines`].
+fn pipeline_key(label: &str, source: &str, entry: &str, constants: &[(&str, f64)], slots: &[Slot]) -> u64 {
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    (label, source, entry).hash(&mut hasher);
+    for (name, value) in constants {
+        (name, value.to_bits()).hash(&mut hasher);
+    }
+    // The slots decide the bind group layout; their Debug text names every field.
+    format!("{slots:?}").hash(&mut hasher);
+    hasher.finish()
+}
+
 /// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
 pub const TILE: u32 = 8;
 
@@ -317,6 +359,9 @@ struct Recipe {
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// The device's count of compiled pipelines ([`Gpu::pipelines_built`]).
     built: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    /// The device's compiled pipelines, and this kernel's key among them.
+    compiled: std::sync::Arc<CompiledPipelines>,
+    key: u64,
 }
 
 /// The module of a kernel whose build was cancelled: no work (more bindings in the layout
@@ -327,6 +372,25 @@ fn stand_in_module(device: &wgpu::Device, label: &str, entry: &str) -> wgpu::Sha
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     })
+}
+
+impl Recipe {
+    /// The pipeline: the device's kept one when it compiled the same before, else
+    /// compiled now (a stand-in of no work, never kept, once the build is cancelled).
+    fn compile(&self, device: &wgpu::Device, label: &str) -> wgpu::ComputePipeline {
+        if self.interrupt.as_ref().is_some_and(|flag| flag.load(Ordering::Relaxed)) {
+            let module = stand_in_module(device, label, &self.entry);
+            self.built.fetch_add(1, Ordering::Relaxed);
+            return compute_pipeline(device, label, &self.pipeline_layout, &module, &self.entry, &[]);
+        }
+        self.compiled.get_or_compile(self.key, || {
+            let module = module_of(device, label, self.source.clone());
+            let constants: Vec<(&str, f64)> =
+                self.constants.iter().map(|(name, value)| (name.as_str(), *value)).collect();
+            self.built.fetch_add(1, Ordering::Relaxed);
+            compute_pipeline(device, label, &self.pipeline_layout, &module, &self.entry, &constants)
+        })
+    }
 }
 
 fn compute_pipeline(
@@ -370,25 +434,29 @@ impl Kernel {
             let module = stand_in_module(&gpu.device, label, entry);
             return Self::from_module(gpu, label, &module, entry, binds, &[]);
         }
-        if !gpu.lazy_pipelines() {
-            let module = shader_module(gpu, label, files);
-            return Self::from_module(gpu, label, &module, entry, binds, constants);
-        }
         // The files are read now, so an unreadable one is the error of whoever makes the
-        // kernel (as for an eager one); only the compilation waits.
+        // kernel; a lazy kernel waits only for the compilation.
         let source = source_or_recorded(gpu, files);
         let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds);
+        let key = pipeline_key(label, &source, entry, constants, &slots);
+        let recipe = Recipe {
+            source,
+            entry: entry.to_string(),
+            constants: constants.iter().map(|(name, value)| (name.to_string(), *value)).collect(),
+            pipeline_layout,
+            interrupt: gpu.build_interrupt(),
+            built: gpu.pipeline_counter(),
+            compiled: gpu.compiled_pipelines.clone(),
+            key,
+        };
+        let pipeline = OnceLock::new();
+        if !gpu.lazy_pipelines() {
+            let _ = pipeline.set(recipe.compile(&gpu.device, label));
+        }
         Kernel {
             label: label.to_string(),
-            pipeline: OnceLock::new(),
-            recipe: Some(Recipe {
-                source,
-                entry: entry.to_string(),
-                constants: constants.iter().map(|(name, value)| (name.to_string(), *value)).collect(),
-                pipeline_layout,
-                interrupt: gpu.build_interrupt(),
-                built: gpu.pipeline_counter(),
-            }),
+            pipeline,
+            recipe: Some(recipe),
             layout,
             slots,
             bind_groups: Mutex::new((gpu.bind_group_epoch.load(Ordering::Relaxed), HashMap::new())),
@@ -457,19 +525,7 @@ impl Kernel {
     fn pipeline(&self, device: &wgpu::Device) -> &wgpu::ComputePipeline {
         self.pipeline.get_or_init(|| {
             let recipe = self.recipe.as_ref().expect("a kernel without a pipeline has a recipe");
-            let cancelled = recipe.interrupt.as_ref().is_some_and(|flag| flag.load(Ordering::Relaxed));
-            let module = if cancelled {
-                stand_in_module(device, &self.label, &recipe.entry)
-            } else {
-                module_of(device, &self.label, recipe.source.clone())
-            };
-            let constants: Vec<(&str, f64)> = if cancelled {
-                Vec::new()
-            } else {
-                recipe.constants.iter().map(|(name, value)| (name.as_str(), *value)).collect()
-            };
-            recipe.built.fetch_add(1, Ordering::Relaxed);
-            compute_pipeline(device, &self.label, &recipe.pipeline_layout, &module, &recipe.entry, &constants)
+            recipe.compile(device, &self.label)
         })
     }
 

@@ -3,6 +3,8 @@
 
 pub mod kernel;
 pub mod layered_target;
+#[cfg(test)]
+pub(crate) mod layout_check;
 pub mod multiview_probe;
 pub mod raster;
 pub mod readback;
@@ -76,6 +78,8 @@ pub struct Gpu {
     lazy_pipelines: bool,
     /// Compute pipelines compiled on this device so far.
     pipelines_built: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    /// The compute pipelines compiled so far, for kernels made again to reuse.
+    pub(crate) compiled_pipelines: std::sync::Arc<kernel::CompiledPipelines>,
     /// Where shaders are read from instead of the compiled-in text ([`Gpu::set_shader_dir`]).
     shader_dir: Option<std::path::PathBuf>,
     /// The first shader file that could not be read ([`Gpu::take_shader_error`]).
@@ -192,6 +196,7 @@ impl Gpu {
             build_interrupt: std::sync::OnceLock::new(),
             lazy_pipelines: false,
             pipelines_built: Default::default(),
+            compiled_pipelines: Default::default(),
             // The application's override (the engine on a host's device reads no
             // environment: Gpu::from_host).
             shader_dir: std::env::var_os(kernel::SHADER_DIR_VAR).map(std::path::PathBuf::from),
@@ -222,6 +227,7 @@ impl Gpu {
             build_interrupt: std::sync::OnceLock::new(),
             lazy_pipelines: false,
             pipelines_built: Default::default(),
+            compiled_pipelines: Default::default(),
             shader_dir: None,
             shader_error: Default::default(),
             bind_group_epoch: Default::default(),

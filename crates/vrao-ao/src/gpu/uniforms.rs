@@ -105,14 +105,7 @@ pub struct AoParamsUniform {
     pub blur_plane_sigma: f32,
     /// Scale of the sample lengths this frame (HBAO's temporal range jitter; 1 otherwise).
     pub range_scale: f32,
-    /// Fixed foveation (`settings::FoveationMap`): the tangent of the angle off the view
-    /// axis where the sample count starts to fall.
-    pub foveation_full_rate_tan: f32,
-    /// The tangent of the angle from which on pixels spend `foveation_edge_rate`.
-    pub foveation_edge_tan: f32,
-    /// The share of the full count spent at the edges (1: foveation off).
-    pub foveation_edge_rate: f32,
-    /// The WGSL struct's size is a multiple of 16 bytes.
+    /// Pads the struct to 80 bytes, a multiple of 16 (`_pad0`… in common.wgsl).
     pub padding: [u32; 3],
 }
 
@@ -218,13 +211,12 @@ impl FrameUniforms {
         // longer Halton kernel, so the accumulated samples are as stratified as one
         // kernel of window × N. Parts alone leave less noise after the window than
         // golden-angle turns of one kernel or parts plus turns — turning a part breaks the
-        // stratification between parts (docs/measurements-in-code.md, kernel-parts). So
+        // stratification between parts (docs/records/2026-11-29/measurements-in-code.md, kernel-parts). So
         // the hemisphere techniques change their pattern by parts and only the marching
         // techniques (HBAO, GTAO), whose directions are not a Halton kernel, turn.
         let part = if ao.temporal.enabled { (frame_index % ao.temporal.max_frames as u64) as u32 } else { 0 };
         let turns = ao.temporal.enabled && entry.samples == SamplePattern::Directions;
         let kernel = hemisphere_kernel_part(part, ao.samples.min(MAX_KERNEL_SAMPLES as u32), density);
-        let foveation = ao.foveation.map();
         let params = AoParamsUniform {
             ao_size: [width, height],
             scale: if ao.resolution.is_half() { 2 } else { 1 },
@@ -247,9 +239,6 @@ impl FrameUniforms {
             blur_radius: if ao.resolution.is_half() { ao.blur_radius.div_ceil(2) } else { ao.blur_radius },
             blur_plane_sigma: ao.blur_plane_sigma,
             range_scale: if turns { temporal_range_scale(frame_index) } else { 1.0 },
-            foveation_full_rate_tan: foveation.full_rate_deg.to_radians().tan(),
-            foveation_edge_tan: foveation.edge_deg.to_radians().tan(),
-            foveation_edge_rate: foveation.edge_rate,
             padding: [0; 3],
         };
         queue.write_buffer(&self.ao, 0, bytemuck::bytes_of(&params));
@@ -306,7 +295,7 @@ fn other_from_view(views: &[Eye], index: usize) -> Mat4 {
 /// HBAO's turn of its directions this frame (radians): the golden angle (137.5°) per frame.
 /// Lin's NCTU thesis turns it 10° per frame, which leaves successive patterns so alike that
 /// accumulating frames cuts the noise far less than golden-angle steps do
-/// (docs/measurements-in-code.md, temporal-angle).
+/// (docs/records/2026-11-29/measurements-in-code.md, temporal-angle).
 pub fn temporal_angle(frame_index: u64) -> f32 {
     ((frame_index as f64 * 137.507_764f64).rem_euclid(360.0)).to_radians() as f32
 }
@@ -316,4 +305,22 @@ pub fn temporal_angle(frame_index: u64) -> f32 {
 pub fn temporal_range_scale(frame_index: u64) -> f32 {
     let golden = 0.618_033_988_749_895_f64;
     (1.0 - 0.1 * (frame_index as f64 * golden).fract()) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::kernel::COMMON;
+    use crate::gpu::layout_check::{self, mirror};
+
+    #[test]
+    fn the_uniforms_match_common_wgsl() {
+        #[rustfmt::skip]
+        layout_check::check(&[
+            mirror!(EyeUniform, [COMMON], "Eye", [clip_from_anchored, view_from_anchored, world_from_view, tangents, other_from_view]),
+            mirror!(FrameUniform, [COMMON], "Frame", [eyes, size, layers, light_count, near, exposure, white_point, has_environment, environment_quadratics]),
+            mirror!(LightUniform, [COMMON], "Light", [pos_or_dir, radiance, kind, spot_direction, cone]),
+            mirror!(AoParamsUniform, [COMMON], "AoParams", [ao_size, scale, samples, directions, steps, technique, noise, radius, strength, bias, range_check, bounce, frame_angle, blur_radius, blur_plane_sigma, range_scale, padding]),
+        ]);
+    }
 }

@@ -577,7 +577,43 @@ fn sampler_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
 #[cfg(test)]
 mod tests {
     use super::saturating_f16;
+    use super::{MaterialUniform, ObjectUniform, MESH_WGSL};
+    use crate::gpu::kernel::COMMON;
+    use crate::gpu::layout_check::{self, mirror};
     use half::f16;
+
+    /// `Vertex` mirrors no WGSL struct in memory: the vertex attributes convert it to
+    /// mesh.wgsl's `VertexIn`, so they are what must match its fields.
+    #[test]
+    fn the_vertex_attributes_match_the_vertex_fields() {
+        use super::Vertex;
+        use std::mem::{offset_of, size_of};
+        let attributes = crate::gpu::raster::MESH_ATTRIBUTES;
+        let fields = [
+            (offset_of!(Vertex, position), size_of::<[f32; 3]>()),
+            (offset_of!(Vertex, normal), size_of::<[f32; 3]>()),
+            (offset_of!(Vertex, uv), size_of::<[f32; 2]>()),
+            (offset_of!(Vertex, color), size_of::<[u8; 4]>()),
+            (offset_of!(Vertex, tangent), size_of::<[i16; 4]>()),
+        ];
+        for (attribute, (offset, size)) in attributes.iter().zip(fields) {
+            let location = attribute.shader_location;
+            assert_eq!(attribute.offset, offset as u64, "location {location}'s offset");
+            assert_eq!(attribute.format.size(), size as u64, "location {location}'s size");
+        }
+        let end = attributes.last().map(|a| a.offset + a.format.size());
+        assert_eq!(end, Some(size_of::<Vertex>() as u64), "the attributes cover the vertex");
+    }
+
+    #[test]
+    fn the_material_and_object_uniforms_match_mesh_wgsl() {
+        // mesh.wgsl as the G-buffer, the depth peel and the light-space pass compile it.
+        #[rustfmt::skip]
+        layout_check::check(&[
+            mirror!(MaterialUniform, [COMMON, MESH_WGSL], "Material", [diffuse, emission, alpha, placements]),
+            mirror!(ObjectUniform, [COMMON, MESH_WGSL], "Object", [anchored_from_local, previous_anchored_from_local, normal_from_local]),
+        ]);
+    }
 
     #[test]
     fn environment_texels_saturate_and_never_carry_nan() {

@@ -484,14 +484,38 @@ fn placed_gltf(file: &Path, _: usize, _: limits::GeometryBudget) -> std::result:
 /// The tracks of a `[mesh.animation]`: one per property the keys give (every key must give
 /// the same properties), times finite, non-negative and strictly increasing.
 fn animation_tracks(animation: &AnimationEntry) -> std::result::Result<NodeTracks, Failure> {
-    let interpolation = match animation.interpolation.as_deref().unwrap_or("linear") {
-        "linear" => Interpolation::Linear,
-        "step" => Interpolation::Step,
-        other => {
-            return Err(Failure::Here(format!("animation interpolation '{other}': expected \"linear\" or \"step\"")));
-        }
-    };
+    let interpolation = animation_interpolation(animation)?;
     let keys = &animation.keys;
+    let times = animation_times(keys)?;
+    check_key_bounds(keys)?;
+    let translation =
+        property_track(keys, &times, interpolation, "translate", |k| k.translate.map(|v| finite3("translate", v)))?;
+    let rotation = property_track(keys, &times, interpolation, "rotate_deg", |k| {
+        k.rotate_deg.map(|v| {
+            finite3("rotate_deg", v)
+                .map(|d| DQuat::from_euler(EulerRot::XYZEx, d.x.to_radians(), d.y.to_radians(), d.z.to_radians()))
+        })
+    })?;
+    let scale = property_track(keys, &times, interpolation, "scale", |k| k.scale.as_ref().map(key_scale))?;
+    let tracks = NodeTracks { translation, rotation, scale };
+    if tracks.is_empty() {
+        return Err(Failure::Here("animation keys give none of translate, rotate_deg or scale".into()));
+    }
+    Ok(tracks)
+}
+
+/// An animation's interpolation: `linear` (the default) or `step`.
+fn animation_interpolation(animation: &AnimationEntry) -> std::result::Result<Interpolation, Failure> {
+    match animation.interpolation.as_deref().unwrap_or("linear") {
+        "linear" => Ok(Interpolation::Linear),
+        "step" => Ok(Interpolation::Step),
+        other => Err(Failure::Here(format!("animation interpolation '{other}': expected \"linear\" or \"step\""))),
+    }
+}
+
+/// The keys' times: 1 to [`MAX_ANIMATION_KEYS`] of them, finite, non-negative and
+/// strictly increasing.
+fn animation_times(keys: &[AnimationKey]) -> std::result::Result<Vec<f64>, Failure> {
     if keys.is_empty() || keys.len() > MAX_ANIMATION_KEYS {
         return Err(Failure::Here(format!("an animation needs 1 to {MAX_ANIMATION_KEYS} keys, found {}", keys.len())));
     }
@@ -502,8 +526,12 @@ fn animation_tracks(animation: &AnimationEntry) -> std::result::Result<NodeTrack
     if let Some(w) = times.windows(2).find(|w| w[1] <= w[0]) {
         return Err(Failure::Here(format!("animation key times {} then {} are not strictly increasing", w[0], w[1])));
     }
-    // The bounds static values have (`limits.rs`): far translations and large scales are
-    // refused, and tiny scales unless exactly 0 (which hides the mesh while it holds).
+    Ok(times)
+}
+
+/// The bounds static values have (`limits.rs`): far translations and large scales are
+/// refused, and tiny scales unless exactly 0 (which hides the mesh while it holds).
+fn check_key_bounds(keys: &[AnimationKey]) -> std::result::Result<(), Failure> {
     for (k, key) in keys.iter().enumerate() {
         let far = key
             .translate
@@ -521,53 +549,42 @@ fn animation_tracks(animation: &AnimationEntry) -> std::result::Result<NodeTrack
             return Err(Failure::Here(trouble));
         }
     }
-    // Each property: present in every key or in none.
-    fn track<T>(
-        keys: &[AnimationKey],
-        times: &[f64],
-        interpolation: Interpolation,
-        name: &str,
-        value: impl Fn(&AnimationKey) -> Option<std::result::Result<T, Failure>>,
-    ) -> std::result::Result<Option<Track<T>>, Failure> {
-        let given = keys.iter().filter(|k| value(k).is_some()).count();
-        if given == 0 {
-            return Ok(None);
-        }
-        if given != keys.len() {
-            return Err(Failure::Here(format!(
-                "animation: {name} is given in {given} of {} keys (all or none)",
-                keys.len()
-            )));
-        }
-        let values = keys.iter().filter_map(&value).collect::<std::result::Result<Vec<T>, Failure>>()?;
-        Ok(Some(Track { interpolation, times: times.to_vec(), values }))
+    Ok(())
+}
+
+/// One property's track. Each property is present in every key or in none (`None`).
+fn property_track<T>(
+    keys: &[AnimationKey],
+    times: &[f64],
+    interpolation: Interpolation,
+    name: &str,
+    value: impl Fn(&AnimationKey) -> Option<std::result::Result<T, Failure>>,
+) -> std::result::Result<Option<Track<T>>, Failure> {
+    let given = keys.iter().filter(|k| value(k).is_some()).count();
+    if given == 0 {
+        return Ok(None);
     }
-    let translation =
-        track(keys, &times, interpolation, "translate", |k| k.translate.map(|v| finite3("translate", v)))?;
-    let rotation = track(keys, &times, interpolation, "rotate_deg", |k| {
-        k.rotate_deg.map(|v| {
-            finite3("rotate_deg", v)
-                .map(|d| DQuat::from_euler(EulerRot::XYZEx, d.x.to_radians(), d.y.to_radians(), d.z.to_radians()))
-        })
-    })?;
-    let scale = track(keys, &times, interpolation, "scale", |k| {
-        k.scale.as_ref().map(|s| {
-            let v = match *s {
-                Scale::Uniform(s) => DVec3::splat(s),
-                Scale::PerAxis(s) => DVec3::from_array(s),
-            };
-            if v.is_finite() && v.as_vec3().is_finite() {
-                Ok(v)
-            } else {
-                Err(Failure::Here(format!("animation scale {:?} is not finite", v.to_array())))
-            }
-        })
-    })?;
-    let tracks = NodeTracks { translation, rotation, scale };
-    if tracks.is_empty() {
-        return Err(Failure::Here("animation keys give none of translate, rotate_deg or scale".into()));
+    if given != keys.len() {
+        return Err(Failure::Here(format!(
+            "animation: {name} is given in {given} of {} keys (all or none)",
+            keys.len()
+        )));
     }
-    Ok(tracks)
+    let values = keys.iter().filter_map(&value).collect::<std::result::Result<Vec<T>, Failure>>()?;
+    Ok(Some(Track { interpolation, times: times.to_vec(), values }))
+}
+
+/// A key's scale as a vector, finite in f64 and in the f32 the GPU reads.
+fn key_scale(scale: &Scale) -> std::result::Result<DVec3, Failure> {
+    let v = match *scale {
+        Scale::Uniform(s) => DVec3::splat(s),
+        Scale::PerAxis(s) => DVec3::from_array(s),
+    };
+    if v.is_finite() && v.as_vec3().is_finite() {
+        Ok(v)
+    } else {
+        Err(Failure::Here(format!("animation scale {:?} is not finite", v.to_array())))
+    }
 }
 
 fn finite3(what: &str, v: [f64; 3]) -> std::result::Result<DVec3, Failure> {

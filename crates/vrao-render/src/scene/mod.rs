@@ -561,25 +561,14 @@ pub(crate) fn gltf_not_built(path: &Path) -> Error {
 /// crevices, corners) where the near-empty `room` shows almost nothing.
 pub const RENDER_DEFAULT: &str = "builtin:furnished";
 
-/// The shared scene directory (`../shared/scenes` beside the repository, or `$VRAO_SCENES`),
-/// when it exists.
+/// The public scenes' directory: `$VRAO_SCENES`, or `shared/scenes` beside the repository
+/// this crate was built from (found from the crate's own place in it, so the dev profile and
+/// an IDE that do not read `.cargo/config.toml` find it too), when it exists.
 pub fn shared_scenes_dir() -> Option<PathBuf> {
     let dir = match std::env::var_os("VRAO_SCENES") {
         Some(dir) => PathBuf::from(dir),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes"),
+        // crates/vrao-render -> the repository -> the folder beside it.
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
     };
     dir.is_dir().then_some(dir)
-}
-
-/// For tests: the shared scene file `relative`, or `None` after a warning (log) that the
-/// test is skipped. Panics when the file is missing and `CI` is set, because CI must run every test.
-#[doc(hidden)]
-pub fn shared_scene_for_test(relative: &str) -> Option<PathBuf> {
-    let path = shared_scenes_dir().map(|dir| dir.join(relative)).filter(|p| p.is_file());
-    if path.is_none() {
-        let message = format!("shared scene file {relative} not found (set VRAO_SCENES)");
-        assert!(std::env::var_os("CI").is_none(), "{message}");
-        log::warn!("skipped: {message}");
-    }
-    path
 }

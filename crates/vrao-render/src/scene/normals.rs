@@ -62,124 +62,195 @@ pub fn compute_normals_with_sources(
     let cos_crease = crease.clamp(0.0, 180.0).to_radians().cos();
     let tris = triangles(positions, indices);
     let units: Vec<Option<Vec3>> = tris.iter().map(|(_, n)| n.try_normalize()).collect();
+    let fans = Fans::new(positions, &tris);
+    let mut corners = CornerNormals {
+        tris: &tris,
+        units: &units,
+        fans: &fans,
+        cos_crease,
+        around_of: HashMap::new(),
+        memo: HashMap::new(),
+    };
+    split_vertices(positions, uvs, &tris, |f, v| corners.normal(f, fans.weld[v as usize]))
+}
 
-    // Weld vertices by exact position (adding 0.0 turns -0.0 into +0.0 so both weld).
-    let mut weld_of_position: HashMap<[u32; 3], usize> = HashMap::new();
-    let weld: Vec<usize> = positions
-        .iter()
-        .map(|p| {
-            let key = (*p + Vec3::ZERO).to_array().map(f32::to_bits);
-            let next = weld_of_position.len();
-            *weld_of_position.entry(key).or_insert(next)
-        })
-        .collect();
+/// Input vertices welded by position, and the faces around each welded vertex: faces
+/// are joined by position, so a texture seam does not become a shading seam.
+struct Fans {
+    /// The welded vertex of each input vertex.
+    weld: Vec<usize>,
+    /// Where each welded vertex's faces begin in `faces` (compressed-row form; one more
+    /// entry than welded vertices).
+    start: Vec<usize>,
+    /// The faces around each welded vertex, one run per vertex.
+    faces: Vec<usize>,
+}
 
-    // Faces around each welded vertex, in compressed-row form.
-    let mut start = vec![0usize; weld_of_position.len() + 1];
-    for (corners, _) in &tris {
-        for &v in corners {
-            start[weld[v as usize] + 1] += 1;
+impl Fans {
+    fn new(positions: &[Vec3], tris: &[([u32; 3], Vec3)]) -> Fans {
+        // Weld vertices by exact position (adding 0.0 turns -0.0 into +0.0 so both weld).
+        let mut weld_of_position: HashMap<[u32; 3], usize> = HashMap::new();
+        let weld: Vec<usize> = positions
+            .iter()
+            .map(|p| {
+                let key = (*p + Vec3::ZERO).to_array().map(f32::to_bits);
+                let next = weld_of_position.len();
+                *weld_of_position.entry(key).or_insert(next)
+            })
+            .collect();
+
+        // Faces around each welded vertex, in compressed-row form.
+        let mut start = vec![0usize; weld_of_position.len() + 1];
+        for (corners, _) in tris {
+            for &v in corners {
+                start[weld[v as usize] + 1] += 1;
+            }
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut faces = vec![0usize; start[start.len() - 1]];
+        for (f, (corners, _)) in tris.iter().enumerate() {
+            for &v in corners {
+                let w = weld[v as usize];
+                faces[fill[w]] = f;
+                fill[w] += 1;
+            }
+        }
+        Fans { weld, start, faces }
+    }
+
+    /// The faces around welded vertex `w`.
+    fn around(&self, w: usize) -> &[usize] {
+        &self.faces[self.start[w]..self.start[w + 1]]
+    }
+}
+
+/// Around a vertex of many faces (a fan's centre, a sphere's pole, or a 1 MB file that
+/// repeats one triangle 100,000 times) summing every face per corner would cost faces²
+/// (hours). There a corner's normal depends only on the vertex and its face's unit
+/// normal, so it is found once per pair, from the faces summed by their unit normal: the
+/// same result up to the order of the additions. A vertex whose faces point in more than
+/// `MANY` directions is smoothed over all of them (no crease split there).
+const MANY: usize = 64;
+
+/// The faces around a vertex of many faces, summed by unit normal.
+enum Around {
+    /// Each distinct unit normal and the sum of its faces' weighted normals.
+    Directions(Vec<(Vec3, Vec3)>),
+    /// More than `MANY` directions: all faces' weighted normals summed.
+    Smooth(Vec3),
+}
+
+impl Around {
+    /// The faces of `around` (indices into `tris` and `units`) grouped by unit normal;
+    /// degenerate faces carry no weight and are left out.
+    fn sum(around: &[usize], tris: &[([u32; 3], Vec3)], units: &[Option<Vec3>]) -> Around {
+        let mut directions: Vec<(Vec3, Vec3)> = Vec::new();
+        let mut index_of: HashMap<[u32; 3], usize> = HashMap::new();
+        for &g in around {
+            let Some(unit) = units[g] else { continue };
+            let next = directions.len();
+            let i = *index_of.entry(unit.to_array().map(f32::to_bits)).or_insert(next);
+            if i == next {
+                directions.push((unit, Vec3::ZERO));
+            }
+            directions[i].1 += tris[g].1;
+        }
+        if directions.len() > MANY {
+            Around::Smooth(directions.iter().map(|d| d.1).sum())
+        } else {
+            Around::Directions(directions)
         }
     }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut fill = start.clone();
-    let mut faces_around = vec![0usize; start[start.len() - 1]];
-    for (f, (corners, _)) in tris.iter().enumerate() {
-        for &v in corners {
-            let w = weld[v as usize];
-            faces_around[fill[w]] = f;
-            fill[w] += 1;
-        }
-    }
+}
 
-    // The normal of face `f`'s corner at welded vertex `w`: the weighted sum over the faces
-    // around `w` within the crease angle of `f`. A degenerate face borrows the normal of
-    // the largest face around `w`.
-    // Face `f`'s unit normal, or for a degenerate face the largest face's of `around`.
-    let own_normal = |f: usize, around: &[usize]| -> Option<Vec3> {
-        units[f].or_else(|| {
+/// Each face corner's normal: the weighted sum over the faces around its welded vertex
+/// within the crease angle of the corner's face.
+struct CornerNormals<'a> {
+    /// The triangles and their unnormalised normals.
+    tris: &'a [([u32; 3], Vec3)],
+    /// Each triangle's unit normal, `None` for a degenerate one.
+    units: &'a [Option<Vec3>],
+    fans: &'a Fans,
+    cos_crease: f32,
+    /// Vertices of many faces, their faces summed by direction (see [`MANY`]).
+    around_of: HashMap<usize, Around>,
+    /// Normals found at vertices of many faces, by vertex and face unit normal.
+    memo: HashMap<(usize, Option<[u32; 3]>), Vec3>,
+}
+
+impl CornerNormals<'_> {
+    /// Face `f`'s unit normal, or for a degenerate face the largest face's of `around`.
+    fn own_normal(&self, f: usize, around: &[usize]) -> Option<Vec3> {
+        self.units[f].or_else(|| {
             let largest = around
                 .iter()
                 .copied()
-                .max_by(|&a, &b| tris[a].1.length_squared().total_cmp(&tris[b].1.length_squared()))?;
-            units[largest]
+                .max_by(|&a, &b| self.tris[a].1.length_squared().total_cmp(&self.tris[b].1.length_squared()))?;
+            self.units[largest]
         })
-    };
-    let corner_normal = |f: usize, w: usize| -> Vec3 {
-        let around = &faces_around[start[w]..start[w + 1]];
-        let own = own_normal(f, around);
-        let Some(own) = own else { return FALLBACK_NORMAL };
-        let sum: Vec3 =
-            around.iter().filter(|&&g| units[g].is_some_and(|u| u.dot(own) >= cos_crease)).map(|&g| tris[g].1).sum();
-        sum.try_normalize().unwrap_or(own)
-    };
-
-    // Around a vertex of many faces (a fan's centre, a sphere's pole, or a 1 MB file that
-    // repeats one triangle 100,000 times) the sum above would cost faces² (hours). There a
-    // corner's normal depends only on the vertex and its face's unit normal, so it is
-    // found once per pair, from the faces summed by their unit normal: the same result up
-    // to the order of the additions. A vertex whose faces point in more than
-    // `MANY` directions is smoothed over all of them (no crease split there).
-    const MANY: usize = 64;
-    enum Around {
-        Directions(Vec<(Vec3, Vec3)>),
-        Smooth(Vec3),
     }
-    let mut around_of: HashMap<usize, Around> = HashMap::new();
-    let mut memo: HashMap<(usize, Option<[u32; 3]>), Vec3> = HashMap::new();
-    let mut corner = |f: usize, w: usize| -> Vec3 {
-        if start[w + 1] - start[w] <= MANY {
-            return corner_normal(f, w);
+
+    /// The normal of face `f`'s corner at welded vertex `w`.
+    fn normal(&mut self, f: usize, w: usize) -> Vec3 {
+        if self.fans.around(w).len() <= MANY {
+            return self.summed_directly(f, w);
         }
-        let key = (w, units[f].map(|u| u.to_array().map(f32::to_bits)));
-        if let Some(&normal) = memo.get(&key) {
+        let key = (w, self.units[f].map(|u| u.to_array().map(f32::to_bits)));
+        if let Some(&normal) = self.memo.get(&key) {
             return normal;
         }
-        let around = &faces_around[start[w]..start[w + 1]];
-        let own = own_normal(f, around);
-        let normal = match own {
-            None => FALLBACK_NORMAL,
-            Some(own) => {
-                let summed = around_of.entry(w).or_insert_with(|| {
-                    let mut directions: Vec<(Vec3, Vec3)> = Vec::new();
-                    let mut index_of: HashMap<[u32; 3], usize> = HashMap::new();
-                    for &g in around {
-                        let Some(unit) = units[g] else { continue };
-                        let next = directions.len();
-                        let i = *index_of.entry(unit.to_array().map(f32::to_bits)).or_insert(next);
-                        if i == next {
-                            directions.push((unit, Vec3::ZERO));
-                        }
-                        directions[i].1 += tris[g].1;
-                    }
-                    if directions.len() > MANY {
-                        Around::Smooth(directions.iter().map(|d| d.1).sum())
-                    } else {
-                        Around::Directions(directions)
-                    }
-                });
-                let sum: Vec3 = match summed {
-                    Around::Directions(directions) => {
-                        directions.iter().filter(|(u, _)| u.dot(own) >= cos_crease).map(|d| d.1).sum()
-                    }
-                    Around::Smooth(sum) => *sum,
-                };
-                sum.try_normalize().unwrap_or(own)
-            }
-        };
-        memo.insert(key, normal);
+        let normal = self.summed_by_direction(f, w);
+        self.memo.insert(key, normal);
         normal
-    };
+    }
 
-    // One output vertex per (input vertex, normal): corners that agree share a vertex.
+    /// The corner normal from every face around `w` (a vertex of few faces).
+    fn summed_directly(&self, f: usize, w: usize) -> Vec3 {
+        let around = self.fans.around(w);
+        let own = self.own_normal(f, around);
+        let Some(own) = own else { return FALLBACK_NORMAL };
+        let sum: Vec3 = around
+            .iter()
+            .filter(|&&g| self.units[g].is_some_and(|u| u.dot(own) >= self.cos_crease))
+            .map(|&g| self.tris[g].1)
+            .sum();
+        sum.try_normalize().unwrap_or(own)
+    }
+
+    /// The corner normal from the faces around `w` summed by direction (a vertex of many).
+    fn summed_by_direction(&mut self, f: usize, w: usize) -> Vec3 {
+        let around = self.fans.around(w);
+        let Some(own) = self.own_normal(f, around) else { return FALLBACK_NORMAL };
+        let (tris, units) = (self.tris, self.units);
+        let summed = self.around_of.entry(w).or_insert_with(|| Around::sum(around, tris, units));
+        let sum: Vec3 = match summed {
+            Around::Directions(directions) => {
+                directions.iter().filter(|(u, _)| u.dot(own) >= self.cos_crease).map(|d| d.1).sum()
+            }
+            Around::Smooth(sum) => *sum,
+        };
+        sum.try_normalize().unwrap_or(own)
+    }
+}
+
+/// One output vertex per (input vertex, normal): corners that agree share a vertex.
+/// `normal(f, v)` is face `f`'s normal at its corner on input vertex `v`. Returns the
+/// geometry and each output vertex's input vertex.
+fn split_vertices(
+    positions: &[Vec3],
+    uvs: &[Vec2],
+    tris: &[([u32; 3], Vec3)],
+    mut normal: impl FnMut(usize, u32) -> Vec3,
+) -> (Geometry, Vec<u32>) {
     let mut out = Geometry::default();
     let mut sources = Vec::new();
     let mut output_of: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
     for (f, (corners, _)) in tris.iter().enumerate() {
         for &v in corners {
-            let normal = corner(f, weld[v as usize]);
+            let normal = normal(f, v);
             let key = (v, normal.to_array().map(f32::to_bits));
             let index = *output_of.entry(key).or_insert_with(|| {
                 out.positions.push(positions[v as usize]);

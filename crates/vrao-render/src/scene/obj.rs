@@ -228,100 +228,162 @@ struct Defined {
     normals: usize,
 }
 
-fn scan_obj(path: &Path, text: &str, used: GeometryBudget) -> Result<ObjScan> {
-    let directory = path.parent().unwrap_or(Path::new(""));
-    let mut scan =
-        ObjScan { clean: String::with_capacity(text.len()), libraries: Vec::new(), used_materials: Vec::new() };
-    let mut defined = Defined::default();
-    // The scene so far plus this file's faces (fan-triangulated) and positions.
-    let mut counted = used;
-    for (number, raw) in text.lines().enumerate() {
-        let line = number + 1;
+/// One OBJ or MTL statement: its keyword and the rest of its line, comment removed.
+struct Statement<'a> {
+    file: &'a Path,
+    line: usize,
+    keyword: &'a str,
+    rest: &'a str,
+}
+
+impl<'a> Statement<'a> {
+    /// Line `line` (1-based) of `file`, reading `raw`.
+    fn parse(file: &'a Path, line: usize, raw: &'a str) -> Statement<'a> {
         let content = strip_comment(raw).trim();
         let (keyword, rest) = content.split_once(char::is_whitespace).unwrap_or((content, ""));
-        let rest = rest.trim();
-        let words: Vec<&str> = rest.split_whitespace().collect();
-        let numbers = |what: &str| words.iter().map(|w| finite(w, what, path, line)).collect::<Result<Vec<f32>>>();
-        let out = &mut scan.clean;
-        match keyword {
-            "v" => {
-                let xyz = match numbers("vertex coordinate")?.as_slice() {
-                    // x y z, optionally followed by a vertex colour (not used).
-                    [x, y, z] | [x, y, z, _, _, _] => [*x, *y, *z],
-                    [x, y, z, w] => {
-                        let scaled = [x / w, y / w, z / w];
-                        if !scaled.iter().all(|c| c.is_finite()) {
-                            return Err(Error::at_line(
-                                path,
-                                line,
-                                format!("vertex weight w = {w} makes the position infinite"),
-                            ));
-                        }
-                        scaled
-                    }
-                    found => {
-                        let message = format!("a vertex needs 3 coordinates (x y z [w]), found {}", found.len());
-                        return Err(Error::at_line(path, line, message));
-                    }
-                };
-                let farthest = xyz.iter().fold(0.0f32, |m, c| m.max(c.abs())) as f64;
-                if let Some(trouble) = super::limits::coordinate_trouble("vertex coordinate", farthest) {
-                    return Err(Error::at_line(path, line, trouble));
-                }
-                out.push_str(&format!("v {} {} {}\n", xyz[0], xyz[1], xyz[2]));
-                defined.vertices += 1;
-                let one = GeometryBudget { triangles: 0, vertices: 1 };
-                counted = counted.plus(one, "this vertex").map_err(|trouble| Error::at_line(path, line, trouble))?;
-            }
-            "vt" => {
-                let uv = numbers("texture coordinate")?;
-                if !(1..=3).contains(&uv.len()) {
-                    let message = format!("a texture coordinate needs 1 to 3 numbers (u [v [w]]), found {}", uv.len());
-                    return Err(Error::at_line(path, line, message));
-                }
-                out.push_str(&format!("vt {} {}\n", uv[0], uv.get(1).copied().unwrap_or(0.0)));
-                defined.texcoords += 1;
-            }
-            "vn" => {
-                if numbers("normal component")?.len() != 3 {
-                    return Err(Error::at_line(path, line, format!("a normal needs 3 numbers, found {}", words.len())));
-                }
-                out.push_str(&format!("vn {rest}\n"));
-                defined.normals += 1;
-            }
-            "f" => {
-                if words.len() < 3 {
-                    let message = format!("a face needs at least 3 vertices, found {}", words.len());
-                    return Err(Error::at_line(path, line, message));
-                }
-                for word in &words {
-                    check_face_vertex(word, &defined).map_err(|problem| Error::at_line(path, line, problem.0))?;
-                }
-                let face = GeometryBudget { triangles: words.len() - 2, vertices: 0 };
-                counted = counted.plus(face, "this face").map_err(|trouble| Error::at_line(path, line, trouble))?;
-                out.push_str(&format!("f {rest}\n"));
-            }
-            "mtllib" => {
-                // A name may contain spaces; otherwise several libraries may share a line.
-                let names = if directory.join(rest).is_file() || words.len() < 2 { vec![rest] } else { words.clone() };
-                for name in names.into_iter().filter(|n| !n.is_empty()) {
-                    scan.libraries.push((directory.join(name), line));
-                    out.push_str(&format!("mtllib {name}\n"));
-                }
-            }
-            "usemtl" => {
-                if rest.is_empty() {
-                    return Err(Error::at_line(path, line, "usemtl needs a material name"));
-                }
-                scan.used_materials.push((rest.to_string(), line));
-                out.push_str(&format!("usemtl {rest}\n"));
-            }
-            "o" | "g" => out.push_str(&format!("{keyword} {rest}\n")),
+        Statement { file, line, keyword, rest: rest.trim() }
+    }
+
+    /// The words after the keyword.
+    fn words(&self) -> Vec<&'a str> {
+        self.rest.split_whitespace().collect()
+    }
+
+    /// The words after the keyword as finite numbers, each named `what` in an error.
+    fn numbers(&self, what: &str) -> Result<Vec<f32>> {
+        self.rest.split_whitespace().map(|w| finite(w, what, self.file, self.line)).collect()
+    }
+
+    /// An error placed at this statement's line.
+    fn at(&self, message: impl Into<String>) -> Error {
+        Error::at_line(self.file, self.line, message)
+    }
+}
+
+/// The OBJ check's state as it reads the file's statements in order.
+struct ObjScanner<'a> {
+    /// The OBJ's directory, which material libraries are resolved against.
+    directory: &'a Path,
+    scan: ObjScan,
+    defined: Defined,
+    /// The scene so far plus this file's faces (fan-triangulated) and positions.
+    counted: GeometryBudget,
+}
+
+fn scan_obj(path: &Path, text: &str, used: GeometryBudget) -> Result<ObjScan> {
+    let mut scanner = ObjScanner {
+        directory: path.parent().unwrap_or(Path::new("")),
+        scan: ObjScan { clean: String::with_capacity(text.len()), libraries: Vec::new(), used_materials: Vec::new() },
+        defined: Defined::default(),
+        counted: used,
+    };
+    for (number, raw) in text.lines().enumerate() {
+        let statement = Statement::parse(path, number + 1, raw);
+        match statement.keyword {
+            "v" => scanner.vertex(&statement)?,
+            "vt" => scanner.texcoord(&statement)?,
+            "vn" => scanner.normal(&statement)?,
+            "f" => scanner.face(&statement)?,
+            "mtllib" => scanner.mtllib(&statement),
+            "usemtl" => scanner.usemtl(&statement)?,
+            "o" | "g" => scanner.scan.clean.push_str(&format!("{} {}\n", statement.keyword, statement.rest)),
             // Smoothing groups, lines, points, free-form geometry: not used.
             _ => {}
         }
     }
-    Ok(scan)
+    Ok(scanner.scan)
+}
+
+impl ObjScanner<'_> {
+    /// `v x y z [w]` (or with a vertex colour): a finite position within the coordinate
+    /// limits, counted against the vertex budget.
+    fn vertex(&mut self, statement: &Statement) -> Result<()> {
+        let xyz = match statement.numbers("vertex coordinate")?.as_slice() {
+            // x y z, optionally followed by a vertex colour (not used).
+            [x, y, z] | [x, y, z, _, _, _] => [*x, *y, *z],
+            [x, y, z, w] => {
+                let scaled = [x / w, y / w, z / w];
+                if !scaled.iter().all(|c| c.is_finite()) {
+                    return Err(statement.at(format!("vertex weight w = {w} makes the position infinite")));
+                }
+                scaled
+            }
+            found => {
+                let message = format!("a vertex needs 3 coordinates (x y z [w]), found {}", found.len());
+                return Err(statement.at(message));
+            }
+        };
+        let farthest = xyz.iter().fold(0.0f32, |m, c| m.max(c.abs())) as f64;
+        if let Some(trouble) = super::limits::coordinate_trouble("vertex coordinate", farthest) {
+            return Err(statement.at(trouble));
+        }
+        self.scan.clean.push_str(&format!("v {} {} {}\n", xyz[0], xyz[1], xyz[2]));
+        self.defined.vertices += 1;
+        let one = GeometryBudget { triangles: 0, vertices: 1 };
+        self.counted = self.counted.plus(one, "this vertex").map_err(|trouble| statement.at(trouble))?;
+        Ok(())
+    }
+
+    /// `vt u [v [w]]`: tobj reads u and v (0 when absent).
+    fn texcoord(&mut self, statement: &Statement) -> Result<()> {
+        let uv = statement.numbers("texture coordinate")?;
+        if !(1..=3).contains(&uv.len()) {
+            let message = format!("a texture coordinate needs 1 to 3 numbers (u [v [w]]), found {}", uv.len());
+            return Err(statement.at(message));
+        }
+        self.scan.clean.push_str(&format!("vt {} {}\n", uv[0], uv.get(1).copied().unwrap_or(0.0)));
+        self.defined.texcoords += 1;
+        Ok(())
+    }
+
+    /// `vn x y z`.
+    fn normal(&mut self, statement: &Statement) -> Result<()> {
+        if statement.numbers("normal component")?.len() != 3 {
+            let found = statement.words().len();
+            return Err(statement.at(format!("a normal needs 3 numbers, found {found}")));
+        }
+        self.scan.clean.push_str(&format!("vn {}\n", statement.rest));
+        self.defined.normals += 1;
+        Ok(())
+    }
+
+    /// `f v1 v2 v3 …`: every vertex names elements defined above, and the face's fan
+    /// triangles are counted against the triangle budget.
+    fn face(&mut self, statement: &Statement) -> Result<()> {
+        let words = statement.words();
+        if words.len() < 3 {
+            return Err(statement.at(format!("a face needs at least 3 vertices, found {}", words.len())));
+        }
+        for word in &words {
+            check_face_vertex(word, &self.defined).map_err(|problem| statement.at(problem.0))?;
+        }
+        let face = GeometryBudget { triangles: words.len() - 2, vertices: 0 };
+        self.counted = self.counted.plus(face, "this face").map_err(|trouble| statement.at(trouble))?;
+        self.scan.clean.push_str(&format!("f {}\n", statement.rest));
+        Ok(())
+    }
+
+    /// `mtllib name …`: the libraries, resolved against the OBJ's directory.
+    fn mtllib(&mut self, statement: &Statement) {
+        let (rest, words) = (statement.rest, statement.words());
+        // A name may contain spaces; otherwise several libraries may share a line.
+        let names = if self.directory.join(rest).is_file() || words.len() < 2 { vec![rest] } else { words };
+        for name in names.into_iter().filter(|n| !n.is_empty()) {
+            self.scan.libraries.push((self.directory.join(name), statement.line));
+            self.scan.clean.push_str(&format!("mtllib {name}\n"));
+        }
+    }
+
+    /// `usemtl name`.
+    fn usemtl(&mut self, statement: &Statement) -> Result<()> {
+        let rest = statement.rest;
+        if rest.is_empty() {
+            return Err(statement.at("usemtl needs a material name"));
+        }
+        self.scan.used_materials.push((rest.to_string(), statement.line));
+        self.scan.clean.push_str(&format!("usemtl {rest}\n"));
+        Ok(())
+    }
 }
 
 /// Checks one face vertex `v`, `v/vt`, `v//vn` or `v/vt/vn`: every index must be an
@@ -413,18 +475,12 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
     let directory = path.parent().unwrap_or(Path::new(""));
     let mut materials: Vec<MtlMaterial> = Vec::new();
     for (number, raw) in text.lines().enumerate() {
-        let line = number + 1;
-        let content = strip_comment(raw).trim();
-        let (key, rest) = content.split_once(char::is_whitespace).unwrap_or((content, ""));
-        let rest = rest.trim();
-        let numbers = || {
-            rest.split_whitespace()
-                .map(|w| finite(w, &format!("{key} value"), path, line))
-                .collect::<Result<Vec<f32>>>()
-        };
-        let at = |message: String| Error::at_line(path, line, message);
+        let statement = Statement::parse(path, number + 1, raw);
+        let (key, rest) = (statement.keyword, statement.rest);
+        // Values before the first newmtl belong to no material (as in tobj): they are
+        // checked, then dropped.
         match key {
-            "newmtl" if rest.is_empty() => return Err(at("newmtl needs a material name".into())),
+            "newmtl" if rest.is_empty() => return Err(statement.at("newmtl needs a material name")),
             "newmtl" => materials.push(MtlMaterial {
                 name: rest.to_string(),
                 diffuse: None,
@@ -434,21 +490,7 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
                 alpha_texture: None,
             }),
             "Kd" | "Ka" | "Ks" | "Ke" => {
-                let colour = match numbers()?.as_slice() {
-                    [grey] => Vec3::splat(*grey),
-                    [r, g, b] => Vec3::new(*r, *g, *b),
-                    found => return Err(at(format!("{key} needs 1 or 3 numbers (r [g b]), found {}", found.len()))),
-                };
-                if (key == "Kd" || key == "Ke") && colour.min_element() < 0.0 {
-                    return Err(at(format!("{key} {rest} is negative")));
-                }
-                // An emitter brighter than the HDR buffer holds would turn to infinity (black).
-                if key == "Ke" {
-                    if let Some(trouble) = super::limits::radiance_trouble("Ke", colour.max_element() as f64) {
-                        return Err(at(trouble));
-                    }
-                }
-                // Values before the first newmtl belong to no material (as in tobj).
+                let colour = mtl_colour(&statement)?;
                 if let Some(m) = materials.last_mut() {
                     match key {
                         "Kd" => m.diffuse = Some(colour),
@@ -458,38 +500,17 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
                 }
             }
             "Ns" | "Ni" | "d" | "Tr" => {
-                let values = numbers()?;
-                if values.len() != 1 {
-                    return Err(at(format!("{key} needs one number, found {}", values.len())));
-                }
-                if key == "d" || key == "Tr" {
-                    let value = values[0];
-                    if !(0.0..=1.0).contains(&value) {
-                        return Err(at(format!("{key} {value} is not in [0, 1]")));
-                    }
-                    if let Some(m) = materials.last_mut() {
-                        // Tr is transparency: 1 − d.
-                        m.alpha = Some(if key == "d" { value } else { 1.0 - value });
-                    }
+                let value = mtl_number(&statement)?;
+                if let Some(m) = materials.last_mut().filter(|_| key == "d" || key == "Tr") {
+                    // Tr is transparency: 1 − d.
+                    m.alpha = Some(if key == "d" { value } else { 1.0 - value });
                 }
             }
             "illum" if rest.parse::<u8>().is_err() => {
-                return Err(at(format!("illum value '{rest}' is not an illumination model number (0-10)")));
+                return Err(statement.at(format!("illum value '{rest}' is not an illumination model number (0-10)")));
             }
             "map_Kd" | "map_d" => {
-                // Options such as `-bm 1` come before the file name.
-                let name = if rest.starts_with('-') { rest.split_whitespace().last().unwrap_or("") } else { rest };
-                if name.is_empty() {
-                    return Err(at(format!("{key} needs a texture file name")));
-                }
-                let texture = directory.join(name);
-                match crate::files::check_regular_file(&texture) {
-                    Ok(_) => {}
-                    Err(e) if matches!(e.problem, crate::files::FileProblem::Missing) => {
-                        return Err(at(format!("texture file '{name}' not found (looked for {})", texture.display())));
-                    }
-                    Err(e) => return Err(at(format!("texture file '{name}' ({}) {}", texture.display(), e.problem))),
-                }
+                let texture = mtl_texture(&statement, directory)?;
                 if let Some(m) = materials.last_mut() {
                     if key == "map_Kd" {
                         m.diffuse_texture = Some(texture);
@@ -502,6 +523,62 @@ fn scan_mtl(path: &Path) -> Result<Vec<MtlMaterial>> {
         }
     }
     Ok(materials)
+}
+
+/// An MTL colour (`Kd`, `Ka`, `Ks`, `Ke`: `r g b` or one grey level); the diffuse and
+/// emitted colours must not be negative.
+fn mtl_colour(statement: &Statement) -> Result<Vec3> {
+    let (key, rest) = (statement.keyword, statement.rest);
+    let colour = match statement.numbers(&format!("{key} value"))?.as_slice() {
+        [grey] => Vec3::splat(*grey),
+        [r, g, b] => Vec3::new(*r, *g, *b),
+        found => return Err(statement.at(format!("{key} needs 1 or 3 numbers (r [g b]), found {}", found.len()))),
+    };
+    if (key == "Kd" || key == "Ke") && colour.min_element() < 0.0 {
+        return Err(statement.at(format!("{key} {rest} is negative")));
+    }
+    // An emitter brighter than the HDR buffer holds would turn to infinity (black).
+    if key == "Ke" {
+        if let Some(trouble) = super::limits::radiance_trouble("Ke", colour.max_element() as f64) {
+            return Err(statement.at(trouble));
+        }
+    }
+    Ok(colour)
+}
+
+/// An MTL key of one number (`Ns`, `Ni`, `d`, `Tr`); the alpha keys `d` and `Tr` must
+/// lie in [0, 1].
+fn mtl_number(statement: &Statement) -> Result<f32> {
+    let key = statement.keyword;
+    let values = statement.numbers(&format!("{key} value"))?;
+    if values.len() != 1 {
+        return Err(statement.at(format!("{key} needs one number, found {}", values.len())));
+    }
+    let value = values[0];
+    if (key == "d" || key == "Tr") && !(0.0..=1.0).contains(&value) {
+        return Err(statement.at(format!("{key} {value} is not in [0, 1]")));
+    }
+    Ok(value)
+}
+
+/// A texture map's file (`map_Kd`, `map_d`), resolved against the MTL's `directory`:
+/// it must exist and be a regular file.
+fn mtl_texture(statement: &Statement, directory: &Path) -> Result<PathBuf> {
+    let (key, rest) = (statement.keyword, statement.rest);
+    // Options such as `-bm 1` come before the file name.
+    let name = if rest.starts_with('-') { rest.split_whitespace().last().unwrap_or("") } else { rest };
+    if name.is_empty() {
+        return Err(statement.at(format!("{key} needs a texture file name")));
+    }
+    let texture = directory.join(name);
+    match crate::files::check_regular_file(&texture) {
+        Ok(_) => {}
+        Err(e) if matches!(e.problem, crate::files::FileProblem::Missing) => {
+            return Err(statement.at(format!("texture file '{name}' not found (looked for {})", texture.display())));
+        }
+        Err(e) => return Err(statement.at(format!("texture file '{name}' ({}) {}", texture.display(), e.problem))),
+    }
+    Ok(texture)
 }
 
 /// The image in a texture file (a regular file of at most [`crate::files::MAX_FILE_BYTES`]),

@@ -130,7 +130,7 @@ impl Pass for BlurPass {
         // point (upsample::reuses_left_eye_upsample), which makes this reuse redundant:
         // it barely changes how many points differ, and its extra right-eye dispatch makes
         // the stereo denoise costlier. At full resolution the eyes already agree and the
-        // reuse's lookups add to the denoise's cost (docs/measurements-in-code.md,
+        // reuse's lookups add to the denoise's cost (docs/records/2026-11-29/measurements-in-code.md,
         // blur-stereo-reuse).
         let reuse = ao.stereo_reuse
             && ao.resolution.is_half()

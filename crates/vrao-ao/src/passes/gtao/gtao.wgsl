@@ -56,7 +56,7 @@ override RIGHT_EYE: bool = false;
 // normal w, gbuffer.wgsl) is a card — a leaf, a grille, a fence — with no depth behind
 // it: instead of a slab it blocks its footprint on the card's plane (`add_sample`).
 // As a slab `thickness` × r deep, a grille 25 cm over a floor read as a half-metre block
-// (the floor under its holes far darker than the reference's; docs/measurements-in-code.md,
+// (the floor under its holes far darker than the reference's; docs/records/2026-11-29/measurements-in-code.md,
 // gtao-thin-cards). Off, no pixel pays the normal's fetch.
 override THIN_CARDS: bool = false;
 // AoRaw's and AoGeometry's left-eye layers in the right eye's dispatch (any array
@@ -79,6 +79,9 @@ struct GtaoParams {
     connect: f32,
     // Columns along each eye's inner border marched with the other-eye lookups.
     inner_band: u32,
+    // Pads the struct to 32 bytes, a multiple of 16 (`padding` of GtaoUniform).
+    _pad0: u32,
+    _pad1: u32,
 };
 @group(0) @binding(9) var<uniform> gtao: GtaoParams;
 
@@ -227,7 +230,7 @@ fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
     let t = (f32(i) + jitter) / f32(steps);
     // t ((2 − P) + (P − 1) t): between even (P = 1) and quadratic (P = 2); two
     // multiply-adds, where t^P cost a pow per sample and was no more accurate
-    // (docs/measurements-in-code.md, gtao-step-power).
+    // (docs/records/2026-11-29/measurements-in-code.md, gtao-step-power).
     return max(t * mix(1.0, t, gtao.step_power - 1.0) * march_px, f32(i) + 1.0);
 }
 

@@ -21,14 +21,14 @@ const DEFAULT_STEP_POWER: f32 = 1.5;
 const DEFAULT_CONNECT: f32 = 0.25;
 
 /// GTAO's own settings (`AoSettings::gtao`), and their command-line flags. The defaults
-/// are tuned against the reference (scripts/tune-gtao.py and docs/gtao-tuning.md).
+/// are tuned against the reference (scripts/tune-gtao.py and docs/records/2026-11-29/gtao-tuning.md).
 #[derive(Clone, Debug, PartialEq)]
 pub struct GtaoSettings {
     /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
     /// radius (thin objects stop occluding behind themselves).
     // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
     // fewer halos (pixels beside depth edges too dark by > 0.1); 0.5 leaves fewer still
-    // but costs RMSE (docs/measurements-in-code.md, gtao-thickness).
+    // but costs RMSE (docs/records/2026-11-29/measurements-in-code.md, gtao-thickness).
     pub thickness: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
     /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
@@ -77,6 +77,10 @@ pub const BINDINGS: [Bind; 10] =
 /// gtao.wgsl: the march over slices and sectors that GTAO and SSDO share.
 pub const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
 
+/// GTAO's WGSL files, in order: gtao.wgsl's march and gtao_light.wgsl's light hooks.
+const GTAO_FILES: [Shader; 5] =
+    [COMMON, VISIBILITY, OCCLUSION_WGSL, GTAO_WGSL, wgsl!("src/passes/gtao/gtao_light.wgsl")];
+
 /// One technique built on gtao.wgsl's march: its name, its WGSL files (the march and,
 /// after it, the file of its light hooks: gtao_light.wgsl for GTAO), its bindings
 /// ([`BINDINGS`] and its own after them), its extra pipeline constants, and what it
@@ -118,7 +122,7 @@ struct GtaoUniform {
 /// slices: the 4×4 noise tile turns each pixel's slices, so the denoise averages 16 × 2
 /// directions anyway, while the occluders a sparse march steps over stay missed (a
 /// bias, not noise): at N = 24, 2×6 gave less error and bias than 3×4
-/// (docs/measurements-in-code.md, gtao-slices-steps).
+/// (docs/records/2026-11-29/measurements-in-code.md, gtao-slices-steps).
 pub fn gtao_slices_steps(samples: u32) -> (u32, u32) {
     let slices = if samples < 128 { 2 } else { 4 };
     (slices, (samples / (2 * slices)).max(1))
@@ -175,7 +179,7 @@ impl GtaoPass {
             March {
                 technique: Technique::Gtao,
                 label: Technique::Gtao.name(),
-                files: vec![COMMON, VISIBILITY, OCCLUSION_WGSL, GTAO_WGSL, wgsl!("src/passes/gtao/gtao_light.wgsl")],
+                files: GTAO_FILES.to_vec(),
                 binds: &BINDINGS,
                 constants: Vec::new(),
                 declare: |decl, _| decl,
@@ -282,6 +286,15 @@ impl Pass for GtaoPass {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gpu::layout_check::{self, mirror};
+
+    #[test]
+    fn the_gtao_uniform_matches_gtao_wgsl() {
+        #[rustfmt::skip]
+        layout_check::check(&[
+            mirror!(GtaoUniform, GTAO_FILES, "GtaoParams", [slices, steps, thickness, step_power, connect, inner_band, padding]),
+        ]);
+    }
 
     #[test]
     fn gtao_presets_spend_ssao_tap_counts() {

@@ -6,7 +6,7 @@
 
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, MoverBox, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, VISIBILITY};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION, PIXEL_MOTION};
@@ -59,6 +59,9 @@ const BINDINGS: [Bind; 11] = [
     Bind::Read(PIXEL_MOTION),
 ];
 
+/// The pass's WGSL files, in order.
+const FILES: [Shader; 3] = [COMMON, VISIBILITY, wgsl!("src/passes/temporal/temporal.wgsl")];
+
 /// Mirrors `Temporal` in temporal.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -93,9 +96,8 @@ pub struct TemporalPass {
 impl TemporalPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> TemporalPass {
-        let files = [COMMON, VISIBILITY, wgsl!("src/passes/temporal/temporal.wgsl")];
         TemporalPass {
-            kernel: Kernel::new(gpu, "temporal", &files, "main", &BINDINGS),
+            kernel: Kernel::new(gpu, "temporal", &FILES, "main", &BINDINGS),
             uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("temporal"),
                 size: std::mem::size_of::<TemporalUniform>() as u64,
@@ -219,4 +221,19 @@ impl Pass for TemporalPass {
 /// them, and the settings ask for it).
 fn uses_motion(setup: &DeclareContext) -> bool {
     setup.motion.vectors && setup.settings.ao.temporal.object_motion
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+    use crate::gpu::layout_check::{self, mirror};
+
+    #[test]
+    fn the_temporal_uniform_matches_temporal_wgsl() {
+        #[rustfmt::skip]
+        layout_check::check(&[
+            mirror!(TemporalUniform, FILES, "Temporal", [anchored_from_view, previous_clip_from_anchored, epsilon, confidence_bias, max_frames, blend, history_valid, pixel_tangent, motion_px, has_motion, previous_anchored_from_view, previous_tangents, previous_view_from_anchored, movers, mover_count, motion_with_distance, motion_uv_scale]),
+            mirror!(MoverBox, FILES, "MoverBox", [box_from_anchored, half_extents]),
+        ]);
+    }
 }

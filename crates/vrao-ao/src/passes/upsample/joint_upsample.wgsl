@@ -5,10 +5,10 @@
 // pixels 2b + {0, 1}² of low-res sample b: all four have the same 2×2 (and 3×3)
 // low-res neighbourhood, so each sample is fetched once per quad instead of once per
 // pixel. On lavapipe the fetches, not the weights, are what upsampling costs
-// (docs/measurements-in-code.md, upsample-per-quad). The quad's four pixels live in
+// (docs/records/2026-11-29/measurements-in-code.md, upsample-per-quad). The quad's four pixels live in
 // arrays indexed only by constants (calls written out four times, never a loop over
 // them): lavapipe keeps an array indexed by a loop counter in memory, which made the
-// per-quad composite slower than a per-pixel one (docs/measurements-in-code.md,
+// per-quad composite slower than a per-pixel one (docs/records/2026-11-29/measurements-in-code.md,
 // upsample-loop-arrays). Each low-res neighbour is
 // weighted by its distance to the pixel and by how well its geometry (normal and
 // distance in AoGeometry, from the full-res pixel it was computed at) matches:

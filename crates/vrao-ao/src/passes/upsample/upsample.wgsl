@@ -6,7 +6,7 @@
 // the left eye's layer. It computes the right eye's own upsample at every quad, where
 // the composite does so only at the quads the left eye does not fully see (its
 // FALLBACK dispatch): the values are the same, this pass costs more than with
-// independent eyes (docs/measurements-in-code.md, upsample-right-eye).
+// independent eyes (docs/records/2026-11-29/measurements-in-code.md, upsample-right-eye).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;

@@ -2,7 +2,7 @@
 // HALF_RES the occlusion arrives at half resolution and is upsampled here, instead of in
 // a pass of its own; so is the RSM bounce. One invocation shades a quad of 2×2 pixels
 // (joint_upsample.wgsl `upsample_quad`: each low-res sample fetched once per quad);
-// without upsampling this costs what one pixel per invocation does (docs/measurements.md).
+// without upsampling this costs what one pixel per invocation does (docs/records/2026-11-29/summary.md).
 // `ao.technique` is the technique table's composite mode: COMPOSITE_UNOCCLUDED, the
 // unoccluded ambient (SH irradiance of the environment); COMPOSITE_SCALAR_AO, ambient × AO
 // (GTAO, SSAO, HBAO); COMPOSITE_DIRECTIONAL, SSDO's gathered irradiance (rgb) replaces it.
@@ -16,7 +16,7 @@
 // outer side, disocclusions: a small share) is listed instead, and a second, indirect
 // dispatch (FALLBACK) over exactly those quads upsamples their own occlusion too. Done
 // in one dispatch, every quad paid for both on lavapipe, which runs an untaken branch
-// anyway (docs/measurements-in-code.md, composite-fallback), and on a GPU every warp
+// anyway (docs/records/2026-11-29/measurements-in-code.md, composite-fallback), and on a GPU every warp
 // holding one such quad would.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -43,7 +43,7 @@
 
 override HALF_RES: bool = false;
 // A pipeline constant, not a uniform: lavapipe pays for the upsample code even when a
-// uniform skips it (docs/measurements-in-code.md, composite-constant).
+// uniform skips it (docs/records/2026-11-29/measurements-in-code.md, composite-constant).
 override RSM: bool = false;
 override RIGHT_EYE: bool = false;
 // The right eye's second dispatch, over the listed quads (implies RIGHT_EYE).

@@ -37,7 +37,7 @@ pub const EMISSION: Resource = Resource::attachment("emission", Size::Full, wgpu
 /// The normals the lighting uses: the normal texture's where a material has one. The AO
 /// keeps the surface's own ([`NORMALS`]): against the reference, normal-textured normals
 /// tilt GTAO's hemisphere into the flat surface they decorate and raise its error several
-/// times (docs/measurements.md, "normal textures and the AO"). Written only in a scene
+/// times (docs/records/2026-11-29/summary.md, "normal textures and the AO"). Written only in a scene
 /// with normal textures; otherwise [`LIGHTING_NORMALS`] is [`NORMALS`].
 pub const SHADING_NORMALS: Resource =
     Resource::attachment("shading-normals", Size::Full, wgpu::TextureFormat::Rgba16Float);
@@ -332,4 +332,17 @@ fn begin<'e, 't>(
         occlusion_query_set: None,
         multiview_mask,
     })
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+    use crate::gpu::layout_check::{self, mirror};
+
+    #[test]
+    fn the_gbuffer_uniform_matches_gbuffer_wgsl() {
+        // The files of the per-eye path (`GBufferPass::new`).
+        let files = [COMMON, MESH_WGSL, GBUFFER_WGSL, wgsl!("src/passes/gbuffer/gbuffer_multipass.wgsl")];
+        layout_check::check(&[mirror!(PreviousEyes, files, "PreviousEyes", [clip_from_anchored, view_from_anchored])]);
+    }
 }

@@ -7,7 +7,7 @@
 use super::gbuffer::{DEPTH, NORMALS};
 use super::shadow::{rsm_active, shadow_casters, LightSpace, RSM_FLUX, RSM_NORMAL, SHADOW_MAP, SHADOW_WGSL};
 use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
 use crate::gpu::uniforms::ao_extent;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size};
@@ -18,6 +18,9 @@ use std::sync::Arc;
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
 pub const NAME: &str = "rsm";
+
+/// The pass's WGSL files, in order.
+const FILES: [Shader; 3] = [COMMON, SHADOW_WGSL, wgsl!("src/passes/rsm/rsm.wgsl")];
 
 /// `RsmParams` of rsm.wgsl.
 #[repr(C)]
@@ -65,8 +68,7 @@ pub struct RsmPass {
 impl RsmPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> RsmPass {
-        let files = [COMMON, SHADOW_WGSL, wgsl!("src/passes/rsm/rsm.wgsl")];
-        let kernel = Kernel::new(gpu, "rsm", &files, "main", &BINDINGS);
+        let kernel = Kernel::new(gpu, "rsm", &FILES, "main", &BINDINGS);
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rsm params"),
             size: std::mem::size_of::<RsmParamsUniform>() as u64,
@@ -111,5 +113,16 @@ impl Pass for RsmPass {
             &resources,
             (w, h, ctx.setup.views),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::{self, mirror};
+
+    #[test]
+    fn the_rsm_uniform_matches_rsm_wgsl() {
+        layout_check::check(&[mirror!(RsmParamsUniform, FILES, "RsmParams", [low_size, samples, frame, radius, _pad])]);
     }
 }

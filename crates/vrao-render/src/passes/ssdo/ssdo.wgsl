@@ -54,7 +54,7 @@ fn gathered_radiance(layer: u32, m0: f32, m1: vec3<f32>) -> vec3<f32> {
 // patch's A/d² far away and at most 2π (a hemisphere) when the sender touches the
 // receiver, where A/d² diverges: Ritschel et al. 2009 clamps d_i there, and a clamp at the
 // patch's own size cut much of the bounce from the nearest senders, which carry most of it
-// (docs/measurements-in-code.md, ssdo-disc-clamp).
+// (docs/records/2026-11-29/measurements-in-code.md, ssdo-disc-clamp).
 fn disc_solid_angle(d2: f32, a: f32) -> f32 {
     let s = sqrt(d2 + a);
     return 2.0 * PI * a / (s * (s + sqrt(d2)));
@@ -146,7 +146,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     // Eq. 1 with Δω = 2π/N estimates ∫ L V cos dω; its N-sample quadrature error
-    // (docs/measurements-in-code.md, ssdo-quadrature) and the pre-filter would make SSDO
+    // (docs/records/2026-11-29/measurements-in-code.md, ssdo-quadrature) and the pre-filter would make SSDO
     // disagree with the unoccluded ambient on an open surface. So the samples decide only
     // which share of the incoming light is blocked, per colour channel, and that share
     // scales the exact SH irradiance: an open plane gets exactly the ambient of the other

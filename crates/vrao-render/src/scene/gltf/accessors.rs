@@ -183,40 +183,7 @@ impl Loader<'_> {
         }
         // At most 16 components of 4 bytes: no overflow.
         let size = accessor.dimensions().multiplicity() * accessor.data_type().size();
-        let base = match accessor.view() {
-            // Zeros cost the file nothing: a few bytes of JSON must not make gigabytes.
-            None if count > MAX_VERTICES => {
-                return Err(self.error(format!(
-                    "{what}: accessor {index} declares {count} elements without a buffer view (vrao's limit for those: {MAX_VERTICES})"
-                )))
-            }
-            None => None,
-            Some(view) => {
-                let data = self.view_bytes(&view, what)?;
-                let stride = view.stride().unwrap_or(size);
-                if stride < size {
-                    return Err(self.error(format!(
-                        "{what}: accessor {index} stride {stride} is less than its element size {size}"
-                    )));
-                }
-                let offset = accessor.offset();
-                let end = match count {
-                    0 => Some(offset),
-                    n => (n - 1).checked_mul(stride).and_then(|b| b.checked_add(size)).and_then(|b| b.checked_add(offset)),
-                };
-                match end {
-                    Some(end) if end <= data.len() => Some((&data[offset..], stride)),
-                    _ => {
-                        let at = if offset == 0 { String::new() } else { format!(" from byteOffset {offset}") };
-                        return Err(self.error(format!(
-                            "{what}: accessor {index} ({count} elements) runs past the end of buffer view {} ({} bytes){at}",
-                            view.index(),
-                            view.length()
-                        )));
-                    }
-                }
-            }
-        };
+        let base = self.dense_base(accessor, size, what)?;
         let mut elements = Elements { count, size, base, indices: Vec::new(), values: &[] };
         let Some(sparse) = accessor.sparse() else { return Ok(elements) };
         let substituted = sparse.count();
@@ -242,7 +209,62 @@ impl Loader<'_> {
         let index_size = indices.index_type().size();
         let index_bytes = packed(indices.view(), indices.offset(), index_size, "indices")?;
         elements.values = packed(sparse.values().view(), sparse.values().offset(), size, "values")?;
-        elements.indices.reserve_exact(substituted);
+        elements.indices = self.sparse_indices(index_bytes, index_size, count, index, what)?;
+        Ok(elements)
+    }
+
+    /// The dense base of an accessor of `size`-byte elements: its buffer view's bytes from
+    /// the accessor's offset and its stride, every element in range, or `None` (zeros)
+    /// without a view.
+    fn dense_base(&self, accessor: &::gltf::Accessor, size: usize, what: &str) -> Result<Option<(&[u8], usize)>> {
+        let index = accessor.index();
+        let count = accessor.count();
+        let Some(view) = accessor.view() else {
+            // Zeros cost the file nothing: a few bytes of JSON must not make gigabytes.
+            if count > MAX_VERTICES {
+                return Err(self.error(format!(
+                    "{what}: accessor {index} declares {count} elements without a buffer view (vrao's limit for those: {MAX_VERTICES})"
+                )));
+            }
+            return Ok(None);
+        };
+        let data = self.view_bytes(&view, what)?;
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(
+                self.error(format!("{what}: accessor {index} stride {stride} is less than its element size {size}"))
+            );
+        }
+        let offset = accessor.offset();
+        let end = match count {
+            0 => Some(offset),
+            n => (n - 1).checked_mul(stride).and_then(|b| b.checked_add(size)).and_then(|b| b.checked_add(offset)),
+        };
+        match end {
+            Some(end) if end <= data.len() => Ok(Some((&data[offset..], stride))),
+            _ => {
+                let at = if offset == 0 { String::new() } else { format!(" from byteOffset {offset}") };
+                Err(self.error(format!(
+                    "{what}: accessor {index} ({count} elements) runs past the end of buffer view {} ({} bytes){at}",
+                    view.index(),
+                    view.length()
+                )))
+            }
+        }
+    }
+
+    /// A sparse accessor's indices from their packed little-endian `index_size`-byte
+    /// integers: each below `count` (the elements of accessor `index`) and strictly
+    /// increasing, so the substitutions apply in one pass.
+    fn sparse_indices(
+        &self,
+        index_bytes: &[u8],
+        index_size: usize,
+        count: usize,
+        index: usize,
+        what: &str,
+    ) -> Result<Vec<u32>> {
+        let mut indices: Vec<u32> = Vec::with_capacity(index_bytes.len() / index_size);
         for (k, b) in index_bytes.chunks_exact(index_size).enumerate() {
             let i = match index_size {
                 1 => b[0] as u32,
@@ -254,16 +276,16 @@ impl Loader<'_> {
                     "{what}: accessor {index} sparse index {i} (at {k}) is out of range ({count} elements)"
                 )));
             }
-            if let Some(&last) = elements.indices.last() {
+            if let Some(&last) = indices.last() {
                 if i <= last {
                     return Err(self.error(format!(
                         "{what}: accessor {index} sparse indices {last} then {i} (at {k}) are not strictly increasing"
                     )));
                 }
             }
-            elements.indices.push(i);
+            indices.push(i);
         }
-        Ok(elements)
+        Ok(indices)
     }
 
     /// An accessor of N-component vectors for `usage`: float, or the integers glTF allows

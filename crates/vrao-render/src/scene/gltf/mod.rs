@@ -317,6 +317,19 @@ struct LocalPrimitive {
     material: usize,
 }
 
+/// A triangle primitive's vertex attributes as read, before normals.
+struct Attributes {
+    positions: Vec<Vec3>,
+    /// The triangle list (strips and fans unrolled), every index below the positions' count.
+    indices: Vec<u32>,
+    /// TEXCOORD_0, one per position, or empty.
+    uvs: Vec<Vec2>,
+    /// COLOR_0, one per position, or empty.
+    colors: Vec<Vec4>,
+    /// TANGENT, one per position, or empty.
+    tangents: Vec<Vec4>,
+}
+
 /// State of one load.
 struct Loader<'a> {
     path: &'a Path,
@@ -344,6 +357,36 @@ struct Parent {
     node: Option<usize>,
 }
 
+/// The nodes a glTF's scene starts from: the default scene's (or the first scene's), or
+/// without a scene every node that is nobody's child.
+fn scene_roots(document: &::gltf::Document) -> Vec<::gltf::Node<'_>> {
+    match document.default_scene().or_else(|| document.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            // No scene: every node that is nobody's child.
+            let mut is_child = vec![false; document.nodes().len()];
+            document.nodes().flat_map(|n| n.children()).for_each(|c| is_child[c.index()] = true);
+            document.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    }
+}
+
+/// The world transform at time 0 of a node placed `here` below `parent`: the static
+/// chain's, or a moving node's from `rest_world` (one per vrao node in `nodes`, filled as
+/// the walk first reaches each: parents come before their children).
+fn world_at_rest(nodes: &[Node], rest_world: &mut Vec<DMat4>, parent: &Parent, here: &Parent) -> DMat4 {
+    match here.node {
+        None => here.world,
+        Some(k) if k == rest_world.len() => {
+            let local = nodes[k].local_at(0.0);
+            let world = parent.node.map_or(local, |p| rest_world[p] * local);
+            rest_world.push(world);
+            world
+        }
+        Some(k) => rest_world[k],
+    }
+}
+
 impl Loader<'_> {
     fn error(&self, message: impl Into<String>) -> Error {
         Error::in_file(self.path, message)
@@ -352,15 +395,7 @@ impl Loader<'_> {
     fn build(&mut self) -> Result<Content> {
         let document = self.document;
         let tracks = self.animation_tracks()?;
-        let roots: Vec<::gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
-            Some(scene) => scene.nodes().collect(),
-            None => {
-                // No scene: every node that is nobody's child.
-                let mut is_child = vec![false; document.nodes().len()];
-                document.nodes().flat_map(|n| n.children()).for_each(|c| is_child[c.index()] = true);
-                document.nodes().filter(|n| !is_child[n.index()]).collect()
-            }
-        };
+        let roots = scene_roots(document);
         if document.skins().next().is_some() {
             self.warnings.ignored.insert("skins (drawn in the bind pose)");
         }
@@ -377,52 +412,9 @@ impl Loader<'_> {
             if std::mem::replace(&mut visited[index], true) {
                 return Err(self.error(format!("node {index} is reached twice (a cycle, or a node with two parents)")));
             }
-            let local = self.local_transform(&node)?;
-            let animated = tracks.get(&index);
-            let here = if parent.node.is_none() && animated.is_none() {
-                Parent { world: parent.world * local.matrix(), node: None }
-            } else {
-                let (base, rest) = match (parent.node, local) {
-                    // A moving root: its static ancestors fold into its base.
-                    (None, local) => (parent.world, local.trs()),
-                    (Some(_), Local::Matrix(m)) => (m, Trs::IDENTITY),
-                    (Some(_), Local::Trs(trs)) => (DMat4::IDENTITY, trs),
-                };
-                content.nodes.push(Node {
-                    name: node.name().map_or_else(|| format!("node {index}"), str::to_string),
-                    parent: parent.node,
-                    base,
-                    rest,
-                    tracks: animated.cloned().unwrap_or_default(),
-                });
-                Parent { world: parent.world, node: Some(content.nodes.len() - 1) }
-            };
-            let world_at_rest = match here.node {
-                None => here.world,
-                Some(k) if k == node_rest_world.len() => {
-                    let local = content.nodes[k].local_at(0.0);
-                    let world = parent.node.map_or(local, |p| node_rest_world[p] * local);
-                    node_rest_world.push(world);
-                    world
-                }
-                Some(k) => node_rest_world[k],
-            };
-
-            if let Some(mesh) = node.mesh() {
-                self.place_mesh(&mesh, &here, &mut content.meshes)?;
-            }
-            if let Some(light) = node.light() {
-                if light.range().is_some() {
-                    self.warnings.ignored.insert("light range (inverse-square falloff everywhere)");
-                }
-                content.lights.push(self.light(&light, &world_at_rest)?);
-            }
-            if node.camera().is_some() && content.camera.is_none() {
-                let (_, rotation, translation) = world_at_rest.to_scale_rotation_translation();
-                if translation.is_finite() && rotation.is_finite() {
-                    content.camera = Some(HeadPose { position: translation, orientation: rotation.normalize() });
-                }
-            }
+            let here = self.node_frame(&node, &parent, tracks.get(&index), &mut content.nodes)?;
+            let world_at_rest = world_at_rest(&content.nodes, &mut node_rest_world, &parent, &here);
+            self.attach(&node, &here, &world_at_rest, &mut content)?;
             for child in node.children().collect::<Vec<_>>().into_iter().rev() {
                 stack.push((child, here));
             }
@@ -433,6 +425,64 @@ impl Loader<'_> {
             return Err(self.error("contains no triangles (no mesh in the default scene)"));
         }
         Ok(content)
+    }
+
+    /// Where `node` places what hangs below it: folded into the static world transform
+    /// while neither it nor an ancestor moves, else a vrao node of its own, pushed onto
+    /// `nodes` (`animated`: its tracks, if it moves).
+    fn node_frame(
+        &self,
+        node: &::gltf::Node,
+        parent: &Parent,
+        animated: Option<&NodeTracks>,
+        nodes: &mut Vec<Node>,
+    ) -> Result<Parent> {
+        let index = node.index();
+        let local = self.local_transform(node)?;
+        if parent.node.is_none() && animated.is_none() {
+            return Ok(Parent { world: parent.world * local.matrix(), node: None });
+        }
+        let (base, rest) = match (parent.node, local) {
+            // A moving root: its static ancestors fold into its base.
+            (None, local) => (parent.world, local.trs()),
+            (Some(_), Local::Matrix(m)) => (m, Trs::IDENTITY),
+            (Some(_), Local::Trs(trs)) => (DMat4::IDENTITY, trs),
+        };
+        nodes.push(Node {
+            name: node.name().map_or_else(|| format!("node {index}"), str::to_string),
+            parent: parent.node,
+            base,
+            rest,
+            tracks: animated.cloned().unwrap_or_default(),
+        });
+        Ok(Parent { world: parent.world, node: Some(nodes.len() - 1) })
+    }
+
+    /// What a node carries, placed `here`: its mesh, its light (at its world transform at
+    /// time 0) and, for the first camera, the head pose.
+    fn attach(
+        &mut self,
+        node: &::gltf::Node,
+        here: &Parent,
+        world_at_rest: &DMat4,
+        content: &mut Content,
+    ) -> Result<()> {
+        if let Some(mesh) = node.mesh() {
+            self.place_mesh(&mesh, here, &mut content.meshes)?;
+        }
+        if let Some(light) = node.light() {
+            if light.range().is_some() {
+                self.warnings.ignored.insert("light range (inverse-square falloff everywhere)");
+            }
+            content.lights.push(self.light(&light, world_at_rest)?);
+        }
+        if node.camera().is_some() && content.camera.is_none() {
+            let (_, rotation, translation) = world_at_rest.to_scale_rotation_translation();
+            if translation.is_finite() && rotation.is_finite() {
+                content.camera = Some(HeadPose { position: translation, orientation: rotation.normalize() });
+            }
+        }
+        Ok(())
     }
 
     /// A node's local transform, checked finite and within the bounds static values have
@@ -579,71 +629,8 @@ impl Loader<'_> {
             if primitive.morph_targets().next().is_some() {
                 self.warnings.ignored.insert("morph targets (drawn in the bind pose)");
             }
-            let position = primitive
-                .get(&::gltf::Semantic::Positions)
-                .ok_or_else(|| self.error(format!("{what} has no POSITION attribute")))?;
-            let positions: Vec<Vec3> = self
-                .read_as::<3>(&position, Use::Position, &format!("{what} POSITION"))?
-                .into_iter()
-                .map(Vec3::from)
-                .collect();
-            let count = positions.len();
-            let indices: Vec<u32> = match primitive.indices() {
-                Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
-                None => (0..count as u32).collect(),
-            };
-            let indices = triangle_list(mode, indices);
-            if !indices.len().is_multiple_of(3) {
-                return Err(self.error(format!("{what}: {} indices, not a whole number of triangles", indices.len())));
-            }
-            let uvs: Vec<Vec2> = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
-                Some(accessor) => {
-                    let label = format!("{what} TEXCOORD_0");
-                    let uvs = self.read_as::<2>(&accessor, Use::TexCoord, &label)?;
-                    self.same_count(uvs.len(), count, &label)?;
-                    uvs.into_iter().map(Vec2::from).collect()
-                }
-                None => Vec::new(),
-            };
-            if primitive.get(&::gltf::Semantic::TexCoords(1)).is_some() {
-                self.warnings.ignored.insert("texture coordinate sets other than 0");
-            }
-            let colors = match primitive.get(&::gltf::Semantic::Colors(0)) {
-                Some(accessor) => self.read_colors(&accessor, &format!("{what} COLOR_0"), count)?,
-                None => Vec::new(),
-            };
-            let tangents: Vec<Vec4> = match primitive.get(&::gltf::Semantic::Tangents) {
-                Some(accessor) => {
-                    let label = format!("{what} TANGENT");
-                    let tangents = self.read_as::<4>(&accessor, Use::Tangent, &label)?;
-                    self.same_count(tangents.len(), count, &label)?;
-                    tangents.into_iter().map(Vec4::from).collect()
-                }
-                None => Vec::new(),
-            };
-            let (geometry, colors, tangents) = match primitive.get(&::gltf::Semantic::Normals) {
-                Some(accessor) => {
-                    let label = format!("{what} NORMAL");
-                    let mut normals: Vec<Vec3> =
-                        self.read_as::<3>(&accessor, Use::Normal, &label)?.into_iter().map(Vec3::from).collect();
-                    self.same_count(normals.len(), count, &label)?;
-                    keep_unit_repair_others(&positions, &mut normals, &indices);
-                    let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
-                    (Geometry { positions, normals, uvs, indices }, colors, tangents)
-                }
-                None => {
-                    // Computed normals split vertices at creases: colours and tangents follow.
-                    let (geometry, sources) =
-                        normals::compute_normals_with_sources(&positions, &uvs, &indices, normals::DEFAULT_CREASE_DEG);
-                    let follow = |values: &[Vec4]| -> Vec<Vec4> {
-                        if values.is_empty() {
-                            return Vec::new();
-                        }
-                        sources.iter().map(|&v| values[v as usize]).collect()
-                    };
-                    (geometry, follow(&colors), follow(&tangents))
-                }
-            };
+            let attributes = self.read_attributes(&primitive, &what)?;
+            let (geometry, colors, tangents) = self.with_normals(&primitive, attributes, &what)?;
             let material = self.material(&primitive.material())?;
             let name = match mesh.primitives().len() {
                 1 => mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string),
@@ -652,6 +639,90 @@ impl Loader<'_> {
             out.push(LocalPrimitive { name, geometry, colors, tangents, material });
         }
         Ok(out)
+    }
+
+    /// A triangle primitive's vertex attributes other than normals, and its triangle list,
+    /// each checked against the positions' count.
+    fn read_attributes(&mut self, primitive: &::gltf::Primitive, what: &str) -> Result<Attributes> {
+        let position = primitive
+            .get(&::gltf::Semantic::Positions)
+            .ok_or_else(|| self.error(format!("{what} has no POSITION attribute")))?;
+        let positions: Vec<Vec3> = self
+            .read_as::<3>(&position, Use::Position, &format!("{what} POSITION"))?
+            .into_iter()
+            .map(Vec3::from)
+            .collect();
+        let count = positions.len();
+        let indices: Vec<u32> = match primitive.indices() {
+            Some(accessor) => self.read_indices(&accessor, count, &format!("{what} indices"))?,
+            None => (0..count as u32).collect(),
+        };
+        let indices = triangle_list(primitive.mode(), indices);
+        if !indices.len().is_multiple_of(3) {
+            return Err(self.error(format!("{what}: {} indices, not a whole number of triangles", indices.len())));
+        }
+        let uvs: Vec<Vec2> = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
+            Some(accessor) => {
+                let label = format!("{what} TEXCOORD_0");
+                let uvs = self.read_as::<2>(&accessor, Use::TexCoord, &label)?;
+                self.same_count(uvs.len(), count, &label)?;
+                uvs.into_iter().map(Vec2::from).collect()
+            }
+            None => Vec::new(),
+        };
+        if primitive.get(&::gltf::Semantic::TexCoords(1)).is_some() {
+            self.warnings.ignored.insert("texture coordinate sets other than 0");
+        }
+        let colors = match primitive.get(&::gltf::Semantic::Colors(0)) {
+            Some(accessor) => self.read_colors(&accessor, &format!("{what} COLOR_0"), count)?,
+            None => Vec::new(),
+        };
+        let tangents: Vec<Vec4> = match primitive.get(&::gltf::Semantic::Tangents) {
+            Some(accessor) => {
+                let label = format!("{what} TANGENT");
+                let tangents = self.read_as::<4>(&accessor, Use::Tangent, &label)?;
+                self.same_count(tangents.len(), count, &label)?;
+                tangents.into_iter().map(Vec4::from).collect()
+            }
+            None => Vec::new(),
+        };
+        Ok(Attributes { positions, indices, uvs, colors, tangents })
+    }
+
+    /// The primitive's geometry with its NORMAL (unit, the broken ones repaired), or with
+    /// normals computed at creases; the colours and tangents then follow the vertices
+    /// the creases split.
+    fn with_normals(
+        &self,
+        primitive: &::gltf::Primitive,
+        attributes: Attributes,
+        what: &str,
+    ) -> Result<(Geometry, Vec<Vec4>, Vec<Vec4>)> {
+        let Attributes { positions, indices, uvs, colors, tangents } = attributes;
+        let count = positions.len();
+        match primitive.get(&::gltf::Semantic::Normals) {
+            Some(accessor) => {
+                let label = format!("{what} NORMAL");
+                let mut normals: Vec<Vec3> =
+                    self.read_as::<3>(&accessor, Use::Normal, &label)?.into_iter().map(Vec3::from).collect();
+                self.same_count(normals.len(), count, &label)?;
+                keep_unit_repair_others(&positions, &mut normals, &indices);
+                let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
+                Ok((Geometry { positions, normals, uvs, indices }, colors, tangents))
+            }
+            None => {
+                // Computed normals split vertices at creases: colours and tangents follow.
+                let (geometry, sources) =
+                    normals::compute_normals_with_sources(&positions, &uvs, &indices, normals::DEFAULT_CREASE_DEG);
+                let follow = |values: &[Vec4]| -> Vec<Vec4> {
+                    if values.is_empty() {
+                        return Vec::new();
+                    }
+                    sources.iter().map(|&v| values[v as usize]).collect()
+                };
+                Ok((geometry, follow(&colors), follow(&tangents)))
+            }
+        }
     }
 
     /// COLOR_0 as linear RGBA (VEC3 gets alpha 1), one per vertex.
@@ -692,17 +763,7 @@ impl Loader<'_> {
         if !factor.iter().all(|c| c.is_finite()) || !emissive.is_finite() || emissive.min_element() < 0.0 {
             return Err(self.error(format!("material '{name}': colour factors must be finite and not negative")));
         }
-        let alpha_mode = match material.alpha_mode() {
-            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            ::gltf::material::AlphaMode::Mask => {
-                let cutoff = material.alpha_cutoff().unwrap_or(0.5);
-                if !(0.0..=1.0).contains(&cutoff) {
-                    return Err(self.error(format!("material '{name}': alphaCutoff {cutoff} is not in [0, 1]")));
-                }
-                AlphaMode::Mask { cutoff }
-            }
-            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
-        };
+        let alpha_mode = self.alpha_mode(material, &name)?;
         let diffuse_texture = match pbr.base_color_texture() {
             Some(info) => Some(self.texture(&info.texture(), placement_of_info(&info), &name)?),
             None => None,
@@ -711,37 +772,8 @@ impl Loader<'_> {
             Some(info) => Some(self.texture(&info.texture(), placement_of_info(&info), &name)?),
             None => None,
         };
-        let normal_texture = match material.normal_texture() {
-            Some(normal) => {
-                let placement =
-                    placement_of_extension(normal.extension_value("KHR_texture_transform"), normal.tex_coord(), &name)
-                        .map_err(|m| self.error(m))?;
-                let scale = normal.scale();
-                if !scale.is_finite() {
-                    return Err(self.error(format!("material '{name}': normalTexture scale {scale} is not finite")));
-                }
-                Some((self.texture(&normal.texture(), Ok(placement), &name)?, scale))
-            }
-            None => None,
-        };
-        let occlusion_texture = match material.occlusion_texture() {
-            Some(occlusion) => {
-                let placement = placement_of_extension(
-                    occlusion.extension_value("KHR_texture_transform"),
-                    occlusion.tex_coord(),
-                    &name,
-                )
-                .map_err(|m| self.error(m))?;
-                let strength = occlusion.strength();
-                if !(0.0..=1.0).contains(&strength) {
-                    return Err(
-                        self.error(format!("material '{name}': occlusionTexture strength {strength} is not in [0, 1]"))
-                    );
-                }
-                Some((self.texture(&occlusion.texture(), Ok(placement), &name)?, strength))
-            }
-            None => None,
-        };
+        let normal_texture = self.normal_texture(material, &name)?;
+        let occlusion_texture = self.occlusion_texture(material, &name)?;
         self.materials.push(Material {
             name,
             diffuse: Vec3::new(factor[0], factor[1], factor[2]).clamp(Vec3::ZERO, Vec3::ONE),
@@ -756,6 +788,47 @@ impl Loader<'_> {
         let i = self.materials.len() - 1;
         self.material_of.insert(material.index(), i);
         Ok(i)
+    }
+
+    /// A material's alpha mode; a mask's cutoff must lie in [0, 1].
+    fn alpha_mode(&self, material: &::gltf::Material, name: &str) -> Result<AlphaMode> {
+        Ok(match material.alpha_mode() {
+            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            ::gltf::material::AlphaMode::Mask => {
+                let cutoff = material.alpha_cutoff().unwrap_or(0.5);
+                if !(0.0..=1.0).contains(&cutoff) {
+                    return Err(self.error(format!("material '{name}': alphaCutoff {cutoff} is not in [0, 1]")));
+                }
+                AlphaMode::Mask { cutoff }
+            }
+            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        })
+    }
+
+    /// A material's normal map and its scale (finite), if it has one.
+    fn normal_texture(&mut self, material: &::gltf::Material, name: &str) -> Result<Option<(Texture, f32)>> {
+        let Some(normal) = material.normal_texture() else { return Ok(None) };
+        let placement =
+            placement_of_extension(normal.extension_value("KHR_texture_transform"), normal.tex_coord(), name)
+                .map_err(|m| self.error(m))?;
+        let scale = normal.scale();
+        if !scale.is_finite() {
+            return Err(self.error(format!("material '{name}': normalTexture scale {scale} is not finite")));
+        }
+        Ok(Some((self.texture(&normal.texture(), Ok(placement), name)?, scale)))
+    }
+
+    /// A material's occlusion map and its strength (in [0, 1]), if it has one.
+    fn occlusion_texture(&mut self, material: &::gltf::Material, name: &str) -> Result<Option<(Texture, f32)>> {
+        let Some(occlusion) = material.occlusion_texture() else { return Ok(None) };
+        let placement =
+            placement_of_extension(occlusion.extension_value("KHR_texture_transform"), occlusion.tex_coord(), name)
+                .map_err(|m| self.error(m))?;
+        let strength = occlusion.strength();
+        if !(0.0..=1.0).contains(&strength) {
+            return Err(self.error(format!("material '{name}': occlusionTexture strength {strength} is not in [0, 1]")));
+        }
+        Ok(Some((self.texture(&occlusion.texture(), Ok(placement), name)?, strength)))
     }
 
     /// A material's texture: its image (decoded once), its sampler and where it is placed

@@ -1,0 +1,537 @@
+//! The AO engine driven by a host: the `embed` example's own geometry and depth prepass
+//! (no vrao scene, no vrao G-buffer) fed to `AoEngine`, against vrao's renderer drawing
+//! the same geometry from the same eyes. One implementation: they must agree.
+
+use crate::common;
+#[path = "../../crates/vrao-ao/examples/embed/host.rs"]
+mod host;
+
+use glam::DVec3;
+use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
+use vrao::ao::{
+    AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostMotion, HostNormals, NormalEncoding, NormalSpace,
+    ViewMatrices,
+};
+use vrao::render::graph::FINAL_AO;
+use vrao::render::scene::Mesh;
+use vrao::render::settings::{AoSettings, Technique};
+use vrao::render::stereo::{Eye, EyeSide, Fov, HeadPose};
+use vrao::{Error, HeadsetProfile, Renderer, Settings};
+
+const WIDTH: u32 = 96;
+const HEIGHT: u32 = 108;
+const NEAR: f64 = 0.05;
+
+/// The demo's eyes as vrao eyes (pose from the host's view matrix, an asymmetric frustum each).
+fn eyes() -> Vec<Eye> {
+    let fovs =
+        [Fov { left: -0.85, right: 0.7, up: 0.8, down: -0.8 }, Fov { left: -0.7, right: 0.85, up: 0.8, down: -0.8 }];
+    demo_eyes()
+        .iter()
+        .zip(fovs)
+        .enumerate()
+        .map(|(i, (view, fov))| {
+            let world_from_view = view.as_dmat4().inverse();
+            let (_, rotation, position) = world_from_view.to_scale_rotation_translation();
+            let side = if i == 0 { EyeSide::Left } else { EyeSide::Right };
+            Eye { side, pose: HeadPose { position, orientation: rotation }, fov }
+        })
+        .collect()
+}
+
+/// The host's matrices for `eyes` in its depth convention.
+fn host_views(eyes: &[Eye], depth: HostDepth) -> Vec<ViewMatrices> {
+    eyes.iter()
+        .map(|eye| {
+            let [l, r, u, d] = eye.fov.tangents().map(|t| t as f32);
+            ViewMatrices {
+                view: eye.view_from_world().as_mat4(),
+                projection: depth.projection([l, r, u, d], NEAR as f32),
+            }
+        })
+        .collect()
+}
+
+/// The same geometry as a vrao scene, for the renderer.
+fn scene() -> vrao::Scene {
+    let meshes = demo_geometry()
+        .into_iter()
+        .enumerate()
+        .map(|(i, m)| Mesh {
+            colors: Vec::new(),
+            tangents: Vec::new(),
+            name: format!("mesh{i}"),
+            origin: DVec3::ZERO,
+            uvs: vec![glam::Vec2::ZERO; m.positions.len()],
+            positions: m.positions,
+            normals: m.normals,
+            indices: m.indices,
+            material: 0,
+            node: None,
+        })
+        .collect();
+    common::bare_scene(meshes)
+}
+
+fn settings(ao: &AoSettings) -> Settings {
+    Settings {
+        profile: HeadsetProfile::with_size("test", WIDTH, HEIGHT),
+        near: NEAR,
+        ao: ao.clone(),
+        ..Settings::default()
+    }
+}
+
+/// Each eye's final AO from vrao's renderer.
+fn renderer_ao(gpu: &std::sync::Arc<vrao::Gpu>, ao: &AoSettings) -> Vec<Vec<f32>> {
+    let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(ao)).unwrap();
+    renderer.render_and_wait(&eyes(), &[FINAL_AO]).unwrap();
+    renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect()
+}
+
+/// Each eye's AO from the engine over the host's depth prepass.
+fn engine_ao(gpu: &vrao::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: bool) -> Vec<Vec<f32>> {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
+    let views = host_views(&eyes(), depth);
+    let config = AoConfig { settings: ao.clone(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let convention = match depth {
+        HostDepth::ReversedInfinite => DepthConvention::REVERSED_INFINITE,
+        HostDepth::StandardFinite { .. } => DepthConvention::STANDARD_FINITE,
+    };
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(device, &mut encoder, &views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: convention,
+        normals: with_normals.then_some(normals),
+        views: &views,
+        motion: None,
+        light: None,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    (0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect()
+}
+
+fn rmse(a: &[Vec<f32>], b: &[Vec<f32>]) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (x, y) in a.iter().zip(b) {
+        assert_eq!(x.len(), y.len());
+        for (p, q) in x.iter().zip(y) {
+            sum += f64::from(p - q).powi(2);
+            n += 1;
+        }
+    }
+    (sum / n as f64).sqrt()
+}
+
+#[test]
+fn the_engine_over_a_host_depth_buffer_matches_the_renderer() {
+    let (gpu, _lock) = common::gpu();
+    let ao = AoSettings::default();
+    let reference = renderer_ao(&gpu, &ao);
+    let mean = reference.iter().flatten().sum::<f32>() / (2 * WIDTH * HEIGHT) as f32;
+    assert!(mean < 0.97 && mean > 0.3, "the demo room shows occlusion (mean AO {mean})");
+
+    let host_normals = engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true);
+    let error = rmse(&host_normals, &reference);
+    eprintln!("engine (reversed-Z Depth32Float, host normals) against the renderer: RMSE {error:.2e}");
+    assert!(error <= 1e-3, "RMSE {error}");
+
+    let rebuilt = engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, false);
+    let error = rmse(&rebuilt, &reference);
+    eprintln!("engine (normals rebuilt from depth) against the renderer: RMSE {error:.4}");
+    assert!(error <= 0.03, "RMSE {error}");
+
+    let standard = engine_ao(&gpu, &ao, HostDepth::StandardFinite { far: 50.0 }, true);
+    let error = rmse(&standard, &reference);
+    eprintln!("engine (standard-Z Depth24Plus, far 50 m, host normals) against the renderer: RMSE {error:.4}");
+    assert!(error <= 0.01, "RMSE {error}");
+}
+
+#[test]
+fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
+    let (gpu, _lock) = common::gpu();
+    for technique in [Technique::Ssao, Technique::Hbao, Technique::Gtao] {
+        for half_res in [false, true] {
+            let ao = AoSettings {
+                technique,
+                resolution: vrao::render::settings::Resolution::from_half_res(half_res),
+                ..AoSettings::default()
+            };
+            let error = rmse(&engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true), &renderer_ao(&gpu, &ao));
+            assert!(error <= 1e-3, "{} half_res {half_res}: RMSE {error}", technique.name());
+        }
+    }
+}
+
+#[test]
+fn a_mono_view_from_a_single_layer_depth_buffer_matches_the_renderer() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let ao = AoSettings::default();
+    let eye = eyes()[0];
+    let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(&ao)).unwrap();
+    renderer.render_and_wait(&[eye], &[FINAL_AO]).unwrap();
+    let reference: Vec<Vec<f32>> =
+        renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect();
+
+    // A plain 2D depth texture (one layer), drawn by the host's prepass into layer 0.
+    let prepass = DepthPrepass::with_layers(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1);
+    let views = host_views(&[eye], HostDepth::ReversedInfinite);
+    let config = AoConfig { settings: ao, width: WIDTH, height: HEIGHT, views: 1 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(device, &mut encoder, &views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: Some(normals),
+        views: &views,
+        motion: None,
+        light: None,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    assert_eq!(texture.size().depth_or_array_layers, 1);
+    let error = rmse(&[host::read_alpha(device, queue, &texture, 0)], &reference[..1]);
+    assert!(error <= 1e-3, "mono: RMSE {error}");
+}
+
+#[test]
+fn bad_host_input_is_a_typed_error_naming_it() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let points = AoConfig {
+        settings: AoSettings { technique: Technique::SsdoPoints, ..AoSettings::default() },
+        width: WIDTH,
+        height: HEIGHT,
+        views: 2,
+    };
+    let e = AoEngine::new(device, queue, &points).err().expect("the point-sampled SSDO is the renderer's");
+    assert!(matches!(e, Error::Input { .. }) && e.to_string().contains("ssdo-points"), "{e}");
+
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let small = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH / 2, HEIGHT));
+    let views = host_views(&eyes(), HostDepth::ReversedInfinite);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let frame = AoFrame {
+        depth: &small.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views: &views,
+        motion: None,
+        light: None,
+    };
+    let e = engine.record(&mut encoder, &frame).err().expect("a depth buffer of another size");
+    assert!(e.to_string().contains("depth") && e.to_string().contains("does not match"), "{e}");
+
+    let right = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT));
+    let frame = AoFrame {
+        depth: &right.depth,
+        depth_convention: DepthConvention::STANDARD_FINITE,
+        normals: None,
+        views: &views,
+        motion: None,
+        light: None,
+    };
+    let e = engine.record(&mut encoder, &frame).err().expect("a convention the projection contradicts");
+    assert!(e.to_string().contains("view 0: projection"), "{e}");
+
+    let mut scaled = views.clone();
+    scaled[1].view *= glam::Mat4::from_scale(glam::Vec3::splat(2.0));
+    let frame = AoFrame {
+        depth: &right.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views: &scaled,
+        motion: None,
+        light: None,
+    };
+    let e = engine.record(&mut encoder, &frame).err().expect("a view matrix with scale");
+    assert!(e.to_string().contains("view 1: view matrix"), "{e}");
+}
+
+/// A host's motion vectors, `Rg32Float`, every texel `value`, one layer per eye.
+fn motion_texture(device: &wgpu::Device, queue: &wgpu::Queue, size: (u32, u32), value: [f32; 2]) -> wgpu::Texture {
+    use wgpu::util::DeviceExt;
+    let texels: Vec<f32> = (0..2 * size.0 * size.1).flat_map(|_| value).collect();
+    device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("host motion"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 2 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rg32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&texels),
+    )
+}
+
+/// Temporal accumulation over a host's depth reads the host's motion vectors: with zero
+/// motion and still views it keeps the same history as reprojecting by the views alone;
+/// vectors pointing far away lose it; a texture of another size is refused.
+#[test]
+fn host_motion_vectors_reach_temporal_accumulation() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let mut ao = AoSettings::default();
+    ao.temporal.enabled = true;
+    let config = AoConfig { settings: ao, width: WIDTH, height: HEIGHT, views: 2 };
+    let prepass = DepthPrepass::new(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT));
+    let views = host_views(&eyes(), HostDepth::ReversedInfinite);
+    let still = motion_texture(device, queue, (WIDTH, HEIGHT), [0.0, 0.0]);
+    let away = motion_texture(device, queue, (WIDTH, HEIGHT), [0.5, 0.0]);
+    let run = |motion: Option<HostMotion>| {
+        let mut engine = AoEngine::new(device, queue, &config).unwrap();
+        let mut texture = None;
+        for _ in 0..6 {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            prepass.record(device, &mut encoder, &views);
+            let frame = AoFrame {
+                depth: &prepass.depth,
+                depth_convention: DepthConvention::REVERSED_INFINITE,
+                normals: None,
+                views: &views,
+                motion,
+                light: None,
+            };
+            texture = Some(engine.record(&mut encoder, &frame).unwrap().texture.clone());
+            queue.submit([encoder.finish()]);
+        }
+        let plan = engine.last_plan().unwrap();
+        let reads_host_motion =
+            plan.resolve(vrao::render::graph::PIXEL_MOTION).map(|r| r.name()) == Some("host-motion");
+        let texture = texture.unwrap();
+        ((0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect::<Vec<_>>(), reads_host_motion)
+    };
+    let (by_views, reads) = run(None);
+    assert!(!reads);
+    let (by_zero_motion, reads) = run(Some(HostMotion { texture: &still, to_previous_uv: [1.0, 1.0] }));
+    assert!(reads, "temporal accumulation reads the host's motion");
+    let (by_wrong_motion, _) = run(Some(HostMotion { texture: &away, to_previous_uv: [1.0, 1.0] }));
+    let same = rmse(&by_views, &by_zero_motion);
+    let lost = rmse(&by_views, &by_wrong_motion);
+    println!("zero motion vs the views alone: RMSE {same:.2e}; vectors half an image away: {lost:.2e}");
+    assert!(same < 1e-3, "zero motion keeps the views' history: {same}");
+    assert!(lost > 10.0 * same.max(1e-5), "vectors half an image away lose the history: {lost} vs {same}");
+
+    let small = motion_texture(device, queue, (WIDTH / 2, HEIGHT), [0.0, 0.0]);
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views: &views,
+        motion: Some(HostMotion { texture: &small, to_previous_uv: [1.0, 1.0] }),
+        light: None,
+    };
+    let e = engine.record(&mut encoder, &frame).err().expect("motion of another size");
+    assert!(e.to_string().contains("motion") && e.to_string().contains("does not match"), "{e}");
+}
+
+/// One frame of the host's reversed-Z prepass and the engine after it, submitted; the
+/// engine's output texture.
+fn reversed_z_frame(
+    gpu: &vrao::Gpu,
+    engine: &mut AoEngine,
+    prepass: &DepthPrepass,
+    views: &[ViewMatrices],
+) -> wgpu::Texture {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    prepass.record(&gpu.device, &mut encoder, views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: None,
+        views,
+        motion: None,
+        light: None,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    gpu.queue.submit([encoder.finish()]);
+    texture
+}
+
+#[test]
+fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_resize() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let depth = HostDepth::ReversedInfinite;
+    let views = host_views(&eyes(), depth);
+    let frame_at = |engine: &mut AoEngine, (width, height): (u32, u32)| -> f32 {
+        let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (width, height));
+        let texture = reversed_z_frame(&gpu, engine, &prepass, &views);
+        assert_eq!((texture.width(), texture.height()), (width, height), "the AO has the engine's size");
+        let alpha = host::read_alpha(device, queue, &texture, 0);
+        alpha.iter().sum::<f32>() / alpha.len() as f32
+    };
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    assert_eq!(engine.pipelines_built(), 0, "nothing compiles before the first frame");
+    let small = frame_at(&mut engine, (WIDTH, HEIGHT));
+    let built = engine.pipelines_built();
+    // Every technique's chain built up front, as the renderer does.
+    let eager = vrao::Gpu::from_host(device, queue).unwrap();
+    let _chain = vrao::render::passes::ao_chain(&eager, Vec::new());
+    assert!(
+        built > 0 && built < eager.pipelines_built(),
+        "{built} compiled for GTAO, {} for every technique",
+        eager.pipelines_built()
+    );
+
+    // A window resize: new targets, the same pipelines, the same picture at a finer grain.
+    engine.resize(WIDTH * 3 / 2, HEIGHT * 3 / 2).unwrap();
+    let large = frame_at(&mut engine, (WIDTH * 3 / 2, HEIGHT * 3 / 2));
+    assert_eq!(engine.pipelines_built(), built, "a resize compiles nothing");
+    assert!((large - small).abs() < 0.03, "mean AO {small} at {WIDTH}x{HEIGHT}, {large} after the resize");
+    assert!(
+        engine.resize(0, HEIGHT).is_err() && engine.config().width == WIDTH * 3 / 2,
+        "a bad size is refused and kept out"
+    );
+
+    // Another technique compiles its own kernels when first chosen.
+    engine.set_settings(&AoSettings { technique: Technique::Ssao, ..AoSettings::default() }).unwrap();
+    frame_at(&mut engine, (WIDTH * 3 / 2, HEIGHT * 3 / 2));
+    assert!(engine.pipelines_built() > built);
+}
+
+#[test]
+fn each_gpu_keeps_its_own_shader_directory_and_shader_errors() {
+    let (gpu, _lock) = common::gpu();
+    let missing = std::env::temp_dir().join("vrao-no-such-shader-dir");
+    let mut broken = vrao::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
+    broken.set_shader_dir(Some(missing.clone()));
+    let healthy = vrao::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
+    // Two chains made at once on two threads, one reading shaders from a missing folder.
+    std::thread::scope(|s| {
+        s.spawn(|| drop(vrao::render::passes::ao_chain(&broken, Vec::new())));
+        s.spawn(|| drop(vrao::render::passes::ao_chain(&healthy, Vec::new())));
+    });
+    assert!(healthy.take_shader_error().is_ok(), "the other Gpu's error leaked");
+    let error = broken.take_shader_error().unwrap_err().to_string();
+    assert!(error.contains("vrao-no-such-shader-dir"), "{error}");
+    assert!(broken.take_shader_error().is_ok(), "an error is returned once");
+}
+
+#[test]
+fn the_single_channel_outputs_hold_the_visibility_the_default_output_holds() {
+    use vrao::ao::AoOutputFormat;
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let depth = HostDepth::ReversedInfinite;
+    let views = host_views(&eyes(), depth);
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let mut visibility = |format: AoOutputFormat| {
+        engine.set_output_format(format);
+        let texture = reversed_z_frame(&gpu, &mut engine, &prepass, &views);
+        assert_eq!(texture.format(), format.texture_format());
+        (0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect::<Vec<_>>()
+    };
+    let rgba = visibility(AoOutputFormat::Rgba16Float);
+    let r16 = visibility(AoOutputFormat::R16Float);
+    let r8 = visibility(AoOutputFormat::R8Unorm);
+    let max_difference = |a: &[Vec<f32>], b: &[Vec<f32>]| {
+        a.iter().flatten().zip(b.iter().flatten()).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max)
+    };
+    // The same f16 value copied; 8-bit rounding is within half a step.
+    assert_eq!(max_difference(&rgba, &r16), 0.0);
+    assert!(max_difference(&rgba, &r8) <= 0.5 / 255.0 + 1e-6, "{}", max_difference(&rgba, &r8));
+    assert_eq!(AoOutputFormat::R8Unorm.bytes_per_pixel(), 1);
+    assert_eq!(AoOutputFormat::R16Float.bytes_per_pixel(), 2);
+    assert_eq!(AoOutputFormat::Rgba16Float.bytes_per_pixel(), 8);
+}
+
+/// SSDO in the engine: without the host's light it is GTAO's AO with no light; with a
+/// constant sky (nine SH coefficients) its light is the sky's irradiance π L times that
+/// AO, pixel by pixel; with the host's direct light as well the bounce only adds.
+#[test]
+fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let depth = HostDepth::ReversedInfinite;
+    let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
+    let views = host_views(&eyes(), depth);
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let direct = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host direct light"),
+        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let bytes: Vec<u8> =
+        (0..WIDTH * HEIGHT * 2).flat_map(|_| [0.5f32, 0.1, 0.1, 1.0]).flat_map(f32::to_le_bytes).collect();
+    queue.write_texture(
+        direct.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(WIDTH * 16), rows_per_image: Some(HEIGHT) },
+        direct.size(),
+    );
+    // A constant sky of radiance L: E(n) = π L, c0 = π L / Y0.
+    let l = [0.4f32, 0.5, 0.6];
+    let mut sh = [[0.0f32; 3]; 9];
+    sh[0] = l.map(|c| std::f32::consts::PI * c / 0.282_095);
+    let run = |technique: Technique, light: Option<HostLight>| {
+        // No denoise: it filters the light with normal edges the AO does not stop at, so
+        // only the raw values are E(n) × AO pixel by pixel.
+        let settings = AoSettings { technique, blur_radius: 0, ..AoSettings::default() };
+        let config = AoConfig { settings, width: WIDTH, height: HEIGHT, views: 2 };
+        let mut engine = AoEngine::new(device, queue, &config).unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        prepass.record(device, &mut encoder, &views);
+        let frame = AoFrame {
+            depth: &prepass.depth,
+            depth_convention: DepthConvention::REVERSED_INFINITE,
+            normals: Some(normals),
+            views: &views,
+            motion: None,
+            light,
+        };
+        let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+        queue.submit([encoder.finish()]);
+        (0..2).flat_map(|layer| host::read_rgba(device, queue, &texture, layer)).collect::<Vec<f32>>()
+    };
+    let gtao = run(Technique::Gtao, None);
+    let dark = run(Technique::Ssdo, None);
+    let sky = Some(HostLight { direct: None, environment_sh: Some(sh) });
+    let lit = run(Technique::Ssdo, sky);
+    let bounced = run(Technique::SsdoBounce, Some(HostLight { direct: Some(&direct), environment_sh: Some(sh) }));
+    let texels = |v: &[f32]| v.chunks(4).map(|t| [t[0], t[1], t[2], t[3]]).collect::<Vec<_>>();
+    let (gtao, dark, lit, bounced) = (texels(&gtao), texels(&dark), texels(&lit), texels(&bounced));
+    let worst_ao = gtao.iter().zip(&dark).map(|(g, s)| (g[3] - s[3]).abs()).fold(0f32, f32::max);
+    assert!(worst_ao <= 1e-3, "ssdo's AO differs from gtao's by {worst_ao}");
+    assert!(dark.iter().all(|t| t[..3] == [0.0; 3]), "light without the host's light");
+    let (mut worst_sky, mut gained) = (0f32, 0f64);
+    for ((s, b), g) in lit.iter().zip(&bounced).zip(&gtao) {
+        for c in 0..3 {
+            // Where the pixel is not the sky (AO 1 and no light there: the host's sky is
+            // its own business).
+            if s[3] < 1.0 || s[c] > 0.0 {
+                worst_sky = worst_sky.max((s[c] - std::f32::consts::PI * l[c] * g[3]).abs());
+            }
+            assert!(b[c] >= s[c] - 2e-3 * std::f32::consts::PI, "the bounce took light away: {b:?} vs {s:?}");
+            gained += f64::from(b[c] - s[c]);
+        }
+        assert!((b[3] - s[3]).abs() <= 1e-3, "the bounce changed the AO");
+    }
+    eprintln!("ssdo in the engine: largest |E - pi L AO| {worst_sky}, bounce gained {gained:.2} in all");
+    assert!(worst_sky <= 0.02, "the sky's light is not its irradiance times the AO: off by {worst_sky}");
+    assert!(gained > 1.0, "no bounce from the host's direct light");
+}

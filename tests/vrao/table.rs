@@ -1,0 +1,162 @@
+//! `vrao table` as CI runs it: the whole GPU table's mechanism on lavapipe at a tiny size
+//! (the figures are for a GPU; this keeps the command from rotting).
+
+use crate::common;
+
+use std::process::{Command, Output};
+
+fn vrao(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_vrao"));
+    command.args(args);
+    command
+}
+
+fn text(out: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+}
+
+/// A millisecond cell: a finite positive number.
+fn ms(cell: &str) -> f64 {
+    let v: f64 = cell.parse().unwrap_or_else(|_| panic!("'{cell}' is not a number of ms"));
+    assert!(v.is_finite() && v > 0.0, "'{cell}' is not a positive finite ms");
+    v
+}
+
+#[test]
+fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
+    let dir = common::temp_dir("table-rows");
+    let out_file = dir.join("table.md");
+    let budget_ms = 25.0;
+    let out = vrao(&[
+        "table",
+        "--scenes",
+        "builtin:room",
+        "--techniques",
+        "gtao,ssao",
+        "--qualities",
+        "low",
+        "--resolutions",
+        "full,half",
+        "--foveations",
+        "off,high",
+        "--width",
+        "48",
+        "--height",
+        "54",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--budget-ms",
+        "25",
+        "--out",
+        out_file.to_str().unwrap(),
+    ])
+    .output()
+    .unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let md = std::fs::read_to_string(&out_file).unwrap();
+    for key in ["adapter:", "driver:", "timing: serial", "48×54", "budget: 25.000 ms", "command: `", "## room"] {
+        assert!(md.contains(key), "the table's header lacks '{key}':\n{md}");
+    }
+    let header: Vec<&str> = md.lines().find(|l| l.starts_with("| technique")).expect("a table").split(" | ").collect();
+    let column = |name: &str| header.iter().position(|h| h.trim_matches(['|', ' ']) == name).unwrap();
+    let rows: Vec<Vec<&str>> = md
+        .lines()
+        .filter(|l| l.starts_with("| gtao") || l.starts_with("| ssao"))
+        .map(|l| l.trim_matches(['|', ' ']).split(" | ").map(str::trim).collect())
+        .collect();
+    // 2 techniques × 1 preset × 2 resolutions × 2 foveations, each once.
+    let mut combos: Vec<String> = rows.iter().map(|r| r[..4].join(" ")).collect();
+    assert_eq!(combos.len(), 8, "{md}");
+    combos.sort();
+    combos.dedup();
+    assert_eq!(combos.len(), 8, "a combination twice:\n{md}");
+    for row in &rows {
+        assert_eq!(row.len(), header.len(), "{row:?}");
+        for name in [
+            "AO pass ms",
+            "denoise ms",
+            "composite ms",
+            "rest ms",
+            "AO chain ms (left eye)",
+            "AO chain ms (stereo)",
+            "stereo frame ms",
+        ] {
+            ms(row[column(name)]);
+        }
+        let left = ms(row[column("AO chain ms (left eye)")]);
+        let stereo = ms(row[column("AO chain ms (stereo)")]);
+        let ratio = ms(row[column("stereo / left")].trim_end_matches('×'));
+        assert!((ratio - stereo / left).abs() <= 0.01 * ratio + 0.01, "{row:?}");
+        // At half resolution the chain also has the composite's inline upsampling: its
+        // excess over the same case's composite at full resolution (at least 0).
+        let passes = ms(row[column("AO pass ms")]) + ms(row[column("denoise ms")]);
+        let expected = if row[2] == "half" {
+            let full = rows
+                .iter()
+                .find(|f| f[2] == "full" && (f[0], f[1], f[3]) == (row[0], row[1], row[3]))
+                .expect("every case runs at both resolutions");
+            let excess = ms(row[column("composite ms")]) - ms(full[column("composite ms")]);
+            passes + excess.max(0.0)
+        } else {
+            passes
+        };
+        assert!((left - expected).abs() < 0.01, "{row:?}");
+        let frame = ms(row[column("stereo frame ms")]);
+        let verdict = row[column("verdict")];
+        let pass = frame <= budget_ms;
+        assert!(verdict.starts_with(if pass { "PASS (" } else { "FAIL (" }), "{frame} ms: {verdict}");
+        assert!(verdict.contains(&format!("{:.2}×", frame / budget_ms)), "{frame} ms: {verdict}");
+    }
+    assert!(md.contains("gtao at half: gtao + blur + composite"), "{md}");
+}
+
+#[test]
+fn bad_values_exit_2_with_one_line_naming_them_before_any_gpu_work() {
+    let dir = common::temp_dir("table-bad");
+    let good_out = dir.join("t.md");
+    let good_out = good_out.to_str().unwrap();
+    let unwritable = "/proc/vrao-no/t.md";
+    for (args, named) in [
+        (vec!["--width", "0", "--out", good_out], "0x1200"),
+        (vec!["--techniques", "gtao,none", "--out", good_out], "'none'"),
+        (vec!["--qualities", "low,low", "--out", good_out], "qualities name low twice"),
+        (vec!["--out", unwritable], unwritable),
+    ] {
+        // No Vulkan driver and no public scenes: only the checks before any device or
+        // scene work can answer (with the defaults, Sibenik would need $VRAO_SCENES).
+        let out = vrao(&["table"])
+            .args(&args)
+            .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+            .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+            .env_remove("VRAO_SCENES")
+            .output()
+            .unwrap();
+        let t = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {t}");
+        assert_eq!(t.trim().lines().count(), 1, "{args:?}: not one line: {t}");
+        assert!(t.contains(named) && !t.contains("no usable GPU"), "{args:?}: {t}");
+    }
+    assert!(!std::path::Path::new(good_out).exists());
+}
+
+#[test]
+fn the_gpu_script_writes_the_table_and_the_adapter_on_lavapipe() {
+    let dir = common::temp_dir("table-script");
+    let out_dir = dir.join("out");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/gpu-table.sh");
+    // A built-in scene needs no public scenes: any folder will do for SCENES.
+    let out = Command::new(script)
+        .args([env!("CARGO_BIN_EXE_vrao"), dir.to_str().unwrap(), out_dir.to_str().unwrap()])
+        .args(["--scenes", "builtin:room", "--width", "32", "--height", "36", "--frames", "1", "--warmup", "0"])
+        .args(["--techniques", "hbao", "--qualities", "low", "--resolutions", "half", "--foveations", "high"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let info = std::fs::read_to_string(out_dir.join("info.txt")).unwrap();
+    assert!(info.contains("adapter:"), "{info}");
+    let md = std::fs::read_to_string(out_dir.join("gpu-table.md")).unwrap();
+    assert_eq!(md.lines().filter(|l| l.starts_with("| hbao | low (12) | half | high |")).count(), 1, "{md}");
+    assert!(std::fs::read_to_string(out_dir.join("gpu-table.log")).unwrap().contains("wrote"));
+}
