@@ -535,3 +535,123 @@ fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
     assert!(worst_sky <= 0.02, "the sky's light is not its irradiance times the AO: off by {worst_sky}");
     assert!(gained > 1.0, "no bounce from the host's direct light");
 }
+
+/// The depth of layer 0 of a single-sample `Depth32Float` texture, one value a pixel.
+fn read_depth(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<f32> {
+    let (width, height) = (texture.width(), texture.height());
+    let row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("depth readback"),
+        size: u64::from(row * height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::DepthOnly,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    queue.submit([encoder.finish()]);
+    buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let bytes = buffer.slice(..).get_mapped_range().expect("the depth readback maps");
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| (y * row + x * 4) as usize))
+        .map(|i| f32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]))
+        .collect()
+}
+
+/// Pixels within two of a depth jump of more than 2 % (or of the sky's edge) in `depth`.
+fn near_silhouettes(depth: &[f32]) -> Vec<bool> {
+    let (w, h) = (WIDTH as i32, HEIGHT as i32);
+    let at = |x: i32, y: i32| depth[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize];
+    let jump = |a: f32, b: f32| (a <= 0.0) != (b <= 0.0) || (a > 0.0 && (a / b - 1.0).abs() > 0.02);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| (-2..=2).any(|dy| (-2..=2).any(|dx| jump(at(x, y), at(x + dx, y + dy)))))
+        .collect()
+}
+
+/// The engine's AO of one mono view over the host's prepass drawn with `samples` samples,
+/// and the prepass (for its single-sample depth).
+fn mono_ao_with_samples(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: bool) -> (Vec<f32>, DepthPrepass) {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let geometry = demo_geometry();
+    let prepass =
+        DepthPrepass::multisampled(device, &geometry, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1, samples);
+    let views = host_views(&[eye], HostDepth::ReversedInfinite);
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 1 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(device, &mut encoder, &views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: with_normals.then_some(normals),
+        views: &views,
+        motion: None,
+        light: None,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    (host::read_alpha(device, queue, &texture, 0), prepass)
+}
+
+#[test]
+fn multisampled_depth_gives_the_single_sample_ao_away_from_silhouettes() {
+    let (gpu, _lock) = common::gpu();
+    let eye = eyes()[0];
+    for with_normals in [true, false] {
+        let (single, prepass) = mono_ao_with_samples(&gpu, eye, 1, with_normals);
+        let edges = near_silhouettes(&read_depth(&gpu.device, &gpu.queue, &prepass.depth));
+        assert!(edges.iter().any(|&e| e) && edges.iter().any(|&e| !e), "the view has silhouettes and surfaces");
+        // 4 is the count every WebGPU device draws these formats with (2 and 8 need
+        // TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES, which the tests' device does not ask for).
+        let samples = 4;
+        let (multi, _) = mono_ao_with_samples(&gpu, eye, samples, with_normals);
+        assert!(multi.iter().all(|a| a.is_finite() && (0.0..=1.0).contains(a)), "{samples}x: AO out of range");
+        let squared = |inside: bool| {
+            let pairs = single.iter().zip(&multi).zip(&edges).filter(|(_, &e)| e == inside);
+            let (sum, n) = pairs.fold((0.0, 0), |(s, n), ((a, b), _)| (s + f64::from(a - b).powi(2), n + 1));
+            (sum / n as f64).sqrt()
+        };
+        let (away, at) = (squared(false), squared(true));
+        eprintln!("{samples}x MSAA, host normals {with_normals}: RMSE against 1x away from silhouettes {away:.4}, at them {at:.4}");
+        assert!(away <= 0.01, "{samples}x, host normals {with_normals}: RMSE {away} away from silhouettes");
+    }
+    gpu.take_error().unwrap();
+}
+
+#[test]
+fn multisampled_inputs_the_engine_does_not_resolve_are_refused_naming_them() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let views = host_views(&eyes()[..1], HostDepth::ReversedInfinite);
+    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 1 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let geometry = demo_geometry();
+    let multi = DepthPrepass::multisampled(device, &geometry, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1, 4);
+    let single = DepthPrepass::with_layers(device, &geometry, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1);
+    let mixed = HostNormals { texture: &single.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let frame = AoFrame {
+        depth: &multi.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: Some(mixed),
+        views: &views,
+        motion: None,
+        light: None,
+    };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let e = engine.record(&mut encoder, &frame).err().expect("normals of another sample count");
+    assert!(e.to_string().contains("normals: sample count 1 where the depth's is 4"), "{e}");
+}

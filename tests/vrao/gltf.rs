@@ -9,7 +9,7 @@ use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use vrao::render::scene::{
-    AlphaMode, HeadPath, Interpolation, Light, Material, Node, NodeTracks, Scene, Texture, Track, Trs,
+    AlphaMode, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene, Texture, Track, Trs,
 };
 use vrao::test_assets::gltf_write::{encode_base64, write, IndexType, Storage, TexcoordType, WriteOptions};
 use vrao::HeadPose;
@@ -30,6 +30,19 @@ fn checker() -> Texture {
 /// with a base, a child with cubic rotation and stepped scale), textured, masked,
 /// blended and emissive materials, the three light kinds and a camera.
 fn source_scene() -> Scene {
+    Scene {
+        name: "source".into(),
+        meshes: source_meshes(),
+        materials: source_materials(),
+        lights: source_lights(),
+        environment: None,
+        head: HeadPath::fixed(HeadPose::IDENTITY),
+        nodes: source_nodes(),
+    }
+}
+
+/// A textured floor and grille (static), a lamp on the hand and a window on the arm.
+fn source_meshes() -> Vec<Mesh> {
     let mut floor = common::square("floor", DVec3::new(0.0, -1.0, -3.0), 4.0, 3);
     floor.uvs = vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO];
     let mut grille = common::square("grille", DVec3::new(0.5, 0.0, -2.0), 1.0, 0);
@@ -38,7 +51,11 @@ fn source_scene() -> Scene {
     lamp.node = Some(1);
     let mut window = common::square("window", DVec3::new(0.0, 0.25, 0.0), 0.5, 1);
     window.node = Some(0);
+    vec![floor, grille, lamp, window]
+}
 
+/// Masked (textured), blended, emissive and plain.
+fn source_materials() -> Vec<Material> {
     let mut masked = Material::plain("checker", Vec3::new(0.9, 0.8, 0.7));
     masked.diffuse_texture = Some(checker());
     masked.alpha_mode = AlphaMode::Mask { cutoff: 0.3 };
@@ -47,8 +64,12 @@ fn source_scene() -> Scene {
     glass.alpha_mode = AlphaMode::Blend;
     let mut emitter = Material::plain("lamp", Vec3::ONE);
     emitter.emissive = Vec3::new(6.0, 3.0, 0.0);
-    let materials = vec![masked, glass, emitter, Material::plain("plain", Vec3::splat(0.5))];
+    vec![masked, glass, emitter, Material::plain("plain", Vec3::splat(0.5))]
+}
 
+/// A moving root with a base (linear translation), and its child with a cubic rotation
+/// and a stepped scale.
+fn source_nodes() -> Vec<Node> {
     let q = |axis: DVec3, angle: f64| DQuat::from_axis_angle(axis, angle);
     let arm = Node {
         name: "arm".into(),
@@ -90,7 +111,12 @@ fn source_scene() -> Scene {
             ..NodeTracks::default()
         },
     };
-    let lights = vec![
+    vec![arm, hand]
+}
+
+/// A directional, a point and a spot light.
+fn source_lights() -> Vec<Light> {
+    vec![
         Light::Directional {
             direction: Vec3::new(0.3, -1.0, -0.2).normalize(),
             color: Vec3::new(1.0, 0.9, 0.8),
@@ -105,16 +131,7 @@ fn source_scene() -> Scene {
             inner_cone: 0.2,
             outer_cone: 0.6,
         },
-    ];
-    Scene {
-        name: "source".into(),
-        meshes: vec![floor, grille, lamp, window],
-        materials,
-        lights,
-        environment: None,
-        head: HeadPath::fixed(HeadPose::IDENTITY),
-        nodes: vec![arm, hand],
-    }
+    ]
 }
 
 fn camera_pose() -> HeadPose {
@@ -379,93 +396,119 @@ fn load_error(dir: &Path, name: &str, text: impl AsRef<[u8]>) -> String {
 #[test]
 fn bad_input_is_one_line_naming_the_file_and_the_problem() {
     let dir = common::temp_dir("gltf-bad");
-    let ok_nodes = json!([{ "mesh": 0 }]);
-    let valid = triangle_file(ok_nodes.clone(), json!({}));
+    let valid = triangle_file(ok_nodes(), json!({}));
     assert!(Scene::load(write_file(&dir, "valid.gltf", &valid).to_str().unwrap()).is_ok());
+    // Each group takes the valid file (or the writer's .glb) and breaks one thing.
+    truncated_glb_and_malformed_json(&dir, &valid);
+    accessors_and_views_out_of_bounds(&dir, &valid);
+    non_finite_positions(&dir, &valid);
+    missing_and_bad_buffers(&dir, &valid);
+    missing_and_undecodable_images(&dir);
+    indices_out_of_range_or_not_whole_triangles(&dir, &valid);
+    unsupported_extensions_and_bad_nodes(&dir);
+    animation_times_not_increasing(&dir, &valid);
+}
 
+/// The nodes of `triangle_file`'s valid file: one drawing mesh 0.
+fn ok_nodes() -> serde_json::Value {
+    json!([{ "mesh": 0 }])
+}
+
+/// A truncated .glb, malformed JSON and glTF the parser refuses.
+fn truncated_glb_and_malformed_json(dir: &Path, valid: &str) {
     // A truncated .glb.
     let glb_path = dir.join("whole.glb");
     write(&source_scene(), &glb_path, &WriteOptions::default()).unwrap();
     let glb = std::fs::read(&glb_path).unwrap();
     for cut in [6, 20, glb.len() / 2, glb.len() - 1] {
-        let e = load_error(&dir, "cut.glb", &glb[..cut]);
+        let e = load_error(dir, "cut.glb", &glb[..cut]);
         assert!(e.contains("truncated .glb"), "{cut}: {e}");
     }
     // Malformed JSON: the parser's message with its line and column.
-    let e = load_error(&dir, "broken.gltf", &valid[..valid.len() - 10]);
+    let e = load_error(dir, "broken.gltf", &valid[..valid.len() - 10]);
     assert!(e.contains("not valid glTF JSON") && e.contains("line 1"), "{e}");
     let e = load_error(
-        &dir,
+        dir,
         "notgltf.gltf",
         "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [{\"mesh\": 7}], \"scenes\": [{\"nodes\": [0]}]}",
     );
     assert!(e.contains("invalid glTF") && e.contains("nodes[0].mesh"), "{e}");
+}
 
+/// Accessors past the end of their view, absurd counts, bad strides; a view past the
+/// end of its buffer.
+fn accessors_and_views_out_of_bounds(dir: &Path, valid: &str) {
     let with_accessor = |accessor: serde_json::Value| {
-        let mut body: serde_json::Value = serde_json::from_str(&valid).unwrap();
+        let mut body: serde_json::Value = serde_json::from_str(valid).unwrap();
         body["accessors"][0] = accessor;
         // POSITION needs bounds to pass the parser's validation.
         body["accessors"][0]["min"] = json!([0, 0, 0]);
         body["accessors"][0]["max"] = json!([1, 1, 0]);
         body.to_string()
     };
-    // Accessors past the end of their view, absurd counts, bad strides.
     let e = load_error(
-        &dir,
+        dir,
         "long.gltf",
         with_accessor(json!({ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3" })),
     );
     assert!(e.contains("accessor 0 (4 elements) runs past the end of buffer view 0"), "{e}");
     let e = load_error(
-        &dir,
+        dir,
         "offset.gltf",
         with_accessor(json!({ "bufferView": 0, "byteOffset": 4, "componentType": 5126, "count": 3, "type": "VEC3" })),
     );
     assert!(e.contains("runs past the end"), "{e}");
     let e = load_error(
-        &dir,
+        dir,
         "huge.gltf",
         with_accessor(json!({ "bufferView": 0, "componentType": 5126, "count": 4_000_000_000u64, "type": "VEC3" })),
     );
     assert!(e.contains("declares 4000000000 elements"), "{e}");
-    let mut body: serde_json::Value = serde_json::from_str(&valid).unwrap();
+    let mut body: serde_json::Value = serde_json::from_str(valid).unwrap();
     body["bufferViews"][0]["byteLength"] = json!(400);
-    let e = load_error(&dir, "view.gltf", body.to_string());
+    let e = load_error(dir, "view.gltf", body.to_string());
     assert!(e.contains("buffer view 0 (bytes 0..+400) runs past the end of buffer 0 (36 bytes)"), "{e}");
+}
 
-    // NaN and infinite positions.
+/// NaN and infinite positions.
+fn non_finite_positions(dir: &Path, valid: &str) {
     for (name, bad) in [("nan.gltf", f32::NAN), ("inf.gltf", f32::INFINITY)] {
         let mut bytes = triangle_bytes();
         bytes[12..16].copy_from_slice(&bad.to_le_bytes());
-        let mut body: serde_json::Value = serde_json::from_str(&valid).unwrap();
+        let mut body: serde_json::Value = serde_json::from_str(valid).unwrap();
         body["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", encode_base64(&bytes)));
-        let e = load_error(&dir, name, body.to_string());
+        let e = load_error(dir, name, body.to_string());
         assert!(e.contains("POSITION: accessor 0 element 1 is not finite"), "{e}");
     }
+}
 
-    // Missing buffer file, bad data URI, a buffer shorter than declared.
-    let mut body: serde_json::Value = serde_json::from_str(&valid).unwrap();
+/// Missing buffer file, bad data URI, a buffer shorter than declared, a buffer without a
+/// URI outside a .glb.
+fn missing_and_bad_buffers(dir: &Path, valid: &str) {
+    let mut body: serde_json::Value = serde_json::from_str(valid).unwrap();
     body["buffers"][0]["uri"] = json!("missing.bin");
-    let e = load_error(&dir, "nobuffer.gltf", body.to_string());
+    let e = load_error(dir, "nobuffer.gltf", body.to_string());
     assert!(e.contains("buffer 0: file 'missing.bin' not found"), "{e}");
     body["buffers"][0]["uri"] = json!("data:application/octet-stream;base64,@@@@");
-    let e = load_error(&dir, "baduri.gltf", body.to_string());
+    let e = load_error(dir, "baduri.gltf", body.to_string());
     assert!(e.contains("buffer 0: data URI holds invalid base64"), "{e}");
     body["buffers"][0]["uri"] = json!("data:text/plain,hello");
-    let e = load_error(&dir, "plainuri.gltf", body.to_string());
+    let e = load_error(dir, "plainuri.gltf", body.to_string());
     assert!(e.contains("not base64"), "{e}");
     body["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", encode_base64(&[0; 12])));
-    let e = load_error(&dir, "short.gltf", body.to_string());
+    let e = load_error(dir, "short.gltf", body.to_string());
     assert!(e.contains("buffer 0 has 12 bytes, the file says 36"), "{e}");
-    let mut glb_without_bin: serde_json::Value = serde_json::from_str(&valid).unwrap();
+    let mut glb_without_bin: serde_json::Value = serde_json::from_str(valid).unwrap();
     glb_without_bin["buffers"][0] = json!({ "byteLength": 36 });
-    let e = load_error(&dir, "nobin.gltf", glb_without_bin.to_string());
+    let e = load_error(dir, "nobin.gltf", glb_without_bin.to_string());
     assert!(e.contains("binary chunk, which is missing"), "{e}");
+}
 
-    // Missing and undecodable images.
+/// Missing and undecodable images.
+fn missing_and_undecodable_images(dir: &Path) {
     let textured = |uri: &str| {
         triangle_file(
-            ok_nodes.clone(),
+            ok_nodes(),
             json!({
                 "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }],
                 "textures": [{ "source": 0 }],
@@ -474,52 +517,60 @@ fn bad_input_is_one_line_naming_the_file_and_the_problem() {
         )
         .replace("\"attributes\"", "\"material\":0,\"attributes\"")
     };
-    let e = load_error(&dir, "noimage.gltf", textured("missing.png"));
+    let e = load_error(dir, "noimage.gltf", textured("missing.png"));
     assert!(e.contains("image 0: file 'missing.png' not found"), "{e}");
     let e =
-        load_error(&dir, "badimage.gltf", textured(&format!("data:image/png;base64,{}", encode_base64(b"not a png"))));
+        load_error(dir, "badimage.gltf", textured(&format!("data:image/png;base64,{}", encode_base64(b"not a png"))));
     assert!(e.contains("image 0: cannot decode"), "{e}");
+}
 
-    // Indices out of range, or not whole triangles.
+/// Indices out of range, or not whole triangles.
+fn indices_out_of_range_or_not_whole_triangles(dir: &Path, valid: &str) {
     let mut bytes = triangle_bytes();
     bytes.extend([0u8, 1, 3, 0]);
-    let mut body: serde_json::Value = serde_json::from_str(&valid).unwrap();
+    let mut body: serde_json::Value = serde_json::from_str(valid).unwrap();
     body["buffers"][0] =
         json!({ "byteLength": 40, "uri": format!("data:application/octet-stream;base64,{}", encode_base64(&bytes)) });
     push(&mut body["bufferViews"], json!({ "buffer": 0, "byteOffset": 36, "byteLength": 3 }));
     push(&mut body["accessors"], json!({ "bufferView": 1, "componentType": 5121, "count": 3, "type": "SCALAR" }));
     body["meshes"][0]["primitives"][0]["indices"] = json!(1);
-    let e = load_error(&dir, "index.gltf", body.to_string());
+    let e = load_error(dir, "index.gltf", body.to_string());
     assert!(e.contains("index 3 at 2 is out of range (3 vertices)"), "{e}");
     body["accessors"][1]["count"] = json!(2);
-    let e = load_error(&dir, "partial.gltf", body.to_string());
+    let e = load_error(dir, "partial.gltf", body.to_string());
     assert!(e.contains("2 indices, not a whole number of triangles"), "{e}");
+}
 
-    // Required extensions vrao lacks; node cycles; too many nodes; bad animation times.
+/// Required extensions vrao lacks; node cycles; too many nodes; a rotation that is not a
+/// quaternion.
+fn unsupported_extensions_and_bad_nodes(dir: &Path) {
     let e = load_error(
-        &dir,
+        dir,
         "draco.gltf",
         triangle_file(
-            ok_nodes.clone(),
+            ok_nodes(),
             json!({ "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"] }),
         ),
     );
     assert!(e.contains("requires extension KHR_draco_mesh_compression, which vrao does not support"), "{e}");
     let e = load_error(
-        &dir,
+        dir,
         "cycle.gltf",
         triangle_file(json!([{ "children": [1] }, { "children": [0], "mesh": 0 }]), json!({})),
     );
     assert!(e.contains("is reached twice"), "{e}");
     let many: Vec<serde_json::Value> = (0..100_001).map(|_| json!({})).collect();
-    let e = load_error(&dir, "many.gltf", triangle_file(json!(many), json!({})));
+    let e = load_error(dir, "many.gltf", triangle_file(json!(many), json!({})));
     assert!(e.contains("100001 nodes, more than vrao's limit of 100000"), "{e}");
-    let e = load_error(&dir, "notrs.gltf", triangle_file(json!([{ "rotation": [0, 0, 0, 0], "mesh": 0 }]), json!({})));
+    let e = load_error(dir, "notrs.gltf", triangle_file(json!([{ "rotation": [0, 0, 0, 0], "mesh": 0 }]), json!({})));
     assert!(e.contains("is not a quaternion"), "{e}");
+}
 
+/// Animation key times that are not increasing.
+fn animation_times_not_increasing(dir: &Path, valid: &str) {
     let mut bytes = triangle_bytes();
     bytes.extend(bytemuck::cast_slice::<f32, u8>(&[1.0, 0.5, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0]));
-    let mut body: serde_json::Value = serde_json::from_str(&valid).unwrap();
+    let mut body: serde_json::Value = serde_json::from_str(valid).unwrap();
     body["buffers"][0] = json!({ "byteLength": bytes.len(), "uri": format!("data:application/octet-stream;base64,{}", encode_base64(&bytes)) });
     body["bufferViews"] = json!([{ "buffer": 0, "byteLength": 36 }, { "buffer": 0, "byteOffset": 36, "byteLength": 12 }, { "buffer": 0, "byteOffset": 48, "byteLength": 24 }]);
     push(
@@ -529,7 +580,7 @@ fn bad_input_is_one_line_naming_the_file_and_the_problem() {
     push(&mut body["accessors"], json!({ "bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3" }));
     body["animations"] = json!([{ "channels": [{ "sampler": 0, "target": { "node": 0, "path": "translation" } }],
                                   "samplers": [{ "input": 1, "output": 2 }] }]);
-    let e = load_error(&dir, "times.gltf", body.to_string());
+    let e = load_error(dir, "times.gltf", body.to_string());
     assert!(e.contains("animation 0 channel 0: key times 1 then 0.5 are not increasing"), "{e}");
 }
 

@@ -291,19 +291,22 @@ fn sample(attribute: &str, ty: Ty, components: usize) -> Vec<f64> {
     }
 }
 
+/// The attributes whose component types are tried, with their accessor types.
+const QUANTIZED_ATTRIBUTES: [(&str, &str); 6] = [
+    ("POSITION", "VEC3"),
+    ("NORMAL", "VEC3"),
+    ("TANGENT", "VEC4"),
+    ("TEXCOORD_0", "VEC2"),
+    ("COLOR_0", "VEC3"),
+    ("COLOR_0", "VEC4"),
+];
+
 #[test]
 fn every_component_type_an_attribute_allows_loads_and_the_others_are_refused() {
     let dir = temp_dir("types");
     let mut loaded = 0;
     let mut refused = 0;
-    for (attribute, kind) in [
-        ("POSITION", "VEC3"),
-        ("NORMAL", "VEC3"),
-        ("TANGENT", "VEC4"),
-        ("TEXCOORD_0", "VEC2"),
-        ("COLOR_0", "VEC3"),
-        ("COLOR_0", "VEC4"),
-    ] {
+    for (attribute, kind) in QUANTIZED_ATTRIBUTES {
         let components = kind[3..].parse::<usize>().unwrap();
         for ty in Ty::ALL {
             for normalized in [false, true] {
@@ -311,30 +314,7 @@ fn every_component_type_an_attribute_allows_loads_and_the_others_are_refused() {
                     continue;
                 }
                 let values = sample(attribute, ty, components);
-                let mut g = Gltf::default();
-                let position = match attribute {
-                    "POSITION" => g.data(ty, normalized, kind, &values),
-                    _ => g.data(Ty::F32, false, "VEC3", &TRIANGLE),
-                };
-                let normal = match attribute {
-                    "NORMAL" => g.data(ty, normalized, kind, &values),
-                    _ => g.data(Ty::F32, false, "VEC3", &UP),
-                };
-                let mut attributes = json!({ "POSITION": position, "NORMAL": normal });
-                let tested = match attribute {
-                    "POSITION" => position,
-                    "NORMAL" => normal,
-                    _ => {
-                        let k = g.data(ty, normalized, kind, &values);
-                        attributes[attribute] = json!(k);
-                        k
-                    }
-                };
-                let text = g.text(
-                    json!({ "attributes": attributes }),
-                    json!({}),
-                    json!({ "extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"] }),
-                );
+                let (text, tested) = quantized_triangle(attribute, kind, ty, normalized, &values);
                 let name = format!("{attribute}-{kind}-{ty:?}-{}.gltf", if normalized { "n" } else { "u" });
                 let decoded: Vec<f32> = values.iter().map(|&v| ty.decode(v, normalized)).collect();
                 if !allowed(attribute, ty, normalized) {
@@ -345,37 +325,7 @@ fn every_component_type_an_attribute_allows_loads_and_the_others_are_refused() {
                     continue;
                 }
                 let scene = load(&dir, &name, &text).unwrap_or_else(|e| panic!("{name}: {e}"));
-                let m = &scene.meshes[0];
-                match attribute {
-                    "POSITION" => {
-                        let expected: Vec<[f64; 3]> =
-                            decoded.chunks(3).map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect();
-                        assert_close(&world(&scene, 0), &expected, &name);
-                    }
-                    "NORMAL" => {
-                        let found: Vec<f32> = m.normals.iter().flat_map(|n| n.to_array()).collect();
-                        assert_eq!(found, decoded, "{name}");
-                        assert_eq!(&found[..6], [1.0, 0.0, 0.0, 0.0, -1.0, 0.0], "{name}");
-                    }
-                    "TANGENT" => {
-                        let found: Vec<f32> = m.tangents.iter().flat_map(|t| t.to_array()).collect();
-                        assert!(found.is_empty() || found == decoded, "{name}: {found:?} != {decoded:?}");
-                    }
-                    "TEXCOORD_0" => {
-                        let found: Vec<f32> = m.uvs.iter().flat_map(|t| t.to_array()).collect();
-                        assert_eq!(found, decoded, "{name}");
-                    }
-                    _ => {
-                        // RGB gets alpha 1; a colour is clamped to [0, 1].
-                        let expected: Vec<f32> = decoded
-                            .chunks(components)
-                            .flat_map(|c| [c[0], c[1], c[2], c.get(3).copied().unwrap_or(1.0)])
-                            .map(|c| c.clamp(0.0, 1.0))
-                            .collect();
-                        let found: Vec<f32> = m.colors.iter().flat_map(|c| c.to_array()).collect();
-                        assert_eq!(found, expected, "{name}");
-                    }
-                }
+                assert_attribute_decoded(&scene, attribute, components, &decoded, &name);
                 loaded += 1;
             }
         }
@@ -383,6 +333,70 @@ fn every_component_type_an_attribute_allows_loads_and_the_others_are_refused() {
     // Float plus: 8 for POSITION and TEXCOORD_0, 2 for NORMAL and TANGENT, 2 per COLOR_0 kind.
     assert_eq!(loaded, 9 + 3 + 3 + 9 + 3 + 3);
     assert_eq!(refused, 6 * 11 - loaded);
+}
+
+/// A quantised triangle whose `attribute` holds `values` as `kind` of `ty`, the other
+/// attributes plain floats; returns the file and the tested accessor's index.
+fn quantized_triangle(attribute: &str, kind: &str, ty: Ty, normalized: bool, values: &[f64]) -> (String, usize) {
+    let mut g = Gltf::default();
+    let position = match attribute {
+        "POSITION" => g.data(ty, normalized, kind, values),
+        _ => g.data(Ty::F32, false, "VEC3", &TRIANGLE),
+    };
+    let normal = match attribute {
+        "NORMAL" => g.data(ty, normalized, kind, values),
+        _ => g.data(Ty::F32, false, "VEC3", &UP),
+    };
+    let mut attributes = json!({ "POSITION": position, "NORMAL": normal });
+    let tested = match attribute {
+        "POSITION" => position,
+        "NORMAL" => normal,
+        _ => {
+            let k = g.data(ty, normalized, kind, values);
+            attributes[attribute] = json!(k);
+            k
+        }
+    };
+    let text = g.text(
+        json!({ "attributes": attributes }),
+        json!({}),
+        json!({ "extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"] }),
+    );
+    (text, tested)
+}
+
+/// The loaded mesh's `attribute` is `decoded` (colours: with alpha 1 for RGB, clamped).
+fn assert_attribute_decoded(scene: &Scene, attribute: &str, components: usize, decoded: &[f32], name: &str) {
+    let m = &scene.meshes[0];
+    match attribute {
+        "POSITION" => {
+            let expected: Vec<[f64; 3]> = decoded.chunks(3).map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect();
+            assert_close(&world(scene, 0), &expected, name);
+        }
+        "NORMAL" => {
+            let found: Vec<f32> = m.normals.iter().flat_map(|n| n.to_array()).collect();
+            assert_eq!(found, decoded, "{name}");
+            assert_eq!(&found[..6], [1.0, 0.0, 0.0, 0.0, -1.0, 0.0], "{name}");
+        }
+        "TANGENT" => {
+            let found: Vec<f32> = m.tangents.iter().flat_map(|t| t.to_array()).collect();
+            assert!(found.is_empty() || found == decoded, "{name}: {found:?} != {decoded:?}");
+        }
+        "TEXCOORD_0" => {
+            let found: Vec<f32> = m.uvs.iter().flat_map(|t| t.to_array()).collect();
+            assert_eq!(found, decoded, "{name}");
+        }
+        _ => {
+            // RGB gets alpha 1; a colour is clamped to [0, 1].
+            let expected: Vec<f32> = decoded
+                .chunks(components)
+                .flat_map(|c| [c[0], c[1], c[2], c.get(3).copied().unwrap_or(1.0)])
+                .map(|c| c.clamp(0.0, 1.0))
+                .collect();
+            let found: Vec<f32> = m.colors.iter().flat_map(|c| c.to_array()).collect();
+            assert_eq!(found, expected, "{name}");
+        }
+    }
 }
 
 #[test]

@@ -15,6 +15,7 @@ mod gltf_materials;
 mod gltf_materials_reference;
 mod gpu_stereo;
 mod layout;
+mod pipelines;
 mod presets;
 mod visibility_mask;
 

@@ -89,12 +89,10 @@ fn budget_rejects_a_budget_that_is_not_a_positive_number() {
     }
 }
 
-#[test]
-fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_it() {
-    let dir = temp_dir("bench");
-    let out_dir = dir.join("bench");
-    let cache = dir.join("cache");
-    let args = [
+/// `vrao bench` on the crease at 48×40: 3 techniques × 2 sample counts × 2 resolutions
+/// at one radius, writing to `out` and caching the reference in `cache`.
+fn bench_args<'a>(out: &'a str, cache: &'a str) -> Vec<&'a str> {
+    vec![
         "bench",
         "--scene",
         "builtin:crease",
@@ -119,72 +117,31 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
         "--stride",
         "2",
         "--out",
-        out_dir.to_str().unwrap(),
+        out,
         "--cache",
-        cache.to_str().unwrap(),
-    ];
+        cache,
+    ]
+}
+
+/// The rows `bench_args` asks for.
+const BENCH_ROWS: usize = 3 * 2 * 2;
+
+#[test]
+fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_it() {
+    let dir = temp_dir("bench");
+    let out_dir = dir.join("bench");
+    let cache = dir.join("cache");
+    let args = bench_args(out_dir.to_str().unwrap(), cache.to_str().unwrap());
     let out = vrao(&args);
     let t = text(&out);
     assert!(out.status.success(), "{t}");
-    let rows = 3 * 2 * 2;
-    let csv = std::fs::read_to_string(out_dir.join("bench.csv")).unwrap();
-    assert_eq!(csv.lines().count(), rows + 1, "{csv}");
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    for line in csv.lines().skip(1) {
-        assert_eq!(line.split(',').count(), header.len(), "{line}");
-    }
-    for want in ["bias", "limit", "flip", "consisten"] {
-        assert!(header.iter().any(|c| c.contains(want) && !c.contains("bounce")), "no '{want}' column: {header:?}");
-    }
-    // bench.md: what ran where (scene, adapter, version, the command line), the table of
-    // rows (header, rule, one line a row), what the columns mean, then the ratios: half /
-    // full for each case, and HBAO and SSDO against SSAO at each setting and resolution.
-    let markdown = std::fs::read_to_string(out_dir.join("bench.md")).unwrap();
-    assert!(markdown.starts_with("# vrao bench: crease\n"), "{markdown}");
-    for line in ["- adapter: ", "- vrao 0.1", "- command: `", "--techniques ssao,hbao,ssdo"] {
-        assert!(markdown.contains(line), "no '{line}' in {markdown}");
-    }
-    let table: Vec<&str> =
-        markdown.lines().skip_while(|l| !l.starts_with("| technique")).take_while(|l| l.starts_with('|')).collect();
-    assert_eq!(table.len(), rows + 2, "{markdown}");
-    for name in ["RMSE", "bias", "RMSE vs limit", "limit RMSE", "FLIP", "stereo ≠", "ms/eye"] {
-        assert!(table[0].split('|').any(|c| c.trim() == name), "no column '{name}': {}", table[0]);
-    }
-    assert!(table[2].contains(" %"), "shares in percent: {}", table[2]);
-    let ratio_rows = |title: &str| {
-        let section = markdown.split(title).nth(1).unwrap_or_else(|| panic!("no '{title}' in {markdown}"));
-        section.lines().skip(4).take_while(|l| l.starts_with("| ")).count()
-    };
-    assert_eq!(ratio_rows("Half / full resolution"), 3 * 2, "{markdown}");
-    assert_eq!(ratio_rows("against SSAO"), 2 * 2 * 2, "{markdown}");
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out_dir.join("bench.json")).unwrap()).unwrap();
+    assert_bench_csv(&out_dir);
+    assert_bench_markdown(&out_dir);
+    let json = read_json(&out_dir.join("bench.json"));
     let records = json["records"].as_array().unwrap();
-    assert_eq!(records.len(), rows);
+    assert_eq!(records.len(), BENCH_ROWS);
     for r in records {
-        let rmse = r["ao_rmse"].as_f64().expect("every row has an error");
-        let ssim = r["ao_ssim"].as_f64().unwrap();
-        assert!((0.0..0.5).contains(&rmse) && (-1.0..=1.0).contains(&ssim), "{r}");
-        assert!(r["occlusion_ms_per_eye"].as_f64().unwrap() > 0.0, "{r}");
-        // The G-buffer the occlusion shares the frame with: the plot's budget line needs it.
-        assert!(r["other_ms_per_eye"].as_f64().is_some_and(|o| o > 0.0), "{r}");
-        // Bias is within ±RMSE (|mean| ≤ RMS; the RMSE has the reference's noise taken
-        // out, so allow for that); the crease is darker than 0.8 near its line.
-        let bias = r["ao_bias"].as_f64().unwrap();
-        assert!(bias.abs() <= rmse + 0.05, "{r}");
-        assert!(r["ao_bias_dark"].as_f64().is_some_and(|b| (-1.0..=1.0).contains(&b)), "{r}");
-        assert!(r["ao_rmse_falloff"].as_f64().is_some_and(|e| (0.0..0.5).contains(&e)), "{r}");
-        // The screen-space limit sees the whole crease (both planes face the eyes): it is
-        // close to the reference, and the technique's distance from it is an RMSE.
-        let limit = r["limit_rmse"].as_f64().unwrap();
-        assert!((0.0..0.06).contains(&limit) && r["limit_bias"].as_f64().unwrap().abs() < 0.03, "{r}");
-        assert!(r["ao_rmse_vs_limit"].as_f64().is_some_and(|e| (0.0..0.5).contains(&e)), "{r}");
-        assert!(r["flip_mean"].as_f64().is_some_and(|f| f > 0.0 && f < 1.0), "{r}");
-        for share in ["stereo_inconsistent", "stereo_inconsistent_inner_border"] {
-            assert!(r[share].as_f64().is_some_and(|s| (0.0..=1.0).contains(&s)), "{share}: {r}");
-        }
-        // No pixel of a 48×40 image is farther than 40 px from every border.
-        assert!(r["stereo_inconsistent_interior"].is_null(), "{r}");
+        assert_bench_record(r);
     }
     // The limit is the same for every row of the radius (one frame's depth buffer).
     assert!(records.iter().all(|r| r["limit_rmse"] == records[0]["limit_rmse"]), "{records:?}");
@@ -195,10 +152,84 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     // The second run finds the reference in the cache.
     let cached: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
     assert_eq!(cached.len(), 1, "one radius, one cached reference");
+    assert_interleaving_keeps_every_row(&dir, &args, records);
+    assert_fit_picks_the_least_error_row(&dir, &out_dir, records);
+}
 
-    // Interleaved in groups of 5 (the last group short), every case keeps its own
-    // renderer: the same rows in the same order with the same errors (the frames are
-    // deterministic), only the times measured round-robin.
+/// bench.csv: a header and one line a row, each with every column, among them the
+/// bias, the screen-space limit, FLIP and stereo consistency.
+fn assert_bench_csv(out_dir: &std::path::Path) {
+    let csv = std::fs::read_to_string(out_dir.join("bench.csv")).unwrap();
+    assert_eq!(csv.lines().count(), BENCH_ROWS + 1, "{csv}");
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    for line in csv.lines().skip(1) {
+        assert_eq!(line.split(',').count(), header.len(), "{line}");
+    }
+    for want in ["bias", "limit", "flip", "consisten"] {
+        assert!(header.iter().any(|c| c.contains(want) && !c.contains("bounce")), "no '{want}' column: {header:?}");
+    }
+}
+
+/// bench.md: what ran where (scene, adapter, version, the command line), the table of
+/// rows (header, rule, one line a row), what the columns mean, then the ratios: half /
+/// full for each case, and HBAO and SSDO against SSAO at each setting and resolution.
+fn assert_bench_markdown(out_dir: &std::path::Path) {
+    let markdown = std::fs::read_to_string(out_dir.join("bench.md")).unwrap();
+    assert!(markdown.starts_with("# vrao bench: crease\n"), "{markdown}");
+    for line in ["- adapter: ", "- vrao 0.1", "- command: `", "--techniques ssao,hbao,ssdo"] {
+        assert!(markdown.contains(line), "no '{line}' in {markdown}");
+    }
+    let table: Vec<&str> =
+        markdown.lines().skip_while(|l| !l.starts_with("| technique")).take_while(|l| l.starts_with('|')).collect();
+    assert_eq!(table.len(), BENCH_ROWS + 2, "{markdown}");
+    for name in ["RMSE", "bias", "RMSE vs limit", "limit RMSE", "FLIP", "stereo ≠", "ms/eye"] {
+        assert!(table[0].split('|').any(|c| c.trim() == name), "no column '{name}': {}", table[0]);
+    }
+    assert!(table[2].contains(" %"), "shares in percent: {}", table[2]);
+    let ratio_rows = |title: &str| {
+        let section = markdown.split(title).nth(1).unwrap_or_else(|| panic!("no '{title}' in {markdown}"));
+        section.lines().skip(4).take_while(|l| l.starts_with("| ")).count()
+    };
+    assert_eq!(ratio_rows("Half / full resolution"), 3 * 2, "{markdown}");
+    assert_eq!(ratio_rows("against SSAO"), 2 * 2 * 2, "{markdown}");
+}
+
+/// A bench.json.
+fn read_json(path: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// One bench row's errors, times and shares are all there and in range.
+fn assert_bench_record(r: &serde_json::Value) {
+    let rmse = r["ao_rmse"].as_f64().expect("every row has an error");
+    let ssim = r["ao_ssim"].as_f64().unwrap();
+    assert!((0.0..0.5).contains(&rmse) && (-1.0..=1.0).contains(&ssim), "{r}");
+    assert!(r["occlusion_ms_per_eye"].as_f64().unwrap() > 0.0, "{r}");
+    // The G-buffer the occlusion shares the frame with: the plot's budget line needs it.
+    assert!(r["other_ms_per_eye"].as_f64().is_some_and(|o| o > 0.0), "{r}");
+    // Bias is within ±RMSE (|mean| ≤ RMS; the RMSE has the reference's noise taken
+    // out, so allow for that); the crease is darker than 0.8 near its line.
+    let bias = r["ao_bias"].as_f64().unwrap();
+    assert!(bias.abs() <= rmse + 0.05, "{r}");
+    assert!(r["ao_bias_dark"].as_f64().is_some_and(|b| (-1.0..=1.0).contains(&b)), "{r}");
+    assert!(r["ao_rmse_falloff"].as_f64().is_some_and(|e| (0.0..0.5).contains(&e)), "{r}");
+    // The screen-space limit sees the whole crease (both planes face the eyes): it is
+    // close to the reference, and the technique's distance from it is an RMSE.
+    let limit = r["limit_rmse"].as_f64().unwrap();
+    assert!((0.0..0.06).contains(&limit) && r["limit_bias"].as_f64().unwrap().abs() < 0.03, "{r}");
+    assert!(r["ao_rmse_vs_limit"].as_f64().is_some_and(|e| (0.0..0.5).contains(&e)), "{r}");
+    assert!(r["flip_mean"].as_f64().is_some_and(|f| f > 0.0 && f < 1.0), "{r}");
+    for share in ["stereo_inconsistent", "stereo_inconsistent_inner_border"] {
+        assert!(r[share].as_f64().is_some_and(|s| (0.0..=1.0).contains(&s)), "{share}: {r}");
+    }
+    // No pixel of a 48×40 image is farther than 40 px from every border.
+    assert!(r["stereo_inconsistent_interior"].is_null(), "{r}");
+}
+
+/// Interleaved in groups of 5 (the last group short), every case keeps its own
+/// renderer: the same rows in the same order with the same errors (the frames are
+/// deterministic), only the times measured round-robin.
+fn assert_interleaving_keeps_every_row(dir: &std::path::Path, args: &[&str], records: &[serde_json::Value]) {
     let interleaved_dir = dir.join("interleaved");
     let mut interleaved_args: Vec<&str> = args.to_vec();
     let out_index = interleaved_args.iter().position(|a| *a == "--out").unwrap() + 1;
@@ -208,10 +239,9 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
     interleaved_args.extend(["--interleave", "5", "--frame"]);
     let out = vrao(&interleaved_args);
     assert!(out.status.success(), "{}", text(&out));
-    let again: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(interleaved_dir.join("bench.json")).unwrap()).unwrap();
+    let again = read_json(&interleaved_dir.join("bench.json"));
     let again = again["records"].as_array().unwrap();
-    assert_eq!(again.len(), rows);
+    assert_eq!(again.len(), BENCH_ROWS);
     for (a, b) in records.iter().zip(again) {
         for key in [
             "technique",
@@ -232,9 +262,15 @@ fn bench_writes_csv_json_markdown_and_plot_holding_every_row_and_fit_picks_from_
         let half = b["resolution"] == "half";
         assert_eq!(b["frame_upsample_ms_per_eye"].as_f64().is_some(), half, "only half rows: {b}");
     }
+}
 
-    // --fit picks the least-error row (at the bench's radius) that fits a generous
-    // budget and measures it.
+/// --fit picks the least-error row (at the bench's radius) that fits a generous
+/// budget and measures it.
+fn assert_fit_picks_the_least_error_row(
+    dir: &std::path::Path,
+    out_dir: &std::path::Path,
+    records: &[serde_json::Value],
+) {
     let best = records
         .iter()
         .min_by(|a, b| a["ao_rmse"].as_f64().unwrap().total_cmp(&b["ao_rmse"].as_f64().unwrap()))

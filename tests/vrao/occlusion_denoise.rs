@@ -7,7 +7,7 @@
 
 use crate::common;
 
-use common::occlusion::{ao, ao_techniques, mean, render, same_surface_blur, settings};
+use common::occlusion::{ao, ao_techniques, mean, render, same_surface_blur, settings, Frame};
 use glam::DVec3;
 use vrao::render::passes::blur::AO_BLURRED;
 use vrao::render::passes::composite::HDR;
@@ -23,67 +23,18 @@ use vrao::HeadPose;
 #[test]
 fn blur_keeps_a_depth_edge() {
     let (gpu, _guard) = common::gpu();
-    // A wall 4 m ahead, and 2 m ahead of it a panel covering the left half of the view
-    // (its right edge at x = 0), both facing the eye: a vertical depth step down the
-    // middle of each image. Without the range check, SSAO darkens the far wall beside
-    // the step (samples in front of the wall that project onto the much closer panel
-    // count as occluded, the classic halo): strongly occluded on the far side of the
-    // edge, unoccluded (AO = 1) on the panel itself.
-    let scene = common::bare_scene(vec![
-        common::square("wall", DVec3::new(0.0, 0.0, -4.0), 12.0, 0),
-        common::square("panel", DVec3::new(-3.0, 0.0, -2.0), 6.0, 0),
-    ]);
-    let mut a = ao(Technique::Ssao, 32, 1.0);
-    a.range_check = false;
-    let s = settings(128, 144, a);
-    let f = render(&gpu, &scene, &s, &HeadPose::IDENTITY, &[AO_RAW, AO_BLURRED]);
-    let (w, h) = (f.width, f.height);
-    let blur = s.ao.blur_radius as i32;
-    let (mut near, mut far) =
-        ((Vec::new(), Vec::new(), Vec::new(), Vec::new()), (Vec::new(), Vec::new(), Vec::new(), Vec::new()));
-    for layer in 0..2 {
-        // 1 = panel (about 2 m away), 2 = wall (about 4 m).
-        let class: Vec<u8> = f.world[layer].iter().map(|p| p.map_or(0, |p| if p.z > -3.0 { 1 } else { 2 })).collect();
-        let raw: Vec<f64> = (0..w * h).map(|i| f.outputs[&AO_RAW][layer][4 * i as usize + 3] as f64).collect();
-        let same = same_surface_blur(&raw, &class, w, h, blur);
-        // A geometry-unaware blur of the same raw AO, to show the test would catch one.
-        let naive = same_surface_blur(&raw, &vec![1; raw.len()], w, h, blur);
-        for y in 0..h as i32 {
-            for x in 0..w as i32 {
-                let i = (y as u32 * w + x as u32) as usize;
-                let c = class[i];
-                // Pixels 1–2 px from the silhouette (Chebyshev), far from the image edge.
-                if c == 0 || x < 16 || y < 16 || x >= w as i32 - 16 || y >= h as i32 - 16 {
-                    continue;
-                }
-                let dist = (1..=3)
-                    .find(|&k| {
-                        (-k..=k)
-                            .any(|dy| (-k..=k).any(|dx| class[((y + dy) as u32 * w + (x + dx) as u32) as usize] != c))
-                    })
-                    .unwrap_or(99);
-                if !(1..=2).contains(&dist) {
-                    continue;
-                }
-                let blurred = f.ao(AO_BLURRED, layer, x as u32, y as u32);
-                let side = if c == 1 { &mut near } else { &mut far };
-                side.0.push(raw[i]);
-                side.1.push(blurred);
-                side.2.push(same[i]);
-                side.3.push(naive[i]);
-            }
-        }
-    }
+    let (f, blur) = render_depth_step(&gpu);
+    let (near, far) = edge_sides(&f, blur);
     let m = |v: &Vec<f64>| mean(v.iter().copied());
-    let (near_raw, near_blur, near_same, near_naive) = (m(&near.0), m(&near.1), m(&near.2), m(&near.3));
-    let (far_raw, far_blur, far_same, far_naive) = (m(&far.0), m(&far.1), m(&far.2), m(&far.3));
+    let (near_raw, near_blur, near_same, near_naive) = (m(&near.raw), m(&near.blurred), m(&near.same), m(&near.naive));
+    let (far_raw, far_blur, far_same, far_naive) = (m(&far.raw), m(&far.blurred), m(&far.same), m(&far.naive));
     eprintln!(
         "blur edge ({} near px, {} far px): near raw {near_raw:.3} blurred {near_blur:.3} same-surface {near_same:.3} naive {near_naive:.3}; \
          far raw {far_raw:.3} blurred {far_blur:.3} same-surface {far_same:.3} naive {far_naive:.3}",
-        near.0.len(),
-        far.0.len()
+        near.raw.len(),
+        far.raw.len()
     );
-    assert!(near.0.len() > 200 && far.0.len() > 200, "the silhouette is visible");
+    assert!(near.raw.len() > 200 && far.raw.len() > 200, "the silhouette is visible");
     // The case has contrast: unoccluded panel, strongly occluded wall beside it.
     assert!(near_raw > 0.97 && near_raw - far_raw > 0.3, "no contrast across the edge: {near_raw} vs {far_raw}");
     // A blur that ignored the edge would pull the panel down and the wall up; this
@@ -103,6 +54,80 @@ fn blur_keeps_a_depth_edge() {
         near_blur - far_blur,
         near_raw - far_raw
     );
+}
+
+/// Renders a depth step with SSAO without the range check; returns the frame and the
+/// blur radius.
+///
+/// A wall 4 m ahead, and 2 m ahead of it a panel covering the left half of the view
+/// (its right edge at x = 0), both facing the eye: a vertical depth step down the
+/// middle of each image. Without the range check, SSAO darkens the far wall beside
+/// the step (samples in front of the wall that project onto the much closer panel
+/// count as occluded, the classic halo): strongly occluded on the far side of the
+/// edge, unoccluded (AO = 1) on the panel itself.
+fn render_depth_step(gpu: &std::sync::Arc<vrao::Gpu>) -> (Frame, i32) {
+    let scene = common::bare_scene(vec![
+        common::square("wall", DVec3::new(0.0, 0.0, -4.0), 12.0, 0),
+        common::square("panel", DVec3::new(-3.0, 0.0, -2.0), 6.0, 0),
+    ]);
+    let mut a = ao(Technique::Ssao, 32, 1.0);
+    a.range_check = false;
+    let s = settings(128, 144, a);
+    let f = render(gpu, &scene, &s, &HeadPose::IDENTITY, &[AO_RAW, AO_BLURRED]);
+    (f, s.ao.blur_radius as i32)
+}
+
+/// The AO of one side's pixels next to the silhouette.
+#[derive(Default)]
+struct EdgeSide {
+    raw: Vec<f64>,
+    /// Blurred on the GPU.
+    blurred: Vec<f64>,
+    /// The raw AO blurred on the CPU within its own surface.
+    same: Vec<f64>,
+    /// The raw AO blurred on the CPU across both surfaces.
+    naive: Vec<f64>,
+}
+
+/// Both eyes' pixels 1–2 px from the silhouette (Chebyshev), far from the image edge:
+/// (panel side, wall side).
+fn edge_sides(f: &Frame, blur: i32) -> (EdgeSide, EdgeSide) {
+    let (w, h) = (f.width, f.height);
+    let (mut near, mut far) = (EdgeSide::default(), EdgeSide::default());
+    for layer in 0..2 {
+        // 1 = panel (about 2 m away), 2 = wall (about 4 m).
+        let class: Vec<u8> = f.world[layer].iter().map(|p| p.map_or(0, |p| if p.z > -3.0 { 1 } else { 2 })).collect();
+        let raw: Vec<f64> = (0..w * h).map(|i| f.outputs[&AO_RAW][layer][4 * i as usize + 3] as f64).collect();
+        let same = same_surface_blur(&raw, &class, w, h, blur);
+        // A geometry-unaware blur of the same raw AO, to show the test would catch one.
+        let naive = same_surface_blur(&raw, &vec![1; raw.len()], w, h, blur);
+        for y in 0..h as i32 {
+            for x in 0..w as i32 {
+                let i = (y as u32 * w + x as u32) as usize;
+                let c = class[i];
+                if c == 0 || x < 16 || y < 16 || x >= w as i32 - 16 || y >= h as i32 - 16 {
+                    continue;
+                }
+                if !(1..=2).contains(&silhouette_distance(&class, w, x, y)) {
+                    continue;
+                }
+                let side = if c == 1 { &mut near } else { &mut far };
+                side.raw.push(raw[i]);
+                side.blurred.push(f.ao(AO_BLURRED, layer, x as u32, y as u32));
+                side.same.push(same[i]);
+                side.naive.push(naive[i]);
+            }
+        }
+    }
+    (near, far)
+}
+
+/// Chebyshev distance (up to 3, else 99) from `(x, y)` to a pixel of another class.
+fn silhouette_distance(class: &[u8], w: u32, x: i32, y: i32) -> i32 {
+    let c = class[(y as u32 * w + x as u32) as usize];
+    (1..=3)
+        .find(|&k| (-k..=k).any(|dy| (-k..=k).any(|dx| class[((y + dy) as u32 * w + (x + dx) as u32) as usize] != c)))
+        .unwrap_or(99)
 }
 
 // ---------------------------------------------------------------------------------------

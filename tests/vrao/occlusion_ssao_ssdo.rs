@@ -251,56 +251,14 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
 
 fn red_wall_bleeds(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounce: Technique) {
     eprintln!("{} and {}:", plain.name(), with_bounce.name());
-    let scene = Scene::load("builtin:room").unwrap();
-    // Looking down at the foot of the red (−X) wall, from the middle of the room.
-    let head = HeadPose::look_at(DVec3::new(0.6, 1.6, -0.8), DVec3::new(ROOM_MIN.x + 0.3, 0.0, -2.6)).unwrap();
-    let run_form = |technique: Technique, bounce: f32, form: BounceForm| {
-        let mut a = ao(technique, 64, 1.0);
-        a.bounce = bounce;
-        a.bounce_form = form;
-        render(gpu, &scene, &settings(128, 144, a), &head, &[HDR, AO_RAW])
-    };
-    let run = |technique: Technique, bounce: f32| run_form(technique, bounce, BounceForm::Direction);
-    let ssdo = run(plain, 1.0);
-    let bounce = run(with_bounce, 1.0);
-    let bounce_off = run(with_bounce, 0.0);
-    // The bounce form is the point-sampled SSDO's; the bitmask's senders have none.
-    let patch = run_form(with_bounce, 1.0, BounceForm::Patch);
-    // Floor within 0.45 m of the red wall, away from the other walls.
-    let near_red_wall =
-        |p: DVec3| p.y.abs() < 1e-3 && p.x < ROOM_MIN.x + 0.45 && p.z < ROOM_MAX.z - 1.0 && p.z > ROOM_MIN.z + 0.5;
-    let measure = |f: &Frame| {
-        let (mut hdr, mut raw, mut n) = ([0.0f64; 3], [0.0f64; 3], 0);
-        for (l, x, y) in f.pixels() {
-            if !f.world(l, x, y).is_some_and(near_red_wall) {
-                continue;
-            }
-            n += 1;
-            let (c, a) = (f.rgb(HDR, l, x, y), f.rgb(AO_RAW, l, x, y));
-            for i in 0..3 {
-                hdr[i] += c[i] as f64;
-                raw[i] += a[i] as f64;
-            }
-        }
-        assert!(n > 200, "floor by the red wall is visible ({n} px)");
-        (hdr.map(|v| v / n as f64), raw.map(|v| v / n as f64))
-    };
-    let (ssdo_hdr, ssdo_raw) = measure(&ssdo);
-    let (bounce_hdr, bounce_raw) = measure(&bounce);
-    let (off_hdr, off_raw) = measure(&bounce_off);
-    let (_, patch_raw) = measure(&patch);
+    let frames = RedWallFrames::render(gpu, plain, with_bounce);
+    let (ssdo_hdr, ssdo_raw) = floor_by_the_red_wall(&frames.ssdo);
+    let (bounce_hdr, bounce_raw) = floor_by_the_red_wall(&frames.bounce);
+    let (off_hdr, off_raw) = floor_by_the_red_wall(&frames.bounce_off);
+    let (_, patch_raw) = floor_by_the_red_wall(&frames.patch);
     let ratio = |c: [f64; 3]| c[0] / c[1];
     let gained: Vec<f64> = (0..3).map(|i| bounce_raw[i] - ssdo_raw[i]).collect();
-    // The patch form of Ritschel et al. 2009 carries the same red, less of it
-    // (tests/reference_error.rs compares both with the reference).
-    let patch_gained: Vec<f64> = (0..3).map(|i| patch_raw[i] - ssdo_raw[i]).collect();
-    eprintln!("bounce: patch form gained {patch_gained:.3?}");
-    if with_bounce == Technique::SsdoPointsBounce {
-        assert!(
-            patch_gained[0] > 0.005 && patch_gained[0] > 3.0 * patch_gained[1].max(patch_gained[2]).max(0.0),
-            "the patch-form bounce is not red: {patch_gained:?}"
-        );
-    }
+    assert_patch_form_is_red(with_bounce, ssdo_raw, patch_raw);
     eprintln!(
         "bounce: floor by the red wall, hdr r/g: ssdo {:.3}, ssdo-bounce {:.3}, bounce 0 {:.3}; \
          ao-raw rgb: ssdo {ssdo_raw:.3?}, ssdo-bounce {bounce_raw:.3?} (gained {gained:.3?}), bounce 0 {off_raw:.3?}",
@@ -319,7 +277,76 @@ fn red_wall_bleeds(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounc
         "the bounce is not red: {gained:?}"
     );
     assert!(ratio(bounce_hdr) > 1.03 * ratio(ssdo_hdr), "no red bleeding: r/g {bounce_hdr:?} vs {ssdo_hdr:?}");
-    // Bounce strength 0 is SSDO exactly (the same pass runs).
+    assert_bounce_zero_is_ssdo(&frames.ssdo, &frames.bounce_off);
+    assert_bounce_blocks_the_same_directions(&frames.ssdo, &frames.bounce);
+}
+
+/// The four renders `red_wall_bleeds` compares, each once.
+struct RedWallFrames {
+    ssdo: Frame,
+    bounce: Frame,
+    bounce_off: Frame,
+    /// With the patch form of the bounce.
+    patch: Frame,
+}
+
+impl RedWallFrames {
+    fn render(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounce: Technique) -> Self {
+        let scene = Scene::load("builtin:room").unwrap();
+        // Looking down at the foot of the red (−X) wall, from the middle of the room.
+        let head = HeadPose::look_at(DVec3::new(0.6, 1.6, -0.8), DVec3::new(ROOM_MIN.x + 0.3, 0.0, -2.6)).unwrap();
+        let run_form = |technique: Technique, bounce: f32, form: BounceForm| {
+            let mut a = ao(technique, 64, 1.0);
+            a.bounce = bounce;
+            a.bounce_form = form;
+            render(gpu, &scene, &settings(128, 144, a), &head, &[HDR, AO_RAW])
+        };
+        let run = |technique: Technique, bounce: f32| run_form(technique, bounce, BounceForm::Direction);
+        let ssdo = run(plain, 1.0);
+        let bounce = run(with_bounce, 1.0);
+        let bounce_off = run(with_bounce, 0.0);
+        // The bounce form is the point-sampled SSDO's; the bitmask's senders have none.
+        let patch = run_form(with_bounce, 1.0, BounceForm::Patch);
+        RedWallFrames { ssdo, bounce, bounce_off, patch }
+    }
+}
+
+/// Mean HDR and AoRaw rgb over the floor within 0.45 m of the red wall, away from the
+/// other walls.
+fn floor_by_the_red_wall(f: &Frame) -> ([f64; 3], [f64; 3]) {
+    let near_red_wall =
+        |p: DVec3| p.y.abs() < 1e-3 && p.x < ROOM_MIN.x + 0.45 && p.z < ROOM_MAX.z - 1.0 && p.z > ROOM_MIN.z + 0.5;
+    let (mut hdr, mut raw, mut n) = ([0.0f64; 3], [0.0f64; 3], 0);
+    for (l, x, y) in f.pixels() {
+        if !f.world(l, x, y).is_some_and(near_red_wall) {
+            continue;
+        }
+        n += 1;
+        let (c, a) = (f.rgb(HDR, l, x, y), f.rgb(AO_RAW, l, x, y));
+        for i in 0..3 {
+            hdr[i] += c[i] as f64;
+            raw[i] += a[i] as f64;
+        }
+    }
+    assert!(n > 200, "floor by the red wall is visible ({n} px)");
+    (hdr.map(|v| v / n as f64), raw.map(|v| v / n as f64))
+}
+
+/// The patch form of Ritschel et al. 2009 carries the same red, less of it
+/// (tests/reference_error.rs compares both with the reference).
+fn assert_patch_form_is_red(with_bounce: Technique, ssdo_raw: [f64; 3], patch_raw: [f64; 3]) {
+    let patch_gained: Vec<f64> = (0..3).map(|i| patch_raw[i] - ssdo_raw[i]).collect();
+    eprintln!("bounce: patch form gained {patch_gained:.3?}");
+    if with_bounce == Technique::SsdoPointsBounce {
+        assert!(
+            patch_gained[0] > 0.005 && patch_gained[0] > 3.0 * patch_gained[1].max(patch_gained[2]).max(0.0),
+            "the patch-form bounce is not red: {patch_gained:?}"
+        );
+    }
+}
+
+/// Bounce strength 0 is SSDO exactly (the same pass runs).
+fn assert_bounce_zero_is_ssdo(ssdo: &Frame, bounce_off: &Frame) {
     for r in [HDR, AO_RAW] {
         let worst = ssdo.outputs[&r]
             .iter()
@@ -329,11 +356,14 @@ fn red_wall_bleeds(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounc
             .fold(0f32, f32::max);
         assert!(worst <= 1e-3, "ssdo-bounce with bounce 0 differs from ssdo in {} by {worst}", r.name());
     }
-    // With the bounce, the occluder probe reads distances packed with the direct light
-    // instead of the depth buffer (one fetch for both): it must block exactly the same
-    // directions, so the visibility (AoRaw alpha) is SSDO's to the f16 target's precision.
+}
+
+/// With the bounce, the occluder probe reads distances packed with the direct light
+/// instead of the depth buffer (one fetch for both): it must block exactly the same
+/// directions, so the visibility (AoRaw alpha) is SSDO's to the f16 target's precision.
+fn assert_bounce_blocks_the_same_directions(ssdo: &Frame, bounce: &Frame) {
     let alpha =
         |f: &Frame| f.outputs[&AO_RAW].iter().flat_map(|l| l.iter().skip(3).step_by(4).copied()).collect::<Vec<f32>>();
-    let worst = alpha(&ssdo).iter().zip(alpha(&bounce)).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
+    let worst = alpha(ssdo).iter().zip(alpha(bounce)).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
     assert!(worst <= 1e-3, "the bounce changed which directions are blocked: visibility differs by {worst}");
 }

@@ -22,12 +22,10 @@ fn ms(cell: &str) -> f64 {
     v
 }
 
-#[test]
-fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
-    let dir = common::temp_dir("table-rows");
-    let out_file = dir.join("table.md");
-    let budget_ms = 25.0;
-    let out = vrao(&[
+/// The arguments of a tiny table: 2 techniques × 1 preset × 2 resolutions × 2
+/// foveations of the room at 48×54, one frame each, against a 25 ms budget.
+fn tiny_table_args(out: &str) -> Vec<&str> {
+    vec![
         "table",
         "--scenes",
         "builtin:room",
@@ -50,22 +48,38 @@ fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
         "--budget-ms",
         "25",
         "--out",
-        out_file.to_str().unwrap(),
-    ])
-    .output()
-    .unwrap();
-    assert!(out.status.success(), "{}", text(&out));
-    let md = std::fs::read_to_string(&out_file).unwrap();
-    for key in ["adapter:", "driver:", "timing: serial", "48×54", "budget: 25.000 ms", "command: `", "## room"] {
-        assert!(md.contains(key), "the table's header lacks '{key}':\n{md}");
-    }
+        out,
+    ]
+}
+
+/// The table's header cells and its rows' cells.
+fn table_rows(md: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
     let header: Vec<&str> = md.lines().find(|l| l.starts_with("| technique")).expect("a table").split(" | ").collect();
-    let column = |name: &str| header.iter().position(|h| h.trim_matches(['|', ' ']) == name).unwrap();
     let rows: Vec<Vec<&str>> = md
         .lines()
         .filter(|l| l.starts_with("| gtao") || l.starts_with("| ssao"))
         .map(|l| l.trim_matches(['|', ' ']).split(" | ").map(str::trim).collect())
         .collect();
+    (header, rows)
+}
+
+/// The index of the column `name` in `header`.
+fn column_index(header: &[&str], name: &str) -> usize {
+    header.iter().position(|h| h.trim_matches(['|', ' ']) == name).unwrap()
+}
+
+#[test]
+fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
+    let dir = common::temp_dir("table-rows");
+    let out_file = dir.join("table.md");
+    let budget_ms = 25.0;
+    let out = vrao(&tiny_table_args(out_file.to_str().unwrap())).output().unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let md = std::fs::read_to_string(&out_file).unwrap();
+    for key in ["adapter:", "driver:", "timing: serial", "48×54", "budget: 25.000 ms", "command: `", "## room"] {
+        assert!(md.contains(key), "the table's header lacks '{key}':\n{md}");
+    }
+    let (header, rows) = table_rows(&md);
     // 2 techniques × 1 preset × 2 resolutions × 2 foveations, each once.
     let mut combos: Vec<String> = rows.iter().map(|r| r[..4].join(" ")).collect();
     assert_eq!(combos.len(), 8, "{md}");
@@ -73,43 +87,50 @@ fn table_has_a_row_per_combination_with_positive_times_and_honest_verdicts() {
     combos.dedup();
     assert_eq!(combos.len(), 8, "a combination twice:\n{md}");
     for row in &rows {
-        assert_eq!(row.len(), header.len(), "{row:?}");
-        for name in [
-            "AO pass ms",
-            "denoise ms",
-            "composite ms",
-            "rest ms",
-            "AO chain ms (left eye)",
-            "AO chain ms (stereo)",
-            "stereo frame ms",
-        ] {
-            ms(row[column(name)]);
-        }
-        let left = ms(row[column("AO chain ms (left eye)")]);
-        let stereo = ms(row[column("AO chain ms (stereo)")]);
-        let ratio = ms(row[column("stereo / left")].trim_end_matches('×'));
-        assert!((ratio - stereo / left).abs() <= 0.01 * ratio + 0.01, "{row:?}");
-        // At half resolution the chain also has the composite's inline upsampling: its
-        // excess over the same case's composite at full resolution (at least 0).
-        let passes = ms(row[column("AO pass ms")]) + ms(row[column("denoise ms")]);
-        let expected = if row[2] == "half" {
-            let full = rows
-                .iter()
-                .find(|f| f[2] == "full" && (f[0], f[1], f[3]) == (row[0], row[1], row[3]))
-                .expect("every case runs at both resolutions");
-            let excess = ms(row[column("composite ms")]) - ms(full[column("composite ms")]);
-            passes + excess.max(0.0)
-        } else {
-            passes
-        };
-        assert!((left - expected).abs() < 0.01, "{row:?}");
-        let frame = ms(row[column("stereo frame ms")]);
-        let verdict = row[column("verdict")];
-        let pass = frame <= budget_ms;
-        assert!(verdict.starts_with(if pass { "PASS (" } else { "FAIL (" }), "{frame} ms: {verdict}");
-        assert!(verdict.contains(&format!("{:.2}×", frame / budget_ms)), "{frame} ms: {verdict}");
+        assert_row_times_and_verdict(&header, &rows, row, budget_ms);
     }
     assert!(md.contains("gtao at half: gtao + blur + composite"), "{md}");
+}
+
+/// Every time in `row` is a positive number, the chain's are the sums of its passes, and
+/// the verdict holds the frame against `budget_ms`.
+fn assert_row_times_and_verdict(header: &[&str], rows: &[Vec<&str>], row: &[&str], budget_ms: f64) {
+    let column = |name: &str| column_index(header, name);
+    assert_eq!(row.len(), header.len(), "{row:?}");
+    for name in [
+        "AO pass ms",
+        "denoise ms",
+        "composite ms",
+        "rest ms",
+        "AO chain ms (left eye)",
+        "AO chain ms (stereo)",
+        "stereo frame ms",
+    ] {
+        ms(row[column(name)]);
+    }
+    let left = ms(row[column("AO chain ms (left eye)")]);
+    let stereo = ms(row[column("AO chain ms (stereo)")]);
+    let ratio = ms(row[column("stereo / left")].trim_end_matches('×'));
+    assert!((ratio - stereo / left).abs() <= 0.01 * ratio + 0.01, "{row:?}");
+    // At half resolution the chain also has the composite's inline upsampling: its
+    // excess over the same case's composite at full resolution (at least 0).
+    let passes = ms(row[column("AO pass ms")]) + ms(row[column("denoise ms")]);
+    let expected = if row[2] == "half" {
+        let full = rows
+            .iter()
+            .find(|f| f[2] == "full" && (f[0], f[1], f[3]) == (row[0], row[1], row[3]))
+            .expect("every case runs at both resolutions");
+        let excess = ms(row[column("composite ms")]) - ms(full[column("composite ms")]);
+        passes + excess.max(0.0)
+    } else {
+        passes
+    };
+    assert!((left - expected).abs() < 0.01, "{row:?}");
+    let frame = ms(row[column("stereo frame ms")]);
+    let verdict = row[column("verdict")];
+    let pass = frame <= budget_ms;
+    assert!(verdict.starts_with(if pass { "PASS (" } else { "FAIL (" }), "{frame} ms: {verdict}");
+    assert!(verdict.contains(&format!("{:.2}×", frame / budget_ms)), "{frame} ms: {verdict}");
 }
 
 #[test]

@@ -1,16 +1,10 @@
-//! vrao-ao: screen-space ambient occlusion for wgpu programs, mono or stereo.
+#![doc = include_str!("../README.md")]
 //!
-//! A program that renders its own depth makes an [`AoEngine`] from its device and queue,
-//! and each frame hands it the depth (and optionally normals and motion vectors) with
-//! each view's matrices; the engine records its passes into the program's encoder and
-//! returns the AO as a layered texture. See [`ao`] for the conventions and
-//! `examples/embed` for a whole program.
+//! ## Where things are
 //!
-//! Techniques: GTAO with a visibility bitmask (the default), SSAO, HBAO and a fetch-only
-//! baseline ([`settings::Technique`]); then temporal accumulation, a spatial denoise and
-//! the upsampling from half resolution, each left out when the settings do not need it.
-//! The same frame graph ([`graph`]) and passes ([`passes`]) run inside vrao's renderer
-//! (the `vrao-render` crate), which adds its scene passes around them.
+//! See [`ao`] for the conventions (depth, normals, matrices, formats). The same frame
+//! graph ([`graph`]) and passes ([`passes`]) run inside vrao's renderer (the
+//! `vrao-render` crate), which adds its scene passes around them.
 
 pub mod ao;
 pub mod driver;

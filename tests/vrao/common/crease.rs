@@ -3,10 +3,10 @@
 //! assertions on those bins. Shared by tests/occlusion_ssao_ssdo.rs and
 //! tests/occlusion_hbao_gtao.rs.
 
-use super::occlusion::{ao, render, same_surface_blur, settings};
+use super::occlusion::{ao, render, same_surface_blur, settings, Frame};
 use glam::DVec3;
 use std::sync::Arc;
-use vrao::measure::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams};
+use vrao::measure::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams, Rect};
 use vrao::render::passes::blur::AO_BLURRED;
 use vrao::render::passes::occlusion::AO_RAW;
 use vrao::render::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
@@ -92,134 +92,190 @@ pub fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
     // The blur is simulated below as a same-surface box of the bilateral's radius.
     settings.ao.denoise = Denoise::Bilateral;
     let f = render(gpu, &scene, &settings, &crease_head(), &[AO_RAW, AO_BLURRED]);
-    let r = CREASE_RADIUS;
-    // SSAO and SSDO by their depth-test simulation, HBAO by its march (None).
-    let estimator = match technique {
-        Technique::Ssao => Some((Estimator::Ssao, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Cosine))),
-        Technique::SsdoPoints | Technique::SsdoPointsBounce => {
-            Some((Estimator::Ssdo, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Uniform)))
-        }
-        Technique::Hbao | Technique::Gtao | Technique::Ssdo | Technique::SsdoBounce => None,
-        other => panic!("no crease expectation for {}", other.name()),
-    };
-    let (directions, steps) = hbao_directions_steps(CREASE_SAMPLES);
-    let hbao = HbaoParams { radius: r, bias: 0.02, directions, steps, rotations: 28 };
-    let rects = analytic::crease_rects();
-    let hit = |o: DVec3, d: DVec3| analytic::first_hit(&rects, o, d);
+    let expectation = CreaseExpectation::new(technique);
     let blur = settings.ao.blur_radius as i32;
     let mut bins: Vec<CreaseBin> =
         (0..CREASE_BINS).map(|i| CreaseBin { lo: i as f64 * CREASE_BIN, ..Default::default() }).collect();
     for layer in 0..2 {
-        let n = (w * h) as usize;
-        let class: Vec<u8> = f.world[layer].iter().map(|p| crease_class(*p)).collect();
-        let mut modelled = vec![false; n];
-        let mut expected = vec![1.0; n];
-        let mut closed = vec![1.0; n];
-        let mut falloff = vec![1.0; n];
-        let view = DepthView { eye: f.eyes.eyes[layer].pose.position, forward: f.forward(layer) };
-        for i in 0..n {
-            let (c, Some(p)) = (class[i], f.world[layer][i]) else { continue };
-            if c == 0 {
-                continue;
+        let model = model_layer(&f, layer, &expectation);
+        bin_layer(&mut bins, &f, layer, &model, blur);
+    }
+    average_bins(&mut bins);
+    print_bins(technique, &bins);
+    bins
+}
+
+/// One technique's expected AO on the crease, computed on the CPU.
+struct CreaseExpectation {
+    technique: Technique,
+    /// SSAO and SSDO by their depth-test simulation, HBAO by its march (None).
+    estimator: Option<(Estimator, Vec<[f32; 4]>)>,
+    hbao: HbaoParams,
+    rects: [Rect; 2],
+}
+
+impl CreaseExpectation {
+    fn new(technique: Technique) -> Self {
+        let estimator = match technique {
+            Technique::Ssao => Some((Estimator::Ssao, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Cosine))),
+            Technique::SsdoPoints | Technique::SsdoPointsBounce => {
+                Some((Estimator::Ssdo, hemisphere_kernel(CREASE_SAMPLES, HemisphereDensity::Uniform)))
             }
-            let d = crease_distance(p, c);
-            // The part of the other surface within r of P is a half disc of radius
-            // √(r² − d²) around the foot of P on the crease line; it (with 0.2 m to
-            // spare for the wall points that hide samples just behind the wall) must be
-            // on screen. Checked along its rim every 15°.
-            let rim = (r * r - d * d).max(0.0).sqrt() + 0.2;
-            let on_screen = (0..=12).all(|k| {
-                let (sin, cos) = (k as f64 * std::f64::consts::PI / 12.0).sin_cos();
-                let q = if c == 1 {
-                    DVec3::new(p.x + rim * cos, rim * sin, CREASE_WALL_Z)
-                } else {
-                    DVec3::new(p.x + rim * cos, 0.0, CREASE_WALL_Z + rim * sin)
+            Technique::Hbao | Technique::Gtao | Technique::Ssdo | Technique::SsdoBounce => None,
+            other => panic!("no crease expectation for {}", other.name()),
+        };
+        let (directions, steps) = hbao_directions_steps(CREASE_SAMPLES);
+        let hbao = HbaoParams { radius: CREASE_RADIUS, bias: 0.02, directions, steps, rotations: 28 };
+        CreaseExpectation { technique, estimator, hbao, rects: analytic::crease_rects() }
+    }
+
+    /// The expectation at pixel `i` of `layer`, which shows surface `c` at `d` from the
+    /// crease line, and the closed form (SSAO and SSDO; 1 for the others).
+    fn at(&self, f: &Frame, view: &DepthView, layer: usize, i: usize, c: u8, d: f64) -> (f64, f64) {
+        let p = f.world[layer][i].unwrap();
+        let r = CREASE_RADIUS;
+        let hit = |o: DVec3, d: DVec3| analytic::first_hit(&self.rects, o, d);
+        let normal = if c == 1 { DVec3::Y } else { DVec3::Z };
+        match &self.estimator {
+            Some((est, kernel)) => {
+                // Depth per metre behind the other surface along the ray to P.
+                let e = (p - view.eye).normalize();
+                let other_normal = if c == 1 { DVec3::Z } else { DVec3::Y };
+                let k = e.dot(view.forward) / e.dot(other_normal).abs();
+                let closed = match est {
+                    Estimator::Ssao => analytic::ssao_crease_expectation_with_depth_scale(d, r, 0.02, kernel, k),
+                    Estimator::Ssdo => analytic::ssdo_crease_expectation_with_depth_scale(d, r, 0.02, kernel, k),
                 };
-                f.on_screen(layer, q, 0.005)
-            });
-            modelled[i] = p.x.abs() <= 3.0 && (d >= r || on_screen);
-            falloff[i] = analytic::crease_visibility_falloff(d, r);
-            if d < r * 1.05 {
-                let normal = if c == 1 { DVec3::Y } else { DVec3::Z };
-                expected[i] = match &estimator {
-                    Some((est, kernel)) => {
-                        // Depth per metre behind the other surface along the ray to P.
-                        let e = (p - view.eye).normalize();
-                        let other_normal = if c == 1 { DVec3::Z } else { DVec3::Y };
-                        let k = e.dot(view.forward) / e.dot(other_normal).abs();
-                        closed[i] = match est {
-                            Estimator::Ssao => {
-                                analytic::ssao_crease_expectation_with_depth_scale(d, r, 0.02, kernel, k)
-                            }
-                            Estimator::Ssdo => {
-                                analytic::ssdo_crease_expectation_with_depth_scale(d, r, 0.02, kernel, k)
-                            }
-                        };
-                        let params = EstimatorParams {
-                            estimator: *est,
-                            radius: r,
-                            bias: 0.02,
-                            range_check: true,
-                            rotations: 24,
-                        };
-                        analytic::screen_space_expectation(&params, p, normal, kernel, &view, hit)
-                    }
-                    // GTAO estimates the reference itself (no simulation of its own).
-                    None if technique == Technique::Gtao => analytic::crease_visibility(d, r),
-                    None => {
-                        let pixel = (i as u32 % w, i as u32 / w);
-                        analytic::hbao_expectation(&hbao, &f.eyes.eyes[layer], (w, h), pixel, normal, hit)
-                    }
-                };
+                let params =
+                    EstimatorParams { estimator: *est, radius: r, bias: 0.02, range_check: true, rotations: 24 };
+                (analytic::screen_space_expectation(&params, p, normal, kernel, view, hit), closed)
             }
-        }
-        let expected_blurred = same_surface_blur(&expected, &class, w, h, blur);
-        let falloff_blurred = same_surface_blur(&falloff, &class, w, h, blur);
-        for y in 0..h {
-            for x in 0..w {
-                let i = f.index(x, y);
-                if !modelled[i] {
-                    continue;
-                }
-                let near_other = |radius: i32, want: &dyn Fn(usize) -> bool| {
-                    (-radius..=radius).all(|dy| {
-                        (-radius..=radius).all(|dx| {
-                            let (qx, qy) = (x as i32 + dx, y as i32 + dy);
-                            qx < 0
-                                || qy < 0
-                                || qx >= w as i32
-                                || qy >= h as i32
-                                || want((qy as u32 * w + qx as u32) as usize)
-                        })
-                    })
-                };
-                // More than 3 px from anything that is not this surface.
-                if !near_other(3, &|q| class[q] == class[i]) {
-                    continue;
-                }
-                let d = crease_distance(f.world[layer][i].unwrap(), class[i]);
-                let bin = (d / CREASE_BIN) as usize;
-                if bin >= CREASE_BINS {
-                    continue;
-                }
-                let b = &mut bins[bin];
-                b.pixels += 1;
-                b.raw += f.ao(AO_RAW, layer, x, y);
-                b.expected_raw += expected[i];
-                b.closed_raw += closed[i];
-                b.reference += analytic::crease_visibility(d, r);
-                b.falloff_raw += falloff[i];
-                let window_ok = near_other(blur, &|q| class[q] != class[i] || modelled[q]);
-                if window_ok {
-                    b.blurred_pixels += 1;
-                    b.blurred += f.ao(AO_BLURRED, layer, x, y);
-                    b.expected_blurred += expected_blurred[i];
-                    b.falloff_blurred += falloff_blurred[i];
-                }
+            // GTAO estimates the reference itself (no simulation of its own).
+            None if self.technique == Technique::Gtao => (analytic::crease_visibility(d, r), 1.0),
+            None => {
+                let (w, h) = CREASE_SIZE;
+                let pixel = (i as u32 % w, i as u32 / w);
+                (analytic::hbao_expectation(&self.hbao, &f.eyes.eyes[layer], (w, h), pixel, normal, hit), 1.0)
             }
         }
     }
-    for b in &mut bins {
+}
+
+/// One eye's per-pixel inputs to the bins.
+struct LayerModel {
+    /// `crease_class` of each pixel.
+    class: Vec<u8>,
+    /// Whether the pixel is used (see `measure_crease`).
+    modelled: Vec<bool>,
+    /// `CreaseExpectation::at`: the expectation and the closed form (1 beyond r).
+    expected: Vec<f64>,
+    closed: Vec<f64>,
+    /// The reference with HBAO's linear falloff.
+    falloff: Vec<f64>,
+}
+
+fn model_layer(f: &Frame, layer: usize, expectation: &CreaseExpectation) -> LayerModel {
+    let (w, h) = CREASE_SIZE;
+    let r = CREASE_RADIUS;
+    let n = (w * h) as usize;
+    let class: Vec<u8> = f.world[layer].iter().map(|p| crease_class(*p)).collect();
+    let mut m = LayerModel {
+        class,
+        modelled: vec![false; n],
+        expected: vec![1.0; n],
+        closed: vec![1.0; n],
+        falloff: vec![1.0; n],
+    };
+    let view = DepthView { eye: f.eyes.eyes[layer].pose.position, forward: f.forward(layer) };
+    for i in 0..n {
+        let (c, Some(p)) = (m.class[i], f.world[layer][i]) else { continue };
+        if c == 0 {
+            continue;
+        }
+        let d = crease_distance(p, c);
+        m.modelled[i] = p.x.abs() <= 3.0 && (d >= r || other_surface_on_screen(f, layer, p, c, d));
+        m.falloff[i] = analytic::crease_visibility_falloff(d, r);
+        if d < r * 1.05 {
+            (m.expected[i], m.closed[i]) = expectation.at(f, &view, layer, i, c, d);
+        }
+    }
+    m
+}
+
+/// Whether the part of the other surface within r of `p` (on surface `c`, `d` from the
+/// crease line) is on screen in `layer`: it is a half disc of radius √(r² − d²) around
+/// the foot of P on the crease line; it (with 0.2 m to spare for the wall points that
+/// hide samples just behind the wall) must be on screen. Checked along its rim every 15°.
+fn other_surface_on_screen(f: &Frame, layer: usize, p: DVec3, c: u8, d: f64) -> bool {
+    let r = CREASE_RADIUS;
+    let rim = (r * r - d * d).max(0.0).sqrt() + 0.2;
+    (0..=12).all(|k| {
+        let (sin, cos) = (k as f64 * std::f64::consts::PI / 12.0).sin_cos();
+        let q = if c == 1 {
+            DVec3::new(p.x + rim * cos, rim * sin, CREASE_WALL_Z)
+        } else {
+            DVec3::new(p.x + rim * cos, 0.0, CREASE_WALL_Z + rim * sin)
+        };
+        f.on_screen(layer, q, 0.005)
+    })
+}
+
+/// Adds one eye's modelled pixels more than 3 px from the other surface to the sums of
+/// their bins (`average_bins` turns them into means); the blurred sums only where the
+/// whole blur window is modelled.
+fn bin_layer(bins: &mut [CreaseBin], f: &Frame, layer: usize, m: &LayerModel, blur: i32) {
+    let (w, h) = CREASE_SIZE;
+    let r = CREASE_RADIUS;
+    let expected_blurred = same_surface_blur(&m.expected, &m.class, w, h, blur);
+    let falloff_blurred = same_surface_blur(&m.falloff, &m.class, w, h, blur);
+    for y in 0..h {
+        for x in 0..w {
+            let i = f.index(x, y);
+            if !m.modelled[i] {
+                continue;
+            }
+            // More than 3 px from anything that is not this surface.
+            if !window_all((x, y), 3, |q| m.class[q] == m.class[i]) {
+                continue;
+            }
+            let d = crease_distance(f.world[layer][i].unwrap(), m.class[i]);
+            let bin = (d / CREASE_BIN) as usize;
+            if bin >= CREASE_BINS {
+                continue;
+            }
+            let b = &mut bins[bin];
+            b.pixels += 1;
+            b.raw += f.ao(AO_RAW, layer, x, y);
+            b.expected_raw += m.expected[i];
+            b.closed_raw += m.closed[i];
+            b.reference += analytic::crease_visibility(d, r);
+            b.falloff_raw += m.falloff[i];
+            let window_ok = window_all((x, y), blur, |q| m.class[q] != m.class[i] || m.modelled[q]);
+            if window_ok {
+                b.blurred_pixels += 1;
+                b.blurred += f.ao(AO_BLURRED, layer, x, y);
+                b.expected_blurred += expected_blurred[i];
+                b.falloff_blurred += falloff_blurred[i];
+            }
+        }
+    }
+}
+
+/// Whether `want` holds at every pixel of the square window of `radius` around `(x, y)`
+/// that lies inside the image.
+fn window_all((x, y): (u32, u32), radius: i32, want: impl Fn(usize) -> bool) -> bool {
+    let (w, h) = CREASE_SIZE;
+    (-radius..=radius).all(|dy| {
+        (-radius..=radius).all(|dx| {
+            let (qx, qy) = (x as i32 + dx, y as i32 + dy);
+            qx < 0 || qy < 0 || qx >= w as i32 || qy >= h as i32 || want((qy as u32 * w + qx as u32) as usize)
+        })
+    })
+}
+
+/// Sums to means: per pixel, and per pixel with a whole blur window.
+fn average_bins(bins: &mut [CreaseBin]) {
+    for b in bins {
         let (n, nb) = (b.pixels.max(1) as f64, b.blurred_pixels.max(1) as f64);
         b.raw /= n;
         b.expected_raw /= n;
@@ -230,11 +286,14 @@ pub fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
         b.expected_blurred /= nb;
         b.falloff_blurred /= nb;
     }
+}
+
+fn print_bins(technique: Technique, bins: &[CreaseBin]) {
     eprintln!(
         "crease {}: distance | px raw expected closed-form | px blurred expected | reference, falloff reference raw blurred",
         technique.name()
     );
-    for b in &bins {
+    for b in bins {
         eprintln!(
             "  [{:.1}, {:.1}) | {:4} {:.3} {:.3} {:.3} | {:4} {:.3} {:.3} | {:.3} {:.3} {:.3}",
             b.lo,
@@ -251,7 +310,6 @@ pub fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
             b.falloff_blurred
         );
     }
-    bins
 }
 
 /// The crease darkens towards its edge: blurred AO per bin never rises by more than the

@@ -162,14 +162,28 @@ impl DepthPrepass {
         device: &wgpu::Device,
         meshes: &[HostMesh],
         depth_kind: HostDepth,
+        size: (u32, u32),
+        layers: u32,
+    ) -> Self {
+        Self::multisampled(device, meshes, depth_kind, size, layers, 1)
+    }
+
+    /// [`DepthPrepass::with_layers`] drawn with `samples` samples per pixel, as a forward
+    /// renderer with MSAA draws (2 layers of a multisampled texture need the device's
+    /// `MULTISAMPLE_ARRAY` feature).
+    pub fn multisampled(
+        device: &wgpu::Device,
+        meshes: &[HostMesh],
+        depth_kind: HostDepth,
         (width, height): (u32, u32),
         layers: u32,
+        samples: u32,
     ) -> Self {
         let (vertices, indices) = merge_meshes(meshes);
         let (vertex_buffer, index_buffer) = upload_geometry(device, &vertices, &indices);
         let layout = view_layout(device);
-        let pipeline = prepass_pipeline(device, &layout, depth_kind);
-        let target = |label, format| layered_target(device, label, format, (width, height), layers);
+        let pipeline = prepass_pipeline(device, &layout, depth_kind, samples);
+        let target = |label, format| layered_target(device, label, format, (width, height), layers, samples);
         DepthPrepass {
             pipeline,
             layout,
@@ -290,6 +304,7 @@ fn prepass_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     depth_kind: HostDepth,
+    samples: u32,
 ) -> wgpu::RenderPipeline {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("host prepass"),
@@ -321,7 +336,7 @@ fn prepass_pipeline(
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: Default::default(),
+        multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs"),
@@ -340,15 +355,19 @@ fn layered_target(
     format: wgpu::TextureFormat,
     (width, height): (u32, u32),
     layers: u32,
+    samples: u32,
 ) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
         mip_level_count: 1,
-        sample_count: 1,
+        sample_count: samples,
         dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        // Copied from only when single-sampled (a test reads the depth back).
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | if samples == 1 { wgpu::TextureUsages::COPY_SRC } else { wgpu::TextureUsages::empty() },
         view_formats: &[],
     })
 }

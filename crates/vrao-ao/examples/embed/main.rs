@@ -7,7 +7,7 @@
 //! eyes, beside the AO, as `OUT/embed_ambient_left.png` and `OUT/embed_ambient_right.png`.
 //!
 //! ```text
-//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--time] [--time-setup]
+//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--msaa N] [--time] [--time-setup]
 //! ```
 //!
 //! The command line is handled like vrao's: `--help` prints the usage and exits 0; an
@@ -15,7 +15,11 @@
 //! that cannot be written (named); any other failure exits 1.
 //!
 //! `--standard-depth` stores depth as `Depth24Plus` with a finite far plane instead of
-//! reversed-Z `Depth32Float`; `--no-normals` lets the engine rebuild normals from depth.
+//! reversed-Z `Depth32Float`; `--no-normals` lets the engine rebuild normals from depth;
+//! `--msaa 4` draws the prepass with 4 samples per pixel (2 and 8 too), as a forward
+//! renderer with MSAA does, and hands the engine the multisampled depth and normals, which
+//! it resolves itself (a 2-layer multisampled texture needs the adapter's
+//! `MULTISAMPLE_ARRAY`; the program says so when it lacks it).
 //! It exits non-zero when the AO is not finite, outside 0..1, or shows no occlusion.
 //! `--time` also times whole frames at 1080×1200 per eye, interleaved: the host's prepass
 //! alone, and with the engine (host normals, rebuilt normals), median wall-clock ms.
@@ -43,6 +47,7 @@ Arguments:
 Options:
   --standard-depth  Depth24Plus with a finite far plane instead of reversed-Z Depth32Float
   --no-normals      let the engine rebuild normals from depth
+  --msaa N          draw the prepass with N samples per pixel (1, 2, 4 or 8; default 1)
   --time            also time whole frames at 1080x1200 per eye (host prepass alone and with the engine)
   --time-setup      also time AoEngine::new, the first frame, a resize and the frame after it
   -h, --help        print this and exit
@@ -54,6 +59,8 @@ struct Args {
     out: std::path::PathBuf,
     standard_depth: bool,
     no_normals: bool,
+    /// Samples per pixel of the host's prepass.
+    msaa: u32,
     time: bool,
     time_setup: bool,
 }
@@ -90,14 +97,26 @@ impl<E: Into<Box<dyn std::error::Error>>> From<E> for Failure {
     }
 }
 
+/// The value of `--msaa`: a sample count the engine takes.
+fn parse_msaa(value: Option<&str>) -> Result<u32, String> {
+    let value = value.ok_or("--msaa needs a sample count: 1, 2, 4 or 8")?;
+    match value.parse::<u32>() {
+        Ok(n) if vrao_ao::ao::import::SAMPLE_COUNTS.contains(&n) => Ok(n),
+        _ => Err(format!("--msaa {value}: the sample count is 1, 2, 4 or 8")),
+    }
+}
+
 /// The command line (without the program's name), or the one line that refuses it.
 fn parse_args(args: &[String]) -> Result<Parsed, String> {
     let mut parsed =
-        Args { out: "out".into(), standard_depth: false, no_normals: false, time: false, time_setup: false };
+        Args { out: "out".into(), standard_depth: false, no_normals: false, msaa: 1, time: false, time_setup: false };
     let mut out: Option<&str> = None;
-    for arg in args {
+    let mut args = args.iter();
+    while let Some(arg) = args.next() {
         match arg.as_str() {
             "-h" | "--help" => return Ok(Parsed::Help),
+            "--msaa" => parsed.msaa = parse_msaa(args.next().map(String::as_str))?,
+            flag if flag.starts_with("--msaa=") => parsed.msaa = parse_msaa(flag.strip_prefix("--msaa="))?,
             "--standard-depth" => parsed.standard_depth = true,
             "--no-normals" => parsed.no_normals = true,
             "--time" => parsed.time = true,
@@ -172,11 +191,13 @@ fn run(args: &Args) -> Result<(), Failure> {
     }
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
     let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))?;
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))?;
+    let features = msaa_features(&adapter, args.msaa, depth_kind.format())?;
+    let descriptor = wgpu::DeviceDescriptor { required_features: features, ..Default::default() };
+    let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))?;
     eprintln!("adapter: {}", adapter.get_info().name);
 
     // The host's frame: its geometry, its eyes, its depth prepass.
-    let prepass = DepthPrepass::new(&device, &demo_geometry(), depth_kind, (WIDTH, HEIGHT));
+    let prepass = DepthPrepass::multisampled(&device, &demo_geometry(), depth_kind, (WIDTH, HEIGHT), 2, args.msaa);
     let near = 0.05;
     let tangents = [[-1.2, 0.9, 1.1, -1.1], [-0.9, 1.2, 1.1, -1.1]];
     let views: Vec<ViewMatrices> = demo_eyes()
@@ -231,6 +252,37 @@ fn run(args: &Args) -> Result<(), Failure> {
         eprintln!("{name} eye: mean AO {mean:.3} -> {}", path.display());
     }
     ambient(&device, &queue, &mut engine, &frame, out)
+}
+
+/// The device features a prepass with `samples` samples needs: both eyes in one
+/// multisampled texture need MULTISAMPLE_ARRAY, and counts other than 1 and 4 the
+/// adapter's own format features; refused naming what the adapter lacks.
+fn msaa_features(adapter: &wgpu::Adapter, samples: u32, depth: wgpu::TextureFormat) -> Result<wgpu::Features, Failure> {
+    let mut features = wgpu::Features::empty();
+    if samples > 1 {
+        features |= wgpu::Features::MULTISAMPLE_ARRAY;
+    }
+    if samples != 1 && samples != 4 {
+        features |= wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+        for format in [depth, wgpu::TextureFormat::Rgba16Float] {
+            if !adapter.get_texture_format_features(format).flags.sample_count_supported(samples) {
+                return Err(format!(
+                    "--msaa {samples}: adapter {} cannot draw {format:?} with {samples} samples",
+                    adapter.get_info().name
+                )
+                .into());
+            }
+        }
+    }
+    if !adapter.features().contains(features) {
+        return Err(format!(
+            "--msaa {samples}: adapter {} lacks {:?}",
+            adapter.get_info().name,
+            features - adapter.features()
+        )
+        .into());
+    }
+    Ok(features)
 }
 
 /// SSDO with one bounce from the host's light: a sky (nine SH coefficients of its
@@ -425,8 +477,13 @@ mod tests {
         let Ok(Parsed::Run(args)) = parse("dir --no-normals --standard-depth --time --time-setup") else { panic!() };
         assert_eq!(
             args,
-            Args { out: "dir".into(), standard_depth: true, no_normals: true, time: true, time_setup: true }
+            Args { out: "dir".into(), standard_depth: true, no_normals: true, msaa: 1, time: true, time_setup: true }
         );
+        let Ok(Parsed::Run(args)) = parse("--msaa 4 dir") else { panic!("--msaa takes its count") };
+        assert_eq!((args.msaa, args.out), (4, "dir".into()));
+        assert!(matches!(parse("--msaa=8"), Ok(Parsed::Run(Args { msaa: 8, .. }))));
+        assert_eq!(parse("--msaa 3"), Err("--msaa 3: the sample count is 1, 2, 4 or 8".into()));
+        assert_eq!(parse("--msaa"), Err("--msaa needs a sample count: 1, 2, 4 or 8".into()));
         // --help anywhere prints the usage and renders nothing.
         assert_eq!(parse("--help"), Ok(Parsed::Help));
         assert_eq!(parse("dir -h --bogus"), Ok(Parsed::Help));

@@ -2,7 +2,9 @@
 //! [`HOST_DEPTH`] and [`HOST_NORMALS`], become the G-buffer's [`DEPTH`] and [`NORMALS`]
 //! in vrao's conventions (import.wgsl), so that every technique reads a host's frame as
 //! it reads vrao's own. One fullscreen triangle per view: a read and a write per pixel
-//! (four more depth reads when the normals are rebuilt).
+//! (four more depth reads when the normals are rebuilt). A multisampled host (2, 4 or 8
+//! samples) is resolved here, each pixel taking its sample nearest the eye
+//! (import_msaa.wgsl): one read per sample instead of one per pixel, nothing else.
 
 use super::{AoConfig, AoFrame, NormalEncoding, NormalSpace, Projection};
 use crate::error::{Error, Result};
@@ -13,7 +15,7 @@ use crate::graph::{PassDecl, Resource, PIXEL_MOTION};
 use crate::passes::inputs::{DEPTH, NORMALS};
 use crate::passes::{DeclareContext, Pass, RecordContext};
 use bytemuck::{Pod, Zeroable};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// The pass's name, as `--explain` and the timings show it.
 pub const NAME: &str = "ao-import";
@@ -28,6 +30,13 @@ pub const HOST_NORMALS: Resource = Resource::imported("host-normals", wgpu::Text
 pub const HOST_MOTION: Resource = Resource::imported("host-motion", wgpu::TextureFormat::Rgba16Float);
 
 const IMPORT_WGSL: Shader = wgsl!("src/ao/import.wgsl");
+/// The reads of a host with one sample per pixel.
+const SINGLE_WGSL: Shader = wgsl!("src/ao/import_single.wgsl");
+/// The reads of a multisampled host.
+const MSAA_WGSL: Shader = wgsl!("src/ao/import_msaa.wgsl");
+
+/// The sample counts the engine takes for the host's depth and normals.
+pub const SAMPLE_COUNTS: [u32; 4] = [1, 2, 4, 8];
 
 /// Depth formats the engine reads (the depth aspect of the depth-stencil ones).
 const DEPTH_FORMATS: [wgpu::TextureFormat; 5] = [
@@ -68,6 +77,8 @@ struct ImportParams {
 pub struct ImportSource {
     params: ImportParams,
     views: u32,
+    /// Samples per pixel of the host's depth (and normals).
+    samples: u32,
     /// Whether the host gave motion vectors.
     motion: bool,
 }
@@ -77,7 +88,13 @@ impl ImportSource {
     /// error names the input and what is wrong with it.
     /// `projections` are the views' projections as [`Projection::of`] read them.
     pub(crate) fn check(frame: &AoFrame, config: &AoConfig, projections: &[Projection]) -> Result<ImportSource> {
-        check_texture("depth", frame.depth, config)?;
+        check_texture_size("depth", frame.depth, config)?;
+        let samples = frame.depth.sample_count();
+        if !SAMPLE_COUNTS.contains(&samples) {
+            return Err(Error::input(format!(
+                "depth: {samples} samples per pixel (the engine takes {SAMPLE_COUNTS:?})"
+            )));
+        }
         if !DEPTH_FORMATS.contains(&frame.depth.format()) {
             return Err(Error::input(format!(
                 "depth: format {:?} is not one of {DEPTH_FORMATS:?}",
@@ -86,7 +103,13 @@ impl ImportSource {
         }
         let mut params = ImportParams::zeroed();
         if let Some(normals) = &frame.normals {
-            check_texture("normals", normals.texture, config)?;
+            check_texture_size("normals", normals.texture, config)?;
+            if normals.texture.sample_count() != samples {
+                return Err(Error::input(format!(
+                    "normals: sample count {} where the depth's is {samples}: give both with the same count",
+                    normals.texture.sample_count()
+                )));
+            }
             let sample = normals.texture.format().sample_type(None, None);
             if !matches!(sample, Some(wgpu::TextureSampleType::Float { .. })) {
                 return Err(Error::input(format!(
@@ -121,7 +144,7 @@ impl ImportSource {
         }
         params.size = [config.width, config.height];
         params.reversed = frame.depth_convention.reversed_z as u32;
-        Ok(ImportSource { params, views: config.views, motion: frame.motion.is_some() })
+        Ok(ImportSource { params, views: config.views, samples, motion: frame.motion.is_some() })
     }
 
     /// The engine's near plane (vrao depth = near / distance).
@@ -133,6 +156,18 @@ impl ImportSource {
 
 /// Refuses a texture of another size, too few layers, multisampled or not bindable.
 pub(crate) fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Result<()> {
+    check_texture_size(what, texture, config)?;
+    if texture.sample_count() != 1 {
+        return Err(Error::input(format!(
+            "{what}: {} samples per pixel; the engine resolves only the depth and normals, so resolve this one first",
+            texture.sample_count()
+        )));
+    }
+    Ok(())
+}
+
+/// Refuses a texture of another size, too few layers or not bindable.
+fn check_texture_size(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Result<()> {
     let size = texture.size();
     if (size.width, size.height) != (config.width, config.height) {
         return Err(Error::input(format!(
@@ -146,9 +181,6 @@ pub(crate) fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConf
             size.depth_or_array_layers, config.views
         )));
     }
-    if texture.sample_count() != 1 {
-        return Err(Error::input(format!("{what}: {} samples per pixel; resolve it first", texture.sample_count())));
-    }
     if !texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
         return Err(Error::input(format!("{what}: the texture lacks TEXTURE_BINDING usage")));
     }
@@ -157,23 +189,40 @@ pub(crate) fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConf
 
 /// The import pass of a host's engine.
 pub struct ImportPass {
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    /// For a host with one sample per pixel.
+    single: ImportPipeline,
+    /// For a multisampled host: made at its first multisampled frame.
+    msaa: OnceLock<MsaaImport>,
     uniform: wgpu::Buffer,
     /// This frame's checked inputs (set by the engine before it plans the frame).
     source: Mutex<Option<ImportSource>>,
 }
 
-impl ImportPass {
-    /// Builds the pipeline (one colour target for the normals, depth written as
-    /// `frag_depth`).
-    pub fn new(gpu: &Gpu) -> ImportPass {
+/// One variant of the import's pipeline and its bind group layout.
+struct ImportPipeline {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+/// The multisampled variant, with the texture it binds in place of normals the host did
+/// not give (a multisampled binding takes no single-sample placeholder).
+struct MsaaImport {
+    pipeline: ImportPipeline,
+    no_normals: wgpu::TextureView,
+}
+
+impl ImportPipeline {
+    /// The pipeline of import.wgsl over `reads` (the host's textures bound as `depth`
+    /// and `normals`): one colour target for the normals, depth written as `frag_depth`.
+    fn new(gpu: &Gpu, reads: Shader, depth: wgpu::BindingType, normals: wgpu::BindingType) -> ImportPipeline {
         let device = &gpu.device;
-        let entries = [
-            Slot::Uniform.layout_entry(0, wgpu::ShaderStages::FRAGMENT),
-            Slot::Depth.layout_entry(1, wgpu::ShaderStages::FRAGMENT),
-            Slot::Layers.layout_entry(2, wgpu::ShaderStages::FRAGMENT),
-        ];
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty,
+            count: None,
+        };
+        let entries = [Slot::Uniform.layout_entry(0, wgpu::ShaderStages::FRAGMENT), entry(1, depth), entry(2, normals)];
         let layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(NAME), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -181,7 +230,7 @@ impl ImportPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = shader_module(gpu, NAME, &[IMPORT_WGSL]);
+        let module = shader_module(gpu, NAME, &[reads, IMPORT_WGSL]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(NAME),
             layout: Some(&pipeline_layout),
@@ -209,13 +258,49 @@ impl ImportPass {
             multiview_mask: None,
             cache: None,
         });
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+        ImportPipeline { pipeline, layout }
+    }
+}
+
+impl MsaaImport {
+    fn new(gpu: &Gpu) -> MsaaImport {
+        let multisampled = |sample_type| wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: true,
+        };
+        let pipeline = ImportPipeline::new(
+            gpu,
+            MSAA_WGSL,
+            multisampled(wgpu::TextureSampleType::Depth),
+            multisampled(wgpu::TextureSampleType::Float { filterable: false }),
+        );
+        let no_normals = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("ao-import no normals"),
+            size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 4,
+            dimension: wgpu::TextureDimension::D2,
+            format: HOST_NORMALS.format(),
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        MsaaImport { pipeline, no_normals: no_normals.create_view(&Default::default()) }
+    }
+}
+
+impl ImportPass {
+    /// Builds the single-sample pipeline (the multisampled one waits for a multisampled
+    /// host).
+    pub fn new(gpu: &Gpu) -> ImportPass {
+        let single = ImportPipeline::new(gpu, SINGLE_WGSL, Slot::Depth.binding_type(), Slot::Layers.binding_type());
+        let uniform = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(NAME),
             size: std::mem::size_of::<ImportParams>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        ImportPass { pipeline, layout, uniform, source: Mutex::new(None) }
+        ImportPass { single, msaa: OnceLock::new(), uniform, source: Mutex::new(None) }
     }
 
     /// The inputs of the frame about to be planned and recorded.
@@ -225,6 +310,53 @@ impl ImportPass {
 
     fn source(&self) -> Option<ImportSource> {
         *self.source.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// One bind group per view: the layered views for a single-sample host (the same
+    /// group for every view), each view's layer for a multisampled one.
+    fn bind_groups(&self, ctx: &RecordContext, source: &ImportSource) -> (&wgpu::RenderPipeline, Vec<wgpu::BindGroup>) {
+        let uniform = self.uniform.as_entire_binding();
+        let group = |layout: &wgpu::BindGroupLayout, depth: &wgpu::BindingResource, normals: &wgpu::BindingResource| {
+            ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(NAME),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniform.clone() },
+                    wgpu::BindGroupEntry { binding: 1, resource: depth.clone() },
+                    wgpu::BindGroupEntry { binding: 2, resource: normals.clone() },
+                ],
+            })
+        };
+        if source.samples == 1 {
+            let single = group(&self.single.layout, &ctx.view(HOST_DEPTH), &ctx.view(HOST_NORMALS));
+            return (&self.single.pipeline, vec![single; source.views as usize]);
+        }
+        let msaa = self.msaa.get_or_init(|| MsaaImport::new(ctx.gpu));
+        let layer_view = |texture: &wgpu::Texture, aspect, layer| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(NAME),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                aspect,
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let groups = (0..source.views)
+            .map(|layer| {
+                let depth = layer_view(&ctx.target(HOST_DEPTH).texture, wgpu::TextureAspect::DepthOnly, layer);
+                let normals = match source.params.host_normals {
+                    1 => layer_view(&ctx.target(HOST_NORMALS).texture, wgpu::TextureAspect::All, layer),
+                    _ => msaa.no_normals.clone(),
+                };
+                group(
+                    &msaa.pipeline.layout,
+                    &wgpu::BindingResource::TextureView(&depth),
+                    &wgpu::BindingResource::TextureView(&normals),
+                )
+            })
+            .collect();
+        (&msaa.pipeline.pipeline, groups)
     }
 }
 
@@ -246,22 +378,14 @@ impl Pass for ImportPass {
         let Some(source) = self.source() else { return };
         let source = source.with_near(ctx.setup.settings.near as f32);
         ctx.gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&source.params));
-        let bind_group = ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(NAME),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: ctx.view(HOST_DEPTH) },
-                wgpu::BindGroupEntry { binding: 2, resource: ctx.view(HOST_NORMALS) },
-            ],
-        });
+        let (pipeline, bind_groups) = self.bind_groups(ctx, &source);
         let (depth, normals) = (ctx.target(DEPTH), ctx.target(NORMALS));
-        for layer in 0..source.views {
+        for (layer, bind_group) in (0..source.views).zip(&bind_groups) {
             let normals = (&normals.layer_views[layer as usize], wgpu::Color::TRANSPARENT);
             let depth = &depth.layer_views[layer as usize];
             let mut pass = raster::colour_and_depth_pass(ctx.encoder, NAME, normals, Some(depth));
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind_group, &[]);
             pass.draw(0..3, layer..layer + 1);
         }
     }
@@ -276,8 +400,8 @@ mod layout_tests {
     fn the_import_uniform_matches_import_wgsl() {
         #[rustfmt::skip]
         layout_check::check(&[
-            mirror!(ImportLayer, [IMPORT_WGSL], "ImportLayer", [view_from_world, tangents, depth_offset, depth_numerator, padding]),
-            mirror!(ImportParams, [IMPORT_WGSL], "ImportParams", [layers, size, near, reversed, host_normals, unsigned_normals, world_normals, padding]),
+            mirror!(ImportLayer, [SINGLE_WGSL, IMPORT_WGSL], "ImportLayer", [view_from_world, tangents, depth_offset, depth_numerator, padding]),
+            mirror!(ImportParams, [SINGLE_WGSL, IMPORT_WGSL], "ImportParams", [layers, size, near, reversed, host_normals, unsigned_normals, world_normals, padding]),
         ]);
     }
 }

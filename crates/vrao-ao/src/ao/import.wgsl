@@ -2,7 +2,10 @@
 // finite or infinite far) becomes vrao's reversed-Z infinite-far depth with the engine's
 // near plane, and the host's normals (view or world space, signed or unorm-packed), or
 // normals rebuilt from the depth, become view-space normals. One fullscreen triangle per
-// layer; the instance index is the layer.
+// layer; the instance index is the layer. The host's textures are read through
+// `host_depth_sample` and `host_normal_sample`, which import_single.wgsl (one sample per
+// pixel, a layered view) or import_msaa.wgsl (a multisampled view of the drawn layer)
+// define.
 
 struct ImportLayer {
     // View from world (rotation part turns world-space normals).
@@ -29,8 +32,6 @@ struct ImportParams {
 };
 
 @group(0) @binding(0) var<uniform> params: ImportParams;
-@group(0) @binding(1) var host_depth: texture_depth_2d_array;
-@group(0) @binding(2) var host_normals: texture_2d_array<f32>;
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
@@ -46,10 +47,21 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) layer: u
     return out;
 }
 
-// Distance along −z of the surface at pixel `p`, 0 for the sky (the far end of the depth
-// range) and for anything the projection cannot have produced.
+// Whether `a` lies nearer the eye than `b` in the host's depth convention.
+fn host_nearer(a: f32, b: f32) -> bool {
+    let standard_nearer = a < b;
+    let reversed_nearer = a > b;
+    return select(standard_nearer, reversed_nearer, params.reversed == 1u);
+}
+
+// Distance along −z of the surface at pixel `p` (its nearest sample where the host
+// multisamples), 0 for the sky (the far end of the depth range) and for anything the
+// projection cannot have produced.
 fn host_distance(p: vec2<i32>, layer: u32) -> f32 {
-    let depth = textureLoad(host_depth, p, i32(layer), 0);
+    return distance_of(host_depth_sample(p, layer).x, layer);
+}
+
+fn distance_of(depth: f32, layer: u32) -> f32 {
     let sky = select(depth >= 1.0, depth <= 0.0, params.reversed == 1u);
     let l = params.layers[layer];
     let distance = l.depth_numerator / (depth + l.depth_offset);
@@ -95,8 +107,8 @@ fn rebuilt_normal(p: vec2<i32>, centre: vec3<f32>, distance: f32, layer: u32) ->
     return normalize(n);
 }
 
-fn host_normal(p: vec2<i32>, centre: vec3<f32>, layer: u32) -> vec3<f32> {
-    var n = textureLoad(host_normals, p, i32(layer), 0).xyz;
+fn host_normal(p: vec2<i32>, centre: vec3<f32>, layer: u32, sample: u32) -> vec3<f32> {
+    var n = host_normal_sample(p, layer, sample);
     if (params.unsigned_normals == 1u) {
         n = n * 2.0 - vec3<f32>(1.0);
     }
@@ -118,7 +130,8 @@ struct ImportOut {
 @fragment
 fn import_frame(in: VertexOut) -> ImportOut {
     let p = vec2<i32>(in.position.xy);
-    let distance = host_distance(p, in.layer);
+    let chosen = host_depth_sample(p, in.layer);
+    let distance = distance_of(chosen.x, in.layer);
     var out: ImportOut;
     out.depth = 0.0;
     out.normal = vec4<f32>(0.0);
@@ -128,7 +141,7 @@ fn import_frame(in: VertexOut) -> ImportOut {
     let centre = position_at(p, distance, in.layer);
     var n: vec3<f32>;
     if (params.host_normals == 1u) {
-        n = host_normal(p, centre, in.layer);
+        n = host_normal(p, centre, in.layer, u32(chosen.y));
     } else {
         n = rebuilt_normal(p, centre, distance, in.layer);
     }

@@ -276,6 +276,11 @@ pub enum Slot {
 }
 
 impl Slot {
+    /// How this slot binds (its layout entry's type).
+    pub fn binding_type(self) -> wgpu::BindingType {
+        self.layout_entry(0, wgpu::ShaderStages::COMPUTE).ty
+    }
+
     /// The layout entry of this slot at `binding`, seen by the `visibility` stages.
     pub fn layout_entry(self, binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
         let ty = match self {

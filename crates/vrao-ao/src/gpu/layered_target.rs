@@ -61,11 +61,17 @@ impl LayeredTarget {
     /// `aspect`; no per-layer views.
     pub fn wrap(texture: &wgpu::Texture, label: &str, aspect: wgpu::TextureAspect, layers: u32) -> LayeredTarget {
         let size = texture.size();
+        // A multisampled texture has only 2D views (of one layer): its reader (the AO
+        // engine's import) makes one per layer itself.
+        let (dimension, array_layer_count) = match texture.sample_count() {
+            1 => (wgpu::TextureViewDimension::D2Array, layers),
+            _ => (wgpu::TextureViewDimension::D2, 1),
+        };
         let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some(label),
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            dimension: Some(dimension),
             aspect,
-            array_layer_count: Some(layers),
+            array_layer_count: Some(array_layer_count),
             ..Default::default()
         });
         LayeredTarget {
