@@ -176,11 +176,10 @@ pub fn output_target(gpu: &Gpu, (width, height, layers): (u32, u32, u32)) -> Lay
     )
 }
 
-/// The engine's test helper that checks the Rust mirrors of WGSL structs (naga is a
-/// dev-dependency of this crate for it).
+/// The engine's checker of Rust mirrors of WGSL structs (its `layout-check` feature, a
+/// dev-dependency of this crate).
 #[cfg(test)]
-#[path = "../../../crates/vrao-ao/src/gpu/layout_check.rs"]
-mod layout_check;
+use vrao_ao::gpu::layout_check;
 
 #[cfg(test)]
 mod tests {

@@ -1,10 +1,11 @@
 //! Test helper: checks each `#[repr(C)]` struct that mirrors a WGSL struct against that
 //! struct as naga lays it out (`naga::proc::Layouter`), from the WGSL files its pipeline
-//! compiles, in the same order. Every crate with mirrors includes this file in its tests
-//! (vrao-ao as `gpu::layout_check`, the others by `#[path]`), with naga as a
-//! dev-dependency, and keeps one [`mirror!`] line per mirror:
+//! compiles, in the same order. vrao-ao's tests use it as `gpu::layout_check`; the crates
+//! that depend on vrao-ao turn on its `layout-check` feature for their tests (their
+//! dev-dependency); the embed example includes this file. Each keeps one [`mirror!`] line
+//! per mirror:
 //!
-//! ```ignore
+//! ```text
 //! use crate::gpu::layout_check::{self, mirror};
 //! layout_check::check(&[
 //!     mirror!(GtaoUniform, GTAO_FILES, "GtaoParams", [slices, steps, thickness, step_power, connect, inner_band]),
@@ -60,7 +61,9 @@ pub fn field_size<T, F>(_field: impl Fn(&T) -> &F) -> usize {
 /// `mirror!(RustType, files, "WgslStruct", [field, …])`: one [`Mirror`]. `files` is what
 /// the pipeline compiles: an array or slice of `Shader`s (or [`Text`]s), in its order.
 /// The caller has this module in scope as `layout_check`.
-macro_rules! mirror {
+#[macro_export]
+#[doc(hidden)]
+macro_rules! layout_check_mirror {
     ($ty:ty, $files:expr, $wgsl:literal, [$($field:ident),+ $(,)?]) => {
         layout_check::Mirror {
             rust: stringify!($ty),
@@ -75,7 +78,7 @@ macro_rules! mirror {
         }
     };
 }
-pub(crate) use mirror;
+pub use crate::layout_check_mirror as mirror;
 
 /// Whether a member is padding (skipped on both sides).
 fn is_padding(name: &str) -> bool {

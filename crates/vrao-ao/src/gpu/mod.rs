@@ -3,8 +3,9 @@
 
 pub mod kernel;
 pub mod layered_target;
-#[cfg(test)]
-pub(crate) mod layout_check;
+#[cfg(any(test, feature = "layout-check"))]
+#[doc(hidden)]
+pub mod layout_check;
 pub mod multiview_probe;
 pub mod raster;
 pub mod readback;

@@ -4,10 +4,6 @@
 pub use vrao_ao::gpu::*;
 
 pub mod kernel;
-/// The engine's test helper that checks the Rust mirrors of WGSL structs.
-#[cfg(test)]
-#[path = "../../../vrao-ao/src/gpu/layout_check.rs"]
-pub(crate) mod layout_check;
 pub mod raster;
 pub mod scene;
 pub mod textures;
