@@ -12,6 +12,8 @@ use vrao::ao::{
     AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostMotion, HostNormals, NormalEncoding, NormalSpace,
     ViewMatrices,
 };
+use vrao::render::gpu::layered_target::LayeredTarget;
+use vrao::render::gpu::readback::read_layers_f32;
 use vrao::render::graph::FINAL_AO;
 use vrao::render::scene::Mesh;
 use vrao::render::settings::{AoSettings, Technique};
@@ -172,31 +174,14 @@ fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
 fn a_mono_view_from_a_single_layer_depth_buffer_matches_the_renderer() {
     let (gpu, _lock) = common::gpu();
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let ao = AoSettings::default();
     let eye = eyes()[0];
-    let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(&ao)).unwrap();
+    let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(&AoSettings::default())).unwrap();
     renderer.render_and_wait(&[eye], &[FINAL_AO]).unwrap();
     let reference: Vec<Vec<f32>> =
         renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect();
 
     // A plain 2D depth texture (one layer), drawn by the host's prepass into layer 0.
-    let prepass = DepthPrepass::with_layers(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1);
-    let views = host_views(&[eye], HostDepth::ReversedInfinite);
-    let config = AoConfig { settings: ao, width: WIDTH, height: HEIGHT, views: 1 };
-    let mut engine = AoEngine::new(device, queue, &config).unwrap();
-    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
-    let mut encoder = device.create_command_encoder(&Default::default());
-    prepass.record(device, &mut encoder, &views);
-    let frame = AoFrame {
-        depth: &prepass.depth,
-        depth_convention: DepthConvention::REVERSED_INFINITE,
-        normals: Some(normals),
-        views: &views,
-        motion: None,
-        light: None,
-    };
-    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
-    queue.submit([encoder.finish()]);
+    let (texture, _) = mono_engine_output(&gpu, eye, 1, true);
     assert_eq!(texture.size().depth_or_array_layers, 1);
     let error = rmse(&[host::read_alpha(device, queue, &texture, 0)], &reference[..1]);
     assert!(error <= 1e-3, "mono: RMSE {error}");
@@ -536,40 +521,6 @@ fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
     assert!(gained > 1.0, "no bounce from the host's direct light");
 }
 
-/// The depth of layer 0 of a single-sample `Depth32Float` texture, one value a pixel.
-fn read_depth(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<f32> {
-    let (width, height) = (texture.width(), texture.height());
-    let row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("depth readback"),
-        size: u64::from(row * height),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::DepthOnly,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
-        },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-    );
-    queue.submit([encoder.finish()]);
-    buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let bytes = buffer.slice(..).get_mapped_range().expect("the depth readback maps");
-    (0..height)
-        .flat_map(|y| (0..width).map(move |x| (y * row + x * 4) as usize))
-        .map(|i| f32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]))
-        .collect()
-}
-
 /// Pixels within two of a depth jump of more than 2 % (or of the sky's edge) in `depth`.
 fn near_silhouettes(depth: &[f32]) -> Vec<bool> {
     let (w, h) = (WIDTH as i32, HEIGHT as i32);
@@ -581,9 +532,9 @@ fn near_silhouettes(depth: &[f32]) -> Vec<bool> {
         .collect()
 }
 
-/// The engine's AO of one mono view over the host's prepass drawn with `samples` samples,
-/// and the prepass (for its single-sample depth).
-fn mono_ao_with_samples(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: bool) -> (Vec<f32>, DepthPrepass) {
+/// The engine's output (default settings) for one mono view over the host's prepass drawn
+/// with `samples` samples, and the prepass (for its depth).
+fn mono_engine_output(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: bool) -> (wgpu::Texture, DepthPrepass) {
     let (device, queue) = (&gpu.device, &gpu.queue);
     let geometry = demo_geometry();
     let prepass =
@@ -604,7 +555,13 @@ fn mono_ao_with_samples(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: b
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
-    (host::read_alpha(device, queue, &texture, 0), prepass)
+    (texture, prepass)
+}
+
+/// The AO of [`mono_engine_output`], one value a pixel.
+fn mono_ao_with_samples(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: bool) -> (Vec<f32>, DepthPrepass) {
+    let (texture, prepass) = mono_engine_output(gpu, eye, samples, with_normals);
+    (host::read_alpha(&gpu.device, &gpu.queue, &texture, 0), prepass)
 }
 
 #[test]
@@ -613,7 +570,8 @@ fn multisampled_depth_gives_the_single_sample_ao_away_from_silhouettes() {
     let eye = eyes()[0];
     for with_normals in [true, false] {
         let (single, prepass) = mono_ao_with_samples(&gpu, eye, 1, with_normals);
-        let edges = near_silhouettes(&read_depth(&gpu.device, &gpu.queue, &prepass.depth));
+        let depth = LayeredTarget::wrap(&prepass.depth, "host depth", wgpu::TextureAspect::DepthOnly, 1);
+        let edges = near_silhouettes(&read_layers_f32(&gpu, &depth).unwrap()[0]);
         assert!(edges.iter().any(|&e| e) && edges.iter().any(|&e| !e), "the view has silhouettes and surfaces");
         // 4 is the count every WebGPU device draws these formats with (2 and 8 need
         // TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES, which the tests' device does not ask for).

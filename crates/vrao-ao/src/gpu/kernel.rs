@@ -454,14 +454,18 @@ impl Kernel {
             compiled: gpu.compiled_pipelines.clone(),
             key,
         };
+        // An eager kernel compiles now and needs its recipe no more.
         let pipeline = OnceLock::new();
-        if !gpu.lazy_pipelines() {
+        let recipe = if gpu.lazy_pipelines() {
+            Some(recipe)
+        } else {
             let _ = pipeline.set(recipe.compile(&gpu.device, label));
-        }
+            None
+        };
         Kernel {
             label: label.to_string(),
             pipeline,
-            recipe: Some(recipe),
+            recipe,
             layout,
             slots,
             bind_groups: Mutex::new((gpu.bind_group_epoch.load(Ordering::Relaxed), HashMap::new())),
