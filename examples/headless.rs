@@ -12,10 +12,10 @@
 
 use std::sync::Arc;
 
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::settings::{AoSettings, Technique};
-use vrao::{BackendChoice, Gpu, HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::plug::FINAL_AO;
+use vrao_ao::{AoSettings, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::{BackendChoice, HeadsetProfile, Renderer, Scene, Settings};
 
 fn main() -> std::process::ExitCode {
     match run() {
@@ -45,7 +45,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
     settings.validate()?;
 
-    let gpu = Arc::new(Gpu::new(BackendChoice::Auto)?);
+    let gpu = Arc::new(vrao_render::open(BackendChoice::Auto)?);
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings)?;
 
     // Both eyes from the scene's head pose at t = 0.

@@ -7,8 +7,9 @@
 //! (reference, metrics, bench, studies) import the renderer and `xr` but not each other;
 //! `formats` (the bench file, still images, writers), `test_assets` and `stats` (the one
 //! definition of a quantile) are shared. The
-//! CLI (`src/cli/`) is the binary's. [`render`] is the renderer crate under the name these
-//! modules use.
+//! CLI (`src/cli/`) is the binary's. The renderer and the engine are named by their own
+//! names (`vrao_render::…`, `vrao_ao::…`); [`error`] wraps the engine's error with the
+//! application's own failures and exit codes.
 //!
 //! Cargo features: `app` (default) adds `app`, `measure` and `xr` with what they use
 //! (winit, egui, clap, the reference tracer's rayon and BVH, the bench's plots and FLIP);
@@ -18,20 +19,25 @@
 
 #[cfg(feature = "app")]
 pub mod app;
+pub mod error;
 pub mod formats;
 #[cfg(feature = "app")]
 pub mod measure;
-pub mod render;
 pub mod stats;
 pub mod test_assets;
 #[cfg(feature = "app")]
 pub mod xr;
 
-pub use render::ao;
-pub use render::error::{Error, Result};
-pub use render::gpu::{BackendChoice, Gpu};
-pub use render::graph::Resource;
-pub use render::renderer::{FrameReport, Renderer};
-pub use render::scene::Scene;
-pub use render::settings::{Settings, StereoMode};
-pub use render::stereo::{Eye, EyePair, Fov, HeadPose, HeadsetProfile};
+pub use error::{Error, Result};
+
+/// A shader of a WGSL file named by its path from the workspace root (the
+/// application's files live in `shaders/`).
+#[cfg(feature = "app")]
+macro_rules! wgsl {
+    ($path:literal) => {
+        vrao_ao::plug::Shader { path: $path, source: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/", $path)) }
+    };
+}
+
+#[cfg(feature = "app")]
+pub(crate) use wgsl;

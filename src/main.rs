@@ -5,7 +5,7 @@ mod cli;
 use clap::{CommandFactory, Parser, Subcommand};
 use cli::choice;
 use std::process::ExitCode;
-use vrao::BackendChoice;
+use vrao_render::BackendChoice;
 
 #[derive(Parser)]
 #[command(name = "vrao", version, about = "Stereo VR ambient-occlusion renderer (SSAO, HBAO, GTAO, SSDO) on wgpu")]

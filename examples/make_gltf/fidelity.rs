@@ -7,14 +7,14 @@
 use glam::{DVec3, Vec2, Vec3, Vec4};
 use serde_json::json;
 use std::path::Path;
-use vrao::render::scene::{HeadPath, Light, Material, Mesh, Sampling, Scene, Texture, Wrap};
 use vrao::test_assets::gltf_write::{encode_base64, write, WriteOptions};
-use vrao::HeadPose;
+use vrao_ao::HeadPose;
+use vrao_render::scene::{HeadPath, Light, Material, Mesh, Sampling, Scene, Texture, Wrap};
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
 /// Writes every fidelity asset into `out` and names them.
-pub fn write_all(out: &Path) -> Result<()> {
+pub(crate) fn write_all(out: &Path) -> Result<()> {
     for (name, scene) in [
         ("tiles.glb", tiles()),
         ("emissive.glb", emissive()),

@@ -21,9 +21,9 @@ mod fidelity;
 use glam::{DVec3, Vec2, Vec3};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use vrao::render::scene::{AlphaMode, HeadPath, Light, Material, Mesh, Scene, Texture};
 use vrao::test_assets::gltf_write::{write, WriteOptions};
-use vrao::HeadPose;
+use vrao_ao::HeadPose;
+use vrao_render::scene::{AlphaMode, HeadPath, Light, Material, Mesh, Scene, Texture};
 
 /// Cells per side of the grille's checker.
 const CHECKER: u32 = 8;
@@ -70,7 +70,7 @@ fn run(out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     println!("wrote grille.glb, grille.obj, grille.mtl, grille_mask.png");
     fidelity::write_all(out)?;
 
-    match vrao::render::scene::shared_scenes_dir().map(|d| d.join("sibenik/sibenik.obj")).filter(|p| p.is_file()) {
+    match vrao_render::scene::shared_scenes_dir().map(|d| d.join("sibenik/sibenik.obj")).filter(|p| p.is_file()) {
         Some(obj) => {
             let scene = Scene::load(obj.to_str().ok_or("non-UTF-8 path")?)?;
             write(&scene, &out.join("sibenik.glb"), &WriteOptions::default())?;

@@ -1,9 +1,8 @@
 //! What the desktop window shows of each eye: the eye images or a buffer behind them.
 
-use crate::render::graph::{Resource, FINAL_AO};
-use crate::render::passes::gbuffer::{DEPTH, NORMALS};
-use crate::render::passes::occlusion::AO_RAW;
-use crate::render::settings::{Settings, Technique};
+use vrao_ao::plug::{Resource, AO_RAW, DEPTH, FINAL_AO, NORMALS};
+use vrao_ao::Technique;
+use vrao_render::settings::Settings;
 
 /// What the desktop window shows of each eye (`vrao run --show`, the panel's "show"):
 /// the eye images, or one of the buffers behind them.

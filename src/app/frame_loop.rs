@@ -5,18 +5,16 @@
 
 use crate::app::governor::Governor;
 use crate::app::{BufferView, PassHistory};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::timing::{passes_ms, FrameTiming};
-use crate::render::gpu::Gpu;
-use crate::render::passes::gbuffer::DEPTH;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::renderer::{FrameReport, Renderer, Timing};
-use crate::render::scene::Scene;
-use crate::render::settings::Settings;
+use crate::error::{Error, Result};
 use crate::xr::{FrameRequest, Headset, SubmittedFrame};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use vrao_ao::plug::{FrameTiming, Gpu, DEPTH};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::renderer::{FrameReport, Renderer, Timing};
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
 
 /// What one step of the loop did.
 pub struct Step {
@@ -121,7 +119,7 @@ impl FrameLoop {
     pub fn renderer_for(gpu: &Arc<Gpu>, scene: &Scene, settings: &Settings, headset: &dyn Headset) -> Result<Renderer> {
         let mut settings = settings.clone();
         (settings.profile.width, settings.profile.height) = headset.recommended_size();
-        Renderer::new(gpu.clone(), scene, &settings)
+        Ok(Renderer::new(gpu.clone(), scene, &settings)?)
     }
 
     /// A loop drawing with `renderer` (made by [`FrameLoop::renderer_for`]) for `headset`.
@@ -196,8 +194,8 @@ impl FrameLoop {
         let serial = self.cpu_adapter && self.renderer.frame_index().is_multiple_of(SERIAL_EVERY);
         self.renderer.set_timing(if serial { Timing::Serial } else { Timing::Pipelined });
         let report = self.render(&request)?;
-        let color = self.renderer.target(COLOR).ok_or_else(|| Error::Gpu("no eye colour".into()))?;
-        let depth = self.renderer.target(DEPTH).ok_or_else(|| Error::Gpu("no eye depth".into()))?;
+        let color = self.renderer.target(COLOR).ok_or_else(|| Error::gpu("no eye colour"))?;
+        let depth = self.renderer.target(DEPTH).ok_or_else(|| Error::gpu("no eye depth"))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
         self.headset.submit(&self.gpu, &request, Some(frame))?;
         self.frames += 1;
@@ -232,11 +230,11 @@ impl FrameLoop {
             self.renderer.set_visibility_mask(self.headset.visibility_mask().cloned());
         }
         let (headset, gpu) = (&mut self.headset, &self.gpu);
-        self.renderer.render_with(&request.eyes.eyes, &outputs, |encoder, targets| {
+        Ok(self.renderer.render_with(&request.eyes.eyes, &outputs, |encoder, targets| {
             if let (Some(color), Some(depth)) = (targets.get(&COLOR), targets.get(&DEPTH)) {
                 headset.record_frame(gpu, encoder, request, color, depth);
             }
-        })
+        })?)
     }
 
     /// Takes the display's refresh period the headset gives this frame as the budget, and
@@ -287,7 +285,7 @@ impl FrameLoop {
     /// them has no span: the governor then estimates the share from its frontier rather
     /// than taking the pass as free.
     fn occlusion_ms(&mut self, timing: &FrameTiming, passes: &[&'static str]) -> Option<f64> {
-        match passes_ms(&timing.spans, passes) {
+        match FrameTiming::passes_ms(&timing.spans, passes) {
             Ok(ms) => Some(ms),
             Err(pass) => {
                 if !std::mem::replace(&mut self.missing_span_reported, true) {

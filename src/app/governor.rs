@@ -34,12 +34,12 @@
 //! predicted of its first frame as a factor on later predictions, so the same load does
 //! not try that raise again.
 
+use crate::error::{Error, Result};
 use crate::formats::bench_file::{BenchFile, BenchRecord};
-use crate::render::error::{Error, Result};
-use crate::render::settings::{AoSettings, Foveation, Technique};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::path::Path;
+use vrao_ao::{AoSettings, Foveation, Technique};
 
 /// The bench committed with vrao: the furnished room, gtao/ssao/hbao × 12–64 samples ×
 /// full/half × temporal at r = 0.3 m, 540x600 per eye on lavapipe.
@@ -78,7 +78,7 @@ impl Level {
         let mut out = ao.clone();
         out.technique = self.technique;
         out.samples = self.samples;
-        out.resolution = crate::render::settings::Resolution::from_half_res(self.half_res);
+        out.resolution = vrao_ao::Resolution::from_half_res(self.half_res);
         out.temporal.enabled = self.temporal;
         out.foveation = self.foveation.max(ao.foveation);
         out

@@ -1,13 +1,13 @@
 //! Which headset a session drives: OpenXR when a runtime answers, the simulated one
 //! otherwise, and the GPU each renders on.
 
-use crate::render::error::Error;
-use crate::render::gpu::{BackendChoice, Gpu};
+use crate::error::Error;
 use crate::xr::openxr::{self, OpenXrOptions, OpenedHeadset, Unavailable};
 use crate::xr::simulated::{SimulatedHeadset, SimulatedOptions};
 use crate::xr::Headset as _;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
+use vrao_render::BackendChoice;
 
 /// Which headset `vrao run` drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -45,7 +45,7 @@ impl From<HeadsetError> for Error {
 
 /// Opens the chosen headset and the GPU to render for it; the message says which one
 /// and, on fall back, why. An OpenXR session brings its own GPU (the runtime creates the
-/// Vulkan device); the simulated headset renders on `Gpu::new(backend)`.
+/// Vulkan device); the simulated headset renders on `vrao_render::open(backend)`.
 ///
 /// The OpenXR headset renders at the runtime's recommended per-eye size (and with its
 /// views) unless `size` asks for another; the profile is the simulated headset's only.
@@ -62,7 +62,7 @@ pub fn open_headset(
     // `why`: the reason the simulated headset stands in for OpenXR, if it does.
     let simulated_headset = |why: Option<String>| -> Result<OpenedHeadset, HeadsetError> {
         let headset = SimulatedHeadset::new(simulated.clone())?;
-        let gpu = Arc::new(Gpu::new(backend)?);
+        let gpu = Arc::new(vrao_render::open(backend).map_err(Error::from)?);
         let using = format!("using the {}", headset.describe());
         let message = match why {
             Some(why) => format!("{why}: {using}"),

@@ -1,8 +1,8 @@
 //! Per-pass GPU times of the most recent frames, for the panel's profiler graph and the
 //! run summary's per-pass medians.
 
-use crate::render::gpu::timing::FrameTiming;
 use std::collections::VecDeque;
+use vrao_ao::plug::FrameTiming;
 
 /// Per-pass GPU times of recent frames (as they come back from the GPU, a few frames
 /// after they were submitted), for the profiler graph.

@@ -4,10 +4,10 @@
 
 use super::governor::Governor;
 use super::{BufferView, PassHistory};
-use crate::render::settings::{
-    AoSettings, BounceForm, DisplayMode, Foveation, Quality, Resolution, Settings, Technique,
-};
 use crate::xr::FrameCounters;
+use vrao_ao::plug::BounceForm;
+use vrao_ao::{AoSettings, Foveation, Quality, Resolution, Technique};
+use vrao_render::settings::{DisplayMode, Settings};
 
 /// Width of the egui side panel in points.
 pub(super) const PANEL_WIDTH: f32 = 300.0;
@@ -244,8 +244,7 @@ fn buffer_label(view: BufferView) -> &'static str {
 fn profiler_ui(ui: &mut egui::Ui, info: &PanelInfo) {
     let history = info.history;
     let serial_only = history.frames.iter().any(|f| f.serial);
-    let frames: Vec<&crate::render::gpu::timing::FrameTiming> =
-        history.frames.iter().filter(|f| !serial_only || f.serial).collect();
+    let frames: Vec<&vrao_ao::plug::FrameTiming> = history.frames.iter().filter(|f| !serial_only || f.serial).collect();
     let mut passes: Vec<String> = Vec::new();
     for frame in &frames {
         for (name, _) in &frame.spans {

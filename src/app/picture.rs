@@ -3,11 +3,9 @@
 //! (shaders/mirror.wgsl).
 
 use crate::app::BufferView;
-use crate::render::error::Result;
-use crate::render::gpu::kernel::try_shader_module;
-use crate::render::gpu::raster::fullscreen_pipeline;
-use crate::render::gpu::Gpu;
-use crate::render::wgsl;
+use crate::error::Result;
+use crate::wgsl;
+use vrao_ao::plug::{fullscreen_pipeline, try_shader_module, Gpu};
 
 /// The picture's pipelines: a full-screen triangle drawing one 2D view into a viewport,
 /// one pipeline per kind of picture: the eye image (filtered), occlusion as grey, normals,

@@ -5,11 +5,7 @@
 use crate::app::governor::{Frontier, Governor, GovernorConfig};
 use crate::app::window::{open_event_loop, run_window, WindowOptions};
 use crate::app::{open_headset, BufferView, FrameLoop, HeadsetChoice, HeadsetError, RunSummary};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::renderer::{Renderer, DEFAULT_FRAMES_IN_FLIGHT};
-use crate::render::scene::Scene;
-use crate::render::settings::{DisplayMode, Settings};
+use crate::error::{Error, Result};
 use crate::xr::simulated::motion::HeadMotion;
 use crate::xr::simulated::reproject::ReprojectionMode;
 use crate::xr::simulated::{SimulatedOptions, TimeMode};
@@ -17,6 +13,11 @@ use crate::xr::Headset;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use vrao_ao::plug::Gpu;
+use vrao_render::renderer::{Renderer, DEFAULT_FRAMES_IN_FLIGHT};
+use vrao_render::scene::Scene;
+use vrao_render::settings::{DisplayMode, Settings};
+use vrao_render::BackendChoice;
 
 /// The most frames a session renders when asked for a count (a day at 90 Hz is 7.8 M).
 pub const RUN_FRAMES_MAX: u64 = 10_000_000;
@@ -189,7 +190,9 @@ pub fn run_session(
         log::log!(level, "{line}");
     }
     let renderer = match renderer_unless_interrupted(&gpu, scene, &settings, headset.as_ref(), &interrupt) {
-        Err(Error::Interrupted) => return end_before_frames(headset.as_mut(), &gpu, &settings, options),
+        Err(Error::Engine(vrao_ao::Error::Interrupted)) => {
+            return end_before_frames(headset.as_mut(), &gpu, &settings, options)
+        }
         renderer => renderer?,
     };
     let mut frame_loop = FrameLoop::with_renderer(gpu, renderer, headset);
@@ -283,7 +286,7 @@ fn renderer_unless_interrupted(
     // (up to 2 s on a CPU adapter; the interrupt cuts that short): end the session now.
     gpu.cancel_builds_on(interrupt.clone());
     if interrupt.load(Ordering::Relaxed) {
-        Err(Error::Interrupted)
+        Err(Error::Engine(vrao_ao::Error::Interrupted))
     } else {
         FrameLoop::renderer_for(gpu, scene, settings, headset)
     }
@@ -350,7 +353,7 @@ fn session_settings(
 ) -> std::result::Result<(Settings, Option<(u32, u32)>), SessionError> {
     let mut profile = crate::xr::profiles::by_name(&options.profile).map_err(SessionError::Profile)?;
     if let Some(hz) = options.refresh {
-        profile = profile.with_refresh(hz).map_err(SessionError::Refresh)?;
+        profile = profile.with_refresh(hz).map_err(|e| SessionError::Refresh(e.into()))?;
     }
     let size = match (options.width, options.height) {
         (None, None) => None,
@@ -361,7 +364,7 @@ fn session_settings(
     }
     let mut settings = settings.clone();
     settings.profile = profile;
-    settings.validate()?;
+    settings.validate().map_err(Error::from)?;
     Ok((settings, size))
 }
 
@@ -370,7 +373,7 @@ fn session_settings(
 fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
     let frontier = match &options.governor_frontier {
         Some(path) => {
-            let text = crate::render::files::read_regular_file_to_string(path, crate::render::files::MAX_TEXT_BYTES)?;
+            let text = vrao_render::files::read_regular_file_to_string(path, vrao_render::files::MAX_TEXT_BYTES)?;
             Frontier::from_json(&text, path, settings.ao.radius)?
         }
         None => Frontier::builtin(),

@@ -4,9 +4,9 @@ use crate::app::governor::GovernorChange;
 use crate::app::{FrameLoop, SERIAL_EVERY};
 use crate::formats::output::significant;
 use crate::formats::spans::summarize;
-use crate::render::settings::AoSettings;
 use crate::stats;
 use std::sync::atomic::Ordering;
+use vrao_ao::AoSettings;
 
 /// What a run did (`vrao run --report`): frames rendered and in flight, the frame budget
 /// and how often it was missed, the headset's counters and per-pass medians.
@@ -147,8 +147,8 @@ impl RunSummary {
     /// headset opened and was ended, nothing was rendered.
     pub fn before_frames(
         headset: &dyn crate::xr::Headset,
-        gpu: &crate::render::gpu::Gpu,
-        settings: &crate::render::settings::Settings,
+        gpu: &vrao_ao::plug::Gpu,
+        settings: &vrao_render::settings::Settings,
         state: String,
         frames_in_flight: usize,
     ) -> RunSummary {
@@ -211,7 +211,7 @@ impl RunSummary {
     /// The report of a run refused before its headset or window opened, for `why` (one
     /// line): nothing was rendered; the budget is the profile's (`profile`, with the
     /// `--refresh` given) where it names one, 0 otherwise.
-    pub fn refused(profile: Option<&crate::render::stereo::HeadsetProfile>, why: &str) -> RunSummary {
+    pub fn refused(profile: Option<&vrao_render::HeadsetProfile>, why: &str) -> RunSummary {
         let budget_ms = profile.map_or(0.0, |p| p.budget_ms());
         let budget_source = match profile {
             Some(p) => {
@@ -289,7 +289,7 @@ impl RunSummary {
 }
 
 /// The mask's source in one line, and whether the passes skip it.
-fn mask_description(mask: Option<&crate::render::visibility::VisibilityMask>, on: bool) -> String {
+fn mask_description(mask: Option<&vrao_ao::VisibilityMask>, on: bool) -> String {
     let Some(mask) = mask else { return "none (the headset gives no visibility mask)".into() };
     let sources: Vec<&str> = mask.views.iter().map(|v| v.source.as_str()).collect();
     let source = if sources.windows(2).all(|w| w[0] == w[1]) { sources[..1].join("") } else { sources.join("; ") };
@@ -321,15 +321,11 @@ mod tests {
 
     #[test]
     fn the_ao_setting_names_technique_samples_radius_and_resolution() {
-        let mut ao = AoSettings {
-            samples: 24,
-            radius: 0.3,
-            resolution: crate::render::settings::Resolution::Half,
-            ..AoSettings::default()
-        };
+        let mut ao =
+            AoSettings { samples: 24, radius: 0.3, resolution: vrao_ao::Resolution::Half, ..AoSettings::default() };
         ao.temporal.enabled = true;
         assert_eq!(ao_setting(&ao), format!("{} temporal N=24 r=0.3 m half", ao.technique.name()));
-        ao.resolution = crate::render::settings::Resolution::Full;
+        ao.resolution = vrao_ao::Resolution::Full;
         ao.temporal.enabled = false;
         assert!(ao_setting(&ao).ends_with("N=24 r=0.3 m full"), "{}", ao_setting(&ao));
     }

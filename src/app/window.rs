@@ -10,15 +10,15 @@
 use super::panel::{panel_ui, PanelInfo, PanelState, PANEL_WIDTH};
 use super::picture::Blit;
 use crate::app::{BufferView, FrameLoop, RunSummary};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::Gpu;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::renderer::Renderer;
-use crate::render::scene::Scene;
-use crate::render::settings::{DisplayMode, Quality};
-use crate::render::stereo::{EyePair, Fov, HeadPose};
+use crate::error::{Error, Result};
 use std::path::PathBuf;
 use std::sync::Arc;
+use vrao_ao::plug::Gpu;
+use vrao_ao::{EyePair, Fov, HeadPose, Quality};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::renderer::Renderer;
+use vrao_render::scene::Scene;
+use vrao_render::settings::DisplayMode;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -170,7 +170,7 @@ impl WindowApp {
             self.finished = true;
             event_loop.exit();
         }
-        self.frame_loop.gpu.take_error()
+        Ok(self.frame_loop.gpu.take_error()?)
     }
 }
 
@@ -186,7 +186,7 @@ impl WindowState {
         let (instance, adapter) = gpu_instance_adapter(gpu)?;
         let surface = instance
             .create_surface(window.clone())
-            .map_err(|e| Error::Device(format!("cannot draw into the window: {e}")))?;
+            .map_err(|e| Error::device(format!("cannot draw into the window: {e}")))?;
         let caps = surface.get_capabilities(adapter);
         // The eye images hold sRGB-encoded values: a non-sRGB surface shows them as they are.
         let format = caps
@@ -195,7 +195,7 @@ impl WindowState {
             .copied()
             .find(|f| !f.is_srgb())
             .or_else(|| caps.formats.first().copied())
-            .ok_or_else(|| Error::Device(format!("{} cannot present to this window", gpu.info.name)))?;
+            .ok_or_else(|| Error::device(format!("{} cannot present to this window", gpu.info.name)))?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -355,7 +355,7 @@ impl WindowState {
                 self.surface = gpu_instance_adapter(&gpu)?
                     .0
                     .create_surface(self.window.clone())
-                    .map_err(|e| Error::Device(format!("cannot recreate the window surface: {e}")))?;
+                    .map_err(|e| Error::device(format!("cannot recreate the window surface: {e}")))?;
                 self.surface.configure(&gpu.device, &self.config);
                 return Ok(());
             }
@@ -476,7 +476,7 @@ impl WindowState {
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         self.encode_picture(frame_loop, &view, &paint_jobs, &screen);
-        let target = crate::render::gpu::layered_target::LayeredTarget {
+        let target = vrao_ao::plug::LayeredTarget {
             layer_views: vec![],
             array_view: texture.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -488,7 +488,7 @@ impl WindowState {
             height,
             layers: 1,
         };
-        let mut pixels = crate::render::gpu::readback::read_layers(&gpu, &target)?.remove(0);
+        let mut pixels = vrao_ao::plug::read_layers(&gpu, &target)?.remove(0);
         if matches!(self.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb) {
             pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
         }
@@ -503,7 +503,7 @@ impl WindowState {
 fn gpu_instance_adapter(gpu: &Gpu) -> Result<(&wgpu::Instance, &wgpu::Adapter)> {
     match (&gpu.instance, &gpu.adapter) {
         (Some(instance), Some(adapter)) => Ok((instance, adapter)),
-        _ => Err(Error::Device("a window needs the wgpu instance and adapter vrao opened itself".into())),
+        _ => Err(Error::device("a window needs the wgpu instance and adapter vrao opened itself")),
     }
 }
 

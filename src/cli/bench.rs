@@ -7,10 +7,12 @@ use std::path::PathBuf;
 use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, ReferenceOptions};
 use vrao::measure::reference::default_cache_dir;
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
-use vrao::render::renderer::TimingChoice;
-use vrao::render::scene::RENDER_DEFAULT;
-use vrao::render::settings::{AoSettings, BounceForm, Denoise, Foveation, Quality, Technique};
-use vrao::{BackendChoice, HeadsetProfile, Result, Scene, Settings};
+use vrao::Result;
+use vrao_ao::plug::BounceForm;
+use vrao_ao::{AoSettings, Denoise, Foveation, Quality, Technique};
+use vrao_render::renderer::TimingChoice;
+use vrao_render::scene::RENDER_DEFAULT;
+use vrao_render::{BackendChoice, HeadsetProfile, Scene, Settings};
 
 /// A sweep over a switch: off, on or both.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -39,7 +41,7 @@ enum Resolution {
 }
 
 #[derive(Args)]
-pub struct BenchArgs {
+pub(crate) struct BenchArgs {
     #[arg(long, default_value = RENDER_DEFAULT, help = SCENE_HELP)]
     scene: String,
     /// Techniques to sweep, comma-separated (by default every estimator, gtao first).
@@ -144,7 +146,7 @@ pub struct BenchArgs {
     replot: Option<PathBuf>,
 }
 
-pub fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
     // An output folder that cannot be written fails now, not after the sweep.
     vrao::formats::output::check_output_folder(&args.out)?;
     let run = match &args.replot {

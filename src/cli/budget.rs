@@ -5,8 +5,9 @@ use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::budget::{measure_budget, BudgetOptions};
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
-use vrao::render::renderer::TimingChoice;
-use vrao::{BackendChoice, HeadsetProfile, Result, Scene};
+use vrao::Result;
+use vrao_render::renderer::TimingChoice;
+use vrao_render::{BackendChoice, HeadsetProfile, Scene};
 
 /// What each measured frame produces.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -16,7 +17,7 @@ enum Measure {
 }
 
 #[derive(Args)]
-pub struct BudgetArgs {
+pub(crate) struct BudgetArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Per-eye width in pixels, 1..=8192.
@@ -53,7 +54,7 @@ pub struct BudgetArgs {
     ao: AoArgs,
 }
 
-pub fn run(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: BudgetArgs) -> Result<()> {
     // A report that cannot be written fails now, not after the measurement.
     vrao::formats::output::check_output_file(&args.out)?;
     let scene = Scene::load(&args.scene)?;

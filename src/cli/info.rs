@@ -1,8 +1,9 @@
 //! `vrao info`: the adapter and what it can do.
 
-use vrao::{BackendChoice, Gpu, Result};
+use vrao::Result;
+use vrao_render::BackendChoice;
 
-pub fn run(backend: BackendChoice) -> Result<()> {
-    println!("{}", Gpu::new(backend)?.describe());
+pub(crate) fn run(backend: BackendChoice) -> Result<()> {
+    println!("{}", vrao_render::open(backend)?.describe());
     Ok(())
 }

@@ -1,20 +1,20 @@
 //! The binary's subcommands, one file each: each parses its options and calls one
 //! library function. This file holds the options several of them share.
 
-pub mod bench;
-pub mod budget;
-pub mod info;
-pub mod peer;
-pub mod render;
-pub mod reprojection;
-pub mod run;
-pub mod table;
-pub mod temporal;
+pub(crate) mod bench;
+pub(crate) mod budget;
+pub(crate) mod info;
+pub(crate) mod peer;
+pub(crate) mod render;
+pub(crate) mod reprojection;
+pub(crate) mod run;
+pub(crate) mod table;
+pub(crate) mod temporal;
 
 /// A flag that the first Ctrl-C (SIGINT) or SIGTERM sets, saying `first` on stderr, for
 /// the command to end cleanly; a second one runs `second` (its last cleaning up) and stops
 /// the process at once (130, as a shell reports an interrupted command).
-pub fn interrupt_on_signals(
+pub(crate) fn interrupt_on_signals(
     first: &'static str,
     second: impl Fn() + Send + 'static,
 ) -> std::sync::Arc<std::sync::atomic::AtomicBool> {
@@ -24,7 +24,7 @@ pub fn interrupt_on_signals(
     let installed = ctrlc::set_handler(move || {
         if flag.swap(true, Ordering::Relaxed) {
             second();
-            std::process::exit(vrao::render::error::EXIT_INTERRUPTED);
+            std::process::exit(vrao::error::EXIT_INTERRUPTED);
         }
         eprintln!("interrupted: {first} (again to stop at once)");
     });
@@ -36,7 +36,7 @@ pub fn interrupt_on_signals(
 
 /// A clap value parser for a setting chosen by name ([`Choice`]): the engine and the
 /// renderer have no command line, so the CLI offers their settings' names itself.
-pub fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
+pub(crate) fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
     let values =
         T::all().iter().map(|v| clap::builder::PossibleValue::new(v.name()).aliases(v.aliases().iter().copied()));
     use clap::builder::TypedValueParser;
@@ -45,26 +45,26 @@ pub fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser
 
 use clap::Args;
 use glam::DVec3;
-use vrao::render::passes::shadow::suggested_rsm_radius;
-use vrao::render::settings::Choice;
-use vrao::render::settings::{
-    AoSettings, BounceForm, Denoise, Foveation, GtaoSettings, Noise, Quality, ShadowSettings, Technique, Temporal,
-    TemporalBlend, AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL,
+use vrao_ao::plug::BounceForm;
+use vrao_ao::{
+    AoSettings, Choice, Denoise, Foveation, GtaoSettings, Noise, Quality, Technique, Temporal, TemporalBlend,
 };
-use vrao::{HeadsetProfile, Scene, Settings};
+use vrao_render::passes::shadow::suggested_rsm_radius;
+use vrao_render::settings::{ShadowSettings, AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL};
+use vrao_render::{HeadsetProfile, Scene, Settings};
 
 /// Help heading of the shadow options (part of every command that renders).
 const SHADOW_HEADING: &str = "Shadows and reflective shadow maps";
 
 /// A switch: on or off.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum OnOff {
+pub(crate) enum OnOff {
     On,
     Off,
 }
 
 impl OnOff {
-    pub fn on(self) -> bool {
+    pub(crate) fn on(self) -> bool {
         self == OnOff::On
     }
 }
@@ -81,7 +81,7 @@ impl From<bool> for OnOff {
 
 /// Shadow options for directional lights.
 #[derive(Args, Clone)]
-pub struct LightArgs {
+pub(crate) struct LightArgs {
     /// Shadow maps with 3×3 PCF for the directional lights: on or off (a scene with no
     /// directional light has none either way).
     #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().enabled))]
@@ -102,7 +102,7 @@ pub struct LightArgs {
 }
 
 impl LightArgs {
-    pub fn settings(&self, scene: &Scene) -> ShadowSettings {
+    pub(crate) fn settings(&self, scene: &Scene) -> ShadowSettings {
         ShadowSettings {
             enabled: self.shadows.on(),
             size: self.shadow_size,
@@ -116,7 +116,7 @@ impl LightArgs {
 /// GTAO's free parameters (its pass's own settings) and the stereo reuse (the render
 /// commands and the bench).
 #[derive(Args, Clone)]
-pub struct GtaoArgs {
+pub(crate) struct GtaoArgs {
     /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
     /// radius (thin objects stop occluding behind themselves).
     #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().thickness)]
@@ -139,11 +139,11 @@ pub struct GtaoArgs {
 
 impl GtaoArgs {
     /// GTAO's own settings as given.
-    pub fn settings(&self) -> GtaoSettings {
+    pub(crate) fn settings(&self) -> GtaoSettings {
         GtaoSettings { thickness: self.thickness, step_power: self.step_power, connect: self.connect }
     }
 
-    pub fn apply(&self, ao: &mut AoSettings) {
+    pub(crate) fn apply(&self, ao: &mut AoSettings) {
         ao.gtao = self.settings();
         ao.stereo_reuse = !self.independent_eyes;
     }
@@ -151,7 +151,7 @@ impl GtaoArgs {
 
 /// Occlusion options (shared by every command that renders).
 #[derive(Args, Clone)]
-pub struct AoArgs {
+pub(crate) struct AoArgs {
     #[command(flatten)]
     pub lights: LightArgs,
     #[arg(value_parser = choice::<Technique>(), long, default_value_t = AoSettings::default().technique, hide_possible_values = true, help = technique_help())]
@@ -257,7 +257,7 @@ fn radius_help() -> String {
 impl AoArgs {
     /// Settings for a Vive-class headset at `width`×`height` per eye with these occlusion,
     /// shadow and RSM options (the commands that render frames share this).
-    pub fn eye_settings(&self, scene: &Scene, width: u32, height: u32) -> Settings {
+    pub(crate) fn eye_settings(&self, scene: &Scene, width: u32, height: u32) -> Settings {
         Settings {
             profile: HeadsetProfile::with_size("vive", width, height),
             ao: self.settings(scene),
@@ -266,7 +266,7 @@ impl AoArgs {
         }
     }
 
-    pub fn settings(&self, scene: &Scene) -> AoSettings {
+    pub(crate) fn settings(&self, scene: &Scene) -> AoSettings {
         AoSettings {
             technique: self.technique,
             samples: self.samples.unwrap_or(self.quality.samples()),
@@ -277,7 +277,7 @@ impl AoArgs {
             bounce: self.bounce,
             bounce_form: self.bounce_form,
             noise: self.noise,
-            resolution: vrao::render::settings::Resolution::from_half_res(self.half_res),
+            resolution: vrao_ao::Resolution::from_half_res(self.half_res),
             depth_peeling: self.depth_peeling,
             denoise: self.denoise,
             blur_radius: self.blur,
@@ -301,10 +301,10 @@ impl AoArgs {
 
 /// `X,Y,Z` in metres, each finite.
 /// The largest scene time the options take (seconds: about 11.6 days).
-pub const MAX_SCENE_TIME_S: f64 = 1e6;
+pub(crate) const MAX_SCENE_TIME_S: f64 = 1e6;
 
 /// A scene time in seconds: finite, within 0..=[`MAX_SCENE_TIME_S`].
-pub fn parse_scene_time(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_scene_time(s: &str) -> Result<f64, String> {
     let t: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number of seconds"))?;
     if !(0.0..=MAX_SCENE_TIME_S).contains(&t) {
         return Err(format!("{t} s is not within 0..={MAX_SCENE_TIME_S} s"));
@@ -312,7 +312,7 @@ pub fn parse_scene_time(s: &str) -> Result<f64, String> {
     Ok(t)
 }
 
-pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
+pub(crate) fn parse_vec3(s: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
         return Err(format!("'{s}' is not X,Y,Z"));
@@ -328,7 +328,7 @@ pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
 }
 
 /// A frame budget in milliseconds: finite and positive.
-pub fn parse_budget_ms(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_budget_ms(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(ms) if ms.is_finite() && ms > 0.0 => Ok(ms),
         _ => Err(format!("'{s}' is not a positive number of milliseconds")),
@@ -336,4 +336,4 @@ pub fn parse_budget_ms(s: &str) -> Result<f64, String> {
 }
 
 /// The `--scene` help every command shares.
-pub const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, a glTF (.gltf, .glb), or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals, grille, moving)";
+pub(crate) const SCENE_HELP: &str = "A scene file (.toml), a bare .obj, a glTF (.gltf, .glb), or builtin:NAME (plane, crease, room, sphere, box, furnished, columns, flipped-normals, grille, moving)";

@@ -10,13 +10,14 @@ use vrao::measure::peer::{
 };
 use vrao::measure::reference::default_cache_dir;
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
-use vrao::render::renderer::TimingChoice;
-use vrao::render::scene::RENDER_DEFAULT;
-use vrao::render::settings::{AoSettings, Quality};
-use vrao::{BackendChoice, HeadsetProfile, Result, Scene, Settings};
+use vrao::Result;
+use vrao_ao::{AoSettings, Quality};
+use vrao_render::renderer::TimingChoice;
+use vrao_render::scene::RENDER_DEFAULT;
+use vrao_render::{BackendChoice, HeadsetProfile, Scene, Settings};
 
 #[derive(Args)]
-pub struct PeerArgs {
+pub(crate) struct PeerArgs {
     #[arg(long, default_value = RENDER_DEFAULT, help = SCENE_HELP)]
     scene: String,
     /// The peer program (build it: cd peers/bevy && cargo build --release).
@@ -69,7 +70,7 @@ pub struct PeerArgs {
     out: PathBuf,
 }
 
-pub fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
     vrao::formats::output::check_output_folder(&args.out)?;
     let work = args.out.join("peer-work");
     let options = PeerOptions {

@@ -6,14 +6,16 @@ use glam::DVec3;
 use std::path::PathBuf;
 use vrao::formats::output::OutputTrail;
 use vrao::formats::still::{render_still, StillOptions};
-use vrao::render::renderer::TimingChoice;
-use vrao::render::scene::HeadPath;
-use vrao::render::settings::{DEFAULT_EXPOSURE, DEFAULT_WHITE_POINT};
-use vrao::{BackendChoice, Error, HeadPose, HeadsetProfile, Result, Scene, Settings, StereoMode};
+use vrao::{Error, Result};
+use vrao_ao::HeadPose;
+use vrao_render::renderer::TimingChoice;
+use vrao_render::scene::HeadPath;
+use vrao_render::settings::{DEFAULT_EXPOSURE, DEFAULT_WHITE_POINT};
+use vrao_render::{BackendChoice, HeadsetProfile, Scene, Settings, StereoMode};
 
 #[derive(Args)]
-pub struct RenderArgs {
-    #[arg(long, default_value = vrao::render::scene::RENDER_DEFAULT, help = SCENE_HELP)]
+pub(crate) struct RenderArgs {
+    #[arg(long, default_value = vrao_render::scene::RENDER_DEFAULT, help = SCENE_HELP)]
     scene: String,
     /// Output directory.
     #[arg(long, default_value = "out")]
@@ -81,7 +83,7 @@ impl RenderArgs {
     }
 }
 
-pub fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
     let mut scene = Scene::load(&args.scene)?;
     if let (Some(eye), Some(target)) = (args.eye, args.look_at) {
         let pose = HeadPose::look_at(eye, target)
@@ -129,10 +131,10 @@ mod tests {
     #[test]
     fn render_with_no_options_uses_the_library_defaults() {
         let args = Render::try_parse_from(["render"]).unwrap().args;
-        assert_eq!(args.scene, vrao::render::scene::RENDER_DEFAULT);
+        assert_eq!(args.scene, vrao_render::scene::RENDER_DEFAULT);
         let scene = Scene::load(&args.scene).unwrap();
         assert_eq!(args.settings(&scene), Settings::default());
-        assert_eq!(Settings::default().ao.technique, vrao::render::settings::Technique::Gtao);
+        assert_eq!(Settings::default().ao.technique, vrao_ao::Technique::Gtao);
     }
 
     #[test]
@@ -141,8 +143,8 @@ mod tests {
         let command = Render::command();
         let technique = command.get_arguments().find(|a| a.get_id() == "technique").unwrap();
         let help = technique.get_help().unwrap().to_string();
-        assert_eq!(help, format!("Occlusion technique: {}", vrao::render::settings::Technique::help_list()));
-        for t in vrao::render::settings::Technique::all() {
+        assert_eq!(help, format!("Occlusion technique: {}", vrao_ao::Technique::help_list()));
+        for t in vrao_ao::Technique::all() {
             assert!(help.contains(t.name()), "{} missing from {help}", t.name());
         }
     }
@@ -155,7 +157,7 @@ mod tests {
         let ao = &settings.ao;
         assert_eq!(
             (ao.samples, ao.resolution.is_half(), ao.radius, ao.technique),
-            (64, true, 0.25, vrao::render::settings::Technique::Hbao)
+            (64, true, 0.25, vrao_ao::Technique::Hbao)
         );
         assert!(ao.temporal.enabled);
         assert_ne!(settings, Settings::default());

@@ -4,10 +4,11 @@ use super::{AoArgs, SCENE_HELP};
 use clap::Args;
 use std::path::PathBuf;
 use vrao::measure::reprojection::{study, to_markdown};
-use vrao::{BackendChoice, HeadsetProfile, Result, Scene};
+use vrao::Result;
+use vrao_render::{BackendChoice, HeadsetProfile, Scene};
 
 #[derive(Args)]
-pub struct ReprojectionArgs {
+pub(crate) struct ReprojectionArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Per-eye width in pixels, 1..=8192.
@@ -23,7 +24,7 @@ pub struct ReprojectionArgs {
     ao: AoArgs,
 }
 
-pub fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: ReprojectionArgs) -> Result<()> {
     if let Some(out) = &args.out {
         vrao::formats::output::check_output_file(out)?;
     }

@@ -8,14 +8,15 @@ use std::sync::Arc;
 use vrao::app::{
     refused_summary, run_session, BufferView, HeadsetChoice, HeadsetError, RunOptions, SessionError, RUN_FRAMES_MAX,
 };
-use vrao::render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
-use vrao::render::settings::DisplayMode;
 use vrao::xr::simulated::motion::HeadMotion;
 use vrao::xr::simulated::reproject::ReprojectionMode;
-use vrao::{BackendChoice, Error, Result, Scene, Settings};
+use vrao::{Error, Result};
+use vrao_render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
+use vrao_render::settings::DisplayMode;
+use vrao_render::{BackendChoice, Scene, Settings};
 
 #[derive(Args)]
-pub struct RunArgs {
+pub(crate) struct RunArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Headset: auto (OpenXR if a runtime answers, else simulated), openxr or simulated.
@@ -86,7 +87,7 @@ pub struct RunArgs {
     ao: AoArgs,
 }
 
-pub fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     // Before anything that takes time or opens a session: a Ctrl-C (or SIGTERM) from
     // here on ends the run cleanly, with its report.
     let interrupt = interrupt_on_ctrl_c();
@@ -168,8 +169,10 @@ fn name_the_option(error: SessionError) -> Error {
 /// `error` with its message led by `option`, its kind (and exit code) kept.
 fn with_option(option: &str, error: Error) -> Error {
     match error {
-        Error::Input { file, line, message } => Error::Input { file, line, message: format!("{option}: {message}") },
-        Error::Device(message) => Error::Device(format!("{option}: {message}")),
+        Error::Engine(vrao_ao::Error::Input { file, line, message }) => {
+            vrao_ao::Error::Input { file, line, message: format!("{option}: {message}") }.into()
+        }
+        Error::Engine(vrao_ao::Error::Device(message)) => Error::device(format!("{option}: {message}")),
         Error::Unavailable(message) => Error::Unavailable(format!("{option}: {message}")),
         other => other,
     }

@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use vrao::measure::bench::{version, Resolution};
 use vrao::measure::table::{check_scene_count, run_table, TableOptions};
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
-use vrao::render::renderer::TimingChoice;
-use vrao::render::settings::{Foveation, Quality, Technique};
-use vrao::{BackendChoice, Error, HeadsetProfile, Result, Scene};
+use vrao::{Error, Result};
+use vrao_ao::{Foveation, Quality, Technique};
+use vrao_render::renderer::TimingChoice;
+use vrao_render::{BackendChoice, HeadsetProfile, Scene};
 
 /// An AO resolution on the command line.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -20,7 +21,7 @@ enum Res {
 }
 
 #[derive(Args)]
-pub struct TableArgs {
+pub(crate) struct TableArgs {
     /// Scenes, comma-separated, each a scene file or builtin:NAME (Sibenik's file names
     /// its mesh under $VRAO_SCENES); at most 16.
     #[arg(long, value_delimiter = ',', default_values_t = ["assets/scenes/sibenik.toml".to_string(), "builtin:furnished".to_string()])]
@@ -62,7 +63,7 @@ pub struct TableArgs {
     out: PathBuf,
 }
 
-pub fn run(backend: BackendChoice, args: TableArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: TableArgs) -> Result<()> {
     // A table that cannot be written, or a bad option, fails now: before the scenes load
     // and long before the sweep ends.
     vrao::formats::output::check_output_file(&args.out)?;

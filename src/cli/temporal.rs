@@ -7,10 +7,11 @@ use std::path::PathBuf;
 use vrao::measure::reference::default_cache_dir;
 use vrao::measure::temporal::motion::{self, motion_study, Sequence};
 use vrao::measure::temporal::{study, to_markdown};
-use vrao::{BackendChoice, Result, Scene};
+use vrao::Result;
+use vrao_render::{BackendChoice, Scene};
 
 #[derive(Args)]
-pub struct TemporalArgs {
+pub(crate) struct TemporalArgs {
     /// Scene: builtin:NAME, a .toml scene file, an .obj or a glTF (default: builtin:room,
     /// or builtin:moving with --motion).
     #[arg(long)]
@@ -45,7 +46,7 @@ pub struct TemporalArgs {
     ao: AoArgs,
 }
 
-pub fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
+pub(crate) fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
     if let Some(out) = &args.out {
         vrao::formats::output::check_output_file(out)?;
     }

@@ -1,14 +1,15 @@
 //! The bench's file format (`vrao bench --out`, JSON): plain data that `measure` writes
 //! and the governor in `app` reads its frontier from, so it lives below both.
 
-use crate::render::error::{Error, Result};
-use crate::render::settings::{Foveation, Technique, RSM_SAMPLES_MAX, SAMPLES_MAX};
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use vrao_ao::{AoSettings, Foveation, Technique};
+use vrao_render::settings::RSM_SAMPLES_MAX;
 
 /// The occlusion's resolution: bench files name it `full` or `half`
 /// ([`Resolution::name`]), as they always have.
-pub use crate::render::settings::Resolution;
+pub use vrao_ao::Resolution;
 
 /// One row as written to CSV, JSON and Markdown.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -236,11 +237,11 @@ impl BenchRecord {
     /// What is wrong with this record, if anything (see [`BenchFile::validate`]).
     fn check(&self) -> std::result::Result<(), Problem> {
         // Rows of reflective shadow maps carry "rsm" and their VPL count as samples.
-        let rsm = self.technique == crate::render::passes::rsm::NAME;
+        let rsm = self.technique == vrao_render::passes::rsm::NAME;
         if !rsm && self.technique.parse::<Technique>().is_err() {
             return Err(Problem(format!("unknown technique '{}'", self.technique)));
         }
-        let samples_max = if rsm { RSM_SAMPLES_MAX } else { SAMPLES_MAX };
+        let samples_max = if rsm { RSM_SAMPLES_MAX } else { AoSettings::SAMPLES_MAX };
         if !(1..=samples_max).contains(&self.samples) {
             return Err(Problem(format!("samples {} is not within 1..={samples_max}", self.samples)));
         }

@@ -6,12 +6,12 @@ pub mod output;
 pub mod spans;
 pub mod still;
 
-/// Serde for a setting chosen by name ([`Choice`](crate::render::settings::Choice)): written as its name, read from its
+/// Serde for a setting chosen by name ([`Choice`](vrao_ao::Choice)): written as its name, read from its
 /// name or an alias, an unknown name refused with the accepted ones
 /// (`#[serde(with = "crate::formats::by_name")]`).
 pub mod by_name {
-    use crate::render::settings::Choice;
     use serde::{de::Error as _, Deserialize, Deserializer, Serializer};
+    use vrao_ao::Choice;
 
     /// Writes the value's name.
     pub fn serialize<T: Choice, S: Serializer>(value: &T, serializer: S) -> Result<S::Ok, S::Error> {

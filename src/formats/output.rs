@@ -1,15 +1,15 @@
 //! Writes eye images and debug views as PNG files.
 
-use crate::render::error::{Error, Result};
-use crate::render::graph::{Resource, FINAL_AO};
-use crate::render::passes::gbuffer::{ALBEDO, DEPTH, NORMALS};
-use crate::render::passes::occlusion::AO_RAW;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::renderer::Renderer;
-use crate::render::settings::{Settings, Technique};
+use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
+use vrao_ao::plug::{Resource, AO_RAW, DEPTH, FINAL_AO, NORMALS};
+use vrao_ao::Technique;
+use vrao_render::passes::gbuffer::ALBEDO;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::renderer::Renderer;
+use vrao_render::settings::Settings;
 
 /// File-name parts of layer 0 and layer 1, in that order.
 pub const EYE_NAMES: [&str; 2] = ["left", "right"];
@@ -139,7 +139,7 @@ impl OutputTrail {
     fn open(&self) -> Result<MutexGuard<'_, Trail>> {
         let trail = self.lock();
         if trail.closed || self.interrupted() {
-            return Err(Error::Interrupted);
+            return Err(Error::Engine(vrao_ao::Error::Interrupted));
         }
         Ok(trail)
     }
@@ -222,7 +222,7 @@ pub fn write_images(
     }
     // The final AO first, then (with `debug`) the raw AO before blur or upsampling.
     for (label, r) in occlusion_written(settings, debug) {
-        let target = renderer.target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
+        let target = renderer.target(r).ok_or_else(|| Error::gpu(format!("{} was not rendered", r.name())))?;
         let size = (target.width, target.height);
         for (name, layer) in names.iter().zip(renderer.read_f32(r)?) {
             save_sized(format!("{label}_{name}.png"), size, occlusion_to_rgba(&layer))?;
@@ -334,7 +334,7 @@ mod tests {
         trail.create_dir_all(&out).unwrap();
         for name in ["left.png", "right.png"] {
             trail
-                .write_file(&out.join(name), |p| std::fs::write(p, "x").map_err(|e| Error::Gpu(e.to_string())))
+                .write_file(&out.join(name), |p| std::fs::write(p, "x").map_err(|e| Error::gpu(e.to_string())))
                 .unwrap();
         }
         assert_eq!(trail.made(), [root.join("a"), out.clone(), out.join("left.png"), out.join("right.png")]);
@@ -343,7 +343,7 @@ mod tests {
         assert!(!root.join("a").exists(), "the folders it created are gone");
         assert!(root.join("theirs.txt").is_file(), "what was there before stays");
         let late = trail.write_file(&root.join("late.png"), |_| panic!("nothing is written after removal"));
-        assert!(matches!(late, Err(Error::Interrupted)));
+        assert!(matches!(late, Err(Error::Engine(vrao_ao::Error::Interrupted))));
         // A folder something else wrote into stays.
         let trail = OutputTrail::new();
         trail.create_dir_all(&root.join("c")).unwrap();
@@ -353,7 +353,7 @@ mod tests {
         // Interrupted: nothing is made at all.
         let flag = Arc::new(AtomicBool::new(true));
         let trail = OutputTrail::interrupted_by(flag);
-        assert!(matches!(trail.create_dir_all(&root.join("d")), Err(Error::Interrupted)));
+        assert!(matches!(trail.create_dir_all(&root.join("d")), Err(Error::Engine(vrao_ao::Error::Interrupted))));
         assert!(!root.join("d").exists());
         std::fs::remove_dir_all(&root).unwrap();
     }

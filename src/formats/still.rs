@@ -1,15 +1,15 @@
 //! One stereo frame written as PNG files, optionally rendered several times to time its
 //! passes: what `vrao render` does, reachable from the library.
 
+use crate::error::{Error, Result};
 use crate::formats::output::OutputTrail;
-use crate::render::error::{Error, Result};
-use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::renderer::{Renderer, TimingChoice};
-use crate::render::scene::Scene;
-use crate::render::settings::Settings;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
+use vrao_render::renderer::{Renderer, TimingChoice};
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
+use vrao_render::BackendChoice;
 
 /// How [`render_still`] renders and what it writes.
 #[derive(Clone, Debug)]
@@ -62,10 +62,11 @@ fn render_and_write(scene: &Scene, settings: &Settings, options: &StillOptions) 
     settings.validate()?;
     // An unwritable directory fails before the GPU starts.
     crate::formats::output::check_output_folder(&options.out)?;
-    let interrupted = || if options.trail.interrupted() { Err(Error::Interrupted) } else { Ok(()) };
-    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let interrupted =
+        || if options.trail.interrupted() { Err(Error::Engine(vrao_ao::Error::Interrupted)) } else { Ok(()) };
+    let gpu = Arc::new(vrao_render::open(options.backend)?);
     if let Some(flag) = options.trail.interrupt_flag() {
-        // An interrupt cuts the pipeline builds short (Renderer::new: Error::Interrupted).
+        // An interrupt cuts the pipeline builds short (Renderer::new: Error::Engine(vrao_ao::Error::Interrupted)).
         gpu.cancel_builds_on(flag);
     }
     interrupted()?;

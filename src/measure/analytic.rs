@@ -20,13 +20,12 @@
 //! cos θ dω to area on the unit disk, so a cosine-weighted fraction of directions is an
 //! area on the disk divided by π.
 
-use crate::render::scene::builtin::{CREASE_FLOOR_END_Z, CREASE_HALF_WIDTH, CREASE_WALL_HEIGHT, CREASE_WALL_Z};
-use crate::render::stereo::Eye;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
+use vrao_ao::Eye;
+use vrao_render::scene::builtin::{CREASE_FLOOR_END_Z, CREASE_HALF_WIDTH, CREASE_WALL_HEIGHT, CREASE_WALL_Z};
 
 pub use crate::measure::metrics::luminance;
-pub use crate::render::stereo::pixel_ray;
 
 /// GLSL/WGSL `smoothstep`: 0 below `edge0`, 1 above `edge1`, Hermite in between.
 pub fn smoothstep(edge0: f64, edge1: f64, x: f64) -> f64 {
@@ -204,7 +203,7 @@ fn rotation_fraction_past_wall(reach: f64, beyond: f64) -> f64 {
 /// Expected SSAO value (before blur) at a floor point at distance x from the crease's
 /// wall, averaged exactly over a uniform rotation of the kernel about the normal.
 ///
-/// `samples` is the kernel as [`crate::render::sampling::hemisphere_kernel`] makes it: unit
+/// `samples` is the kernel as [`vrao_ao::plug::hemisphere_kernel`] makes it: unit
 /// directions around +Z (the normal; on the floor the normal is +Y) and a length as a
 /// fraction of `radius`. The estimator, as the renderer implements it: sample i lies at
 /// P + bias·r·n + sᵢ ωᵢ with sᵢ = lengthᵢ · r; it counts as occluded when the surface the
@@ -259,7 +258,7 @@ pub fn ssao_crease_expectation_with_depth_scale(
 /// Expected SSDO visibility (`.a`, before blur) at a floor point at distance x from the
 /// crease's wall, averaged exactly over a uniform kernel rotation.
 ///
-/// `samples` is [`crate::render::sampling::hemisphere_kernel`] with uniform density: directions
+/// `samples` is [`vrao_ao::plug::hemisphere_kernel`] with uniform density: directions
 /// uniform in solid angle around +Z and λᵢ = lengthᵢ · r. Sample i at P + bias·r·n + λᵢ ωᵢ
 /// is blocked when it lies more than bias·r behind the wall plane (the depth test, under
 /// the same assumptions as [`ssao_crease_expectation`]); visibility is the cosine-weighted
@@ -444,7 +443,7 @@ pub fn hbao_expectation(
 ) -> f64 {
     let origin = eye.pose.position;
     let surface = |x: f64, y: f64| {
-        let dir = pixel_ray(eye, size, (x, y));
+        let dir = vrao_ao::Eye::pixel_ray(eye, size, (x, y));
         hit(origin, dir).map(|t| origin + dir * t)
     };
     let Some(p) = surface(pixel.0 as f64 + 0.5, pixel.1 as f64 + 0.5) else { return 1.0 };

@@ -2,6 +2,7 @@
 //! pass per eye over many frames, as a table, CSV and Markdown. (Error against the
 //! reference tracer joins these rows when the tracer exists.)
 
+use crate::error::{Error, Result};
 pub use crate::formats::bench_file::{BenchFile, BenchRecord, LimitInfo, ReferenceInfo, Resolution};
 pub use crate::formats::output::significant;
 use crate::formats::spans::{summarize, SpanSummary};
@@ -11,20 +12,17 @@ use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{ReferenceImage, ReferencePixel};
 use crate::measure::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency, BORDER_PX};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::timing::is_per_eye;
-use crate::render::gpu::Gpu;
-use crate::render::graph::FINAL_AO;
-use crate::render::passes::composite::HDR;
-use crate::render::passes::gbuffer::{DEPTH, NORMALS};
-use crate::render::passes::rsm::{self, RSM_INDIRECT};
-use crate::render::passes::shadow;
-use crate::render::renderer::{Renderer, Timing};
-use crate::render::scene::Scene;
-use crate::render::settings::{Foveation, Settings, Technique};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
+use vrao_ao::plug::{FrameTiming, Gpu, DEPTH, FINAL_AO, NORMALS};
+use vrao_ao::{Foveation, Technique};
+use vrao_render::passes::composite::HDR;
+use vrao_render::passes::rsm::{self, RSM_INDIRECT};
+use vrao_render::passes::shadow;
+use vrao_render::renderer::{Renderer, Timing};
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
 
 mod errors;
 mod report;
@@ -121,16 +119,17 @@ impl BenchRow {
     /// budget with, for the plot's budget line.
     pub fn other_ms_per_eye(&self) -> f64 {
         let occlusion = &self.occlusion_passes;
-        let other = self.spans.iter().filter(|s| !is_per_eye(&s.label) && !occlusion.contains(&s.label.as_str()));
+        let other =
+            self.spans.iter().filter(|s| !FrameTiming::is_per_eye(&s.label) && !occlusion.contains(&s.label.as_str()));
         other.map(|s| s.median_ms).sum::<f64>() / self.views as f64
     }
 }
 
 /// Each eye's pixels the `mask` shows for `settings`' size (`None`: all of them).
 pub fn lens_coverage(
-    mask: &crate::render::visibility::VisibilityMask,
+    mask: &vrao_ao::VisibilityMask,
     settings: &Settings,
-    eyes: &[crate::render::stereo::Eye],
+    eyes: &[vrao_ao::Eye],
 ) -> Vec<Option<Vec<u8>>> {
     let (w, h) = (settings.profile.width, settings.profile.height);
     eyes.iter()
@@ -169,11 +168,11 @@ pub fn measure(
 struct CaseRun {
     case: BenchCase,
     settings: Settings,
-    output: crate::render::graph::Resource,
+    output: vrao_ao::plug::Resource,
     /// What each frame renders: the occlusion, and with `whole_frame` the lit image.
-    outputs: Vec<crate::render::graph::Resource>,
+    outputs: Vec<vrao_ao::plug::Resource>,
     renderer: Renderer,
-    eyes: crate::render::stereo::EyePair,
+    eyes: vrao_ao::EyePair,
     timing: Timing,
     timings: Vec<Vec<(String, f64)>>,
     /// Each eye's pixels the profile's lens shows (0: hidden): rows are scored there.
@@ -187,7 +186,7 @@ impl CaseRun {
         settings.ao.technique = case.technique;
         settings.ao.samples = case.samples;
         settings.ao.radius = case.radius;
-        settings.ao.resolution = crate::render::settings::Resolution::from_half_res(case.half_res);
+        settings.ao.resolution = vrao_ao::Resolution::from_half_res(case.half_res);
         settings.ao.depth_peeling = case.depth_peeling;
         settings.ao.temporal.enabled = case.temporal;
         settings.ao.foveation = case.foveation;
@@ -197,7 +196,7 @@ impl CaseRun {
         }
         let output = FINAL_AO;
         if timing == Timing::Pipelined && !gpu.caps.timestamps {
-            return Err(Error::Device(format!(
+            return Err(Error::device(format!(
                 "{} has no timestamp queries; use serial timing",
                 gpu.info.name.clone()
             )));
@@ -226,8 +225,8 @@ impl CaseRun {
     }
 
     /// One frame, not measured (warm-up).
-    fn frame(&mut self) -> Result<crate::render::renderer::FrameReport> {
-        self.renderer.render_and_wait(&self.eyes.eyes, &self.outputs)
+    fn frame(&mut self) -> Result<vrao_render::renderer::FrameReport> {
+        Ok(self.renderer.render_and_wait(&self.eyes.eyes, &self.outputs)?)
     }
 
     /// One measured frame: serial timing keeps each pass's wall-clock time; pipelined,
@@ -255,7 +254,7 @@ impl CaseRun {
     fn bounce_limit(&self, reference: &ReferenceImage) -> Result<Option<f64>> {
         let depth = self.renderer.read_f32(DEPTH)?;
         let normals = self.renderer.read_f32(NORMALS)?;
-        let direct = self.renderer.read_f32(crate::render::passes::direct::DIRECT)?;
+        let direct = self.renderer.read_f32(vrao_render::passes::direct::DIRECT)?;
         let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()).min(direct.len()))
             .map(|k| EyeBuffers {
                 depth: &depth[k],
@@ -280,7 +279,7 @@ impl CaseRun {
     fn finish(mut self, reference: Option<&ReferenceImage>, limit: Option<&ScreenLimit>) -> Result<BenchRow> {
         let (settings, output) = (&self.settings, self.output);
         // The measured frames' plan, before the bounce below renders a frame of another.
-        let plan = self.renderer.last_plan().cloned().ok_or_else(|| Error::Gpu("no frame was measured".into()))?;
+        let plan = self.renderer.last_plan().cloned().ok_or_else(|| Error::gpu("no frame was measured"))?;
         let spans = summarize(&self.timings);
         check_timed(&plan.names, &spans)?;
         let occlusion = self.renderer.read_f32(output)?;
@@ -358,7 +357,7 @@ pub const RSM_PASS: &str = rsm::NAME;
 /// name, and one timed under another name would otherwise read as 0 ms.
 fn check_timed(ran: &[&'static str], spans: &[SpanSummary]) -> Result<()> {
     match ran.iter().find(|pass| !spans.iter().any(|s| s.label == **pass)) {
-        Some(pass) => Err(Error::Gpu(format!("pass '{pass}' ran but no GPU time was measured under its name"))),
+        Some(pass) => Err(Error::gpu(format!("pass '{pass}' ran but no GPU time was measured under its name"))),
         None => Ok(()),
     }
 }
@@ -377,7 +376,7 @@ pub fn measure_rsm(
     reference: Option<&ReferenceImage>,
 ) -> Result<BenchRow> {
     let Measurement { timing, warmup, frames, .. } = how;
-    if crate::render::passes::shadow::shadow_casters(scene).is_empty() {
+    if vrao_render::passes::shadow::shadow_casters(scene).is_empty() {
         return Err(Error::input(format!(
             "reflective shadow maps need a directional light; '{}' has none",
             scene.name

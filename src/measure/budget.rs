@@ -8,14 +8,13 @@
 //! what each eye costs. Both are reported. An eye passes when the sum of its passes fits
 //! half the budget; the stereo frame passes when the sum of its passes fits the budget.
 
+use crate::error::Result;
 use crate::formats::spans::{summarize, SpanSummary};
-use crate::render::error::Result;
-use crate::render::gpu::timing::is_per_eye;
-use crate::render::graph::Resource;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::renderer::{FrameReport, Renderer, Timing};
-use crate::render::stereo::EyePair;
 use serde::{Deserialize, Serialize};
+use vrao_ao::plug::{FrameTiming, Resource};
+use vrao_ao::EyePair;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::renderer::{FrameReport, Renderer, Timing};
 
 mod fit;
 pub use fit::{fit_setting, measure_budget, BudgetOptions, BudgetOutcome, Fit};
@@ -107,10 +106,10 @@ impl BudgetReport {
     }
 
     /// `None` within budget; otherwise what is over it, as the error `vrao budget` exits 3 with.
-    pub fn over_budget(&self) -> Option<crate::render::error::Error> {
+    pub fn over_budget(&self) -> Option<crate::error::Error> {
         let over: Vec<&str> = self.verdicts.iter().filter(|v| !v.pass).map(|v| v.what.name()).collect();
         (!over.is_empty()).then(|| {
-            crate::render::error::Error::OverBudget(format!(
+            crate::error::Error::OverBudget(format!(
                 "{} over the {:.3} ms stereo frame budget",
                 over.join(", "),
                 self.budget_ms
@@ -184,7 +183,7 @@ pub struct BudgetRun {
 fn pass_times(report: &FrameReport, timing: Timing) -> Vec<(String, f64)> {
     let source = if timing == Timing::Serial { &report.wall_ms } else { &report.gpu_ms };
     // Per-eye sub-spans inside a pass ("gbuffer left") are not passes of their own.
-    source.iter().filter(|(name, _)| !is_per_eye(name)).cloned().collect()
+    source.iter().filter(|(name, _)| !FrameTiming::is_per_eye(name)).cloned().collect()
 }
 
 /// Renders `warmup + frames` rounds of (stereo frame, left eye alone, right eye alone)
@@ -193,7 +192,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
     // Bounded counts: `warmup + frames` never wraps, and there is a measured frame.
     crate::measure::check_frames(how.warmup, how.frames)?;
     renderer.set_timing(how.timing);
-    let views: [&[crate::render::stereo::Eye]; 3] = [&eyes.eyes, &eyes.eyes[..1], &eyes.eyes[1..]];
+    let views: [&[vrao_ao::Eye]; 3] = [&eyes.eyes, &eyes.eyes[..1], &eyes.eyes[1..]];
     let mut times: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut encode: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut pass_order: Vec<String> = Vec::new();

@@ -18,7 +18,7 @@ pub mod stereo_consistency;
 pub mod table;
 pub mod temporal;
 
-use crate::render::error::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The most warm-up frames a measurement takes (`--warmup` of bench and budget): a few
 /// suffice for pipeline compilation and first-touch allocation.

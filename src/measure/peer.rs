@@ -15,24 +15,23 @@
 //! With serial timing (lavapipe) both are wall clock around work submitted alone; with
 //! pipelined timing (a GPU) both are GPU timestamps.
 
+use crate::error::{Error, Result};
 use crate::measure::bench::{
     pixels_per_degree, score, sweep, BenchCase, BenchRow, ErrorFigures, Measurement, ReferenceOptions,
 };
 use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{trace_cached, ProgressBar, ReferenceImage, ReferenceSettings};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::graph::FINAL_AO;
-use crate::render::passes::gbuffer::{DEPTH, NORMALS};
-use crate::render::renderer::{Renderer, Timing, TimingChoice};
-use crate::render::scene::Scene;
-use crate::render::settings::{Foveation, Settings, Technique};
-use crate::render::stereo::{reversed_z_projection, Eye, EyePair};
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use vrao_ao::plug::{Gpu, DEPTH, FINAL_AO, NORMALS};
+use vrao_ao::{Eye, EyePair, Foveation, Technique};
+use vrao_render::renderer::{Renderer, Timing, TimingChoice};
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
+use vrao_render::BackendChoice;
 
 /// Bevy 0.19's own SSAO presets: (name, slices, samples per slice side).
 pub const BEVY_PRESETS: [(&str, u32, u32); 4] = [("low", 1, 2), ("medium", 2, 2), ("high", 3, 3), ("ultra", 9, 3)];
@@ -211,7 +210,7 @@ pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result
     let gltf = &options.gltf;
     let (width, height) = (base.profile.width, base.profile.height);
     let eyes = base.profile.eyes(&scene.head.pose_at(0.0), base.near);
-    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let gpu = Arc::new(vrao_render::open(options.backend)?);
     let timing = options.timing.resolve(&gpu);
     let adapter = format!("{} ({:?}, {})", gpu.info.name, gpu.info.backend, gpu.info.driver_info);
     let radius = base.ao.radius;
@@ -295,7 +294,7 @@ fn check_cases(base: &Settings, cases: &[BenchCase]) -> Result<()> {
     for case in cases {
         let mut s = base.clone();
         (s.ao.technique, s.ao.samples, s.ao.resolution) =
-            (case.technique, case.samples, crate::render::settings::Resolution::from_half_res(case.half_res));
+            (case.technique, case.samples, vrao_ao::Resolution::from_half_res(case.half_res));
         s.validate()?;
     }
     Ok(())
@@ -308,7 +307,7 @@ struct PeerScoring<'a> {
     visible: &'a ReferenceImage,
     limit: &'a ScreenLimit,
     ppd: f64,
-    fovs: &'a [crate::render::stereo::Fov],
+    fovs: &'a [vrao_ao::Fov],
 }
 
 /// The Bevy rows, one per preset: the median time per eye over the rounds, and the last
@@ -349,7 +348,7 @@ fn vrao_rows(cases: &[BenchCase], vrao_rounds: &[Vec<BenchRow>]) -> Result<(Vec<
                 vrao_passes.push(pass.to_string());
             }
         }
-        let error = last.error.clone().ok_or_else(|| Error::Gpu("a vrao row was not scored".into()))?;
+        let error = last.error.clone().ok_or_else(|| Error::gpu("a vrao row was not scored"))?;
         rows.push(PeerRow {
             family: Family::Vrao,
             setting: setting_name(case),
@@ -394,7 +393,7 @@ fn rgba_of(ao: &[f32]) -> Vec<f32> {
 pub fn scene_for_peer(scene: &Scene) -> Scene {
     let mut plain = scene.clone();
     for m in &mut plain.materials {
-        if m.diffuse_texture.is_some() && m.alpha_mode != crate::render::scene::AlphaMode::Opaque {
+        if m.diffuse_texture.is_some() && m.alpha_mode != vrao_render::scene::AlphaMode::Opaque {
             log::warn!("peer: material '{}' is cut out by its texture in vrao, solid for the peer", m.name);
         }
         (m.diffuse_texture, m.emissive_texture, m.normal_texture, m.occlusion_texture) = (None, None, None, None);
@@ -449,7 +448,7 @@ fn limit_and_default(
 /// vrao builds them.
 fn eye_line(name: &str, eye: &Eye, near: f64) -> String {
     let world_from_view = eye.pose.world_from_local().as_mat4();
-    let clip_from_view = reversed_z_projection(&eye.fov, near).as_mat4();
+    let clip_from_view = vrao_ao::Fov::reversed_z_projection(&eye.fov, near).as_mat4();
     let numbers: Vec<String> = world_from_view
         .to_cols_array()
         .iter()
@@ -500,7 +499,7 @@ fn run_peer_round(
     if !status.success() {
         let text = std::fs::read_to_string(&log_path).unwrap_or_default();
         let tail: Vec<&str> = text.lines().rev().take(3).collect();
-        return Err(Error::Gpu(format!(
+        return Err(Error::gpu(format!(
             "the peer failed ({status}): {}",
             tail.into_iter().rev().collect::<Vec<_>>().join(" / ")
         )));
@@ -508,19 +507,19 @@ fn run_peer_round(
     let file_path = dir.join("peer.json");
     let text = std::fs::read_to_string(&file_path).map_err(|e| output(&file_path, e))?;
     let file: PeerFile =
-        serde_json::from_str(&text).map_err(|e| Error::Gpu(format!("the peer's peer.json does not read: {e}")))?;
+        serde_json::from_str(&text).map_err(|e| Error::gpu(format!("the peer's peer.json does not read: {e}")))?;
     if (file.width, file.height) != (width, height) || file.presets.len() != options.presets.len() {
-        return Err(Error::Gpu("the peer's peer.json does not match its job".into()));
+        return Err(Error::gpu("the peer's peer.json does not match its job"));
     }
     if timing == Timing::Pipelined && !file.timestamps {
-        return Err(Error::Device("the peer's device has no timestamp queries; use serial timing".into()));
+        return Err(Error::device("the peer's device has no timestamp queries; use serial timing"));
     }
     let mut round = Vec::new();
     for preset in &file.presets {
         let mut per_eye = Vec::new();
         for (k, eye) in preset.eyes.iter().enumerate() {
             if eye.eye != EYE_NAMES[k] {
-                return Err(Error::Gpu(format!("the peer's eye {k} is '{}'", eye.eye)));
+                return Err(Error::gpu(format!("the peer's eye {k} is '{}'", eye.eye)));
             }
             let ms = match timing {
                 Timing::Serial => eye.median_wall_ms,
@@ -530,7 +529,7 @@ fn run_peer_round(
             let ao_path = dir.join(&eye.ao);
             let bytes = std::fs::read(&ao_path).map_err(|e| output(&ao_path, e))?;
             if bytes.len() != width as usize * height as usize * 4 {
-                return Err(Error::Gpu(format!("{} is not {width}x{height} f32 values", ao_path.display())));
+                return Err(Error::gpu(format!("{} is not {width}x{height} f32 values", ao_path.display())));
             }
             let ao: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
             per_eye.push((ms, ao));
@@ -734,12 +733,12 @@ mod tests {
 
     #[test]
     fn an_eye_line_carries_the_projection_vrao_renders_with() {
-        let profile = crate::render::stereo::HeadsetProfile::with_size("vive", 64, 80);
-        let eyes = profile.eyes(&crate::render::stereo::HeadPose::IDENTITY, 0.05);
+        let profile = vrao_render::HeadsetProfile::with_size("vive", 64, 80);
+        let eyes = profile.eyes(&vrao_ao::HeadPose::IDENTITY, 0.05);
         let line = eye_line("left", &eyes.eyes[0], eyes.near);
         let numbers: Vec<f32> = line.split_whitespace().skip(2).map(|s| s.parse().unwrap()).collect();
         assert_eq!(numbers.len(), 32);
-        let projection = reversed_z_projection(&eyes.eyes[0].fov, eyes.near).as_mat4();
+        let projection = vrao_ao::Fov::reversed_z_projection(&eyes.eyes[0].fov, eyes.near).as_mat4();
         assert_eq!(&numbers[16..], &projection.to_cols_array()[..]);
         // Reversed Z with the far plane at infinity: a point at the near plane lands at 1.
         let clip = projection * glam::Vec4::new(0.0, 0.0, -(eyes.near as f32), 1.0);

@@ -20,7 +20,7 @@ use plotters::prelude::*;
 use plotters_backend::text_anchor::{HPos, VPos};
 use plotters_backend::{BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingErrorKind};
 
-use crate::render::error::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Colour of the Pareto-front line.
 pub const PARETO_COLOR: [u8; 3] = [70, 70, 70];
@@ -649,7 +649,7 @@ mod tests {
         assert_eq!(drawn.points.len(), 1);
         assert!(drawn.vertical_line.is_none());
         assert!(ScatterPlot::default().render(400, 300).is_ok());
-        assert!(matches!(nasty.render(100, 100), Err(Error::Input { .. })));
+        assert!(matches!(nasty.render(100, 100), Err(Error::Engine(vrao_ao::Error::Input { .. }))));
     }
 
     #[test]

@@ -1,15 +1,14 @@
 //! How good the compositor's warp is: a frame rendered at one head pose is reprojected to
 //! a moved pose and compared with a frame rendered fresh at that pose, for each mode.
 
-use crate::render::error::Result;
-use crate::render::gpu::readback::read_layers;
-use crate::render::passes::gbuffer::DEPTH;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::renderer::Renderer;
-use crate::render::stereo::HeadPose;
+use crate::error::Result;
 use crate::xr::simulated::reproject::{output_target, ReprojectionMode, Reprojector};
 use glam::{DQuat, DVec3};
 use serde::Serialize;
+use vrao_ao::plug::{read_layers, DEPTH};
+use vrao_ao::HeadPose;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::renderer::Renderer;
 
 /// A head movement between rendering and display.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -94,20 +93,8 @@ pub fn measure(
     // Keep the source frame: the fresh renders below reuse the renderer's targets.
     let extent = renderer.target(COLOR).expect("rendered").extent();
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-    let color = crate::render::gpu::layered_target::LayeredTarget::new(
-        &gpu.device,
-        "source colour",
-        COLOR.format(),
-        extent,
-        usage,
-    );
-    let depth = crate::render::gpu::layered_target::LayeredTarget::new(
-        &gpu.device,
-        "source depth",
-        DEPTH.format(),
-        extent,
-        usage,
-    );
+    let color = vrao_ao::plug::LayeredTarget::new(&gpu.device, "source colour", COLOR.format(), extent, usage);
+    let depth = vrao_ao::plug::LayeredTarget::new(&gpu.device, "source depth", DEPTH.format(), extent, usage);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     for (resource, copy) in [(COLOR, &color), (DEPTH, &depth)] {
         let from = renderer.target(resource).expect("rendered");
@@ -141,7 +128,7 @@ pub fn measure(
             );
             gpu.queue.submit([encoder.finish()]);
             gpu.take_error()?;
-            read_layers(&gpu, &output)
+            Ok(read_layers(&gpu, &output)?)
         };
         let rotational = warped(ReprojectionMode::Rotational)?;
         let depth_based = warped(ReprojectionMode::Depth)?;
@@ -160,12 +147,12 @@ pub fn measure(
 /// at time 0 on a new device, fresh frames one frame period later in a scene that moves;
 /// also returns the adapter's name.
 pub fn study(
-    backend: crate::render::gpu::BackendChoice,
-    scene: &crate::render::scene::Scene,
-    settings: &crate::render::settings::Settings,
+    backend: vrao_render::BackendChoice,
+    scene: &vrao_render::scene::Scene,
+    settings: &vrao_render::settings::Settings,
 ) -> Result<(Vec<ReprojectionError>, String)> {
     settings.validate()?;
-    let gpu = std::sync::Arc::new(crate::render::gpu::Gpu::new(backend)?);
+    let gpu = std::sync::Arc::new(vrao_render::open(backend)?);
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     let late_s = if scene.is_animated() { 1.0 / settings.profile.refresh_hz } else { 0.0 };
     let rows = measure(&mut renderer, &scene.head.pose_at(0.0), &default_movements(), late_s)?;

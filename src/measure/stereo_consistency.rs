@@ -22,10 +22,10 @@
 //! where one eye's screen-space samples leave the image while the other eye still sees the
 //! scene there. *Interior* pixels are farther than [`BORDER_PX`] from every edge.
 
-use crate::render::stereo::{view_position_from_depth, Eye};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use vrao_ao::Eye;
 
 /// AO difference above which a point counts as inconsistent between the eyes.
 pub const AO_TOLERANCE: f32 = 0.02;
@@ -118,7 +118,7 @@ fn direction(eyes: &[Eye; 2], images: &[EyeImages; 2], a: usize, size: (u32, u32
                     continue;
                 }
                 let uv = [(x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64];
-                let v = b_from_a.transform_point3(view_position_from_depth(uv, depth, &ea.fov, near));
+                let v = b_from_a.transform_point3(vrao_ao::Fov::view_position_from_depth(uv, depth, &ea.fov, near));
                 let Some(ao_b) = lookup(image_b, v, [l, r, u, d], size, near) else {
                     continue;
                 };
@@ -176,7 +176,8 @@ pub(crate) fn lookup(image: &EyeImages, v: DVec3, [l, r, u, d]: [f64; 4], size: 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::stereo::{HeadPose, HeadsetProfile};
+    use vrao_ao::HeadPose;
+    use vrao_render::HeadsetProfile;
 
     const NEAR: f64 = 0.05;
     const SIZE: (u32, u32) = (120, 132);

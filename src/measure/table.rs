@@ -7,19 +7,20 @@
 //! eye's AO passes, the AO chain for the left eye alone and for the stereo frame (their
 //! ratio is the right eye's marginal cost), and the stereo frame against the budget.
 
+use crate::error::{Error, Result};
 use crate::measure::bench::Resolution;
 use crate::measure::budget::{self, BudgetReport, BudgetRun, PassTimes, Scope};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::passes::tonemap::COLOR;
-use crate::render::passes::{blur, composite, shadow};
-use crate::render::renderer::{Renderer, TimingChoice};
-use crate::render::scene::Scene;
-use crate::render::settings::{AoSettings, Foveation, Quality, Settings, ShadowSettings, Technique};
-use crate::render::stereo::{EyePair, HeadsetProfile};
 use std::fmt::Write as _;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use vrao_ao::plug::BLUR_PASS;
+use vrao_ao::{AoSettings, EyePair, Foveation, Quality, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::passes::{composite, shadow};
+use vrao_render::renderer::{Renderer, TimingChoice};
+use vrao_render::scene::Scene;
+use vrao_render::settings::{Settings, ShadowSettings};
+use vrao_render::{BackendChoice, HeadsetProfile};
 
 /// How long each scene's first row renders before it is measured (when the run warms up
 /// at all), and at most how many frames that takes. A GPU that idled has clocked down:
@@ -284,7 +285,7 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
             case.settings(&base_settings(scene, options)).validate()?;
         }
     }
-    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let gpu = Arc::new(vrao_render::open(options.backend)?);
     let timing = options.timing.resolve(&gpu);
     let budget_ms = options.budget_ms();
     let how = BudgetRun { timing, warmup: options.warmup, frames: options.frames, budget_ms, output: COLOR };
@@ -459,7 +460,7 @@ impl Table {
             "Timing serial: each pass submitted alone and timed by the wall clock (CPU adapters, whose timestamps misplace work); pipelined: GPU timestamps around each pass of one submission.".to_string(),
             format!(
                 "AO pass, denoise (`{}`), composite and rest are the left eye rendered alone; rest is every other pass of its frame, summed.",
-                blur::NAME
+                BLUR_PASS
             ),
             "AO chain: the passes the frame graph marks as occlusion cost (the technique, temporal, denoise, upsample as they ran) plus, at half resolution, the composite's inline upsampling of the half-resolution AO: the composite's excess over the same case's at full resolution (scope by scope, at least 0), or the whole composite, marked *, where no full-resolution row was measured. By row kind:".to_string(),
         ];
@@ -485,7 +486,7 @@ impl Table {
 /// One row's cells, in [`COLUMNS`] order; a pass that did not run is `-`.
 fn row_cells(row: &TableRow) -> Vec<String> {
     let ms = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-    let shown = [row.pass, blur::NAME, composite::NAME];
+    let shown = [row.pass, BLUR_PASS, composite::NAME];
     let frame = row.stereo_frame();
     let ratio = frame.ms / frame.budget_ms;
     let whole = if row.chain.contains(&composite::NAME) && row.inline_upsampling.is_none() { "*" } else { "" };
@@ -495,7 +496,7 @@ fn row_cells(row: &TableRow) -> Vec<String> {
         row.case.resolution.name().to_string(),
         row.case.foveation.name().to_string(),
         ms(row.left_ms(row.pass)),
-        ms(row.left_ms(blur::NAME)),
+        ms(row.left_ms(BLUR_PASS)),
         ms(row.left_ms(composite::NAME)),
         ms(Some(row.left_rest_ms(&shown))),
         // * : the chain counts the whole composite (no full-resolution row to subtract).

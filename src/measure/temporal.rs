@@ -5,20 +5,18 @@
 pub mod flicker;
 pub mod motion;
 
+use crate::error::{Error, Result};
 use crate::measure::bench::error_figures;
 use crate::measure::reference::{trace_cached, ReferenceImage, ReferenceSettings};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::timing::passes_ms;
-use crate::render::gpu::Gpu;
-use crate::render::graph::FINAL_AO;
-use crate::render::renderer::Renderer;
-use crate::render::scene::Scene;
-use crate::render::settings::Settings;
 use crate::stats;
 use crate::xr::simulated::motion::HeadMotion;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
+use vrao_ao::plug::{FrameTiming, Gpu, FINAL_AO};
+use vrao_render::renderer::Renderer;
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
 
 /// The error after `frame` frames of one configuration.
 #[derive(Clone, Debug, Serialize)]
@@ -62,14 +60,14 @@ pub fn convergence(
         converged_settings.ao.temporal.enabled = false;
         let mut converged = Renderer::new(gpu.clone(), scene, &converged_settings)?;
         let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
-        renderer.set_timing(crate::render::renderer::Timing::Serial);
+        renderer.set_timing(vrao_render::renderer::Timing::Serial);
         let mut times = Vec::new();
         for frame in 1..=*CHECKPOINTS.last().unwrap() {
             let head = motion.pose_at(&scene.head, frame as f64 * dt);
             let eyes = settings.profile.eyes(&head, settings.near);
             let report = renderer.render_and_wait(&eyes.eyes, &[FINAL_AO])?;
-            let ms = passes_ms(&report.wall_ms, &report.plan.occlusion_passes())
-                .map_err(|pass| Error::Gpu(format!("pass '{pass}' ran but no time was measured under its name")))?;
+            let ms = FrameTiming::passes_ms(&report.wall_ms, &report.plan.occlusion_passes())
+                .map_err(|pass| Error::gpu(format!("pass '{pass}' ran but no time was measured under its name")))?;
             times.push(ms / eyes.eyes.len() as f64);
             if !CHECKPOINTS.contains(&frame) {
                 continue;
@@ -105,7 +103,7 @@ pub fn convergence(
 /// without blur, and with 4× the samples) next to temporal accumulation (averaged, with
 /// and without blur, and blended by confidence), all at `base`'s sample count N.
 pub fn configurations(base: &Settings) -> Vec<(String, Settings)> {
-    use crate::render::settings::TemporalBlend;
+    use vrao_ao::TemporalBlend;
     let n = base.ao.samples;
     let blur = base.ao.blur_radius;
     let with = |temporal: bool, blend: TemporalBlend, samples: u32, blur: u32| {
@@ -139,7 +137,7 @@ pub struct TemporalStudy {
 /// static head and with a yaw sweep, against a reference of `rays` rays per pixel at
 /// every 2nd pixel (cached in `cache`).
 pub fn study(
-    backend: crate::render::gpu::BackendChoice,
+    backend: vrao_render::BackendChoice,
     scene: &Scene,
     base: &Settings,
     rays: u32,
@@ -150,7 +148,7 @@ pub fn study(
     for (_, s) in &configurations {
         s.validate()?;
     }
-    let gpu = Arc::new(Gpu::new(backend)?);
+    let gpu = Arc::new(vrao_render::open(backend)?);
     let reference =
         ReferenceSettings { radius: base.ao.radius as f64, rays_per_pixel: rays, stride: 2, near: base.near };
     let mut points = Vec::new();

@@ -10,9 +10,9 @@
 //! Any result is fine, `Ok` or `Err`; a panic, a hang, a NaN or a value beyond the
 //! renderer's bounds in a loaded scene is a bug.
 
-use crate::render::error::Result;
-use crate::render::scene::Scene;
+use crate::error::Result;
 use std::path::Path;
+use vrao_render::scene::Scene;
 
 /// Which loader the bytes feed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,7 +67,7 @@ pub const VALID_GLTF: &str = "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\
 pub fn load_bytes(target: Target, data: &[u8], dir: &Path) -> Result<Scene> {
     let write = |name: &str, bytes: &[u8]| {
         std::fs::write(dir.join(name), bytes)
-            .map_err(|e| crate::render::error::Error::Output { path: dir.join(name), message: e.to_string() })
+            .map_err(|e| crate::error::Error::Output { path: dir.join(name), message: e.to_string() })
     };
     write("fuzz.obj", if target == Target::Obj { data } else { VALID_OBJ.as_bytes() })?;
     write("fuzz.mtl", if target == Target::Mtl { data } else { VALID_MTL.as_bytes() })?;
@@ -90,7 +90,7 @@ fn fuzz_bin() -> Vec<u8> {
     let start = VALID_GLTF.find("base64,").map_or(0, |i| i + 7);
     let end = VALID_GLTF[start..].find('"').map_or(start, |i| start + i);
     #[cfg(feature = "gltf")]
-    return crate::render::scene::gltf::decode_base64(&VALID_GLTF[start..end]).unwrap_or_default();
+    return vrao_render::scene::gltf::decode_base64(&VALID_GLTF[start..end]).unwrap_or_default();
     #[cfg(not(feature = "gltf"))]
     return VALID_GLTF.as_bytes()[start..end].to_vec();
 }
@@ -137,19 +137,19 @@ fn check_finite(scene: &Scene) {
         assert!(mesh.material < scene.materials.len(), "mesh {} material out of range", mesh.name);
         // Finite is not enough: nothing beyond what the renderer can draw (limits.rs).
         if mesh.node.is_none() {
-            assert_eq!(crate::render::scene::limits::mesh_trouble(mesh), None, "mesh {} is out of range", mesh.name);
+            assert_eq!(vrao_render::scene::limits::mesh_trouble(mesh), None, "mesh {} is out of range", mesh.name);
         }
     }
     for m in &scene.materials {
         assert!(m.diffuse.is_finite() && m.emissive.is_finite(), "material {} is not finite", m.name);
         let brightest = m.emissive.max_element() as f64;
-        assert!(brightest <= crate::render::scene::limits::RADIANCE_MAX, "material {} emits {brightest}", m.name);
+        assert!(brightest <= vrao_render::scene::limits::RADIANCE_MAX, "material {} emits {brightest}", m.name);
     }
     for t in [0.0, 0.5, 1e6] {
         assert!(scene.node_transforms(t).iter().all(|m| m.is_finite()), "a node transform is not finite at {t}");
     }
     // Moving meshes and the head stay where static geometry may be; the scene within budget.
-    use crate::render::scene::limits;
+    use vrao_render::scene::limits;
     assert_eq!(limits::motion_trouble(&scene.meshes, &scene.nodes), None, "a moving mesh is out of range");
     assert_eq!(limits::head_trouble(&scene.head), None, "the head is out of range");
     assert_eq!(limits::GeometryBudget::of(&scene.meshes).trouble(), None, "over the triangle budget");

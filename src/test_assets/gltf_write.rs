@@ -18,15 +18,15 @@
 //! Positions are written as f32 (an origin far from zero loses what f32 loses); times as
 //! f32.
 
-use crate::render::error::{Error, Result};
-use crate::render::scene::texture::{uv_transform, uv_transform_parts};
-use crate::render::scene::{
-    AlphaMode, Filter, Interpolation, Light, Material, Mesh, Sampling, Scene, Texture, Track, Wrap,
-};
-use crate::render::stereo::HeadPose;
+use crate::error::{Error, Result};
 use glam::{Affine2, DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use serde_json::{json, Value};
 use std::path::Path;
+use vrao_ao::HeadPose;
+use vrao_render::scene::texture::{uv_transform, uv_transform_parts};
+use vrao_render::scene::{
+    AlphaMode, Filter, Interpolation, Light, Material, Mesh, Sampling, Scene, Texture, Track, Wrap,
+};
 
 /// Where buffers or images go.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -825,8 +825,8 @@ pub fn encode_base64(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::scene::HeadPath;
     use serde_json::Value;
+    use vrao_render::scene::HeadPath;
 
     /// A 2×2 RGBA texture sampled as `sampling`.
     fn texture(sampling: Sampling) -> Texture {
@@ -1013,7 +1013,7 @@ mod tests {
             let bytes: Vec<u8> = (0..n).map(|i| (i * 37 + 11) as u8).collect();
             let text = super::encode_base64(&bytes);
             assert_eq!(text.len() % 4, 0);
-            assert_eq!(crate::render::scene::gltf::decode_base64(&text).unwrap(), bytes, "{text}");
+            assert_eq!(vrao_render::scene::gltf::decode_base64(&text).unwrap(), bytes, "{text}");
         }
         assert_eq!(super::encode_base64(b"hello"), "aGVsbG8=");
     }

@@ -6,11 +6,10 @@ pub mod openxr;
 pub mod profiles;
 pub mod simulated;
 
-use crate::render::error::Result;
-use crate::render::gpu::layered_target::LayeredTarget;
-use crate::render::gpu::Gpu;
-use crate::render::stereo::EyePair;
+use crate::error::Result;
 use serde::Serialize;
+use vrao_ao::plug::{Gpu, LayeredTarget};
+use vrao_ao::EyePair;
 
 /// One frame the headset asks the application to render.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -228,7 +227,7 @@ pub trait Headset {
     /// none. An OpenXR runtime's may change during the session
     /// (`XrEventDataVisibilityMaskChangedKHR`): the frame loop asks every frame and hands a
     /// changed one to the renderer.
-    fn visibility_mask(&self) -> Option<&crate::render::visibility::VisibilityMask> {
+    fn visibility_mask(&self) -> Option<&vrao_ao::VisibilityMask> {
         None
     }
     /// Ends the session cleanly.

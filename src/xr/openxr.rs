@@ -14,8 +14,8 @@
 //! allow more): [`probe_runtime`] and [`OpenXrHeadset::open`] share one slot.
 
 use super::simulated::SimulatedOptions;
-use crate::render::stereo::HeadPose;
 use glam::{DQuat, DVec3};
+use vrao_ao::HeadPose;
 
 pub mod mask;
 #[cfg(feature = "xr")]
@@ -71,10 +71,10 @@ impl From<RuntimeFailure> for Unavailable {
     }
 }
 
-impl From<RuntimeFailure> for crate::render::error::Error {
+impl From<RuntimeFailure> for crate::error::Error {
     /// The runtime's device could not be used: `Error::Device`.
-    fn from(failure: RuntimeFailure) -> crate::render::error::Error {
-        crate::render::error::Error::Device(failure.0)
+    fn from(failure: RuntimeFailure) -> crate::error::Error {
+        crate::error::Error::device(failure.0)
     }
 }
 
@@ -382,8 +382,7 @@ pub fn runtime_trouble(manifest: Option<&std::path::Path>, active: &[std::path::
         },
     };
     let shown = manifest.display();
-    let text = match crate::render::files::read_regular_file_to_string(&manifest, crate::render::files::MAX_TEXT_BYTES)
-    {
+    let text = match vrao_render::files::read_regular_file_to_string(&manifest, vrao_render::files::MAX_TEXT_BYTES) {
         Ok(text) => text,
         Err(e) => return format!("{named_by} manifest {shown} cannot be read: {}", e.problem),
     };
@@ -425,7 +424,7 @@ pub fn probe_runtime() -> Result<String, Unavailable> {
 }
 
 /// A headset, the GPU to render for it, and one line saying what was opened.
-pub type OpenedHeadset = (Box<dyn super::Headset>, std::sync::Arc<crate::render::gpu::Gpu>, String);
+pub type OpenedHeadset = (Box<dyn super::Headset>, std::sync::Arc<vrao_ao::plug::Gpu>, String);
 
 /// Opens the OpenXR headset and the GPU its session runs on, for `vrao run`.
 #[cfg(feature = "xr")]

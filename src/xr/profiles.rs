@@ -6,9 +6,10 @@
 //! an app gets from the runtime (OpenVR's GetProjectionRaw, OpenXR's xrLocateViews). The right
 //! eye is the left eye mirrored: each dump's right eye matches that to within 0.3°.
 
-use crate::render::error::{Error, Result};
-use crate::render::stereo::{Fov, HeadsetProfile, DEFAULT_IPD};
-use crate::render::visibility::{ViewMask, VisibilityMask};
+use crate::error::{Error, Result};
+use vrao_ao::{Fov, ViewMask, VisibilityMask};
+use vrao_render::headset::DEFAULT_IPD;
+use vrao_render::HeadsetProfile;
 
 /// The names [`by_name`] knows, as the CLI spells them.
 pub const PROFILE_NAMES: [&str; 6] = ["vive", "vive-pro-2", "index", "quest-2", "quest-3", "pico-4"];
@@ -292,7 +293,7 @@ mod tests {
     #[test]
     fn unknown_name_is_one_line_naming_it_and_every_known_name() {
         let err = by_name("rift-cv1").unwrap_err();
-        assert_eq!(err.exit_code(), crate::render::error::EXIT_INPUT);
+        assert_eq!(err.exit_code(), crate::error::EXIT_INPUT);
         let err = err.to_string();
         assert!(!err.contains('\n'), "{err}");
         assert!(err.contains("'rift-cv1'"), "{err}");

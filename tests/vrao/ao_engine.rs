@@ -8,17 +8,15 @@ mod host;
 
 use glam::DVec3;
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
-use vrao::ao::{
+use vrao_ao::plug::{read_layers_f32, LayeredTarget, FINAL_AO};
+use vrao_ao::Error;
+use vrao_ao::{
     AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostMotion, HostNormals, NormalEncoding, NormalSpace,
     ViewMatrices,
 };
-use vrao::render::gpu::layered_target::LayeredTarget;
-use vrao::render::gpu::readback::read_layers_f32;
-use vrao::render::graph::FINAL_AO;
-use vrao::render::scene::Mesh;
-use vrao::render::settings::{AoSettings, Technique};
-use vrao::render::stereo::{Eye, EyeSide, Fov, HeadPose};
-use vrao::{Error, HeadsetProfile, Renderer, Settings};
+use vrao_ao::{AoSettings, Eye, EyeSide, Fov, HeadPose, Technique};
+use vrao_render::scene::Mesh;
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 108;
@@ -55,7 +53,7 @@ fn host_views(eyes: &[Eye], depth: HostDepth) -> Vec<ViewMatrices> {
 }
 
 /// The same geometry as a vrao scene, for the renderer.
-fn scene() -> vrao::Scene {
+fn scene() -> vrao_render::Scene {
     let meshes = demo_geometry()
         .into_iter()
         .enumerate()
@@ -85,14 +83,14 @@ fn settings(ao: &AoSettings) -> Settings {
 }
 
 /// Each eye's final AO from vrao's renderer.
-fn renderer_ao(gpu: &std::sync::Arc<vrao::Gpu>, ao: &AoSettings) -> Vec<Vec<f32>> {
+fn renderer_ao(gpu: &std::sync::Arc<vrao_ao::plug::Gpu>, ao: &AoSettings) -> Vec<Vec<f32>> {
     let mut renderer = Renderer::new(gpu.clone(), &scene(), &settings(ao)).unwrap();
     renderer.render_and_wait(&eyes(), &[FINAL_AO]).unwrap();
     renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect()
 }
 
 /// Each eye's AO from the engine over the host's depth prepass.
-fn engine_ao(gpu: &vrao::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: bool) -> Vec<Vec<f32>> {
+fn engine_ao(gpu: &vrao_ao::plug::Gpu, ao: &AoSettings, depth: HostDepth, with_normals: bool) -> Vec<Vec<f32>> {
     let (device, queue) = (&gpu.device, &gpu.queue);
     let prepass = DepthPrepass::new(device, &demo_geometry(), depth, (WIDTH, HEIGHT));
     let views = host_views(&eyes(), depth);
@@ -161,7 +159,7 @@ fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
         for half_res in [false, true] {
             let ao = AoSettings {
                 technique,
-                resolution: vrao::render::settings::Resolution::from_half_res(half_res),
+                resolution: vrao_ao::Resolution::from_half_res(half_res),
                 ..AoSettings::default()
             };
             let error = rmse(&engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true), &renderer_ao(&gpu, &ao));
@@ -295,8 +293,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
             queue.submit([encoder.finish()]);
         }
         let plan = engine.last_plan().unwrap();
-        let reads_host_motion =
-            plan.resolve(vrao::render::graph::PIXEL_MOTION).map(|r| r.name()) == Some("host-motion");
+        let reads_host_motion = plan.resolve(vrao_ao::plug::PIXEL_MOTION).map(|r| r.name()) == Some("host-motion");
         let texture = texture.unwrap();
         ((0..2).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect::<Vec<_>>(), reads_host_motion)
     };
@@ -329,7 +326,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
 /// One frame of the host's reversed-Z prepass and the engine after it, submitted; the
 /// engine's output texture.
 fn reversed_z_frame(
-    gpu: &vrao::Gpu,
+    gpu: &vrao_ao::plug::Gpu,
     engine: &mut AoEngine,
     prepass: &DepthPrepass,
     views: &[ViewMatrices],
@@ -368,8 +365,8 @@ fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_
     let small = frame_at(&mut engine, (WIDTH, HEIGHT));
     let built = engine.pipelines_built();
     // Every technique's chain built up front, as the renderer does.
-    let eager = vrao::Gpu::from_host(device, queue).unwrap();
-    let _chain = vrao::render::passes::ao_chain(&eager, Vec::new());
+    let eager = vrao_ao::plug::Gpu::from_host(device, queue).unwrap();
+    let _chain = vrao_ao::plug::ao_chain(&eager, Vec::new());
     assert!(
         built > 0 && built < eager.pipelines_built(),
         "{built} compiled for GTAO, {} for every technique",
@@ -396,13 +393,13 @@ fn the_engine_builds_its_technique_s_pipelines_at_its_first_frame_and_none_at_a_
 fn each_gpu_keeps_its_own_shader_directory_and_shader_errors() {
     let (gpu, _lock) = common::gpu();
     let missing = std::env::temp_dir().join("vrao-no-such-shader-dir");
-    let mut broken = vrao::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
+    let mut broken = vrao_ao::plug::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
     broken.set_shader_dir(Some(missing.clone()));
-    let healthy = vrao::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
+    let healthy = vrao_ao::plug::Gpu::from_host(&gpu.device, &gpu.queue).unwrap();
     // Two chains made at once on two threads, one reading shaders from a missing folder.
     std::thread::scope(|s| {
-        s.spawn(|| drop(vrao::render::passes::ao_chain(&broken, Vec::new())));
-        s.spawn(|| drop(vrao::render::passes::ao_chain(&healthy, Vec::new())));
+        s.spawn(|| drop(vrao_ao::plug::ao_chain(&broken, Vec::new())));
+        s.spawn(|| drop(vrao_ao::plug::ao_chain(&healthy, Vec::new())));
     });
     assert!(healthy.take_shader_error().is_ok(), "the other Gpu's error leaked");
     let error = broken.take_shader_error().unwrap_err().to_string();
@@ -412,7 +409,7 @@ fn each_gpu_keeps_its_own_shader_directory_and_shader_errors() {
 
 #[test]
 fn the_single_channel_outputs_hold_the_visibility_the_default_output_holds() {
-    use vrao::ao::AoOutputFormat;
+    use vrao_ao::AoOutputFormat;
     let (gpu, _lock) = common::gpu();
     let (device, queue) = (&gpu.device, &gpu.queue);
     let depth = HostDepth::ReversedInfinite;
@@ -534,7 +531,12 @@ fn near_silhouettes(depth: &[f32]) -> Vec<bool> {
 
 /// The engine's output (default settings) for one mono view over the host's prepass drawn
 /// with `samples` samples, and the prepass (for its depth).
-fn mono_engine_output(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: bool) -> (wgpu::Texture, DepthPrepass) {
+fn mono_engine_output(
+    gpu: &vrao_ao::plug::Gpu,
+    eye: Eye,
+    samples: u32,
+    with_normals: bool,
+) -> (wgpu::Texture, DepthPrepass) {
     let (device, queue) = (&gpu.device, &gpu.queue);
     let geometry = demo_geometry();
     let prepass =
@@ -559,7 +561,12 @@ fn mono_engine_output(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: boo
 }
 
 /// The AO of [`mono_engine_output`], one value a pixel.
-fn mono_ao_with_samples(gpu: &vrao::Gpu, eye: Eye, samples: u32, with_normals: bool) -> (Vec<f32>, DepthPrepass) {
+fn mono_ao_with_samples(
+    gpu: &vrao_ao::plug::Gpu,
+    eye: Eye,
+    samples: u32,
+    with_normals: bool,
+) -> (Vec<f32>, DepthPrepass) {
     let (texture, prepass) = mono_engine_output(gpu, eye, samples, with_normals);
     (host::read_alpha(&gpu.device, &gpu.queue, &texture, 0), prepass)
 }

@@ -6,7 +6,8 @@ use crate::common;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use vrao::{Error, HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::Error;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 #[test]
 fn a_set_token_interrupts_the_renderer_build_and_a_clear_one_does_not() {
@@ -17,8 +18,8 @@ fn a_set_token_interrupts_the_renderer_build_and_a_clear_one_does_not() {
     gpu.cancel_builds_on(interrupt.clone());
     let mut renderer = Renderer::new(gpu.clone(), &scene, &settings).expect("a clear token builds as usual");
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
-    renderer.render_and_wait(&eyes.eyes, &[vrao::render::graph::FINAL_AO]).unwrap();
-    let ao = renderer.read_f32(vrao::render::graph::FINAL_AO).unwrap();
+    renderer.render_and_wait(&eyes.eyes, &[vrao_ao::plug::FINAL_AO]).unwrap();
+    let ao = renderer.read_f32(vrao_ao::plug::FINAL_AO).unwrap();
     assert!(
         ao[0].chunks(4).any(|texel| texel[3] > 0.0 && texel[3] < 1.0),
         "the renderer built with a clear token draws AO"
@@ -30,5 +31,5 @@ fn a_set_token_interrupts_the_renderer_build_and_a_clear_one_does_not() {
         Err(other) => panic!("expected Error::Interrupted, got {other}"),
         Ok(_) => panic!("a set token must interrupt the build"),
     }
-    assert_eq!(Error::Interrupted.exit_code(), 130);
+    assert_eq!(vrao::Error::from(Error::Interrupted).exit_code(), 130);
 }

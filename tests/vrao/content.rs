@@ -6,12 +6,11 @@ use crate::common;
 
 use glam::DVec3;
 use vrao::measure::reference::{trace, world_position, ReferenceSettings};
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::gbuffer::{DEPTH, MOTION, NORMALS};
-use vrao::render::scene::content::{grille_solid_at, BALL_RADIUS, GRILLE_HEIGHT};
-use vrao::render::scene::HeadPath;
-use vrao::render::stereo::HeadPose;
-use vrao::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::plug::{DEPTH, FINAL_AO, MOTION, NORMALS};
+use vrao_ao::HeadPose;
+use vrao_render::scene::content::{grille_solid_at, BALL_RADIUS, GRILLE_HEIGHT};
+use vrao_render::scene::HeadPath;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 fn settings(scene: &Scene, width: u32, height: u32) -> Settings {
     let mut settings = Settings { profile: HeadsetProfile::with_size("test", width, height), ..Settings::default() };
@@ -22,7 +21,7 @@ fn settings(scene: &Scene, width: u32, height: u32) -> Settings {
 /// The grille as an OBJ: floor and plate quads, the plate's MTL material alpha-tested by
 /// a `map_d` greyscale checker (255 solid, 0 hole) laid out as `builtin:grille`'s mask.
 fn grille_obj(dir: &std::path::Path) -> std::path::PathBuf {
-    use vrao::render::scene::content::{GRILLE_CELLS, GRILLE_HALF_SIZE, GRILLE_HEIGHT};
+    use vrao_render::scene::content::{GRILLE_CELLS, GRILLE_HALF_SIZE, GRILLE_HEIGHT};
     let side = GRILLE_CELLS * 8;
     let mask =
         image::GrayImage::from_fn(side, side, |x, y| image::Luma([if (x / 8 + y / 8) % 2 == 0 { 255 } else { 0 }]));
@@ -198,7 +197,7 @@ fn motion_vectors_follow_the_ball_and_the_eyes() {
     let (t0, t1) = (0.8, 0.8 + 1.0 / 90.0);
     let head0 = scene.head.pose_at(0.0);
     // The head moves too: 2 cm sideways between the frames.
-    let head1 = vrao::HeadPose { position: head0.position + DVec3::new(0.02, 0.0, 0.0), ..head0 };
+    let head1 = vrao_ao::HeadPose { position: head0.position + DVec3::new(0.02, 0.0, 0.0), ..head0 };
     let eyes0 = settings.profile.eyes(&head0, settings.near);
     let eyes1 = settings.profile.eyes(&head1, settings.near);
     let mut renderer = Renderer::new(gpu, &scene, &settings).unwrap();
@@ -263,6 +262,6 @@ fn a_still_opaque_scene_adds_no_motion_or_alpha_work() {
     let gbuffer = plan.decls.iter().find(|d| d.name == "gbuffer").unwrap();
     assert!(gbuffer.writes.contains(&MOTION));
     let temporal = plan.decls.iter().find(|d| d.name == "temporal").unwrap();
-    assert!(!temporal.unbound.contains(&vrao::render::graph::PIXEL_MOTION));
-    assert_eq!(plan.resolve(vrao::render::graph::PIXEL_MOTION), Some(MOTION));
+    assert!(!temporal.unbound.contains(&vrao_ao::plug::PIXEL_MOTION));
+    assert_eq!(plan.resolve(vrao_ao::plug::PIXEL_MOTION), Some(MOTION));
 }

@@ -9,12 +9,11 @@ use crate::common;
 use glam::{DVec3, Vec3};
 use vrao::measure::bench::error_figures;
 use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::peel::DEPTH_LAYER_2;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::settings::{AoSettings, Technique};
-use vrao::{HeadsetProfile, Renderer, Resource, Scene, Settings};
+use vrao_ao::plug::{Resource, DEPTH, FINAL_AO};
+use vrao_ao::{AoSettings, Technique};
+use vrao_render::passes::peel::DEPTH_LAYER_2;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 144);
 const RADIUS: f32 = 0.5;
@@ -190,8 +189,7 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
         let s = settings(AoSettings { technique, depth_peeling, ..AoSettings::default() });
         Renderer::new(gpu.clone(), &scene, &s).unwrap().plan(2, outputs).unwrap()
     };
-    let reason =
-        |p: &vrao::render::graph::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
+    let reason = |p: &vrao_ao::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
     for technique in [Technique::SsdoPoints, Technique::SsdoPointsBounce] {
         let on = plan(technique, true, &[COLOR]);
         assert!(on.runs("depth-peel"), "{on}");
@@ -221,10 +219,8 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
 fn peeling_at_half_resolution_with_the_bounce_stays_finite() {
     let scene = Scene::load("builtin:room").unwrap();
     for technique in [Technique::SsdoPoints, Technique::SsdoPointsBounce] {
-        let s = settings(AoSettings {
-            resolution: vrao::render::settings::Resolution::Half,
-            ..AoSettings { technique, ..ssdo(true) }
-        });
+        let s =
+            settings(AoSettings { resolution: vrao_ao::Resolution::Half, ..AoSettings { technique, ..ssdo(true) } });
         render(&scene, &s);
     }
 }

@@ -8,12 +8,10 @@
 
 use crate::common;
 
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Foveation, Technique};
-use vrao::render::stereo::{Fov, HeadsetProfile};
-use vrao::{Renderer, Resource, Settings};
+use vrao_ao::plug::{Resource, AO_RAW, DEPTH};
+use vrao_ao::{AoSettings, Fov, Foveation, Technique};
+use vrao_render::scene::Scene;
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 const TECHNIQUES: [Technique; 5] =
     [Technique::Gtao, Technique::Hbao, Technique::Ssao, Technique::Ssdo, Technique::SsdoPoints];

@@ -42,7 +42,7 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
             seeds.push(VALID_GLTF_FILES.as_bytes().to_vec());
             // The same content as a .glb container, as vrao's writer makes it.
             let glb = scratch("glb-seed").join("seed.glb");
-            let scene = vrao::render::scene::Scene::load("builtin:furnished").unwrap();
+            let scene = vrao_render::scene::Scene::load("builtin:furnished").unwrap();
             vrao::test_assets::gltf_write::write(&scene, &glb, &Default::default()).unwrap();
             seeds.push(std::fs::read(glb).unwrap());
         }

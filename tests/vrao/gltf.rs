@@ -8,11 +8,11 @@ use crate::common;
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use vrao::render::scene::{
+use vrao::test_assets::gltf_write::{encode_base64, write, IndexType, Storage, TexcoordType, WriteOptions};
+use vrao_ao::HeadPose;
+use vrao_render::scene::{
     AlphaMode, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene, Texture, Track, Trs,
 };
-use vrao::test_assets::gltf_write::{encode_base64, write, IndexType, Storage, TexcoordType, WriteOptions};
-use vrao::HeadPose;
 
 /// A 4×4 checker whose dark cells are transparent.
 fn checker() -> Texture {
@@ -622,10 +622,8 @@ fn mesh_quantization_positions_decode() {
 
 #[test]
 fn sibenik_as_glb_gives_the_objs_g_buffer() {
-    use vrao::render::graph::FINAL_AO;
-    use vrao::render::passes::gbuffer::{DEPTH, NORMALS};
-    use vrao::render::stereo::HeadsetProfile;
-    use vrao::{Renderer, Settings};
+    use vrao_ao::plug::{DEPTH, FINAL_AO, NORMALS};
+    use vrao_render::{HeadsetProfile, Renderer, Settings};
     let Some(obj) = common::public_scene("sibenik/sibenik.obj") else { return };
     let dir = common::temp_dir("gltf-sibenik");
     let from_obj = Scene::load(obj.to_str().unwrap()).unwrap();
@@ -696,7 +694,7 @@ fn obj_map_d_and_d_become_alpha() {
     // OBJ textures tile on both axes (V was clamped).
     assert_eq!(
         (t.sampling.wrap_u, t.sampling.wrap_v),
-        (vrao::render::scene::Wrap::Repeat, vrao::render::scene::Wrap::Repeat)
+        (vrao_render::scene::Wrap::Repeat, vrao_render::scene::Wrap::Repeat)
     );
     let bare = material(&scene, "bare").diffuse_texture.as_ref().unwrap();
     assert_eq!((bare.width, bare.height, &bare.rgba8[..8]), (2, 2, &[255, 255, 255, 0, 255, 255, 255, 255][..]));
@@ -783,9 +781,8 @@ animation = { interpolation = "linear", keys = [
 
 #[test]
 fn a_spot_light_lights_its_cone_with_gltfs_falloff_on_the_gpu() {
-    use vrao::render::passes::composite::HDR;
-    use vrao::render::stereo::HeadsetProfile;
-    use vrao::{Renderer, Settings};
+    use vrao_render::passes::composite::HDR;
+    use vrao_render::{HeadsetProfile, Renderer, Settings};
     let (intensity, inner, outer) = (8.0f32, 0.1f32, 0.7f32);
     let mut floor = common::square("floor", DVec3::ZERO, 8.0, 0);
     // Turn the square (facing +Z) to face up.
@@ -815,7 +812,7 @@ fn a_spot_light_lights_its_cone_with_gltfs_falloff_on_the_gpu() {
     };
     // albedo/π × I × falloff × cos / d² at a floor point `angle` off the spot's axis.
     let expected = |angle: f32| {
-        let (cos_outer, scale) = vrao::render::scene::spot_ramp(inner, outer);
+        let (cos_outer, scale) = vrao_render::scene::spot_ramp(inner, outer);
         let ramp = ((angle.cos() - cos_outer) * scale).clamp(0.0, 1.0);
         let d = 2.0 / angle.cos();
         0.5 / std::f32::consts::PI * intensity * ramp * ramp * angle.cos() / (d * d)
@@ -827,7 +824,7 @@ fn a_spot_light_lights_its_cone_with_gltfs_falloff_on_the_gpu() {
     }
     assert_eq!(radiance_at(DVec3::new(2.0 * 0.8f64.tan(), 0.0, 0.0)), 0.0, "outside the outer cone");
     assert!(
-        (vrao::render::scene::spot_falloff(0.3f32.cos(), inner, outer) - {
+        (vrao_render::scene::spot_falloff(0.3f32.cos(), inner, outer) - {
             let r: f32 = (0.3f32.cos() - outer.cos()) / (inner.cos() - outer.cos());
             r * r
         })

@@ -8,9 +8,9 @@ use serde_json::{json, Value};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use vrao::render::scene::Scene;
 use vrao::test_assets::fuzz::{load_bytes, Mutator, Target};
 use vrao::test_assets::gltf_write::encode_base64;
+use vrao_render::scene::Scene;
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("vrao-test-{}-accessors-{name}", std::process::id()));
@@ -184,8 +184,8 @@ fn write_file(dir: &Path, name: &str, text: impl AsRef<[u8]>) -> PathBuf {
     path
 }
 
-fn load(dir: &Path, name: &str, text: &str) -> vrao::Result<Scene> {
-    vrao::render::scene::gltf::load(&write_file(dir, name, text))
+fn load(dir: &Path, name: &str, text: &str) -> vrao_ao::Result<Scene> {
+    vrao_render::scene::gltf::load(&write_file(dir, name, text))
 }
 
 /// The error of a load that must fail: one line naming the file.

@@ -6,16 +6,17 @@
 use crate::common;
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
-use vrao::render::passes::gbuffer::{ALBEDO, DEPTH, EMISSION, NORMALS, SHADING_NORMALS};
-use vrao::render::scene::{uv_transform, AlphaMode, Filter, Sampling, Scene, Texture, Wrap};
-use vrao::render::stereo::HeadsetProfile;
-use vrao::{HeadPose, Renderer, Settings};
+use vrao_ao::plug::{DEPTH, NORMALS};
+use vrao_ao::HeadPose;
+use vrao_render::passes::gbuffer::{ALBEDO, EMISSION, SHADING_NORMALS};
+use vrao_render::scene::{uv_transform, AlphaMode, Filter, Sampling, Scene, Texture, Wrap};
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 const SIZE: (u32, u32) = (96, 108);
 
 /// A 4 m square in z = 0 from (0, 0) to (4, 4), facing +z, its texture coordinates
 /// u = x and v = 4 − y (v = 0 at the top, as glTF's are).
-fn quad() -> vrao::render::scene::Mesh {
+fn quad() -> vrao_render::scene::Mesh {
     let mut mesh = common::square("quad", DVec3::new(2.0, 2.0, 0.0), 4.0, 0);
     mesh.uvs = mesh.positions.iter().map(|p| Vec2::new(p.x + 2.0, 2.0 - p.y)).collect();
     mesh
@@ -52,13 +53,13 @@ fn texel_at(texture: &Texture, uv: Vec2) -> [u8; 3] {
 /// Renders `scene` seen from 2.2 m in front of the quad's centre and reads `resources`
 /// back; with a lookup of the left eye's pixel (4 floats per texel) at a world point.
 struct Frame {
-    eyes: vrao::EyePair,
+    eyes: vrao_ao::EyePair,
     near: f64,
     images: Vec<Vec<f32>>,
 }
 
 impl Frame {
-    fn render(scene: &Scene, resources: &[vrao::Resource]) -> Frame {
+    fn render(scene: &Scene, resources: &[vrao_ao::plug::Resource]) -> Frame {
         let (gpu, _guard) = common::gpu();
         let settings = Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ..Settings::default() };
         let head = HeadPose::look_at(DVec3::new(2.0, 2.0, 2.2), DVec3::new(2.0, 2.0, 0.0)).unwrap();
@@ -81,7 +82,7 @@ impl Frame {
     }
 }
 
-fn scene_of(mesh: vrao::render::scene::Mesh, material: vrao::render::scene::Material) -> Scene {
+fn scene_of(mesh: vrao_render::scene::Mesh, material: vrao_render::scene::Material) -> Scene {
     let mut scene = common::bare_scene(vec![mesh]);
     scene.materials = vec![material];
     scene
@@ -110,7 +111,7 @@ fn each_wrap_mode_on_each_axis_addresses_texels_as_gltf_says() {
         (Wrap::ClampToEdge, Wrap::Repeat),
     ];
     for (wrap_u, wrap_v) in combinations {
-        let mut material = vrao::render::scene::Material::plain("tiled", Vec3::ONE);
+        let mut material = vrao_render::scene::Material::plain("tiled", Vec3::ONE);
         material.diffuse_texture = Some(four_texels(wrap_u, wrap_v));
         let texture = material.diffuse_texture.clone().unwrap();
         let frame = Frame::render(&scene_of(quad(), material), &[ALBEDO]);
@@ -126,7 +127,7 @@ fn each_wrap_mode_on_each_axis_addresses_texels_as_gltf_says() {
 fn texture_transform_moves_where_the_texture_is_read() {
     let mut texture = four_texels(Wrap::Repeat, Wrap::Repeat);
     texture.sampling.transform = uv_transform(Vec2::new(0.25, 0.5), 0.3, Vec2::new(1.5, 0.75));
-    let mut material = vrao::render::scene::Material::plain("placed", Vec3::ONE);
+    let mut material = vrao_render::scene::Material::plain("placed", Vec3::ONE);
     material.diffuse_texture = Some(texture.clone());
     let frame = Frame::render(&scene_of(quad(), material), &[ALBEDO]);
     let mut checked = 0;
@@ -152,7 +153,7 @@ fn vertex_colours_multiply_the_base_colour_and_their_alpha_cuts_holes() {
         .iter()
         .map(|p| if p.x < 0.0 { Vec4::new(0.2, 0.5, 1.0, 0.0) } else { Vec4::new(1.0, 0.5, 1.0, 1.0) })
         .collect();
-    let mut material = vrao::render::scene::Material::plain("coloured", Vec3::new(1.0, 0.8, 0.5));
+    let mut material = vrao_render::scene::Material::plain("coloured", Vec3::new(1.0, 0.8, 0.5));
     material.alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
     let scene = scene_of(mesh, material);
     assert!(scene.has_alpha_test(), "the vertex alpha can fail the test");
@@ -187,7 +188,7 @@ fn vertex_colours_multiply_the_base_colour_and_their_alpha_cuts_holes() {
 
 #[test]
 fn emissive_texture_limits_the_emission_and_occlusion_texture_reaches_the_albedo_alpha() {
-    let mut material = vrao::render::scene::Material::plain("lamp", Vec3::splat(0.5));
+    let mut material = vrao_render::scene::Material::plain("lamp", Vec3::splat(0.5));
     material.emissive = Vec3::new(4.0, 2.0, 1.0);
     // Emissive: left half black, right half white (sRGB 255 = 1); occlusion: red 51 (0.2)
     // on the left, 255 on the right, at strength 0.5.
@@ -240,7 +241,7 @@ fn normal_textures_tilt_the_lighting_normal_with_mesh_tangents_or_without_them_a
     for (label, mesh, scale) in
         [("derived frame", quad(), 1.0), ("mesh tangents", with_tangents, 1.0), ("scale 0", quad(), 0.0)]
     {
-        let mut material = vrao::render::scene::Material::plain("bumpy", Vec3::splat(0.5));
+        let mut material = vrao_render::scene::Material::plain("bumpy", Vec3::splat(0.5));
         material.normal_texture = Some((tilt.clone(), scale));
         let frame = Frame::render(&scene_of(mesh, material), &[SHADING_NORMALS, NORMALS]);
         // The normal in view space: the eye looks down −z with +x to its right (it is
@@ -262,12 +263,12 @@ fn normal_textures_tilt_the_lighting_normal_with_mesh_tangents_or_without_them_a
 
 #[test]
 fn the_ambient_light_takes_the_smaller_of_the_baked_and_the_screen_space_occlusion() {
-    use vrao::render::graph::FINAL_AO;
-    use vrao::render::passes::composite::HDR;
+    use vrao_ao::plug::FINAL_AO;
+    use vrao_render::passes::composite::HDR;
     // A floor under the sky alone (no lights): its radiance is albedo/π × the sky's
     // irradiance × the occlusion the composite applies.
     let lit = |baked: Option<f32>| {
-        let mut material = vrao::render::scene::Material::plain("floor", Vec3::splat(0.5));
+        let mut material = vrao_render::scene::Material::plain("floor", Vec3::splat(0.5));
         material.occlusion_texture = baked.map(|b| {
             let r = (b * 255.0).round() as u8;
             (
@@ -276,7 +277,7 @@ fn the_ambient_light_takes_the_smaller_of_the_baked_and_the_screen_space_occlusi
             )
         });
         let mut scene = scene_of(quad(), material);
-        scene.environment = Some(vrao::render::scene::Environment::default_sky());
+        scene.environment = Some(vrao_render::scene::Environment::default_sky());
         Frame::render(&scene, &[HDR, FINAL_AO])
     };
     let plain = lit(None);

@@ -9,11 +9,12 @@
 use glam::{DVec3, Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 use vrao::measure::reference::{trace, world_position, ReferenceImage, ReferencePixel, ReferenceSettings};
-use vrao::render::scene::texture::uv_transform;
-use vrao::render::scene::{AlphaMode, Filter, HeadPath, Light, Material, Mesh, Sampling, Texture, Wrap};
-use vrao::render::stereo::DEFAULT_NEAR;
 use vrao::test_assets::gltf_write::{write, WriteOptions};
-use vrao::{Eye, HeadPose, HeadsetProfile, Scene};
+use vrao_ao::plug::DEFAULT_NEAR;
+use vrao_ao::{Eye, HeadPose};
+use vrao_render::scene::texture::uv_transform;
+use vrao_render::scene::{AlphaMode, Filter, HeadPath, Light, Material, Mesh, Sampling, Texture, Wrap};
+use vrao_render::{HeadsetProfile, Scene};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("vrao-gltf-materials-{name}-{}", std::process::id()));

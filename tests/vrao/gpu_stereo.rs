@@ -3,11 +3,12 @@
 use crate::common;
 
 use glam::DVec3;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::gbuffer::{ALBEDO, DEPTH, NORMALS};
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::stereo::{view_position_from_depth, HeadsetProfile};
-use vrao::{HeadPose, Renderer, Scene, Settings, StereoMode};
+use vrao_ao::plug::{DEPTH, NORMALS};
+use vrao_ao::HeadPose;
+use vrao_render::passes::composite::HDR;
+use vrao_render::passes::gbuffer::ALBEDO;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings, StereoMode};
 
 fn settings(width: u32, height: u32, stereo: StereoMode) -> Settings {
     Settings { profile: HeadsetProfile::with_size("test", width, height), stereo, ..Settings::default() }
@@ -89,7 +90,7 @@ fn depth_reconstructs_view_position_from_5cm_to_10km() {
                     let d = depth[layer][(y * w + x) as usize] as f64;
                     assert!(d > 0.0, "wall at {distance} m missing at ({x}, {y})");
                     let uv = [(x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64];
-                    let p = view_position_from_depth(uv, d, &eye.fov, s.near);
+                    let p = vrao_ao::Fov::view_position_from_depth(uv, d, &eye.fov, s.near);
                     // The exact hit of this pixel's ray with the wall plane.
                     let [l, r, u, dn] = eye.fov.tangents();
                     let exact = DVec3::new(l + (r - l) * uv[0], u + (dn - u) * uv[1], -1.0) * eye_to_wall;
@@ -101,7 +102,7 @@ fn depth_reconstructs_view_position_from_5cm_to_10km() {
     }
 }
 
-fn render_all(gpu: &std::sync::Arc<vrao::Gpu>, scene: &Scene, stereo: StereoMode) -> Vec<Vec<Vec<u8>>> {
+fn render_all(gpu: &std::sync::Arc<vrao_ao::plug::Gpu>, scene: &Scene, stereo: StereoMode) -> Vec<Vec<Vec<u8>>> {
     let s = settings(128, 144, stereo);
     let mut renderer = Renderer::new(gpu.clone(), scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
@@ -127,7 +128,7 @@ fn differing_bytes(a: &[Vec<Vec<u8>>], b: &[Vec<Vec<u8>>]) -> Vec<(&'static str,
 /// by a sun and a point light: no triangle needs clipping.
 fn unclipped_scene() -> Scene {
     let mut scene = common::bare_scene(Vec::new());
-    scene.materials.push(vrao::render::scene::Material::plain("red", glam::Vec3::new(0.8, 0.1, 0.1)));
+    scene.materials.push(vrao_render::scene::Material::plain("red", glam::Vec3::new(0.8, 0.1, 0.1)));
     for (i, (x, y, z)) in
         [(-0.5, 0.3, -2.0), (0.4, -0.2, -3.0), (0.0, 0.0, -5.0), (-0.3, -0.5, -1.5)].iter().enumerate()
     {
@@ -142,12 +143,12 @@ fn unclipped_scene() -> Scene {
         scene.meshes.push(square);
     }
     scene.lights = vec![
-        vrao::render::scene::Light::Directional {
+        vrao_render::scene::Light::Directional {
             direction: glam::Vec3::new(0.3, -1.0, -0.5).normalize(),
             color: glam::Vec3::ONE,
             intensity: 2.0,
         },
-        vrao::render::scene::Light::Point {
+        vrao_render::scene::Light::Point {
             position: DVec3::new(0.5, 1.0, -1.0),
             color: glam::Vec3::ONE,
             intensity: 3.0,
@@ -201,8 +202,8 @@ fn the_graph_runs_only_what_the_requested_outputs_need() {
     let scene = Scene::load("builtin:room").unwrap();
     let mut s = settings(64, 72, StereoMode::Auto);
     // GTAO at full resolution, denoised, without temporal accumulation.
-    s.ao.technique = vrao::render::settings::Technique::Gtao;
-    s.ao.resolution = vrao::render::settings::Resolution::Full;
+    s.ao.technique = vrao_ao::Technique::Gtao;
+    s.ao.resolution = vrao_ao::Resolution::Full;
     s.ao.temporal.enabled = false;
     let mut renderer = Renderer::new(gpu.clone(), &scene, &s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
@@ -278,7 +279,7 @@ fn frames_stay_in_flight_and_every_frames_gpu_times_come_back_once() {
         assert_eq!(frames, (0..6).collect::<Vec<_>>(), "each frame's times come back once, in order");
         for t in &timings {
             let passes: f64 =
-                t.spans.iter().filter(|(s, _)| !vrao::render::gpu::timing::is_per_eye(s)).map(|(_, ms)| ms).sum();
+                t.spans.iter().filter(|(s, _)| !vrao_ao::plug::FrameTiming::is_per_eye(s)).map(|(_, ms)| ms).sum();
             assert!((t.total_ms - passes).abs() < 1e-9 && t.total_ms > 0.0, "{t:?}");
         }
     }

@@ -99,10 +99,12 @@ fn virtual_time_runs_are_deterministic_and_count_late_frames_as_reprojected() {
 #[test]
 fn depth_based_reprojection_beats_rotational_under_translation_and_both_beat_no_warp_under_rotation() {
     let (gpu, _one_at_a_time) = common::gpu();
-    let scene = vrao::Scene::load("builtin:room").unwrap();
-    let settings =
-        vrao::Settings { profile: vrao::HeadsetProfile::with_size("test", 160, 144), ..vrao::Settings::default() };
-    let mut renderer = vrao::Renderer::new(gpu, &scene, &settings).unwrap();
+    let scene = vrao_render::Scene::load("builtin:room").unwrap();
+    let settings = vrao_render::Settings {
+        profile: vrao_render::HeadsetProfile::with_size("test", 160, 144),
+        ..vrao_render::Settings::default()
+    };
+    let mut renderer = vrao_render::Renderer::new(gpu, &scene, &settings).unwrap();
     let head = scene.head.pose_at(0.0);
     let moves = [HeadMove::RotateDegrees(5.0), HeadMove::TranslateCm(5.0), HeadMove::TranslateCm(10.0)];
     let rows = measure(&mut renderer, &head, &moves, 0.0).unwrap();

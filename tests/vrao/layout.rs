@@ -1,9 +1,10 @@
 //! The dependency rule between the application library's folders (see `src/lib.rs`):
-//! `render` (the renderer crate under the name the others use) imports nothing else;
-//! the shared `formats` and `test_assets` import only the renderer (and `stats`, the one
-//! quantile definition, a leaf); `xr` only `render` and `stats`; `app` and `measure` use
-//! `render`, `xr`, `formats` and `stats` but not each other; and nothing in the library
-//! reaches the CLI. Cargo enforces the rule between the crates.
+//! the shared `formats` and `test_assets` import only the leaves (`error`, the
+//! application's error, and `stats`, the one quantile definition); `xr` only the leaves
+//! (and the `wgsl!` macro); `app` and `measure` use `xr`, `formats` and the leaves but not
+//! each other; and nothing in the library reaches the CLI. Cargo enforces the rule
+//! between the crates, and no crate re-exports another's modules: each is named by its
+//! own name.
 
 use std::path::{Path, PathBuf};
 
@@ -42,13 +43,12 @@ fn references(text: &str) -> Vec<(usize, String)> {
 #[test]
 fn each_folder_imports_only_what_the_rule_allows() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let allowed: [(&str, &[&str]); 6] = [
-        ("render", &["render"]),
-        ("formats", &["render", "formats", "stats"]),
-        ("test_assets", &["render", "test_assets"]),
-        ("xr", &["render", "xr", "stats"]),
-        ("app", &["render", "xr", "app", "formats", "stats"]),
-        ("measure", &["render", "xr", "measure", "formats", "stats"]),
+    let allowed: [(&str, &[&str]); 5] = [
+        ("formats", &["error", "formats", "stats"]),
+        ("test_assets", &["error", "test_assets"]),
+        ("xr", &["error", "xr", "stats", "wgsl"]),
+        ("app", &["error", "xr", "app", "formats", "stats", "wgsl"]),
+        ("measure", &["error", "xr", "measure", "formats", "stats"]),
     ];
     let mut violations = Vec::new();
     let mut files_checked = 0;
@@ -65,7 +65,7 @@ fn each_folder_imports_only_what_the_rule_allows() {
     }
     assert!(
         files_checked > 50,
-        "only {files_checked} files under src/render, formats, test_assets, xr, app and measure"
+        "only {files_checked} files under src/formats, test_assets, xr, app and measure"
     );
     assert!(violations.is_empty(), "the dependency rule is broken:\n{}", violations.join("\n"));
 }
@@ -79,7 +79,39 @@ fn the_library_never_reaches_the_cli() {
 
 #[test]
 fn the_reference_scanner_sees_imports_and_skips_comments() {
-    let text = "use crate::render::gpu::Gpu;\n// crate::app in a comment\n/// [`crate::xr::Headset`]\nlet x = crate::measure::metrics::rmse(a, b);";
+    let text = "use crate::error::Result;\n// crate::app in a comment\n/// [`crate::xr::Headset`]\nlet x = crate::measure::metrics::rmse(a, b);";
     let names: Vec<String> = references(text).into_iter().map(|(_, n)| n).collect();
-    assert_eq!(names, ["render", "xr", "measure"]);
+    assert_eq!(names, ["error", "xr", "measure"]);
+}
+
+/// `pub use` lines in `dir` that re-export a module (or everything) of another
+/// workspace crate: the crates are named by their own names, not merged.
+fn cross_crate_reexports(dir: &Path) -> Vec<String> {
+    let mut found = Vec::new();
+    for file in rust_files(dir) {
+        let text = std::fs::read_to_string(&file).expect("readable source");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.trim_start();
+            let Some(path) = code.strip_prefix("pub use ") else { continue };
+            let crate_named = path.starts_with("vrao_ao::") || path.starts_with("vrao_render::");
+            let last = path.trim_end_matches(';').rsplit("::").next().unwrap_or("");
+            let module_or_glob = last == "*" || last.chars().next().is_some_and(|c| c.is_ascii_lowercase());
+            if crate_named && module_or_glob {
+                found.push(format!("{}:{}: {code}", file.display(), n + 1));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn no_crate_re_exports_another_crates_modules() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut found = cross_crate_reexports(&root.join("src"));
+    found.extend(cross_crate_reexports(&root.join("crates/vrao-render/src")));
+    assert!(found.is_empty(), "re-exports across crates:\n{}", found.join("\n"));
+    let sample = root.join("target/layout-reexport-sample");
+    std::fs::create_dir_all(&sample).unwrap();
+    std::fs::write(sample.join("a.rs"), "pub use vrao_ao::plug::*;\npub use vrao_ao::AoEngine;\n").unwrap();
+    assert_eq!(cross_crate_reexports(&sample).len(), 1, "the scanner finds a glob and passes an item");
 }

@@ -314,12 +314,12 @@ fn sibenik_throughput() {
     }
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/sibenik.toml");
     let started = std::time::Instant::now();
-    let scene = vrao::Scene::load(path.to_str().unwrap()).unwrap();
+    let scene = vrao_render::Scene::load(path.to_str().unwrap()).unwrap();
     eprintln!("loaded {} triangles in {:.2} s", scene.triangle_count(), started.elapsed().as_secs_f64());
     let size = (270, 300);
-    let near = vrao::render::stereo::DEFAULT_NEAR;
+    let near = vrao_ao::plug::DEFAULT_NEAR;
     let s = ReferenceSettings { radius: scene.suggested_ao_radius() as f64, rays_per_pixel: 64, stride: 1, near };
-    let eyes = vrao::HeadsetProfile::with_size("test", size.0, size.1).eyes(&scene.head.pose_at(0.0), near);
+    let eyes = vrao_render::HeadsetProfile::with_size("test", size.0, size.1).eyes(&scene.head.pose_at(0.0), near);
     let mut bar = ProgressBar::new("sibenik");
     let image = trace(&scene, &eyes.eyes, size, &s, &mut |p| bar.update(p)).unwrap();
     bar.finish();

@@ -8,18 +8,13 @@ use crate::common;
 
 use glam::{DQuat, DVec3, Vec3};
 use std::sync::Arc;
-use vrao::render::gpu::layered_target::LayeredTarget;
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::blur::AO_BLURRED;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::scene::{Light, Material, Scene};
-use vrao::render::settings::{AoSettings, Denoise, Technique};
-use vrao::render::stereo::{Fov, HeadPose};
 use vrao::xr::simulated::reproject::{output_target, ReprojectionMode, Reprojector};
-use vrao::{Gpu, HeadsetProfile, Renderer, Settings};
+use vrao_ao::plug::{Gpu, LayeredTarget, AO_BLURRED, AO_RAW, DEPTH, FINAL_AO};
+use vrao_ao::{AoSettings, Denoise, Fov, HeadPose, Technique};
+use vrao_render::passes::composite::HDR;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::{Light, Material, Scene};
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 const TECHNIQUES: [Technique; 5] =
     [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoBounce, Technique::SsdoPointsBounce];
@@ -79,7 +74,7 @@ fn every_technique(gpu: &Arc<Gpu>, label: &str, scene: &Scene, base: &Settings, 
         for half_res in [false, true] {
             let mut s = base.clone();
             s.ao.technique = technique;
-            s.ao.resolution = vrao::render::settings::Resolution::from_half_res(half_res);
+            s.ao.resolution = vrao_ao::Resolution::from_half_res(half_res);
             all.push(render_checked(gpu, &format!("{label} / {} half={half_res}", technique.name()), scene, &s, head));
         }
     }
@@ -250,12 +245,7 @@ fn sizes_1x1_3x5_and_1081x1199_at_half_resolution() {
     for technique in TECHNIQUES {
         let s = settings(
             (1081, 1199),
-            AoSettings {
-                technique,
-                resolution: vrao::render::settings::Resolution::Half,
-                samples: 8,
-                ..AoSettings::default()
-            },
+            AoSettings { technique, resolution: vrao_ao::Resolution::Half, samples: 8, ..AoSettings::default() },
         );
         render_checked(&gpu, &format!("1081x1199 half {}", technique.name()), &scene, &s, &room_head());
     }
@@ -282,8 +272,8 @@ fn nan_or_inf_in_vertex_data_is_rejected_at_load_naming_the_line() {
         let path = dir.join("bad.obj");
         std::fs::write(&path, text).unwrap();
         let err = Scene::load(path.to_str().unwrap()).unwrap_err();
-        assert_eq!(err.exit_code(), 2);
         let message = err.to_string();
+        assert_eq!(vrao::Error::from(err).exit_code(), 2);
         assert!(message.contains("bad.obj:") && message.contains(bad), "{message}");
     }
 }
@@ -408,7 +398,7 @@ fn a_reprojection_history_without_usable_depth_falls_back_to_the_rotational_warp
         reprojector.record(&gpu, &mut encoder, mode, color, depth, &source.eyes, &target.eyes, s.near, &output);
         gpu.queue.submit([encoder.finish()]);
         gpu.take_error().unwrap();
-        vrao::render::gpu::readback::read_layers(&gpu, &output).unwrap()
+        vrao_ao::plug::read_layers(&gpu, &output).unwrap()
     };
     // NaN cannot reach a Depth32Float history (copies into it are forbidden and
     // rasterisation clamps depth to [0, 1]); the shader still treats anything outside

@@ -9,13 +9,10 @@ use crate::common;
 
 use common::occlusion::{ao, ao_techniques, mean, render, same_surface_blur, settings, Frame};
 use glam::DVec3;
-use vrao::render::passes::blur::AO_BLURRED;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::passes::upsample::AO_FULL;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Technique};
-use vrao::HeadPose;
+use vrao_ao::plug::{AO_BLURRED, AO_FULL, AO_RAW};
+use vrao_ao::{AoSettings, HeadPose, Technique};
+use vrao_render::passes::composite::HDR;
+use vrao_render::scene::Scene;
 
 // ---------------------------------------------------------------------------------------
 // Bilateral blur
@@ -65,7 +62,7 @@ fn blur_keeps_a_depth_edge() {
 /// the step (samples in front of the wall that project onto the much closer panel
 /// count as occluded, the classic halo): strongly occluded on the far side of the
 /// edge, unoccluded (AO = 1) on the panel itself.
-fn render_depth_step(gpu: &std::sync::Arc<vrao::Gpu>) -> (Frame, i32) {
+fn render_depth_step(gpu: &std::sync::Arc<vrao_ao::plug::Gpu>) -> (Frame, i32) {
     let scene = common::bare_scene(vec![
         common::square("wall", DVec3::new(0.0, 0.0, -4.0), 12.0, 0),
         common::square("panel", DVec3::new(-3.0, 0.0, -2.0), 6.0, 0),
@@ -141,7 +138,7 @@ fn half_resolution_stays_close_to_full_resolution() {
     for technique in [Technique::Ssao, Technique::Hbao, Technique::Ssdo, Technique::SsdoPoints] {
         let full = settings(128, 144, ao(technique, 24, 1.0));
         let mut half = full.clone();
-        half.ao.resolution = vrao::render::settings::Resolution::Half;
+        half.ao.resolution = vrao_ao::Resolution::Half;
         let f = render(&gpu, &scene, &full, &head, &[AO_BLURRED]);
         let g = render(&gpu, &scene, &half, &head, &[AO_FULL]);
         let pairs: Vec<(f64, f64)> = f
@@ -187,7 +184,7 @@ fn odd_sizes_work_at_half_resolution() {
     let head = scene.head.pose_at(0.0);
     for technique in ao_techniques() {
         let mut a = ao(technique, 12, 0.5);
-        a.resolution = vrao::render::settings::Resolution::Half;
+        a.resolution = vrao_ao::Resolution::Half;
         let s = settings(97, 109, a);
         let outputs = [AO_RAW, AO_BLURRED, AO_FULL, HDR];
         let f = render(&gpu, &scene, &s, &head, &outputs);
@@ -217,7 +214,7 @@ fn the_composite_upsamples_half_resolution_occlusion_inline() {
     for technique in [Technique::Ssao, Technique::Ssdo, Technique::SsdoPoints] {
         let base = AoSettings { technique, samples: 32, radius: 1.0, ..AoSettings::default() };
         let full = render(&gpu, &scene, &settings(128, 144, base.clone()), &head, &[HDR]);
-        let half_settings = AoSettings { resolution: vrao::render::settings::Resolution::Half, ..base };
+        let half_settings = AoSettings { resolution: vrao_ao::Resolution::Half, ..base };
         let half = render(&gpu, &scene, &settings(128, 144, half_settings), &head, &[HDR]);
         assert!(!half.report.plan.runs("upsample"), "the frame upsampled in a pass of its own");
         let (mut diff, mut total) = (0.0, 0.0);

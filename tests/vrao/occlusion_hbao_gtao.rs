@@ -8,7 +8,7 @@
 use crate::common;
 
 use common::crease::{assert_bins, assert_falls_towards_the_edge, measure_crease, EXPECTATION_TOLERANCE};
-use vrao::render::settings::Technique;
+use vrao_ao::Technique;
 
 // ---------------------------------------------------------------------------------------
 // 90° crease (tests/common/crease.rs)

@@ -6,15 +6,11 @@
 use crate::common;
 
 use common::occlusion::{ao_passes, render, settings};
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::blur::AO_BLURRED;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::passes::temporal::AO_ACCUMULATED;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::passes::upsample::AO_FULL;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Resolution, Technique};
-use vrao::Renderer;
+use vrao_ao::plug::{AO_ACCUMULATED, AO_BLURRED, AO_FULL, AO_RAW, FINAL_AO};
+use vrao_ao::{AoSettings, Resolution, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::Scene;
+use vrao_render::Renderer;
 
 // ---------------------------------------------------------------------------------------
 // The plan (`--explain`)

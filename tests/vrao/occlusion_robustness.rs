@@ -8,12 +8,10 @@
 use crate::common;
 
 use common::occlusion::{ao, ao_techniques, render, settings};
-use vrao::render::passes::blur::AO_BLURRED;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::occlusion::{AO_GEOMETRY, AO_RAW};
-use vrao::render::passes::upsample::AO_FULL;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Noise};
+use vrao_ao::plug::{AO_BLURRED, AO_FULL, AO_GEOMETRY, AO_RAW};
+use vrao_ao::{AoSettings, Noise};
+use vrao_render::passes::composite::HDR;
+use vrao_render::scene::Scene;
 
 // ---------------------------------------------------------------------------------------
 // Open plane
@@ -78,7 +76,7 @@ fn flipped_normals_give_no_zero_ao_and_no_black_pixel() {
     for technique in ao_techniques() {
         for half_res in [false, true] {
             let mut a = ao(technique, 12, scene.suggested_ao_radius());
-            a.resolution = vrao::render::settings::Resolution::from_half_res(half_res);
+            a.resolution = vrao_ao::Resolution::from_half_res(half_res);
             let s = settings(270, 300, a);
             // The final full-resolution AO.
             let final_ao = if half_res { AO_FULL } else { AO_BLURRED };
@@ -150,21 +148,14 @@ fn no_output_is_ever_nan_or_inf() {
                 cases.push((
                     name,
                     scene,
-                    AoSettings {
-                        resolution: vrao::render::settings::Resolution::from_half_res(half_res),
-                        ..ao(technique, 24, 0.5)
-                    },
+                    AoSettings { resolution: vrao_ao::Resolution::from_half_res(half_res), ..ao(technique, 24, 0.5) },
                 ));
             }
         }
         // Stiff settings: one sample and a micro radius, every sample and a huge radius,
         // no bias with the strongest strength and widest blur, the tiled noise without range
         // check.
-        cases.push((
-            "room",
-            &room,
-            AoSettings { resolution: vrao::render::settings::Resolution::Half, ..ao(technique, 1, 1e-4) },
-        ));
+        cases.push(("room", &room, AoSettings { resolution: vrao_ao::Resolution::Half, ..ao(technique, 1, 1e-4) }));
         cases.push(("plane", &plane, ao(technique, 256, 1e4)));
         cases.push(("room", &room, AoSettings { bias: 0.0, strength: 4.0, blur_radius: 16, ..ao(technique, 12, 2.0) }));
         cases.push((
@@ -173,7 +164,7 @@ fn no_output_is_ever_nan_or_inf() {
             AoSettings {
                 noise: Noise::Tiled5x5,
                 range_check: false,
-                resolution: vrao::render::settings::Resolution::Half,
+                resolution: vrao_ao::Resolution::Half,
                 ..ao(technique, 12, 1.0)
             },
         ));

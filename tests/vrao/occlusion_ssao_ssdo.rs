@@ -13,12 +13,11 @@ use common::crease::{assert_bins, assert_falls_towards_the_edge, measure_crease,
 use common::occlusion::{ao, mean, render, settings, Frame};
 use glam::{DVec3, Vec3};
 use vrao::measure::analytic;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::scene::builtin::{ROOM_MAX, ROOM_MIN};
-use vrao::render::scene::{environment, Environment, Scene};
-use vrao::render::settings::{BounceForm, Technique};
-use vrao::HeadPose;
+use vrao_ao::plug::{BounceForm, AO_RAW};
+use vrao_ao::{HeadPose, Technique};
+use vrao_render::passes::composite::HDR;
+use vrao_render::scene::builtin::{ROOM_MAX, ROOM_MIN};
+use vrao_render::scene::{environment, Environment, Scene};
 
 // ---------------------------------------------------------------------------------------
 // 90° crease (tests/common/crease.rs)
@@ -249,7 +248,7 @@ fn red_wall_bleeds_red_only_with_the_bounce() {
     red_wall_bleeds(&gpu, Technique::SsdoPoints, Technique::SsdoPointsBounce);
 }
 
-fn red_wall_bleeds(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounce: Technique) {
+fn red_wall_bleeds(gpu: &std::sync::Arc<vrao_ao::plug::Gpu>, plain: Technique, with_bounce: Technique) {
     eprintln!("{} and {}:", plain.name(), with_bounce.name());
     let frames = RedWallFrames::render(gpu, plain, with_bounce);
     let (ssdo_hdr, ssdo_raw) = floor_by_the_red_wall(&frames.ssdo);
@@ -291,7 +290,7 @@ struct RedWallFrames {
 }
 
 impl RedWallFrames {
-    fn render(gpu: &std::sync::Arc<vrao::Gpu>, plain: Technique, with_bounce: Technique) -> Self {
+    fn render(gpu: &std::sync::Arc<vrao_ao::plug::Gpu>, plain: Technique, with_bounce: Technique) -> Self {
         let scene = Scene::load("builtin:room").unwrap();
         // Looking down at the foot of the red (−X) wall, from the middle of the room.
         let head = HeadPose::look_at(DVec3::new(0.6, 1.6, -0.8), DVec3::new(ROOM_MIN.x + 0.3, 0.0, -2.6)).unwrap();

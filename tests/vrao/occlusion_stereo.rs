@@ -9,13 +9,10 @@ use crate::common;
 
 use common::occlusion::{ao, ao_techniques, mean, render, settings};
 use vrao::measure::stereo_consistency::{stereo_consistency, EyeImages};
-use vrao::render::passes::blur::AO_BLURRED;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::passes::upsample::AO_FULL;
-use vrao::render::scene::Scene;
-use vrao::render::settings::Technique;
+use vrao_ao::plug::{AO_BLURRED, AO_FULL, AO_RAW, DEPTH};
+use vrao_ao::Technique;
+use vrao_render::passes::composite::HDR;
+use vrao_render::scene::Scene;
 
 // ---------------------------------------------------------------------------------------
 // Stereo consistency
@@ -98,7 +95,7 @@ fn the_right_eye_reuses_the_left_eye_where_it_sees_the_same_point() {
         let mut shares = [0.0; 2];
         for (i, reuse) in [false, true].into_iter().enumerate() {
             let mut a = ao(technique, 24, 0.3);
-            (a.stereo_reuse, a.resolution) = (reuse, vrao::render::settings::Resolution::from_half_res(half_res));
+            (a.stereo_reuse, a.resolution) = (reuse, vrao_ao::Resolution::from_half_res(half_res));
             let s = settings(540, 600, a);
             let final_ao = if half_res { AO_FULL } else { AO_BLURRED };
             let f = render(&gpu, &scene, &s, &head, &[final_ao, DEPTH]);
@@ -134,7 +131,7 @@ fn the_composite_shows_the_ao_the_bench_scores_and_the_right_eye_takes_the_left_
     let head = scene.head.pose_at(0.0);
     for (technique, reuse) in [(Technique::Gtao, true), (Technique::Hbao, true), (Technique::Gtao, false)] {
         let mut a = ao(technique, 12, 0.3);
-        (a.stereo_reuse, a.resolution) = (reuse, vrao::render::settings::Resolution::Half);
+        (a.stereo_reuse, a.resolution) = (reuse, vrao_ao::Resolution::Half);
         let f = render(&gpu, &scene, &settings(96, 112, a), &head, &[AO_FULL, HDR]);
         let case = format!("{technique:?}, reuse {reuse}");
         let mut surface = 0;

@@ -13,19 +13,16 @@ use crate::common;
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use vrao::render::gpu::layered_target::LayeredTarget;
-use vrao::render::gpu::readback::{read_layers, read_layers_f32};
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::scene::Scene;
-use vrao::render::settings::Settings;
-use vrao::render::stereo::HeadsetProfile;
 use vrao::xr::openxr::{
     probe_runtime, EyeBlit, OpenXrHeadset, OpenXrOptions, SessionPhase, SwapchainLayout, Unavailable,
 };
 use vrao::xr::simulated::{SimulatedOptions, TimeMode};
 use vrao::xr::{Headset, SubmittedFrame};
-use vrao::{BackendChoice, Gpu};
+use vrao_ao::plug::{read_layers, read_layers_f32, Gpu, LayeredTarget, DEPTH};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
+use vrao_render::{BackendChoice, HeadsetProfile};
 
 const RUNTIME_VAR: &str = "XR_RUNTIME_JSON";
 
@@ -318,7 +315,7 @@ fn the_swapchain_blit_keeps_srgb_bytes_and_depth_exact_and_decodes_for_linear_sw
 fn run_frames(
     headset: &mut dyn Headset,
     gpu: &Arc<Gpu>,
-    renderer: &mut vrao::render::renderer::Renderer,
+    renderer: &mut vrao_render::renderer::Renderer,
     frames: u64,
 ) -> u64 {
     let mut rendered = 0;
@@ -347,11 +344,11 @@ fn session_options(fallback: Option<SimulatedOptions>) -> OpenXrOptions {
     OpenXrOptions { size: Some((96, 80)), report: false, fallback, ..OpenXrOptions::from_simulated(&simulated, None) }
 }
 
-fn renderer_for(headset: &OpenXrHeadset, gpu: &Arc<Gpu>) -> vrao::render::renderer::Renderer {
+fn renderer_for(headset: &OpenXrHeadset, gpu: &Arc<Gpu>) -> vrao_render::renderer::Renderer {
     let scene = Scene::load("builtin:room").unwrap();
     let (width, height) = headset.recommended_size();
     let settings = Settings { profile: HeadsetProfile::with_size("openxr", width, height), ..Settings::default() };
-    vrao::render::renderer::Renderer::new(gpu.clone(), &scene, &settings).unwrap()
+    vrao_render::renderer::Renderer::new(gpu.clone(), &scene, &settings).unwrap()
 }
 
 /// `want` appears in `seen` in order (other states may come between).

@@ -10,8 +10,8 @@
 use std::path::PathBuf;
 use vrao::measure::bench::ReferenceOptions;
 use vrao::measure::peer::{run_peer, scene_for_peer, Family, PeerOptions};
-use vrao::render::renderer::TimingChoice;
-use vrao::{BackendChoice, HeadsetProfile, Scene, Settings};
+use vrao_render::renderer::TimingChoice;
+use vrao_render::{BackendChoice, HeadsetProfile, Scene, Settings};
 
 #[test]
 #[ignore = "needs the Bevy peer: bash .ci/peer builds it and runs this test"]

@@ -3,8 +3,8 @@
 
 use crate::common;
 
-use vrao::render::graph::FINAL_AO;
-use vrao::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::plug::FINAL_AO;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 #[test]
 fn a_renderer_made_again_with_the_same_settings_compiles_no_compute_pipeline() {

@@ -13,12 +13,11 @@ use crate::common;
 
 use glam::DVec3;
 use std::sync::Arc;
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Quality, Technique};
-use vrao::{Gpu, HeadPose, HeadsetProfile, Renderer, Settings};
+use vrao_ao::plug::{Gpu, DEPTH, FINAL_AO};
+use vrao_ao::{AoSettings, HeadPose, Quality, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::Scene;
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 /// Per-eye size of the scenes' own views.
 const SIZE: (u32, u32) = (120, 135);
@@ -81,7 +80,7 @@ fn cases() -> Vec<AoSettings> {
     cases.push(AoSettings {
         technique: Technique::Gtao,
         samples: Quality::Ultra.samples(),
-        resolution: vrao::render::settings::Resolution::Half,
+        resolution: vrao_ao::Resolution::Half,
         ..defaults.clone()
     });
     for technique in Technique::estimators() {
@@ -132,7 +131,7 @@ fn black_surface_pixels(frame: &Frame) -> Vec<(usize, usize)> {
 fn check_view(gpu: &Arc<Gpu>, view: &View) -> Vec<String> {
     let base = Settings {
         profile: HeadsetProfile::with_size("test", view.size.0, view.size.1),
-        ao: vrao::render::settings::ao_fitted_to(&view.scene),
+        ao: vrao_render::settings::ao_fitted_to(&view.scene),
         ..Settings::default()
     };
     let none = Settings { ao: AoSettings { technique: Technique::None, ..base.ao.clone() }, ..base.clone() };

@@ -5,9 +5,9 @@ use crate::common;
 
 use vrao::measure::bench::{error_figures, ErrorFigures};
 use vrao::measure::reference::{trace, ReferenceSettings};
-use vrao::render::graph::FINAL_AO;
-use vrao::render::settings::{BounceForm, Technique};
-use vrao::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::plug::{BounceForm, FINAL_AO};
+use vrao_ao::Technique;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 112);
 const RADIUS: f32 = 0.5;

@@ -3,7 +3,7 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use std::path::{Path, PathBuf};
-use vrao::render::scene::{builtin, Light, Scene};
+use vrao_render::scene::{builtin, Light, Scene};
 
 /// A scratch directory under the system temp dir, removed when dropped.
 struct TempDir(PathBuf);
@@ -29,7 +29,7 @@ impl Drop for TempDir {
     }
 }
 
-fn load(path: &Path) -> vrao::Result<Scene> {
+fn load(path: &Path) -> vrao_ao::Result<Scene> {
     Scene::load(path.to_str().unwrap())
 }
 
@@ -400,7 +400,7 @@ fn scene_files_render_from_a_copy_of_assets_outside_the_repository() {
 #[test]
 fn venice_sunset_loads_with_the_sun_in_it() {
     let Some(path) = crate::common::public_scene("envmaps/venice_sunset_1k.hdr") else { return };
-    let env = vrao::render::scene::Environment::load_hdr(&path, 1.0).unwrap();
+    let env = vrao_render::scene::Environment::load_hdr(&path, 1.0).unwrap();
     assert_eq!((env.width, env.height), (1024, 512));
     assert!(env.texels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0));
     let peak = env.texels.iter().flatten().fold(0f32, |a, &b| a.max(b));

@@ -13,18 +13,16 @@ use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use vrao::measure::analytic::luminance;
-use vrao::render::passes::composite::HDR;
-use vrao::render::passes::direct::DIRECT;
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::passes::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
-use vrao::render::passes::shadow::{RSM_FLUX, RSM_NORMAL, SHADOW_MAP};
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
-use vrao::render::scene::{Light, Material, Scene};
-use vrao::render::settings::Technique;
-use vrao::render::stereo::HeadsetProfile;
-use vrao::{Gpu, HeadPose, Renderer, Resource, Settings};
+use vrao_ao::plug::{Gpu, Resource, AO_RAW, DEPTH};
+use vrao_ao::{HeadPose, Technique};
+use vrao_render::passes::composite::HDR;
+use vrao_render::passes::direct::DIRECT;
+use vrao_render::passes::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
+use vrao_render::passes::shadow::{RSM_FLUX, RSM_NORMAL, SHADOW_MAP};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
+use vrao_render::scene::{Light, Material, Scene};
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 fn settings(width: u32, height: u32) -> Settings {
     let mut s = Settings { profile: HeadsetProfile::with_size("test", width, height), ..Settings::default() };
@@ -224,8 +222,7 @@ fn only_directional_lights_get_a_shadow_pass_and_explain_says_why() {
     let plan = |scene: &Scene, s: &Settings, outputs: &[Resource]| {
         Renderer::new(gpu.clone(), scene, s).unwrap().plan(2, outputs).unwrap()
     };
-    let reason =
-        |p: &vrao::render::graph::Plan, pass: &str| p.left_out.iter().find(|(n, _)| *n == pass).map(|(_, r)| r.clone());
+    let reason = |p: &vrao_ao::Plan, pass: &str| p.left_out.iter().find(|(n, _)| *n == pass).map(|(_, r)| r.clone());
     // The room has one point light: no shadow pass, and --explain says why.
     let room = Scene::load("builtin:room").unwrap();
     assert!(room.lights.iter().all(|l| matches!(l, Light::Point { .. })));
@@ -412,7 +409,7 @@ fn no_shadow_or_rsm_output_is_ever_nan_or_inf() {
     far.meshes.iter_mut().for_each(|m| m.origin += DVec3::new(1e5, 0.0, -1e5));
     let head = boxed.head.pose_at(0.0);
     far.head =
-        vrao::render::scene::HeadPath::fixed(HeadPose { position: head.position + DVec3::new(1e5, 0.0, -1e5), ..head });
+        vrao_render::scene::HeadPath::fixed(HeadPose { position: head.position + DVec3::new(1e5, 0.0, -1e5), ..head });
     cases.push(("1e5 m out".into(), far, base.clone()));
     for (label, samples, radius, size) in
         [("1 VPL, 1 µm", 1, 1e-6, 16), ("1024 VPLs, 1e6 m", 1024, 1e6, 64), ("16² map", 64, 1.0, 16)]
@@ -423,7 +420,7 @@ fn no_shadow_or_rsm_output_is_ever_nan_or_inf() {
     }
     let mut ssdo = base.clone();
     ssdo.ao.technique = Technique::SsdoBounce;
-    ssdo.ao.resolution = vrao::render::settings::Resolution::Half;
+    ssdo.ao.resolution = vrao_ao::Resolution::Half;
     cases.push(("ssdo-bounce half-res".into(), boxed.clone(), ssdo));
     for (label, scene, s) in &cases {
         let f = render(&gpu, scene, s, &outputs);

@@ -6,11 +6,11 @@
 use crate::common;
 
 use vrao::app::FrameLoop;
-use vrao::render::settings::AoSettings;
 use vrao::xr::simulated::motion::HeadMotion;
 use vrao::xr::simulated::reproject::ReprojectionMode;
 use vrao::xr::simulated::{SimulatedHeadset, SimulatedOptions, TimeMode};
-use vrao::{HeadsetProfile, Scene, Settings};
+use vrao_ao::AoSettings;
+use vrao_render::{HeadsetProfile, Scene, Settings};
 
 /// Resident set size of this process in KiB (Linux /proc).
 fn rss_kib() -> u64 {
@@ -51,11 +51,7 @@ fn five_thousand_frames_keep_memory_and_gpu_resources_flat() {
         // The bilateral blur is off: on lavapipe 22.3 its two dispatches grow RSS by about
         // 0.5 MB a frame inside the driver (wgpu's live objects stay flat; reported in
         // the closing note of the numerics issue). Everything else runs.
-        ao: AoSettings {
-            resolution: vrao::render::settings::Resolution::Half,
-            blur_radius: 0,
-            ..AoSettings::default()
-        },
+        ao: AoSettings { resolution: vrao_ao::Resolution::Half, blur_radius: 0, ..AoSettings::default() },
         ..Settings::default()
     };
     let headset = SimulatedHeadset::new(SimulatedOptions {

@@ -14,9 +14,9 @@ use crate::common;
 
 use vrao::measure::bench::{bounce_figures, error_figures};
 use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
-use vrao::render::graph::FINAL_AO;
-use vrao::render::settings::Technique;
-use vrao::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::plug::FINAL_AO;
+use vrao_ao::Technique;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 144);
 const RADIUS: f32 = 0.6;

@@ -6,13 +6,10 @@
 use crate::common;
 
 use glam::{DQuat, DVec3};
-use vrao::render::graph::Resource;
-use vrao::render::passes::occlusion::{AO_GEOMETRY, AO_RAW};
-use vrao::render::passes::temporal::{AO_ACCUMULATED, HISTORY_POSITION, HISTORY_VALUE};
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::settings::{AoSettings, Technique};
-use vrao::render::stereo::HeadPose;
-use vrao::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_ao::plug::{Resource, AO_ACCUMULATED, AO_GEOMETRY, AO_RAW, HISTORY_POSITION, HISTORY_VALUE};
+use vrao_ao::{AoSettings, HeadPose, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (96, 80);
 

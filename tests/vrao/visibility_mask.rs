@@ -7,14 +7,11 @@
 
 use crate::common;
 
-use vrao::render::graph::FINAL_AO;
-use vrao::render::passes::gbuffer::DEPTH;
-use vrao::render::passes::tonemap::COLOR;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{AoSettings, Foveation, Resolution, Technique};
-use vrao::render::stereo::HeadsetProfile;
-use vrao::render::visibility::{ViewMask, VisibilityMask};
-use vrao::{Renderer, Resource, Settings};
+use vrao_ao::plug::{Resource, DEPTH, FINAL_AO};
+use vrao_ao::{AoSettings, Foveation, Resolution, Technique, ViewMask, VisibilityMask};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::Scene;
+use vrao_render::{HeadsetProfile, Renderer, Settings};
 
 const SIZE: (u32, u32) = (160, 180);
 
@@ -48,7 +45,7 @@ fn render(scene: &Scene, ao: &AoSettings, mask: Option<&VisibilityMask>) -> Fram
 
 /// The ellipse touching the rectangle's edges (21.5 % hidden) for both eyes of the profile.
 fn lens(profile: &HeadsetProfile) -> VisibilityMask {
-    let view = |fov: &vrao::render::stereo::Fov| ViewMask::superellipse(fov.tangents(), 2.0, 128, "test ellipse");
+    let view = |fov: &vrao_ao::Fov| ViewMask::superellipse(fov.tangents(), 2.0, 128, "test ellipse");
     VisibilityMask { views: vec![view(&profile.fov_left), view(&profile.fov_right)] }
 }
 

@@ -1,15 +1,9 @@
-//! One error type for the library; the CLI maps it to exit codes.
+//! The engine's error type. A program around the engine wraps it in its own (vrao's
+//! application adds its exit codes and its own failures).
 
 use std::path::{Path, PathBuf};
 
-/// Exit code for bad input or an unusable device (clear error, never a panic).
-pub const EXIT_INPUT: i32 = 2;
-/// Exit code for a run that finished but did not fit its frame budget.
-pub const EXIT_OVER_BUDGET: i32 = 3;
-/// Exit code for a run ended by Ctrl-C (SIGINT): the shell's code for such a process.
-pub const EXIT_INTERRUPTED: i32 = 130;
-
-/// Every failure vrao reports; each maps to a process exit code ([`Error::exit_code`]).
+/// Every failure the engine (and a renderer built on it) reports.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Malformed or missing input. `file` and `line` name the place when known.
@@ -25,22 +19,9 @@ pub enum Error {
     /// No usable GPU adapter or device.
     #[error("no usable GPU: {0}")]
     Device(String),
-    /// Something other than the GPU that a run needs cannot be used: a desktop window
-    /// (no display), an OpenXR runtime (none installed, a broken manifest). Not the GPU's
-    /// fault, so never called "no usable GPU"; the message names the cause.
-    #[error("{0}")]
-    Unavailable(String),
     /// A GPU operation failed while running (validation, lost device, readback).
     #[error("GPU error: {0}")]
     Gpu(String),
-    /// Writing an output failed.
-    #[error("{}: {message}", path.display())]
-    Output {
-        /// The file that could not be written.
-        path: PathBuf,
-        /// Why, as the OS or encoder said it.
-        message: String,
-    },
     /// The frame graph could not plan a frame: a pass reads what nothing before it
     /// provides, or a requested output has no producer. A fault in vrao (or in a pass an
     /// embedder added), not in the input or the GPU.
@@ -50,9 +31,6 @@ pub enum Error {
     /// ([`crate::gpu::Gpu::cancel_builds_on`]).
     #[error("interrupted")]
     Interrupted,
-    /// The run finished but did not fit its frame budget (`vrao budget`).
-    #[error("{0}")]
-    OverBudget(String),
 }
 
 /// "file:line: message", "file: message" or "message", as much as is known.
@@ -77,20 +55,9 @@ impl Error {
     pub fn at_line(file: &Path, line: usize, message: impl Into<String>) -> Self {
         Error::Input { file: Some(file.to_path_buf()), line: Some(line), message: message.into() }
     }
-    /// The process exit code for this error: 2 bad input/device/output, 1 GPU failure, 3 over
-    /// budget, 130 interrupted.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            // An output that cannot be written is the path the user gave (or its disk).
-            Error::Input { .. } | Error::Device(_) | Error::Unavailable(_) | Error::Output { .. } => EXIT_INPUT,
-            Error::Gpu(_) | Error::Plan(_) => 1,
-            Error::OverBudget(_) => EXIT_OVER_BUDGET,
-            Error::Interrupted => EXIT_INTERRUPTED,
-        }
-    }
 }
 
-/// vrao's result type, with [`Error`] as the default error.
+/// The engine's result type, with [`Error`] as the default error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 #[cfg(test)]
@@ -104,11 +71,7 @@ mod tests {
         assert_eq!(Error::in_file(f, "missing").to_string(), "a/scene.toml: missing");
         assert_eq!(Error::input("plain").to_string(), "plain");
         assert_eq!(Error::Device("none".into()).to_string(), "no usable GPU: none");
-        assert_eq!(Error::Unavailable("no display".into()).to_string(), "no display");
-        assert_eq!(Error::Unavailable("no display".into()).exit_code(), EXIT_INPUT);
         assert_eq!(Error::Gpu("lost".into()).to_string(), "GPU error: lost");
-        let out = Error::Output { path: PathBuf::from("o.png"), message: "denied".into() };
-        assert_eq!(out.to_string(), "o.png: denied");
-        assert_eq!(Error::OverBudget("over".into()).to_string(), "over");
+        assert_eq!(Error::Plan("no producer".into()).to_string(), "frame graph: no producer");
     }
 }

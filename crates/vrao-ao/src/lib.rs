@@ -1,28 +1,43 @@
 #![doc = include_str!("../README.md")]
 //!
-//! ## Where things are
+//! ## Two faces
 //!
-//! See [`ao`] for the conventions (depth, normals, matrices, formats). The same frame
-//! graph ([`graph`]) and passes ([`passes`]) run inside vrao's renderer (the
-//! `vrao-render` crate), which adds its scene passes around them.
+//! The crate root is the host's face: everything a wgpu program needs to hand the
+//! engine its depth (and normals, motion, light) and take the AO back. [`plug`] is the
+//! renderer's face: the frame graph, the GPU helpers and the chain's resources, for a
+//! renderer that adds its own passes around the engine's (as vrao's renderer does).
+//! Everything else is private.
 
-pub mod ao;
-pub mod driver;
-pub mod error;
-pub mod gpu;
-pub mod graph;
-pub mod graph_targets;
-pub mod passes;
-pub mod sampling;
-pub mod settings;
-pub mod sh;
-pub mod stereo;
-pub mod technique;
-pub mod visibility;
+mod ao;
+mod driver;
+mod error;
+mod gpu;
+mod graph;
+mod graph_targets;
+mod passes;
+pub mod plug;
+mod sampling;
+mod settings;
+mod sh;
+mod stereo;
+mod technique;
+mod visibility;
+
+/// The check of WGSL mirrors against naga's layout, for the workspace's tests (feature
+/// `layout-check`); not part of either face.
+#[cfg(any(test, feature = "layout-check"))]
+#[doc(hidden)]
+pub use gpu::layout_check;
 
 pub use ao::{
     AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostLight, HostMotion, HostNormals,
-    ViewMatrices,
+    NormalEncoding, NormalSpace, ViewMatrices,
 };
 pub use error::{Error, Result};
-pub use settings::{AoSettings, Technique};
+pub use graph::Plan;
+pub use settings::{
+    AoSettings, Choice, Denoise, Foveation, GtaoSettings, March, Noise, Quality, Resolution, Technique, Temporal,
+    TemporalBlend,
+};
+pub use stereo::{Eye, EyePair, EyeSide, Fov, HeadPose, InvalidFov};
+pub use visibility::{ViewMask, VisibilityMask};

@@ -5,7 +5,7 @@
 use std::f64::consts::PI;
 
 /// The radical inverse of `index` in `base`: the Halton sequence's `index`-th element.
-pub fn halton(mut index: u32, base: u32) -> f64 {
+pub(crate) fn halton(mut index: u32, base: u32) -> f64 {
     let mut result = 0.0;
     let mut fraction = 1.0 / base as f64;
     while index > 0 {
@@ -37,7 +37,7 @@ pub fn hemisphere_kernel(n: u32, density: HemisphereDensity) -> Vec<[f32; 4]> {
 /// Part `part` of a longer kernel: Halton points part·n + 1 ..= (part + 1)·n, so the
 /// parts 0..k together are the first k·n points, as stratified as one kernel of k·n.
 /// Temporal accumulation gives each frame of its window its own part.
-pub fn hemisphere_kernel_part(part: u32, n: u32, density: HemisphereDensity) -> Vec<[f32; 4]> {
+pub(crate) fn hemisphere_kernel_part(part: u32, n: u32, density: HemisphereDensity) -> Vec<[f32; 4]> {
     (part * n + 1..=(part + 1) * n)
         .map(|i| {
             let azimuth = 2.0 * PI * halton(i, 2);

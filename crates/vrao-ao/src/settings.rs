@@ -3,13 +3,13 @@
 //! passes can trust them; every default lives here.
 
 use crate::error::{Error, Result};
-pub use crate::passes::gtao::GtaoSettings;
+pub use crate::passes::gtao::{GtaoSettings, March};
 pub use crate::technique::Technique;
 
 /// The occlusion radius of [`AoSettings::default`], in the host's world units.
-pub const DEFAULT_RADIUS: f32 = 0.5;
+pub(crate) const DEFAULT_RADIUS: f32 = 0.5;
 /// The most depth taps per pixel an occlusion technique takes (`--samples`).
-pub const SAMPLES_MAX: u32 = 256;
+pub(crate) const SAMPLES_MAX: u32 = 256;
 
 /// A setting chosen by name from a fixed list: what a command line, a file or a panel
 /// offers (the engine has no command line; its host's wraps these).
@@ -34,7 +34,7 @@ pub trait Choice: Copy + PartialEq + std::fmt::Debug + 'static {
 #[doc(hidden)]
 macro_rules! impl_choice {
     ($($t:ty),* $(,)?) => {$(
-        impl $crate::settings::Choice for $t {
+        impl $crate::Choice for $t {
             fn all() -> &'static [Self] {
                 &<$t>::ALL
             }
@@ -50,16 +50,7 @@ macro_rules! impl_choice {
     )*};
 }
 
-crate::impl_choice!(
-    Technique,
-    Quality,
-    BounceForm,
-    Denoise,
-    Foveation,
-    TemporalBlend,
-    Resolution,
-    crate::gpu::BackendChoice
-);
+crate::impl_choice!(Technique, Quality, BounceForm, Denoise, Foveation, TemporalBlend, Resolution);
 
 /// The resolution the occlusion runs at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -431,7 +422,7 @@ impl Default for Temporal {
 }
 
 /// GTAO at the medium preset (N = 24) and full resolution, the tile denoise, no temporal
-/// accumulation and a radius of [`DEFAULT_RADIUS`] in the host's units (half a metre when
+/// accumulation and a radius of `DEFAULT_RADIUS` in the host's units (half a metre when
 /// they are metres). Constant: no scene is consulted. A host sets the radius to the
 /// scale of the detail it wants shaded; vrao's renderer fits it to each scene.
 impl Default for AoSettings {
@@ -461,6 +452,9 @@ impl Default for AoSettings {
 }
 
 impl AoSettings {
+    /// The most samples a technique takes (`SAMPLES_MAX`).
+    pub const SAMPLES_MAX: u32 = SAMPLES_MAX;
+
     /// Checks every value's range; the error names the value and its range.
     pub fn validate(&self) -> Result<()> {
         if !(1..=SAMPLES_MAX).contains(&self.samples) {

@@ -77,7 +77,7 @@ pub fn prefiltered_radiance(irradiance: &[Vec3; 9]) -> [Vec3; 9] {
 /// `frame.environment_quadratics` for up to two views from the irradiance's nine SH
 /// coefficients in world space and each view's world-from-view rotation: the irradiance
 /// of view 0 and 1, then the pre-filtered radiance of view 0 and 1.
-pub fn view_quadratics(irradiance: &[Vec3; 9], world_from_views: &[Mat3]) -> [[[f32; 4]; 10]; 4] {
+pub(crate) fn view_quadratics(irradiance: &[Vec3; 9], world_from_views: &[Mat3]) -> [[[f32; 4]; 10]; 4] {
     let mut out = [[[0.0; 4]; 10]; 4];
     let (e, l) = (sh9_quadratic(irradiance), sh9_quadratic(&prefiltered_radiance(irradiance)));
     for (index, rotation) in world_from_views.iter().enumerate().take(2) {

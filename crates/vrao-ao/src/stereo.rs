@@ -3,18 +3,10 @@
 //! turns a depth sample back into a view-space position; `shaders/common.wgsl` mirrors it.
 
 use crate::error::{Error, Result};
-use glam::{DMat4, DQuat, DVec3, Mat4, Vec3};
+use glam::{DMat4, DQuat, DVec3, Mat4};
 
-/// Default interpupillary distance in metres.
-pub const DEFAULT_IPD: f64 = 0.064;
 /// Default near plane in metres (the far plane is at infinity).
 pub const DEFAULT_NEAR: f64 = 0.05;
-/// The slowest display rate a headset session takes (Hz): Monado's simulated headset
-/// runs at 20 Hz; below 10 Hz nothing is a headset any more.
-pub const REFRESH_HZ_MIN: f64 = 10.0;
-/// The fastest display rate a headset session takes (Hz), well above any headset's 144.
-pub const REFRESH_HZ_MAX: f64 = 500.0;
-
 /// Head (or eye) pose in world space: where it is and which way it faces.
 /// The pose looks down its local −Z with +Y up.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -112,40 +104,42 @@ impl From<InvalidFov> for String {
     }
 }
 
-/// Reversed-Z projection with an infinite far plane for an asymmetric frustum.
-/// Clip z = near and w = −z_view, so depth = near / distance: 1 at the near plane,
-/// 0 at infinity. Built in f64 and rounded once.
-pub fn reversed_z_projection(fov: &Fov, near: f64) -> DMat4 {
-    let [l, r, u, d] = fov.tangents();
-    DMat4::from_cols_array(&[
-        2.0 / (r - l),
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        2.0 / (u - d),
-        0.0,
-        0.0,
-        (r + l) / (r - l),
-        (u + d) / (u - d),
-        0.0,
-        -1.0,
-        0.0,
-        0.0,
-        near,
-        0.0,
-    ])
-}
+impl Fov {
+    /// Reversed-Z projection with an infinite far plane for an asymmetric frustum.
+    /// Clip z = near and w = −z_view, so depth = near / distance: 1 at the near plane,
+    /// 0 at infinity. Built in f64 and rounded once.
+    pub fn reversed_z_projection(&self, near: f64) -> DMat4 {
+        let [l, r, u, d] = self.tangents();
+        DMat4::from_cols_array(&[
+            2.0 / (r - l),
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            2.0 / (u - d),
+            0.0,
+            0.0,
+            (r + l) / (r - l),
+            (u + d) / (u - d),
+            0.0,
+            -1.0,
+            0.0,
+            0.0,
+            near,
+            0.0,
+        ])
+    }
 
-/// View-space position of the surface seen at texture coordinate `uv` (0..1, origin at
-/// the top-left) with reversed-Z depth `depth`. Uses the frustum tangents directly, so
-/// no matrix inverse loses precision. `depth` must be > 0 (0 is the sky at infinity).
-pub fn view_position_from_depth(uv: [f64; 2], depth: f64, fov: &Fov, near: f64) -> DVec3 {
-    let [l, r, u, d] = fov.tangents();
-    let distance = near / depth; // −z_view
-    let tan_x = l + (r - l) * uv[0];
-    let tan_y = u + (d - u) * uv[1];
-    DVec3::new(tan_x * distance, tan_y * distance, -distance)
+    /// View-space position of the surface seen at texture coordinate `uv` (0..1, origin at
+    /// the top-left) with reversed-Z depth `depth`. Uses the frustum tangents directly, so
+    /// no matrix inverse loses precision. `depth` must be > 0 (0 is the sky at infinity).
+    pub fn view_position_from_depth(uv: [f64; 2], depth: f64, fov: &Fov, near: f64) -> DVec3 {
+        let [l, r, u, d] = fov.tangents();
+        let distance = near / depth; // −z_view
+        let tan_x = l + (r - l) * uv[0];
+        let tan_y = u + (d - u) * uv[1];
+        DVec3::new(tan_x * distance, tan_y * distance, -distance)
+    }
 }
 
 /// Which eye; the index is also the texture-array layer.
@@ -178,7 +172,7 @@ impl Eye {
     /// scene far from the origin keeps its precision near the eye.
     pub fn clip_from_anchored(&self, anchor: DVec3, near: f64) -> Mat4 {
         let view = self.view_from_world() * DMat4::from_translation(anchor);
-        (reversed_z_projection(&self.fov, near) * view).as_mat4()
+        (Fov::reversed_z_projection(&self.fov, near) * view).as_mat4()
     }
 
     /// Rotation part of view-from-world, for normals.
@@ -193,7 +187,7 @@ impl Eye {
         if v.z >= 0.0 {
             return None;
         }
-        let clip = reversed_z_projection(&self.fov, near) * v.extend(1.0);
+        let clip = Fov::reversed_z_projection(&self.fov, near) * v.extend(1.0);
         let ndc = clip.truncate() / clip.w;
         Some(([(ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5], ndc.z))
     }
@@ -228,123 +222,36 @@ impl EyePair {
     }
 }
 
-/// A headset's display description: per-eye size, refresh rate and fields of view.
-/// Named real headsets are in `xr::profiles` (above this module).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HeadsetProfile {
-    /// Short name (`vive`, `index`, …).
-    pub name: &'static str,
-    /// Per-eye render width in pixels.
-    pub width: u32,
-    /// Per-eye render height in pixels.
-    pub height: u32,
-    /// The rate in use; `budget_ms` follows it.
-    pub refresh_hz: f64,
-    /// The rates the headset can run at (`with_refresh` picks among them).
-    pub refresh_rates_hz: &'static [f64],
-    /// Interpupillary distance in metres.
-    pub ipd: f64,
-    /// The left eye's field of view.
-    pub fov_left: Fov,
-    /// The right eye's field of view.
-    pub fov_right: Fov,
-}
-
-impl HeadsetProfile {
-    /// An HTC Vive-class headset: 1080×1200 per eye at 90 Hz. The frustum is 52° up and
-    /// down, 45° towards the nose, and outward as wide as square pixels require.
-    /// Size: the Vive's own config, `eye_target_width/height_in_pixels` 1080×1200
-    /// (<https://gist.github.com/ChristophHaag/c6235817421f2ce5da839772eff48f40>); 90 Hz: its
-    /// hmdq dump (<https://risa2000.github.io/hmdgdb/hmd_cfgs/Vive_Native_R90.html>). The
-    /// frustum is an approximation kept as is because earlier measurements used it (the
-    /// dump measures 54.4° out, 46.8° nasal, 55.7° up, 55.9° down).
-    pub fn vive() -> HeadsetProfile {
-        HeadsetProfile::with_size("vive", 1080, 1200)
+impl Eye {
+    /// The world-space direction (unit) through the centre of `pixel` of an eye whose image
+    /// is `size` pixels (x right, y down from the top-left corner).
+    pub fn pixel_ray(&self, size: (u32, u32), pixel: (f64, f64)) -> DVec3 {
+        let [l, r, u, d] = self.fov.tangents();
+        let (s, t) = (pixel.0 / size.0 as f64, pixel.1 / size.1 as f64);
+        (self.pose.orientation * DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0)).normalize()
     }
-
-    /// The Vive-class frustum for another per-eye size, keeping pixels square.
-    pub fn with_size(name: &'static str, width: u32, height: u32) -> HeadsetProfile {
-        let tan_vertical = 52f64.to_radians().tan();
-        let tan_inward = 45f64.to_radians().tan();
-        let tan_outward = 2.0 * tan_vertical * width as f64 / height as f64 - tan_inward;
-        let left_eye = Fov {
-            left: -(tan_outward.atan() as f32),
-            right: tan_inward.atan() as f32,
-            up: tan_vertical.atan() as f32,
-            down: -(tan_vertical.atan() as f32),
-        };
-        HeadsetProfile {
-            name,
-            width,
-            height,
-            refresh_hz: 90.0,
-            refresh_rates_hz: &[90.0],
-            ipd: DEFAULT_IPD,
-            fov_left: left_eye,
-            fov_right: left_eye.mirrored(),
-        }
-    }
-
-    /// The same headset rendered at another per-eye size, keeping its field of view (the
-    /// pixels stop being square when the aspect differs from the frustum's).
-    pub fn with_render_size(self, width: u32, height: u32) -> HeadsetProfile {
-        HeadsetProfile { width, height, ..self }
-    }
-
-    /// The same headset at another refresh rate: any rate within
-    /// [`REFRESH_HZ_MIN`]..=[`REFRESH_HZ_MAX`] (a runtime may run a headset at a rate its
-    /// product sheet does not list, such as Monado's simulated 20 Hz; the simulated
-    /// headset takes any of them). A rate outside is `Error::Input` naming the range and
-    /// the rates the real headset lists.
-    pub fn with_refresh(self, hz: f64) -> Result<HeadsetProfile> {
-        // A listed rate parsed from text (e.g. "72.0") is taken exactly as listed.
-        if let Some(&rate) = self.refresh_rates_hz.iter().find(|&&r| (r - hz).abs() < 1e-6) {
-            return Ok(HeadsetProfile { refresh_hz: rate, ..self });
-        }
-        if hz.is_finite() && (REFRESH_HZ_MIN..=REFRESH_HZ_MAX).contains(&hz) {
-            return Ok(HeadsetProfile { refresh_hz: hz, ..self });
-        }
-        let rates: Vec<String> = self.refresh_rates_hz.iter().map(|r| r.to_string()).collect();
-        Err(Error::input(format!(
-            "refresh rate {hz:?} Hz is not within {REFRESH_HZ_MIN}..={REFRESH_HZ_MAX} Hz (headset profile '{}' lists {} Hz)",
-            self.name,
-            rates.join(", ")
-        )))
-    }
-
-    /// The frame budget in milliseconds (one refresh period).
-    pub fn budget_ms(&self) -> f64 {
-        1000.0 / self.refresh_hz
-    }
-
-    /// Both eyes of this headset for a head pose: [`EyePair::from_head`] with its IPD and
-    /// fields of view.
-    pub fn eyes(&self, head: &HeadPose, near: f64) -> EyePair {
-        EyePair::from_head(head, self.ipd, self.fov_left, self.fov_right, near)
-    }
-}
-
-/// Helper for tests and tools: the unit vector a pose looks along.
-pub fn forward(pose: &HeadPose) -> Vec3 {
-    (pose.orientation * -DVec3::Z).as_vec3()
-}
-
-/// The world-space direction (unit) through the centre of `pixel` of an eye whose image
-/// is `size` pixels (x right, y down from the top-left corner).
-pub fn pixel_ray(eye: &Eye, size: (u32, u32), pixel: (f64, f64)) -> DVec3 {
-    let [l, r, u, d] = eye.fov.tangents();
-    let (s, t) = (pixel.0 / size.0 as f64, pixel.1 / size.1 as f64);
-    (eye.pose.orientation * DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0)).normalize()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A Vive-class left-eye frustum (52° up and down, 45° nasal, 55.6° out).
+    fn vive_fov() -> Fov {
+        let (vertical, inward) = (52f64.to_radians().tan(), 45f64.to_radians().tan());
+        let outward = 2.0 * vertical * 1080.0 / 1200.0 - inward;
+        Fov {
+            left: -(outward.atan() as f32),
+            right: inward.atan() as f32,
+            up: vertical.atan() as f32,
+            down: -(vertical.atan() as f32),
+        }
+    }
+
     #[test]
     fn projection_maps_near_plane_to_one_and_infinity_to_zero() {
-        let fov = HeadsetProfile::vive().fov_left;
-        let p = reversed_z_projection(&fov, 0.1);
+        let fov = vive_fov();
+        let p = Fov::reversed_z_projection(&fov, 0.1);
         let near = p * glam::DVec4::new(0.0, 0.0, -0.1, 1.0);
         assert!((near.z / near.w - 1.0).abs() < 1e-12);
         let far = p * glam::DVec4::new(0.0, 0.0, -1e12, 1.0);
@@ -353,9 +260,9 @@ mod tests {
 
     #[test]
     fn frustum_edges_map_to_ndc_edges() {
-        let fov = HeadsetProfile::vive().fov_left;
+        let fov = vive_fov();
         let [l, r, u, d] = fov.tangents();
-        let p = reversed_z_projection(&fov, 0.05);
+        let p = Fov::reversed_z_projection(&fov, 0.05);
         for (x, y, ex, ey) in [(l, u, -1.0, 1.0), (r, d, 1.0, -1.0)] {
             let c = p * glam::DVec4::new(x * 3.0, y * 3.0, -3.0, 1.0);
             assert!((c.x / c.w - ex).abs() < 1e-12 && (c.y / c.w - ey).abs() < 1e-12);
@@ -364,36 +271,17 @@ mod tests {
 
     #[test]
     fn depth_round_trip_is_exact_in_f32_from_5cm_to_10km() {
-        let fov = HeadsetProfile::vive().fov_right;
+        let fov = vive_fov().mirrored();
         let near = DEFAULT_NEAR;
         let eye = Eye { side: EyeSide::Right, pose: HeadPose::IDENTITY, fov };
         for distance in [0.05, 0.3, 1.0, 17.0, 250.0, 1e3, 1e4] {
             let world = DVec3::new(0.2 * distance, -0.1 * distance, -distance);
             let (uv, depth) = eye.project(world, near).unwrap();
             let depth32 = depth as f32 as f64; // what a Depth32Float target stores
-            let back = view_position_from_depth(uv, depth32, &fov, near);
+            let back = Fov::view_position_from_depth(uv, depth32, &fov, near);
             let rel = (back - world).length() / world.length();
             assert!(rel < 1e-6, "distance {distance}: relative error {rel}");
         }
-    }
-
-    #[test]
-    fn vive_profile_has_square_pixels_and_mirrored_eyes() {
-        let p = HeadsetProfile::vive();
-        let [l, r, u, d] = p.fov_left.tangents();
-        let aspect = (r - l) / (u - d);
-        assert!((aspect - 1080.0 / 1200.0).abs() < 1e-6);
-        assert_eq!(p.fov_right.left, -p.fov_left.right);
-        assert!((p.budget_ms() - 11.111).abs() < 1e-3);
-    }
-
-    #[test]
-    fn eyes_are_ipd_apart_along_head_right() {
-        let head = HeadPose::look_at(DVec3::new(1.0, 1.6, 2.0), DVec3::new(-3.0, 1.0, -1.0)).unwrap();
-        let pair = HeadsetProfile::vive().eyes(&head, DEFAULT_NEAR);
-        let delta = pair.eyes[1].pose.position - pair.eyes[0].pose.position;
-        assert!((delta.length() - DEFAULT_IPD).abs() < 1e-12);
-        assert!(delta.dot(head.orientation * DVec3::X) > 0.0, "right eye is to the right");
     }
 
     #[test]

@@ -95,7 +95,7 @@ pub enum FoveationRule {
 }
 
 /// What makes a technique's pass for the engine's chain.
-pub type MakePass = fn(&Gpu) -> Box<dyn Pass>;
+pub(crate) type MakePass = fn(&Gpu) -> Box<dyn Pass>;
 
 /// One technique's line of the table.
 #[derive(Clone, Copy, Debug)]
@@ -121,7 +121,7 @@ pub struct TechniqueEntry {
 }
 
 /// Every technique, in the order the CLI and the bench list them.
-pub const TECHNIQUES: [TechniqueEntry; 9] = [
+pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
     TechniqueEntry {
         technique: Technique::None,
         name: "none",
@@ -226,12 +226,12 @@ impl Technique {
         all
     };
 
-    /// The technique's line of [`TECHNIQUES`].
+    /// The technique's line of `TECHNIQUES`.
     pub fn entry(self) -> &'static TechniqueEntry {
         TECHNIQUES.iter().find(|e| e.technique == self).expect("every technique has a line (checked by a test)")
     }
 
-    /// Every technique's name in [`TECHNIQUES`]' order with its help in brackets (the
+    /// Every technique's name in `TECHNIQUES`' order with its help in brackets (the
     /// default's marked), the last after "or": the list the command line's help shows.
     pub fn help_list() -> String {
         let items: Vec<String> = TECHNIQUES
@@ -259,7 +259,7 @@ impl Technique {
     }
 
     /// True for the techniques whose occlusion targets carry gathered light in rgb
-    /// ([`TechniqueKind::LightGathering`]); the others write AO in alpha alone (rgb 0),
+    /// (`LightGathering`); the others write AO in alpha alone (rgb 0),
     /// so the denoise filters alpha alone for them.
     pub fn carries_light(self) -> bool {
         self.entry().kind == TechniqueKind::LightGathering

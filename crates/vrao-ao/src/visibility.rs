@@ -20,10 +20,10 @@ use glam::Vec2;
 
 /// Full-resolution pixels on a side of one tile of [`RateMap`]'s first level (a full
 /// resolution workgroup's 8×8 pixels).
-pub const TILE_PIXELS: u32 = 8;
+pub(crate) const TILE_PIXELS: u32 = 8;
 
 /// The most triangles one view's mask may hold (runtimes give tens to a few hundred).
-pub const MAX_MASK_TRIANGLES: usize = 65_536;
+pub(crate) const MAX_MASK_TRIANGLES: usize = 65_536;
 
 /// Where a mask's triangles lie: on the pixels the lens hides, or on those it shows.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +44,9 @@ pub struct ViewMask {
 }
 
 impl ViewMask {
+    /// The most triangles one view's mask takes (`MAX_MASK_TRIANGLES`).
+    pub const MAX_TRIANGLES: usize = MAX_MASK_TRIANGLES;
+
     /// A mask from a runtime's hidden triangle mesh (indexed, three indices a triangle).
     /// Indices out of range, a count that is not a multiple of three, too many triangles
     /// or a vertex that is not finite is `Error::Input`.
@@ -194,7 +197,7 @@ pub struct VisibilityMask {
 /// One view's map: per tile the share of the full sample count its pixels spend (0: the
 /// lens hides the whole tile), as bytes (255 = 1), at two tile sizes.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RateMap {
+pub(crate) struct RateMap {
     /// Tiles per row of the first level (8×8 pixels each), even so that the second
     /// level's tiles are exactly 2×2 of them.
     pub width: u32,
@@ -209,7 +212,13 @@ pub struct RateMap {
 impl RateMap {
     /// The map of a `width` × `height` view with frustum `tangents`, its pixels' coverage
     /// ([`ViewMask::coverage`]; `None`: every pixel shown) and `foveation`.
-    pub fn new(width: u32, height: u32, tangents: [f64; 4], coverage: Option<&[u8]>, foveation: &FoveationMap) -> Self {
+    pub(crate) fn new(
+        width: u32,
+        height: u32,
+        tangents: [f64; 4],
+        coverage: Option<&[u8]>,
+        foveation: &FoveationMap,
+    ) -> Self {
         let tiles_x = width.div_ceil(2 * TILE_PIXELS) * 2;
         let tiles_y = height.div_ceil(2 * TILE_PIXELS) * 2;
         let [left, right, up, down] = tangents;

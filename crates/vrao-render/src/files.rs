@@ -10,10 +10,10 @@
 //!   file that has more is refused;
 //! - named in the error: [`FileError`] carries the path and a typed [`FileProblem`].
 
-use crate::error::Error;
 use std::fmt;
 use std::io::Read;
 use std::path::{Path, PathBuf};
+use vrao_ao::Error;
 
 /// The largest model, texture, environment map, glTF buffer or image file read (1 GiB).
 pub const MAX_FILE_BYTES: u64 = 1 << 30;

@@ -1,13 +1,12 @@
 //! The scene's lights and environment as the frame uniforms hold them: in each view's
 //! space, for the engine's [`FrameLighting`].
 
-use crate::gpu::uniforms::{FrameLighting, LightUniform};
-use crate::scene::environment::quadratic_in_view;
 use crate::scene::{spot_ramp, Light, Scene};
 use crate::settings::Settings;
-use crate::stereo::Eye;
 use bytemuck::Zeroable;
 use glam::{DVec3, Mat3, Vec3};
+use vrao_ao::plug::{quadratic_in_view, FrameLighting, LightUniform};
+use vrao_ao::Eye;
 
 /// A frame's lights and environment in each of its views' space.
 pub struct ViewLighting {

@@ -8,25 +8,22 @@
 //! frames later in [`FrameReport::finished`]. Only pixel readbacks and
 //! [`Renderer::render_and_wait`] (measurements) wait.
 
-use crate::error::{Error, Result};
-use crate::gpu::layered_target::LayeredTarget;
-use crate::gpu::readback;
+use crate::gpu::direct_readback::decode_direct;
 use crate::gpu::scene::GpuScene;
-use crate::gpu::timing::{FrameTiming, PassTimer};
-use crate::gpu::Gpu;
-use crate::graph::{Plan, Resource};
 use crate::lighting::ViewLighting;
-use crate::passes::{self, ChainSettings, FrameMotion, MoverBox, Pass};
+use crate::passes;
 use crate::scene::{Aabb, Scene};
 use crate::settings::{Settings, StereoMode};
-use crate::stereo::Eye;
-use crate::visibility::VisibilityMask;
 use glam::DVec3;
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
-use vrao_ao::driver::{FrameParams, GraphDriver, Submission};
+use vrao_ao::plug::{
+    ao_chain, read_layers, read_layers_f32, ChainSettings, FrameMotion, FrameParams, FrameTiming, Gpu, GraphDriver,
+    LayeredTarget, MoverBox, Pass, PassTimer, Resource, Submission,
+};
+use vrao_ao::{Error, Eye, Plan, Result, VisibilityMask};
 
 /// Frames the renderer lets the GPU work on at once unless told otherwise.
 pub const DEFAULT_FRAMES_IN_FLIGHT: usize = 2;
@@ -173,7 +170,7 @@ impl Renderer {
         let driver = GraphDriver::new(&gpu, scene.lights.len(), PassTimer::new(&gpu)?);
         let passes = RendererPasses {
             scene: passes::scene_passes(&gpu, scene, &gpu_scene, driver.uniforms()),
-            ao_chain: passes::ao_chain(&gpu, vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]),
+            ao_chain: ao_chain(&gpu, vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]),
             output: passes::output_passes(&gpu),
         };
         if gpu.builds_cancelled() {
@@ -503,7 +500,7 @@ impl Renderer {
     /// Raw bytes per layer of a resource the last frame produced.
     pub fn read_bytes(&self, r: Resource) -> Result<Vec<Vec<u8>>> {
         let target = self.kept_target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
-        readback::read_layers(&self.gpu, &target)
+        read_layers(&self.gpu, &target)
     }
 
     /// Values per layer (channels interleaved) of a float or depth resource; the packed
@@ -511,9 +508,9 @@ impl Renderer {
     pub fn read_f32(&self, r: Resource) -> Result<Vec<Vec<f32>>> {
         let target = self.kept_target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
         if target.format == passes::direct::DIRECT.format() {
-            return Ok(readback::decode_direct(readback::read_layers(&self.gpu, &target)?));
+            return Ok(decode_direct(read_layers(&self.gpu, &target)?));
         }
-        readback::read_layers_f32(&self.gpu, &target)
+        read_layers_f32(&self.gpu, &target)
     }
 }
 
@@ -539,7 +536,7 @@ fn mover_bounds(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, Aabb)> {
 struct RendererPasses {
     /// Before the AO chain (G-buffer, lights): [`passes::scene_passes`].
     scene: Vec<Box<dyn Pass>>,
-    /// The engine's AO chain ([`passes::ao_chain`]) over the G-buffer's depth and normals,
+    /// The engine's AO chain ([`ao_chain`]) over the G-buffer's depth and normals,
     /// with the renderer's SSDO among its techniques.
     ao_chain: Vec<Box<dyn Pass>>,
     /// After the AO chain (composite, tone mapping): [`passes::output_passes`].

@@ -1,12 +1,12 @@
 //! Render settings, validated once so passes can trust them: the engine's AO settings
-//! ([`vrao_ao::settings`], re-exported here) and the renderer's own around them.
+//! ([`vrao_ao::AoSettings`]) and the renderer's own around them.
 
-use crate::error::{Error, Result};
+use crate::headset::HeadsetProfile;
 use crate::passes::shadow::suggested_rsm_radius;
 use crate::scene::{Scene, RENDER_DEFAULT};
-use crate::stereo::{HeadsetProfile, DEFAULT_NEAR};
 use std::sync::OnceLock;
-pub use vrao_ao::settings::*;
+use vrao_ao::plug::DEFAULT_NEAR;
+use vrao_ao::{AoSettings, Error, Result};
 
 /// A scene's default occlusion radius is this fraction of its bounding-box diagonal
 /// ([`Scene::suggested_ao_radius`]), kept within [`AO_RADIUS_MIN`]..=[`AO_RADIUS_MAX`].
@@ -58,7 +58,7 @@ impl StereoMode {
     }
 }
 
-vrao_ao::impl_choice!(StereoMode, DisplayMode, crate::renderer::TimingChoice);
+vrao_ao::impl_choice!(StereoMode, DisplayMode, crate::renderer::TimingChoice, crate::gpu::open::BackendChoice);
 
 /// What the desktop window shows (Belonogov 2018 §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -203,7 +203,8 @@ impl Settings {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+
+    use vrao_ao::Foveation;
 
     #[test]
     fn foveation_maps_keep_full_rate_near_the_axis_and_fall_monotonically_to_their_edge_rate() {

@@ -1,8 +1,8 @@
 //! Tests of `governor.rs`.
 
 use super::*;
-use crate::render::settings::Resolution;
 use crate::xr::simulated::compositor::{Clock, Compositor, VsyncOutcome};
+use vrao_ao::Resolution;
 
 /// A bench file of rows (technique, samples, half, temporal, radius, ms per eye, RMSE).
 type Row<'a> = (&'a str, u32, bool, bool, f32, f64, Option<f64>);
@@ -383,7 +383,7 @@ fn the_frontier_keeps_the_strictly_pareto_optimal_rows_of_the_nearest_radius() {
     let e = Frontier::from_bench(&no_errors, 0.5).unwrap_err().to_string();
     assert!(e.contains("'synthetic'") && e.contains("AO error"), "{e}");
     let e = Frontier::from_json("{}", std::path::Path::new("my.json"), 0.5).unwrap_err();
-    assert_eq!(e.exit_code(), crate::render::error::EXIT_INPUT);
+    assert_eq!(e.exit_code(), crate::error::EXIT_INPUT);
     let e = e.to_string();
     assert!(e.starts_with("my.json:1: not a vrao bench file"), "{e}");
 }

@@ -1,7 +1,7 @@
 //! Tests of `analytic.rs`.
 
 use super::*;
-use crate::render::sampling::{hemisphere_kernel, HemisphereDensity};
+use vrao_ao::plug::{hemisphere_kernel, HemisphereDensity};
 
 const R: f64 = 1.0;
 
@@ -227,9 +227,10 @@ fn hbao_slices_integrate_to_the_falloff_reference() {
 }
 
 fn crease_eye() -> Eye {
-    use crate::render::stereo::{EyeSide, HeadsetProfile};
+    use vrao_ao::EyeSide;
+    use vrao_render::HeadsetProfile;
     let target = DVec3::new(0.0, 0.0, CREASE_WALL_Z);
-    let pose = crate::render::stereo::HeadPose::look_at(target + DVec3::new(0.0, 1.8, 1.8), target).unwrap();
+    let pose = vrao_ao::HeadPose::look_at(target + DVec3::new(0.0, 1.8, 1.8), target).unwrap();
     Eye { side: EyeSide::Left, pose, fov: HeadsetProfile::with_size("t", 160, 180).fov_left }
 }
 
@@ -244,7 +245,7 @@ fn hbao_on_an_open_floor_is_one_and_on_the_crease_near_the_reference() {
     // Walk down the middle column from the crease line towards the eye.
     let mut seen = 0;
     for y in 95..180 {
-        let dir = pixel_ray(&eye, size, (80.5, y as f64 + 0.5));
+        let dir = vrao_ao::Eye::pixel_ray(&eye, size, (80.5, y as f64 + 0.5));
         let Some(t) = hit(eye.pose.position, dir) else { continue };
         let p = eye.pose.position + dir * t;
         if p.y.abs() > 1e-9 {
@@ -274,6 +275,6 @@ fn pixel_ray_matches_projection() {
     let size = (160, 180);
     let p = DVec3::new(0.3, 0.0, CREASE_WALL_Z + 0.4);
     let (uv, _) = eye.project(p, 0.05).unwrap();
-    let dir = pixel_ray(&eye, size, (uv[0] * 160.0, uv[1] * 180.0));
+    let dir = vrao_ao::Eye::pixel_ray(&eye, size, (uv[0] * 160.0, uv[1] * 180.0));
     assert!(dir.dot((p - eye.pose.position).normalize()) > 1.0 - 1e-12);
 }

@@ -94,7 +94,7 @@ pub const DARK_REFERENCE: f32 = 0.8;
 
 /// Pixels per degree of an eye `width` pixels across its horizontal field of view (the
 /// mean over the field: a Vive-class 1080-pixel eye over ~97.5° has ~11.1).
-pub fn pixels_per_degree(fov: &crate::render::stereo::Fov, width: u32) -> f64 {
+pub fn pixels_per_degree(fov: &vrao_ao::Fov, width: u32) -> f64 {
     width as f64 / (fov.right as f64 - fov.left as f64).to_degrees()
 }
 
@@ -103,7 +103,7 @@ pub fn pixels_per_degree(fov: &crate::render::stereo::Fov, width: u32) -> f64 {
 /// central field of the project's Vive-class headset profile at the reference's size
 /// (what [`score`] takes from the frame's eyes), no screen-space limit.
 pub fn error_figures(technique: Technique, occlusion: &[Vec<f32>], reference: &ReferenceImage) -> ErrorFigures {
-    let profile = crate::render::stereo::HeadsetProfile::with_size("vive", reference.width, reference.height);
+    let profile = vrao_render::HeadsetProfile::with_size("vive", reference.width, reference.height);
     let fovs = [profile.fov_left, profile.fov_right];
     score(technique, occlusion, reference, None, pixels_per_degree(&profile.fov_left, reference.width), &fovs)
 }
@@ -117,7 +117,7 @@ pub fn score(
     reference: &ReferenceImage,
     limit: Option<&ScreenLimit>,
     pixels_per_degree: f64,
-    fovs: &[crate::render::stereo::Fov],
+    fovs: &[vrao_ao::Fov],
 ) -> ErrorFigures {
     let limit = limit.filter(|l| l.grid_size() == reference.grid_size() && l.layers.len() >= reference.layers.len());
     let (gw, gh) = reference.grid_size();
@@ -204,7 +204,7 @@ fn eye_cells(
     reference: &ReferenceImage,
     layer: usize,
     limit: Option<&ScreenLimit>,
-    fov: Option<crate::render::stereo::Fov>,
+    fov: Option<vrao_ao::Fov>,
 ) -> Vec<Cell> {
     let (w, h) = (reference.width as usize, reference.height as usize);
     // A pixel centre's tangents off the view axis, as the projection lays them out.

@@ -3,7 +3,8 @@
 
 // The bench's types and imports (this file is a part of bench.rs split out for size).
 use super::*;
-use crate::render::passes::{blur, composite, peel, upsample};
+use vrao_ao::plug::{BLUR_PASS, UPSAMPLE_PASS};
+use vrao_render::passes::{composite, peel};
 
 /// The records of measured rows, with the Pareto front marked.
 pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
@@ -23,8 +24,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 mask: c.mask,
                 ao_rmse_whole: row.error.as_ref().and_then(|e| e.ao_rmse_whole),
                 technique_ms_per_eye: per_eye(name),
-                blur_ms_per_eye: per_eye(blur::NAME),
-                upsample_ms_per_eye: per_eye(upsample::NAME),
+                blur_ms_per_eye: per_eye(BLUR_PASS),
+                upsample_ms_per_eye: per_eye(UPSAMPLE_PASS),
                 occlusion_ms_per_eye: row.occlusion_ms_per_eye(),
                 p75_over_p25: spread,
                 ao_rmse: row.error.as_ref().map(|e| e.ao_rmse),
@@ -483,7 +484,7 @@ pub fn to_json(file: &BenchFile) -> String {
 
 /// Reads a bench JSON file (for `vrao budget --fit`).
 pub fn read_json(path: &std::path::Path) -> Result<BenchFile> {
-    let text = crate::render::files::read_regular_file_to_string(path, crate::render::files::MAX_TEXT_BYTES)?;
+    let text = vrao_render::files::read_regular_file_to_string(path, vrao_render::files::MAX_TEXT_BYTES)?;
     BenchFile::from_json(&text, path)
 }
 

@@ -5,16 +5,17 @@ use super::{
     estimate_seconds, mark_pareto, markdown_report, measure_rsm, pixels_per_degree, plot, read_json, records, sweep,
     to_csv, to_json, BenchCase, BenchFile, BenchRecord, BenchRow, LimitInfo, Measurement, ReferenceInfo, Resolution,
 };
+use crate::error::{Error, Result};
 use crate::measure::reference::{trace_cached_visible, ProgressBar, ReferenceImage, ReferenceSettings};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::renderer::TimingChoice;
-use crate::render::scene::Scene;
-use crate::render::settings::Foveation;
-use crate::render::settings::{Settings, Technique};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use vrao_ao::plug::Gpu;
+use vrao_ao::{Foveation, Technique};
+use vrao_render::renderer::TimingChoice;
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
+use vrao_render::BackendChoice;
 
 /// What a bench sweeps and how it measures.
 #[derive(Clone, Debug)]
@@ -126,7 +127,7 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
     };
     let cases = cases(options, &radii);
     check_options(scene, base, options, &cases)?;
-    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let gpu = Arc::new(vrao_render::open(options.backend)?);
     let info = gpu.info.clone();
     let timing = options.timing.resolve(&gpu);
     let (width, height) = (base.profile.width, base.profile.height);
@@ -214,7 +215,7 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
             case.technique,
             case.samples,
             case.radius,
-            crate::render::settings::Resolution::from_half_res(case.half_res),
+            vrao_ao::Resolution::from_half_res(case.half_res),
             case.depth_peeling,
         );
         s.validate()?;
@@ -222,7 +223,7 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
             return Err(Error::input("the bench's techniques include none, which has no occlusion to measure"));
         }
     }
-    if !options.rsm_samples.is_empty() && crate::render::passes::shadow::shadow_casters(scene).is_empty() {
+    if !options.rsm_samples.is_empty() && vrao_render::passes::shadow::shadow_casters(scene).is_empty() {
         return Err(Error::input(format!(
             "reflective shadow map rows: '{}' has no directional light to bounce",
             scene.name
@@ -310,7 +311,7 @@ fn rsm_rows(
 fn trace_references(
     scene: &Scene,
     base: &Settings,
-    eyes: &[crate::render::stereo::Eye],
+    eyes: &[vrao_ao::Eye],
     radii: &[f32],
     options: &ReferenceOptions,
     coverage: Option<&[Option<Vec<u8>>]>,

@@ -2,7 +2,8 @@
 
 use super::errors::near_depth_edge;
 use super::*;
-use crate::render::passes::{blur, gbuffer};
+use vrao_ao::plug::{BLUR_PASS, UPSAMPLE_PASS};
+use vrao_render::passes::gbuffer;
 
 fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
     let span = |label: &str, median_ms| SpanSummary {
@@ -25,10 +26,10 @@ fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
             foveation: Foveation::Off,
             mask: false,
         },
-        spans: vec![span(technique.name(), ms), span(blur::NAME, 2.0), span(gbuffer::NAME, 50.0)],
+        spans: vec![span(technique.name(), ms), span(BLUR_PASS, 2.0), span(gbuffer::NAME, 50.0)],
         views: 2,
         pass: technique.name(),
-        occlusion_passes: vec![technique.name(), blur::NAME],
+        occlusion_passes: vec![technique.name(), BLUR_PASS],
         error: Some(ErrorFigures {
             ao_rmse,
             ao_rmse_central: Some(ao_rmse),
@@ -145,11 +146,11 @@ fn csv_markdown_and_json_hold_every_row() {
 #[test]
 fn a_pass_that_ran_without_a_span_is_an_error_not_zero_ms() {
     let spans = row(Technique::Ssao, 10.0, 0.1).spans;
-    assert!(check_timed(&[Technique::Ssao.name(), blur::NAME, gbuffer::NAME], &spans).is_ok());
-    let error = check_timed(&[Technique::Ssao.name(), crate::render::passes::upsample::NAME], &spans).unwrap_err();
+    assert!(check_timed(&[Technique::Ssao.name(), BLUR_PASS, gbuffer::NAME], &spans).is_ok());
+    let error = check_timed(&[Technique::Ssao.name(), UPSAMPLE_PASS], &spans).unwrap_err();
     assert!(error.to_string().contains("'upsample'"), "{error}");
     // A pass that did not run reads 0 ms.
-    assert_eq!(row(Technique::Ssao, 10.0, 0.1).median_ms(crate::render::passes::upsample::NAME), 0.0);
+    assert_eq!(row(Technique::Ssao, 10.0, 0.1).median_ms(UPSAMPLE_PASS), 0.0);
 }
 
 #[test]

@@ -2,15 +2,17 @@
 //! file (the least AO error that fits the budget), and measure it.
 
 use super::{run, BudgetReport, BudgetRun, Scope};
+use crate::error::{Error, Result};
 use crate::measure::bench::{BenchFile, BenchRecord};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::{BackendChoice, Gpu};
-use crate::render::passes::tonemap::COLOR;
-use crate::render::renderer::{Renderer, TimingChoice};
-use crate::render::scene::Scene;
-use crate::render::settings::{AoSettings, Settings, Technique};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use vrao_ao::plug::Gpu;
+use vrao_ao::{AoSettings, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::renderer::{Renderer, TimingChoice};
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
+use vrao_render::BackendChoice;
 
 /// How [`measure_budget`] measures.
 #[derive(Clone, Debug)]
@@ -64,15 +66,15 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
         Some(path) => Some((crate::measure::bench::read_json(path)?, path)),
         None => None,
     };
-    let gpu = Arc::new(Gpu::new(options.backend)?);
+    let gpu = Arc::new(vrao_render::open(options.backend)?);
     let timing = options.timing.resolve(&gpu);
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
     let measure = |settings: &Settings, frames: u32| -> Result<BudgetReport> {
         let output = if options.occlusion_only {
-            if settings.ao.technique == crate::render::settings::Technique::None {
+            if settings.ao.technique == vrao_ao::Technique::None {
                 return Err(Error::input("measuring the occlusion alone needs an occlusion technique, not none"));
             }
-            crate::render::graph::FINAL_AO
+            vrao_ao::plug::FINAL_AO
         } else {
             COLOR
         };
@@ -134,7 +136,7 @@ pub fn fit_setting(
     let left_per_eye = budget_ms / 2.0 - base_ms;
     let chosen = choose_row(file, path, settings.ao.radius, left_per_eye, base_ms, &mut notes)?;
     let mut ao = settings.ao.clone();
-    ao.technique = chosen.technique.parse().map_err(|e: Error| Error::in_file(path, e.to_string()))?;
+    ao.technique = chosen.technique.parse().map_err(|e: vrao_ao::Error| Error::in_file(path, e.to_string()))?;
     ao.samples = chosen.samples;
     ao.radius = chosen.radius_m;
     ao.resolution = chosen.resolution;

@@ -23,10 +23,10 @@
 //! with a warning and traced again (and overwritten).
 
 use super::{grid_size, Progress, ReferenceImage, ReferencePixel, ReferenceSettings, ReferenceStats};
-use crate::render::error::{Error, Result};
-use crate::render::scene::{Filter, Light, Scene, Texture, Wrap};
-use crate::render::stereo::Eye;
+use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
+use vrao_ao::Eye;
+use vrao_render::scene::{Filter, Light, Scene, Texture, Wrap};
 
 /// Version of the cache file layout.
 pub const FORMAT_VERSION: u32 = 2;
@@ -37,7 +37,7 @@ const HEADER_BYTES: usize = 8 + 4 + 8 + 6 * 4 + 8 + 4 * 8 + 8;
 
 /// FNV-1a, 64 bit: stable across runs, platforms and Rust versions (unlike std's hasher).
 #[derive(Clone, Copy, Debug)]
-pub struct Fnv64(u64);
+pub(super) struct Fnv64(u64);
 
 impl Default for Fnv64 {
     fn default() -> Self {
@@ -46,7 +46,7 @@ impl Default for Fnv64 {
 }
 
 impl Fnv64 {
-    pub fn bytes(&mut self, bytes: &[u8]) {
+    pub(super) fn bytes(&mut self, bytes: &[u8]) {
         let mut h = self.0;
         for &b in bytes {
             h ^= b as u64;
@@ -54,24 +54,24 @@ impl Fnv64 {
         }
         self.0 = h;
     }
-    pub fn u32(&mut self, v: u32) {
+    pub(super) fn u32(&mut self, v: u32) {
         self.bytes(&v.to_le_bytes());
     }
-    pub fn u64(&mut self, v: u64) {
+    pub(super) fn u64(&mut self, v: u64) {
         self.bytes(&v.to_le_bytes());
     }
-    pub fn f32s(&mut self, v: &[f32]) {
+    pub(super) fn f32s(&mut self, v: &[f32]) {
         self.u64(v.len() as u64);
         for x in v {
             self.u32(x.to_bits());
         }
     }
-    pub fn f64s(&mut self, v: &[f64]) {
+    pub(super) fn f64s(&mut self, v: &[f64]) {
         for x in v {
             self.u64(x.to_bits());
         }
     }
-    pub fn finish(&self) -> u64 {
+    pub(super) fn finish(&self) -> u64 {
         self.0
     }
 }
@@ -281,7 +281,7 @@ pub fn write_cache(path: &Path, key: u64, image: &ReferenceImage) -> Result<()> 
 
 /// Reads the image stored under `key` at `path`; the error says why it is unusable.
 pub fn read_cache(path: &Path, key: u64) -> std::result::Result<ReferenceImage, UnusableCache> {
-    let bytes = crate::render::files::read_regular_file(path, crate::render::files::MAX_FILE_BYTES)
+    let bytes = vrao_render::files::read_regular_file(path, vrao_render::files::MAX_FILE_BYTES)
         .map_err(|e| UnusableCache(e.problem.to_string()))?;
     decode(&bytes, key)
 }

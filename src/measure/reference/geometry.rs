@@ -10,8 +10,7 @@
 //! where the GPU minifies, its mip average and the tracer's full-size texel differ as the
 //! texture's detail does.
 
-use crate::render::error::{Error, Result};
-use crate::render::scene::{Filter, Material, Mesh, Sampling, Scene, Texture};
+use crate::error::{Error, Result};
 use glam::{DVec3, Vec2, Vec3, Vec3A, Vec4};
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
@@ -19,6 +18,7 @@ use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 use std::sync::OnceLock;
 use std::time::Duration;
+use vrao_render::scene::{Filter, Material, Mesh, Sampling, Scene, Texture};
 
 /// A triangle's vertices relative to the anchor.
 #[derive(Clone, Copy, Debug)]
@@ -229,7 +229,7 @@ impl SceneGeometry {
     /// Flattens `scene` relative to `anchor` and builds the BVH. Triangles with a
     /// non-finite vertex or no area are left out (they rasterise to nothing); an index or
     /// material out of range is an input error.
-    pub fn build(scene: &Scene, anchor: DVec3) -> Result<SceneGeometry> {
+    pub(super) fn build(scene: &Scene, anchor: DVec3) -> Result<SceneGeometry> {
         // A scene that moves is traced frozen: callers pass `Scene::at_time` of the
         // frame's time; one that is not frozen is traced at time 0.
         let frozen;
@@ -260,7 +260,7 @@ impl SceneGeometry {
     }
 
     #[cfg(test)]
-    pub fn triangle_count(&self) -> usize {
+    pub(super) fn triangle_count(&self) -> usize {
         self.tris.len()
     }
 
@@ -284,7 +284,7 @@ impl SceneGeometry {
 
     /// The closest hit with t in (`tmin`, `tmax`) along unit `dir` from `origin`, ignoring
     /// triangle `skip` (`u32::MAX` for none) and alpha-tested holes.
-    pub fn closest(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
+    pub(super) fn closest(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         // obvhs's box test takes the sign of a zero component from its bits but selects the
         // near and far planes by `< 0`: a −0.0 would miss every box. Adding +0.0 makes it +0.0.
@@ -319,7 +319,7 @@ impl SceneGeometry {
     }
 
     /// The attributes at `hit`.
-    pub fn surface(&self, hit: &Hit) -> Surface {
+    pub(super) fn surface(&self, hit: &Hit) -> Surface {
         let tri = &self.tris[hit.prim as usize];
         let a = &self.attributes[hit.prim as usize];
         let [p0, p1, p2] = tri.p.map(Vec3::from);
@@ -351,7 +351,7 @@ impl SceneGeometry {
     /// tangents or where the frame degenerates. Only the direct light of a bounce's sender
     /// reads it (as the direct pass lights the G-buffer's normal-mapped normal); the
     /// occlusion and the environment stay on the vertex normal.
-    pub fn lighting_normal(&self, surface: &Surface) -> Vec3 {
+    pub(super) fn lighting_normal(&self, surface: &Surface) -> Vec3 {
         let n = surface.shading;
         let Some((texture, scale)) = &self.materials[surface.material].normal_texture else { return n };
         let a = &self.attributes[surface.prim as usize];
@@ -473,7 +473,7 @@ const TEXEL_LIMIT: f64 = (1u64 << 40) as f64;
 
 /// `texture` at `uv` as its [`Sampling`] says: `uv` moved by the transform, then wrapped
 /// per axis and filtered with the magnification filter, at the full-size level (see the
-/// module docs); v = 0 is the top row ([`crate::render::scene::Mesh::uvs`]). `texel` reads
+/// module docs); v = 0 is the top row ([`vrao_render::scene::Mesh::uvs`]). `texel` reads
 /// the texel at a byte offset into `rgba8`; `lerp` blends two of them.
 fn filtered<T: Copy>(texture: &Texture, uv: Vec2, texel: impl Fn(usize) -> T, lerp: impl Fn(T, T, f32) -> T) -> T {
     let Sampling { wrap_u, wrap_v, magnify, .. } = texture.sampling;
@@ -526,8 +526,8 @@ pub(crate) fn sample_alpha(texture: &Texture, uv: Vec2) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::scene::{HeadPath, Material, Mesh};
-    use crate::render::stereo::HeadPose;
+    use vrao_ao::HeadPose;
+    use vrao_render::scene::{HeadPath, Material, Mesh};
 
     fn quad_scene(origin: DVec3) -> Scene {
         // Two triangles sharing the diagonal of the unit square in z = 0 (around `origin`).
@@ -633,9 +633,9 @@ mod sampling_tests {
     //! Texture lookups as the GPU's sampler makes them: wrap per axis, nearest or linear,
     //! the texture transform first.
     use super::*;
-    use crate::render::scene::texture::uv_transform;
-    use crate::render::scene::Wrap;
     use glam::Affine2;
+    use vrao_render::scene::texture::uv_transform;
+    use vrao_render::scene::Wrap;
 
     /// A 2×2 texture whose texel (x, y) has alpha (10 + 10x + 20y) / 255 (10, 20 on the
     /// top row, 30, 40 below), sampled as `sampling` says.

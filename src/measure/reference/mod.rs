@@ -1,14 +1,14 @@
 //! The CPU ray tracer that computes ground truth for the GPU occlusion techniques.
 //!
 //! For every traced pixel of every eye it follows the pixel's centre ray
-//! ([`crate::render::stereo::pixel_ray`], from the near plane on, as the rasteriser clips) to
+//! ([`vrao_ao::Eye::pixel_ray`], from the near plane on, as the rasteriser clips) to
 //! the first surface and there estimates, with the same M stratified cosine-weighted
 //! directions about the shading normal, one ray each:
 //!
 //! - `ao`: V = 1 − (1/π) ∫ [hit within r] cos θ dω (the test oracle `measure::analytic` computes it in closed form);
 //! - `ao_falloff`: the same with each occluded direction weighted by W(d) = max(0, 1 − d/r);
 //! - `environment_visible`: ∫ L_env(ω) [no hit within r] cos θ dω from the real lat-long
-//!   map ([`Environment::sample`](crate::render::scene::Environment::sample)), what SSDO approximates;
+//!   map ([`Environment::sample`](vrao_render::scene::Environment::sample)), what SSDO approximates;
 //! - `bounce`: ∫ [hit within r] L_direct(hit, towards the receiver) cos θ dω, one bounce of
 //!   the direct model of `src/render/passes/direct/direct.wgsl` (albedo/π · Σ light irradiance + emission, at
 //!   the hit triangle's interpolated albedo (base colour × texture × vertex colour), its
@@ -25,7 +25,7 @@
 //! open plane gives exactly 1). A direction about the shading normal that points below the
 //! geometric surface (possible where vertex normals bend away from the faces) counts as
 //! occluded at distance 0 (weight 1, no environment, no bounce): the surface itself blocks
-//! it. Texture v = 0 is the top row of the image, as [`crate::render::scene::Mesh::uvs`] says;
+//! it. Texture v = 0 is the top row of the image, as [`vrao_render::scene::Mesh::uvs`] says;
 //! textures are sampled as their sampler says (transform, wrap per axis, magnification
 //! filter) at their full-size level (`geometry.rs`). The normal texture tilts only the
 //! light a bounce's sender reflects: the AO, like every estimate's hemisphere, is of the
@@ -70,15 +70,16 @@ pub use cache::{
 };
 pub use progress::ProgressBar;
 
-use crate::render::error::{Error, Result};
-use crate::render::scene::Scene;
-use crate::render::stereo::{Eye, DEFAULT_NEAR};
+use crate::error::{Error, Result};
 use geometry::SceneGeometry;
 use glam::DVec3;
 use rayon::prelude::*;
 use shading::{pixel_seed, Estimator, Lighting, Rng};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
+use vrao_ao::plug::DEFAULT_NEAR;
+use vrao_ao::Eye;
+use vrao_render::scene::Scene;
 
 /// Bumped whenever the tracer's results change for the same inputs (it is part of the
 /// cache key, so older cache files are recomputed). 3: textures wrap per axis as their
@@ -448,7 +449,7 @@ impl RowTracer<'_> {
         let geometry = self.estimator.geometry;
         let origin = (eye.pose.position - self.anchor).as_vec3();
         let forward = eye.pose.orientation * DVec3::NEG_Z;
-        let dir = crate::render::stereo::pixel_ray(eye, self.size, (x as f64 + 0.5, y as f64 + 0.5));
+        let dir = vrao_ao::Eye::pixel_ray(eye, self.size, (x as f64 + 0.5, y as f64 + 0.5));
         let along = dir.dot(forward);
         let dir32 = dir.as_vec3();
         let tmin = (self.settings.near / along) as f32;
@@ -506,7 +507,7 @@ pub fn world_position(image: &ReferenceImage, eye: &Eye, layer: usize, i: u32, j
     }
     let (x, y) = image.pixel_of(i, j);
     let eye = Eye { pose: eye.pose.sanitized(), ..*eye };
-    let dir = crate::render::stereo::pixel_ray(&eye, (image.width, image.height), (x as f64 + 0.5, y as f64 + 0.5));
+    let dir = vrao_ao::Eye::pixel_ray(&eye, (image.width, image.height), (x as f64 + 0.5, y as f64 + 0.5));
     let along = dir.dot(eye.pose.orientation * DVec3::NEG_Z);
     Some(eye.pose.position + dir * (p.depth as f64 / along))
 }

@@ -45,10 +45,10 @@
 
 use super::shading::{concentric_disk, orthonormal_basis, pixel_seed, stratified_points, Rng};
 use super::{grid_size, pixel_of, ReferenceImage};
-use crate::render::error::{Error, Result};
-use crate::render::stereo::{view_position_from_depth, Fov};
+use crate::error::{Error, Result};
 use glam::DVec3;
 use rayon::prelude::*;
+use vrao_ao::Fov;
 
 /// Default rays per pixel of the march.
 pub const DEFAULT_RAYS: u32 = 64;
@@ -235,7 +235,7 @@ impl<'a> Marcher<'a> {
     /// The view-space surface point at the centre of pixel (x, y) with depth `d`.
     fn position(&self, x: u32, y: u32, d: f64) -> DVec3 {
         let uv = [(x as f64 + 0.5) / self.size.0 as f64, (y as f64 + 0.5) / self.size.1 as f64];
-        view_position_from_depth(uv, d, &self.eye.fov, self.settings.near)
+        vrao_ao::Fov::view_position_from_depth(uv, d, &self.eye.fov, self.settings.near)
     }
 
     /// The pixel a view-space point projects to, `None` off the image or not in front.
@@ -375,7 +375,7 @@ mod tests {
     fn position(depth: &[f32], size: (u32, u32), stride: u32, i: u32, j: u32) -> DVec3 {
         let (x, y) = pixel_of(size, stride, i, j);
         let uv = [(x as f64 + 0.5) / size.0 as f64, (y as f64 + 0.5) / size.1 as f64];
-        view_position_from_depth(uv, depth[(y * size.0 + x) as usize] as f64, &fov(), NEAR)
+        vrao_ao::Fov::view_position_from_depth(uv, depth[(y * size.0 + x) as usize] as f64, &fov(), NEAR)
     }
 
     #[test]
@@ -404,7 +404,7 @@ mod tests {
     }
 
     /// `rects` given in world space, moved into the view space of an eye at `pose`.
-    fn into_view(rects: &[Rect], pose: &crate::render::stereo::HeadPose) -> Vec<Rect> {
+    fn into_view(rects: &[Rect], pose: &vrao_ao::HeadPose) -> Vec<Rect> {
         let view = pose.world_from_local().inverse();
         rects
             .iter()
@@ -426,7 +426,7 @@ mod tests {
             Rect { corner: DVec3::new(-20.0, 0.0, 0.0), u: DVec3::new(40.0, 0.0, 0.0), v: DVec3::new(0.0, 0.0, 20.0) };
         let wall =
             Rect { corner: DVec3::new(-20.0, 0.0, 0.0), u: DVec3::new(40.0, 0.0, 0.0), v: DVec3::new(0.0, 20.0, 0.0) };
-        let pose = crate::render::stereo::HeadPose::look_at(DVec3::new(0.0, 1.0, 1.0), DVec3::ZERO).unwrap();
+        let pose = vrao_ao::HeadPose::look_at(DVec3::new(0.0, 1.0, 1.0), DVec3::ZERO).unwrap();
         let (size, stride, radius) = ((96, 96), 2, 0.6);
         let settings = LimitSettings { rays_per_pixel: 256, steps: 48, ..LimitSettings::new(radius, stride, NEAR) };
         let (limit, depth) = limit(&into_view(&[floor, wall], &pose), size, settings);

@@ -6,9 +6,9 @@
 //! normal-mapped normal; the receiver's hemisphere is about its vertex normal.
 
 use super::geometry::{sample_texture, SceneGeometry, Surface};
-use crate::render::scene::{Environment, Light, Scene};
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
+use vrao_render::scene::{Environment, Light, Scene};
 
 /// A direction counts as below the surface (occluded at distance 0) when its cosine with
 /// the geometric normal is below this. Zero would do for exact arithmetic; the margin
@@ -31,7 +31,7 @@ impl Rng {
     const MULTIPLIER: u64 = 6364136223846793005;
     const INCREMENT: u64 = 1442695040888963407;
 
-    pub fn new(seed: u64) -> Rng {
+    pub(super) fn new(seed: u64) -> Rng {
         let mut rng = Rng { state: 0 };
         rng.next_u32();
         rng.state = rng.state.wrapping_add(seed);
@@ -39,7 +39,7 @@ impl Rng {
         rng
     }
 
-    pub fn next_u32(&mut self) -> u32 {
+    pub(super) fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(Self::MULTIPLIER).wrapping_add(Self::INCREMENT);
         let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
@@ -47,7 +47,7 @@ impl Rng {
     }
 
     /// Uniform in [0, 1) with 32 random bits.
-    pub fn next_f64(&mut self) -> f64 {
+    pub(super) fn next_f64(&mut self) -> f64 {
         self.next_u32() as f64 * (1.0 / 4294967296.0)
     }
 }
@@ -116,7 +116,7 @@ pub(crate) enum AnchoredLight {
     /// `towards` is the unit direction towards the light (−direction).
     Directional { towards: Vec3, radiance: Vec3 },
     /// Point and spot lights; a spot has `cone` = (unit axis, cos outer cone, ramp scale)
-    /// as [`crate::render::scene::spot_ramp`] gives them.
+    /// as [`vrao_render::scene::spot_ramp`] gives them.
     Point { position: Vec3, radiance: Vec3, cone: Option<(Vec3, f32, f32)> },
 }
 
@@ -126,7 +126,7 @@ pub(crate) struct Lighting<'a> {
 }
 
 impl<'a> Lighting<'a> {
-    pub fn new(scene: &'a Scene, anchor: DVec3) -> Lighting<'a> {
+    pub(super) fn new(scene: &'a Scene, anchor: DVec3) -> Lighting<'a> {
         let lights = scene
             .lights
             .iter()
@@ -144,7 +144,7 @@ impl<'a> Lighting<'a> {
                     position: (position - anchor).as_vec3(),
                     radiance: color * intensity,
                     cone: {
-                        let (cos_outer, scale) = crate::render::scene::spot_ramp(inner_cone, outer_cone);
+                        let (cos_outer, scale) = vrao_render::scene::spot_ramp(inner_cone, outer_cone);
                         Some((direction.normalize_or_zero(), cos_outer, scale))
                     },
                 },
@@ -159,7 +159,7 @@ impl<'a> Lighting<'a> {
     /// counts only when a shadow ray towards it (leaving along the geometric normal on the
     /// light's side, past the surface's own triangle) hits nothing. Point lights have no
     /// shadow maps on the GPU and none here either.
-    pub fn shadowed_irradiance(&self, geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
+    pub(super) fn shadowed_irradiance(&self, geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
         let n = geometry.lighting_normal(surface);
         let offset = OFFSET_ULPS * surface.magnitude.max(f32::MIN_POSITIVE);
         let mut e = Vec3::ZERO;
@@ -268,7 +268,7 @@ impl Estimator<'_> {
     /// eye as the G-buffer does; ray origins leave along the geometric normal flipped to
     /// the eye's side. A direction below the geometric surface counts as occluded at
     /// distance 0: the surface itself is in the way.
-    pub fn estimate(
+    pub(super) fn estimate(
         &self,
         surface: &Surface,
         view_dir: Vec3,

@@ -5,11 +5,12 @@ use super::geometry::SceneGeometry;
 use super::shading::{Estimator, Lighting, Rng};
 use super::*;
 use crate::measure::analytic::{crease_visibility, crease_visibility_falloff};
-use crate::render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
-use crate::render::scene::{Environment, HeadPath, Light, Material, Mesh, Texture};
-use crate::render::stereo::{HeadPose, HeadsetProfile};
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
+use vrao_ao::HeadPose;
+use vrao_render::scene::builtin::{CREASE_HALF_WIDTH, CREASE_WALL_Z};
+use vrao_render::scene::{Environment, HeadPath, Light, Material, Mesh, Texture};
+use vrao_render::HeadsetProfile;
 
 fn eyes_for(scene: &Scene, size: (u32, u32)) -> Vec<Eye> {
     HeadsetProfile::with_size("test", size.0, size.1).eyes(&scene.head.pose_at(0.0), DEFAULT_NEAR).eyes.to_vec()
@@ -359,7 +360,7 @@ fn a_spot_light_follows_gltfs_cone_falloff() {
         let x = 2.0 + 3.0 * angle.tan();
         let e = lighting.shadowed_irradiance(&geometry, &floor_at(x)).x;
         let d2 = 9.0 / (angle.cos() * angle.cos());
-        let expected = 9.0 * crate::render::scene::spot_falloff(angle.cos(), inner, outer) * angle.cos() / d2;
+        let expected = 9.0 * vrao_render::scene::spot_falloff(angle.cos(), inner, outer) * angle.cos() / d2;
         assert!((e - expected).abs() < 1e-4, "{angle} rad: {e}, expected {expected}");
     }
     assert!(lighting.shadowed_irradiance(&geometry, &floor_at(2.0 + 3.0 * 0.4f32.tan())).x > 0.1);
@@ -501,7 +502,10 @@ fn bad_input_and_unwritable_cache_are_errors() {
         ReferenceSettings { stride: 0, ..settings(1.0, 4) },
         ReferenceSettings { near: -1.0, ..settings(1.0, 4) },
     ] {
-        assert!(matches!(trace(&scene, &eyes, size, &bad, &mut none), Err(Error::Input { .. })), "{bad:?}");
+        assert!(
+            matches!(trace(&scene, &eyes, size, &bad, &mut none), Err(Error::Engine(vrao_ao::Error::Input { .. }))),
+            "{bad:?}"
+        );
     }
     assert!(trace(&scene, &eyes, (0, 9), &settings(1.0, 4), &mut none).is_err());
     assert!(trace(&scene, &[], size, &settings(1.0, 4), &mut none).is_err());
@@ -543,8 +547,8 @@ fn surface_below(g: &SceneGeometry, x: f32, z: f32) -> Option<super::geometry::S
 
 #[test]
 fn vertex_colours_interpolate_tint_the_albedo_and_cut_alpha_tested_holes() {
-    use crate::render::scene::AlphaMode;
     use glam::Vec4;
+    use vrao_render::scene::AlphaMode;
     let mut floor = floor_mesh(1.0);
     // Corners (x, z): (−1, −1) red, (−1, 1) green, (1, 1) blue, (1, −1) black.
     floor.colors =
@@ -577,7 +581,7 @@ fn vertex_colours_interpolate_tint_the_albedo_and_cut_alpha_tested_holes() {
 
 /// A texture of one row of sRGB grey levels, sampled nearest.
 fn grey_row(levels: &[u8]) -> Texture {
-    use crate::render::scene::{Filter, Sampling};
+    use vrao_render::scene::{Filter, Sampling};
     Texture {
         width: levels.len() as u32,
         height: 1,

@@ -6,18 +6,16 @@
 //! changes is flicker: the noise pattern sliding over the surfaces, the denoise and the
 //! temporal accumulation not holding it.
 
+use crate::error::Result;
 use crate::measure::metrics::luminance;
 use crate::measure::stereo_consistency::{lookup, EyeImages};
-use crate::render::error::Result;
-use crate::render::gpu::Gpu;
-use crate::render::graph::FINAL_AO;
-use crate::render::passes::inputs::DEPTH;
-use crate::render::renderer::Renderer;
-use crate::render::scene::Scene;
-use crate::render::settings::Settings;
-use crate::render::stereo::{view_position_from_depth, HeadPose};
 use glam::DQuat;
 use std::sync::Arc;
+use vrao_ao::plug::{Gpu, DEPTH, FINAL_AO};
+use vrao_ao::HeadPose;
+use vrao_render::renderer::Renderer;
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
 
 /// Frames rendered before the first one compared (temporal accumulation settles).
 pub const SETTLE_FRAMES: u32 = 8;
@@ -35,7 +33,7 @@ pub struct FrameChange {
 }
 
 /// The last frame's eyes, then its AO, light and depth per eye.
-type PreviousFrame = (Vec<crate::render::stereo::Eye>, Vec<Vec<f32>>, Vec<Vec<f32>>, Vec<Vec<f32>>);
+type PreviousFrame = (Vec<vrao_ao::Eye>, Vec<Vec<f32>>, Vec<Vec<f32>>, Vec<Vec<f32>>);
 
 /// Renders `frames` frames (after [`SETTLE_FRAMES`]) at 90 Hz of `scene` from its head
 /// turning about the vertical at `degrees_per_second`, and measures the change between
@@ -78,7 +76,7 @@ pub fn frame_to_frame(
                                 continue;
                             }
                             let uv = [(x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64];
-                            let v = then_from_now.transform_point3(view_position_from_depth(
+                            let v = then_from_now.transform_point3(vrao_ao::Fov::view_position_from_depth(
                                 uv,
                                 d,
                                 &now.fov,

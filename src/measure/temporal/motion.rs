@@ -3,20 +3,18 @@
 //! temporal accumulation off, reprojecting by the eyes alone, and by the G-buffer's motion
 //! vectors, next to the same scene frozen at that time (what the static-scene error is).
 
+use crate::error::{Error, Result};
 use crate::measure::bench::error_figures;
 use crate::measure::reference::{trace_cached, world_position, ReferenceImage, ReferenceSettings};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::Gpu;
-use crate::render::graph::FINAL_AO;
-use crate::render::passes::MoverBox;
-use crate::render::renderer::Renderer;
-use crate::render::scene::Scene;
-use crate::render::settings::Settings;
-use crate::render::stereo::Eye;
 use glam::DVec3;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
+use vrao_ao::plug::{MoverBox, FINAL_AO};
+use vrao_ao::Eye;
+use vrao_render::renderer::Renderer;
+use vrao_render::scene::Scene;
+use vrao_render::settings::Settings;
 
 /// Near a moving object, an AO value further than this from what the same settings give
 /// for the scene frozen at that time (converged), and from the reference, is a ghost:
@@ -110,7 +108,7 @@ pub fn configurations(base: &Settings) -> Vec<(String, Settings)> {
 /// (which must move) for each configuration, scoring the scored frames against
 /// references traced at their times (cached in `cache`) and the frozen scene's AO.
 pub fn motion_study(
-    backend: crate::render::gpu::BackendChoice,
+    backend: vrao_render::BackendChoice,
     scene: &Scene,
     base: &Settings,
     sequence: Sequence,
@@ -127,7 +125,7 @@ pub fn motion_study(
             sequence.scored, sequence.every
         )));
     }
-    let gpu = Arc::new(Gpu::new(backend)?);
+    let gpu = Arc::new(vrao_render::open(backend)?);
     let reference =
         ReferenceSettings { radius: base.ao.radius as f64, rays_per_pixel: rays, stride: 2, near: base.near };
     let size = (base.profile.width, base.profile.height);
@@ -244,7 +242,7 @@ fn moving_boxes(scene: &Scene, t: f64) -> Vec<MoverBox> {
         .iter()
         .filter_map(|m| {
             let world = transforms.get(m.node?)?;
-            let mut local = crate::render::scene::Aabb::EMPTY;
+            let mut local = vrao_render::scene::Aabb::EMPTY;
             m.positions.iter().for_each(|p| local.extend(m.origin + p.as_dvec3()));
             (!local.is_empty()).then(|| MoverBox::of((local.min, local.max), world, DVec3::ZERO))
         })

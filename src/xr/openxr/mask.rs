@@ -13,9 +13,8 @@
 //! 1473430ee). vrao does not call it there ([`skip_runtime_mask`]) and takes the default
 //! Monado itself would give such a device; [`MASK_VAR`] overrides the choice.
 
-use crate::render::stereo::Fov;
-use crate::render::visibility::{ViewMask, VisibilityMask, MAX_MASK_TRIANGLES};
 use glam::Vec2;
+use vrao_ao::{Fov, ViewMask, VisibilityMask};
 
 /// Views of PRIMARY_STEREO: left, then right.
 pub const VIEWS: usize = 2;
@@ -24,8 +23,8 @@ pub const VIEWS: usize = 2;
 pub const RUNTIME_SOURCE: &str = "the OpenXR runtime (XR_KHR_visibility_mask)";
 
 /// The most vertices or indices vrao takes from one of the runtime's meshes (three per
-/// triangle of [`MAX_MASK_TRIANGLES`]): a larger count is refused, not allocated.
-pub const MAX_MESH_ELEMENTS: usize = 3 * MAX_MASK_TRIANGLES;
+/// triangle of [`ViewMask::MAX_TRIANGLES`]): a larger count is refused, not allocated.
+pub const MAX_MESH_ELEMENTS: usize = 3 * ViewMask::MAX_TRIANGLES;
 
 /// One mesh as `xrGetVisibilityMaskKHR` returned it: vertices on the view's image plane
 /// at z = −1 (the tangents of the view angles, x right, y up), three indices a triangle.

@@ -24,9 +24,7 @@ use super::{
     application_info, load_entry, vulkan, InstanceSlot, OpenXrOptions, OpenXrReport, RuntimeFailure, SessionPhase,
     Unavailable,
 };
-use crate::render::error::{Error, Result};
-use crate::render::gpu::Gpu;
-use crate::render::stereo::{Eye, EyePair, EyeSide, Fov, HeadPose};
+use crate::error::{Error, Result};
 use crate::xr::simulated::SimulatedHeadset;
 use crate::xr::{DisplayRate, FrameCounters, FrameRequest, Headset, SubmittedFrame};
 use glam::{DQuat, DVec3, Quat, Vec3};
@@ -36,6 +34,8 @@ use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracking::{fov_from_xr, pose_from_xr, Tracking};
+use vrao_ao::plug::Gpu;
+use vrao_ao::{Eye, EyePair, EyeSide, Fov, HeadPose};
 
 const VIEW_TYPE: xr::ViewConfigurationType = xr::ViewConfigurationType::PRIMARY_STEREO;
 /// How often an idle session (not running) is polled for events.
@@ -585,7 +585,7 @@ impl Headset for OpenXrHeadset {
             return Ok(());
         };
         if pending.index != request.index {
-            return Err(Error::Gpu(format!(
+            return Err(Error::gpu(format!(
                 "submit for frame {} while OpenXR frame {} is open",
                 request.index, pending.index
             )));
@@ -624,7 +624,7 @@ impl Headset for OpenXrHeadset {
         Some(self.report())
     }
 
-    fn visibility_mask(&self) -> Option<&crate::render::visibility::VisibilityMask> {
+    fn visibility_mask(&self) -> Option<&vrao_ao::VisibilityMask> {
         match &self.fallback {
             Some(simulated) => simulated.visibility_mask(),
             None => self.mask.mask(),

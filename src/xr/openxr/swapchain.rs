@@ -16,12 +16,10 @@
 //! (frag_depth), which also leaves it in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
 
 use super::RuntimeFailure;
-use crate::render::gpu::layered_target::LayeredTarget;
-use crate::render::gpu::raster::fullscreen_pipeline;
-use crate::render::gpu::Gpu;
 use ash::vk;
 use ash::vk::Handle as _;
 use openxr as xr;
+use vrao_ao::plug::{fullscreen_pipeline, Gpu, LayeredTarget};
 use wgpu::hal::api::Vulkan as HalVulkan;
 
 /// Colour formats in order of preference (Vulkan format, wgpu format).
@@ -113,10 +111,7 @@ impl Chain {
                 .iter()
                 .map(|&image| wrap_image(gpu, vk::Image::from_raw(image), label, size, format, uses))
                 .collect();
-            let views = textures
-                .iter()
-                .map(|texture| crate::render::gpu::raster::layer_views(texture, label, layers))
-                .collect();
+            let views = textures.iter().map(|texture| vrao_ao::plug::layer_views(texture, label, layers)).collect();
             chain.swapchains.push(swapchain);
             chain.textures.push(textures);
             chain.views.push(views);
@@ -288,7 +283,7 @@ impl EyeBlit {
                 },
             ],
         });
-        let mut pass = crate::render::gpu::raster::colour_and_depth_pass(
+        let mut pass = vrao_ao::plug::colour_and_depth_pass(
             encoder,
             "openxr swapchain blit",
             (color_view, wgpu::Color::BLACK),
@@ -303,7 +298,7 @@ impl EyeBlit {
 
 /// Where one eye's image is in the swapchains, for the projection layer.
 #[derive(Clone, Copy, Debug)]
-pub struct SubImage {
+pub(super) struct SubImage {
     pub swapchain: usize,
     pub array_index: u32,
     pub width: u32,
@@ -311,7 +306,7 @@ pub struct SubImage {
 }
 
 /// Colour and depth swapchains for both eyes.
-pub struct EyeSwapchains {
+pub(super) struct EyeSwapchains {
     color: Chain,
     depth: Option<Chain>,
     blit: EyeBlit,
@@ -324,7 +319,7 @@ impl EyeSwapchains {
     /// array per kind when the runtime accepts it, otherwise one per eye (or only the
     /// given `layout`). `with_depth` is false when the runtime lacks
     /// XR_KHR_composition_layer_depth.
-    pub fn create(
+    pub(super) fn create(
         gpu: &Gpu,
         session: &xr::Session<xr::Vulkan>,
         size: (u32, u32),
@@ -360,12 +355,12 @@ impl EyeSwapchains {
         Err(RuntimeFailure(format!("xrCreateSwapchain: {}", last_error.expect("at least one layout was tried"))))
     }
 
-    pub fn has_depth(&self) -> bool {
+    pub(super) fn has_depth(&self) -> bool {
         self.depth.is_some()
     }
 
     /// One line: layout, formats and size.
-    pub fn describe(&self) -> String {
+    pub(super) fn describe(&self) -> String {
         let layout = match self.layout {
             SwapchainLayout::Array => "one 2-layer array swapchain",
             SwapchainLayout::PerEye => "one swapchain per eye",
@@ -377,11 +372,11 @@ impl EyeSwapchains {
         format!("{}x{} per eye, {layout}, colour {:?}{depth}", self.size.0, self.size.1, self.color.vk_format)
     }
 
-    pub fn color_swapchain(&self, index: usize) -> &xr::Swapchain<xr::Vulkan> {
+    pub(super) fn color_swapchain(&self, index: usize) -> &xr::Swapchain<xr::Vulkan> {
         &self.color.swapchains[index]
     }
 
-    pub fn depth_swapchain(&self, index: usize) -> Option<&xr::Swapchain<xr::Vulkan>> {
+    pub(super) fn depth_swapchain(&self, index: usize) -> Option<&xr::Swapchain<xr::Vulkan>> {
         self.depth.as_ref().map(|d| &d.swapchains[index])
     }
 
@@ -389,7 +384,7 @@ impl EyeSwapchains {
     /// into them, submits the copy and releases the images (the copy is queued before
     /// the release, on the queue the session was created with). Returns each eye's
     /// sub-image.
-    pub fn fill(
+    pub(super) fn fill(
         &mut self,
         gpu: &Gpu,
         color: &LayeredTarget,
@@ -421,14 +416,14 @@ impl EyeSwapchains {
         gpu.queue.submit([encoder.finish()]);
         let gpu_error = gpu.take_error();
         let released = self.color.release().and_then(|()| self.depth.as_mut().map(Chain::release).unwrap_or(Ok(())));
-        gpu_error.map_err(FillError::Gpu)?;
+        gpu_error.map_err(|e| FillError::Gpu(e.into()))?;
         released?;
         Ok(sub_images)
     }
 
     /// Destroys the wgpu side of the images (the runtime destroys the images themselves
     /// with the swapchains). Call with the GPU idle.
-    pub fn destroy_textures(&mut self) {
+    pub(super) fn destroy_textures(&mut self) {
         for chain in std::iter::once(&mut self.color).chain(self.depth.as_mut()) {
             chain.views.clear();
             for texture in chain.textures.drain(..).flatten() {
@@ -440,10 +435,10 @@ impl EyeSwapchains {
 
 /// Why a frame could not be copied into the swapchains.
 #[derive(Debug)]
-pub enum FillError {
+pub(super) enum FillError {
     /// The OpenXR call that failed and its result.
     Xr(&'static str, xr::sys::Result),
-    Gpu(crate::render::error::Error),
+    Gpu(crate::error::Error),
 }
 
 impl std::fmt::Display for FillError {

@@ -10,10 +10,10 @@
 //! application the owner of both.
 
 use super::RuntimeFailure;
-use crate::render::gpu::Gpu;
 use ash::vk;
 use ash::vk::Handle as _;
 use std::ffi::{c_char, CStr};
+use vrao_ao::plug::Gpu;
 use wgpu::hal::api::Vulkan as HalVulkan;
 use wgpu::hal::{ExposedAdapter, OpenDevice};
 
@@ -26,7 +26,7 @@ pub(super) struct Binding {
 }
 
 impl Binding {
-    pub fn session_create_info(&self) -> openxr::vulkan::SessionCreateInfo {
+    pub(super) fn session_create_info(&self) -> openxr::vulkan::SessionCreateInfo {
         openxr::vulkan::SessionCreateInfo {
             instance: self.instance.as_raw() as usize as _,
             physical_device: self.physical_device.as_raw() as usize as _,
@@ -88,7 +88,7 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
     let instance = unsafe { wgpu::Instance::from_hal::<HalVulkan>(hal_instance) };
     // SAFETY: the adapter was exposed by the instance just wrapped.
     let adapter = unsafe { instance.create_adapter_from_hal(exposed) };
-    let desc = Gpu::device_descriptor(&adapter);
+    let desc = vrao_render::gpu::open::device_descriptor(&adapter);
     let queue_family_index = graphics_queue_family(&ash_instance, physical_device, &adapter_name)?;
 
     let request = DeviceRequest {
@@ -105,7 +105,7 @@ pub(super) fn create_gpu(xr: &openxr::Instance, system: openxr::SystemId) -> Res
     // SAFETY: the hal device was opened from this adapter with `desc`'s features/limits.
     let (device, queue) = unsafe { adapter.create_device_from_hal(open, &desc) }
         .map_err(|e| format!("{adapter_name} refused a device: {e}"))?;
-    let gpu = Gpu::from_device(instance, adapter, device, queue).map_err(|e| e.to_string())?;
+    let gpu = vrao_render::gpu::open::from_device(instance, adapter, device, queue).map_err(|e| e.to_string())?;
     let binding = Binding { instance: vk_instance, physical_device, device: vk_device, queue_family_index };
     Ok((gpu, binding))
 }

@@ -13,18 +13,17 @@ pub mod motion;
 pub mod reproject;
 
 use super::{FrameCounters, FrameRequest, Headset, SubmittedFrame};
-use crate::render::error::{Error, Result};
-use crate::render::gpu::layered_target::LayeredTarget;
-use crate::render::gpu::Gpu;
-use crate::render::passes::gbuffer::DEPTH;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::scene::HeadPath;
-use crate::render::stereo::{EyePair, HeadsetProfile};
+use crate::error::{Error, Result};
 use compositor::{Clock, Compositor, VsyncOutcome};
 use motion::HeadMotion;
 use reproject::{output_target, ReprojectionMode, Reprojector};
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
+use vrao_ao::plug::{Gpu, LayeredTarget, DEPTH};
+use vrao_ao::EyePair;
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::HeadPath;
+use vrao_render::HeadsetProfile;
 
 /// How time passes on the simulated headset.
 #[derive(Clone, Debug, PartialEq)]
@@ -118,7 +117,7 @@ pub struct SimulatedHeadset {
     exit_requested: bool,
     ended: bool,
     /// The profile's lens ([`crate::xr::profiles::visibility_mask`]).
-    mask: crate::render::visibility::VisibilityMask,
+    mask: vrao_ao::VisibilityMask,
 }
 
 impl SimulatedHeadset {
@@ -250,7 +249,7 @@ impl SimulatedHeadset {
             }
         }
         gpu.queue.submit([encoder.finish()]);
-        gpu.take_error()
+        Ok(gpu.take_error()?)
     }
 
     /// The outcome of the newest processed vsync.
@@ -314,7 +313,7 @@ impl SimulatedHeadset {
 }
 
 impl Headset for SimulatedHeadset {
-    fn visibility_mask(&self) -> Option<&crate::render::visibility::VisibilityMask> {
+    fn visibility_mask(&self) -> Option<&vrao_ao::VisibilityMask> {
         Some(&self.mask)
     }
 
@@ -366,7 +365,7 @@ impl Headset for SimulatedHeadset {
 
     fn submit(&mut self, gpu: &Gpu, request: &FrameRequest, frame: Option<SubmittedFrame>) -> Result<()> {
         let (start_vsync, pose_time) =
-            self.started.take().ok_or_else(|| Error::Gpu("submit without a frame from wait_frame".into()))?;
+            self.started.take().ok_or_else(|| Error::gpu("submit without a frame from wait_frame"))?;
         if let TimeMode::Virtual { render_ms } = &self.options.time {
             let ms = if frame.is_some() { render_ms[(request.index % render_ms.len() as u64) as usize] } else { 0.0 };
             self.clock.advance(ms / 1e3);

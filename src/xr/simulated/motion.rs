@@ -1,10 +1,10 @@
 //! Scripted head motion for the simulated headset: offsets on top of the scene's head
 //! pose (or its path), as a function of time.
 
-use crate::render::scene::HeadPath;
-use crate::render::stereo::HeadPose;
 use glam::{DQuat, DVec3};
 use std::f64::consts::TAU;
+use vrao_ao::HeadPose;
+use vrao_render::scene::HeadPath;
 
 /// Head motion the simulated headset adds to the scene's pose, for testing stereo and reprojection under movement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

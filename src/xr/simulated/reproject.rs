@@ -2,15 +2,13 @@
 //! re-presented at a newer head pose, rotationally (orientation only, a homography per
 //! eye) or positionally (the submitted depth forward-splatted into the new view).
 
-use crate::render::error::Result;
-use crate::render::gpu::kernel::{try_shader_module, Bind, Kernel, Slot, COMMON};
-use crate::render::gpu::layered_target::LayeredTarget;
-use crate::render::gpu::Gpu;
-use crate::render::passes::tonemap::COLOR;
-use crate::render::stereo::Eye;
-use crate::render::wgsl;
+use crate::error::Result;
+use crate::wgsl;
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
+use vrao_ao::plug::{try_shader_module, Bind, Gpu, Kernel, LayeredTarget, Slot, COMMON};
+use vrao_ao::Eye;
+use vrao_render::passes::tonemap::COLOR;
 
 /// How the simulated compositor warps a frame to a newer head pose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -59,7 +57,7 @@ pub struct Reprojector {
     splatted: Option<wgpu::Buffer>,
     /// Group 1 every kernel has (the AO chain's visibility maps): the warp masks nothing,
     /// the runtime's compositor having no lens of its own here.
-    visibility: crate::render::gpu::visibility::VisibilityMaps,
+    visibility: vrao_ao::plug::VisibilityMaps,
 }
 
 /// shaders/reproject.wgsl's bindings: the warp's uniform, the held depth and colour and their
@@ -98,7 +96,7 @@ impl Reprojector {
                 ..Default::default()
             }),
             splatted: None,
-            visibility: crate::render::gpu::visibility::VisibilityMaps::new(gpu),
+            visibility: vrao_ao::plug::VisibilityMaps::new(gpu),
         })
     }
 
@@ -179,7 +177,7 @@ pub fn output_target(gpu: &Gpu, (width, height, layers): (u32, u32, u32)) -> Lay
 /// The engine's checker of Rust mirrors of WGSL structs (its `layout-check` feature, a
 /// dev-dependency of this crate).
 #[cfg(test)]
-use vrao_ao::gpu::layout_check;
+use vrao_ao::layout_check;
 
 #[cfg(test)]
 mod tests {

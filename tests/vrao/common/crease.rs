@@ -7,32 +7,29 @@ use super::occlusion::{ao, render, same_surface_blur, settings, Frame};
 use glam::DVec3;
 use std::sync::Arc;
 use vrao::measure::analytic::{self, DepthView, Estimator, EstimatorParams, HbaoParams, Rect};
-use vrao::render::passes::blur::AO_BLURRED;
-use vrao::render::passes::occlusion::AO_RAW;
-use vrao::render::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
-use vrao::render::scene::builtin::CREASE_WALL_Z;
-use vrao::render::scene::Scene;
-use vrao::render::settings::{Denoise, Noise, Technique};
-use vrao::{Gpu, HeadPose};
+use vrao_ao::plug::{hbao_directions_steps, hemisphere_kernel, Gpu, HemisphereDensity, AO_BLURRED, AO_RAW};
+use vrao_ao::{Denoise, HeadPose, Noise, Technique};
+use vrao_render::scene::builtin::CREASE_WALL_Z;
+use vrao_render::scene::Scene;
 
-pub const CREASE_SIZE: (u32, u32) = (160, 180);
-pub const CREASE_RADIUS: f64 = 1.0;
-pub const CREASE_SAMPLES: u32 = 64;
+pub(crate) const CREASE_SIZE: (u32, u32) = (160, 180);
+pub(crate) const CREASE_RADIUS: f64 = 1.0;
+pub(crate) const CREASE_SAMPLES: u32 = 64;
 /// Bins of distance to the crease line (metres).
-pub const CREASE_BIN: f64 = 0.1;
-pub const CREASE_BINS: usize = 13;
+pub(crate) const CREASE_BIN: f64 = 0.1;
+pub(crate) const CREASE_BINS: usize = 13;
 
 /// Eye on the crease's bisector plane, 2.5 m from the crease line and looking at it, so
 /// floor and wall are mirror images, both seen at 45°, and a floor strip of 1 m in
 /// front of the wall spans about 28 rows at 180 rows.
-pub fn crease_head() -> HeadPose {
+pub(crate) fn crease_head() -> HeadPose {
     let target = DVec3::new(0.0, 0.0, CREASE_WALL_Z);
     let d = 2.5 / 2f64.sqrt();
     HeadPose::look_at(target + DVec3::new(0.0, d, d), target).unwrap()
 }
 
 /// 1 = floor, 2 = wall, 0 = neither (sky, the crease line itself, anything else).
-pub fn crease_class(p: Option<DVec3>) -> u8 {
+pub(crate) fn crease_class(p: Option<DVec3>) -> u8 {
     let Some(p) = p else { return 0 };
     let on_floor = p.y.abs() < 1e-3 && p.z > CREASE_WALL_Z + 1e-3;
     let on_wall = (p.z - CREASE_WALL_Z).abs() < 1e-3 && p.y > 1e-3;
@@ -44,7 +41,7 @@ pub fn crease_class(p: Option<DVec3>) -> u8 {
 }
 
 /// Distance from a floor or wall point to the crease line.
-pub fn crease_distance(p: DVec3, class: u8) -> f64 {
+pub(crate) fn crease_distance(p: DVec3, class: u8) -> f64 {
     if class == 1 {
         p.z - CREASE_WALL_Z
     } else {
@@ -54,7 +51,7 @@ pub fn crease_distance(p: DVec3, class: u8) -> f64 {
 
 /// Per-bin means of one crease measurement.
 #[derive(Debug, Default, Clone)]
-pub struct CreaseBin {
+pub(crate) struct CreaseBin {
     pub lo: f64,
     pub pixels: usize,
     pub raw: f64,
@@ -84,7 +81,7 @@ pub struct CreaseBin {
 /// part of the other surface within r on screen in that eye (screen-space methods miss
 /// off-screen occluders). For the blurred comparison every same-surface pixel of the
 /// 11×11 window must be modelled too.
-pub fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
+pub(crate) fn measure_crease(gpu: &Arc<Gpu>, technique: Technique) -> Vec<CreaseBin> {
     let scene = Scene::load("builtin:crease").unwrap();
     let (w, h) = CREASE_SIZE;
     let mut settings = settings(w, h, ao(technique, CREASE_SAMPLES, CREASE_RADIUS as f32));
@@ -315,7 +312,7 @@ fn print_bins(technique: Technique, bins: &[CreaseBin]) {
 /// The crease darkens towards its edge: blurred AO per bin never rises by more than the
 /// noise (0.01) towards the wall, and the bin nearest the wall is clearly darker than
 /// the open floor beyond r.
-pub fn assert_falls_towards_the_edge(name: &str, bins: &[CreaseBin]) {
+pub(crate) fn assert_falls_towards_the_edge(name: &str, bins: &[CreaseBin]) {
     let used: Vec<&CreaseBin> = bins.iter().filter(|b| b.blurred_pixels >= 100).collect();
     assert!(used.len() >= 10, "{name}: too few populated bins ({})", used.len());
     for pair in used.windows(2) {
@@ -339,7 +336,7 @@ pub fn assert_falls_towards_the_edge(name: &str, bins: &[CreaseBin]) {
 }
 
 /// Asserts `|value − expected| ≤ tolerance` in every bin with at least 100 pixels.
-pub fn assert_bins(
+pub(crate) fn assert_bins(
     name: &str,
     what: &str,
     bins: &[CreaseBin],
@@ -378,4 +375,4 @@ pub fn assert_bins(
 /// 0.01 covers these. It is tight enough to catch a wrong parameter: at 0.15 m from
 /// the crease a radius 10 % short raises SSAO by 0.016, no bias lowers it by 0.013, a
 /// doubled bias raises it by 0.018, half the taps (a shorter kernel) by 0.006.
-pub const EXPECTATION_TOLERANCE: f64 = 0.01;
+pub(crate) const EXPECTATION_TOLERANCE: f64 = 0.01;

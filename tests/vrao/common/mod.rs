@@ -7,26 +7,27 @@
 // The occlusion tests' frame and crease helpers (tests/occlusion_*.rs, all of which
 // require `app`; the crease needs `vrao::measure`).
 #[cfg(feature = "app")]
-pub mod crease;
+pub(crate) mod crease;
 #[cfg(feature = "app")]
-pub mod occlusion;
+pub(crate) mod occlusion;
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
-use vrao::render::scene::{HeadPath, Material, Mesh, Scene};
-use vrao::{BackendChoice, Gpu};
+use vrao_ao::plug::Gpu;
+use vrao_render::scene::{HeadPath, Material, Mesh, Scene};
+use vrao_render::BackendChoice;
 
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 /// Holds the GPU for one test (also for tests that run the `vrao` binary).
-pub fn gpu_lock() -> MutexGuard<'static, ()> {
+pub(crate) fn gpu_lock() -> MutexGuard<'static, ()> {
     ONE_AT_A_TIME.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 /// The public scene file `relative` (under `$VRAO_SCENES`, or `shared/scenes` beside the
 /// repository), or `None` after reporting the calling test as skipped.
-pub fn public_scene(relative: &str) -> Option<PathBuf> {
+pub(crate) fn public_scene(relative: &str) -> Option<PathBuf> {
     let path = public_scenes()?.join(relative);
     if path.is_file() {
         return Some(path);
@@ -36,8 +37,8 @@ pub fn public_scene(relative: &str) -> Option<PathBuf> {
 }
 
 /// The public scenes' directory, or `None` after reporting the calling test as skipped.
-pub fn public_scenes() -> Option<PathBuf> {
-    let dir = vrao::render::scene::shared_scenes_dir();
+pub(crate) fn public_scenes() -> Option<PathBuf> {
+    let dir = vrao_render::scene::shared_scenes_dir();
     if dir.is_none() {
         skip("needs the public scenes (shared/scenes beside the repository, or $VRAO_SCENES)");
     }
@@ -47,7 +48,7 @@ pub fn public_scenes() -> Option<PathBuf> {
 /// Reports the calling test as skipped: a line on stderr and, when `VRAO_SKIP_LOG` names a
 /// file (`.ci/test` sets it and prints the count and reasons after the run), a line there.
 /// Under CI (`CI` set) a skip is a failure: CI must run every test.
-pub fn skip(reason: &str) {
+pub(crate) fn skip(reason: &str) {
     let test = std::thread::current().name().unwrap_or("(unnamed test)").to_string();
     assert!(std::env::var_os("CI").is_none(), "{test} cannot run under CI: it {reason}");
     eprintln!("skipped {test}: it {reason}");
@@ -61,7 +62,7 @@ pub fn skip(reason: &str) {
 /// For a test that measures its whole process (its memory): true in a child process of
 /// this test binary that runs the calling test alone; in the test binary itself, runs that
 /// child (holding the GPU), fails if it fails, and returns false.
-pub fn alone_in_a_process() -> bool {
+pub(crate) fn alone_in_a_process() -> bool {
     const CHILD: &str = "VRAO_TEST_ALONE";
     if std::env::var_os(CHILD).is_some() {
         return true;
@@ -81,7 +82,7 @@ pub fn alone_in_a_process() -> bool {
 }
 
 /// A fresh, empty directory for one test's files.
-pub fn temp_dir(name: &str) -> std::path::PathBuf {
+pub(crate) fn temp_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("vrao-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -90,13 +91,13 @@ pub fn temp_dir(name: &str) -> std::path::PathBuf {
 
 /// A GPU of the caller's own, for a test that changes a GPU for good (a cancellation
 /// token, a shader directory), with the one-at-a-time lock.
-pub fn own_gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
+pub(crate) fn own_gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
     let guard = gpu_lock();
     (Arc::new(new_gpu()), guard)
 }
 
 /// The shared GPU of the test binary, with the one-at-a-time lock.
-pub fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
+pub(crate) fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
     static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
     let guard = gpu_lock();
     let gpu = GPU.get_or_init(|| Arc::new(new_gpu()));
@@ -108,11 +109,11 @@ fn new_gpu() -> Gpu {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
-    Gpu::new(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests")
+    vrao_render::open(BackendChoice::Auto).expect("a GPU or lavapipe is needed for GPU tests")
 }
 
 /// A square of side `size` centred on `center`, facing +Z (towards a viewer on +Z).
-pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Mesh {
+pub(crate) fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Mesh {
     let h = size * 0.5;
     Mesh {
         colors: Vec::new(),
@@ -134,7 +135,7 @@ pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Me
 }
 
 /// A disc of `radius` centred on `center`, facing +Z, as a 64-sided fan.
-pub fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Mesh {
+pub(crate) fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Mesh {
     let sides = 64;
     let mut positions = vec![glam::Vec3::ZERO];
     let mut indices = Vec::new();
@@ -160,21 +161,21 @@ pub fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Me
 
 /// A scene of the given meshes with one grey material, no lights and no environment,
 /// viewed from the origin looking down −Z.
-pub fn bare_scene(meshes: Vec<Mesh>) -> Scene {
+pub(crate) fn bare_scene(meshes: Vec<Mesh>) -> Scene {
     Scene {
         name: "test".into(),
         meshes,
         materials: vec![Material::plain("grey", glam::Vec3::splat(0.5))],
         lights: Vec::new(),
         environment: None,
-        head: HeadPath::fixed(vrao::HeadPose::IDENTITY),
+        head: HeadPath::fixed(vrao_ao::HeadPose::IDENTITY),
         nodes: Vec::new(),
     }
 }
 
 /// A closed axis-aligned box of `size` (x, y, z extents) centred on `center`: six faces,
 /// normals facing out (a two-manifold solid, as depth peeling assumes).
-pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize) -> Mesh {
+pub(crate) fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize) -> Mesh {
     let h = size * 0.5;
     let mut positions = Vec::new();
     let mut normals = Vec::new();
@@ -212,9 +213,9 @@ pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize
 
 /// The world position of every pixel of a depth readback (reversed-Z, one layer per eye,
 /// `width` × `height`), or None on the sky: what the GPU tests compare pixels by.
-pub fn world_positions(
+pub(crate) fn world_positions(
     depth: &[Vec<f32>],
-    eyes: &[vrao::render::stereo::Eye],
+    eyes: &[vrao_ao::Eye],
     width: u32,
     height: u32,
     near: f64,
@@ -230,8 +231,7 @@ pub fn world_positions(
                     (d > 0.0).then(|| {
                         let uv =
                             [((i % width) as f64 + 0.5) / width as f64, ((i / width) as f64 + 0.5) / height as f64];
-                        world_from_view
-                            .transform_point3(vrao::render::stereo::view_position_from_depth(uv, d, &eye.fov, near))
+                        world_from_view.transform_point3(vrao_ao::Fov::view_position_from_depth(uv, d, &eye.fov, near))
                     })
                 })
                 .collect()

@@ -9,7 +9,7 @@ use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 /// A triangle mesh in world space.
-pub struct HostMesh {
+pub(crate) struct HostMesh {
     /// Vertex positions (m).
     pub positions: Vec<Vec3>,
     /// Unit vertex normals.
@@ -19,7 +19,7 @@ pub struct HostMesh {
 }
 
 /// An axis-aligned box (six faces, normals out).
-pub fn cuboid(center: Vec3, size: Vec3) -> HostMesh {
+pub(crate) fn cuboid(center: Vec3, size: Vec3) -> HostMesh {
     let h = size * 0.5;
     let mut mesh = HostMesh { positions: Vec::new(), normals: Vec::new(), indices: Vec::new() };
     for axis in 0..3 {
@@ -41,7 +41,7 @@ pub fn cuboid(center: Vec3, size: Vec3) -> HostMesh {
 
 /// The demo's room corner: a floor, two walls, a crate against them, a low step and a
 /// column: contact shadows, creases and corners for the AO.
-pub fn demo_geometry() -> Vec<HostMesh> {
+pub(crate) fn demo_geometry() -> Vec<HostMesh> {
     vec![
         cuboid(Vec3::new(0.0, -0.05, -2.0), Vec3::new(4.0, 0.1, 4.0)),
         cuboid(Vec3::new(0.0, 1.0, -4.05), Vec3::new(4.0, 2.0, 0.1)),
@@ -54,7 +54,7 @@ pub fn demo_geometry() -> Vec<HostMesh> {
 
 /// Where the demo's eyes are: 1.5 m up, 1 m in front of the room, looking at its corner;
 /// 64 mm apart.
-pub fn demo_eyes() -> [Mat4; 2] {
+pub(crate) fn demo_eyes() -> [Mat4; 2] {
     let head = Vec3::new(0.3, 1.5, 0.2);
     let target = Vec3::new(-0.6, 0.3, -3.0);
     let forward = (target - head).normalize();
@@ -67,7 +67,7 @@ pub fn demo_eyes() -> [Mat4; 2] {
 
 /// How the host's depth is stored: a format and a projection of the matching kind.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum HostDepth {
+pub(crate) enum HostDepth {
     /// `Depth32Float`, reversed-Z, far plane at infinity.
     ReversedInfinite,
     /// `Depth24Plus`, depth 0 at the near plane and 1 at a far plane.
@@ -79,7 +79,7 @@ pub enum HostDepth {
 
 impl HostDepth {
     /// The depth texture's format.
-    pub fn format(self) -> wgpu::TextureFormat {
+    pub(crate) fn format(self) -> wgpu::TextureFormat {
         match self {
             HostDepth::ReversedInfinite => wgpu::TextureFormat::Depth32Float,
             HostDepth::StandardFinite { .. } => wgpu::TextureFormat::Depth24Plus,
@@ -88,7 +88,7 @@ impl HostDepth {
 
     /// An asymmetric projection of the given frustum tangents (left, right, up, down)
     /// with this depth convention (wgpu's 0..1 depth range).
-    pub fn projection(self, [l, r, u, d]: [f32; 4], near: f32) -> Mat4 {
+    pub(crate) fn projection(self, [l, r, u, d]: [f32; 4], near: f32) -> Mat4 {
         let (sx, sy) = (2.0 / (r - l), 2.0 / (u - d));
         let (cx, cy) = ((r + l) / (r - l), (u + d) / (u - d));
         // depth = a + b / distance, as clip z = a·(−z) ... written as z_clip = p22·z + p32.
@@ -138,7 +138,7 @@ struct Out { @builtin(position) clip: vec4<f32>, @location(0) normal: vec3<f32> 
 "#;
 
 /// The host's depth prepass: its own pipeline, vertex buffers and targets.
-pub struct DepthPrepass {
+pub(crate) struct DepthPrepass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     vertices: wgpu::Buffer,
@@ -153,12 +153,12 @@ pub struct DepthPrepass {
 
 impl DepthPrepass {
     /// Uploads `meshes` and makes both eyes' targets (2-layer arrays) at `width` × `height`.
-    pub fn new(device: &wgpu::Device, meshes: &[HostMesh], depth_kind: HostDepth, size: (u32, u32)) -> Self {
+    pub(crate) fn new(device: &wgpu::Device, meshes: &[HostMesh], depth_kind: HostDepth, size: (u32, u32)) -> Self {
         Self::with_layers(device, meshes, depth_kind, size, 2)
     }
 
     /// [`DepthPrepass::new`] with `layers` layers (1: plain 2D textures for a mono view).
-    pub fn with_layers(
+    pub(crate) fn with_layers(
         device: &wgpu::Device,
         meshes: &[HostMesh],
         depth_kind: HostDepth,
@@ -171,7 +171,7 @@ impl DepthPrepass {
     /// [`DepthPrepass::with_layers`] drawn with `samples` samples per pixel, as a forward
     /// renderer with MSAA draws (2 layers of a multisampled texture need the device's
     /// `MULTISAMPLE_ARRAY` feature).
-    pub fn multisampled(
+    pub(crate) fn multisampled(
         device: &wgpu::Device,
         meshes: &[HostMesh],
         depth_kind: HostDepth,
@@ -197,7 +197,12 @@ impl DepthPrepass {
     }
 
     /// Draws every eye's depth and normals: one render pass per layer.
-    pub fn record(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, views: &[super::ViewMatrices]) {
+    pub(crate) fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        views: &[super::ViewMatrices],
+    ) {
         for (layer, m) in views.iter().enumerate() {
             let uniform = ViewUniform {
                 clip_from_world: (m.projection * m.view).to_cols_array_2d(),
@@ -374,7 +379,7 @@ fn layered_target(
 
 /// One layer of the engine's output, read back: the visibility (alpha of `Rgba16Float`,
 /// red of the single-channel outputs), one value a pixel.
-pub fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
+pub(crate) fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
     let (texel, value): (u32, fn(&[u8]) -> f32) = match texture.format() {
         wgpu::TextureFormat::Rgba16Float => (8, |t| half::f16::from_bits(u16::from_le_bytes([t[6], t[7]])).to_f32()),
         wgpu::TextureFormat::R16Float => (2, |t| half::f16::from_bits(u16::from_le_bytes([t[0], t[1]])).to_f32()),
@@ -385,7 +390,7 @@ pub fn read_alpha(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Te
 }
 
 /// One layer of an `Rgba16Float` output, read back: r, g, b, a per pixel.
-pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
+pub(crate) fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32) -> Vec<f32> {
     assert_eq!(texture.format(), wgpu::TextureFormat::Rgba16Float, "the light is in the Rgba16Float output");
     let half = |t: &[u8]| half::f16::from_bits(u16::from_le_bytes([t[0], t[1]])).to_f32();
     read_layer(device, queue, texture, layer, 8).chunks(2).map(half).collect()

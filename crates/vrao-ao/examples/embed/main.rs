@@ -27,11 +27,11 @@
 mod host;
 
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
-use vrao_ao::ao::AoOutputFormat;
-use vrao_ao::ao::{
+use vrao_ao::AoOutputFormat;
+use vrao_ao::{
     AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
 };
-use vrao_ao::settings::{AoSettings, Technique};
+use vrao_ao::{AoSettings, Technique};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 360;
@@ -101,7 +101,7 @@ impl<E: Into<Box<dyn std::error::Error>>> From<E> for Failure {
 fn parse_msaa(value: Option<&str>) -> Result<u32, String> {
     let value = value.ok_or("--msaa needs a sample count: 1, 2, 4 or 8")?;
     match value.parse::<u32>() {
-        Ok(n) if vrao_ao::ao::import::SAMPLE_COUNTS.contains(&n) => Ok(n),
+        Ok(n) if AoConfig::SAMPLE_COUNTS.contains(&n) => Ok(n),
         _ => Err(format!("--msaa {value}: the sample count is 1, 2, 4 or 8")),
     }
 }
@@ -385,9 +385,9 @@ fn time_setup(
     engine.resize(width, height)?;
     let resize_ms = ms(started);
     let after_resize_ms = frame(&mut engine, &larger.depth)?;
-    let eager = vrao_ao::gpu::Gpu::from_host(device, queue)?;
+    let eager = vrao_ao::plug::Gpu::from_host(device, queue)?;
     let started = std::time::Instant::now();
-    let chain = vrao_ao::passes::ao_chain(&eager, Vec::new());
+    let chain = vrao_ao::plug::ao_chain(&eager, Vec::new());
     let eager_ms = ms(started);
     drop(chain);
     eprintln!(

@@ -9,8 +9,7 @@
 use super::{AoConfig, AoFrame, NormalEncoding, NormalSpace, Projection};
 use crate::error::{Error, Result};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, Slot};
-use crate::gpu::raster;
-use crate::gpu::Gpu;
+use crate::gpu::{raster, Gpu};
 use crate::graph::{PassDecl, Resource, PIXEL_MOTION};
 use crate::passes::inputs::{DEPTH, NORMALS};
 use crate::passes::{DeclareContext, Pass, RecordContext};
@@ -18,16 +17,16 @@ use bytemuck::{Pod, Zeroable};
 use std::sync::{Mutex, OnceLock};
 
 /// The pass's name, as `--explain` and the timings show it.
-pub const NAME: &str = "ao-import";
+pub(crate) const NAME: &str = "ao-import";
 
 /// The host's depth buffer (any depth format; its readers bind it as depth).
-pub const HOST_DEPTH: Resource = Resource::imported("host-depth", wgpu::TextureFormat::Depth32Float);
+pub(crate) const HOST_DEPTH: Resource = Resource::imported("host-depth", wgpu::TextureFormat::Depth32Float);
 
 /// The host's normals (any float-sampled format).
-pub const HOST_NORMALS: Resource = Resource::imported("host-normals", wgpu::TextureFormat::Rgba16Float);
+pub(crate) const HOST_NORMALS: Resource = Resource::imported("host-normals", wgpu::TextureFormat::Rgba16Float);
 /// The host's motion vectors (any float format): temporal accumulation reads them
 /// directly as [`crate::graph::PIXEL_MOTION`].
-pub const HOST_MOTION: Resource = Resource::imported("host-motion", wgpu::TextureFormat::Rgba16Float);
+pub(crate) const HOST_MOTION: Resource = Resource::imported("host-motion", wgpu::TextureFormat::Rgba16Float);
 
 const IMPORT_WGSL: Shader = wgsl!("src/ao/import.wgsl");
 /// The reads of a host with one sample per pixel.
@@ -36,7 +35,7 @@ const SINGLE_WGSL: Shader = wgsl!("src/ao/import_single.wgsl");
 const MSAA_WGSL: Shader = wgsl!("src/ao/import_msaa.wgsl");
 
 /// The sample counts the engine takes for the host's depth and normals.
-pub const SAMPLE_COUNTS: [u32; 4] = [1, 2, 4, 8];
+pub(crate) const SAMPLE_COUNTS: [u32; 4] = [1, 2, 4, 8];
 
 /// Depth formats the engine reads (the depth aspect of the depth-stencil ones).
 const DEPTH_FORMATS: [wgpu::TextureFormat; 5] = [
@@ -74,7 +73,7 @@ struct ImportParams {
 
 /// A host frame's inputs, checked: what the import pass writes into its uniform.
 #[derive(Clone, Copy)]
-pub struct ImportSource {
+pub(crate) struct ImportSource {
     params: ImportParams,
     views: u32,
     /// Samples per pixel of the host's depth (and normals).
@@ -188,7 +187,7 @@ fn check_texture_size(what: &str, texture: &wgpu::Texture, config: &AoConfig) ->
 }
 
 /// The import pass of a host's engine.
-pub struct ImportPass {
+pub(crate) struct ImportPass {
     /// For a host with one sample per pixel.
     single: ImportPipeline,
     /// For a multisampled host: made at its first multisampled frame.
@@ -292,7 +291,7 @@ impl MsaaImport {
 impl ImportPass {
     /// Builds the single-sample pipeline (the multisampled one waits for a multisampled
     /// host).
-    pub fn new(gpu: &Gpu) -> ImportPass {
+    pub(crate) fn new(gpu: &Gpu) -> ImportPass {
         let single = ImportPipeline::new(gpu, SINGLE_WGSL, Slot::Depth.binding_type(), Slot::Layers.binding_type());
         let uniform = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(NAME),
@@ -304,7 +303,7 @@ impl ImportPass {
     }
 
     /// The inputs of the frame about to be planned and recorded.
-    pub fn set_source(&self, source: ImportSource) {
+    pub(crate) fn set_source(&self, source: ImportSource) {
         *self.source.lock().unwrap_or_else(|p| p.into_inner()) = Some(source);
     }
 

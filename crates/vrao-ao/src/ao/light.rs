@@ -11,10 +11,10 @@ use crate::passes::ssdo::LightInputs;
 use crate::passes::{DeclareContext, Pass, RecordContext};
 
 /// The pass's name, as `--explain` and the timings show it.
-pub const NAME: &str = "ao-light-import";
+pub(crate) const NAME: &str = "ao-light-import";
 
 /// The host's direct light (any float-sampled format).
-pub const HOST_DIRECT: Resource = Resource::imported("host-direct", wgpu::TextureFormat::Rgba16Float);
+pub(crate) const HOST_DIRECT: Resource = Resource::imported("host-direct", wgpu::TextureFormat::Rgba16Float);
 
 /// What a host gives SSDO (`Technique::Ssdo`, `Technique::SsdoBounce`) besides depth.
 /// Without it SSDO returns GTAO's AO and no light; other techniques ignore it.
@@ -33,7 +33,7 @@ pub struct HostLight<'a> {
 }
 
 /// Packs the host's direct light with the view distance into [`DIRECT_LIGHT`].
-pub struct LightImportPass {
+pub(crate) struct LightImportPass {
     kernel: Kernel,
 }
 
@@ -41,7 +41,7 @@ const BINDINGS: [Bind; 4] = [Bind::Frame, Bind::Read(DEPTH), Bind::Read(HOST_DIR
 
 impl LightImportPass {
     /// Builds the pass's pipeline.
-    pub fn new(gpu: &Gpu) -> Self {
+    pub(crate) fn new(gpu: &Gpu) -> Self {
         let files = [COMMON, wgsl!("src/ao/light.wgsl")];
         LightImportPass { kernel: Kernel::new(gpu, NAME, &files, "main", &BINDINGS) }
     }

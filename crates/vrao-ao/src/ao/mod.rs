@@ -21,8 +21,8 @@
 //! and depth in 0..1 (wgpu's), standard or reversed, finite or infinite far, as the
 //! frame's [`DepthConvention`] says; one depth layer per view.
 
-pub mod import;
-pub mod light;
+pub(crate) mod import;
+pub(crate) mod light;
 mod pack;
 
 pub use light::HostLight;
@@ -143,6 +143,14 @@ pub struct AoConfig {
     pub height: u32,
     /// 1 (mono) or 2 (stereo).
     pub views: u32,
+}
+
+impl AoConfig {
+    /// The largest view side the engine takes, in pixels.
+    pub const MAX_SIDE: u32 = MAX_SIDE;
+    /// The samples per pixel a host's depth, normals and motion may have (a multisampled
+    /// texture is resolved in the engine's import pass).
+    pub const SAMPLE_COUNTS: [u32; 4] = import::SAMPLE_COUNTS;
 }
 
 /// The engine's AO for the frame just recorded: full resolution, one layer per view, the
@@ -445,7 +453,7 @@ fn pipeline_errors_as_device<T>(gpu: &Gpu, record: impl FnOnce() -> T) -> Result
 }
 
 /// The largest view side the engine takes, in pixels.
-pub const MAX_SIDE: u32 = 8192;
+pub(crate) const MAX_SIDE: u32 = 8192;
 
 /// The renderer settings the engine's passes read: the host's AO settings, its size as
 /// the profile's, and its near plane. The point-sampled SSDO is refused (see the
@@ -530,7 +538,7 @@ pub(crate) struct Projection {
 impl Projection {
     /// Reads `projection` as a right-handed perspective of the stated convention; errors
     /// start with `what`.
-    pub fn of(projection: &Mat4, convention: DepthConvention, what: &str) -> Result<Projection> {
+    pub(crate) fn of(projection: &Mat4, convention: DepthConvention, what: &str) -> Result<Projection> {
         let refuse = |why: String| Err(Error::input(format!("{what}: {why}")));
         let p: DMat4 = projection.as_dmat4();
         if !p.is_finite() {
@@ -593,7 +601,7 @@ mod tests {
         fn send_sync<T: Send + Sync>() {}
         send_sync::<AoEngine>();
     }
-    use crate::stereo::reversed_z_projection;
+    use crate::stereo::Fov;
 
     fn fov() -> Fov {
         Fov { left: -0.8, right: 0.7, up: 0.75, down: -0.85 }
@@ -601,7 +609,7 @@ mod tests {
 
     #[test]
     fn vrao_s_own_projection_reads_back_its_field_of_view_and_near() {
-        let p = reversed_z_projection(&fov(), 0.05).as_mat4();
+        let p = Fov::reversed_z_projection(&fov(), 0.05).as_mat4();
         let read = Projection::of(&p, DepthConvention::REVERSED_INFINITE, "p").unwrap();
         for (a, b) in [(read.fov.left, -0.8), (read.fov.right, 0.7), (read.fov.up, 0.75), (read.fov.down, -0.85)] {
             assert!((a - b).abs() < 1e-6, "{:?}", read.fov);

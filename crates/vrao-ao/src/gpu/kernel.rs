@@ -58,10 +58,10 @@ fn pipeline_key(label: &str, source: &str, entry: &str, constants: &[(&str, f64)
 }
 
 /// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
-pub const TILE: u32 = 8;
+pub(crate) const TILE: u32 = 8;
 
 /// One WGSL file, compiled into the binary so it runs from any directory; `path` is
-/// relative to the workspace root (for `VRAO_SHADER_DIR`). Made by a crate-internal
+/// relative to the workspace root (for a shader directory, [`Gpu::set_shader_dir`]). Made by a crate-internal
 /// `wgsl!` macro from the path within its crate.
 #[derive(Clone, Copy, Debug)]
 pub struct Shader {
@@ -95,16 +95,11 @@ pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");
 /// foveation map (`tile_rate`, `pixel_shown`), for the kernels that read it.
 pub const VISIBILITY: Shader = wgsl!("shaders/visibility.wgsl");
 
-/// The environment variable that makes the application's shaders load from disk
-/// (`Gpu::new` reads it; [`Gpu::set_shader_dir`] sets a directory for one `Gpu`):
-/// `VRAO_SHADER_DIR=.` (the workspace root) runs an edited shader without rebuilding.
-pub const SHADER_DIR_VAR: &str = "VRAO_SHADER_DIR";
-
 /// The text of `files`, concatenated in order (common first) so passes share
 /// `common.wgsl` without string formatting: as compiled in, or read from `gpu`'s shader
 /// directory when it has one ([`Gpu::set_shader_dir`]). A file that cannot be read there
 /// is `Error::Input` naming it.
-pub fn shader_source(gpu: &Gpu, files: &[Shader]) -> Result<String> {
+pub(crate) fn shader_source(gpu: &Gpu, files: &[Shader]) -> Result<String> {
     source_from(gpu.shader_dir(), files)
 }
 
@@ -115,8 +110,9 @@ fn source_from(dir: Option<&Path>, files: &[Shader]) -> Result<String> {
         match dir {
             Some(dir) => {
                 let path = dir.join(file.path);
-                let text = read_shader(&path)
-                    .map_err(|e| Error::in_file(&path, format!("cannot read this shader ({SHADER_DIR_VAR}): {e}")))?;
+                let text = read_shader(&path).map_err(|e| {
+                    Error::in_file(&path, format!("cannot read this shader (from the shader directory): {e}"))
+                })?;
                 source.push_str(&text);
             }
             None => source.push_str(file.source),
@@ -174,7 +170,7 @@ impl ErrorSlot {
     }
 }
 
-/// A shader module of `files` ([`shader_source`]); an unreadable file is the error.
+/// A shader module of `files` (`shader_source`); an unreadable file is the error.
 pub fn try_shader_module(gpu: &Gpu, label: &str, files: &[Shader]) -> Result<wgpu::ShaderModule> {
     Ok(module_of(&gpu.device, label, shader_source(gpu, files)?))
 }
@@ -188,7 +184,7 @@ fn source_or_recorded(gpu: &Gpu, files: &[Shader]) -> String {
     })
 }
 
-/// A shader module of `files` ([`shader_source`]) that always succeeds, for the passes'
+/// A shader module of `files` (`shader_source`) that always succeeds, for the passes'
 /// constructors: a file that cannot be read is recorded for [`Gpu::take_shader_error`]
 /// and the compiled-in text stands in, so the module is valid until the error is returned.
 pub fn shader_module(gpu: &Gpu, label: &str, files: &[Shader]) -> wgpu::ShaderModule {
@@ -652,14 +648,13 @@ mod tests {
         let dir = dir.as_path();
         assert_eq!(source_from(Some(dir), &[COMMON]).unwrap(), format!("{}\n", COMMON.source));
         let error = source_from(Some(dir), &COMMON_AND_MISSING).unwrap_err();
-        assert_eq!(error.exit_code(), crate::error::EXIT_INPUT);
         match &error {
             Error::Input { file: Some(file), .. } => {
                 assert_eq!(file, &dir.join("crates/vrao-ao/shaders/no-such-file.wgsl"))
             }
             other => panic!("not an input error naming the file: {other:?}"),
         }
-        assert!(error.to_string().contains("no-such-file.wgsl") && error.to_string().contains(SHADER_DIR_VAR));
+        assert!(error.to_string().contains("no-such-file.wgsl"));
     }
 
     #[test]

@@ -18,7 +18,7 @@
 //! failure names both), and the structs by size: a WGSL struct's size is already a
 //! multiple of its alignment, so equal sizes also keep the Rust size aligned.
 
-#![allow(dead_code)]
+#![allow(dead_code, unreachable_pub)]
 
 /// One Rust field of a mirror.
 pub struct Field {

@@ -1,46 +1,19 @@
-//! Device and adapter choice, layered targets, compute-kernel plumbing, GPU timing and
+//! The device (a host's or a renderer's), layered targets, compute-kernel plumbing, GPU timing and
 //! readback. Everything GPU-side that is not a technique lives here.
 
-pub mod kernel;
-pub mod layered_target;
+pub(crate) mod kernel;
+pub(crate) mod layered_target;
 #[cfg(any(test, feature = "layout-check"))]
-#[doc(hidden)]
 pub mod layout_check;
-pub mod multiview_probe;
-pub mod raster;
-pub mod readback;
-pub mod support;
-pub mod timing;
-pub mod uniforms;
-pub mod visibility;
+pub(crate) mod raster;
+pub(crate) mod readback;
+pub(crate) mod support;
+pub(crate) mod timing;
+pub(crate) mod uniforms;
+pub(crate) mod visibility;
 
 use crate::error::{Error, Result};
 use std::fmt::Write as _;
-
-/// Which wgpu backend to use. `Auto` prefers a real GPU and falls back to lavapipe.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum BackendChoice {
-    /// Whichever backend has a real GPU, falling back to lavapipe (software Vulkan).
-    #[default]
-    Auto,
-    /// Vulkan only.
-    Vulkan,
-    /// OpenGL (ES) only, for machines without Vulkan.
-    Gl,
-}
-
-impl BackendChoice {
-    /// Every choice, the default first.
-    pub const ALL: [BackendChoice; 3] = [BackendChoice::Auto, BackendChoice::Vulkan, BackendChoice::Gl];
-    /// The choice's command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            BackendChoice::Auto => "auto",
-            BackendChoice::Vulkan => "vulkan",
-            BackendChoice::Gl => "gl",
-        }
-    }
-}
 
 /// What the chosen device can do that the renderer cares about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,93 +62,23 @@ pub struct Gpu {
     /// forgets its bind groups, which would otherwise keep dropped textures alive.
     pub(crate) bind_group_epoch: std::sync::Arc<std::sync::atomic::AtomicU64>,
     /// Bind group 1 of every compute kernel: the visibility mask and foveation map
-    /// ([`visibility::bind_group_layout`]).
+    /// (`bind_group_layout`).
     pub visibility_layout: wgpu::BindGroupLayout,
 }
 
 impl Gpu {
-    /// Opens the best adapter for `choice`: a discrete or integrated GPU when one exists,
-    /// otherwise a CPU (lavapipe) adapter. No adapter at all is `Error::Device`.
-    pub fn new(choice: BackendChoice) -> Result<Gpu> {
-        // Auto tries the native APIs first and OpenGL only when they found nothing, so a
-        // machine with Vulkan never initialises (and hears from) the GL/EGL stack.
-        let attempts: &[wgpu::Backends] = match choice {
-            BackendChoice::Auto => &[wgpu::Backends::PRIMARY, wgpu::Backends::GL],
-            BackendChoice::Vulkan => &[wgpu::Backends::VULKAN],
-            BackendChoice::Gl => &[wgpu::Backends::GL],
-        };
-        let mut last_error = None;
-        for &backends in attempts {
-            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-            desc.backends = backends;
-            let instance = wgpu::Instance::new(desc);
-            match pick_adapter(&instance, backends) {
-                Ok(adapter) => return Self::from_adapter(instance, adapter),
-                Err(e) => last_error = Some(e),
-            }
-        }
-        Err(last_error.unwrap_or_else(|| Error::Device("no backend was tried".into())))
-    }
-
-    fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu> {
-        let desc = Self::device_descriptor(&adapter);
-        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
-            .map_err(|e| Error::Device(format!("{} refused a device: {e}", adapter.get_info().name)))?;
-        Self::from_device(instance, adapter, device, queue)
-    }
-
-    /// The features and limits vrao asks of `adapter`: multiview and timestamp queries
-    /// when offered, and limits large enough for full-size layered targets. Devices that
-    /// others create for us (the OpenXR runtime's) are opened with the same descriptor.
-    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
-        let available = adapter.features();
-        let adapter_limits = adapter.limits();
-        let multiview = available.contains(wgpu::Features::MULTIVIEW) && adapter_limits.max_multiview_view_count >= 2;
-        let timestamps =
-            available.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
-        let mut features = wgpu::Features::empty();
-        if multiview {
-            features |= wgpu::Features::MULTIVIEW;
-        }
-        if timestamps {
-            features |= wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        }
-        // Ask for what the adapter has so full-size layered targets fit; keep the
-        // downlevel defaults otherwise.
-        let mut limits = wgpu::Limits::downlevel_defaults().using_resolution(adapter_limits.clone());
-        limits.max_texture_array_layers = adapter_limits.max_texture_array_layers.min(256);
-        limits.max_storage_textures_per_shader_stage = adapter_limits.max_storage_textures_per_shader_stage.min(8);
-        limits.max_storage_buffers_per_shader_stage = adapter_limits.max_storage_buffers_per_shader_stage.min(8);
-        limits.max_compute_workgroup_storage_size = adapter_limits.max_compute_workgroup_storage_size;
-        // A moving, normal-textured scene's G-buffer writes five targets (36 bytes a pixel).
-        limits.max_color_attachments = adapter_limits.max_color_attachments.min(8);
-        limits.max_color_attachment_bytes_per_sample = adapter_limits.max_color_attachment_bytes_per_sample.min(64);
-        limits.max_buffer_size = adapter_limits.max_buffer_size;
-        limits.max_storage_buffer_binding_size = adapter_limits.max_storage_buffer_binding_size;
-        if multiview {
-            limits.max_multiview_view_count = 2;
-        }
-        wgpu::DeviceDescriptor {
-            label: Some("vrao"),
-            required_features: features,
-            required_limits: limits,
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }
-    }
-
-    /// The `Gpu` for a device opened with [`Gpu::device_descriptor`] (by wgpu, or wrapped
-    /// from a device an OpenXR runtime created): the adapter is checked for what the
-    /// kernels need (a refusal names what it lacks), GPU errors are kept for
-    /// [`Gpu::take_error`], and the multiview probe runs.
+    /// The `Gpu` for a device a renderer opened on `adapter` and hands over (vrao's
+    /// renderer, or a device an OpenXR runtime created): the adapter is checked for what
+    /// the kernels need (a refusal names what it lacks) and GPU errors are kept for
+    /// [`Gpu::take_error`]. Multiview is marked unreliable until the renderer's probe says
+    /// otherwise (`caps.multiview_reliable`).
     pub fn from_device(
         instance: wgpu::Instance,
         adapter: wgpu::Adapter,
         device: wgpu::Device,
         queue: wgpu::Queue,
     ) -> Result<Gpu> {
-        refuse_missing(&adapter.get_info(), support::missing_capabilities(&support::AdapterSupport::of(&adapter)))?;
+        Self::check_adapter(&adapter)?;
         let uncaptured = std::sync::Arc::new(std::sync::Mutex::new(None));
         let sink = uncaptured.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
@@ -185,7 +88,7 @@ impl Gpu {
         }));
         let info = adapter.get_info();
         let visibility_layout = visibility::bind_group_layout(&device);
-        let mut gpu = Gpu {
+        Ok(Gpu {
             visibility_layout,
             caps: Self::capabilities_of(&device),
             instance: Some(instance),
@@ -198,14 +101,21 @@ impl Gpu {
             lazy_pipelines: false,
             pipelines_built: Default::default(),
             compiled_pipelines: Default::default(),
-            // The application's override (the engine on a host's device reads no
-            // environment: Gpu::from_host).
-            shader_dir: std::env::var_os(kernel::SHADER_DIR_VAR).map(std::path::PathBuf::from),
+            shader_dir: None,
             shader_error: Default::default(),
             bind_group_epoch: Default::default(),
-        };
-        gpu.caps.multiview_reliable = gpu.caps.multiview && multiview_probe::multiview_reaches_every_layer(&gpu);
-        Ok(gpu)
+        })
+    }
+
+    /// What `adapter` lacks that the kernels need (empty when nothing), for a renderer
+    /// choosing among adapters.
+    pub fn missing_capabilities(adapter: &wgpu::Adapter) -> Vec<String> {
+        support::missing_capabilities(&support::AdapterSupport::of(adapter))
+    }
+
+    /// `Error::Device` naming what `adapter` lacks, if anything.
+    pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<()> {
+        refuse_missing(&adapter.get_info(), Self::missing_capabilities(adapter))
     }
 
     /// The `Gpu` for a device a host application opened and keeps (the AO engine's):
@@ -380,37 +290,4 @@ fn refuse_missing(info: &wgpu::AdapterInfo, missing: Vec<String>) -> Result<()> 
         info.name,
         missing.join(" and ")
     )))
-}
-
-/// Prefers a hardware adapter; a CPU adapter (lavapipe) is the fall-back. Adapters that
-/// lack something the renderer needs ([`support::missing_capabilities`]) are passed over;
-/// when only such adapters exist, the best one is refused with what it lacks.
-fn pick_adapter(instance: &wgpu::Instance, backends: wgpu::Backends) -> Result<wgpu::Adapter> {
-    let adapters = pollster::block_on(instance.enumerate_adapters(backends));
-    let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
-        wgpu::DeviceType::DiscreteGpu => 0,
-        wgpu::DeviceType::IntegratedGpu => 1,
-        wgpu::DeviceType::VirtualGpu => 2,
-        wgpu::DeviceType::Other => 3,
-        wgpu::DeviceType::Cpu => 4,
-    };
-    let mut ranked: Vec<(wgpu::Adapter, Vec<String>)> = adapters
-        .into_iter()
-        .map(|a| {
-            let missing = support::missing_capabilities(&support::AdapterSupport::of(&a));
-            (a, missing)
-        })
-        .collect();
-    ranked.sort_by_key(|(a, missing)| (!missing.is_empty(), rank(a)));
-    match ranked.into_iter().next() {
-        Some((adapter, missing)) if missing.is_empty() => Ok(adapter),
-        Some((adapter, missing)) => {
-            refuse_missing(&adapter.get_info(), missing)?;
-            unreachable!("an adapter that lacks something is refused")
-        }
-        None => Err(Error::Device(format!(
-            "no adapter on backends {backends:?}; install a Vulkan driver \
-             (for a CPU fall-back: apt install mesa-vulkan-drivers)"
-        ))),
-    }
 }

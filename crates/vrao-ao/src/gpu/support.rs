@@ -6,7 +6,7 @@
 /// (`Slot::Output`): colour, the AO targets and history, world positions, and the
 /// packed direct light. Checked when each kernel is made (`Kernel::with_constants`), so
 /// a pass that writes another format fails every test until it is listed here.
-pub const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
+pub(crate) const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
     wgpu::TextureFormat::Rgba8Unorm,
     wgpu::TextureFormat::Rgba16Float,
     wgpu::TextureFormat::Rgba32Float,
@@ -16,7 +16,7 @@ pub const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
 /// What an adapter reports that the renderer depends on, as plain data so the decision
 /// can be tested without one.
 #[derive(Clone, Debug)]
-pub struct AdapterSupport {
+pub(crate) struct AdapterSupport {
     /// The adapter's backend.
     pub backend: wgpu::Backend,
     /// The adapter's downlevel flags (compute, storage support).
@@ -27,7 +27,7 @@ pub struct AdapterSupport {
 
 impl AdapterSupport {
     /// Reads the support figures from a real adapter.
-    pub fn of(adapter: &wgpu::Adapter) -> AdapterSupport {
+    pub(crate) fn of(adapter: &wgpu::Adapter) -> AdapterSupport {
         AdapterSupport {
             backend: adapter.get_info().backend,
             downlevel: adapter.get_downlevel_capabilities().flags,
@@ -37,7 +37,7 @@ impl AdapterSupport {
 }
 
 /// What the renderer needs that `support` lacks, one phrase each; empty when it can run.
-pub fn missing_capabilities(support: &AdapterSupport) -> Vec<String> {
+pub(crate) fn missing_capabilities(support: &AdapterSupport) -> Vec<String> {
     let mut missing = Vec::new();
     if !support.downlevel.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
         missing.push("compute shaders (DownlevelFlags::COMPUTE_SHADERS)".to_string());
@@ -65,7 +65,7 @@ pub fn missing_capabilities(support: &AdapterSupport) -> Vec<String> {
 /// What the kernels need that a device alone can say (a host's device, whose adapter
 /// vrao never sees): its backend, and the limits a compute pass over layered targets uses.
 #[derive(Clone, Debug)]
-pub struct DeviceSupport {
+pub(crate) struct DeviceSupport {
     /// The backend the device runs on.
     pub backend: wgpu::Backend,
     /// The device's limits.
@@ -74,7 +74,7 @@ pub struct DeviceSupport {
 
 impl DeviceSupport {
     /// What `device` reports.
-    pub fn of(device: &wgpu::Device) -> DeviceSupport {
+    pub(crate) fn of(device: &wgpu::Device) -> DeviceSupport {
         DeviceSupport { backend: device.adapter_info().backend, limits: device.limits() }
     }
 }
@@ -86,7 +86,7 @@ const STORAGE_TEXTURES_PER_KERNEL: u32 = 3;
 /// What a host's device lacks for the AO engine's kernels. The formats the kernels write
 /// ([`STORAGE_WRITE_FORMATS`]) are write-only storage formats of every non-GL backend's
 /// baseline (WebGPU's core set), so the backend and the limits decide.
-pub fn missing_device_capabilities(support: &DeviceSupport) -> Vec<String> {
+pub(crate) fn missing_device_capabilities(support: &DeviceSupport) -> Vec<String> {
     let mut missing = Vec::new();
     let limits = &support.limits;
     let tile = super::kernel::TILE;

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use std::collections::VecDeque;
 
 /// One finished frame's spans: (label, GPU milliseconds) in the order they were
-/// recorded; per-eye spans ([`is_per_eye`]) lie inside their pass's span.
+/// recorded; per-eye spans ([`FrameTiming::is_per_eye`]) lie inside their pass's span.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameTiming {
     /// The renderer's frame number the spans belong to.
@@ -122,7 +122,7 @@ impl PassTimer {
             let mut spans = Vec::new();
             flatten(&results, &mut spans);
             // A pass's per-eye spans lie inside its own span: only passes add up.
-            let total_ms = spans.iter().filter(|(label, _)| !is_per_eye(label)).map(|(_, ms)| ms).sum();
+            let total_ms = spans.iter().filter(|(label, _)| !FrameTiming::is_per_eye(label)).map(|(_, ms)| ms).sum();
             done.push(FrameTiming { frame, spans, total_ms, serial: false });
         }
         done
@@ -134,27 +134,29 @@ impl PassTimer {
     }
 }
 
-/// Per-eye spans (a pass run once per eye) are labelled "`<pass> left`" / "`<pass> right`".
-pub fn is_per_eye(label: &str) -> bool {
-    label.ends_with(" left") || label.ends_with(" right")
-}
-
-/// The summed GPU ms of `passes` in one frame's `spans`, or the first of them that has no
-/// span: every pass that runs is timed under its name, so a missing one means a name
-/// and its span disagree, and counting it as 0 ms would hide that.
-pub fn passes_ms<'a>(spans: &[(String, f64)], passes: &[&'a str]) -> std::result::Result<f64, &'a str> {
-    passes.iter().try_fold(0.0, |sum, &pass| match spans.iter().find(|(label, _)| label == pass) {
-        Some((_, ms)) => Ok(sum + ms),
-        None => Err(pass),
-    })
-}
-
 fn flatten(results: &[wgpu_profiler::GpuTimerQueryResult], out: &mut Vec<(String, f64)>) {
     for r in results {
         if let Some(time) = &r.time {
             out.push((r.label.clone(), (time.end - time.start).max(0.0) * 1e3));
         }
         flatten(&r.nested_queries, out);
+    }
+}
+
+impl FrameTiming {
+    /// Per-eye spans (a pass run once per eye) are labelled "`<pass> left`" / "`<pass> right`".
+    pub fn is_per_eye(label: &str) -> bool {
+        label.ends_with(" left") || label.ends_with(" right")
+    }
+
+    /// The summed GPU ms of `passes` in one frame's `spans`, or the first of them that has no
+    /// span: every pass that runs is timed under its name, so a missing one means a name
+    /// and its span disagree, and counting it as 0 ms would hide that.
+    pub fn passes_ms<'a>(spans: &[(String, f64)], passes: &[&'a str]) -> std::result::Result<f64, &'a str> {
+        passes.iter().try_fold(0.0, |sum, &pass| match spans.iter().find(|(label, _)| label == pass) {
+            Some((_, ms)) => Ok(sum + ms),
+            None => Err(pass),
+        })
     }
 }
 
@@ -165,8 +167,8 @@ mod tests {
     #[test]
     fn pass_times_add_up_and_a_missing_span_is_named() {
         let spans = vec![("ssao".to_string(), 1.5), ("ssao left".to_string(), 0.75), ("blur".to_string(), 0.25)];
-        assert_eq!(passes_ms(&spans, &["ssao", "blur"]), Ok(1.75));
-        assert_eq!(passes_ms(&spans, &[]), Ok(0.0));
-        assert_eq!(passes_ms(&spans, &["ssao", "upsample"]), Err("upsample"));
+        assert_eq!(FrameTiming::passes_ms(&spans, &["ssao", "blur"]), Ok(1.75));
+        assert_eq!(FrameTiming::passes_ms(&spans, &[]), Ok(0.0));
+        assert_eq!(FrameTiming::passes_ms(&spans, &["ssao", "upsample"]), Err("upsample"));
     }
 }

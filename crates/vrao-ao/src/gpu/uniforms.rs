@@ -12,7 +12,7 @@ use glam::{DMat4, DVec3, Mat4};
 /// One eye's matrices as the shaders read them (`Eye` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-pub struct EyeUniform {
+pub(crate) struct EyeUniform {
     /// Clip from the scene's anchor frame (geometry is stored relative to the f64 anchor).
     pub clip_from_anchored: [[f32; 4]; 4],
     /// View from the anchor frame (normals use its rotation).
@@ -28,7 +28,7 @@ pub struct EyeUniform {
 /// Per-frame constants of every pass (`Frame` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-pub struct FrameUniform {
+pub(crate) struct FrameUniform {
     /// The views of layer 0 and layer 1 (layer 1 all zeros for a mono view).
     pub eyes: [EyeUniform; 2],
     /// Full-resolution image size in pixels, per eye.
@@ -71,7 +71,7 @@ pub struct LightUniform {
 /// The occlusion passes' parameters (`AoParams` of common.wgsl; layout must match).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-pub struct AoParamsUniform {
+pub(crate) struct AoParamsUniform {
     /// Size of the occlusion targets in pixels (half the full size, rounded up, at half resolution).
     pub ao_size: [u32; 2],
     /// Full-resolution pixels per occlusion pixel along each axis: 1 or 2.
@@ -110,7 +110,7 @@ pub struct AoParamsUniform {
 }
 
 /// Most samples a kernel may hold (the settings' limit on N).
-pub const MAX_KERNEL_SAMPLES: usize = 256;
+pub(crate) const MAX_KERNEL_SAMPLES: usize = 256;
 
 /// What of a scene the frame uniforms carry: the anchor the geometry is stored relative
 /// to, the lights and the environment in each view's space, and the tone mapping. A
@@ -124,7 +124,7 @@ pub struct FrameLighting<'a> {
     /// per view as `lights.len() / views`).
     pub lights: &'a [LightUniform],
     /// The environment's quadratics in each view's space, as
-    /// [`FrameUniform::environment_quadratics`] holds them; `None` without one.
+    /// `environment_quadratics` holds them; `None` without one.
     pub environment: Option<&'a [[[f32; 4]; 10]; 4]>,
     /// Linear exposure before tone mapping.
     pub exposure: f32,
@@ -140,7 +140,7 @@ impl FrameLighting<'_> {
 
 /// The uniform and light buffers of one frame.
 pub struct FrameUniforms {
-    /// The [`FrameUniform`].
+    /// The `FrameUniform`.
     pub frame: wgpu::Buffer,
     /// [`LightUniform`]s of both eyes (at least one element: wgpu rejects empty bindings).
     pub lights: wgpu::Buffer,
@@ -296,13 +296,13 @@ fn other_from_view(views: &[Eye], index: usize) -> Mat4 {
 /// Lin's NCTU thesis turns it 10° per frame, which leaves successive patterns so alike that
 /// accumulating frames cuts the noise far less than golden-angle steps do
 /// (docs/records/2026-11-29/measurements-in-code.md, temporal-angle).
-pub fn temporal_angle(frame_index: u64) -> f32 {
+pub(crate) fn temporal_angle(frame_index: u64) -> f32 {
     ((frame_index as f64 * 137.507_764f64).rem_euclid(360.0)).to_radians() as f32
 }
 
 /// The range jitter of Lin's NCTU thesis (HBAO): the sample lengths scale by a factor in [0.9,
 /// 1] that follows the golden-ratio sequence, so successive frames reach different depths.
-pub fn temporal_range_scale(frame_index: u64) -> f32 {
+pub(crate) fn temporal_range_scale(frame_index: u64) -> f32 {
     let golden = 0.618_033_988_749_895_f64;
     (1.0 - 0.1 * (frame_index as f64 * golden).fract()) as f32
 }

@@ -11,7 +11,7 @@ use crate::visibility::{RateMap, VisibilityMask};
 
 /// The layout of bind group 1: the rate map (two mip levels) and the per-pixel coverage,
 /// both `texture_2d_array<f32>` read with `textureLoad`.
-pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+pub(crate) fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,

@@ -6,22 +6,21 @@
 //! execution order; a renderer adds its own passes around them through the same [`Pass`]
 //! trait (vrao-render's G-buffer, lights, SSDO and composite).
 
-pub mod blur;
-pub mod fetch_only;
-pub mod gtao;
-pub mod hbao;
-pub mod inputs;
-pub mod occlusion;
-pub mod ssao;
-pub mod ssdo;
-pub mod temporal;
-pub mod upsample;
+pub(crate) mod blur;
+pub(crate) mod fetch_only;
+pub(crate) mod gtao;
+pub(crate) mod hbao;
+pub(crate) mod inputs;
+pub(crate) mod occlusion;
+pub(crate) mod ssao;
+pub(crate) mod ssdo;
+pub(crate) mod temporal;
+pub(crate) mod upsample;
 
 use crate::gpu::kernel::Bind;
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::timing::SpanRecorder;
-use crate::gpu::uniforms::ao_extent;
-use crate::gpu::uniforms::FrameUniforms;
+use crate::gpu::uniforms::{ao_extent, FrameUniforms};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
 use crate::settings::AoSettings;
@@ -30,7 +29,7 @@ use std::any::Any;
 use std::collections::{BTreeMap, HashMap};
 
 /// The AO chain, in execution order: each technique of the table that has a pass (one
-/// runs; [`crate::technique::TECHNIQUES`]), then `light_gathering`
+/// runs; `TECHNIQUES`), then `light_gathering`
 /// (a renderer's light-gathering technique, such as vrao-render's point-sampled SSDO), temporal
 /// accumulation, the denoise and the upsampling to full resolution. It reads
 /// [`inputs::DEPTH`] and [`inputs::NORMALS`] and provides [`crate::graph::OCCLUSION`] and

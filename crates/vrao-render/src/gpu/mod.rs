@@ -1,9 +1,10 @@
-//! The engine's GPU plumbing ([`vrao_ao::gpu`]) and the renderer's own pieces: the scene
-//! uploaded to the GPU and the mesh-drawing pipelines.
+//! The renderer's GPU pieces beside the engine's ([`vrao_ao::plug`]): opening the
+//! device, the scene uploaded to the GPU and the mesh-drawing pipelines.
 
-pub use vrao_ao::gpu::*;
-
+pub mod direct_readback;
 pub mod kernel;
+pub(crate) mod multiview_probe;
+pub mod open;
 pub mod raster;
 pub mod scene;
 pub mod textures;

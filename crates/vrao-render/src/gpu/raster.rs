@@ -1,9 +1,8 @@
 //! The mesh-drawing pieces of the renderer's raster passes: the scene's vertex layout and
 //! the mesh pipeline (G-buffer, depth peeling, shadow maps). The engine's raster pieces
-//! (full-screen pipeline, layer views) are re-exported here.
+//! (full-screen pipeline, layer views) are in [`vrao_ao::plug`].
 
 use super::scene::Vertex;
-pub use vrao_ao::gpu::raster::*;
 
 /// The scene's vertices (position, normal, uv, colour, tangent) as the raster passes read them.
 pub const MESH_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![

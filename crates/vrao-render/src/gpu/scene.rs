@@ -8,12 +8,12 @@
 //! moved by its object's transform, which [`GpuScene::set_time`] writes each frame with the
 //! previous frame's beside it (the G-buffer's motion vectors), so nothing is re-uploaded.
 
-use super::kernel::{wgsl, Shader};
+use super::kernel::wgsl;
 use super::textures::{self, Encoding, Samplers};
-use super::Gpu;
 use crate::scene::{Environment, Material, Scene, Texture};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
+use vrao_ao::plug::{Gpu, Shader};
 use wgpu::util::DeviceExt;
 
 /// mesh.wgsl: the material bind group, `VertexIn` and the material's albedo, shared by
@@ -576,11 +576,10 @@ fn sampler_layout(binding: u32) -> wgpu::BindGroupLayoutEntry {
 
 #[cfg(test)]
 mod tests {
-    use super::saturating_f16;
-    use super::{MaterialUniform, ObjectUniform, MESH_WGSL};
-    use crate::gpu::kernel::COMMON;
-    use crate::gpu::layout_check::{self, mirror};
+    use super::{saturating_f16, MaterialUniform, ObjectUniform, MESH_WGSL};
     use half::f16;
+    use vrao_ao::layout_check::{self, mirror};
+    use vrao_ao::plug::COMMON;
 
     /// `Vertex` mirrors no WGSL struct in memory: the vertex attributes convert it to
     /// mesh.wgsl's `VertexIn`, so they are what must match its fields.

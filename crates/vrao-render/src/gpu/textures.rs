@@ -2,9 +2,9 @@
 //! 2×2 box filtered, in linear light for sRGB images), and one sampler per distinct
 //! [`Sampling`] (wrap per axis, filters), shared by every material that samples that way.
 
-use super::Gpu;
 use crate::scene::{Filter, Sampling, Texture, Wrap};
 use std::collections::HashMap;
+use vrao_ao::plug::Gpu;
 use wgpu::util::DeviceExt;
 
 /// How a texture's bytes encode its values.

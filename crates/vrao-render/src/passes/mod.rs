@@ -1,9 +1,8 @@
-//! The engine's passes ([`vrao_ao::passes`]) and the renderer's own, one folder each:
+//! The renderer's own passes, one folder each, written against the engine's plug
+//! ([`vrao_ao::plug`]):
 //! [`scene_passes`] run before the AO chain and [`output_passes`] after it. The
 //! renderer's passes read its scene, uploaded scene and settings as the frame's
 //! extensions ([`scene_of`], [`gpu_scene_of`], [`settings_of`]).
-
-pub use vrao_ao::passes::*;
 
 pub mod composite;
 pub mod direct;
@@ -15,11 +14,10 @@ pub mod ssdo;
 pub mod tonemap;
 
 use crate::gpu::scene::GpuScene;
-use crate::gpu::uniforms::FrameUniforms;
-use crate::gpu::Gpu;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use std::sync::Arc;
+use vrao_ao::plug::{DeclareContext, FrameUniforms, Gpu, Pass};
 
 /// The renderer's passes before the AO chain, in execution order: the G-buffer, the
 /// directional lights' maps and direct light, their bounce, and the second depth layer

@@ -9,10 +9,9 @@
 //! screen-space AO's failure modes.
 
 use super::{Environment, HeadPath, Light, Material, Mesh, Scene};
-use crate::error::{Error, Result};
-use crate::stereo::HeadPose;
 use glam::{DVec3, Vec3};
 use std::f64::consts::{PI, TAU};
+use vrao_ao::{Error, HeadPose, Result};
 
 /// The built-in scene names, as `builtin:NAME` or `builtin = "NAME"` in a scene file.
 pub const NAMES: [&str; 10] =
@@ -169,7 +168,7 @@ pub(super) struct Face {
 
 impl Face {
     /// The same face seen from the other side.
-    pub fn flipped(self) -> Face {
+    pub(super) fn flipped(self) -> Face {
         Face { u: self.v, v: self.u, ..self }
     }
 }
@@ -204,7 +203,7 @@ pub(super) struct Builder {
 
 impl Builder {
     /// `face` as an n×n grid of quads, each split into two CCW triangles.
-    pub fn face(&mut self, face: &Face, n: u32) {
+    pub(super) fn face(&mut self, face: &Face, n: u32) {
         let normal = face.u.cross(face.v).normalize().as_vec3();
         let base = self.positions.len() as u32;
         for j in 0..=n {
@@ -217,19 +216,19 @@ impl Builder {
     }
 
     /// An axis-aligned box, normals outward, one quad a face.
-    pub fn cuboid(&mut self, min: DVec3, max: DVec3) {
+    pub(super) fn cuboid(&mut self, min: DVec3, max: DVec3) {
         cuboid_faces(min, max).iter().for_each(|f| self.face(f, 1));
     }
 
     /// The parallelepiped at `corner` with right-handed edges `x`, `y`, `z` (a turned box),
     /// normals outward, one quad a face.
-    pub fn parallelepiped(&mut self, corner: DVec3, x: DVec3, y: DVec3, z: DVec3) {
+    pub(super) fn parallelepiped(&mut self, corner: DVec3, x: DVec3, y: DVec3, z: DVec3) {
         parallelepiped_faces(corner, x, y, z).iter().for_each(|f| self.face(f, 1));
     }
 
     /// An upright closed cylinder standing on `base` (the centre of its bottom disc):
     /// radial normals on the side, flat caps.
-    pub fn cylinder(&mut self, base: DVec3, radius: f64, height: f64, segments: u32) {
+    pub(super) fn cylinder(&mut self, base: DVec3, radius: f64, height: f64, segments: u32) {
         // Angle φ runs from +X towards −Z, so the side's grid (u around, v up) faces out.
         let rim = |i: u32| {
             let phi = TAU * i as f64 / segments as f64;
@@ -261,7 +260,7 @@ impl Builder {
     }
 
     /// A UV sphere with radial normals: `rings` bands from +Y to −Y, `segments` around.
-    pub fn sphere(&mut self, centre: DVec3, radius: f64, rings: u32, segments: u32) {
+    pub(super) fn sphere(&mut self, centre: DVec3, radius: f64, rings: u32, segments: u32) {
         let base = self.positions.len() as u32;
         for r in 0..=rings {
             let theta = PI * r as f64 / rings as f64;
@@ -295,7 +294,7 @@ impl Builder {
         }
     }
 
-    pub fn finish(self, name: &str, material: usize) -> Mesh {
+    pub(super) fn finish(self, name: &str, material: usize) -> Mesh {
         let (origin, positions) = Mesh::recentre(&self.positions);
         Mesh {
             colors: Vec::new(),

@@ -9,10 +9,10 @@
 //! and the left/right edges are +Z. This is how a panorama is viewed from inside, so the
 //! usual HDRIs (Poly Haven, three.js examples) appear the right way round.
 
-use crate::error::{Error, Result};
 use glam::Vec3;
 use std::f32::consts::{PI, TAU};
 use std::path::Path;
+use vrao_ao::{Error, Result};
 
 /// Largest finite f16: texels are uploaded as `Rgba16Float`, so anything above would
 /// become infinity on the GPU.
@@ -143,7 +143,7 @@ impl Environment {
     /// noticeable share of its time, docs/records/2026-11-29/measurements-in-code.md, sh-band-2; the window
     /// gave band 2 only a quarter weight anyway). Evaluate with [`sh9_basis`] and clamp at 0.
     pub fn radiance_sh_prefiltered(&self) -> [Vec3; 9] {
-        vrao_ao::sh::prefiltered_radiance(&self.irradiance_sh_scaled())
+        vrao_ao::plug::prefiltered_radiance(&self.irradiance_sh_scaled())
     }
 
     /// The pre-filtered radiance of [`Environment::radiance_sh_prefiltered`] in the
@@ -217,12 +217,13 @@ pub fn sh9_basis(d: Vec3) -> [f32; 9] {
     ]
 }
 
-pub use vrao_ao::sh::{quadratic_in_view, sh9_quadratic};
+pub(crate) use vrao_ao::plug::sh9_quadratic;
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Mat3;
+    use vrao_ao::plug::quadratic_in_view;
 
     fn uniform(width: u32, height: u32, radiance: f32) -> Environment {
         let texels = vec![[radiance; 3]; (width * height) as usize];

@@ -68,14 +68,13 @@ use super::{
     builtin, limits, obj, Environment, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene,
 };
 use super::{Track, Trs};
-use crate::error::{Error, Result};
-use crate::stereo::HeadPose;
 use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
+use vrao_ao::{Error, HeadPose, Result};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -6,7 +6,7 @@
 //! the bounds and their messages, in one place.
 
 use super::{Mesh, Scene};
-use crate::error::{Error, Result};
+use vrao_ao::{Error, Result};
 
 /// The brightest radiance a light, emitter or sky multiplier may give (linear, per colour
 /// channel): the largest finite half float, the HDR buffer's format. One light at this

@@ -2,7 +2,7 @@
 //!
 //! Loaded from OBJ+MTL (`obj.rs`), from a TOML scene file (`file.rs`), or built in
 //! (`builtin.rs`, addressed as `builtin:NAME`). Every loader validates what it reads and
-//! returns [`crate::error::Error::Input`] naming the file and line for anything malformed.
+//! returns [`vrao_ao::Error::Input`] naming the file and line for anything malformed.
 
 pub mod animation;
 pub mod builtin;
@@ -19,10 +19,9 @@ pub mod normals;
 pub mod obj;
 pub mod texture;
 
-use crate::error::{Error, Result};
-use crate::stereo::HeadPose;
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
+use vrao_ao::{Error, HeadPose, Result};
 
 pub use animation::{Interpolation, Node, NodeTracks, Track, Trs};
 pub use environment::Environment;

@@ -25,11 +25,11 @@
 use super::limits::GeometryBudget;
 use super::normals::{self, Geometry};
 use super::{Environment, HeadPath, Light, Material, Mesh, Scene, Texture};
-use crate::error::{Error, Result};
 use glam::{DVec3, Vec2, Vec3};
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use vrao_ao::{Error, Result};
 
 /// Diffuse reflectance when a material gives no `Kd`, and of the material given to meshes
 /// without one.
@@ -129,7 +129,7 @@ pub fn load_bare(path: &Path) -> Result<Scene> {
         meshes,
         materials,
         environment: Some(Environment::default_sky()),
-        head: HeadPath::fixed(crate::stereo::HeadPose::IDENTITY),
+        head: HeadPath::fixed(vrao_ao::HeadPose::IDENTITY),
         nodes: Vec::new(),
     };
     scene.head = HeadPath::fixed(scene.bounds().framing_pose());

@@ -4,8 +4,8 @@
 //! `openxr/mask.rs`'s.
 
 use super::*;
-use crate::render::visibility::ViewMask;
 use crate::xr::openxr::mask::{check_counts, skip_runtime_mask, view_mask, MaskMesh, SessionMask, MASK_VAR, VIEWS};
+use vrao_ao::ViewMask;
 
 /// How often the two-call idiom is tried again when the mask grows between its calls.
 const READ_TRIES: usize = 3;

@@ -17,7 +17,8 @@ use crate::settings::{Denoise, Technique};
 pub const NAME: &str = "blur";
 
 /// Horizontally denoised occlusion (first half of the separable filter).
-pub const AO_BLUR_H: Resource = Resource::storage("ao-blur-h", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+pub(crate) const AO_BLUR_H: Resource =
+    Resource::storage("ao-blur-h", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
 
 /// The denoised occlusion, at AO resolution.
 pub const AO_BLURRED: Resource = Resource::storage("ao-blurred", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
@@ -77,7 +78,7 @@ impl DenoiseKernels {
 
 /// The spatial denoise of the occlusion: the tile denoise or the separable bilateral blur
 /// (module docs).
-pub struct BlurPass {
+pub(crate) struct BlurPass {
     /// The tile denoise by whether the occlusion carries light in rgb (SSDO) or AO alone.
     tile: [DenoiseKernels; 2],
     bilateral: DenoiseKernels,
@@ -85,7 +86,7 @@ pub struct BlurPass {
 
 impl BlurPass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu) -> Self {
+    pub(crate) fn new(gpu: &Gpu) -> Self {
         BlurPass {
             tile: [false, true].map(|carries_light| {
                 let constants = [("CARRIES_LIGHT", f64::from(carries_light))];

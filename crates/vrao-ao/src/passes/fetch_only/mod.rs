@@ -8,6 +8,6 @@ use crate::gpu::Gpu;
 use crate::settings::Technique;
 
 /// The fetch-only pass.
-pub fn pass(gpu: &Gpu) -> TechniquePass {
+pub(crate) fn pass(gpu: &Gpu) -> TechniquePass {
     TechniquePass::new(gpu, Technique::FetchOnly, wgsl!("src/passes/fetch_only/fetch_only.wgsl"))
 }

@@ -71,11 +71,11 @@ impl GtaoSettings {
 /// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`),
 /// and at 9 GTAO's own parameters. A march that gathers light (SSDO) binds more after
 /// these ([`March::binds`]).
-pub const BINDINGS: [Bind; 10] =
+pub(crate) const BINDINGS: [Bind; 10] =
     occlusion::bindings_and([Bind::Own(Slot::Layers), Bind::Own(Slot::Layers), Bind::Own(Slot::Uniform)]);
 
 /// gtao.wgsl: the march over slices and sectors that GTAO and SSDO share.
-pub const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
+pub(crate) const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
 
 /// GTAO's WGSL files, in order: gtao.wgsl's march and gtao_light.wgsl's light hooks.
 const GTAO_FILES: [Shader; 5] =
@@ -83,7 +83,7 @@ const GTAO_FILES: [Shader; 5] =
 
 /// One technique built on gtao.wgsl's march: its name, its WGSL files (the march and,
 /// after it, the file of its light hooks: gtao_light.wgsl for GTAO), its bindings
-/// ([`BINDINGS`] and its own after them), its extra pipeline constants, and what it
+/// (`BINDINGS` and its own after them), its extra pipeline constants, and what it
 /// adds to its declaration.
 pub struct March {
     /// The technique (its pass runs when it is chosen).
@@ -92,7 +92,7 @@ pub struct March {
     pub label: &'static str,
     /// The WGSL files, in order.
     pub files: Vec<Shader>,
-    /// The bindings: [`BINDINGS`] first.
+    /// The bindings: `BINDINGS` first.
     pub binds: &'static [Bind],
     /// Extra `override` values.
     pub constants: Vec<(&'static str, f64)>,
@@ -123,7 +123,7 @@ struct GtaoUniform {
 /// directions anyway, while the occluders a sparse march steps over stay missed (a
 /// bias, not noise): at N = 24, 2×6 gave less error and bias than 3×4
 /// (docs/records/2026-11-29/measurements-in-code.md, gtao-slices-steps).
-pub fn gtao_slices_steps(samples: u32) -> (u32, u32) {
+pub(crate) fn gtao_slices_steps(samples: u32) -> (u32, u32) {
     let slices = if samples < 128 { 2 } else { 4 };
     (slices, (samples / (2 * slices)).max(1))
 }
@@ -132,7 +132,7 @@ pub fn gtao_slices_steps(samples: u32) -> (u32, u32) {
 /// width (whole 8-pixel workgroups). Only marches from this band look past the inner
 /// border into the other eye; one from further in that would cross it (its radius spans
 /// more than a quarter of the image: a surface very near the eye) stops there instead.
-pub fn gtao_inner_band(width: u32) -> u32 {
+pub(crate) fn gtao_inner_band(width: u32) -> u32 {
     (width / 4).next_multiple_of(8).min(width)
 }
 
@@ -162,7 +162,7 @@ impl Kernels {
 
 /// GTAO's pipelines and its parameters; with another [`March`], a technique that
 /// marches the same slices (SSDO).
-pub struct GtaoPass {
+pub(crate) struct GtaoPass {
     march: March,
     /// Built when the pass is made for an eager [`March`], else on its first frame.
     solid: std::sync::OnceLock<Kernels>,
@@ -173,7 +173,7 @@ pub struct GtaoPass {
 
 impl GtaoPass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu) -> Self {
+    pub(crate) fn new(gpu: &Gpu) -> Self {
         Self::with_march(
             gpu,
             March {
@@ -189,7 +189,7 @@ impl GtaoPass {
     }
 
     /// The pass of another technique on GTAO's march.
-    pub fn with_march(gpu: &Gpu, march: March) -> Self {
+    pub(crate) fn with_march(gpu: &Gpu, march: March) -> Self {
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("gtao params"),
             size: std::mem::size_of::<GtaoUniform>() as u64,

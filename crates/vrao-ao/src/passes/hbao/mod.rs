@@ -7,6 +7,6 @@ use crate::gpu::Gpu;
 use crate::settings::Technique;
 
 /// The occlusion pass of HBAO.
-pub fn pass(gpu: &Gpu) -> TechniquePass {
+pub(crate) fn pass(gpu: &Gpu) -> TechniquePass {
     TechniquePass::new(gpu, Technique::Hbao, wgsl!("src/passes/hbao/hbao.wgsl"))
 }

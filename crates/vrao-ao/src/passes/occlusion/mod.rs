@@ -28,7 +28,7 @@ pub const OCCLUSION_WGSL: Shader = wgsl!("src/passes/occlusion/occlusion.wgsl");
 
 /// Bindings 0–6 of occlusion.wgsl: frame, AO parameters, sample kernel, depth, normals,
 /// raw occlusion out, AO geometry out.
-pub const BINDINGS: [Bind; 7] = [
+pub(crate) const BINDINGS: [Bind; 7] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::SampleKernel,
@@ -38,7 +38,7 @@ pub const BINDINGS: [Bind; 7] = [
     Bind::Write(AO_GEOMETRY),
 ];
 
-/// [`BINDINGS`] followed by a technique's own bindings (from binding 7 on); `M` is the
+/// `BINDINGS` followed by a technique's own bindings (from binding 7 on); `M` is the
 /// total, checked when the constant is made.
 pub const fn bindings_and<const N: usize, const M: usize>(own: [Bind; N]) -> [Bind; M] {
     assert!(M == BINDINGS.len() + N, "M must be 7 + N");
@@ -70,14 +70,14 @@ pub fn technique_decl(name: &'static str, binds: &[Bind], runs_for: &[Technique]
 
 /// A technique that is one kernel of the shared layout: its WGSL defines the
 /// occlusion of one pixel, occlusion.wgsl the rest.
-pub struct TechniquePass {
+pub(crate) struct TechniquePass {
     technique: Technique,
     kernel: Kernel,
 }
 
 impl TechniquePass {
     /// The pass of `technique`, whose WGSL is `shader`.
-    pub fn new(gpu: &Gpu, technique: Technique, shader: Shader) -> Self {
+    pub(crate) fn new(gpu: &Gpu, technique: Technique, shader: Shader) -> Self {
         let files = [COMMON, VISIBILITY, OCCLUSION_WGSL, shader];
         TechniquePass { technique, kernel: Kernel::new(gpu, technique.name(), &files, "main", &BINDINGS) }
     }

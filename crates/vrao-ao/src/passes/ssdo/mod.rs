@@ -34,7 +34,7 @@ const BINDINGS: [Bind; 11] = {
 /// What a host's frame gives SSDO beyond depth (the AO engine puts it among the frame's
 /// extensions; vrao's renderer, which always has its direct light, puts none).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LightInputs {
+pub(crate) struct LightInputs {
     /// Whether [`DIRECT_LIGHT`] holds the host's direct light this frame.
     pub direct: bool,
 }
@@ -46,7 +46,7 @@ fn has_direct(setup: &DeclareContext) -> bool {
 
 /// SSDO or SSDO with the bounce: GTAO's march with the light hooks, its pipelines built
 /// at the first frame that runs it.
-pub struct SsdoPass {
+pub(crate) struct SsdoPass {
     technique: Technique,
     /// The march without the bounce (`ssdo`, or `ssdo-bounce` at bounce strength 0).
     plain: GtaoPass,
@@ -56,7 +56,7 @@ pub struct SsdoPass {
 
 impl SsdoPass {
     /// The pass of `technique` ([`Technique::Ssdo`] or [`Technique::SsdoBounce`]).
-    pub fn new(gpu: &Gpu, technique: Technique) -> Self {
+    pub(crate) fn new(gpu: &Gpu, technique: Technique) -> Self {
         let march = |label: &'static str, bounce: bool| {
             GtaoPass::with_march(
                 gpu,

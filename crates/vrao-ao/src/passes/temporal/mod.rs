@@ -17,7 +17,7 @@ use std::sync::Mutex;
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
-pub const NAME: &str = "temporal";
+pub(crate) const NAME: &str = "temporal";
 
 /// Occlusion accumulated over frames by reverse reprojection, at AO resolution, laid out
 /// as the raw occlusion.
@@ -86,7 +86,7 @@ struct TemporalUniform {
 }
 
 /// Temporal accumulation of the occlusion by reverse reprojection (module docs).
-pub struct TemporalPass {
+pub(crate) struct TemporalPass {
     kernel: Kernel,
     uniform: wgpu::Buffer,
     /// [value a, value b, position a, position b], made at the occlusion's size.
@@ -95,7 +95,7 @@ pub struct TemporalPass {
 
 impl TemporalPass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu) -> TemporalPass {
+    pub(crate) fn new(gpu: &Gpu) -> TemporalPass {
         TemporalPass {
             kernel: Kernel::new(gpu, "temporal", &FILES, "main", &BINDINGS),
             uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {

@@ -53,7 +53,7 @@ pub fn reuses_left_eye_upsample(settings: &ChainSettings, layers: u32) -> bool {
 }
 
 /// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
-pub struct UpsamplePass {
+pub(crate) struct UpsamplePass {
     kernel: Kernel,
     /// The right eye's dispatch that reuses the left eye's result.
     right_eye: Kernel,
@@ -61,7 +61,7 @@ pub struct UpsamplePass {
 
 impl UpsamplePass {
     /// Builds the pass's pipelines.
-    pub fn new(gpu: &Gpu) -> Self {
+    pub(crate) fn new(gpu: &Gpu) -> Self {
         let files = [COMMON, VISIBILITY, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/upsample/upsample.wgsl")];
         let kernel = |label: &str, right_eye: bool| {
             Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &[("RIGHT_EYE", f64::from(right_eye))])

@@ -10,17 +10,17 @@
 //! listed on the GPU and composited by an indirect dispatch over just them.
 
 use super::direct::DIRECT;
-use super::gbuffer::{ALBEDO, DEPTH, LIGHTING_NORMALS, NORMALS};
-use super::occlusion::AO_GEOMETRY;
+use super::gbuffer::{ALBEDO, LIGHTING_NORMALS};
 use super::rsm::{RSM_GEOMETRY, RSM_INDIRECT};
 use super::shadow::rsm_active;
-use super::upsample::{reuses_left_eye_upsample, JOINT_UPSAMPLE_WGSL};
-use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, IRRADIANCE, VISIBILITY};
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
-use crate::settings::Technique;
+use super::{scene_of, settings_of};
+use crate::gpu::kernel::wgsl;
 use std::sync::Mutex;
+use vrao_ao::plug::{
+    reuses_left_eye_upsample, Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource, Size, Slot,
+    AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION, VISIBILITY,
+};
+use vrao_ao::Technique;
 use wgpu::util::DeviceExt;
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports

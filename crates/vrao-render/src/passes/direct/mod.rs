@@ -3,13 +3,14 @@
 //! Directional lights are shadowed by their shadow maps (3×3 PCF, passes/shadow) when
 //! shadows are on.
 
-use super::gbuffer::{ALBEDO, DEPTH, EMISSION, LIGHTING_NORMALS};
+use super::gbuffer::{ALBEDO, EMISSION, LIGHTING_NORMALS};
 use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
-use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Slot, COMMON, VISIBILITY};
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource};
+use super::{scene_of, settings_of};
+use crate::gpu::kernel::wgsl;
 use std::sync::Arc;
+use vrao_ao::plug::{
+    Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource, Slot, COMMON, DEPTH, VISIBILITY,
+};
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
@@ -18,7 +19,7 @@ pub const NAME: &str = "direct";
 /// Outgoing direct radiance (lights and emission) and the view distance, packed
 /// (common.wgsl `pack_direct`: distance f32, radiance RGB9E5): the composite's base, and
 /// the depth test plus sender radiance of SSDO's bounce in a single fetch.
-pub const DIRECT: Resource = vrao_ao::passes::inputs::DIRECT_LIGHT;
+pub const DIRECT: Resource = vrao_ao::plug::DIRECT_LIGHT;
 
 /// direct.wgsl's bindings: the G-buffer in, the direct light out, and the shadows
 /// (their `Shadows` uniform, every light's map, the comparison sampler).

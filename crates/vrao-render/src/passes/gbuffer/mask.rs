@@ -3,20 +3,18 @@
 //! test before they are shaded, and afterwards those pixels read as sky, so that no
 //! compute pass finds a surface there.
 
-use super::DEPTH;
-use crate::gpu::kernel::{shader_module, wgsl};
-use crate::gpu::Gpu;
-use crate::passes::RecordContext;
+use crate::gpu::kernel::wgsl;
+use vrao_ao::plug::{shader_module, Gpu, RecordContext, DEPTH};
 
 /// The two depth-only pipelines: hidden pixels to the near plane, then to the sky.
-pub struct MaskDepth {
+pub(super) struct MaskDepth {
     near: wgpu::RenderPipeline,
     far: wgpu::RenderPipeline,
 }
 
 /// Which depth the hidden pixels get.
 #[derive(Clone, Copy, PartialEq, Eq)]
-pub enum MaskStep {
+pub(super) enum MaskStep {
     /// Before the scene (the depth target cleared first): the near plane.
     Near,
     /// After the scene: the sky.
@@ -24,7 +22,7 @@ pub enum MaskStep {
 }
 
 impl MaskDepth {
-    pub fn new(gpu: &Gpu) -> MaskDepth {
+    pub(super) fn new(gpu: &Gpu) -> MaskDepth {
         let device = &gpu.device;
         let module = shader_module(gpu, "gbuffer mask", &[wgsl!("src/passes/gbuffer/mask.wgsl")]);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -66,7 +64,7 @@ impl MaskDepth {
 
     /// Writes `step`'s depth on every layer's hidden pixels (clearing the depth target
     /// first for [`MaskStep::Near`]).
-    pub fn draw(&self, ctx: &mut RecordContext, step: MaskStep) {
+    pub(super) fn draw(&self, ctx: &mut RecordContext, step: MaskStep) {
         let (pipeline, load) = match step {
             MaskStep::Near => (&self.near, wgpu::LoadOp::Clear(0.0)),
             MaskStep::Far => (&self.far, wgpu::LoadOp::Load),

@@ -9,16 +9,17 @@
 
 mod mask;
 
-use super::{gpu_scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
-use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
+use super::{gpu_scene_of, settings_of};
+use crate::gpu::kernel::wgsl;
+use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
-use crate::gpu::uniforms::FrameUniforms;
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size, PIXEL_MOTION};
 use bytemuck::{Pod, Zeroable};
 use mask::{MaskDepth, MaskStep};
 use std::num::NonZeroU32;
+use vrao_ao::plug::{
+    shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, Resource, Shader,
+    Size, COMMON, PIXEL_MOTION,
+};
 use wgpu::util::DeviceExt;
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
@@ -27,7 +28,7 @@ pub const NAME: &str = "gbuffer";
 
 /// The depth, normals and motion the G-buffer writes are the textures the AO engine
 /// reads.
-pub use vrao_ao::passes::inputs::{DEPTH, MOTION, NORMALS};
+use vrao_ao::plug::{DEPTH, MOTION, NORMALS};
 /// Diffuse albedo in rgb (sRGB-encoded, sampled back linear); in alpha the material's baked
 /// occlusion (glTF `occlusionTexture`, 1 without one), which the composite combines with the AO.
 pub const ALBEDO: Resource = Resource::attachment("albedo", Size::Full, wgpu::TextureFormat::Rgba8UnormSrgb);
@@ -337,7 +338,7 @@ fn begin<'e, 't>(
 #[cfg(test)]
 mod layout_tests {
     use super::*;
-    use crate::gpu::layout_check::{self, mirror};
+    use vrao_ao::layout_check::{self, mirror};
 
     #[test]
     fn the_gbuffer_uniform_matches_gbuffer_wgsl() {

@@ -7,15 +7,15 @@
 //! One depth-only render pass per eye layer, whatever the G-buffer uses: multiview is
 //! unreliable on lavapipe, and each pass reads its own layer of the first depth.
 
-use super::{gpu_scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{shader_module, wgsl, COMMON};
-use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
+use super::{gpu_scene_of, settings_of};
+use crate::gpu::kernel::wgsl;
+use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
-use crate::gpu::uniforms::FrameUniforms;
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size};
-use crate::passes::gbuffer::DEPTH;
-use crate::settings::Technique;
+use vrao_ao::plug::{
+    shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, Resource, Size,
+    COMMON, DEPTH,
+};
+use vrao_ao::Technique;
 use wgpu::util::DeviceExt;
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports

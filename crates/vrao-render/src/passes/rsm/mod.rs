@@ -4,16 +4,16 @@
 //! per pixel and per frame. The composite upsamples the irradiance (3×3 joint
 //! bilateral, in composite.wgsl) and adds irradiance × albedo/π to the ambient.
 
-use super::gbuffer::{DEPTH, NORMALS};
 use super::shadow::{rsm_active, shadow_casters, LightSpace, RSM_FLUX, RSM_NORMAL, SHADOW_MAP, SHADOW_WGSL};
-use super::{scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON};
-use crate::gpu::uniforms::ao_extent;
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size};
+use super::{scene_of, settings_of};
+use crate::gpu::kernel::wgsl;
 use bytemuck::{Pod, Zeroable};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
+use vrao_ao::plug::{
+    ao_extent, Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource, Shader, Size, Slot, COMMON,
+    DEPTH, NORMALS,
+};
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
@@ -119,7 +119,7 @@ impl Pass for RsmPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::layout_check::{self, mirror};
+    use vrao_ao::layout_check::{self, mirror};
 
     #[test]
     fn the_rsm_uniform_matches_rsm_wgsl() {

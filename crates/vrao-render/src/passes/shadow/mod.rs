@@ -17,17 +17,18 @@
 //! ~2.4 cm texels. Cascades (or a fit to the visible depth range, which needs a GPU
 //! reduction) are the way to spend texels on what is near; see the report.
 
-use super::{gpu_scene_of, scene_of, settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{shader_module, wgsl, Shader, COMMON};
-use crate::gpu::raster::{mesh_pipeline, uniform_entry, MeshPipeline, MESH_ATTRIBUTES};
+use super::{gpu_scene_of, scene_of, settings_of};
+use crate::gpu::kernel::wgsl;
+use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size};
 use crate::scene::{Light, Scene};
 use crate::settings::Settings;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, DVec4, Vec3};
 use std::sync::Arc;
+use vrao_ao::plug::{
+    shader_module, uniform_entry, DeclareContext, Gpu, Pass, PassDecl, RecordContext, Resource, Shader, Size, COMMON,
+};
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
@@ -449,7 +450,7 @@ impl Pass for ShadowPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::layout_check::{self, mirror};
+    use vrao_ao::layout_check::{self, mirror};
 
     #[test]
     fn the_shadow_uniforms_match_shadow_wgsl() {

@@ -7,17 +7,18 @@
 //! occlusion-only frame.
 
 use super::direct::DIRECT;
-use super::occlusion::{self, technique_decl, OCCLUSION_WGSL};
 use super::peel::DEPTH_LAYER_2;
-use super::{settings_of, DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON, IRRADIANCE, VISIBILITY};
-use crate::gpu::Gpu;
-use crate::graph::PassDecl;
-use crate::settings::{BounceForm, Technique};
+use super::settings_of;
+use crate::gpu::kernel::wgsl;
+use vrao_ao::plug::{
+    bindings_and, technique_decl, Bind, BounceForm, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, COMMON,
+    IRRADIANCE, OCCLUSION_WGSL, VISIBILITY,
+};
+use vrao_ao::Technique;
 
 /// The shared occlusion bindings plus the direct light (binding 7, the bounce's senders)
 /// and the second depth layer (binding 8, depth peeling).
-const BINDINGS: [Bind; 9] = occlusion::bindings_and([Bind::Read(DIRECT), Bind::Read(DEPTH_LAYER_2)]);
+const BINDINGS: [Bind; 9] = bindings_and([Bind::Read(DIRECT), Bind::Read(DEPTH_LAYER_2)]);
 
 /// SSDO, with its bounce when the technique asks for it (module docs).
 pub struct SsdoPass {

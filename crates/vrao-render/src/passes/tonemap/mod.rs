@@ -1,10 +1,8 @@
 //! Reinhard tone mapping with a white point (the Czech SSDO thesis, eq. 2.4) and sRGB encoding.
 
 use super::composite::HDR;
-use super::{DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, COMMON};
-use crate::gpu::Gpu;
-use crate::graph::{PassDecl, Resource, Size};
+use crate::gpu::kernel::wgsl;
+use vrao_ao::plug::{Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource, Size, COMMON};
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.

@@ -6,8 +6,8 @@
 //! ([`Use::integers`]): glTF 2.0's, widened for mesh attributes by `KHR_mesh_quantization`.
 
 use super::{Loader, MAX_ACCESSOR_COUNT, MAX_VERTICES};
-use crate::error::Result;
 use ::gltf::accessor::{DataType, Dimensions};
+use vrao_ao::Result;
 
 /// What an accessor holds, which decides the component types glTF allows for it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

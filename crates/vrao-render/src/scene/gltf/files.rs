@@ -4,9 +4,9 @@
 //! are refused naming the URI, as is anything that is not a regular file.
 
 use super::MAX_FILE_BYTES;
-use crate::error::{Error, Result};
 use crate::files::{check_regular_file, read_regular_file, FileProblem};
 use std::path::{Component, Path, PathBuf};
+use vrao_ao::{Error, Result};
 
 /// Reads `file` (the glTF itself or a file it names) as a regular file of at most
 /// [`MAX_FILE_BYTES`]. Errors name `gltf`, the file the user gave, and `file` when it differs.

@@ -42,10 +42,10 @@ mod accessors;
 mod files;
 
 use super::normals::{self, Geometry};
-use super::{obj, AlphaMode, Environment, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene};
-use super::{Texture, Track, Trs};
-use crate::error::{Error, Result};
-use crate::stereo::HeadPose;
+use super::{
+    obj, AlphaMode, Environment, HeadPath, Interpolation, Light, Material, Mesh, Node, NodeTracks, Scene, Texture,
+    Track, Trs,
+};
 use ::gltf::json;
 use ::gltf::mesh::Mode;
 use accessors::Use;
@@ -53,6 +53,7 @@ use files::{load_buffers, read_bounded, resolve_uri, split_glb};
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
+use vrao_ao::{Error, HeadPose, Result};
 
 pub use files::decode_base64;
 

@@ -3,18 +3,14 @@
 //! leaves holes in the right eye and ghosts in the left. A driver that fails the probe
 //! is used one pass per eye unless the user insists.
 
-use super::kernel::shader_module;
-use super::layered_target::LayeredTarget;
-use super::readback::read_layers;
-use super::Gpu;
-use crate::gpu::kernel::wgsl;
-use crate::gpu::raster::fullscreen_pipeline;
+use super::kernel::wgsl;
 use std::num::NonZeroU32;
+use vrao_ao::plug::{fullscreen_pipeline, read_layers, shader_module, Gpu, LayeredTarget};
 
 const SIZE: u32 = 16;
 
 /// True when an oversized multiview triangle covers both layers completely.
-pub fn multiview_reaches_every_layer(gpu: &Gpu) -> bool {
+pub(crate) fn multiview_reaches_every_layer(gpu: &Gpu) -> bool {
     let device = &gpu.device;
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let target =

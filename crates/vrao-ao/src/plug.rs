@@ -1,0 +1,35 @@
+//! The renderer's face: what a renderer needs to run the engine's chain inside its own
+//! frame graph and to add passes of its own around it (vrao's renderer is one). A host
+//! that only wants AO for its depth never needs this module (see the crate root).
+//!
+//! A pass is a [`Pass`]: it declares what it reads and writes ([`PassDecl`], resources
+//! named by [`Resource`]) when the graph plans a frame, and records its commands
+//! ([`RecordContext`]) when the [`GraphDriver`] runs it. Compute passes are [`Kernel`]s
+//! over WGSL [`Shader`] files; the chain's resources ([`DEPTH`], [`NORMALS`], …,
+//! [`FINAL_AO`]) are the names a renderer's passes write for the chain and read from it.
+
+pub use crate::driver::{FrameParams, GraphDriver, Submission};
+pub use crate::gpu::kernel::try_shader_module;
+pub use crate::gpu::kernel::{shader_module, Bind, Kernel, Shader, Slot, COMMON, IRRADIANCE, VISIBILITY};
+pub use crate::gpu::layered_target::LayeredTarget;
+pub use crate::gpu::raster::colour_and_depth_pass;
+pub use crate::gpu::raster::{fullscreen_pipeline, layer_views, uniform_entry};
+pub use crate::gpu::readback::{read_layers, read_layers_f32};
+pub use crate::gpu::timing::{FrameTiming, PassTimer};
+pub use crate::gpu::uniforms::{ao_extent, FrameLighting, FrameUniforms, LightUniform};
+pub use crate::gpu::visibility::VisibilityMaps;
+pub use crate::gpu::{Capabilities, Gpu};
+pub use crate::graph::{plan, Kind, PassDecl, Resource, Size, Written, FINAL_AO, OCCLUSION, PIXEL_MOTION};
+pub use crate::passes::blur::AO_BLURRED;
+pub use crate::passes::blur::NAME as BLUR_PASS;
+pub use crate::passes::inputs::{DEPTH, DIRECT_LIGHT, MOTION, NORMALS};
+pub use crate::passes::occlusion::{bindings_and, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
+pub use crate::passes::temporal::AO_ACCUMULATED;
+pub use crate::passes::temporal::{HISTORY_POSITION, HISTORY_VALUE};
+pub use crate::passes::upsample::NAME as UPSAMPLE_PASS;
+pub use crate::passes::upsample::{reuses_left_eye_upsample, AO_FULL, JOINT_UPSAMPLE_WGSL};
+pub use crate::passes::{ao_chain, record, ChainSettings, DeclareContext, FrameMotion, MoverBox, Pass, RecordContext};
+pub use crate::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
+pub use crate::settings::BounceForm;
+pub use crate::sh::{prefiltered_radiance, quadratic_in_view, sh9_quadratic};
+pub use crate::stereo::DEFAULT_NEAR;
