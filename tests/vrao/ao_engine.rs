@@ -110,6 +110,7 @@ fn engine_ao(gpu: &vrao_ao::plug::Gpu, ao: &AoSettings, depth: HostDepth, with_n
         views: &views,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
@@ -210,6 +211,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         views: &views,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a depth buffer of another size");
     assert!(e.to_string().contains("depth") && e.to_string().contains("does not match"), "{e}");
@@ -222,6 +224,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         views: &views,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a convention the projection contradicts");
     assert!(e.to_string().contains("view 0: projection"), "{e}");
@@ -235,6 +238,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
         views: &scaled,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("a view matrix with scale");
     assert!(e.to_string().contains("view 1: view matrix"), "{e}");
@@ -288,6 +292,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
                 views: &views,
                 motion,
                 light: None,
+                exclusion: None,
             };
             texture = Some(engine.record(&mut encoder, &frame).unwrap().texture.clone());
             queue.submit([encoder.finish()]);
@@ -318,6 +323,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
         views: &views,
         motion: Some(HostMotion { texture: &small, to_previous_uv: [1.0, 1.0] }),
         light: None,
+        exclusion: None,
     };
     let e = engine.record(&mut encoder, &frame).err().expect("motion of another size");
     assert!(e.to_string().contains("motion") && e.to_string().contains("does not match"), "{e}");
@@ -340,6 +346,7 @@ fn reversed_z_frame(
         views,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     gpu.queue.submit([encoder.finish()]);
@@ -485,6 +492,7 @@ fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
             views: &views,
             motion: None,
             light,
+            exclusion: None,
         };
         let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
         queue.submit([encoder.finish()]);
@@ -554,6 +562,7 @@ fn mono_engine_output(
         views: &views,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
     queue.submit([encoder.finish()]);
@@ -615,8 +624,176 @@ fn multisampled_inputs_the_engine_does_not_resolve_are_refused_naming_them() {
         views: &views,
         motion: None,
         light: None,
+        exclusion: None,
     };
     let mut encoder = device.create_command_encoder(&Default::default());
     let e = engine.record(&mut encoder, &frame).err().expect("normals of another sample count");
     assert!(e.to_string().contains("normals: sample count 1 where the depth's is 4"), "{e}");
+}
+
+/// The demo room with a hand-sized box (18 × 5 × 10 cm) held 10 cm above the step, the
+/// way a hand hovers over a table.
+fn demo_with_hand() -> Vec<host::HostMesh> {
+    // The step's top is at y = 0.16 m; the box's underside 10 cm above it.
+    let mut meshes = demo_geometry();
+    meshes.push(host::cuboid(glam::Vec3::new(0.4, 0.285, -2.2), glam::Vec3::new(0.18, 0.05, 0.1)));
+    meshes
+}
+
+/// One engine frame over `meshes` at `size`, with `exclusion` made from `mask` (one
+/// value a pixel per eye) in a texture of `format` when given: each eye's AO.
+fn excluded_ao(
+    gpu: &vrao_ao::plug::Gpu,
+    meshes: &[host::HostMesh],
+    size: (u32, u32),
+    mask: Option<(&[Vec<u8>], wgpu::TextureFormat, u32, u32)>,
+) -> Vec<Vec<f32>> {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let prepass = DepthPrepass::new(device, meshes, HostDepth::ReversedInfinite, size);
+    let views = host_views(&eyes(), HostDepth::ReversedInfinite);
+    let config = AoConfig { settings: AoSettings::default(), width: size.0, height: size.1, views: 2 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let texture = mask.map(|(values, format, _, _)| mask_texture(device, queue, values, format, size));
+    let exclusion = texture
+        .as_ref()
+        .zip(mask)
+        .map(|(texture, (_, _, receive_none, cast_none))| vrao_ao::HostExclusion { texture, receive_none, cast_none });
+    let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    prepass.record(device, &mut encoder, &views);
+    let frame = AoFrame {
+        depth: &prepass.depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        normals: Some(normals),
+        views: &views,
+        motion: None,
+        light: None,
+        exclusion,
+    };
+    let output = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    (0..2).map(|layer| host::read_alpha(device, queue, &output, layer)).collect()
+}
+
+/// A 2-layer mask texture of `format` holding `values`: an integer texture, or the
+/// stencil aspect of a depth-stencil one.
+fn mask_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    values: &[Vec<u8>],
+    format: wgpu::TextureFormat,
+    (width, height): (u32, u32),
+) -> wgpu::Texture {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host mask"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let aspect = if format.has_stencil_aspect() { wgpu::TextureAspect::StencilOnly } else { wgpu::TextureAspect::All };
+    for (layer, layer_values) in values.iter().enumerate() {
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: layer as u32 },
+                aspect,
+            },
+            layer_values,
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width), rows_per_image: Some(height) },
+            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        );
+    }
+    texture
+}
+
+/// The pixels of each eye where `with` is nearer than `without` (what the hand covers).
+fn covered_pixels(
+    gpu: &vrao_ao::plug::Gpu,
+    with: &[host::HostMesh],
+    without: &[host::HostMesh],
+    size: (u32, u32),
+) -> Vec<Vec<u8>> {
+    let depth_of = |meshes: &[host::HostMesh]| {
+        let prepass = DepthPrepass::new(&gpu.device, meshes, HostDepth::ReversedInfinite, size);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        prepass.record(&gpu.device, &mut encoder, &host_views(&eyes(), HostDepth::ReversedInfinite));
+        gpu.queue.submit([encoder.finish()]);
+        let depth = LayeredTarget::wrap(&prepass.depth, "host depth", wgpu::TextureAspect::DepthOnly, 2);
+        read_layers_f32(gpu, &depth).unwrap()
+    };
+    let (a, b) = (depth_of(with), depth_of(without));
+    a.iter().zip(&b).map(|(a, b)| a.iter().zip(b).map(|(x, y)| u8::from(x > y)).collect()).collect()
+}
+
+/// RMSE of `a` against `b` over the pixels `region` marks.
+fn rmse_where(a: &[Vec<f32>], b: &[Vec<f32>], region: &[Vec<bool>]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for ((a, b), region) in a.iter().zip(b).zip(region) {
+        for ((x, y), inside) in a.iter().zip(b).zip(region) {
+            if *inside {
+                sum += f64::from(x - y).powi(2);
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 100, "the region holds {n} pixels");
+    (sum / n as f64).sqrt()
+}
+
+/// Pixels within `reach` pixels of a covered one, not covered themselves: where a hand's
+/// halo would fall.
+fn around(covered: &[Vec<u8>], (width, height): (u32, u32), reach: i32) -> Vec<Vec<bool>> {
+    covered
+        .iter()
+        .map(|layer| {
+            (0..height as i32)
+                .flat_map(|y| (0..width as i32).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let at = |x: i32, y: i32| layer[(y as u32 * width + x as u32) as usize] != 0;
+                    let near = (y - reach..=y + reach).any(|v| {
+                        (x - reach..=x + reach)
+                            .any(|u| u >= 0 && v >= 0 && (u as u32) < width && (v as u32) < height && at(u, v))
+                    });
+                    near && !at(x, y)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn a_hand_marked_cast_none_leaves_the_table_as_without_it_and_receive_none_gives_ao_one() {
+    let (gpu, _lock) = common::gpu();
+    let size = (192, 216);
+    let with_hand = demo_with_hand();
+    let covered = covered_pixels(&gpu, &with_hand, &demo_geometry(), size);
+    let halo_region = around(&covered, size, 24);
+    let without_hand = excluded_ao(&gpu, &demo_geometry(), size, None);
+    let hand_casting = excluded_ao(&gpu, &with_hand, size, None);
+    let r8 = wgpu::TextureFormat::R8Uint;
+    let hand_cast_none = excluded_ao(&gpu, &with_hand, size, Some((&covered, r8, 0, 1)));
+    let halo = rmse_where(&hand_casting, &without_hand, &halo_region);
+    let left_out = rmse_where(&hand_cast_none, &without_hand, &halo_region);
+    eprintln!("around the hand: RMSE {halo:.4} with it casting, {left_out:.4} marked cast-none");
+    assert!(left_out <= 0.02, "the table around a cast-none hand differs from the empty table by RMSE {left_out}");
+    assert!(halo > 2.0 * left_out && halo > 0.02, "the hand casts a halo when not left out ({halo} vs {left_out})");
+    // The stencil of a depth-stencil texture marks the same pixels as an R8Uint mask.
+    let stencil = excluded_ao(&gpu, &with_hand, size, Some((&covered, wgpu::TextureFormat::Stencil8, 0, 1)));
+    assert_eq!(stencil, hand_cast_none, "a stencil mask and an R8Uint mask leave out the same pixels");
+    // Receive-none: the hand's own pixels get AO 1, every other pixel is unchanged; a
+    // mask whose bits mark nothing changes nothing.
+    let shifted: Vec<Vec<u8>> = covered.iter().map(|l| l.iter().map(|v| v << 1).collect()).collect();
+    let receive_none = excluded_ao(&gpu, &with_hand, size, Some((&shifted, r8, 2, 0)));
+    for ((got, casting), covered) in receive_none.iter().zip(&hand_casting).zip(&covered) {
+        for ((g, c), cov) in got.iter().zip(casting).zip(covered) {
+            assert_eq!(*g, if *cov != 0 { 1.0 } else { *c }, "receive-none gives AO 1 on the hand alone");
+        }
+    }
+    let nothing_marked = excluded_ao(&gpu, &with_hand, size, Some((&covered, r8, 4, 8)));
+    assert_eq!(nothing_marked, hand_casting, "bits that mark no pixel leave the AO bit-identical");
 }

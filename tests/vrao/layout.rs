@@ -63,10 +63,7 @@ fn each_folder_imports_only_what_the_rule_allows() {
             }
         }
     }
-    assert!(
-        files_checked > 50,
-        "only {files_checked} files under src/formats, test_assets, xr, app and measure"
-    );
+    assert!(files_checked > 50, "only {files_checked} files under src/formats, test_assets, xr, app and measure");
     assert!(violations.is_empty(), "the dependency rule is broken:\n{}", violations.join("\n"));
 }
 

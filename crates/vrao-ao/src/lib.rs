@@ -30,8 +30,8 @@ mod visibility;
 pub use gpu::layout_check;
 
 pub use ao::{
-    AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostLight, HostMotion, HostNormals,
-    NormalEncoding, NormalSpace, ViewMatrices,
+    AoConfig, AoEngine, AoFrame, AoOutput, AoOutputFormat, DepthConvention, HostExclusion, HostLight, HostMotion,
+    HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
 };
 pub use error::{Error, Result};
 pub use graph::Plan;

@@ -397,7 +397,13 @@ pub(crate) fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wg
 }
 
 /// One layer's texels (`texel` bytes each), rows packed.
-fn read_layer(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layer: u32, texel: u32) -> Vec<u8> {
+pub(crate) fn read_layer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    layer: u32,
+    texel: u32,
+) -> Vec<u8> {
     let size = texture.size();
     let row = (size.width * texel).div_ceil(256) * 256;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {

@@ -224,6 +224,7 @@ fn run(args: &Args) -> Result<(), Failure> {
         // The example's geometry stands still.
         motion: None,
         light: None,
+        exclusion: None,
     };
     let ao = engine.record(&mut encoder, &frame)?.texture.clone();
     queue.submit([encoder.finish()]);
@@ -366,7 +367,15 @@ fn time_setup(
     let frame = |engine: &mut AoEngine, depth: &wgpu::Texture| -> Result<f64, Box<dyn std::error::Error>> {
         let started = std::time::Instant::now();
         let mut encoder = device.create_command_encoder(&Default::default());
-        let frame = AoFrame { depth, depth_convention: convention, normals: None, views, motion: None, light: None };
+        let frame = AoFrame {
+            depth,
+            depth_convention: convention,
+            normals: None,
+            views,
+            motion: None,
+            light: None,
+            exclusion: None,
+        };
         engine.record(&mut encoder, &frame)?;
         queue.submit([encoder.finish()]);
         device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None })?;
@@ -445,6 +454,7 @@ fn time_frames(
                     views: &views,
                     motion: None,
                     light: None,
+                    exclusion: None,
                 };
                 engine.record(&mut encoder, &frame)?;
             }

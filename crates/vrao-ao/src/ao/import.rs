@@ -68,7 +68,7 @@ struct ImportParams {
     host_normals: u32,
     unsigned_normals: u32,
     world_normals: u32,
-    padding: u32,
+    cast_none: u32,
 }
 
 /// A host frame's inputs, checked: what the import pass writes into its uniform.
@@ -143,6 +143,7 @@ impl ImportSource {
         }
         params.size = [config.width, config.height];
         params.reversed = frame.depth_convention.reversed_z as u32;
+        params.cast_none = frame.exclusion.map_or(0, |e| e.cast_none);
         Ok(ImportSource { params, views: config.views, samples, motion: frame.motion.is_some() })
     }
 
@@ -195,6 +196,9 @@ pub(crate) struct ImportPass {
     uniform: wgpu::Buffer,
     /// This frame's checked inputs (set by the engine before it plans the frame).
     source: Mutex<Option<ImportSource>>,
+    /// This frame's exclusion mask (all views), or the placeholder of zeros.
+    mask: Mutex<Option<wgpu::TextureView>>,
+    placeholder_mask: wgpu::TextureView,
 }
 
 /// One variant of the import's pipeline and its bind group layout.
@@ -221,7 +225,12 @@ impl ImportPipeline {
             ty,
             count: None,
         };
-        let entries = [Slot::Uniform.layout_entry(0, wgpu::ShaderStages::FRAGMENT), entry(1, depth), entry(2, normals)];
+        let entries = [
+            Slot::Uniform.layout_entry(0, wgpu::ShaderStages::FRAGMENT),
+            entry(1, depth),
+            entry(2, normals),
+            entry(3, super::exclusion::MASK_BINDING),
+        ];
         let layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(NAME), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -299,12 +308,21 @@ impl ImportPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        ImportPass { single, msaa: OnceLock::new(), uniform, source: Mutex::new(None) }
+        let placeholder_mask = super::exclusion::placeholder(gpu);
+        ImportPass {
+            single,
+            msaa: OnceLock::new(),
+            uniform,
+            source: Mutex::new(None),
+            mask: Mutex::new(None),
+            placeholder_mask,
+        }
     }
 
-    /// The inputs of the frame about to be planned and recorded.
-    pub(crate) fn set_source(&self, source: ImportSource) {
+    /// The inputs of the frame about to be planned and recorded, and its exclusion mask.
+    pub(crate) fn set_source(&self, source: ImportSource, mask: Option<wgpu::TextureView>) {
         *self.source.lock().unwrap_or_else(|p| p.into_inner()) = Some(source);
+        *self.mask.lock().unwrap_or_else(|p| p.into_inner()) = mask;
     }
 
     fn source(&self) -> Option<ImportSource> {
@@ -315,6 +333,8 @@ impl ImportPass {
     /// group for every view), each view's layer for a multisampled one.
     fn bind_groups(&self, ctx: &RecordContext, source: &ImportSource) -> (&wgpu::RenderPipeline, Vec<wgpu::BindGroup>) {
         let uniform = self.uniform.as_entire_binding();
+        let mask = self.mask.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        let mask = mask.unwrap_or_else(|| self.placeholder_mask.clone());
         let group = |layout: &wgpu::BindGroupLayout, depth: &wgpu::BindingResource, normals: &wgpu::BindingResource| {
             ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(NAME),
@@ -323,6 +343,7 @@ impl ImportPass {
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.clone() },
                     wgpu::BindGroupEntry { binding: 1, resource: depth.clone() },
                     wgpu::BindGroupEntry { binding: 2, resource: normals.clone() },
+                    wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&mask) },
                 ],
             })
         };
@@ -400,7 +421,7 @@ mod layout_tests {
         #[rustfmt::skip]
         layout_check::check(&[
             mirror!(ImportLayer, [SINGLE_WGSL, IMPORT_WGSL], "ImportLayer", [view_from_world, tangents, depth_offset, depth_numerator, padding]),
-            mirror!(ImportParams, [SINGLE_WGSL, IMPORT_WGSL], "ImportParams", [layers, size, near, reversed, host_normals, unsigned_normals, world_normals, padding]),
+            mirror!(ImportParams, [SINGLE_WGSL, IMPORT_WGSL], "ImportParams", [layers, size, near, reversed, host_normals, unsigned_normals, world_normals, cast_none]),
         ]);
     }
 }

@@ -28,10 +28,13 @@ struct ImportParams {
     host_normals: u32,
     unsigned_normals: u32,
     world_normals: u32,
-    padding: u32,
+    // The host mask's bits of pixels that cast no AO (0: no mask).
+    cast_none: u32,
 };
 
 @group(0) @binding(0) var<uniform> params: ImportParams;
+// The host's exclusion mask (one sample per pixel), or a placeholder of zeros.
+@group(0) @binding(3) var host_mask: texture_2d_array<u32>;
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,
@@ -136,6 +139,11 @@ fn import_frame(in: VertexOut) -> ImportOut {
     out.depth = 0.0;
     out.normal = vec4<f32>(0.0);
     if (distance == 0.0) {
+        return out;
+    }
+    // A pixel that casts no AO leaves the depth the chain marches: every other pixel's
+    // march and denoise see the open sky there (and it gets none itself).
+    if (params.cast_none != 0u && (textureLoad(host_mask, p, i32(in.layer), 0).r & params.cast_none) != 0u) {
         return out;
     }
     let centre = position_at(p, distance, in.layer);

@@ -21,10 +21,12 @@
 //! and depth in 0..1 (wgpu's), standard or reversed, finite or infinite far, as the
 //! frame's [`DepthConvention`] says; one depth layer per view.
 
+pub(crate) mod exclusion;
 pub(crate) mod import;
 pub(crate) mod light;
 mod pack;
 
+pub use exclusion::HostExclusion;
 pub use light::HostLight;
 pub use pack::AoOutputFormat;
 
@@ -130,6 +132,9 @@ pub struct AoFrame<'a> {
     /// The host's light for SSDO (its direct light and environment), or `None`: SSDO then
     /// returns AO alone; the other techniques never read it.
     pub light: Option<HostLight<'a>>,
+    /// What the host leaves out (hands, controllers, UI panels), or `None`: every pixel
+    /// casts and receives AO.
+    pub exclusion: Option<HostExclusion<'a>>,
 }
 
 /// What the engine is made for: the AO settings, the size of each view and their number.
@@ -316,7 +321,9 @@ impl AoEngine {
         let settings = host_settings(config, projections[0].near)?;
         let layers = config.views;
         self.import_host_buffers(frame, layers);
-        self.import.set_source(source);
+        let mask = frame.exclusion.as_ref().map(|e| exclusion::mask_view(e, &self.config)).transpose()?;
+        let receive_none = frame.exclusion.map_or(0, |e| e.receive_none);
+        self.import.set_source(source, mask.clone());
         // SSDO's light: the host's direct light (imported, then packed with the depth by
         // the light import pass) and its environment's quadratics in each view.
         let direct = self.import_direct_light(frame, layers)?;
@@ -347,7 +354,8 @@ impl AoEngine {
         })?;
         recorded?;
         self.driver.end_frame(&eyes);
-        self.output(encoder, &plan, spans)
+        let receiving = mask.filter(|_| receive_none != 0).map(|view| (view, receive_none));
+        self.output(encoder, &plan, spans, receiving)
     }
 
     /// Imports the host's depth, and its normals and motion vectors when given, as this
@@ -390,12 +398,14 @@ impl AoEngine {
     }
 
     /// The final AO target the plan resolved, as the host asked for it: the chain's own
-    /// `Rgba16Float` texture, or its copy packed into a single-channel format.
+    /// `Rgba16Float` texture, or its copy packed into a single-channel format (or copied
+    /// with AO 1 where the host's mask says a pixel receives none).
     fn output(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         plan: &Plan,
         spans: Option<&dyn SpanRecorder>,
+        receiving: Option<(wgpu::TextureView, u32)>,
     ) -> Result<AoOutput<'_>> {
         let output = plan.resolve(FINAL_AO).ok_or_else(|| Error::Plan("nothing provides the final AO".into()))?;
         let target = self
@@ -404,11 +414,11 @@ impl AoEngine {
             .targets
             .get(&output)
             .ok_or_else(|| Error::Plan(format!("{} was not allocated", output.name())))?;
-        if self.output_format == AoOutputFormat::Rgba16Float {
+        if self.output_format == AoOutputFormat::Rgba16Float && receiving.is_none() {
             return Ok(AoOutput { texture: &target.texture, view: &target.array_view });
         }
         let span = spans.map(|s| (s, s.begin(encoder, "pack")));
-        let packed = self.pack.record(&self.gpu, encoder, target, self.output_format);
+        let packed = self.pack.record(&self.gpu, encoder, target, self.output_format, receiving);
         if let Some((s, span)) = span {
             s.end(encoder, span);
         }

@@ -1,7 +1,9 @@
 //! The engine's output in the format the host chose ([`AoOutputFormat`]): the final AO
 //! as the chain leaves it (`Rgba16Float`, visibility in alpha), or its alpha alone in a
 //! single-channel texture that costs the host's lighting pass 2 or 1 bytes a pixel
-//! instead of 8, for one extra full-screen draw per view here.
+//! instead of 8, for one extra full-screen draw per view here. The same draw sets AO 1
+//! where the host's exclusion mask says a pixel receives none (then for `Rgba16Float`
+//! too).
 
 use crate::gpu::kernel::{shader_module, wgsl, Slot};
 use crate::gpu::layered_target::LayeredTarget;
@@ -40,14 +42,16 @@ impl AoOutputFormat {
 /// The pass that copies the final AO's visibility into a single-channel target.
 pub(crate) struct PackPass {
     layout: wgpu::BindGroupLayout,
-    pipelines: [(AoOutputFormat, wgpu::RenderPipeline); 2],
+    pipelines: [(AoOutputFormat, wgpu::RenderPipeline); 3],
     /// One uniform per view layer: the layer its draw reads.
     layer_uniforms: [wgpu::Buffer; 2],
     /// The output target and the format it was made for.
     target: Option<(AoOutputFormat, LayeredTarget)>,
-    /// Each layer's bind group and the final AO view they read: made again only when the
-    /// chain's targets change.
-    bind_groups: Option<(wgpu::TextureView, Vec<wgpu::BindGroup>)>,
+    /// Each layer's bind group and the final AO and mask views they read: made again only
+    /// when those change.
+    bind_groups: Option<([wgpu::TextureView; 2], Vec<wgpu::BindGroup>)>,
+    /// What binds in place of a host's exclusion mask when there is none.
+    placeholder_mask: wgpu::TextureView,
 }
 
 impl PackPass {
@@ -56,6 +60,12 @@ impl PackPass {
         let entries = [
             Slot::Layers.layout_entry(0, wgpu::ShaderStages::FRAGMENT),
             Slot::Uniform.layout_entry(1, wgpu::ShaderStages::FRAGMENT),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: super::exclusion::MASK_BINDING,
+                count: None,
+            },
         ];
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("pack"), entries: &entries });
@@ -66,11 +76,12 @@ impl PackPass {
         });
         let module = shader_module(gpu, "pack", &[wgsl!("src/ao/pack.wgsl")]);
         let pipeline = |format: AoOutputFormat| {
+            let entry = if format == AoOutputFormat::Rgba16Float { "fs_rgba" } else { "fs_main" };
             let pipeline = fullscreen_pipeline(
                 device,
                 "pack",
                 &pipeline_layout,
-                (&module, "fs_main"),
+                (&module, entry),
                 format.texture_format(),
                 None,
                 None,
@@ -89,22 +100,33 @@ impl PackPass {
         };
         PackPass {
             layout,
-            pipelines: [pipeline(AoOutputFormat::R16Float), pipeline(AoOutputFormat::R8Unorm)],
+            pipelines: [
+                pipeline(AoOutputFormat::R16Float),
+                pipeline(AoOutputFormat::R8Unorm),
+                pipeline(AoOutputFormat::Rgba16Float),
+            ],
             layer_uniforms: [layer_uniform(0), layer_uniform(1)],
             target: None,
             bind_groups: None,
+            placeholder_mask: super::exclusion::placeholder(gpu),
         }
     }
 
     /// Records the copy of `final_ao`'s visibility into this pass's target of `format`
-    /// (made anew at a new size or format) and returns the target.
+    /// (made anew at a new size or format), 1 where `receiving`'s mask has its bits, and
+    /// returns the target.
     pub(crate) fn record(
         &mut self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         final_ao: &LayeredTarget,
         format: AoOutputFormat,
+        receiving: Option<(wgpu::TextureView, u32)>,
     ) -> &LayeredTarget {
+        let (mask, receive_none) = receiving.unwrap_or_else(|| (self.placeholder_mask.clone(), 0));
+        for (layer, uniform) in self.layer_uniforms.iter().enumerate() {
+            gpu.queue.write_buffer(uniform, 0, bytemuck::cast_slice(&[layer as u32, receive_none, 0, 0]));
+        }
         let extent = final_ao.extent();
         let stale = self.target.as_ref().is_none_or(|(f, t)| *f != format || t.extent() != extent);
         if stale {
@@ -112,7 +134,8 @@ impl PackPass {
             let target = LayeredTarget::new(&gpu.device, "ao output", format.texture_format(), extent, usage);
             self.target = Some((format, target));
         }
-        if self.bind_groups.as_ref().is_none_or(|(view, _)| *view != final_ao.array_view) {
+        let views = [final_ao.array_view.clone(), mask];
+        if self.bind_groups.as_ref().is_none_or(|(bound, _)| *bound != views) {
             let bind_group = |uniform: &wgpu::Buffer| {
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("pack"),
@@ -123,15 +146,16 @@ impl PackPass {
                             resource: wgpu::BindingResource::TextureView(&final_ao.array_view),
                         },
                         wgpu::BindGroupEntry { binding: 1, resource: uniform.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&views[1]) },
                     ],
                 })
             };
             let groups = self.layer_uniforms.iter().map(bind_group).collect();
-            self.bind_groups = Some((final_ao.array_view.clone(), groups));
+            self.bind_groups = Some((views, groups));
         }
         let (_, target) = self.target.as_ref().expect("made above");
         let (_, bind_groups) = self.bind_groups.as_ref().expect("made above");
-        let pipeline = &self.pipelines.iter().find(|(f, _)| *f == format).expect("a single-channel format").1;
+        let pipeline = &self.pipelines.iter().find(|(f, _)| *f == format).expect("every output format").1;
         for (view, bind_group) in target.layer_views.iter().zip(bind_groups) {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("pack"),
