@@ -128,6 +128,7 @@ pub fn square(name: &str, center: glam::DVec3, size: f32, material: usize) -> Me
         ],
         normals: vec![glam::Vec3::Z; 4],
         uvs: vec![glam::Vec2::ZERO; 4],
+        uvs1: Vec::new(),
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
     }
@@ -153,6 +154,7 @@ pub fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize) -> Me
         positions,
         normals: vec![glam::Vec3::Z; n],
         uvs: vec![glam::Vec2::ZERO; n],
+        uvs1: Vec::new(),
         indices,
         material,
     }
@@ -204,6 +206,7 @@ pub fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material: usize
         positions,
         normals,
         uvs,
+        uvs1: Vec::new(),
         indices,
         material,
         node: None,
