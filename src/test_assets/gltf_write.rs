@@ -4,7 +4,7 @@
 //! Written: every mesh (static meshes in world space, moving ones under their node; vertex
 //! colours as `COLOR_0`, VEC3 when every alpha is 1 and VEC4 otherwise; tangents as
 //! `TANGENT` with the normals), materials (base colour and alpha factor, alpha mode and
-//! cutoff, emission with `KHR_materials_emissive_strength` above 1, `doubleSided: true`;
+//! cutoff, emission with `KHR_materials_emissive_strength` above 1, `doubleSided`;
 //! base colour, emission, normal (with its scale) and occlusion (with its strength)
 //! textures as PNG, each with its sampler unless that is glTF's default, and with
 //! `KHR_texture_transform` on its texture reference unless the transform is the identity), the node
@@ -157,6 +157,9 @@ impl Builder {
         if textured && v.uvs.len() == count {
             attributes["TEXCOORD_0"] = json!(self.texcoords(&v.uvs, options.texcoords));
         }
+        if textured && count > 0 && v.uvs1.len() == count {
+            attributes["TEXCOORD_1"] = json!(self.texcoords(&v.uvs1, options.texcoords));
+        }
         if count > 0 && v.colors.len() == count {
             let (flat, kind): (Vec<f32>, _) = if v.colors.iter().all(|c| c.w == 1.0) {
                 (v.colors.iter().flat_map(|c| c.truncate().to_array()).collect(), "VEC3")
@@ -268,6 +271,7 @@ struct MeshVertices {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     uvs: Vec<Vec2>,
+    uvs1: Vec<Vec2>,
     colors: Vec<Vec4>,
     tangents: Vec<Vec4>,
     indices: Vec<u32>,
@@ -321,7 +325,7 @@ impl Document {
             if let Some(texture) = &m.diffuse_texture {
                 pbr["baseColorTexture"] = self.add_texture(texture, &image(""), files, m)?;
             }
-            let mut material = json!({ "name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": true });
+            let mut material = json!({ "name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": m.double_sided });
             self.set_emission(&mut material, m.emissive);
             if let Some(texture) = &m.emissive_texture {
                 material["emissiveTexture"] = self.add_texture(texture, &image("_emissive"), files, m)?;
@@ -354,6 +358,9 @@ impl Document {
         }
         self.textures.push(entry);
         let mut info = json!({ "index": self.textures.len() - 1 });
+        if texture.sampling.tex_coord != 0 {
+            info["texCoord"] = json!(texture.sampling.tex_coord);
+        }
         let transform = texture.sampling.transform;
         if transform != Affine2::IDENTITY {
             let (offset, rotation, scale) = uv_transform_parts(&transform);
@@ -665,6 +672,7 @@ fn mesh_vertices(mesh: &Mesh, index_type: IndexType) -> MeshVertices {
     let mut positions = world_f32(mesh.origin, &mesh.positions);
     let mut normals = mesh.normals.clone();
     let mut uvs = mesh.uvs.clone();
+    let mut uvs1 = mesh.uvs1.clone();
     let mut colors = mesh.colors.clone();
     let mut tangents = mesh.tangents.clone();
     let mut indices = mesh.indices.clone();
@@ -672,6 +680,9 @@ fn mesh_vertices(mesh: &Mesh, index_type: IndexType) -> MeshVertices {
         positions = indices.iter().map(|&i| positions[i as usize]).collect();
         normals = indices.iter().map(|&i| normals[i as usize]).collect();
         uvs = indices.iter().map(|&i| uvs[i as usize]).collect();
+        if !uvs1.is_empty() {
+            uvs1 = indices.iter().map(|&i| uvs1[i as usize]).collect();
+        }
         if !colors.is_empty() {
             colors = indices.iter().map(|&i| colors[i as usize]).collect();
         }
@@ -680,7 +691,7 @@ fn mesh_vertices(mesh: &Mesh, index_type: IndexType) -> MeshVertices {
         }
         indices = (0..positions.len() as u32).collect();
     }
-    MeshVertices { positions, normals, uvs, colors, tangents, indices }
+    MeshVertices { positions, normals, uvs, uvs1, colors, tangents, indices }
 }
 
 /// The index type a mesh of `count` vertices is written with (`None`: non-indexed).
@@ -841,6 +852,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
             normals: vec![Vec3::Z; 4],
             uvs: vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y],
+            uvs1: Vec::new(),
             colors,
             tangents,
             indices: vec![0, 1, 2, 0, 2, 3],
@@ -872,6 +884,7 @@ mod tests {
             minify: Filter::Linear,
             mipmaps: None,
             transform: uv_transform(Vec2::new(0.25, -0.5), 0.3, Vec2::new(2.0, 3.0)),
+            tex_coord: 0,
         };
         let mut m = Material::plain("everything", Vec3::new(0.5, 0.6, 0.7));
         m.emissive = Vec3::new(0.2, 0.1, 0.0);

@@ -63,6 +63,7 @@ fn scene() -> vrao_render::Scene {
             name: format!("mesh{i}"),
             origin: DVec3::ZERO,
             uvs: vec![glam::Vec2::ZERO; m.positions.len()],
+            uvs1: Vec::new(),
             positions: m.positions,
             normals: m.normals,
             indices: m.indices,

@@ -33,6 +33,8 @@ mod gl;
 mod gltf;
 #[cfg(feature = "gltf")]
 mod gltf_accessors;
+#[cfg(all(feature = "app", feature = "gltf"))]
+mod gltf_as_authored;
 #[cfg(feature = "app")]
 mod headset;
 #[cfg(all(feature = "app", feature = "gltf"))]

@@ -11,7 +11,7 @@ struct Material {
     // none); w: occlusion texture strength (0: none).
     alpha: vec4<f32>,
     // Each texture's placement (KHR_texture_transform), two rows per texture in the
-    // order below: (the 2×2 matrix's columns), (the offset, 0, 0).
+    // order below: (the 2×2 matrix's columns), (the offset, the uv set it reads, 0).
     placements: array<vec4<f32>, 8>,
 };
 const DIFFUSE: u32 = 0u;
@@ -41,7 +41,7 @@ struct Object {
 struct VertexIn {
     @location(0) position: vec3<f32>,   // anchored (static) or the object's local frame
     @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
+    @location(2) uv: vec4<f32>,         // xy: set 0 (TEXCOORD_0), zw: set 1 (TEXCOORD_1)
     @location(3) color: vec4<f32>,      // linear RGBA, white without vertex colours
     @location(4) tangent: vec4<f32>,    // xyz along +u, w the bitangent's sign; 0 without
 };
@@ -66,29 +66,32 @@ fn anchored_tangent(v: VertexIn) -> vec4<f32> {
     return vec4<f32>((object.anchored_from_local * vec4<f32>(v.tangent.xyz, 0.0)).xyz, v.tangent.w);
 }
 
-// Where texture `k` reads the mesh's texture coordinates `uv`.
-fn placed(k: u32, uv: vec2<f32>) -> vec2<f32> {
+// Where texture `k` reads the mesh's texture coordinates `uvs` (sets 0 and 1 in xy, zw):
+// the set it names, placed.
+fn placed(k: u32, uvs: vec4<f32>) -> vec2<f32> {
     let m = material.placements[2u * k];
-    return m.xy * uv.x + m.zw * uv.y + material.placements[2u * k + 1u].xy;
+    let row = material.placements[2u * k + 1u];
+    let uv = select(uvs.xy, uvs.zw, row.z > 0.5);
+    return m.xy * uv.x + m.zw * uv.y + row.xy;
 }
 
 // The material's albedo at `uv` times the vertex colour, in 0..1. Call it in uniform
 // control flow, every fragment (untextured materials bind a white texel): sampling inside
 // a branch made lavapipe 22.3 leak memory at every draw
 // (docs/records/2026-11-29/measurements-in-code.md, mesh-albedo-leak).
-fn material_albedo(uv: vec2<f32>, color: vec4<f32>) -> vec3<f32> {
+fn material_albedo(uv: vec4<f32>, color: vec4<f32>) -> vec3<f32> {
     let texel = textureSample(diffuse_texture, diffuse_sampler, placed(DIFFUSE, uv)).rgb;
     let albedo = material.diffuse.rgb * select(vec3<f32>(1.0), texel, material.diffuse.w > 0.5) * color.rgb;
     return clamp(albedo, vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
 // Emitted radiance at `uv` (the factor times the emissive texture, white without one).
-fn material_emission(uv: vec2<f32>) -> vec3<f32> {
+fn material_emission(uv: vec4<f32>) -> vec3<f32> {
     return material.emission.rgb * textureSample(emissive_texture, emissive_sampler, placed(EMISSIVE, uv)).rgb;
 }
 
 // Baked occlusion at `uv`: 1 + strength × (texel − 1), 1 without an occlusion texture.
-fn material_occlusion(uv: vec2<f32>) -> f32 {
+fn material_occlusion(uv: vec4<f32>) -> f32 {
     let texel = textureSample(occlusion_texture, occlusion_sampler, placed(OCCLUSION, uv)).r;
     return clamp(1.0 + material.alpha.w * (texel - 1.0), 0.0, 1.0);
 }
@@ -98,7 +101,7 @@ fn material_occlusion(uv: vec2<f32>) -> f32 {
 // the mesh has none (zero), the tangent frame found from the position's and the
 // coordinates' screen-space derivatives (as the glTF sample viewer does). `n` itself
 // without a normal texture (scale 0).
-fn mapped_normal(n: vec3<f32>, tangent: vec4<f32>, view_position: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
+fn mapped_normal(n: vec3<f32>, tangent: vec4<f32>, view_position: vec3<f32>, uv: vec4<f32>) -> vec3<f32> {
     let at = placed(NORMAL, uv);
     let texel = textureSample(normal_texture, normal_sampler, at).xyz * 2.0 - 1.0;
     let scale = material.alpha.z;
@@ -133,7 +136,7 @@ fn sign_or_one(x: f32) -> f32 {
 // Discards the fragment where the material's alpha (times the vertex colour's) is below
 // its cutoff: a hole in every pass that draws the mesh. The sample is taken
 // unconditionally (see material_albedo).
-fn alpha_test(uv: vec2<f32>, vertex_alpha: f32) {
+fn alpha_test(uv: vec4<f32>, vertex_alpha: f32) {
     let alpha = material.alpha.x * vertex_alpha * textureSample(diffuse_texture, diffuse_sampler, placed(DIFFUSE, uv)).a;
     if (ALPHA_TEST && alpha < material.alpha.y) {
         discard;

@@ -11,8 +11,9 @@ use vrao_ao::{AoSettings, Error, Result};
 /// A scene's default occlusion radius is this fraction of its bounding-box diagonal
 /// ([`Scene::suggested_ao_radius`]), kept within [`AO_RADIUS_MIN`]..=[`AO_RADIUS_MAX`].
 pub const AO_RADIUS_OF_DIAGONAL: f64 = 0.08;
-/// The smallest default occlusion radius, metres (a scene of a few centimetres).
-pub const AO_RADIUS_MIN: f32 = 0.01;
+/// The smallest default occlusion radius, metres: 8 % of a 6 mm diagonal, so a model of
+/// a few millimetres (framed whole: `Aabb::framing_pose`) gets a radius smaller than itself.
+pub const AO_RADIUS_MIN: f32 = 0.0005;
 /// The largest default occlusion radius, metres: room-scale detail, even in a cathedral.
 pub const AO_RADIUS_MAX: f32 = 1.0;
 /// The most virtual point lights the reflective shadow maps gather per pixel.

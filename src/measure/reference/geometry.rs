@@ -51,6 +51,8 @@ struct TriExtras {
     /// Tangents with the bitangent's sign in w (zero where the mesh has none or its
     /// material no normal texture).
     tangents: [Vec4; 3],
+    /// Texture coordinates of set 1 (set 0's where the mesh has none).
+    uvs1: [Vec2; 3],
 }
 
 /// A material with its textures ready for sampling.
@@ -69,6 +71,8 @@ pub(crate) struct SurfaceMaterial {
     /// the cutoff.
     pub alpha: f32,
     pub cutoff: Option<f32>,
+    /// Whether rays hit its back faces (single-sided: they pass through them).
+    pub double_sided: bool,
 }
 
 impl SurfaceMaterial {
@@ -93,14 +97,16 @@ impl SurfaceMaterial {
             normal_texture: material.normal_texture.clone().filter(|(t, _)| usable(t)),
             alpha: material.alpha,
             cutoff: material.alpha_mode.cutoff().filter(|&cutoff| lowest < cutoff),
+            double_sided: material.double_sided,
         }
     }
 
-    /// Whether a ray passes through this material at `uv` with vertex colour alpha
-    /// `vertex_alpha` (an alpha-tested hole).
-    fn is_hole(&self, uv: Vec2, vertex_alpha: f32) -> bool {
+    /// Whether a ray passes through this material at texture coordinates `uvs` (sets 0
+    /// and 1) with vertex colour alpha `vertex_alpha` (an alpha-tested hole).
+    fn is_hole(&self, uvs: [Vec2; 2], vertex_alpha: f32) -> bool {
         let Some(cutoff) = self.cutoff else { return false };
-        let alpha = self.alpha * vertex_alpha * self.texture.as_ref().map_or(1.0, |t| sample_alpha(t, uv));
+        let alpha =
+            self.alpha * vertex_alpha * self.texture.as_ref().map_or(1.0, |t| sample_alpha(t, t.sampling.pick(uvs)));
         alpha < cutoff
     }
 }
@@ -123,7 +129,8 @@ pub(crate) struct Surface {
     pub geometric: Vec3,
     /// Interpolated vertex normal, normalised; the geometric normal when that is not usable.
     pub shading: Vec3,
-    pub uv: Vec2,
+    /// Texture coordinates of sets 0 and 1 (each texture reads the one it names).
+    pub uvs: [Vec2; 2],
     /// Interpolated linear RGBA vertex colour (white without vertex colours).
     pub color: Vec4,
     /// Barycentric weights of v1 and v2 (for the attributes looked up only when needed).
@@ -145,6 +152,8 @@ pub(crate) struct SceneGeometry {
     pub materials: Vec<SurfaceMaterial>,
     /// Whether some material is alpha-tested (rays then test each hit's alpha).
     has_holes: bool,
+    /// Whether some material is single-sided (rays then pass through its back faces).
+    has_single_sided: bool,
 }
 
 /// A scene's triangles as they are flattened, before the BVH puts them in leaf order.
@@ -171,6 +180,7 @@ impl Flattened {
         let has_normals = mesh.normals.len() == count;
         let has_uvs = mesh.uvs.len() == count;
         let has_colors = mesh.colors.len() == count;
+        let has_uvs1 = mesh.uvs1.len() == count;
         let normal_mapped = materials[mesh.material].normal_texture.is_some();
         let has_tangents = normal_mapped && mesh.tangents.len() == count;
         for t in mesh.indices.chunks_exact(3) {
@@ -188,10 +198,12 @@ impl Flattened {
                 continue;
             }
             self.tris.push(Tri { p: p.map(|v| v.to_array()) });
-            let extra = if has_colors || has_tangents {
+            let uv = |i: usize| if has_uvs { mesh.uvs[i] } else { Vec2::ZERO };
+            let extra = if has_colors || has_tangents || has_uvs1 {
                 self.extras.push(TriExtras {
                     colors: idx.map(|i| if has_colors { mesh.colors[i] } else { Vec4::ONE }),
                     tangents: idx.map(|i| if has_tangents { mesh.tangents[i] } else { Vec4::ZERO }),
+                    uvs1: idx.map(|i| if has_uvs1 { mesh.uvs1[i] } else { uv(i) }),
                 });
                 (self.extras.len() - 1) as u32
             } else {
@@ -199,7 +211,7 @@ impl Flattened {
             };
             self.attributes.push(TriAttributes {
                 normals: idx.map(|i| if has_normals { mesh.normals[i] } else { Vec3::ZERO }),
-                uvs: idx.map(|i| if has_uvs { mesh.uvs[i] } else { Vec2::ZERO }),
+                uvs: idx.map(uv),
                 geometric: geometric / length,
                 material: mesh.material as u32,
                 extras: extra,
@@ -256,7 +268,8 @@ impl SceneGeometry {
             .map(|(i, m)| SurfaceMaterial::new(m, lowest_vertex_alpha(&scene.meshes, i)))
             .collect();
         let has_holes = materials.iter().any(|m| m.cutoff.is_some());
-        Ok(SceneGeometry { bvh, tris, attributes, extras, materials, has_holes })
+        let has_single_sided = materials.iter().any(|m| !m.double_sided);
+        Ok(SceneGeometry { bvh, tris, attributes, extras, materials, has_holes, has_single_sided })
     }
 
     #[cfg(test)]
@@ -264,10 +277,15 @@ impl SceneGeometry {
         self.tris.len()
     }
 
-    /// The uv at barycentrics (b1, b2) of leaf-order triangle `prim`.
-    fn uv_at(&self, prim: usize, b1: f32, b2: f32) -> Vec2 {
+    /// The uvs of sets 0 and 1 at barycentrics (b1, b2) of leaf-order triangle `prim`.
+    fn uvs_at(&self, prim: usize, b1: f32, b2: f32) -> [Vec2; 2] {
         let a = &self.attributes[prim];
-        a.uvs[0] * (1.0 - b1 - b2) + a.uvs[1] * b1 + a.uvs[2] * b2
+        let at = |uvs: &[Vec2; 3]| uvs[0] * (1.0 - b1 - b2) + uvs[1] * b1 + uvs[2] * b2;
+        let uv0 = at(&a.uvs);
+        match a.extras {
+            NO_EXTRAS => [uv0, uv0],
+            i => [uv0, at(&self.extras[i as usize].uvs1)],
+        }
     }
 
     /// The interpolated vertex colour at barycentrics (b1, b2) of leaf-order triangle
@@ -299,6 +317,7 @@ impl SceneGeometry {
             }
             // The traversal keeps a hit only when it is strictly closer than its tmax.
             match pre.intersect(&self.tris[id], ray.tmin, ray.tmax) {
+                Some(_) if self.has_single_sided && self.is_behind(id, dir) => f32::INFINITY,
                 Some((_, b1, b2)) if self.has_holes && self.is_hole(id, b1, b2) => f32::INFINITY,
                 Some((t, b1, b2)) if t < ray.tmax => {
                     best = Some(Hit { t, prim: id as u32, b1, b2 });
@@ -315,7 +334,14 @@ impl SceneGeometry {
     /// Whether the hit at (b1, b2) of `prim` falls in an alpha-tested hole.
     fn is_hole(&self, prim: usize, b1: f32, b2: f32) -> bool {
         let material = &self.materials[self.attributes[prim].material as usize];
-        material.cutoff.is_some() && material.is_hole(self.uv_at(prim, b1, b2), self.color_at(prim, b1, b2).w)
+        material.cutoff.is_some() && material.is_hole(self.uvs_at(prim, b1, b2), self.color_at(prim, b1, b2).w)
+    }
+
+    /// Whether a ray along `dir` meets `prim` from behind and its material is single-sided
+    /// (culled, as the raster passes cull it: counter-clockwise is the front).
+    fn is_behind(&self, prim: usize, dir: Vec3) -> bool {
+        let a = &self.attributes[prim];
+        !self.materials[a.material as usize].double_sided && a.geometric.dot(dir) >= 0.0
     }
 
     /// The attributes at `hit`.
@@ -328,14 +354,13 @@ impl SceneGeometry {
         let position = p0 + (p1 - p0) * b1 + (p2 - p0) * b2;
         let n = a.normals[0] * b0 + a.normals[1] * b1 + a.normals[2] * b2;
         let shading = n.try_normalize().unwrap_or(a.geometric);
-        let uv = a.uvs[0] * b0 + a.uvs[1] * b1 + a.uvs[2] * b2;
         let magnitude = p0.abs().max(p1.abs()).max(p2.abs()).max_element();
         Surface {
             prim: hit.prim,
             position,
             geometric: a.geometric,
             shading,
-            uv,
+            uvs: self.uvs_at(hit.prim as usize, b1, b2),
             color: self.color_at(hit.prim as usize, b1, b2),
             b1,
             b2,
@@ -364,7 +389,7 @@ impl SceneGeometry {
         let Some(tangent) = (tangent.truncate() - n * n.dot(tangent.truncate())).try_normalize() else { return n };
         let sign = if tangent_sign(t, b1, b2) < 0.0 { -1.0 } else { 1.0 };
         let bitangent = n.cross(tangent) * sign;
-        let texel = sample_linear(texture, surface.uv) * 2.0 - Vec3::ONE;
+        let texel = sample_linear(texture, texture.sampling.pick(surface.uvs)) * 2.0 - Vec3::ONE;
         let (x, y) = (texel.x * scale, texel.y * scale);
         (tangent * x + bitangent * y + n * texel.z).try_normalize().unwrap_or(n)
     }
@@ -541,6 +566,7 @@ mod tests {
                 origin,
                 normals: vec![Vec3::Z; 4],
                 uvs: vec![Vec2::ZERO; 4],
+                uvs1: Vec::new(),
                 positions,
                 indices: vec![0, 1, 2, 0, 2, 3],
                 material: 0,

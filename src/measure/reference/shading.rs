@@ -198,7 +198,7 @@ pub(crate) fn albedo(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
     let m = &geometry.materials[surface.material];
     let mut a = m.diffuse * surface.color.truncate();
     if let Some(t) = &m.texture {
-        a *= sample_texture(t, surface.uv);
+        a *= sample_texture(t, t.sampling.pick(surface.uvs));
     }
     let a = a.clamp(Vec3::ZERO, Vec3::ONE);
     if a.is_finite() {
@@ -214,7 +214,7 @@ pub(crate) fn albedo(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
 pub(crate) fn emission(geometry: &SceneGeometry, surface: &Surface) -> Vec3 {
     let m = &geometry.materials[surface.material];
     match &m.emissive_texture {
-        Some(t) if m.emissive != Vec3::ZERO => m.emissive * sample_texture(t, surface.uv),
+        Some(t) if m.emissive != Vec3::ZERO => m.emissive * sample_texture(t, t.sampling.pick(surface.uvs)),
         _ => m.emissive,
     }
 }

@@ -147,6 +147,7 @@ fn sphere_mesh(centre: DVec3, radius: f64, rings: u32, segments: u32) -> Mesh {
         positions,
         normals,
         uvs,
+        uvs1: Vec::new(),
         indices,
         material: 0,
         node: None,
@@ -167,6 +168,7 @@ fn floor_mesh(half: f32) -> Mesh {
         origin: DVec3::ZERO,
         normals: vec![Vec3::Y; 4],
         uvs: vec![Vec2::ZERO; 4],
+        uvs1: Vec::new(),
         positions,
         indices: vec![0, 1, 2, 0, 2, 3],
         material: 0,
@@ -608,7 +610,7 @@ fn the_emission_texture_limits_the_emissive_factor_and_vertex_colours_do_not_tin
     assert_eq!(out(0.5), Vec3::new(2.0, 1.0, 0.5));
     // It repeats as its sampler says: u = 1.25 is u = 0.25 again.
     let s = surface_below(&g, 0.5, 0.2).unwrap();
-    let shifted = super::geometry::Surface { uv: Vec2::new(1.25, s.uv.y), ..s };
+    let shifted = super::geometry::Surface { uvs: [Vec2::new(1.25, s.uvs[0].y); 2], ..s };
     assert_eq!(super::shading::emission(&g, &shifted), Vec3::ZERO);
 }
 

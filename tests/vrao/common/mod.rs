@@ -129,6 +129,7 @@ pub(crate) fn square(name: &str, center: glam::DVec3, size: f32, material: usize
         ],
         normals: vec![glam::Vec3::Z; 4],
         uvs: vec![glam::Vec2::ZERO; 4],
+        uvs1: Vec::new(),
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
     }
@@ -154,6 +155,7 @@ pub(crate) fn disc(name: &str, center: glam::DVec3, radius: f32, material: usize
         positions,
         normals: vec![glam::Vec3::Z; n],
         uvs: vec![glam::Vec2::ZERO; n],
+        uvs1: Vec::new(),
         indices,
         material,
     }
@@ -205,6 +207,7 @@ pub(crate) fn cuboid(name: &str, center: glam::DVec3, size: glam::Vec3, material
         positions,
         normals,
         uvs,
+        uvs1: Vec::new(),
         indices,
         material,
         node: None,

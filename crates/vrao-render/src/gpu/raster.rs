@@ -4,9 +4,10 @@
 
 use super::scene::Vertex;
 
-/// The scene's vertices (position, normal, uv, colour, tangent) as the raster passes read them.
+/// The scene's vertices (position, normal, uv sets 0 and 1, colour, tangent) as the raster
+/// passes read them.
 pub const MESH_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
-    0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Unorm8x4, 4 => Snorm16x4
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Unorm8x4, 4 => Snorm16x4
 ];
 
 /// One vertex buffer of [`Vertex`] with the given attributes (all, or the position only).
@@ -38,11 +39,58 @@ pub struct MeshPipeline<'a> {
     /// Whether the fragment stage discards alpha-tested holes (mesh.wgsl's `ALPHA_TEST`
     /// override; the module must include mesh.wgsl and have a fragment stage).
     pub alpha_test: bool,
+    /// Whether back faces (clockwise on screen) are culled: single-sided materials.
+    pub cull: bool,
 }
 
-/// A pipeline that draws the scene's meshes two-sided, writing depth (OBJ windings are
-/// not trusted: the G-buffer faces normals towards the eye, depth peeling wants the back
-/// faces, and both faces of a surface cast shadows).
+/// What a draw needs of its pipeline: an alpha test, back-face culling, both or neither.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawKind {
+    /// Its material is alpha-tested ([`MeshPipeline::alpha_test`]).
+    pub alpha_test: bool,
+    /// Its material is single-sided ([`MeshPipeline::cull`]).
+    pub cull: bool,
+}
+
+impl DrawKind {
+    /// Every kind, in drawing order: solid before alpha-tested (early depth test).
+    pub const ALL: [DrawKind; 4] = [
+        DrawKind { alpha_test: false, cull: false },
+        DrawKind { alpha_test: false, cull: true },
+        DrawKind { alpha_test: true, cull: false },
+        DrawKind { alpha_test: true, cull: true },
+    ];
+}
+
+/// One pass's mesh pipelines: one per [`DrawKind`] the scene draws, none for the others.
+pub struct MeshPipelines {
+    /// In [`DrawKind::ALL`] order.
+    pub by_kind: [Option<wgpu::RenderPipeline>; 4],
+}
+
+impl MeshPipelines {
+    /// `make`'s pipeline for each kind among `kinds` (what the scene draws).
+    pub fn new(kinds: &[DrawKind], mut make: impl FnMut(DrawKind) -> wgpu::RenderPipeline) -> MeshPipelines {
+        MeshPipelines { by_kind: DrawKind::ALL.map(|k| kinds.contains(&k).then(|| make(k))) }
+    }
+
+    /// The pipeline for `kind`, if the scene draws it.
+    pub fn get(&self, kind: DrawKind) -> Option<&wgpu::RenderPipeline> {
+        let i = DrawKind::ALL.iter().position(|&k| k == kind)?;
+        self.by_kind[i].as_ref()
+    }
+
+    /// Whether some pipeline discards alpha-tested holes.
+    pub fn alpha_tested(&self) -> bool {
+        DrawKind::ALL.iter().zip(&self.by_kind).any(|(k, p)| k.alpha_test && p.is_some())
+    }
+}
+
+/// A pipeline that draws the scene's meshes, writing depth: two-sided for double-sided
+/// materials (OBJ windings are not trusted: the G-buffer faces normals towards the eye,
+/// depth peeling wants the back faces, and both faces of a surface cast shadows); with
+/// `cull`, a single-sided material's back faces are gone in every pass, shadow maps
+/// included, as Unity's and Bevy's shadow casters follow the material's culling.
 pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipeline {
     let (format, compare) = p.depth;
     let alpha_constants = [("ALPHA_TEST", 1.0)];
@@ -59,7 +107,11 @@ pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipe
             compilation_options: Default::default(),
             buffers: &[Some(mesh_vertex_buffer(p.vertex.1))],
         },
-        primitive: wgpu::PrimitiveState::default(),
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: p.cull.then_some(wgpu::Face::Back),
+            ..Default::default()
+        },
         depth_stencil: Some(wgpu::DepthStencilState {
             format,
             depth_write_enabled: Some(true),

@@ -9,6 +9,7 @@
 //! previous frame's beside it (the G-buffer's motion vectors), so nothing is re-uploaded.
 
 use super::kernel::wgsl;
+use super::raster::{DrawKind, MeshPipelines};
 use super::textures::{self, Encoding, Samplers};
 use crate::scene::{Environment, Material, Scene, Texture};
 use bytemuck::{Pod, Zeroable};
@@ -28,8 +29,9 @@ pub struct Vertex {
     pub position: [f32; 3],
     /// Unit surface normal in world space.
     pub normal: [f32; 3],
-    /// Texture coordinates (set 0, which every texture reads).
-    pub uv: [f32; 2],
+    /// Texture coordinates: set 0 in the first two, set 1 (set 0 again where the mesh has
+    /// none) in the last two; each texture reads the set its placement names.
+    pub uv: [f32; 4],
     /// Linear RGBA vertex colour (unorm8; white without one).
     pub color: [u8; 4],
     /// Tangent along +u and the bitangent's sign in w (snorm16); zero without one, when
@@ -49,7 +51,7 @@ pub struct MaterialUniform {
     /// texture's scale (0 without one); w: the occlusion texture's strength (0 without one).
     pub alpha: [f32; 4],
     /// Each texture's placement (`KHR_texture_transform`) in [`MaterialTexture`] order, two
-    /// rows each: (the 2×2 matrix's columns), (the offset, 0, 0).
+    /// rows each: (the 2×2 matrix's columns), (the offset, the texture coordinate set, 0).
     pub placements: [[f32; 4]; 8],
 }
 
@@ -85,18 +87,6 @@ pub struct ObjectUniform {
 /// alignment a device may ask for.
 const OBJECT_STRIDE: u64 = 256;
 
-/// Which draws [`GpuScene::draw`] records: passes with an alpha-tested pipeline draw the
-/// solid materials with their plain pipeline and the alpha-tested ones with the other.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DrawSet {
-    /// Every draw (a scene without alpha-tested materials, or a pass that ignores alpha).
-    All,
-    /// Draws of materials without an alpha test.
-    Solid,
-    /// Draws of alpha-tested materials.
-    AlphaTested,
-}
-
 /// One material on the GPU: its uniform, and its textures with their samplers.
 pub struct GpuMaterial {
     /// The [`MaterialUniform`].
@@ -105,6 +95,8 @@ pub struct GpuMaterial {
     pub textures: [(wgpu::TextureView, wgpu::Sampler); 4],
     /// Whether it has its own diffuse texture (rather than the placeholder).
     pub has_texture: bool,
+    /// Whether both its faces are drawn ([`Material::double_sided`]).
+    pub double_sided: bool,
 }
 
 /// A contiguous range of indices drawn with one material and one object transform.
@@ -115,8 +107,8 @@ pub struct Draw {
     pub material: usize,
     /// The object slot that moves it (0: static geometry).
     pub object: usize,
-    /// Whether its material is alpha-tested.
-    pub alpha_tested: bool,
+    /// Whether its material is alpha-tested, and single-sided (its back faces culled).
+    pub kind: DrawKind,
     /// Its material and object (layout: [`GpuScene::material_layout`]).
     pub group: wgpu::BindGroup,
 }
@@ -143,8 +135,8 @@ pub struct GpuScene {
     pub objects: wgpu::Buffer,
     /// The scene node each object slot after 0 follows.
     pub object_nodes: Vec<usize>,
-    /// Whether some draw is alpha-tested (passes then build their alpha-tested pipelines).
-    pub alpha_tested: bool,
+    /// The kinds of draw the scene has (passes build a pipeline for each).
+    pub kinds: Vec<DrawKind>,
     /// Whether some material has a normal texture (the G-buffer then writes the lighting's
     /// normals apart from the AO's).
     pub normal_mapped: bool,
@@ -155,38 +147,19 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
-    /// Records the draws of `set` into `pass`, binding each draw's material and object at
-    /// group 1.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass, set: DrawSet) {
+    /// Records every draw into `pass`, grouped by kind (solid before alpha-tested, for the
+    /// early depth test), each group with its pipeline from `pipelines`, binding each
+    /// draw's material and object at group 1.
+    pub fn draw_with(&self, pass: &mut wgpu::RenderPass, pipelines: &MeshPipelines) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        let wanted = |d: &&Draw| match set {
-            DrawSet::All => true,
-            DrawSet::Solid => !d.alpha_tested,
-            DrawSet::AlphaTested => d.alpha_tested,
-        };
-        for draw in self.draws.iter().filter(|d| !d.indices.is_empty()).filter(wanted) {
-            pass.set_bind_group(1, &draw.group, &[]);
-            pass.draw_indexed(draw.indices.clone(), 0, 0..1);
-        }
-    }
-
-    /// Draws every mesh with `solid`, or, when the pass has an `alpha_tested` pipeline,
-    /// the solid materials first (early depth test) and the alpha-tested ones with it.
-    pub fn draw_with(
-        &self,
-        pass: &mut wgpu::RenderPass,
-        solid: &wgpu::RenderPipeline,
-        alpha_tested: Option<&wgpu::RenderPipeline>,
-    ) {
-        pass.set_pipeline(solid);
-        match alpha_tested {
-            Some(alpha_tested) => {
-                self.draw(pass, DrawSet::Solid);
-                pass.set_pipeline(alpha_tested);
-                self.draw(pass, DrawSet::AlphaTested);
+        for kind in DrawKind::ALL {
+            let Some(pipeline) = pipelines.get(kind) else { continue };
+            pass.set_pipeline(pipeline);
+            for draw in self.draws.iter().filter(|d| d.kind == kind && !d.indices.is_empty()) {
+                pass.set_bind_group(1, &draw.group, &[]);
+                pass.draw_indexed(draw.indices.clone(), 0, 0..1);
             }
-            None => self.draw(pass, DrawSet::All),
         }
     }
 
@@ -238,7 +211,9 @@ impl GpuScene {
         };
         let draws: Vec<Draw> =
             geometry.runs.into_iter().map(|run| bindings.draw(device, run, &materials, &cutoffs)).collect();
-        let alpha_tested = draws.iter().any(|d| d.alpha_tested);
+        let mut kinds: Vec<DrawKind> = draws.iter().map(|d| d.kind).collect();
+        kinds.sort_by_key(|k| (k.alpha_test, k.cull));
+        kinds.dedup();
         let normal_mapped = scene.materials.iter().any(|m| m.normal_texture.is_some());
         GpuScene {
             anchor,
@@ -249,7 +224,7 @@ impl GpuScene {
             material_layout: bindings.layout,
             objects: bindings.objects,
             object_nodes: geometry.object_nodes,
-            alpha_tested,
+            kinds,
             normal_mapped,
             environment: environment_texture(gpu, scene.environment.as_ref()),
             sampler: bindings.sampler,
@@ -278,6 +253,10 @@ impl Geometry {
     /// node's local frame.
     fn gather(scene: &Scene, anchor: DVec3) -> Geometry {
         let mut g = Geometry { vertices: Vec::new(), indices: Vec::new(), runs: Vec::new(), object_nodes: Vec::new() };
+        // A node that mirrors (at rest) would turn its meshes' fronts away: their winding
+        // is reversed so that culling keeps the faces the file meant.
+        let rest = scene.node_transforms(0.0);
+        let mirrored = |node: usize| rest.get(node).is_some_and(|m| glam::DMat3::from_mat4(*m).determinant() < 0.0);
         for mesh in &scene.meshes {
             let base = g.vertices.len() as u32;
             let (offset, object) = match mesh.node {
@@ -291,7 +270,7 @@ impl Geometry {
                 g.vertices.push(Vertex {
                     position: (mesh.positions[i] + offset).to_array(),
                     normal: mesh.normals[i].to_array(),
-                    uv: mesh.uvs.get(i).copied().unwrap_or_default().to_array(),
+                    uv: uv_pair(mesh, i),
                     color: color.to_array().map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8),
                     tangent: tangent
                         .to_array()
@@ -300,6 +279,9 @@ impl Geometry {
             }
             let start = g.indices.len() as u32;
             g.indices.extend(mesh.indices.iter().map(|i| i + base));
+            if mesh.node.is_some_and(mirrored) {
+                g.indices[start as usize..].chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
+            }
             g.runs.push(Run { indices: start..g.indices.len() as u32, material: mesh.material, object });
         }
         // wgpu rejects empty buffers; an empty scene draws nothing from a dummy vertex.
@@ -319,6 +301,13 @@ impl Geometry {
         });
         slot + 1
     }
+}
+
+/// Vertex `i`'s texture coordinates, sets 0 and 1 ([`Vertex::uv`]).
+fn uv_pair(mesh: &crate::scene::Mesh, i: usize) -> [f32; 4] {
+    let uv0 = mesh.uvs.get(i).copied().unwrap_or_default();
+    let uv1 = mesh.uvs1.get(i).copied().unwrap_or(uv0);
+    [uv0.x, uv0.y, uv1.x, uv1.y]
 }
 
 /// What every draw's bind group binds besides its material: the layout, the diffuse
@@ -356,8 +345,9 @@ impl DrawBindings {
                 sampler_entry(m, MaterialTexture::Occlusion),
             ],
         });
-        let alpha_tested = cutoffs[run.material].is_some();
-        Draw { indices: run.indices, material: run.material, object: run.object, alpha_tested, group }
+        let kind =
+            DrawKind { alpha_test: cutoffs[run.material].is_some(), cull: !materials[run.material].double_sided };
+        Draw { indices: run.indices, material: run.material, object: run.object, kind, group }
     }
 }
 
@@ -409,7 +399,7 @@ fn upload_material(
             Some(t) => textures::upload(gpu, &format!("{} {kind}", m.name), t, encoding),
             None => placeholder.clone(),
         };
-        (view, samplers.get(&gpu.device, &sampling), sampling.transform)
+        (view, samplers.get(&gpu.device, &sampling), sampling)
     };
     let normal = m.normal_texture.as_ref();
     let occlusion = m.occlusion_texture.as_ref();
@@ -420,10 +410,12 @@ fn upload_material(
         upload(occlusion.map(|(t, _)| t), "occlusion", Encoding::Linear, &placeholders.white_linear),
     ];
     let mut placements = [[0.0; 4]; 8];
-    for (k, (_, _, transform)) in uploaded.iter().enumerate() {
+    for (k, (_, _, sampling)) in uploaded.iter().enumerate() {
+        let transform = sampling.transform;
         let (x, y) = (transform.matrix2.x_axis, transform.matrix2.y_axis);
         placements[2 * k] = [x.x, x.y, y.x, y.y];
-        placements[2 * k + 1] = [transform.translation.x, transform.translation.y, 0.0, 0.0];
+        let set = sampling.tex_coord.min(1) as f32;
+        placements[2 * k + 1] = [transform.translation.x, transform.translation.y, set, 0.0];
     }
     let has_texture = m.diffuse_texture.is_some();
     let uniform = MaterialUniform {
@@ -434,7 +426,7 @@ fn upload_material(
     };
     let uniform = buffer_init(&gpu.device, &m.name, bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
     let textures = uploaded.map(|(view, sampler, _)| (view, sampler));
-    GpuMaterial { uniform, textures, has_texture }
+    GpuMaterial { uniform, textures, has_texture, double_sided: m.double_sided }
 }
 
 /// The environment's sampler: the equirectangular map repeats around the horizon and
@@ -591,7 +583,7 @@ mod tests {
         let fields = [
             (offset_of!(Vertex, position), size_of::<[f32; 3]>()),
             (offset_of!(Vertex, normal), size_of::<[f32; 3]>()),
-            (offset_of!(Vertex, uv), size_of::<[f32; 2]>()),
+            (offset_of!(Vertex, uv), size_of::<[f32; 4]>()),
             (offset_of!(Vertex, color), size_of::<[u8; 4]>()),
             (offset_of!(Vertex, tangent), size_of::<[i16; 4]>()),
         ];

@@ -303,6 +303,7 @@ impl Builder {
             origin,
             node: None,
             uvs: vec![glam::Vec2::ZERO; positions.len()],
+            uvs1: Vec::new(),
             positions,
             normals: self.normals,
             indices: self.indices,

@@ -62,6 +62,7 @@ fn plate(y: f64, h: f64, material: usize) -> Mesh {
         positions,
         normals: vec![Vec3::Y; 4],
         uvs,
+        uvs1: Vec::new(),
         // Counter-clockwise seen from above (+Y).
         indices: vec![0, 2, 1, 0, 3, 2],
         material,

@@ -33,7 +33,8 @@
 //!     { t = 2.0, translate = [1, 0, 0], rotate_deg = [0, 90, 0], scale = 1.0 } ] }
 //!
 //! [[light]]                        # no [[light]]: the rule of `obj::default_lights`
-//! type = "directional"             # (emissive meshes, else a sun); `light = []`: no lights
+//! type = "directional"             # (emissive meshes, else a sun; with a glTF placed, the sun
+//!                                  # and emissive meshes); `light = []`: no lights
 //! direction = [0.3, -1.0, -0.2]    # the way the light travels; normalised on load
 //! color = [1.0, 0.95, 0.9]         # linear RGB, optional (white)
 //! intensity = 3.0                  # irradiance on a surface facing the light
@@ -213,7 +214,11 @@ fn parse(path: &Path, text: &str) -> Result<Scene> {
                 nodes: nodes.clone(),
             }
             .at_time(0.0);
-            obj::default_lights(&still.meshes, &materials)
+            // A placed glTF keeps the sun, as it does alone (its glow is no room lamp).
+            match file.mesh.iter().any(|e| e.get_ref().gltf.is_some()) {
+                true => obj::sun_and_emitters(&still.meshes, &materials),
+                false => obj::default_lights(&still.meshes, &materials),
+            }
         }
         Some(entries) => entries
             .iter()

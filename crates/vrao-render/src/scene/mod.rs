@@ -42,6 +42,9 @@ pub struct Mesh {
     /// Texture coordinates, one per position (zero when the source has none). v = 0 is the
     /// top row of the texture (OBJ's bottom-up v is flipped at load).
     pub uvs: Vec<Vec2>,
+    /// The second texture coordinates (glTF `TEXCOORD_1`), one per position, or empty:
+    /// a texture that reads set 1 ([`Sampling::tex_coord`]) then reads `uvs`.
+    pub uvs1: Vec<Vec2>,
     /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position, multiplying the
     /// material's base colour and alpha; empty when the source has none (white).
     pub colors: Vec<Vec4>,
@@ -125,6 +128,10 @@ pub struct Material {
     pub alpha: f32,
     /// What alpha does (opaque, alpha-tested or blended).
     pub alpha_mode: AlphaMode,
+    /// Whether both faces are drawn (OBJ and built-in materials; glTF `doubleSided`). A
+    /// single-sided surface is culled from behind (counter-clockwise is its front) in
+    /// every raster pass, shadow maps included, and by the reference tracer's rays.
+    pub double_sided: bool,
 }
 
 impl Material {
@@ -140,6 +147,7 @@ impl Material {
             occlusion_texture: None,
             alpha: 1.0,
             alpha_mode: AlphaMode::Opaque,
+            double_sided: true,
         }
     }
 
@@ -265,6 +273,10 @@ impl Aabb {
     /// slightly above the centre and looking at it, far enough back that the bounding
     /// sphere fits (half diagonal / tan 40°) plus half the depth, so the eye is outside
     /// the box. An open-fronted model such as the Cornell box is seen from its open side.
+    /// A model smaller than [`FRAMING_MIN_EXTENT`] is framed as if it were that size: the
+    /// eyes sit 32 mm either side of the head, so closer than that a small model would
+    /// leave both eyes' views (and fall inside the 5 cm near plane); from there it lies
+    /// whole beyond the near plane in both eyes, as a jeweller's loupe would show it.
     /// Empty bounds give a standing head at the origin looking along −Z.
     pub fn framing_pose(&self) -> HeadPose {
         let size = self.size();
@@ -273,13 +285,18 @@ impl Aabb {
             return HeadPose::look_at(DVec3::new(0.0, 1.6, 0.0), DVec3::new(0.0, 1.6, -1.0))
                 .unwrap_or(HeadPose::IDENTITY);
         }
-        let extent = if diagonal > 1e-9 { diagonal } else { 1.0 };
+        let extent = diagonal.max(FRAMING_MIN_EXTENT);
         let distance = 0.5 * extent / 40f64.to_radians().tan() + 0.5 * size.z;
         let centre = self.center();
         let eye = centre + DVec3::new(0.0, 0.1 * extent, distance);
         HeadPose::look_at(eye, centre).unwrap_or(HeadPose { position: eye, orientation: glam::DQuat::IDENTITY })
     }
 }
+
+/// The smallest diagonal [`Aabb::framing_pose`] frames as it is, metres: twice a typical
+/// IPD (64 mm), so each eye sees the model within ~25° of its centre, and its front lies
+/// at least 7.6 cm away, beyond the default 5 cm near plane.
+pub const FRAMING_MIN_EXTENT: f64 = 0.128;
 
 /// The head pose over time: one key for a static head, several for a scripted path.
 /// Between keys, position is interpolated linearly and orientation by slerp.
@@ -533,6 +550,7 @@ fn bake(mesh: &Mesh, world: &DMat4) -> Mesh {
         positions,
         normals,
         uvs: mesh.uvs.clone(),
+        uvs1: mesh.uvs1.clone(),
         indices,
         material: mesh.material,
         node: None,

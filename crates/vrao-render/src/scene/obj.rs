@@ -146,15 +146,44 @@ pub fn load_bare(path: &Path) -> Result<Scene> {
 /// right straight below a ceiling light and too bright sideways, the better error for
 /// the usual downward-facing lamp.
 pub fn default_lights(meshes: &[Mesh], materials: &[Material]) -> Vec<Light> {
-    let lights: Vec<Light> = meshes
-        .iter()
-        .filter_map(|m| materials.get(m.material).and_then(|mat| emitter_light(m, mat.emissive)))
-        .collect();
+    let lights = emitter_lights(meshes, materials);
     if lights.is_empty() {
         vec![Light::default_sun()]
     } else {
         lights
     }
+}
+
+/// The lights of a glTF that brings none of its own (or of a scene file placing one):
+/// the default sun, always (its meshes' glow is texture detail, not the room's lamps), and
+/// each emitter's point light as [`default_lights`] makes it.
+pub fn sun_and_emitters(meshes: &[Mesh], materials: &[Material]) -> Vec<Light> {
+    let mut lights = vec![Light::default_sun()];
+    lights.extend(emitter_lights(meshes, materials));
+    lights
+}
+
+/// One point light per emissive mesh ([`default_lights`]); a material's emission is its
+/// factor times the mean of its emissive texture, so a mostly black map adds little
+/// light and an all-black one none.
+pub fn emitter_lights(meshes: &[Mesh], materials: &[Material]) -> Vec<Light> {
+    let emission: Vec<Vec3> = materials.iter().map(mean_emission).collect();
+    meshes.iter().filter_map(|m| emission.get(m.material).and_then(|&e| emitter_light(m, e))).collect()
+}
+
+/// A material's emitted radiance averaged over its emissive texture (sRGB texels taken
+/// to linear, as the G-buffer samples them).
+pub fn mean_emission(material: &Material) -> Vec3 {
+    let Some(texture) = &material.emissive_texture else { return material.emissive };
+    if material.emissive == Vec3::ZERO || texture.rgba8.len() < 4 {
+        return material.emissive;
+    }
+    let linear: Vec<f64> = (0..=255u8).map(|b| f64::from(super::texture::srgb_to_linear(b))).collect();
+    let mut sum = glam::DVec3::ZERO;
+    for texel in texture.rgba8.chunks_exact(4) {
+        sum += glam::DVec3::new(linear[texel[0] as usize], linear[texel[1] as usize], linear[texel[2] as usize]);
+    }
+    material.emissive * (sum / (texture.rgba8.len() / 4) as f64).as_vec3()
 }
 
 fn emitter_light(mesh: &Mesh, emissive: Vec3) -> Option<Light> {
@@ -463,6 +492,8 @@ impl MtlMaterial {
             diffuse_texture,
             alpha,
             alpha_mode,
+            // OBJ windings are not trusted.
+            double_sided: true,
         })
     }
 }
@@ -670,6 +701,7 @@ fn convert(model: tobj::Model, material: usize) -> Option<Mesh> {
         positions: geometry.positions,
         normals: geometry.normals,
         uvs: geometry.uvs,
+        uvs1: Vec::new(),
         indices: geometry.indices,
         material,
     })
@@ -743,6 +775,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 0.0)],
             normals: vec![Vec3::NEG_Y; 4],
             uvs: vec![Vec2::ZERO; 4],
+            uvs1: Vec::new(),
             indices: vec![0, 2, 1, 0, 3, 2],
             material: 0,
             node: None,

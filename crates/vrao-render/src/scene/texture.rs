@@ -76,6 +76,9 @@ pub struct Sampling {
     /// From the mesh's texture coordinates to where the texture is read
     /// (`KHR_texture_transform`: translation · rotation · scale).
     pub transform: Affine2,
+    /// The mesh's texture coordinate set it reads: 0 ([`super::Mesh::uvs`]) or 1
+    /// ([`super::Mesh::uvs1`]); glTF `texCoord`, or `KHR_texture_transform`'s.
+    pub tex_coord: u32,
 }
 
 impl Default for Sampling {
@@ -89,15 +92,31 @@ impl Default for Sampling {
             minify: Filter::Linear,
             mipmaps: Some(Filter::Linear),
             transform: Affine2::IDENTITY,
+            tex_coord: 0,
         }
     }
 }
 
 impl Sampling {
+    /// The coordinates it reads of a point whose sets 0 and 1 are `uvs`.
+    pub fn pick(&self, uvs: [Vec2; 2]) -> Vec2 {
+        if self.tex_coord == 1 {
+            uvs[1]
+        } else {
+            uvs[0]
+        }
+    }
+
     /// `uv` as the mesh gives it, moved by [`Sampling::transform`].
     pub fn place(&self, uv: Vec2) -> Vec2 {
         self.transform.transform_point2(uv)
     }
+}
+
+/// An sRGB-encoded byte as a linear value in [0, 1].
+pub fn srgb_to_linear(byte: u8) -> f32 {
+    let c = f64::from(byte) / 255.0;
+    (if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }) as f32
 }
 
 /// `KHR_texture_transform`'s matrix: offset · rotation · scale, the rotation as the

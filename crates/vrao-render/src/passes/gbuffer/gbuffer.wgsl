@@ -18,7 +18,7 @@ struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) view_position: vec3<f32>,
     @location(1) view_normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
+    @location(2) uv: vec4<f32>,
     @location(3) color: vec4<f32>,
     @location(4) view_tangent: vec4<f32>,
 };
@@ -28,7 +28,7 @@ struct MotionVertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) view_position: vec3<f32>,
     @location(1) view_normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
+    @location(2) uv: vec4<f32>,
     @location(3) color: vec4<f32>,
     @location(4) view_tangent: vec4<f32>,
     @location(5) previous_clip: vec4<f32>,

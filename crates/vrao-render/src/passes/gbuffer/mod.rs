@@ -11,7 +11,7 @@ mod mask;
 
 use super::{gpu_scene_of, settings_of};
 use crate::gpu::kernel::wgsl;
-use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MESH_ATTRIBUTES};
+use crate::gpu::raster::{mesh_pipeline, DrawKind, MeshPipeline, MeshPipelines, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
 use bytemuck::{Pod, Zeroable};
 use mask::{MaskDepth, MaskStep};
@@ -61,17 +61,14 @@ struct PreviousEyes {
     view_from_anchored: [[[f32; 4]; 4]; 2],
 }
 
-/// The pipelines of one path (multiview or per eye): solid materials, and alpha-tested
-/// ones when the scene has any.
-struct Pipelines {
-    solid: wgpu::RenderPipeline,
-    alpha_tested: Option<wgpu::RenderPipeline>,
-}
+/// The pipelines of one path (multiview or per eye): one per kind of draw the scene has
+/// (alpha-tested or not, single-sided or not).
+struct Pipelines(MeshPipelines);
 
 impl Pipelines {
     /// Draws the scene: solid materials first (early depth test), then the alpha-tested.
     fn draw(&self, pass: &mut wgpu::RenderPass, scene: &GpuScene) {
-        scene.draw_with(pass, &self.solid, self.alpha_tested.as_ref());
+        scene.draw_with(pass, &self.0);
     }
 }
 
@@ -122,8 +119,9 @@ impl GBufferPass {
         let motion = scene.has_moving_objects();
         let mapped = scene.normal_mapped;
         let pipelines = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, mask: Option<NonZeroU32>| {
-            let make = |alpha_test: bool| pipeline(device, layout, module, mask, (motion, mapped), alpha_test);
-            Pipelines { solid: make(false), alpha_tested: scene.alpha_tested.then(|| make(true)) }
+            Pipelines(MeshPipelines::new(&scene.kinds, |kind| {
+                pipeline(device, layout, module, mask, (motion, mapped), kind)
+            }))
         };
         let multiview = gpu.caps.multiview.then(|| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -207,7 +205,7 @@ fn pipeline(
     module: &wgpu::ShaderModule,
     multiview_mask: Option<NonZeroU32>,
     (motion, mapped): (bool, bool),
-    alpha_test: bool,
+    kind: DrawKind,
 ) -> wgpu::RenderPipeline {
     let targets: Vec<_> = color_targets(motion, mapped)
         .into_iter()
@@ -223,7 +221,7 @@ fn pipeline(
     mesh_pipeline(
         device,
         MeshPipeline {
-            label: if alpha_test { "gbuffer alpha-tested" } else { "gbuffer" },
+            label: if kind.alpha_test { "gbuffer alpha-tested" } else { "gbuffer" },
             layout,
             module,
             vertex: (vertex, &MESH_ATTRIBUTES),
@@ -231,7 +229,8 @@ fn pipeline(
             depth: (DEPTH.format(), wgpu::CompareFunction::Greater),
             fragment: Some((fragment, &targets)),
             multiview_mask,
-            alpha_test,
+            alpha_test: kind.alpha_test,
+            cull: kind.cull,
         },
     )
 }
@@ -249,7 +248,7 @@ impl Pass for GBufferPass {
         } else {
             decl.provide(LIGHTING_NORMALS, NORMALS).note("shading normals left out: no material has a normal texture")
         };
-        if self.multipass.alpha_tested.is_none() {
+        if !self.multipass.0.alpha_tested() {
             decl = decl.note("alpha test left out: no material has holes");
         }
         decl

@@ -9,7 +9,7 @@
 
 use super::{gpu_scene_of, settings_of};
 use crate::gpu::kernel::wgsl;
-use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MESH_ATTRIBUTES};
+use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MeshPipelines, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
 use vrao_ao::plug::{
     shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, Resource, Size,
@@ -29,9 +29,8 @@ pub const DEPTH_LAYER_2: Resource =
 
 /// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
-    pipeline: wgpu::RenderPipeline,
-    /// The alpha-tested materials' (a scene with some only).
-    alpha_tested: Option<wgpu::RenderPipeline>,
+    /// One per kind of draw the scene has.
+    pipelines: MeshPipelines,
     frame_group: wgpu::BindGroup,
     eye_layout: wgpu::BindGroupLayout,
     /// The eye index (0 left, 1 right) each per-eye pass binds.
@@ -68,7 +67,7 @@ impl DepthPeelPass {
             immediate_size: 0,
         });
         let module = shader_module(gpu, "depth peel", &[COMMON, MESH_WGSL, wgsl!("src/passes/peel/peel.wgsl")]);
-        let make = |alpha_test: bool| {
+        let pipelines = MeshPipelines::new(&scene.kinds, |kind| {
             mesh_pipeline(
                 device,
                 MeshPipeline {
@@ -76,16 +75,16 @@ impl DepthPeelPass {
                     layout: &layout,
                     module: &module,
                     vertex: ("vs_peel", &MESH_ATTRIBUTES),
-                    // Reversed Z; two-sided: the back faces are what this pass is for.
+                    // Reversed Z; two-sided where the material is: the back faces are what
+                    // this pass is for (a single-sided surface has none).
                     depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
                     fragment: Some(("fs_peel", &[])),
                     multiview_mask: None,
-                    alpha_test,
+                    alpha_test: kind.alpha_test,
+                    cull: kind.cull,
                 },
             )
-        };
-        let pipeline = make(false);
-        let alpha_tested = scene.alpha_tested.then(|| make(true));
+        });
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("depth peel frame"),
             layout: &frame_layout,
@@ -98,7 +97,7 @@ impl DepthPeelPass {
                 usage: wgpu::BufferUsages::UNIFORM,
             })
         });
-        DepthPeelPass { pipeline, alpha_tested, frame_group, eye_layout, eye_index }
+        DepthPeelPass { pipelines, frame_group, eye_layout, eye_index }
     }
 }
 
@@ -155,7 +154,7 @@ impl Pass for DepthPeelPass {
                 });
                 pass.set_bind_group(0, &self.frame_group, &[]);
                 pass.set_bind_group(2, &eye_group, &[]);
-                gpu_scene.draw_with(&mut pass, &self.pipeline, self.alpha_tested.as_ref());
+                gpu_scene.draw_with(&mut pass, &self.pipelines);
             }
             ctx.timer.end(ctx.encoder, span);
         }

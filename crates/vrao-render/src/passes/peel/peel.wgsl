@@ -22,7 +22,7 @@ override PEEL_GAP: f32 = 1e-3;
 
 struct PeelVertexOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) uv: vec2<f32>,
+    @location(0) uv: vec4<f32>,
     @location(1) vertex_alpha: f32,
 };
 

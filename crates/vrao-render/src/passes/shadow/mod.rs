@@ -19,7 +19,7 @@
 
 use super::{gpu_scene_of, scene_of, settings_of};
 use crate::gpu::kernel::wgsl;
-use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MESH_ATTRIBUTES};
+use crate::gpu::raster::{mesh_pipeline, DrawKind, MeshPipeline, MeshPipelines, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
 use crate::scene::{Light, Scene};
 use crate::settings::Settings;
@@ -292,9 +292,9 @@ impl LightSpace {
 /// The light-space pass: per shadowed light, depth (and with RSM normal and flux).
 pub struct ShadowPass {
     light_space: Arc<LightSpace>,
-    /// [solid, alpha-tested] (the second only in a scene with alpha-tested materials).
-    depth_only: [Option<wgpu::RenderPipeline>; 2],
-    reflective: [Option<wgpu::RenderPipeline>; 2],
+    /// One per kind of draw the scene has, depth only and with the RSM's targets.
+    depth_only: MeshPipelines,
+    reflective: MeshPipelines,
     /// One uniform (`ShadowLight`) and bind group per fitted light.
     light_buffers: Vec<wgpu::Buffer>,
     light_groups: Vec<wgpu::BindGroup>,
@@ -319,9 +319,7 @@ impl ShadowPass {
             &[COMMON, SHADOW_WGSL, MESH_WGSL, wgsl!("src/passes/shadow/shadow_map.wgsl")],
         );
         let variants = |reflective: bool| {
-            [false, true].map(|alpha_test| {
-                (!alpha_test || scene.alpha_tested).then(|| pipeline(device, &layout, &module, reflective, alpha_test))
-            })
+            MeshPipelines::new(&scene.kinds, |kind| pipeline(device, &layout, &module, reflective, kind))
         };
         let depth_only = variants(false);
         let reflective = variants(true);
@@ -356,8 +354,9 @@ fn pipeline(
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     reflective: bool,
-    alpha_test: bool,
+    kind: DrawKind,
 ) -> wgpu::RenderPipeline {
+    let alpha_test = kind.alpha_test;
     let targets = [RSM_NORMAL, RSM_FLUX].map(|r| Some(wgpu::ColorTargetState::from(r.format())));
     // The depth-only map has no fragment stage unless it must discard holes.
     let fragment = match (reflective, alpha_test) {
@@ -377,6 +376,7 @@ fn pipeline(
             fragment,
             multiview_mask: None,
             alpha_test,
+            cull: kind.cull,
         },
     )
 }
@@ -439,10 +439,8 @@ impl Pass for ShadowPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            let [solid, alpha_tested] = if reflective { &self.reflective } else { &self.depth_only };
             pass.set_bind_group(0, group, &[]);
-            let solid = solid.as_ref().expect("the solid pipelines always exist");
-            gpu_scene.draw_with(&mut pass, solid, alpha_tested.as_ref());
+            gpu_scene.draw_with(&mut pass, if reflective { &self.reflective } else { &self.depth_only });
         }
     }
 }

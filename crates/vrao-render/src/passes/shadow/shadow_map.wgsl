@@ -11,7 +11,7 @@ struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     // Normal in light view (+z towards the light).
     @location(0) normal: vec3<f32>,
-    @location(1) uv: vec2<f32>,
+    @location(1) uv: vec4<f32>,
     @location(2) color: vec4<f32>,
 };
 

@@ -15,22 +15,24 @@
 //! What is read: the default scene (else the first; else every root node) with its
 //! TRS and matrix transforms; triangle primitives (indexed u8/u16/u32 or not; strips and
 //! fans become triangle lists; points and lines are skipped with one warning); POSITION,
-//! NORMAL (computed as for OBJ when missing), TEXCOORD_0, TANGENT, COLOR_0 (times the base
-//! colour and alpha); the base-colour factor and texture; `alphaMode` OPAQUE / MASK
-//! (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]); the emissive factor ×
-//! texture × `KHR_materials_emissive_strength`, so emitters become lights as in OBJ when
-//! the file has no punctual light; normal textures (scale) and occlusion textures
-//! (strength); each texture's sampler (wrap, filters, mipmaps) and `KHR_texture_transform`;
+//! NORMAL (computed as for OBJ when missing), TEXCOORD_0 and TEXCOORD_1 (each texture
+//! reads the set its `texCoord`, or its `KHR_texture_transform`'s, names), TANGENT, COLOR_0
+//! (times the base colour and alpha); the base-colour factor and texture; `alphaMode`
+//! OPAQUE / MASK (`alphaCutoff`, default 0.5) / BLEND (see [`AlphaMode::Blend`]);
+//! `doubleSided` (single-sided materials are culled from behind, [`Material::double_sided`]);
+//! the emissive factor × texture × `KHR_materials_emissive_strength`; a file without
+//! punctual lights gets the default sun and, for each emitter, a point light weighted by
+//! its emissive texture's mean ([`obj::sun_and_emitters`]); normal textures (scale) and
+//! occlusion textures (strength); each texture's sampler (wrap, filters, mipmaps) and `KHR_texture_transform`;
 //! `KHR_lights_punctual` directional, point and spot lights (intensities taken as vrao's
 //! units: lux as irradiance, candela as radiant intensity); the first camera's node as
 //! the head pose; translation, rotation and scale animation channels (STEP, LINEAR,
 //! CUBICSPLINE).
 //!
 //! Not read, one warning line per file (`Warnings`): points and lines, skins and morph
-//! targets (drawn in the bind pose), weight animations, texture sets other than 0,
-//! metallic-roughness, light `range`, unknown optional extensions. `doubleSided` is moot
-//! (vrao draws every face from both sides, as for OBJ). Lights hang where their nodes are
-//! at time 0 (they do not move).
+//! targets (drawn in the bind pose), weight animations, texture sets beyond 1,
+//! metallic-roughness, light `range`, unknown optional extensions. Lights hang where their
+//! nodes are at time 0 (they do not move).
 //!
 //! Motion: only meshes below an animated node keep a [`Node`]; static geometry is baked
 //! into world space (f64 transform, then [`Mesh::recentre`], exactly as the OBJ loader
@@ -95,7 +97,8 @@ pub struct Content {
 }
 
 /// A glTF file as a scene: its camera as the head pose (else framed as a bare OBJ), its
-/// punctual lights (else [`obj::default_lights`]), under the default sky.
+/// punctual lights (else the default sun and its emitters, [`obj::sun_and_emitters`]),
+/// under the default sky.
 pub fn load(path: &Path) -> Result<Scene> {
     let content = load_content(path, 0)?;
     let mut scene = Scene {
@@ -110,7 +113,7 @@ pub fn load(path: &Path) -> Result<Scene> {
     scene.lights = if content.lights.is_empty() {
         // Emitters where they are at time 0 (a moving emitter's positions are local).
         let still = scene.at_time(0.0);
-        obj::default_lights(&still.meshes, &still.materials)
+        obj::sun_and_emitters(&still.meshes, &still.materials)
     } else {
         content.lights
     };
@@ -310,12 +313,21 @@ impl Warnings {
 struct LocalPrimitive {
     name: String,
     geometry: Geometry,
-    /// COLOR_0, one per vertex of `geometry`, or empty.
-    colors: Vec<Vec4>,
-    /// TANGENT, one per vertex of `geometry`, or empty.
-    tangents: Vec<Vec4>,
+    /// What follows the vertices of `geometry` besides its own attributes.
+    extras: VertexExtras,
     /// Index into the loaded materials (before the offset).
     material: usize,
+}
+
+/// The vertex attributes [`Geometry`] does not hold, each one per vertex or empty.
+#[derive(Clone, Default)]
+struct VertexExtras {
+    /// TEXCOORD_1.
+    uvs1: Vec<Vec2>,
+    /// COLOR_0.
+    colors: Vec<Vec4>,
+    /// TANGENT.
+    tangents: Vec<Vec4>,
 }
 
 /// A triangle primitive's vertex attributes as read, before normals.
@@ -325,6 +337,8 @@ struct Attributes {
     indices: Vec<u32>,
     /// TEXCOORD_0, one per position, or empty.
     uvs: Vec<Vec2>,
+    /// TEXCOORD_1, one per position, or empty.
+    uvs1: Vec<Vec2>,
     /// COLOR_0, one per position, or empty.
     colors: Vec<Vec4>,
     /// TANGENT, one per position, or empty.
@@ -596,8 +610,9 @@ impl Loader<'_> {
                     let points: Vec<DVec3> = g.positions.iter().map(|p| p.as_dvec3()).collect();
                     let (origin, positions) = Mesh::recentre(&points);
                     Mesh {
-                        colors: primitive.colors.clone(),
-                        tangents: primitive.tangents.clone(),
+                        colors: primitive.extras.colors.clone(),
+                        tangents: primitive.extras.tangents.clone(),
+                        uvs1: primitive.extras.uvs1.clone(),
                         name: primitive.name.clone(),
                         origin,
                         positions,
@@ -631,13 +646,13 @@ impl Loader<'_> {
                 self.warnings.ignored.insert("morph targets (drawn in the bind pose)");
             }
             let attributes = self.read_attributes(&primitive, &what)?;
-            let (geometry, colors, tangents) = self.with_normals(&primitive, attributes, &what)?;
+            let (geometry, extras) = self.with_normals(&primitive, attributes, &what)?;
             let material = self.material(&primitive.material())?;
             let name = match mesh.primitives().len() {
                 1 => mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string),
                 _ => format!("{}.{}", mesh.name().unwrap_or("mesh"), primitive.index()),
             };
-            out.push(LocalPrimitive { name, geometry, colors, tangents, material });
+            out.push(LocalPrimitive { name, geometry, extras, material });
         }
         Ok(out)
     }
@@ -662,17 +677,10 @@ impl Loader<'_> {
         if !indices.len().is_multiple_of(3) {
             return Err(self.error(format!("{what}: {} indices, not a whole number of triangles", indices.len())));
         }
-        let uvs: Vec<Vec2> = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
-            Some(accessor) => {
-                let label = format!("{what} TEXCOORD_0");
-                let uvs = self.read_as::<2>(&accessor, Use::TexCoord, &label)?;
-                self.same_count(uvs.len(), count, &label)?;
-                uvs.into_iter().map(Vec2::from).collect()
-            }
-            None => Vec::new(),
-        };
-        if primitive.get(&::gltf::Semantic::TexCoords(1)).is_some() {
-            self.warnings.ignored.insert("texture coordinate sets other than 0");
+        let uvs = self.read_texcoords(primitive, 0, count, what)?;
+        let uvs1 = self.read_texcoords(primitive, 1, count, what)?;
+        if primitive.get(&::gltf::Semantic::TexCoords(2)).is_some() {
+            self.warnings.ignored.insert("texture coordinate sets beyond 1");
         }
         let colors = match primitive.get(&::gltf::Semantic::Colors(0)) {
             Some(accessor) => self.read_colors(&accessor, &format!("{what} COLOR_0"), count)?,
@@ -687,19 +695,28 @@ impl Loader<'_> {
             }
             None => Vec::new(),
         };
-        Ok(Attributes { positions, indices, uvs, colors, tangents })
+        Ok(Attributes { positions, indices, uvs, uvs1, colors, tangents })
+    }
+
+    /// TEXCOORD_`set`, one per position, or empty when the primitive has none.
+    fn read_texcoords(&self, primitive: &::gltf::Primitive, set: u32, count: usize, what: &str) -> Result<Vec<Vec2>> {
+        let Some(accessor) = primitive.get(&::gltf::Semantic::TexCoords(set)) else { return Ok(Vec::new()) };
+        let label = format!("{what} TEXCOORD_{set}");
+        let uvs = self.read_as::<2>(&accessor, Use::TexCoord, &label)?;
+        self.same_count(uvs.len(), count, &label)?;
+        Ok(uvs.into_iter().map(Vec2::from).collect())
     }
 
     /// The primitive's geometry with its NORMAL (unit, the broken ones repaired), or with
-    /// normals computed at creases; the colours and tangents then follow the vertices
-    /// the creases split.
+    /// normals computed at creases; the second uvs, colours and tangents then follow the
+    /// vertices the creases split.
     fn with_normals(
         &self,
         primitive: &::gltf::Primitive,
         attributes: Attributes,
         what: &str,
-    ) -> Result<(Geometry, Vec<Vec4>, Vec<Vec4>)> {
-        let Attributes { positions, indices, uvs, colors, tangents } = attributes;
+    ) -> Result<(Geometry, VertexExtras)> {
+        let Attributes { positions, indices, uvs, uvs1, colors, tangents } = attributes;
         let count = positions.len();
         match primitive.get(&::gltf::Semantic::Normals) {
             Some(accessor) => {
@@ -709,19 +726,18 @@ impl Loader<'_> {
                 self.same_count(normals.len(), count, &label)?;
                 keep_unit_repair_others(&positions, &mut normals, &indices);
                 let uvs = if uvs.is_empty() { vec![Vec2::ZERO; count] } else { uvs };
-                Ok((Geometry { positions, normals, uvs, indices }, colors, tangents))
+                Ok((Geometry { positions, normals, uvs, indices }, VertexExtras { uvs1, colors, tangents }))
             }
             None => {
                 // Computed normals split vertices at creases: colours and tangents follow.
                 let (geometry, sources) =
                     normals::compute_normals_with_sources(&positions, &uvs, &indices, normals::DEFAULT_CREASE_DEG);
-                let follow = |values: &[Vec4]| -> Vec<Vec4> {
-                    if values.is_empty() {
-                        return Vec::new();
-                    }
-                    sources.iter().map(|&v| values[v as usize]).collect()
+                let extras = VertexExtras {
+                    uvs1: follow(&sources, &uvs1),
+                    colors: follow(&sources, &colors),
+                    tangents: follow(&sources, &tangents),
                 };
-                Ok((geometry, follow(&colors), follow(&tangents)))
+                Ok((geometry, extras))
             }
         }
     }
@@ -785,6 +801,7 @@ impl Loader<'_> {
             occlusion_texture,
             alpha: factor[3].clamp(0.0, 1.0),
             alpha_mode,
+            double_sided: material.double_sided(),
         });
         let i = self.materials.len() - 1;
         self.material_of.insert(material.index(), i);
@@ -841,11 +858,15 @@ impl Loader<'_> {
         material: &str,
     ) -> Result<Texture> {
         let placement = placement.map_err(|m| self.error(m))?;
-        if placement.tex_coord != 0 {
-            self.warnings.ignored.insert("texture coordinate sets other than 0");
-        }
         let mut image = self.image(&texture.source())?;
         image.sampling = sampling_of(&texture.sampler(), placement.transform);
+        image.sampling.tex_coord = match placement.tex_coord {
+            0 | 1 => placement.tex_coord,
+            _ => {
+                self.warnings.ignored.insert("texture coordinate sets beyond 1");
+                0
+            }
+        };
         if !image.sampling.transform.is_finite() {
             return Err(self.error(format!("material '{material}': KHR_texture_transform is not finite")));
         }
@@ -988,6 +1009,14 @@ impl Loader<'_> {
         self.warn_hidden_nodes(&tracks);
         Ok(tracks)
     }
+}
+
+/// `values` (one per source vertex, or empty) for the vertices made from `sources`.
+fn follow<T: Copy>(sources: &[u32], values: &[T]) -> Vec<T> {
+    if values.is_empty() {
+        return Vec::new();
+    }
+    sources.iter().map(|&v| values[v as usize]).collect()
 }
 
 /// The size of each axis of a matrix's linear part (its columns' lengths).
@@ -1134,6 +1163,7 @@ fn sampling_of(sampler: &::gltf::texture::Sampler, transform: glam::Affine2) -> 
         minify,
         mipmaps,
         transform,
+        tex_coord: 0,
     }
 }
 
@@ -1183,7 +1213,7 @@ fn bake_static(primitive: &LocalPrimitive, world: &DMat4, material: usize) -> Me
     let (origin, positions) = Mesh::recentre(&points);
     let mut indices = g.indices.clone();
     let mut normals = g.normals.clone();
-    let mut tangents = primitive.tangents.clone();
+    let mut tangents = primitive.extras.tangents.clone();
     if !identity {
         let linear = DMat3::from_mat4(*world);
         let normal_matrix = linear.inverse().transpose();
@@ -1201,7 +1231,8 @@ fn bake_static(primitive: &LocalPrimitive, world: &DMat4, material: usize) -> Me
         positions,
         normals,
         uvs: g.uvs.clone(),
-        colors: primitive.colors.clone(),
+        uvs1: primitive.extras.uvs1.clone(),
+        colors: primitive.extras.colors.clone(),
         tangents,
         indices,
         material,
