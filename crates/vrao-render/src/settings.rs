@@ -2,9 +2,7 @@
 //! ([`vrao_ao::AoSettings`]) and the renderer's own around them.
 
 use crate::headset::HeadsetProfile;
-use crate::passes::shadow::suggested_rsm_radius;
-use crate::scene::{Scene, RENDER_DEFAULT};
-use std::sync::OnceLock;
+use crate::scene::Scene;
 use vrao_ao::plug::DEFAULT_NEAR;
 use vrao_ao::{AoSettings, Error, Result};
 
@@ -23,16 +21,13 @@ pub const DEFAULT_EXPOSURE: f32 = 1.0;
 /// Reinhard's white point, by default.
 pub const DEFAULT_WHITE_POINT: f32 = 4.0;
 
-/// The occlusion and RSM radii that the default scene ([`RENDER_DEFAULT`], what `vrao
-/// render` draws when no scene is named) suggests: [`Settings::default`] is that
-/// command's setting with no options, so its radii are the default scene's. Built once.
-fn default_scene_radii() -> (f32, f32) {
-    static RADII: OnceLock<(f32, f32)> = OnceLock::new();
-    *RADII.get_or_init(|| {
-        let scene = Scene::load(RENDER_DEFAULT).expect("the default scene is built in");
-        (scene.suggested_ao_radius(), suggested_rsm_radius(&scene))
-    })
-}
+/// The occlusion radius the default scene ([`crate::scene::RENDER_DEFAULT`], what `vrao render` draws
+/// when no scene is named) suggests ([`Scene::suggested_ao_radius`]): [`Settings::default`]
+/// is that command's setting with no options. A constant, so that no default builds a
+/// scene; a test keeps it equal to the scene's suggestion.
+pub const DEFAULT_SCENE_AO_RADIUS: f32 = 0.675_763_25;
+/// The RSM gather radius the default scene suggests ([`crate::passes::shadow::suggested_rsm_radius`]).
+pub const DEFAULT_SCENE_RSM_RADIUS: f32 = 2.111_760_1;
 
 /// How the G-buffer reaches both eye layers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -134,10 +129,10 @@ pub struct ShadowSettings {
 }
 
 /// Shadows on (2048² maps), no RSM; the RSM radius is the default scene's
-/// ([`suggested_rsm_radius`]), as `vrao render` sets it with no options.
+/// ([`crate::passes::shadow::suggested_rsm_radius`]), as `vrao render` sets it with no options.
 impl Default for ShadowSettings {
     fn default() -> Self {
-        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: default_scene_radii().1 }
+        ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: DEFAULT_SCENE_RSM_RADIUS }
     }
 }
 
@@ -169,7 +164,7 @@ impl Default for Settings {
             near: DEFAULT_NEAR,
             exposure: DEFAULT_EXPOSURE,
             white_point: DEFAULT_WHITE_POINT,
-            ao: AoSettings { radius: default_scene_radii().0, ..AoSettings::default() },
+            ao: AoSettings { radius: DEFAULT_SCENE_AO_RADIUS, ..AoSettings::default() },
             shadows: ShadowSettings::default(),
         }
     }
@@ -204,8 +199,19 @@ impl Settings {
 
 #[cfg(test)]
 mod tests {
-
+    use super::*;
+    use crate::passes::shadow::suggested_rsm_radius;
+    use crate::scene::RENDER_DEFAULT;
     use vrao_ao::Foveation;
+
+    #[test]
+    fn the_default_radii_are_the_default_scene_s_suggestions() {
+        let scene = Scene::load(RENDER_DEFAULT).unwrap();
+        assert_eq!(
+            (DEFAULT_SCENE_AO_RADIUS, DEFAULT_SCENE_RSM_RADIUS),
+            (scene.suggested_ao_radius(), suggested_rsm_radius(&scene))
+        );
+    }
 
     #[test]
     fn foveation_maps_keep_full_rate_near_the_axis_and_fall_monotonically_to_their_edge_rate() {
