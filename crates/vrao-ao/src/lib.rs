@@ -35,6 +35,7 @@ pub use ao::{
 };
 pub use error::{Error, Result};
 pub use graph::Plan;
+pub use passes::RightEyeTiles;
 pub use settings::{
     AoSettings, Choice, Denoise, Foveation, GtaoSettings, March, Noise, Quality, Resolution, Technique, Temporal,
     TemporalBlend,

@@ -23,7 +23,7 @@ use vrao_ao::plug::{
     ao_chain, read_layers, read_layers_f32, ChainSettings, FrameMotion, FrameParams, FrameTiming, Gpu, GraphDriver,
     LayeredTarget, MoverBox, Pass, PassTimer, Resource, Submission,
 };
-use vrao_ao::{Error, Eye, Plan, Result, VisibilityMask};
+use vrao_ao::{Error, Eye, Plan, Result, RightEyeTiles, VisibilityMask};
 
 /// Frames the renderer lets the GPU work on at once unless told otherwise.
 pub const DEFAULT_FRAMES_IN_FLIGHT: usize = 2;
@@ -482,6 +482,13 @@ impl Renderer {
     /// The plan of the last frame, if one was rendered.
     pub fn last_plan(&self) -> Option<&Plan> {
         self.driver.last_plan()
+    }
+
+    /// The right eye's tiles the AO chain computed rather than copied from the left eye
+    /// in the last frame, read back from the GPU after it finished (blocking: for
+    /// reports); `None` when the right eye does not reuse the left eye's by tiles.
+    pub fn right_eye_tiles(&self) -> Option<RightEyeTiles> {
+        self.passes.ao_chain.iter().filter_map(|p| p.right_eye_tiles(&self.gpu)).max_by_key(|t| t.frame)
     }
 
     /// The target a previous frame wrote, if that frame needed it (a named output: its

@@ -36,7 +36,7 @@ use crate::gpu::timing::{PassTimer, SpanRecorder};
 use crate::gpu::uniforms::FrameLighting;
 use crate::gpu::Gpu;
 use crate::graph::{Plan, FINAL_AO};
-use crate::passes::{self, ChainSettings, FrameMotion, Pass};
+use crate::passes::{self, ChainSettings, FrameMotion, Pass, RightEyeTiles};
 use crate::settings::{AoSettings, Technique};
 use crate::stereo::{Eye, EyeSide, Fov, HeadPose};
 use glam::{DMat4, DQuat, Mat4};
@@ -286,6 +286,13 @@ impl AoEngine {
     /// The passes the last frame ran and the ones it left out, with the reasons.
     pub fn last_plan(&self) -> Option<&Plan> {
         self.driver.last_plan()
+    }
+
+    /// The right eye's tiles the chain computed rather than copied from the left eye in
+    /// the last frame, read back once the GPU finished it (blocking: for reports);
+    /// `None` when the right eye does not reuse the left eye's by tiles.
+    pub fn right_eye_tiles(&self) -> Option<RightEyeTiles> {
+        self.chain.iter().filter_map(|p| p.right_eye_tiles(&self.gpu)).max_by_key(|t| t.frame)
     }
 
     /// Records one frame of AO into `encoder` from the host's depth (and normals) and

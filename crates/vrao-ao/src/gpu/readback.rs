@@ -20,6 +20,31 @@ fn texel_bytes(format: wgpu::TextureFormat) -> u32 {
     }
 }
 
+/// The bytes of `source` (which has `COPY_SRC`) once the work submitted so far has run.
+pub(crate) fn read_buffer(gpu: &Gpu, source: &wgpu::Buffer) -> Result<Vec<u8>> {
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: source.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
+    gpu.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    gpu.wait_idle()?;
+    rx.recv()
+        .map_err(|_| Error::Gpu("readback callback never ran".into()))?
+        .map_err(|e| Error::Gpu(format!("readback failed: {e}")))?;
+    let bytes = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?.to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
 /// Raw bytes of every layer, rows tightly packed (the 256-byte row padding removed).
 pub fn read_layers(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<u8>>> {
     let bpt = texel_bytes(target.format);

@@ -318,4 +318,30 @@ pub trait Pass: Send + Sync {
     fn kept_target(&self, _r: Resource) -> Option<LayeredTarget> {
         None
     }
+    /// The right eye's tiles the pass computed in the last frame it recorded, read back
+    /// from the GPU (blocking; for reports, never inside a frame): `None` for a pass
+    /// whose right eye does not reuse the left eye's work by tiles.
+    fn right_eye_tiles(&self, _gpu: &Gpu) -> Option<RightEyeTiles> {
+        None
+    }
+}
+
+/// How much of the right eye a pass computed rather than copied from the left eye, in
+/// tiles of 8×8 occlusion pixels: the same count on every machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RightEyeTiles {
+    /// Tiles the right eye's indirect dispatch ran (any pixel the left eye cannot give).
+    pub computed: u32,
+    /// Tiles of the right eye's image.
+    pub total: u32,
+    /// The frame they were counted in (`DeclareContext::frame_index`): of several
+    /// passes, the one that ran last counted the frame's.
+    pub frame: u64,
+}
+
+impl RightEyeTiles {
+    /// `computed` as a share of `total` (0..=1).
+    pub fn share(&self) -> f64 {
+        f64::from(self.computed) / f64::from(self.total.max(1))
+    }
 }

@@ -28,7 +28,8 @@
 // along its inner border with those lookups compiled in (INNER_BAND = true), and the
 // rest of the image without them, where a march that leaves the image stops (open). The
 // lookups' code, even never taken, made every pixel's march about half as slow again.
-// With two views and `stereo_reuse`, the right eye then runs as a third (RIGHT_EYE).
+// With two views and `stereo_reuse`, the right eye then runs as a classifying dispatch
+// and an indirect one over the tiles it listed (RIGHT_EYE).
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 // The light a march gathers besides the visibility (`begin_light`, `gather_sample` for
@@ -43,14 +44,18 @@ const SECTORS: f32 = 32.0;
 // the rest of the image.
 override INNER_BAND: bool = false;
 
-// The right eye's dispatch, after the left eye's: a right-eye pixel whose surface point
+// The right eye's dispatches, after the left eye's: a right-eye pixel whose surface point
 // the left eye sees takes the left eye's raw value there instead of marching. The
 // visibility within r is a property of the surface point, not of the eye, so the eyes
 // then agree by construction, and the right eye marches only what the left eye cannot
 // see (its outer side, disocclusions). Its outputs are bound as one-layer views
 // (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layers of AoRaw and
-// AoGeometry (common.wgsl `left_eye_value`).
+// AoGeometry (common.wgsl `left_eye_value`). First `classify_right_eye` copies every
+// pixel it can and lists the 8×8 tiles (workgroups) holding any pixel that must march;
+// then `main` with LISTED_TILES runs over the listed tiles alone, by an indirect
+// dispatch: a GPU warp with one pixel to march no longer pays for a whole eye of them.
 override RIGHT_EYE: bool = false;
+override LISTED_TILES: bool = false;
 
 // Set when the scene has alpha-tested materials. A depth sample on one (the G-buffer's
 // normal w, gbuffer.wgsl) is a card — a leaf, a grille, a fence — with no depth behind
@@ -85,9 +90,28 @@ struct GtaoParams {
 };
 @group(0) @binding(9) var<uniform> gtao: GtaoParams;
 
-// The occlusion pixel of invocation `id` in this dispatch's part of the image, or none
-// (x = ao_size.x) past its part's width.
-fn dispatch_pixel(id: vec3<u32>) -> vec3<u32> {
+// The right eye's tiles that march, listed by `classify_right_eye`, and the indirect
+// dispatch's workgroup counts over them (x grows by one per tile; y = z = 1).
+struct RightEyeTiles {
+    groups_x: atomic<u32>,
+    groups_y: u32,
+    groups_z: u32,
+    count: atomic<u32>,
+    // Tile t (in workgroups of 8×8 occlusion pixels) packed as t.x | t.y << 16.
+    tiles: array<u32>,
+};
+@group(0) @binding(10) var<storage, read_write> right_tiles: RightEyeTiles;
+
+// Whether any pixel of this workgroup's tile must march (`classify_right_eye`).
+var<workgroup> tile_marches: atomic<u32>;
+
+// The occlusion pixel of invocation `id` (in workgroup `group`, at `local` within it) in
+// this dispatch's part of the image, or none (x = ao_size.x) past its part's width.
+fn dispatch_pixel(id: vec3<u32>, group: vec3<u32>, local: vec3<u32>) -> vec3<u32> {
+    if (RIGHT_EYE && LISTED_TILES) {
+        let packed = right_tiles.tiles[group.x];
+        return vec3<u32>(vec2<u32>(packed & 0xffffu, packed >> 16u) * 8u + local.xy, 1u);
+    }
     if (RIGHT_EYE) {
         return vec3<u32>(id.x, id.y, 1u);
     }
@@ -339,21 +363,59 @@ fn block(march: ptr<function, March>, side: f32, lo: f32, hi: f32, sector_offset
     }
 }
 
+// Right-eye pixel `id`'s value from the left eye where the left eye sees its surface
+// point (stored, true), else false; the sky and hidden tiles are stored as open (true).
+fn reused_from_left_eye(id: vec3<u32>, r: Receiver) -> bool {
+    if (!r.valid) {
+        return true;
+    }
+    let left = left_eye_value(
+        r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
+    );
+    if (left.found) {
+        store_occlusion(id, vec4<f32>(reused_light(left.value), left.value.a));
+    }
+    return left.found;
+}
+
+// The right eye's first dispatch (module notes): every pixel the left eye gives a value
+// is stored, and a tile with any other pixel is listed for the march.
 @compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
-    let id = dispatch_pixel(invocation);
+fn classify_right_eye(
+    @builtin(global_invocation_id) invocation: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    if (local == 0u) {
+        atomicStore(&tile_marches, 0u);
+    }
+    workgroupBarrier();
+    let id = vec3<u32>(invocation.xy, 1u);
+    if (!reused_from_left_eye(id, begin_receiver(id))) {
+        atomicOr(&tile_marches, 1u);
+    }
+    workgroupBarrier();
+    if (local == 0u && atomicLoad(&tile_marches) != 0u) {
+        let i = atomicAdd(&right_tiles.count, 1u);
+        right_tiles.tiles[i] = group.x | (group.y << 16u);
+        atomicAdd(&right_tiles.groups_x, 1u);
+    }
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(
+    @builtin(global_invocation_id) invocation: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+) {
+    let id = dispatch_pixel(invocation, group, local);
     let r = begin_receiver(id);
     if (!r.valid) {
         return;
     }
-    if (RIGHT_EYE) {
-        let left = left_eye_value(
-            r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
-        );
-        if (left.found) {
-            store_occlusion(id, vec4<f32>(reused_light(left.value), left.value.a));
-            return;
-        }
+    // In a listed tile, a pixel the left eye gives a value still copies it.
+    if (RIGHT_EYE && reused_from_left_eye(id, r)) {
+        return;
     }
     let p = r.position;
     let view = normalize(-p);

@@ -5,8 +5,9 @@
 //! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
-use super::{DeclareContext, Pass, RecordContext};
+use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::error::{Error, Result};
+use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
@@ -68,11 +69,15 @@ impl GtaoSettings {
 }
 
 /// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
-/// layers for the right eye's dispatch (gtao.wgsl `left_occlusion`, `left_geometry`),
-/// and at 9 GTAO's own parameters. A march that gathers light (SSDO) binds more after
-/// these ([`March::binds`]).
-pub(crate) const BINDINGS: [Bind; 10] =
-    occlusion::bindings_and([Bind::Own(Slot::Layers), Bind::Own(Slot::Layers), Bind::Own(Slot::Uniform)]);
+/// layers for the right eye's dispatches (gtao.wgsl `left_occlusion`, `left_geometry`),
+/// at 9 GTAO's own parameters and at 10 the right eye's list of tiles to march. A march
+/// that gathers light (SSDO) binds more after these ([`March::binds`]).
+pub(crate) const BINDINGS: [Bind; 11] = occlusion::bindings_and([
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::Uniform),
+    Bind::Own(Slot::ReadWriteBuffer),
+]);
 
 /// gtao.wgsl: the march over slices and sectors that GTAO and SSDO share.
 pub(crate) const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
@@ -136,27 +141,92 @@ pub(crate) fn gtao_inner_band(width: u32) -> u32 {
     (width / 4).next_multiple_of(8).min(width)
 }
 
-/// GTAO's three pipelines (module docs) of one variant: solid occluders only, or with
+/// GTAO's pipelines (module docs) of one variant: solid occluders only, or with
 /// alpha-tested surfaces taken as thin cards (gtao.wgsl `THIN_CARDS`).
 struct Kernels {
     interior: Kernel,
     inner_band: Kernel,
-    right_eye: Kernel,
+    /// The right eye's copy of what the left eye gives, listing the tiles left to march.
+    right_classify: Kernel,
+    /// The right eye's march over the listed tiles (an indirect dispatch).
+    right_listed: Kernel,
 }
 
 impl Kernels {
     fn new(gpu: &Gpu, march: &March, thin_cards: bool) -> Self {
-        let kernel = |band: bool, right: bool| {
+        let kernel = |entry: &str, band: bool, right: bool| {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
                 ("RIGHT_EYE", f64::from(right)),
+                ("LISTED_TILES", f64::from(right)),
                 ("SINGLE_LAYER_OUTPUT", f64::from(right)),
                 ("THIN_CARDS", f64::from(thin_cards)),
             ];
             constants.extend_from_slice(&march.constants);
-            Kernel::with_constants(gpu, march.label, &march.files, "main", march.binds, &constants)
+            Kernel::with_constants(gpu, march.label, &march.files, entry, march.binds, &constants)
         };
-        Kernels { interior: kernel(false, false), inner_band: kernel(true, false), right_eye: kernel(false, true) }
+        Kernels {
+            interior: kernel("main", false, false),
+            inner_band: kernel("main", true, false),
+            right_classify: kernel("classify_right_eye", false, true),
+            right_listed: kernel("main", false, true),
+        }
+    }
+}
+
+/// Bytes of gtao.wgsl's `RightEyeTiles` before its list: the indirect arguments (x, y,
+/// z) and the count.
+const TILES_HEADER_BYTES: u64 = 16;
+
+/// The right eye's list of tiles to march, kept from frame to frame (module docs).
+struct RightEyeList {
+    /// `RightEyeTiles`: the header, then room for every tile of the frame.
+    list: Option<wgpu::Buffer>,
+    /// What each frame's header starts from (no tiles, y = z = 1), and what binds in the
+    /// list's place for the dispatches that do not use it.
+    header: wgpu::Buffer,
+    /// The indirect arguments copied out of the list (a buffer may not be both a
+    /// dispatch's read-write binding and its arguments).
+    args: wgpu::Buffer,
+    /// Tiles of the right eye's image in the last frame that listed them (0: none did).
+    total: u32,
+    /// That frame's index.
+    frame: u64,
+}
+
+impl RightEyeList {
+    fn new(gpu: &Gpu) -> Self {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        let header = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("gtao right-eye tiles header"),
+            // The header and one tile: what a binding of the list holds at least.
+            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0]),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        });
+        let args = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gtao right-eye tiles args"),
+            size: 12,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        RightEyeList { list: None, header, args, total: 0, frame: 0 }
+    }
+
+    /// The list with room for `tiles` (a clone of the one buffer: wgpu buffers are
+    /// shared handles).
+    fn with_room(&mut self, device: &wgpu::Device, tiles: u32) -> wgpu::Buffer {
+        let size = TILES_HEADER_BYTES + 4 * u64::from(tiles);
+        if self.list.as_ref().is_none_or(|b| b.size() < size) {
+            self.list = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gtao right-eye tiles"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        self.total = tiles;
+        self.list.clone().expect("made above")
     }
 }
 
@@ -169,6 +239,7 @@ pub(crate) struct GtaoPass {
     /// Built on the first frame of a scene with alpha-tested materials.
     thin_cards: std::sync::OnceLock<Kernels>,
     params: wgpu::Buffer,
+    right_eye: std::sync::Mutex<RightEyeList>,
 }
 
 impl GtaoPass {
@@ -200,7 +271,8 @@ impl GtaoPass {
         if march.eager {
             let _ = solid.set(Kernels::new(gpu, &march, false));
         }
-        GtaoPass { march, solid, thin_cards: std::sync::OnceLock::new(), params }
+        let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu));
+        GtaoPass { march, solid, thin_cards: std::sync::OnceLock::new(), params, right_eye }
     }
 }
 
@@ -247,9 +319,12 @@ impl Pass for GtaoPass {
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
-        // Bindings 7 and 8 are unused before the right eye's dispatch: the normals stand in.
+        // Bindings 7, 8 and 10 are unused before the right eye's dispatches: the normals
+        // and the list's header stand in.
         let normals = ctx.view(super::inputs::NORMALS);
-        let resources = ctx.bind(self.march.binds, &[normals.clone(), normals, self.params.as_entire_binding()]);
+        let header = self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).header.clone();
+        let stand_ins = [normals.clone(), normals, self.params.as_entire_binding(), header.as_entire_binding()];
+        let resources = ctx.bind(self.march.binds, &stand_ins);
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
         kernels.interior.dispatch(
@@ -266,20 +341,47 @@ impl Pass for GtaoPass {
             &resources,
             (band, height, marched_layers),
         );
-        if !reuse {
-            return;
+        if reuse {
+            self.record_right_eye(ctx, kernels, (width, height));
+        } else {
+            self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).total = 0;
         }
-        // The right eye writes layer 1 of the occlusion and its geometry alone, and reads
-        // the left eye's layer 0 of both.
+    }
+
+    fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
+        let right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
+        if right_eye.total == 0 {
+            return None;
+        }
+        let args = crate::gpu::readback::read_buffer(gpu, &right_eye.args).ok()?;
+        let computed = u32::from_le_bytes(args.get(..4)?.try_into().ok()?);
+        Some(RightEyeTiles { computed, total: right_eye.total, frame: right_eye.frame })
+    }
+}
+
+impl GtaoPass {
+    /// The right eye after the left: a dispatch that copies what the left eye gives and
+    /// lists the tiles left to march, then an indirect dispatch over those tiles. Both
+    /// write layer 1 of the occlusion and its geometry alone and read the left eye's
+    /// layer 0 of both.
+    fn record_right_eye(&self, ctx: &mut RecordContext, kernels: &Kernels, (width, height): (u32, u32)) {
+        let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
+        let list = right_eye.with_room(&ctx.gpu.device, width.div_ceil(TILE) * height.div_ceil(TILE));
+        right_eye.frame = ctx.setup.frame_index;
+        ctx.encoder.copy_buffer_to_buffer(&right_eye.header, 0, &list, 0, TILES_HEADER_BYTES);
         let (ao_right, geometry_right) = (ctx.layer_view(AO_RAW, 1), ctx.layer_view(AO_GEOMETRY, 1));
         let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
         let view = wgpu::BindingResource::TextureView;
         let resources = ctx.bind_overriding(
             self.march.binds,
-            &[view(&ao_left), view(&geometry_left), self.params.as_entire_binding()],
+            &[view(&ao_left), view(&geometry_left), self.params.as_entire_binding(), list.as_entire_binding()],
             &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))],
         );
-        kernels.right_eye.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (width, height, 1));
+        let device = &ctx.gpu.device;
+        let visibility = ctx.visibility.bind_group();
+        kernels.right_classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
+        ctx.encoder.copy_buffer_to_buffer(&list, 0, &right_eye.args, 0, 12);
+        kernels.right_listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, &right_eye.args, 0);
     }
 }
 

@@ -14,15 +14,16 @@
 use super::gtao::{GtaoPass, March, BINDINGS as GTAO_BINDINGS, GTAO_WGSL};
 use super::inputs::DIRECT_LIGHT;
 use super::occlusion::OCCLUSION_WGSL;
-use super::{DeclareContext, Pass, RecordContext};
+use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::gpu::kernel::{wgsl, Bind, COMMON, IRRADIANCE, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::Technique;
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
-/// GTAO's bindings and, at 10, the packed direct light (ssdo.wgsl `direct_layers`).
-const BINDINGS: [Bind; 11] = {
-    let mut all = [Bind::Read(DIRECT_LIGHT); 11];
+/// GTAO's bindings and, at 11, the packed direct light (ssdo.wgsl `direct_layers`).
+const BINDINGS: [Bind; 12] = {
+    let mut all = [Bind::Read(DIRECT_LIGHT); 12];
     let mut i = 0;
     while i < GTAO_BINDINGS.len() {
         all[i] = GTAO_BINDINGS[i];
@@ -52,6 +53,8 @@ pub(crate) struct SsdoPass {
     plain: GtaoPass,
     /// The march with the bounce (`ssdo-bounce` only).
     bounce: Option<GtaoPass>,
+    /// Whether the last frame recorded ran the bounce's march.
+    last_recorded_bounce: AtomicBool,
 }
 
 impl SsdoPass {
@@ -79,7 +82,12 @@ impl SsdoPass {
             )
         };
         let bounce = (technique == Technique::SsdoBounce).then(|| march(Technique::SsdoBounce.name(), true));
-        SsdoPass { technique, plain: march(Technique::Ssdo.name(), false), bounce }
+        SsdoPass {
+            technique,
+            plain: march(Technique::Ssdo.name(), false),
+            bounce,
+            last_recorded_bounce: AtomicBool::new(false),
+        }
     }
 
     /// The march this frame runs.
@@ -118,6 +126,15 @@ impl Pass for SsdoPass {
     }
 
     fn record(&self, ctx: &mut RecordContext) {
-        self.march(ctx.setup).record(ctx)
+        let march = self.march(ctx.setup);
+        self.last_recorded_bounce.store(self.bounce.as_ref().is_some_and(|b| std::ptr::eq(b, march)), Relaxed);
+        march.record(ctx)
+    }
+
+    fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
+        match (self.last_recorded_bounce.load(Relaxed), &self.bounce) {
+            (true, Some(bounce)) => bounce.right_eye_tiles(gpu),
+            _ => self.plain.right_eye_tiles(gpu),
+        }
     }
 }
