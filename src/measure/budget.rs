@@ -97,6 +97,27 @@ pub struct BudgetReport {
     pub cpu_encode: Vec<SpanSummary>,
     /// Left eye, right eye and stereo frame against their budgets.
     pub verdicts: Vec<Verdict>,
+    /// The right eye's tiles (8×8 occlusion pixels) the stereo frame's AO chain computed
+    /// rather than copied from the left eye, read back from its indirect dispatch (the
+    /// same on every machine); absent when the right eye does not reuse the left's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub right_eye_tiles: Vec<RightEyeTilesReport>,
+}
+
+/// [`BudgetReport::right_eye_tiles`]: the right eye's computed tiles against all its tiles
+/// (the left eye computes every one of its own).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RightEyeTilesReport {
+    /// The pass.
+    pub pass: String,
+    /// Tiles (workgroups of 64 items) the right eye computed in the last stereo frame.
+    pub computed: u32,
+    /// The items it computed (pixels; quads of 2×2 for the upsampling); it copied the rest.
+    pub items: u32,
+    /// Tiles of the right eye's occlusion image.
+    pub total: u32,
+    /// `computed / total`: the right eye's share of the left eye's work, in tiles.
+    pub share: f64,
 }
 
 impl BudgetReport {
@@ -150,6 +171,17 @@ impl BudgetReport {
                 cell(&encode[2])
             );
         }
+        for t in &self.right_eye_tiles {
+            let _ = writeln!(
+                s,
+                "right eye, {}: {} of {} tiles computed ({:.1} %: {} items), the rest copied from the left eye",
+                t.pass,
+                t.computed,
+                t.total,
+                100.0 * t.share,
+                t.items
+            );
+        }
         for v in &self.verdicts {
             let _ = writeln!(
                 s,
@@ -196,11 +228,25 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
     let mut times: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut encode: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut pass_order: Vec<String> = Vec::new();
+    let mut right_eye_tiles = Vec::new();
     for round in 0..how.warmup + how.frames {
         for (k, v) in views.iter().enumerate() {
             let report = renderer.render_and_wait(v, &[how.output])?;
             if round < how.warmup {
                 continue;
+            }
+            if k == 0 {
+                right_eye_tiles = renderer
+                    .right_eye_tiles()
+                    .iter()
+                    .map(|t| RightEyeTilesReport {
+                        pass: t.pass.to_string(),
+                        computed: t.computed,
+                        items: t.items,
+                        total: t.total,
+                        share: t.share(),
+                    })
+                    .collect();
             }
             let t = pass_times(&report, how.timing);
             for (name, _) in &t {
@@ -250,6 +296,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         passes,
         cpu_encode,
         verdicts,
+        right_eye_tiles,
     })
 }
 

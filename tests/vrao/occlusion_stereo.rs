@@ -211,3 +211,37 @@ fn marches_past_the_inner_border_continue_in_the_other_eye() {
     assert!(occluded > 0.05, "nothing occluded at the inner borders: the case cannot tell");
     assert!(bias.abs() < 0.015, "the eye at its inner border disagrees with the other eye by {bias:+.4}");
 }
+
+/// The right eye computes only what the left eye cannot give it (gtao.wgsl
+/// `classify_right_eye`, upsample.wgsl's FALLBACK): counted from the indirect dispatches'
+/// arguments, the work is a share of the right eye's tiles; two eyes at one place with
+/// one field of view need none of it; independent eyes report nothing.
+#[test]
+fn the_right_eye_computes_only_the_tiles_the_left_eye_cannot_give() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:furnished").unwrap();
+    let head = scene.head.pose_at(0.0);
+    let counts = |s: &vrao_render::Settings| {
+        let mut renderer = vrao_render::Renderer::new(gpu.clone(), &scene, s).unwrap();
+        renderer.render_and_wait(&s.profile.eyes(&head, s.near).eyes, &[AO_FULL]).unwrap();
+        renderer.right_eye_tiles()
+    };
+    let mut a = ao(Technique::Gtao, 24, 0.3);
+    a.resolution = vrao_ao::Resolution::Half;
+    let stereo = settings(192, 216, a.clone());
+    let tiles = counts(&stereo);
+    let passes: Vec<&str> = tiles.iter().map(|t| t.pass).collect();
+    assert_eq!(passes, ["gtao", "upsample"], "{tiles:?}");
+    for t in &tiles {
+        eprintln!("{}: {} of {} tiles, {} items", t.pass, t.computed, t.total, t.items);
+        assert_eq!(t.computed, t.items.div_ceil(64), "64 listed items to a dispatched tile: {t:?}");
+        assert!(t.computed > 0 && t.share() < 0.35, "the right eye computes a part of its tiles: {t:?}");
+    }
+    let mut one_place = stereo.clone();
+    (one_place.profile.ipd, one_place.profile.fov_right) = (0.0, one_place.profile.fov_left);
+    for t in counts(&one_place) {
+        assert!(t.items * 100 <= t.total * 64, "eyes at one place with one view share all but a few items: {t:?}");
+    }
+    a.stereo_reuse = false;
+    assert!(counts(&settings(192, 216, a)).is_empty(), "independent eyes list nothing");
+}

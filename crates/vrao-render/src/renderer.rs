@@ -484,11 +484,12 @@ impl Renderer {
         self.driver.last_plan()
     }
 
-    /// The right eye's tiles the AO chain computed rather than copied from the left eye
-    /// in the last frame, read back from the GPU after it finished (blocking: for
-    /// reports); `None` when the right eye does not reuse the left eye's by tiles.
-    pub fn right_eye_tiles(&self) -> Option<RightEyeTiles> {
-        self.passes.ao_chain.iter().filter_map(|p| p.right_eye_tiles(&self.gpu)).max_by_key(|t| t.frame)
+    /// Per pass, the right eye's tiles the AO chain computed rather than copied from the
+    /// left eye in the last frame, read back from the GPU after it finished (blocking:
+    /// for reports); empty when the right eye reuses nothing.
+    pub fn right_eye_tiles(&self) -> Vec<RightEyeTiles> {
+        let passes: Vec<&dyn Pass> = self.passes.ao_chain.iter().map(|p| p.as_ref()).collect();
+        RightEyeTiles::latest(&passes, &self.gpu)
     }
 
     /// The target a previous frame wrote, if that frame needed it (a named output: its

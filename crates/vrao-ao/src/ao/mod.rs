@@ -288,11 +288,12 @@ impl AoEngine {
         self.driver.last_plan()
     }
 
-    /// The right eye's tiles the chain computed rather than copied from the left eye in
-    /// the last frame, read back once the GPU finished it (blocking: for reports);
-    /// `None` when the right eye does not reuse the left eye's by tiles.
-    pub fn right_eye_tiles(&self) -> Option<RightEyeTiles> {
-        self.chain.iter().filter_map(|p| p.right_eye_tiles(&self.gpu)).max_by_key(|t| t.frame)
+    /// Per pass, the right eye's tiles the chain computed rather than copied from the
+    /// left eye in the last frame, read back once the GPU finished it (blocking: for
+    /// reports); empty when the right eye reuses nothing.
+    pub fn right_eye_tiles(&self) -> Vec<RightEyeTiles> {
+        let passes: Vec<&dyn Pass> = self.chain.iter().map(|p| p.as_ref()).collect();
+        RightEyeTiles::latest(&passes, &self.gpu)
     }
 
     /// Records one frame of AO into `encoder` from the host's depth (and normals) and

@@ -12,6 +12,7 @@ pub(crate) mod gtao;
 pub(crate) mod hbao;
 pub(crate) mod inputs;
 pub(crate) mod occlusion;
+mod right_eye_list;
 pub(crate) mod ssao;
 pub(crate) mod ssdo;
 pub(crate) mod temporal;
@@ -320,26 +321,39 @@ pub trait Pass: Send + Sync {
     }
     /// The right eye's tiles the pass computed in the last frame it recorded, read back
     /// from the GPU (blocking; for reports, never inside a frame): `None` for a pass
-    /// whose right eye does not reuse the left eye's work by tiles.
+    /// whose right eye does not reuse the left eye's work through a list.
     fn right_eye_tiles(&self, _gpu: &Gpu) -> Option<RightEyeTiles> {
         None
     }
 }
 
 /// How much of the right eye a pass computed rather than copied from the left eye, in
-/// tiles of 8×8 occlusion pixels: the same count on every machine.
+/// tiles (workgroups of 64 occlusion pixels): the same count on every machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RightEyeTiles {
-    /// Tiles the right eye's indirect dispatch ran (any pixel the left eye cannot give).
+    /// The pass (its span's name).
+    pub pass: &'static str,
+    /// Tiles the right eye's indirect dispatch ran: its listed items (the pixels, or
+    /// quads of 2×2, the left eye cannot give), 64 to a tile.
     pub computed: u32,
-    /// Tiles of the right eye's image.
+    /// Tiles of the right eye's image (8×8 items each): what the left eye dispatches.
     pub total: u32,
+    /// The items the right eye computed (pixels, or quads for the upsampling).
+    pub items: u32,
     /// The frame they were counted in (`DeclareContext::frame_index`): of several
     /// passes, the one that ran last counted the frame's.
     pub frame: u64,
 }
 
 impl RightEyeTiles {
+    /// The counts of the passes in `passes` that ran in the latest frame any of them
+    /// counted (older counts are of passes a later frame left out).
+    pub fn latest(passes: &[&dyn Pass], gpu: &Gpu) -> Vec<RightEyeTiles> {
+        let all: Vec<RightEyeTiles> = passes.iter().filter_map(|p| p.right_eye_tiles(gpu)).collect();
+        let latest = all.iter().map(|t| t.frame).max();
+        all.into_iter().filter(|t| Some(t.frame) == latest).collect()
+    }
+
     /// `computed` as a share of `total` (0..=1).
     pub fn share(&self) -> f64 {
         f64::from(self.computed) / f64::from(self.total.max(1))

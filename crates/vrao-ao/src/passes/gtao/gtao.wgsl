@@ -29,7 +29,7 @@
 // rest of the image without them, where a march that leaves the image stops (open). The
 // lookups' code, even never taken, made every pixel's march about half as slow again.
 // With two views and `stereo_reuse`, the right eye then runs as a classifying dispatch
-// and an indirect one over the tiles it listed (RIGHT_EYE).
+// and an indirect one over the pixels it listed (RIGHT_EYE).
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 // The light a march gathers besides the visibility (`begin_light`, `gather_sample` for
@@ -51,9 +51,11 @@ override INNER_BAND: bool = false;
 // see (its outer side, disocclusions). Its outputs are bound as one-layer views
 // (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layers of AoRaw and
 // AoGeometry (common.wgsl `left_eye_value`). First `classify_right_eye` copies every
-// pixel it can and lists the 8×8 tiles (workgroups) holding any pixel that must march;
-// then `main` with LISTED_TILES runs over the listed tiles alone, by an indirect
-// dispatch: a GPU warp with one pixel to march no longer pays for a whole eye of them.
+// pixel it can and lists the pixels that must march; then `main` with LISTED_TILES runs
+// over the listed pixels alone, 64 to a workgroup (a tile), by an indirect dispatch: the
+// right eye pays for the pixels the left eye cannot give, not for every warp that holds
+// one of them (listing 8×8 tiles of the image instead dispatched every tile a silhouette
+// crosses: a quarter of Sibenik's right eye).
 override RIGHT_EYE: bool = false;
 override LISTED_TILES: bool = false;
 
@@ -90,27 +92,28 @@ struct GtaoParams {
 };
 @group(0) @binding(9) var<uniform> gtao: GtaoParams;
 
-// The right eye's tiles that march, listed by `classify_right_eye`, and the indirect
-// dispatch's workgroup counts over them (x grows by one per tile; y = z = 1).
-struct RightEyeTiles {
+// The right eye's pixels that march, listed by `classify_right_eye`, and the indirect
+// dispatch's workgroup counts over them (x grows by one per 64 pixels; y = z = 1).
+struct RightEyeList {
     groups_x: atomic<u32>,
     groups_y: u32,
     groups_z: u32,
     count: atomic<u32>,
-    // Tile t (in workgroups of 8×8 occlusion pixels) packed as t.x | t.y << 16.
-    tiles: array<u32>,
+    // Occlusion pixel p packed as p.x | p.y << 16.
+    pixels: array<u32>,
 };
-@group(0) @binding(10) var<storage, read_write> right_tiles: RightEyeTiles;
-
-// Whether any pixel of this workgroup's tile must march (`classify_right_eye`).
-var<workgroup> tile_marches: atomic<u32>;
+@group(0) @binding(10) var<storage, read_write> right_list: RightEyeList;
 
 // The occlusion pixel of invocation `id` (in workgroup `group`, at `local` within it) in
 // this dispatch's part of the image, or none (x = ao_size.x) past its part's width.
-fn dispatch_pixel(id: vec3<u32>, group: vec3<u32>, local: vec3<u32>) -> vec3<u32> {
+fn dispatch_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
     if (RIGHT_EYE && LISTED_TILES) {
-        let packed = right_tiles.tiles[group.x];
-        return vec3<u32>(vec2<u32>(packed & 0xffffu, packed >> 16u) * 8u + local.xy, 1u);
+        let i = group.x * 64u + local;
+        if (i >= atomicLoad(&right_list.count)) {
+            return vec3<u32>(ao.ao_size.x, 0u, 1u);
+        }
+        let packed = right_list.pixels[i];
+        return vec3<u32>(packed & 0xffffu, packed >> 16u, 1u);
     }
     if (RIGHT_EYE) {
         return vec3<u32>(id.x, id.y, 1u);
@@ -379,26 +382,17 @@ fn reused_from_left_eye(id: vec3<u32>, r: Receiver) -> bool {
 }
 
 // The right eye's first dispatch (module notes): every pixel the left eye gives a value
-// is stored, and a tile with any other pixel is listed for the march.
+// is stored, and every other is listed for the march.
 @compute @workgroup_size(8, 8, 1)
-fn classify_right_eye(
-    @builtin(global_invocation_id) invocation: vec3<u32>,
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-) {
-    if (local == 0u) {
-        atomicStore(&tile_marches, 0u);
-    }
-    workgroupBarrier();
+fn classify_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let id = vec3<u32>(invocation.xy, 1u);
-    if (!reused_from_left_eye(id, begin_receiver(id))) {
-        atomicOr(&tile_marches, 1u);
+    if (reused_from_left_eye(id, begin_receiver(id))) {
+        return;
     }
-    workgroupBarrier();
-    if (local == 0u && atomicLoad(&tile_marches) != 0u) {
-        let i = atomicAdd(&right_tiles.count, 1u);
-        right_tiles.tiles[i] = group.x | (group.y << 16u);
-        atomicAdd(&right_tiles.groups_x, 1u);
+    let i = atomicAdd(&right_list.count, 1u);
+    right_list.pixels[i] = id.x | (id.y << 16u);
+    if (i % 64u == 0u) {
+        atomicAdd(&right_list.groups_x, 1u);
     }
 }
 
@@ -406,17 +400,14 @@ fn classify_right_eye(
 fn main(
     @builtin(global_invocation_id) invocation: vec3<u32>,
     @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
 ) {
     let id = dispatch_pixel(invocation, group, local);
     let r = begin_receiver(id);
     if (!r.valid) {
         return;
     }
-    // In a listed tile, a pixel the left eye gives a value still copies it.
-    if (RIGHT_EYE && reused_from_left_eye(id, r)) {
-        return;
-    }
+    // The first right-eye dispatch stored what the left eye gives; these march.
     let p = r.position;
     let view = normalize(-p);
     let distance = -p.z;

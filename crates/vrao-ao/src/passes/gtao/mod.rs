@@ -5,6 +5,7 @@
 //! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
+use super::right_eye_list::RightEyeList;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::error::{Error, Result};
 use crate::gpu::kernel::TILE;
@@ -70,7 +71,7 @@ impl GtaoSettings {
 
 /// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
 /// layers for the right eye's dispatches (gtao.wgsl `left_occlusion`, `left_geometry`),
-/// at 9 GTAO's own parameters and at 10 the right eye's list of tiles to march. A march
+/// at 9 GTAO's own parameters and at 10 the right eye's list of pixels to march. A march
 /// that gathers light (SSDO) binds more after these ([`March::binds`]).
 pub(crate) const BINDINGS: [Bind; 11] = occlusion::bindings_and([
     Bind::Own(Slot::Layers),
@@ -146,9 +147,9 @@ pub(crate) fn gtao_inner_band(width: u32) -> u32 {
 struct Kernels {
     interior: Kernel,
     inner_band: Kernel,
-    /// The right eye's copy of what the left eye gives, listing the tiles left to march.
+    /// The right eye's copy of what the left eye gives, listing the pixels left to march.
     right_classify: Kernel,
-    /// The right eye's march over the listed tiles (an indirect dispatch).
+    /// The right eye's march over the listed pixels (an indirect dispatch).
     right_listed: Kernel,
 }
 
@@ -171,62 +172,6 @@ impl Kernels {
             right_classify: kernel("classify_right_eye", false, true),
             right_listed: kernel("main", false, true),
         }
-    }
-}
-
-/// Bytes of gtao.wgsl's `RightEyeTiles` before its list: the indirect arguments (x, y,
-/// z) and the count.
-const TILES_HEADER_BYTES: u64 = 16;
-
-/// The right eye's list of tiles to march, kept from frame to frame (module docs).
-struct RightEyeList {
-    /// `RightEyeTiles`: the header, then room for every tile of the frame.
-    list: Option<wgpu::Buffer>,
-    /// What each frame's header starts from (no tiles, y = z = 1), and what binds in the
-    /// list's place for the dispatches that do not use it.
-    header: wgpu::Buffer,
-    /// The indirect arguments copied out of the list (a buffer may not be both a
-    /// dispatch's read-write binding and its arguments).
-    args: wgpu::Buffer,
-    /// Tiles of the right eye's image in the last frame that listed them (0: none did).
-    total: u32,
-    /// That frame's index.
-    frame: u64,
-}
-
-impl RightEyeList {
-    fn new(gpu: &Gpu) -> Self {
-        use wgpu::util::DeviceExt;
-        let device = &gpu.device;
-        let header = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("gtao right-eye tiles header"),
-            // The header and one tile: what a binding of the list holds at least.
-            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0]),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        });
-        let args = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("gtao right-eye tiles args"),
-            size: 12,
-            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        RightEyeList { list: None, header, args, total: 0, frame: 0 }
-    }
-
-    /// The list with room for `tiles` (a clone of the one buffer: wgpu buffers are
-    /// shared handles).
-    fn with_room(&mut self, device: &wgpu::Device, tiles: u32) -> wgpu::Buffer {
-        let size = TILES_HEADER_BYTES + 4 * u64::from(tiles);
-        if self.list.as_ref().is_none_or(|b| b.size() < size) {
-            self.list = Some(device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("gtao right-eye tiles"),
-                size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
-        self.total = tiles;
-        self.list.clone().expect("made above")
     }
 }
 
@@ -271,7 +216,7 @@ impl GtaoPass {
         if march.eager {
             let _ = solid.set(Kernels::new(gpu, &march, false));
         }
-        let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu));
+        let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu, "gtao right-eye pixels"));
         GtaoPass { march, solid, thin_cards: std::sync::OnceLock::new(), params, right_eye }
     }
 }
@@ -322,7 +267,7 @@ impl Pass for GtaoPass {
         // Bindings 7, 8 and 10 are unused before the right eye's dispatches: the normals
         // and the list's header stand in.
         let normals = ctx.view(super::inputs::NORMALS);
-        let header = self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).header.clone();
+        let header = self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).stand_in();
         let stand_ins = [normals.clone(), normals, self.params.as_entire_binding(), header.as_entire_binding()];
         let resources = ctx.bind(self.march.binds, &stand_ins);
         let reuse = ao.stereo_reuse && layers == 2;
@@ -344,31 +289,25 @@ impl Pass for GtaoPass {
         if reuse {
             self.record_right_eye(ctx, kernels, (width, height));
         } else {
-            self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).total = 0;
+            self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).skip();
         }
     }
 
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
         let right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-        if right_eye.total == 0 {
-            return None;
-        }
-        let args = crate::gpu::readback::read_buffer(gpu, &right_eye.args).ok()?;
-        let computed = u32::from_le_bytes(args.get(..4)?.try_into().ok()?);
-        Some(RightEyeTiles { computed, total: right_eye.total, frame: right_eye.frame })
+        right_eye.read(gpu, self.march.label)
     }
 }
 
 impl GtaoPass {
     /// The right eye after the left: a dispatch that copies what the left eye gives and
-    /// lists the tiles left to march, then an indirect dispatch over those tiles. Both
+    /// lists the pixels left to march, then an indirect dispatch over those, 64 to a
+    /// workgroup. Both
     /// write layer 1 of the occlusion and its geometry alone and read the left eye's
     /// layer 0 of both.
     fn record_right_eye(&self, ctx: &mut RecordContext, kernels: &Kernels, (width, height): (u32, u32)) {
         let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-        let list = right_eye.with_room(&ctx.gpu.device, width.div_ceil(TILE) * height.div_ceil(TILE));
-        right_eye.frame = ctx.setup.frame_index;
-        ctx.encoder.copy_buffer_to_buffer(&right_eye.header, 0, &list, 0, TILES_HEADER_BYTES);
+        let list = right_eye.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
         let (ao_right, geometry_right) = (ctx.layer_view(AO_RAW, 1), ctx.layer_view(AO_GEOMETRY, 1));
         let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
         let view = wgpu::BindingResource::TextureView;
@@ -380,8 +319,8 @@ impl GtaoPass {
         let device = &ctx.gpu.device;
         let visibility = ctx.visibility.bind_group();
         kernels.right_classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
-        ctx.encoder.copy_buffer_to_buffer(&list, 0, &right_eye.args, 0, 12);
-        kernels.right_listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, &right_eye.args, 0);
+        right_eye.take_arguments(ctx.encoder, &list);
+        kernels.right_listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, right_eye.arguments(), 0);
     }
 }
 

@@ -6,12 +6,15 @@
 
 use super::inputs::{DEPTH, NORMALS};
 use super::occlusion::AO_GEOMETRY;
-use super::{DeclareContext, Pass, RecordContext};
+use super::right_eye_list::RightEyeList;
+use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
+use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
 use crate::passes::ChainSettings;
 use crate::settings::Technique;
+use std::sync::Mutex;
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
@@ -25,9 +28,10 @@ pub const AO_FULL: Resource = Resource::storage("ao-full", Size::Full, wgpu::Tex
 pub const JOINT_UPSAMPLE_WGSL: Shader = wgsl!("src/passes/upsample/joint_upsample.wgsl");
 
 /// upsample.wgsl's bindings: frame, AO parameters, the G-buffer and the occlusion's
-/// geometry, the occlusion in, the full-resolution AO out and, at 7, its left-eye layer
-/// for the right eye's dispatch (the geometry stands in before it).
-const BINDINGS: [Bind; 8] = [
+/// geometry, the occlusion in, the full-resolution AO out and, for the right eye's
+/// dispatches, at 7 its left-eye layer (the geometry stands in before them) and at 8 the
+/// list of quads the left eye does not fully see.
+const BINDINGS: [Bind; 9] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::Read(DEPTH),
@@ -36,6 +40,7 @@ const BINDINGS: [Bind; 8] = [
     Bind::Read(OCCLUSION),
     Bind::Write(AO_FULL),
     Bind::Own(Slot::Layers),
+    Bind::Own(Slot::ReadWriteBuffer),
 ];
 
 /// Whether the right eye takes the left eye's upsampled AO instead of upsampling its own
@@ -55,18 +60,27 @@ pub fn reuses_left_eye_upsample(settings: &ChainSettings, layers: u32) -> bool {
 /// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
 pub(crate) struct UpsamplePass {
     kernel: Kernel,
-    /// The right eye's dispatch that reuses the left eye's result.
+    /// The right eye's dispatch that reuses the left eye's result and lists the quads
+    /// it cannot, and the indirect one over those.
     right_eye: Kernel,
+    right_eye_fallback: Kernel,
+    fallback: Mutex<RightEyeList>,
 }
 
 impl UpsamplePass {
     /// Builds the pass's pipelines.
     pub(crate) fn new(gpu: &Gpu) -> Self {
         let files = [COMMON, VISIBILITY, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/upsample/upsample.wgsl")];
-        let kernel = |label: &str, right_eye: bool| {
-            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &[("RIGHT_EYE", f64::from(right_eye))])
+        let kernel = |label: &str, right_eye: bool, fallback: bool| {
+            let constants = [("RIGHT_EYE", f64::from(right_eye)), ("FALLBACK", f64::from(fallback))];
+            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
         };
-        UpsamplePass { kernel: kernel("upsample", false), right_eye: kernel("upsample right eye", true) }
+        UpsamplePass {
+            kernel: kernel("upsample", false, false),
+            right_eye: kernel("upsample right eye", true, false),
+            right_eye_fallback: kernel("upsample right eye fallback", true, true),
+            fallback: Mutex::new(RightEyeList::new(gpu, "upsample right-eye quads")),
+        }
     }
 }
 
@@ -82,7 +96,9 @@ impl Pass for UpsamplePass {
     }
 
     fn record(&self, ctx: &mut RecordContext) {
-        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY)]);
+        let mut fallback = self.fallback.lock().unwrap_or_else(|p| p.into_inner());
+        let stand_in = fallback.stand_in();
+        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), stand_in.as_entire_binding()]);
         // One invocation per quad of 2×2 full-res pixels (upsample.wgsl): both eyes
         // alike, or the left eye and then the right eye reusing it.
         let (w, h, layers) = ctx.quad_extent();
@@ -95,15 +111,27 @@ impl Pass for UpsamplePass {
             &resources,
             (w, h, if reuse { 1 } else { layers }),
         );
-        if reuse {
-            // The right eye writes layer 1 alone and reads the left eye's layer 0.
-            let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));
-            let resources = ctx.bind_overriding(
-                &BINDINGS,
-                &[wgpu::BindingResource::TextureView(&left)],
-                &[(AO_FULL, wgpu::BindingResource::TextureView(&right))],
-            );
-            self.right_eye.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (w, h, 1));
+        if !reuse {
+            fallback.skip();
+            return;
         }
+        // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists the
+        // quads it could not reuse.
+        let list = fallback.start(ctx, w * h, w.div_ceil(TILE) * h.div_ceil(TILE));
+        let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));
+        let resources = ctx.bind_overriding(
+            &BINDINGS,
+            &[wgpu::BindingResource::TextureView(&left), list.as_entire_binding()],
+            &[(AO_FULL, wgpu::BindingResource::TextureView(&right))],
+        );
+        let device = &ctx.gpu.device;
+        let visibility = ctx.visibility.bind_group();
+        self.right_eye.dispatch(device, ctx.encoder, visibility, &resources, (w, h, 1));
+        fallback.take_arguments(ctx.encoder, &list);
+        self.right_eye_fallback.dispatch_indirect(device, ctx.encoder, visibility, &resources, fallback.arguments(), 0);
+    }
+
+    fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
+        self.fallback.lock().unwrap_or_else(|p| p.into_inner()).read(gpu, NAME)
     }
 }

@@ -1,12 +1,13 @@
 // The upsample pass: writes AoFull from half-resolution occlusion (joint_upsample.wgsl),
 // one invocation per quad of 2×2 full-res pixels, i.e. per low-res sample. Frames do
-// not need it (the composite upsamples inline); debug images and tests do. With the
-// stereo reuse (RIGHT_EYE) the right eye runs as a dispatch of its own after the left
-// (joint_upsample.wgsl `right_eye_quad`), its output bound as a one-layer view beside
-// the left eye's layer. It computes the right eye's own upsample at every quad, where
-// the composite does so only at the quads the left eye does not fully see (its
-// FALLBACK dispatch): the values are the same, this pass costs more than with
-// independent eyes (docs/records/2026-11-29/measurements-in-code.md, upsample-right-eye).
+// not need it (the composite upsamples inline); the AO engine, debug images and tests do.
+// With the stereo reuse (RIGHT_EYE) the right eye runs after the left, its output bound
+// as a one-layer view beside the left eye's layer: a dispatch takes the left eye's final
+// AO wherever the left eye sees the same point (joint_upsample.wgsl `left_eye_quad`) and
+// lists the quads it does not fully see; a second, indirect dispatch (FALLBACK) over
+// just those upsamples them (`right_eye_quad`), as the composite does. Computing the
+// right eye's own upsample at every quad made this pass cost more than with independent
+// eyes (docs/records/2026-11-29/measurements-in-code.md, upsample-right-eye).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
@@ -19,10 +20,35 @@
 @group(0) @binding(7) var left_final: texture_2d_array<f32>;
 
 override RIGHT_EYE: bool = false;
+override FALLBACK: bool = false;
+
+// The right-eye quads the left eye does not fully see, and the indirect dispatch's
+// workgroup counts over them (x grows by one per 64 quads listed; y = z = 1).
+struct FallbackQuads {
+    groups_x: atomic<u32>,
+    groups_y: u32,
+    groups_z: u32,
+    count: atomic<u32>,
+    // Quad b packed as b.x | b.y << 16.
+    quads: array<u32>,
+};
+@group(0) @binding(8) var<storage, read_write> fallback: FallbackQuads;
 
 @compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
+fn main(
+    @builtin(global_invocation_id) invocation: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    var id = invocation;
+    if (FALLBACK) {
+        let i = group.x * 64u + local;
+        if (i >= atomicLoad(&fallback.count)) {
+            return;
+        }
+        let packed = fallback.quads[i];
+        id = vec3<u32>(packed & 0xffffu, packed >> 16u, 0u);
+    } else if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
     // The layer read, and the layer of the bound output written.
@@ -41,7 +67,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
     var values: array<vec4<f32>, 4>;
-    if (RIGHT_EYE) {
+    if (RIGHT_EYE && !FALLBACK) {
+        let left = left_eye_quad(depth_layers, left_final, quad);
+        if (!all(left.found)) {
+            let i = atomicAdd(&fallback.count, 1u);
+            fallback.quads[i] = id.x | (id.y << 16u);
+            if (i % 64u == 0u) {
+                atomicAdd(&fallback.groups_x, 1u);
+            }
+            return;
+        }
+        values = left.values;
+    } else if (RIGHT_EYE) {
         values = right_eye_quad(depth_layers, left_final, geometry_low, occlusion_low, quad, vec2<i32>(id.xy), eye.tangents);
     } else {
         values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents);

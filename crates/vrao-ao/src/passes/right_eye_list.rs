@@ -1,0 +1,96 @@
+//! The right eye's list of work the left eye cannot give it, shared by the passes that
+//! reuse the left eye's results: a first right-eye dispatch copies what it can and
+//! appends the rest (pixels or quads) to a list on the GPU, whose header holds the
+//! workgroup counts of a second, indirect dispatch over just those (64 to a workgroup).
+//! Nothing is read back in a frame; a report reads the last frame's counts.
+
+use super::{RecordContext, RightEyeTiles};
+use crate::gpu::Gpu;
+use wgpu::util::DeviceExt;
+
+/// Bytes of the list's header: the indirect arguments (x, y, z), then the count (WGSL:
+/// `groups_x: atomic<u32>, groups_y, groups_z, count: atomic<u32>`, then the items).
+const HEADER_BYTES: u64 = 16;
+
+/// One pass's list, kept from frame to frame.
+pub(crate) struct RightEyeList {
+    label: &'static str,
+    /// The header, then room for every item of the frame.
+    list: Option<wgpu::Buffer>,
+    /// What each frame's header starts from (no items, y = z = 1) and one item: what
+    /// binds in the list's place for the dispatches that do not use it.
+    header: wgpu::Buffer,
+    /// The header copied out of the list (a buffer may not be both a dispatch's
+    /// read-write binding and its arguments).
+    arguments: wgpu::Buffer,
+    /// Tiles (8×8 workgroups) of the right eye's image in the last frame that listed
+    /// items (0: none did), and that frame's index.
+    tiles: u32,
+    frame: u64,
+}
+
+impl RightEyeList {
+    pub(crate) fn new(gpu: &Gpu, label: &'static str) -> Self {
+        let device = &gpu.device;
+        let header = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0]),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        });
+        let arguments = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: HEADER_BYTES,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        RightEyeList { label, list: None, header, arguments, tiles: 0, frame: 0 }
+    }
+
+    /// What binds in the list's place before the right eye's dispatches.
+    pub(crate) fn stand_in(&self) -> wgpu::Buffer {
+        self.header.clone()
+    }
+
+    /// Starts this frame's list, with room for `items`, over an image of `tiles` tiles;
+    /// returns it (a clone of the one buffer: wgpu buffers are shared handles).
+    pub(crate) fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
+        let size = HEADER_BYTES + 4 * u64::from(items.max(1));
+        if self.list.as_ref().is_none_or(|b| b.size() < size) {
+            self.list = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(self.label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        (self.tiles, self.frame) = (tiles, ctx.setup.frame_index);
+        let list = self.list.clone().expect("made above");
+        ctx.encoder.copy_buffer_to_buffer(&self.header, 0, &list, 0, HEADER_BYTES);
+        list
+    }
+
+    /// Copies the list's header (filled by the first dispatch) out for the indirect one.
+    pub(crate) fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder, list: &wgpu::Buffer) {
+        encoder.copy_buffer_to_buffer(list, 0, &self.arguments, 0, HEADER_BYTES);
+    }
+
+    /// The indirect dispatch's arguments (at offset 0).
+    pub(crate) fn arguments(&self) -> &wgpu::Buffer {
+        &self.arguments
+    }
+
+    /// Marks a frame that did not reuse the left eye: nothing to report.
+    pub(crate) fn skip(&mut self) {
+        self.tiles = 0;
+    }
+
+    /// The last listing frame's counts, read back (blocking).
+    pub(crate) fn read(&self, gpu: &Gpu, pass: &'static str) -> Option<RightEyeTiles> {
+        if self.tiles == 0 {
+            return None;
+        }
+        let header = crate::gpu::readback::read_buffer(gpu, &self.arguments).ok()?;
+        let word = |k: usize| Some(u32::from_le_bytes(header.get(4 * k..4 * k + 4)?.try_into().ok()?));
+        Some(RightEyeTiles { pass, computed: word(0)?, items: word(3)?, total: self.tiles, frame: self.frame })
+    }
+}
