@@ -35,6 +35,9 @@ pub enum Error {
     /// The run finished but did not fit its frame budget (`vrao budget`).
     #[error("{0}")]
     OverBudget(String),
+    /// The peer `vrao peer` compares with failed, hung, or wrote what it should not.
+    #[error("the peer: {0}")]
+    Peer(String),
 }
 
 impl Error {
@@ -76,7 +79,7 @@ impl Error {
         match self {
             // An output that cannot be written is the path the user gave (or its disk).
             Error::Engine(E::Input { .. } | E::Device(_)) | Error::Unavailable(_) | Error::Output { .. } => EXIT_INPUT,
-            Error::Engine(E::Gpu(_) | E::Plan(_)) => 1,
+            Error::Engine(E::Gpu(_) | E::Plan(_)) | Error::Peer(_) => 1,
             Error::OverBudget(_) => EXIT_OVER_BUDGET,
             Error::Engine(E::Interrupted) => EXIT_INTERRUPTED,
         }

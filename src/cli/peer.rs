@@ -94,6 +94,7 @@ pub(crate) fn run(backend: BackendChoice, args: PeerArgs) -> Result<()> {
         },
         out: args.out.clone(),
         gltf: work.join("scene.glb"),
+        interrupt: super::interrupt_on_signals("ending the peer", || {}),
     };
     check_options(&options)?;
     let scene = Scene::load(&args.scene)?;

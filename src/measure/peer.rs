@@ -67,6 +67,8 @@ pub struct PeerOptions {
     pub out: PathBuf,
     /// The scene as glTF for the peer ([`scene_for_peer`] written by the caller).
     pub gltf: PathBuf,
+    /// Set when vrao is interrupted: a running peer is then ended.
+    pub interrupt: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 /// Which program a row measured.
@@ -490,53 +492,116 @@ fn run_peer_round(
     let log_path = dir.join("peer.log");
     let log = std::fs::File::create(&log_path).map_err(|e| output(&log_path, e))?;
     let log2 = log.try_clone().map_err(|e| output(&log_path, e))?;
-    let status = std::process::Command::new(&options.peer)
+    let child = std::process::Command::new(&options.peer)
         .arg(&job_path)
         .stdout(log)
         .stderr(log2)
-        .status()
+        .spawn()
         .map_err(|e| Error::input(format!("running the peer {}: {e}", options.peer.display())))?;
+    let status = wait_for_peer(child, &options.interrupt)?;
     if !status.success() {
         let text = std::fs::read_to_string(&log_path).unwrap_or_default();
         let tail: Vec<&str> = text.lines().rev().take(3).collect();
-        return Err(Error::gpu(format!(
-            "the peer failed ({status}): {}",
+        return Err(Error::Peer(format!(
+            "it failed ({status}): {}",
             tail.into_iter().rev().collect::<Vec<_>>().join(" / ")
         )));
     }
     let file_path = dir.join("peer.json");
-    let text = std::fs::read_to_string(&file_path).map_err(|e| output(&file_path, e))?;
+    let text = vrao_render::files::read_regular_file_to_string(&file_path, vrao_render::files::MAX_TEXT_BYTES)?;
     let file: PeerFile =
-        serde_json::from_str(&text).map_err(|e| Error::gpu(format!("the peer's peer.json does not read: {e}")))?;
+        serde_json::from_str(&text).map_err(|e| Error::Peer(format!("its peer.json does not read: {e}")))?;
     if (file.width, file.height) != (width, height) || file.presets.len() != options.presets.len() {
-        return Err(Error::gpu("the peer's peer.json does not match its job"));
+        return Err(Error::Peer("its peer.json does not match its job (size or presets)".into()));
     }
     if timing == Timing::Pipelined && !file.timestamps {
         return Err(Error::device("the peer's device has no timestamp queries; use serial timing"));
     }
+    Ok((file.adapter.clone(), presets_of(&file, dir, (width, height), timing)?))
+}
+
+/// Each preset's name and its eyes' times and AO, as the peer's `file` lists them (its
+/// AO files in `dir`), checked like any input: two eyes, left then right, finite times,
+/// AO files of the right size and range.
+fn presets_of(file: &PeerFile, dir: &Path, (width, height): (u32, u32), timing: Timing) -> Result<PeerRound> {
     let mut round = Vec::new();
     for preset in &file.presets {
+        if preset.eyes.len() != EYE_NAMES.len() {
+            return Err(Error::Peer(format!(
+                "its preset '{}' lists {} eyes (want {})",
+                preset.name,
+                preset.eyes.len(),
+                EYE_NAMES.join(" and ")
+            )));
+        }
         let mut per_eye = Vec::new();
-        for (k, eye) in preset.eyes.iter().enumerate() {
-            if eye.eye != EYE_NAMES[k] {
-                return Err(Error::gpu(format!("the peer's eye {k} is '{}'", eye.eye)));
+        for (eye, name) in preset.eyes.iter().zip(EYE_NAMES) {
+            if eye.eye != name {
+                return Err(Error::Peer(format!("its eye '{}' stands where '{name}' belongs", eye.eye)));
             }
             let ms = match timing {
                 Timing::Serial => eye.median_wall_ms,
                 Timing::Pipelined => eye.median_gpu_ms,
-            }
-            .unwrap_or(f64::NAN);
-            let ao_path = dir.join(&eye.ao);
-            let bytes = std::fs::read(&ao_path).map_err(|e| output(&ao_path, e))?;
-            if bytes.len() != width as usize * height as usize * 4 {
-                return Err(Error::gpu(format!("{} is not {width}x{height} f32 values", ao_path.display())));
-            }
-            let ao: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-            per_eye.push((ms, ao));
+            };
+            let ms = ms.filter(|ms| ms.is_finite() && *ms >= 0.0).ok_or_else(|| {
+                Error::Peer(format!("its {name} eye's time {ms:?} ms is missing, negative or not finite"))
+            })?;
+            per_eye.push((ms, read_peer_ao(dir, &eye.ao, (width, height))?));
         }
         round.push((preset.name.clone(), per_eye));
     }
-    Ok((file.adapter, round))
+    Ok(round)
+}
+
+/// The longest a peer may run for one round before vrao ends it.
+const PEER_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(30 * 60);
+
+/// Waits for the peer, ending it when it outlives [`PEER_TIMEOUT`] or when vrao is
+/// interrupted (Ctrl-C), so that no peer is left running after vrao.
+fn wait_for_peer(
+    mut child: std::process::Child,
+    interrupt: &std::sync::atomic::AtomicBool,
+) -> Result<std::process::ExitStatus> {
+    let started = std::time::Instant::now();
+    loop {
+        match child.try_wait() {
+            Ok(Some(status)) => return Ok(status),
+            Ok(None) => {}
+            Err(e) => return Err(Error::Peer(format!("waiting for it: {e}"))),
+        }
+        let interrupted = interrupt.load(std::sync::atomic::Ordering::Relaxed);
+        if interrupted || started.elapsed() > PEER_TIMEOUT {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(if interrupted {
+                vrao_ao::Error::Interrupted.into()
+            } else {
+                Error::Peer(format!("it ran past {} minutes and was ended", PEER_TIMEOUT.as_secs() / 60))
+            });
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
+/// One eye's AO from the peer: `name` is a plain file name in its work folder `dir` (no
+/// other folder, no link out), a regular file of exactly `width` × `height` f32 values,
+/// each finite and within 0..=1.
+fn read_peer_ao(dir: &Path, name: &str, (width, height): (u32, u32)) -> Result<Vec<f32>> {
+    let plain = Path::new(name).file_name().is_some_and(|f| f == std::ffi::OsStr::new(name));
+    if !plain || name.starts_with('.') {
+        return Err(Error::Peer(format!("its AO file '{name}' is not a plain file name in its work folder")));
+    }
+    let path = dir.join(name);
+    let expected = u64::from(width) * u64::from(height) * 4;
+    let bytes = vrao_render::files::read_regular_file(&path, expected)?;
+    if bytes.len() as u64 != expected {
+        return Err(Error::Peer(format!("{} is not {width}x{height} f32 values", path.display())));
+    }
+    let ao: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    if let Some(bad) = ao.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+        return Err(Error::Peer(format!("{} holds {bad}, not an AO within 0..=1", path.display())));
+    }
+    Ok(ao)
 }
 
 /// `side_by_side_left.png`: the left eye's AO from Bevy (High, or the last preset run),
@@ -698,6 +763,89 @@ pub fn write_outputs(out: &Path, run: &PeerRun) -> Result<String> {
 mod tests {
     use super::*;
 
+    /// A work folder with `files` (name, bytes) in it.
+    fn work_dir(name: &str, files: &[(&str, Vec<u8>)]) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("vrao-peer-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, bytes) in files {
+            std::fs::write(dir.join(file), bytes).unwrap();
+        }
+        dir
+    }
+
+    fn f32_bytes(values: &[f32]) -> Vec<u8> {
+        values.iter().flat_map(|v| v.to_le_bytes()).collect()
+    }
+
+    #[test]
+    fn a_peer_s_files_are_input_checked_like_any_other() {
+        let good = f32_bytes(&[0.5; 6]);
+        let dir = work_dir(
+            "files",
+            &[
+                ("ao.f32", good.clone()),
+                ("nan.f32", f32_bytes(&[0.5, 0.5, 0.5, f32::NAN, 0.5, 0.5])),
+                ("short.f32", f32_bytes(&[0.5; 5])),
+            ],
+        );
+        assert_eq!(read_peer_ao(&dir, "ao.f32", (3, 2)).unwrap(), vec![0.5; 6]);
+        for (name, says) in [
+            ("../ao.f32", "plain file name"),
+            ("/etc/passwd", "plain file name"),
+            ("nan.f32", "not an AO"),
+            ("short.f32", "not 3x2"),
+            ("missing.f32", "missing.f32"),
+        ] {
+            let e = read_peer_ao(&dir, name, (3, 2)).unwrap_err();
+            assert!(e.to_string().contains(says), "{name}: {e}");
+        }
+        // A file larger than the image is refused by its size before it is read.
+        std::fs::write(dir.join("big.f32"), vec![0u8; 1 << 20]).unwrap();
+        assert!(read_peer_ao(&dir, "big.f32", (3, 2)).is_err());
+    }
+
+    #[test]
+    fn a_peer_listing_other_than_two_eyes_or_bad_times_is_refused_not_a_panic() {
+        let dir = work_dir("eyes", &[("ao.f32", f32_bytes(&[1.0; 4]))]);
+        let eye = |name: &str, ms: Option<f64>| PeerEye {
+            eye: name.into(),
+            ao: "ao.f32".into(),
+            median_wall_ms: ms,
+            median_gpu_ms: ms,
+        };
+        let file = |eyes: Vec<PeerEye>| PeerFile {
+            adapter: "peer".into(),
+            width: 2,
+            height: 2,
+            timestamps: true,
+            presets: vec![PeerPreset { name: "high".into(), eyes }],
+        };
+        let ok = presets_of(&file(vec![eye("left", Some(1.0)), eye("right", Some(2.0))]), &dir, (2, 2), Timing::Serial);
+        assert_eq!(ok.unwrap()[0].1.iter().map(|(ms, _)| *ms).collect::<Vec<_>>(), [1.0, 2.0]);
+        for (eyes, says) in [
+            (vec![eye("left", Some(1.0))], "lists 1 eyes"),
+            (vec![eye("left", Some(1.0)), eye("right", Some(1.0)), eye("right", Some(1.0))], "lists 3 eyes"),
+            (vec![eye("right", Some(1.0)), eye("left", Some(1.0))], "stands where 'left' belongs"),
+            (vec![eye("left", Some(f64::NAN)), eye("right", Some(1.0))], "not finite"),
+            (vec![eye("left", Some(-1.0)), eye("right", Some(1.0))], "negative"),
+            (vec![eye("left", None), eye("right", Some(1.0))], "missing"),
+        ] {
+            let e = presets_of(&file(eyes), &dir, (2, 2), Timing::Serial).unwrap_err();
+            assert!(e.to_string().starts_with("the peer: ") && e.to_string().contains(says), "{e}");
+            assert_eq!(e.exit_code(), 1, "a peer's failure is the peer's, not a GPU error");
+        }
+    }
+
+    #[test]
+    fn a_peer_is_ended_when_vrao_is_interrupted() {
+        let child = std::process::Command::new("sleep").arg("30").spawn().unwrap();
+        let interrupt = std::sync::atomic::AtomicBool::new(true);
+        let started = std::time::Instant::now();
+        let e = wait_for_peer(child, &interrupt).unwrap_err();
+        assert!(matches!(e, Error::Engine(vrao_ao::Error::Interrupted)), "{e}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(10), "the peer was ended, not waited for");
+    }
+
     fn options() -> PeerOptions {
         PeerOptions {
             backend: BackendChoice::Auto,
@@ -712,6 +860,7 @@ mod tests {
             reference: ReferenceOptions { rays_per_pixel: 16, stride: 8, cache: PathBuf::from("/tmp") },
             out: PathBuf::from("/tmp"),
             gltf: PathBuf::from("/nonexistent/scene.glb"),
+            interrupt: Default::default(),
         }
     }
 

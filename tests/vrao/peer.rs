@@ -38,6 +38,7 @@ fn bevy_on_an_open_plane_reads_its_known_084_against_a_reference_of_1() {
         reference: ReferenceOptions { rays_per_pixel: 64, stride: 4, cache: out.join("cache") },
         out: out.clone(),
         gltf,
+        interrupt: Default::default(),
     };
     let run = run_peer(&scene, &base, &options).unwrap();
     let bevy = run.rows.iter().find(|r| r.family == Family::Bevy).unwrap();
