@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 /// A triangle mesh in world space.
+#[derive(Clone)]
 pub(crate) struct HostMesh {
     /// Vertex positions (m).
     pub positions: Vec<Vec3>,
@@ -50,6 +51,12 @@ pub(crate) fn demo_geometry() -> Vec<HostMesh> {
         cuboid(Vec3::new(0.4, 0.08, -2.2), Vec3::new(1.2, 0.16, 0.6)),
         cuboid(Vec3::new(1.1, 0.9, -3.2), Vec3::new(0.25, 1.8, 0.25)),
     ]
+}
+
+/// A hand-sized box (18 × 5 × 10 cm) held 10 cm above the step, as a hand or controller
+/// hovers over a table.
+pub(crate) fn demo_hand() -> HostMesh {
+    cuboid(Vec3::new(0.4, 0.285, -2.2), Vec3::new(0.18, 0.05, 0.1))
 }
 
 /// Where the demo's eyes are: 1.5 m up, 1 m in front of the room, looking at its corner;
@@ -140,6 +147,9 @@ struct Out { @builtin(position) clip: vec4<f32>, @location(0) normal: vec3<f32> 
 /// The host's depth prepass: its own pipeline, vertex buffers and targets.
 pub(crate) struct DepthPrepass {
     pipeline: wgpu::RenderPipeline,
+    /// The hand's draw, when it is marked in the stencil: its pipeline (stencil set to
+    /// [`HAND_STENCIL`]) and its indices, after the scene's.
+    hand: Option<(wgpu::RenderPipeline, std::ops::Range<u32>)>,
     layout: wgpu::BindGroupLayout,
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
@@ -182,10 +192,11 @@ impl DepthPrepass {
         let (vertices, indices) = merge_meshes(meshes);
         let (vertex_buffer, index_buffer) = upload_geometry(device, &vertices, &indices);
         let layout = view_layout(device);
-        let pipeline = prepass_pipeline(device, &layout, depth_kind, samples);
+        let pipeline = prepass_pipeline(device, &layout, depth_kind, depth_kind.format(), samples, None);
         let target = |label, format| layered_target(device, label, format, (width, height), layers, samples);
         DepthPrepass {
             pipeline,
+            hand: None,
             layout,
             vertices: vertex_buffer,
             indices: index_buffer,
@@ -194,6 +205,31 @@ impl DepthPrepass {
             depth: target("host depth", depth_kind.format()),
             normals: target("host normals", wgpu::TextureFormat::Rgba16Float),
         }
+    }
+
+    /// [`DepthPrepass::new`] with `hand` drawn last and marked in the stencil of a
+    /// `Depth24PlusStencil8` depth buffer ([`HAND_STENCIL`]), as hosts mark hands and UI.
+    pub(crate) fn with_marked_hand(
+        device: &wgpu::Device,
+        meshes: &[HostMesh],
+        hand: &HostMesh,
+        depth_kind: HostDepth,
+        size: (u32, u32),
+    ) -> Self {
+        let format = wgpu::TextureFormat::Depth24PlusStencil8;
+        let mut all: Vec<&HostMesh> = meshes.iter().collect();
+        all.push(hand);
+        let owned: Vec<HostMesh> = all.into_iter().cloned().collect();
+        let mut prepass = Self::new(device, &owned, depth_kind, size);
+        let scene_indices: u32 = meshes.iter().map(|m| m.indices.len() as u32).sum();
+        let mark = wgpu::StencilFaceState { pass_op: wgpu::StencilOperation::Replace, ..Default::default() };
+        let stencil = wgpu::StencilState { front: mark, back: mark, read_mask: 0xff, write_mask: 0xff };
+        prepass.pipeline = prepass_pipeline(device, &prepass.layout, depth_kind, format, 1, None);
+        let hand_pipeline = prepass_pipeline(device, &prepass.layout, depth_kind, format, 1, Some(stencil));
+        prepass.hand = Some((hand_pipeline, scene_indices..prepass.index_count));
+        prepass.index_count = scene_indices;
+        prepass.depth = layered_target(device, "host depth", format, size, 2, 1);
+        prepass
     }
 
     /// Draws every eye's depth and normals: one render pass per layer.
@@ -244,7 +280,10 @@ impl DepthPrepass {
                         load: wgpu::LoadOp::Clear(self.depth_kind.clear()),
                         store: wgpu::StoreOp::Store,
                     }),
-                    stencil_ops: None,
+                    stencil_ops: self
+                        .hand
+                        .as_ref()
+                        .map(|_| wgpu::Operations { load: wgpu::LoadOp::Clear(0), store: wgpu::StoreOp::Store }),
                 }),
                 timestamp_writes: None,
                 occlusion_query_set: None,
@@ -255,6 +294,11 @@ impl DepthPrepass {
             pass.set_vertex_buffer(0, self.vertices.slice(..));
             pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..self.index_count, 0, 0..1);
+            if let Some((pipeline, indices)) = &self.hand {
+                pass.set_pipeline(pipeline);
+                pass.set_stencil_reference(HAND_STENCIL);
+                pass.draw_indexed(indices.clone(), 0, 0..1);
+            }
         }
     }
 }
@@ -303,13 +347,18 @@ fn view_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// The prepass pipeline: back-face culled meshes into `depth_kind`'s depth and
-/// `Rgba16Float` view-space normals.
+/// The stencil value the host's hand is drawn with (the engine's `cast_none` bit).
+pub(crate) const HAND_STENCIL: u32 = 1;
+
+/// The prepass pipeline: back-face culled meshes into `depth_kind`'s depth (of `format`)
+/// and `Rgba16Float` view-space normals, writing `stencil` when given.
 fn prepass_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     depth_kind: HostDepth,
+    format: wgpu::TextureFormat,
     samples: u32,
+    stencil: Option<wgpu::StencilState>,
 ) -> wgpu::RenderPipeline {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("host prepass"),
@@ -335,10 +384,10 @@ fn prepass_pipeline(
         },
         primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
-            format: depth_kind.format(),
+            format,
             depth_write_enabled: Some(true),
             depth_compare: Some(depth_kind.compare()),
-            stencil: Default::default(),
+            stencil: stencil.unwrap_or_default(),
             bias: Default::default(),
         }),
         multisample: wgpu::MultisampleState { count: samples, ..Default::default() },

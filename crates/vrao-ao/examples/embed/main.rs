@@ -7,13 +7,17 @@
 //! eyes, beside the AO, as `OUT/embed_ambient_left.png` and `OUT/embed_ambient_right.png`.
 //!
 //! ```text
-//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--msaa N] [--time] [--time-setup]
+//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--msaa N] [--hand MODE] [--time] [--time-setup]
 //! ```
 //!
 //! The command line is handled like vrao's: `--help` prints the usage and exits 0; an
 //! unknown option or a second folder is one line naming it and exit 2, as is a folder
 //! that cannot be written (named); any other failure exits 1.
 //!
+//! `--hand left-out` adds a hand-sized box over the step, marked in the stencil of a
+//! `Depth24PlusStencil8` depth buffer and handed to the engine as casting no AO (the step
+//! below it keeps its AO, as without the hand); `--hand casting` draws it like the rest
+//! (its halo on the step, for comparison).
 //! `--standard-depth` stores depth as `Depth24Plus` with a finite far plane instead of
 //! reversed-Z `Depth32Float`; `--no-normals` lets the engine rebuild normals from depth;
 //! `--msaa 4` draws the prepass with 4 samples per pixel (2 and 8 too), as a forward
@@ -26,10 +30,11 @@
 
 mod host;
 
-use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
+use host::{demo_eyes, demo_geometry, demo_hand, DepthPrepass, HostDepth, HAND_STENCIL};
 use vrao_ao::AoOutputFormat;
 use vrao_ao::{
-    AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostNormals, NormalEncoding, NormalSpace, ViewMatrices,
+    AoConfig, AoEngine, AoFrame, DepthConvention, HostExclusion, HostLight, HostNormals, NormalEncoding, NormalSpace,
+    ViewMatrices,
 };
 use vrao_ao::{AoSettings, Technique};
 
@@ -48,6 +53,7 @@ Options:
   --standard-depth  Depth24Plus with a finite far plane instead of reversed-Z Depth32Float
   --no-normals      let the engine rebuild normals from depth
   --msaa N          draw the prepass with N samples per pixel (1, 2, 4 or 8; default 1)
+  --hand MODE       add a hand over the step: left-out (marked in the stencil, casting no AO) or casting
   --time            also time whole frames at 1080x1200 per eye (host prepass alone and with the engine)
   --time-setup      also time AoEngine::new, the first frame, a resize and the frame after it
   -h, --help        print this and exit
@@ -61,8 +67,29 @@ struct Args {
     no_normals: bool,
     /// Samples per pixel of the host's prepass.
     msaa: u32,
+    /// A hand over the step, left out of the AO through the stencil, or casting it.
+    hand: Option<Hand>,
     time: bool,
     time_setup: bool,
+}
+
+/// How `--hand` draws the host's hand.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Hand {
+    /// Marked in the stencil and handed to the engine as casting no AO.
+    LeftOut,
+    /// Drawn like the rest: it casts AO onto the step below it.
+    Casting,
+}
+
+/// The value of `--hand`.
+fn parse_hand(value: Option<&str>) -> Result<Hand, String> {
+    match value {
+        Some("left-out") => Ok(Hand::LeftOut),
+        Some("casting") => Ok(Hand::Casting),
+        Some(other) => Err(format!("--hand {other}: the hand is 'left-out' or 'casting'")),
+        None => Err("--hand needs 'left-out' or 'casting'".into()),
+    }
 }
 
 /// What [`parse_args`] found instead of a run.
@@ -108,8 +135,15 @@ fn parse_msaa(value: Option<&str>) -> Result<u32, String> {
 
 /// The command line (without the program's name), or the one line that refuses it.
 fn parse_args(args: &[String]) -> Result<Parsed, String> {
-    let mut parsed =
-        Args { out: "out".into(), standard_depth: false, no_normals: false, msaa: 1, time: false, time_setup: false };
+    let mut parsed = Args {
+        out: "out".into(),
+        standard_depth: false,
+        no_normals: false,
+        msaa: 1,
+        hand: None,
+        time: false,
+        time_setup: false,
+    };
     let mut out: Option<&str> = None;
     let mut args = args.iter();
     while let Some(arg) = args.next() {
@@ -117,6 +151,8 @@ fn parse_args(args: &[String]) -> Result<Parsed, String> {
             "-h" | "--help" => return Ok(Parsed::Help),
             "--msaa" => parsed.msaa = parse_msaa(args.next().map(String::as_str))?,
             flag if flag.starts_with("--msaa=") => parsed.msaa = parse_msaa(flag.strip_prefix("--msaa="))?,
+            "--hand" => parsed.hand = Some(parse_hand(args.next().map(String::as_str))?),
+            flag if flag.starts_with("--hand=") => parsed.hand = Some(parse_hand(flag.strip_prefix("--hand="))?),
             "--standard-depth" => parsed.standard_depth = true,
             "--no-normals" => parsed.no_normals = true,
             "--time" => parsed.time = true,
@@ -140,6 +176,9 @@ fn parse_args(args: &[String]) -> Result<Parsed, String> {
     }
     if let Some(out) = out {
         parsed.out = out.into();
+    }
+    if parsed.hand.is_some() && parsed.msaa > 1 {
+        return Err("--hand with --msaa: the example marks its hand in a single-sampled stencil".into());
     }
     Ok(Parsed::Run(parsed))
 }
@@ -196,8 +235,18 @@ fn run(args: &Args) -> Result<(), Failure> {
     let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))?;
     eprintln!("adapter: {}", adapter.get_info().name);
 
-    // The host's frame: its geometry, its eyes, its depth prepass.
-    let prepass = DepthPrepass::multisampled(&device, &demo_geometry(), depth_kind, (WIDTH, HEIGHT), 2, args.msaa);
+    // The host's frame: its geometry, its eyes, its depth prepass (with the hand, when
+    // asked for: marked in the stencil to be left out, or drawn like the rest).
+    let size = (WIDTH, HEIGHT);
+    let prepass = match args.hand {
+        None => DepthPrepass::multisampled(&device, &demo_geometry(), depth_kind, size, 2, args.msaa),
+        Some(Hand::LeftOut) => {
+            DepthPrepass::with_marked_hand(&device, &demo_geometry(), &demo_hand(), depth_kind, size)
+        }
+        Some(Hand::Casting) => {
+            DepthPrepass::new(&device, &[demo_geometry(), vec![demo_hand()]].concat(), depth_kind, size)
+        }
+    };
     let near = 0.05;
     let tangents = [[-1.2, 0.9, 1.1, -1.1], [-0.9, 1.2, 1.1, -1.1]];
     let views: Vec<ViewMatrices> = demo_eyes()
@@ -224,7 +273,12 @@ fn run(args: &Args) -> Result<(), Failure> {
         // The example's geometry stands still.
         motion: None,
         light: None,
-        exclusion: None,
+        // The hand casts no AO: the engine reads the stencil of the depth buffer.
+        exclusion: (args.hand == Some(Hand::LeftOut)).then_some(HostExclusion {
+            texture: &prepass.depth,
+            receive_none: 0,
+            cast_none: HAND_STENCIL,
+        }),
     };
     let ao = engine.record(&mut encoder, &frame)?.texture.clone();
     queue.submit([encoder.finish()]);
@@ -487,7 +541,22 @@ mod tests {
         let Ok(Parsed::Run(args)) = parse("dir --no-normals --standard-depth --time --time-setup") else { panic!() };
         assert_eq!(
             args,
-            Args { out: "dir".into(), standard_depth: true, no_normals: true, msaa: 1, time: true, time_setup: true }
+            Args {
+                out: "dir".into(),
+                standard_depth: true,
+                no_normals: true,
+                msaa: 1,
+                hand: None,
+                time: true,
+                time_setup: true
+            }
+        );
+        assert!(matches!(parse("--hand left-out"), Ok(Parsed::Run(Args { hand: Some(Hand::LeftOut), .. }))));
+        assert!(matches!(parse("--hand=casting"), Ok(Parsed::Run(Args { hand: Some(Hand::Casting), .. }))));
+        assert_eq!(parse("--hand up"), Err("--hand up: the hand is 'left-out' or 'casting'".into()));
+        assert_eq!(
+            parse("--hand --msaa 4"),
+            Err("--hand with --msaa: the example marks its hand in a single-sampled stencil".into())
         );
         let Ok(Parsed::Run(args)) = parse("--msaa 4 dir") else { panic!("--msaa takes its count") };
         assert_eq!((args.msaa, args.out), (4, "dir".into()));
