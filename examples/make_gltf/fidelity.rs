@@ -91,7 +91,7 @@ fn sheet(name: &str, corner: DVec3, u: Vec3, v: Vec3, uv_max: Vec2, cells: u32, 
 
 /// An image of `side`² texels from `texel(x, y)` (RGBA8).
 fn image(side: u32, sampling: Sampling, texel: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
-    let rgba8 = (0..side * side).flat_map(|i| texel(i % side, i / side)).collect();
+    let rgba8 = (0..side * side).flat_map(|i| texel(i % side, i / side)).collect::<Vec<u8>>().into();
     Texture { width: side, height: side, rgba8, source: None, sampling }
 }
 

@@ -147,7 +147,8 @@ fn grille_scene() -> Scene {
             let (x, y) = (i % CHECKER, i / CHECKER);
             [230, 230, 230, checker_alpha(x, y)]
         })
-        .collect();
+        .collect::<Vec<u8>>()
+        .into();
     let mut grille = Material::plain("grille", Vec3::new(0.7, 0.6, 0.5));
     grille.diffuse_texture =
         Some(Texture { sampling: Default::default(), width: CHECKER, height: CHECKER, rgba8, source: None });

@@ -841,7 +841,13 @@ mod tests {
 
     /// A 2×2 RGBA texture sampled as `sampling`.
     fn texture(sampling: Sampling) -> Texture {
-        Texture { width: 2, height: 2, rgba8: (0..16).map(|i| i * 16).collect(), source: None, sampling }
+        Texture {
+            width: 2,
+            height: 2,
+            rgba8: (0..16).map(|i| i * 16).collect::<Vec<u8>>().into(),
+            source: None,
+            sampling,
+        }
     }
 
     /// A unit quad in z = 0 with `colors` and `tangents` (each empty or one per corner).

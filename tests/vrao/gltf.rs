@@ -23,7 +23,7 @@ fn checker() -> Texture {
             rgba8.extend(if solid { [200, 150, 100, 255] } else { [20, 30, 40, 0] });
         }
     }
-    Texture { sampling: Default::default(), width: 4, height: 4, rgba8, source: None }
+    Texture { sampling: Default::default(), width: 4, height: 4, rgba8: rgba8.into(), source: None }
 }
 
 /// Every feature the writer and loader share: static and moving meshes (a moving root

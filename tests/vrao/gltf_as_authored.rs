@@ -73,7 +73,7 @@ fn texels(w: u32, h: u32, first: [u8; 4], fill: [u8; 4]) -> Texture {
     let mut rgba8 = fill.repeat((w * h) as usize);
     rgba8[..4].copy_from_slice(&first);
     let sampling = Sampling { magnify: Filter::Nearest, minify: Filter::Nearest, mipmaps: None, ..Sampling::default() };
-    Texture { width: w, height: h, rgba8, source: None, sampling }
+    Texture { width: w, height: h, rgba8: rgba8.into(), source: None, sampling }
 }
 
 #[test]

@@ -38,7 +38,7 @@ fn four_texels(wrap_u: Wrap, wrap_v: Wrap) -> Texture {
         mipmaps: None,
         ..Default::default()
     };
-    Texture { width: 2, height: 2, rgba8, source: None, sampling }
+    Texture { width: 2, height: 2, rgba8: rgba8.into(), source: None, sampling }
 }
 
 /// The texel of [`four_texels`] that `uv` (already placed) reads, as the sampler's wrap
@@ -195,7 +195,7 @@ fn emissive_texture_limits_the_emission_and_occlusion_texture_reaches_the_albedo
     let halves = |left: [u8; 4], right: [u8; 4]| Texture {
         width: 2,
         height: 1,
-        rgba8: [left, right].concat(),
+        rgba8: [left, right].concat().into(),
         source: None,
         sampling: Sampling { magnify: Filter::Nearest, mipmaps: None, ..Default::default() },
     };
@@ -229,7 +229,7 @@ fn normal_textures_tilt_the_lighting_normal_with_mesh_tangents_or_without_them_a
     let tilt = Texture {
         width: 1,
         height: 1,
-        rgba8: vec![encode(s), encode(0.0), encode(c), 255],
+        rgba8: vec![encode(s), encode(0.0), encode(c), 255].into(),
         source: None,
         sampling: Sampling::default(),
     };
@@ -272,7 +272,13 @@ fn the_ambient_light_takes_the_smaller_of_the_baked_and_the_screen_space_occlusi
         material.occlusion_texture = baked.map(|b| {
             let r = (b * 255.0).round() as u8;
             (
-                Texture { width: 1, height: 1, rgba8: vec![r, r, r, 255], source: None, sampling: Sampling::default() },
+                Texture {
+                    width: 1,
+                    height: 1,
+                    rgba8: vec![r, r, r, 255].into(),
+                    source: None,
+                    sampling: Sampling::default(),
+                },
                 1.0,
             )
         });

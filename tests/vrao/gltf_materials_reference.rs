@@ -140,7 +140,13 @@ fn checker(sampling: Sampling) -> Texture {
     let solid = [200, 150, 100, 255];
     let hole = [20, 30, 40, 0];
     let rgba8 = [solid, hole, hole, solid].concat();
-    Texture { width: 2, height: 2, rgba8, source: None, sampling: Sampling { magnify: Filter::Nearest, ..sampling } }
+    Texture {
+        width: 2,
+        height: 2,
+        rgba8: rgba8.into(),
+        source: None,
+        sampling: Sampling { magnify: Filter::Nearest, ..sampling },
+    }
 }
 
 #[test]
@@ -244,7 +250,7 @@ fn an_emission_texture_limits_what_a_wall_emits() {
     glow.emissive = Vec3::splat(2.0);
     let half = [[0u8, 0, 0, 255], [255, 255, 255, 255]].concat();
     let nearest = Sampling { magnify: Filter::Nearest, ..Sampling::default() };
-    glow.emissive_texture = Some(Texture { width: 2, height: 1, rgba8: half, source: None, sampling: nearest });
+    glow.emissive_texture = Some(Texture { width: 2, height: 1, rgba8: half.into(), source: None, sampling: nearest });
     let materials = vec![Material::plain("floor", Vec3::splat(0.5)), glow];
     let source = scene(vec![floor("floor", 0.0, 6.0, 1.0, 0), wall(-1.0, 1)], materials, vec![]);
     let head = HeadPose::look_at(DVec3::new(0.0, 1.2, 1.0), DVec3::new(0.0, 0.0, -1.0)).unwrap();
@@ -281,7 +287,7 @@ fn normal_and_occlusion_textures_leave_the_ao_reference_as_it_is() {
     let texel = |rgba: [u8; 4]| Texture {
         width: 1,
         height: 1,
-        rgba8: rgba.to_vec(),
+        rgba8: rgba.to_vec().into(),
         source: None,
         sampling: Sampling::default(),
     };

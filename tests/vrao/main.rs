@@ -61,6 +61,8 @@ mod openxr;
 mod peer;
 #[cfg(feature = "app")]
 mod reference_error;
+#[cfg(feature = "gltf")]
+mod resource_bounds;
 #[cfg(feature = "app")]
 mod scene_loading;
 #[cfg(feature = "app")]

@@ -157,7 +157,7 @@ fn diffuse_texture_is_loaded_and_v_flipped() {
     let text = format!("mtllib m.mtl\n{SQUARE}vt 0 0\nvt 1 0\nvt 1 1\nusemtl tex\nf 1/1 2/2 3/3\n");
     let scene = load(&dir.write("m.obj", &text)).unwrap();
     let texture = scene.materials[0].diffuse_texture.as_ref().expect("texture");
-    assert_eq!((texture.width, texture.height, &texture.rgba8), (2, 1, &pixels));
+    assert_eq!((texture.width, texture.height, &texture.rgba8), (2, 1, &std::sync::Arc::new(pixels)));
     let mesh = &scene.meshes[0];
     let origin_vertex = mesh.positions.iter().position(|p| (mesh.origin.as_vec3() + *p).length() < 1e-6).unwrap();
     assert_eq!(mesh.uvs[origin_vertex], Vec2::new(0.0, 1.0), "OBJ's v = 0 is the bottom row");

@@ -643,7 +643,7 @@ mod tests {
         assert!((srgb_to_linear(188) - 0.5).abs() < 0.01);
         // 2×2: top row black/white, bottom row red/green.
         let rgba8 = vec![0, 0, 0, 255, 255, 255, 255, 255, 255, 0, 0, 255, 0, 255, 0, 255];
-        let t = Texture { sampling: Default::default(), width: 2, height: 2, rgba8, source: None };
+        let t = Texture { sampling: Default::default(), width: 2, height: 2, rgba8: rgba8.into(), source: None };
         assert_eq!(sample_texture(&t, Vec2::new(0.25, 0.25)), Vec3::ZERO);
         assert_eq!(sample_texture(&t, Vec2::new(0.75, 0.25)), Vec3::ONE);
         assert_eq!(sample_texture(&t, Vec2::new(0.25, 0.75)), Vec3::X);
@@ -666,7 +666,7 @@ mod sampling_tests {
     /// A 2×2 texture whose texel (x, y) has alpha (10 + 10x + 20y) / 255 (10, 20 on the
     /// top row, 30, 40 below), sampled as `sampling` says.
     fn two_by_two(sampling: Sampling) -> Texture {
-        let rgba8 = [10u8, 20, 30, 40].iter().flat_map(|&a| [a, a, a, a]).collect();
+        let rgba8 = [10u8, 20, 30, 40].iter().flat_map(|&a| [a, a, a, a]).collect::<Vec<u8>>().into();
         Texture { width: 2, height: 2, rgba8, source: None, sampling }
     }
 
@@ -739,7 +739,7 @@ mod sampling_tests {
         assert!(close(c, 10.0 + 0.25 * 10.0 + 0.25 * 20.0), "{c}");
         // Colour is decoded from sRGB before it is blended, as an sRGB format does.
         let mut t = two_by_two(Sampling::default());
-        t.rgba8 = [0u8, 255, 0, 255].iter().flat_map(|&c| [c, c, c, 255]).collect();
+        t.rgba8 = [0u8, 255, 0, 255].iter().flat_map(|&c| [c, c, c, 255]).collect::<Vec<u8>>().into();
         assert!((sample_texture(&t, Vec2::new(0.5, 0.25)) - Vec3::splat(0.5)).abs().max_element() < 1e-6);
         t.sampling.magnify = Filter::Nearest;
         assert_eq!(sample_texture(&t, Vec2::new(0.5, 0.25)), Vec3::ONE);

@@ -587,7 +587,7 @@ fn grey_row(levels: &[u8]) -> Texture {
     Texture {
         width: levels.len() as u32,
         height: 1,
-        rgba8: levels.iter().flat_map(|&l| [l, l, l, 255]).collect(),
+        rgba8: levels.iter().flat_map(|&l| [l, l, l, 255]).collect::<Vec<u8>>().into(),
         source: None,
         sampling: Sampling { magnify: Filter::Nearest, ..Sampling::default() },
     }
@@ -620,7 +620,7 @@ fn a_normal_texture_tilts_the_light_a_sender_reflects_but_not_its_occlusion() {
     let mut floor = floor_with_uvs(20.0);
     // +u is +x; the bitangent's sign flips with w.
     floor.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
-    let texel = |rgb: [u8; 3]| Texture { rgba8: vec![rgb[0], rgb[1], rgb[2], 255], ..grey_row(&[0]) };
+    let texel = |rgb: [u8; 3]| Texture { rgba8: vec![rgb[0], rgb[1], rgb[2], 255].into(), ..grey_row(&[0]) };
     let mut bumpy = Material::plain("bumpy", Vec3::splat(0.5));
     // Tilted all the way towards +u.
     bumpy.normal_texture = Some((texel([255, 128, 128]), 1.0));

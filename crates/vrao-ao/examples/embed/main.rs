@@ -555,7 +555,7 @@ mod tests {
         assert!(matches!(parse("--hand=casting"), Ok(Parsed::Run(Args { hand: Some(Hand::Casting), .. }))));
         assert_eq!(parse("--hand up"), Err("--hand up: the hand is 'left-out' or 'casting'".into()));
         assert_eq!(
-            parse("--hand --msaa 4"),
+            parse("--hand left-out --msaa 4"),
             Err("--hand with --msaa: the example marks its hand in a single-sampled stencil".into())
         );
         let Ok(Parsed::Run(args)) = parse("--msaa 4 dir") else { panic!("--msaa takes its count") };

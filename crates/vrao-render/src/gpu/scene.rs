@@ -14,6 +14,7 @@ use super::textures::{self, Encoding, Samplers};
 use crate::scene::{Environment, Material, Scene, Texture};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
+use std::collections::HashMap;
 use vrao_ao::plug::{Gpu, Shader};
 use wgpu::util::DeviceExt;
 
@@ -197,12 +198,13 @@ impl GpuScene {
         // Each material's alpha-test cutoff, found once (it scans the texture's alpha).
         let cutoffs = scene.alpha_cutoffs();
         let mut samplers = Samplers::default();
+        let mut uploaded = UploadedTextures::new();
         let placeholders = Placeholders::new(gpu);
         let materials: Vec<GpuMaterial> = scene
             .materials
             .iter()
             .zip(&cutoffs)
-            .map(|(m, &cutoff)| upload_material(gpu, m, cutoff, &mut samplers, &placeholders))
+            .map(|(m, &cutoff)| upload_material(gpu, m, cutoff, &mut samplers, &placeholders, &mut uploaded))
             .collect();
         let bindings = DrawBindings {
             sampler: environment_sampler(device),
@@ -384,6 +386,10 @@ impl Placeholders {
     }
 }
 
+/// Textures already on the GPU, by their texels (shared by every material slot that
+/// names one image), encoding and whether they carry mipmaps: each uploaded once.
+type UploadedTextures = HashMap<(usize, Encoding, bool), wgpu::TextureView>;
+
 /// Material `m` on the GPU: its uniform (with its alpha-test `cutoff`) and its textures,
 /// placeholders where it has none.
 fn upload_material(
@@ -392,11 +398,16 @@ fn upload_material(
     cutoff: Option<f32>,
     samplers: &mut Samplers,
     placeholders: &Placeholders,
+    uploaded_textures: &mut UploadedTextures,
 ) -> GpuMaterial {
     let mut upload = |texture: Option<&Texture>, kind: &str, encoding: Encoding, placeholder: &wgpu::TextureView| {
         let sampling = texture.map(|t| t.sampling).unwrap_or_default();
         let view = match texture {
-            Some(t) => textures::upload(gpu, &format!("{} {kind}", m.name), t, encoding),
+            Some(t) => {
+                let key = (std::sync::Arc::as_ptr(&t.rgba8) as usize, encoding, t.sampling.mipmaps.is_some());
+                let label = format!("{} {kind}", m.name);
+                uploaded_textures.entry(key).or_insert_with(|| textures::upload(gpu, &label, t, encoding)).clone()
+            }
             None => placeholder.clone(),
         };
         (view, samplers.get(&gpu.device, &sampling), sampling)

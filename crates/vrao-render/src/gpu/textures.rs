@@ -8,7 +8,7 @@ use vrao_ao::plug::Gpu;
 use wgpu::util::DeviceExt;
 
 /// How a texture's bytes encode its values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Encoding {
     /// Colour (base colour, emission): sRGB, filtered in linear light.
     Srgb,
@@ -30,7 +30,7 @@ pub fn upload(gpu: &Gpu, label: &str, texture: &Texture, encoding: Encoding) -> 
     let levels = if texture.sampling.mipmaps.is_some() {
         mip_chain(texture.width, texture.height, &texture.rgba8, encoding)
     } else {
-        vec![texture.rgba8.clone()]
+        vec![texture.rgba8.to_vec()]
     };
     let data: Vec<u8> = levels.concat();
     let view = gpu.device.create_texture_with_data(
@@ -53,7 +53,8 @@ pub fn upload(gpu: &Gpu, label: &str, texture: &Texture, encoding: Encoding) -> 
 
 /// A 1×1 texture of one texel, bound where a material has no texture of that kind.
 pub fn placeholder(gpu: &Gpu, label: &str, texel: [u8; 4], encoding: Encoding) -> wgpu::TextureView {
-    let texture = Texture { width: 1, height: 1, rgba8: texel.to_vec(), source: None, sampling: Sampling::default() };
+    let texture =
+        Texture { width: 1, height: 1, rgba8: texel.to_vec().into(), source: None, sampling: Sampling::default() };
     upload(gpu, label, &texture, encoding)
 }
 

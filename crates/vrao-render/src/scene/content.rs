@@ -43,7 +43,7 @@ fn checker_texture() -> Texture {
             rgba8.extend([200, 200, 200, if solid { 255 } else { 0 }]);
         }
     }
-    Texture { sampling: Default::default(), width: side, height: side, rgba8, source: None }
+    Texture { sampling: Default::default(), width: side, height: side, rgba8: rgba8.into(), source: None }
 }
 
 /// A two-sided horizontal quad at height `y` over x, z in ±`h`, with uvs as

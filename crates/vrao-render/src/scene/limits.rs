@@ -32,6 +32,13 @@ pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// The most vertices a scene may hold, over every mesh instance (20 million).
 pub const MAX_VERTICES: usize = 20_000_000;
+/// The most meshes a scene draws (each one draw in every raster pass, per eye pass): a
+/// city block's worth; a million one-triangle primitives spent minutes and gigabytes on
+/// draw records before this bound.
+pub const MAX_MESHES: usize = 65_536;
+/// The most bytes of decoded texels (RGBA8, before mipmaps) a scene's distinct images
+/// may hold together: one image at the largest side, or many smaller ones.
+pub const MAX_TEXTURE_BYTES: u64 = 1 << 30;
 
 /// The largest texture side in texels, for every image a scene names.
 pub const MAX_TEXTURE_SIDE: u32 = 16_384;
@@ -45,6 +52,8 @@ pub struct GeometryBudget {
     pub triangles: usize,
     /// Vertices so far.
     pub vertices: usize,
+    /// Meshes so far: each is a draw of every raster pass (a glTF primitive instance).
+    pub meshes: usize,
 }
 
 impl GeometryBudget {
@@ -53,6 +62,7 @@ impl GeometryBudget {
         meshes.iter().fold(GeometryBudget::default(), |b, m| GeometryBudget {
             triangles: b.triangles + m.indices.len() / 3,
             vertices: b.vertices + m.positions.len(),
+            meshes: b.meshes + 1,
         })
     }
 
@@ -62,6 +72,7 @@ impl GeometryBudget {
         let sum = GeometryBudget {
             triangles: self.triangles.saturating_add(more.triangles),
             vertices: self.vertices.saturating_add(more.vertices),
+            meshes: self.meshes.saturating_add(more.meshes),
         };
         match sum.trouble() {
             Some(trouble) => Err(format!("{what} brings the scene to {trouble}")),
@@ -71,6 +82,13 @@ impl GeometryBudget {
 
     /// One-line trouble when these counts pass either limit.
     pub fn trouble(self) -> Option<String> {
+        if self.meshes > MAX_MESHES {
+            return Some(format!(
+                "{} meshes (glTF primitives drawn, each instance one draw per pass), more than vrao's limit of \
+                 {MAX_MESHES}: merge primitives that share a material",
+                self.meshes
+            ));
+        }
         (self.triangles > MAX_TRIANGLES || self.vertices > MAX_VERTICES).then(|| {
             format!(
                 "{} triangles and {} vertices, more than vrao's limit of {MAX_TRIANGLES} triangles and {MAX_VERTICES} \
@@ -273,9 +291,12 @@ mod tests {
 
     #[test]
     fn one_budget_for_the_scene_and_every_builtin_within_it() {
-        let most = GeometryBudget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES };
+        let most = GeometryBudget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES, meshes: MAX_MESHES };
         assert_eq!(most.trouble(), None);
-        let e = most.plus(GeometryBudget { triangles: 1, vertices: 0 }, "mesh obj 'a.obj'").unwrap_err();
+        let e = most.plus(GeometryBudget { triangles: 0, vertices: 0, meshes: 1 }, "mesh 'a'").unwrap_err();
+        assert!(e.starts_with("mesh 'a' brings the scene to 65537 meshes") && e.contains("merge primitives"), "{e}");
+        let most = GeometryBudget { meshes: 0, ..most };
+        let e = most.plus(GeometryBudget { triangles: 1, vertices: 0, meshes: 0 }, "mesh obj 'a.obj'").unwrap_err();
         assert_eq!(
             e,
             "mesh obj 'a.obj' brings the scene to 20000001 triangles and 20000000 vertices, more than vrao's limit \
@@ -299,7 +320,7 @@ mod tests {
             sampling: Default::default(),
             width: 17,
             height: 1,
-            rgba8: vec![255; 17 * 4],
+            rgba8: vec![255; 17 * 4].into(),
             source: Some(std::path::PathBuf::from("tex/wide.png")),
         };
         material.diffuse_texture = Some(texture);

@@ -348,7 +348,7 @@ impl ObjScanner<'_> {
         }
         self.scan.clean.push_str(&format!("v {} {} {}\n", xyz[0], xyz[1], xyz[2]));
         self.defined.vertices += 1;
-        let one = GeometryBudget { triangles: 0, vertices: 1 };
+        let one = GeometryBudget { triangles: 0, vertices: 1, meshes: 0 };
         self.counted = self.counted.plus(one, "this vertex").map_err(|trouble| statement.at(trouble))?;
         Ok(())
     }
@@ -386,7 +386,7 @@ impl ObjScanner<'_> {
         for word in &words {
             check_face_vertex(word, &self.defined).map_err(|problem| statement.at(problem.0))?;
         }
-        let face = GeometryBudget { triangles: words.len() - 2, vertices: 0 };
+        let face = GeometryBudget { triangles: words.len() - 2, vertices: 0, meshes: 0 };
         self.counted = self.counted.plus(face, "this face").map_err(|trouble| statement.at(trouble))?;
         self.scan.clean.push_str(&format!("f {}\n", statement.rest));
         Ok(())
@@ -627,7 +627,7 @@ fn load_texture(path: &Path) -> Result<Texture> {
         sampling: Default::default(),
         width: image.width(),
         height: image.height(),
-        rgba8: image.into_raw(),
+        rgba8: image.into_raw().into(),
         source: Some(path.into()),
     })
 }
@@ -653,7 +653,7 @@ fn with_alpha(diffuse: Option<Texture>, width: u32, height: u32, coverage: &[u8]
         sampling: Default::default(),
         width,
         height,
-        rgba8: vec![255; 4 * width as usize * height as usize],
+        rgba8: vec![255; 4 * width as usize * height as usize].into(),
         source: None,
     });
     let (tw, th) = (texture.width as u64, texture.height as u64);
@@ -661,7 +661,7 @@ fn with_alpha(diffuse: Option<Texture>, width: u32, height: u32, coverage: &[u8]
         for x in 0..tw {
             let (sx, sy) = (x * width as u64 / tw, y * height as u64 / th);
             let alpha = coverage.get((sy * width as u64 + sx) as usize).copied().unwrap_or(255);
-            texture.rgba8[((y * tw + x) * 4 + 3) as usize] = alpha;
+            std::sync::Arc::make_mut(&mut texture.rgba8)[((y * tw + x) * 4 + 3) as usize] = alpha;
         }
     }
     texture
@@ -719,7 +719,7 @@ mod tests {
     fn the_scene_budget_is_counted_face_by_face_on_top_of_the_scene_so_far() {
         use super::super::limits::{MAX_TRIANGLES, MAX_VERTICES};
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
-        let nearly = |triangles, vertices| GeometryBudget { triangles, vertices };
+        let nearly = |triangles, vertices| GeometryBudget { triangles, vertices, meshes: 0 };
         assert!(scan_obj(Path::new("t.obj"), text, nearly(MAX_TRIANGLES - 2, MAX_VERTICES - 4)).is_ok());
         let e = scan_obj(Path::new("t.obj"), text, nearly(MAX_TRIANGLES - 1, 0)).unwrap_err().to_string();
         assert!(e.starts_with("t.obj:6: this face brings the scene to 20000001 triangles and 4 vertices"), "{e}");

@@ -12,8 +12,9 @@ pub struct Texture {
     pub width: u32,
     /// Height in texels.
     pub height: u32,
-    /// `width × height` texels, four bytes each.
-    pub rgba8: Vec<u8>,
+    /// `width × height` texels, four bytes each; shared by every material slot that
+    /// names the same image (decoded, held and uploaded once).
+    pub rgba8: std::sync::Arc<Vec<u8>>,
     /// The image file it was decoded from (`None` when it came from no file of its own),
     /// named when the device cannot take the texture.
     pub source: Option<PathBuf>,

@@ -5,7 +5,9 @@
 
 use super::MAX_FILE_BYTES;
 use crate::files::{check_regular_file, read_regular_file, FileProblem};
+use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
+use std::sync::Arc;
 use vrao_ao::{Error, Result};
 
 /// Reads `file` (the glTF itself or a file it names) as a regular file of at most
@@ -52,17 +54,29 @@ pub(super) fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], O
 }
 
 /// The bytes of every buffer: the GLB's BIN chunk, a data URI or a file beside the glTF.
-pub(super) fn load_buffers(path: &Path, document: &::gltf::Document, mut bin: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
+/// Buffers naming one URI share one read of it (eight buffers naming one large file
+/// read it once, not eight times).
+pub(super) fn load_buffers(
+    path: &Path,
+    document: &::gltf::Document,
+    bin: Option<Vec<u8>>,
+) -> Result<Vec<Arc<Vec<u8>>>> {
     let mut buffers = Vec::new();
+    let bin = bin.map(Arc::new);
+    let mut read: HashMap<&str, Arc<Vec<u8>>> = HashMap::new();
     for buffer in document.buffers() {
         let i = buffer.index();
         let data = match buffer.source() {
-            ::gltf::buffer::Source::Bin => bin.take().ok_or_else(|| {
+            ::gltf::buffer::Source::Bin => bin.clone().ok_or_else(|| {
                 Error::in_file(path, format!("buffer {i} refers to the .glb's binary chunk, which is missing"))
             })?,
-            ::gltf::buffer::Source::Uri(uri) => {
-                resolve_uri(path, uri).map_err(|m| Error::in_file(path, format!("buffer {i}: {m}")))?
-            }
+            ::gltf::buffer::Source::Uri(uri) => match read.get(uri) {
+                Some(bytes) => bytes.clone(),
+                None => {
+                    let bytes = resolve_uri(path, uri).map_err(|m| Error::in_file(path, format!("buffer {i}: {m}")))?;
+                    read.entry(uri).or_insert(Arc::new(bytes)).clone()
+                }
+            },
         };
         if data.len() < buffer.length() {
             let message = format!("buffer {i} has {} bytes, the file says {}", data.len(), buffer.length());

@@ -172,6 +172,7 @@ pub fn load_content_within(
         buffers,
         warnings,
         images: HashMap::new(),
+        texture_bytes: 0,
         materials: Vec::new(),
         material_of: HashMap::new(),
         material_offset,
@@ -349,10 +350,13 @@ struct Attributes {
 struct Loader<'a> {
     path: &'a Path,
     document: &'a ::gltf::Document,
-    buffers: Vec<Vec<u8>>,
+    buffers: Vec<std::sync::Arc<Vec<u8>>>,
     warnings: Warnings,
-    /// Decoded images by glTF image index.
-    images: HashMap<usize, Texture>,
+    /// Decoded images by their source (a URI, or a buffer view): image entries naming one
+    /// file are decoded, held and uploaded once.
+    images: HashMap<ImageSource, Texture>,
+    /// Bytes of decoded texels over the distinct images so far (bounded).
+    texture_bytes: u64,
     materials: Vec<Material>,
     /// vrao material index by glTF material index (`None` = the default material).
     material_of: HashMap<Option<usize>, usize>,
@@ -361,6 +365,13 @@ struct Loader<'a> {
     primitives: HashMap<usize, Vec<LocalPrimitive>>,
     /// Drawn so far, over every instance (bounded).
     budget: super::limits::GeometryBudget,
+}
+
+/// Where an image's bytes come from: image entries with the same source are one image.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum ImageSource {
+    Uri(String),
+    View(usize),
 }
 
 /// Where a node sits while the hierarchy is walked.
@@ -602,7 +613,11 @@ impl Loader<'_> {
             if g.indices.is_empty() {
                 continue;
             }
-            let more = super::limits::GeometryBudget { triangles: g.indices.len() / 3, vertices: g.positions.len() };
+            let more = super::limits::GeometryBudget {
+                triangles: g.indices.len() / 3,
+                vertices: g.positions.len(),
+                meshes: 1,
+            };
             self.budget = self.budget.plus(more, &format!("mesh '{}'", primitive.name)).map_err(|m| self.error(m))?;
             let material = self.material_offset + primitive.material;
             out.push(match at.node {
@@ -873,10 +888,15 @@ impl Loader<'_> {
         Ok(image)
     }
 
-    /// A decoded image (PNG, JPEG, ... by content), once per image.
+    /// A decoded image (PNG, JPEG, ... by content), once per source, within the scene's
+    /// texture budget.
     fn image(&mut self, image: &::gltf::Image) -> Result<Texture> {
         let index = image.index();
-        if let Some(t) = self.images.get(&index) {
+        let source = match image.source() {
+            ::gltf::image::Source::View { view, .. } => ImageSource::View(view.index()),
+            ::gltf::image::Source::Uri { uri, .. } => ImageSource::Uri(uri.to_string()),
+        };
+        if let Some(t) = self.images.get(&source) {
             return Ok(t.clone());
         }
         let what = format!("image {index}");
@@ -889,7 +909,15 @@ impl Loader<'_> {
             }
         };
         let texture = decode_image(&bytes).map_err(|Problem(m)| self.error(format!("{what}: {m}")))?;
-        self.images.insert(index, texture.clone());
+        self.texture_bytes += texture.rgba8.len() as u64;
+        if self.texture_bytes > super::limits::MAX_TEXTURE_BYTES {
+            return Err(self.error(format!(
+                "{what} brings the scene's textures to {} MiB of texels, over vrao's budget of {} MiB",
+                self.texture_bytes >> 20,
+                super::limits::MAX_TEXTURE_BYTES >> 20
+            )));
+        }
+        self.images.insert(source, texture.clone());
         Ok(texture)
     }
 
@@ -1181,7 +1209,7 @@ fn decode_image(bytes: &[u8]) -> std::result::Result<Texture, Problem> {
         sampling: Default::default(),
         width: image.width(),
         height: image.height(),
-        rgba8: image.into_raw(),
+        rgba8: image.into_raw().into(),
         source: None,
     })
 }
