@@ -49,10 +49,10 @@ pub(crate) struct BenchArgs {
     techniques: Vec<Technique>,
     /// Sample counts, comma-separated, each 1..=256 (by default the presets' counts, the
     /// grid of Belonogov 2018).
-    #[arg(long, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
+    #[arg(long, allow_negative_numbers = true, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
     samples: Vec<u32>,
     /// Radii in metres, comma-separated (default: the scene's radius × 0.5, 1, 2).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, allow_negative_numbers = true, value_delimiter = ',')]
     radii: Vec<f32>,
     /// Resolutions: full, half or both.
     #[arg(long, default_value = "both", hide_possible_values = true)]
@@ -79,13 +79,13 @@ pub(crate) struct BenchArgs {
     /// these VPL counts (each 1..=1024), comma-separated, gathering within each radius: rows "rsm", whose
     /// error against the reference's bounce (bounce_rel_rmse, bounce_rel_bias) is also
     /// given for ssdo-bounce rows.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, allow_negative_numbers = true, value_delimiter = ',')]
     rsm_samples: Vec<u32>,
     /// Measured frames per case, after warm-up; 1..=100000.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
     /// Warm-up frames per case (not measured), 0..=1000.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
     /// eq. 2).
@@ -98,12 +98,12 @@ pub(crate) struct BenchArgs {
     #[arg(value_parser = choice::<Denoise>(), long, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
     denoise: Denoise,
     /// Bilateral blur radius in full-resolution pixels; 0 turns any denoise off.
-    #[arg(long, default_value_t = AoSettings::default().blur_radius)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().blur_radius)]
     blur: u32,
     /// Measure this many cases at a time, round-robin one frame each, so that the
     /// machine's drift during a long sweep falls on all of them alike (fair ratios
     /// between techniques); each needs its own targets in memory at once. 1..=64.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     interleave: u32,
     /// Render whole frames (direct light and composite too), not only the occlusion: the
     /// composite is timed, and each half-resolution row gets the cost of upsampling as a
@@ -112,10 +112,10 @@ pub(crate) struct BenchArgs {
     #[arg(long)]
     frame: bool,
     /// Per-eye width in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Timing: pipelined (one submission per frame, GPU timestamps), serial (one
     /// submission per pass, wall clock) or auto (serial on CPU adapters such as lavapipe,
@@ -126,10 +126,10 @@ pub(crate) struct BenchArgs {
     #[arg(long, default_value = "bench")]
     out: PathBuf,
     /// Reference rays per traced pixel (cosine-weighted, stratified), 1..=65536.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
     /// Trace the reference at every STRIDE-th pixel in x and y (errors are measured there), 1..=64.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     stride: u32,
     /// Skip the reference: time only, no error columns.
     #[arg(long)]

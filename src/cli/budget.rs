@@ -21,16 +21,16 @@ pub(crate) struct BudgetArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Per-eye width in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Measured frames (each: the stereo frame, then each eye alone), after warm-up; 1..=100000.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
     /// Warm-up frames (not measured), 0..=1000.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// Budget of one stereo frame in ms (default: the headset's refresh interval, 11.1 ms
     /// at 90 Hz); each eye gets half.

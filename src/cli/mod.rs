@@ -87,14 +87,14 @@ pub(crate) struct LightArgs {
     #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().enabled))]
     shadows: OnOff,
     /// Texels along each side of the square light-space maps, 16..=8192.
-    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().size)]
+    #[arg(long, allow_negative_numbers = true, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().size)]
     shadow_size: u32,
     /// One bounce of the directional lights from reflective shadow maps: on or off.
     #[arg(long, help_heading = SHADOW_HEADING, value_enum, default_value_t = OnOff::from(ShadowSettings::default().rsm))]
     rsm: OnOff,
     /// Virtual point lights gathered per pixel and light by the reflective shadow maps,
     /// 1..=1024.
-    #[arg(long, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().rsm_samples)]
+    #[arg(long, allow_negative_numbers = true, help_heading = SHADOW_HEADING, default_value_t = ShadowSettings::default().rsm_samples)]
     rsm_samples: u32,
     /// RSM gather radius in metres (default: a quarter of the scene's diagonal, within 0.1..=4 m).
     #[arg(long, help_heading = SHADOW_HEADING, allow_negative_numbers = true)]
@@ -160,7 +160,7 @@ pub(crate) struct AoArgs {
     #[arg(value_parser = choice::<Quality>(), long, default_value_t = Quality::default(), hide_possible_values = true)]
     quality: Quality,
     /// Depth taps per pixel, 1..=256 (overrides --quality).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     samples: Option<u32>,
     #[arg(long, allow_negative_numbers = true, help = radius_help())]
     radius: Option<f32>,
@@ -201,7 +201,7 @@ pub(crate) struct AoArgs {
     denoise: Denoise,
     /// Bilateral blur radius in full-resolution pixels, 0..=16 (5 = 11×11); 0 turns any
     /// denoise off.
-    #[arg(long, default_value_t = AoSettings::default().blur_radius)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().blur_radius)]
     blur: u32,
     /// Blur depth-edge width as a fraction of the pixel's distance (smaller keeps sharper edges).
     #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().blur_plane_sigma)]
@@ -227,7 +227,7 @@ pub(crate) struct AoArgs {
     #[arg(value_parser = choice::<TemporalBlend>(), long, default_value_t = Temporal::default().blend, hide_possible_values = true)]
     temporal_blend: TemporalBlend,
     /// Frames after which a pixel counts as converged, 1..=1024.
-    #[arg(long, default_value_t = Temporal::default().max_frames)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = Temporal::default().max_frames)]
     temporal_frames: u32,
     /// Motion-adaptive temporal window: a pixel that moved m pixels since the last frame
     /// averages at most frames / (1 + m / this) frames (at least 4); 0 turns it off.

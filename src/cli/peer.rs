@@ -27,39 +27,39 @@ pub(crate) struct PeerArgs {
     #[arg(long, value_delimiter = ',', default_values_t = BEVY_PRESETS.map(|p| p.0.to_string()))]
     presets: Vec<String>,
     /// vrao's GTAO sample counts, comma-separated, each 1..=256 (by default its presets').
-    #[arg(long, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
+    #[arg(long, allow_negative_numbers = true, value_delimiter = ',', default_values_t = Quality::ALL.map(Quality::samples))]
     samples: Vec<u32>,
     /// vrao's resolutions: full, half or both.
     #[arg(long, default_value = "both", value_parser = ["full", "half", "both"])]
     resolution: String,
     /// Measured frames per case and round, 1..=100000.
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
     /// Warm-up frames per case and round, 0..=1000.
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// Rounds of Bevy and vrao, alternating which goes first, 1..=20.
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=ROUNDS_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=ROUNDS_MAX as i64))]
     rounds: u32,
     /// AO radius in metres of vrao's cases and of the reference (Bevy's own is fixed: 0.73 m
     /// with a falloff from 0.28 m).
-    #[arg(long, default_value_t = AoSettings::default().radius, value_parser = parse_radius)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().radius, value_parser = parse_radius)]
     radius: f32,
     /// Per-eye width in pixels, 16..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().width, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().width, value_parser = clap::value_parser!(u32).range(16..=8192))]
     width: u32,
     /// Per-eye height in pixels, 16..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().height, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().height, value_parser = clap::value_parser!(u32).range(16..=8192))]
     height: u32,
     /// Timing of both sides: serial (wall clock around work submitted alone), pipelined
     /// (GPU timestamps) or auto (serial on CPU adapters such as lavapipe).
     #[arg(value_parser = choice::<TimingChoice>(), long, default_value = "auto", hide_possible_values = true)]
     timing: TimingChoice,
     /// Reference rays per traced pixel, 1..=65536.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
     /// Trace the reference at every STRIDE-th pixel in x and y, 1..=64.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     stride: u32,
     /// Directory of cached reference images (default: $XDG_CACHE_HOME/vrao or ~/.cache/vrao).
     #[arg(long)]

@@ -37,10 +37,10 @@ pub(crate) struct RenderArgs {
     #[arg(value_parser = choice::<StereoMode>(), long, default_value_t = StereoMode::default(), hide_possible_values = true)]
     stereo: StereoMode,
     /// Per-eye width in pixels, 1..=8192 (Vive-class default).
-    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels, 1..=8192 (Vive-class default).
-    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Interpupillary distance in metres.
     #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().ipd)]
@@ -54,7 +54,7 @@ pub(crate) struct RenderArgs {
     timing: TimingChoice,
     /// Render this many frames and report per-pass GPU medians (with --explain); the
     /// first frames are warm-up and not counted. 1..=100000.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Scene time in seconds (0 to 1e6): where animated objects and a scripted head are.
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.0, value_parser = super::parse_scene_time)]

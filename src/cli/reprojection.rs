@@ -12,10 +12,10 @@ pub(crate) struct ReprojectionArgs {
     #[arg(long, default_value = "builtin:room", help = SCENE_HELP)]
     scene: String,
     /// Per-eye width in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Write the rows as JSON here.
     #[arg(long)]

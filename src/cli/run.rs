@@ -27,7 +27,7 @@ pub(crate) struct RunArgs {
     display: DisplayMode,
     /// Stop after this many frames, 1..=10000000 (default: until the window is closed;
     /// 600 without one).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=RUN_FRAMES_MAX))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=RUN_FRAMES_MAX))]
     frames: Option<u64>,
     /// Simulated head motion: static, yaw-sweep, figure-eight or head-roll.
     #[arg(long, default_value = "static", hide_possible_values = true)]
@@ -37,7 +37,7 @@ pub(crate) struct RunArgs {
     reprojection: ReprojectionMode,
     /// Run the simulated headset in virtual time, each frame taking these render times
     /// in ms (cycled), each within 0..=10000: deterministic counters.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, allow_negative_numbers = true, value_delimiter = ',')]
     virtual_time: Vec<f64>,
     /// Headset profile of the simulated headset: vive, vive-pro-2, index, quest-2,
     /// quest-3 or pico-4 (per-eye size, field of view, refresh rate; the frame budget
@@ -52,11 +52,11 @@ pub(crate) struct RunArgs {
     refresh: Option<f64>,
     /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     width: Option<u32>,
     /// Per-eye height to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     height: Option<u32>,
     /// Budget governor: on (choose the AO setting by error per millisecond so that each
     /// frame's GPU time stays under the display period) or off (keep the settings).
@@ -67,7 +67,7 @@ pub(crate) struct RunArgs {
     #[arg(long)]
     governor_frontier: Option<PathBuf>,
     /// Frames the GPU may work on at once, 1..=8.
-    #[arg(long, default_value_t = DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = DEFAULT_FRAMES_IN_FLIGHT as u64, value_parser = clap::value_parser!(u64).range(1..=8))]
     frames_in_flight: u64,
     /// Window size WIDTHxHEIGHT, each 1..=16384.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]

@@ -39,17 +39,17 @@ pub(crate) struct TableArgs {
     #[arg(value_parser = choice::<Foveation>(), long, value_delimiter = ',', default_values_t = [Foveation::Off, Foveation::High], hide_possible_values = true)]
     foveations: Vec<Foveation>,
     /// Per-eye width in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().width)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().width)]
     width: u32,
     /// Per-eye height in pixels, 1..=8192.
-    #[arg(long, default_value_t = HeadsetProfile::vive().height)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HeadsetProfile::vive().height)]
     height: u32,
     /// Measured rounds per row (each: the stereo frame, then each eye alone), after
     /// warm-up; 1..=100000.
-    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=MEASURED_FRAMES_MAX as i64))]
     frames: u32,
     /// Warm-up rounds per row (not measured), 0..=1000.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=WARMUP_MAX as i64))]
     warmup: u32,
     /// Budget of one stereo frame in ms (default: the headset's refresh interval, 11.1 ms
     /// at 90 Hz).

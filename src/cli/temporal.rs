@@ -25,19 +25,19 @@ pub(crate) struct TemporalArgs {
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.5, value_parser = super::parse_scene_time)]
     start: f64,
     /// With --motion: frames scored (each traces a reference), 1 to 64.
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
     scored: u32,
     /// With --motion: frames (at 90 Hz) between scored frames, 1 to 90.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=90))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=90))]
     every: u32,
     /// Per-eye width in pixels, 1..=8192.
-    #[arg(long, default_value_t = 270)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 270)]
     width: u32,
     /// Per-eye height in pixels, 1..=8192.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 300)]
     height: u32,
     /// Reference rays per traced pixel, 1..=65536.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     rays: u32,
     /// Write the points as JSON here.
     #[arg(long)]

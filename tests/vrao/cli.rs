@@ -703,6 +703,23 @@ fn negative_numbers_are_values_refused_by_their_range_and_the_bench_refuses_dupl
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("techniques name ssao twice"), "{stderr}");
+    // A negative count or size is a value its parser refuses, naming it, not a flag.
+    for args in [
+        &["render", "--samples", "-1"][..],
+        &["render", "--width", "-5"],
+        &["run", "--frames-in-flight", "-1", "--headset", "simulated", "--display", "none"],
+        &["peer", "--radius", "-1"],
+    ] {
+        let out = vrao(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        let names_it = stderr.contains("-1") || stderr.contains("-5");
+        assert!(!stderr.contains("unexpected argument") && names_it, "{args:?}: {stderr}");
+    }
+    let out = vrao(&["bench", "--mask", "on,on", "--no-reference", "--width", "8", "--height", "8", "--frames", "1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("mask settings name on twice"), "{stderr}");
 }
 
 #[test]

@@ -89,3 +89,22 @@ fn a_file_named_by_many_buffers_or_images_is_read_and_decoded_once() {
         "64 image entries naming one file share one decoded image"
     );
 }
+
+#[test]
+fn a_byte_order_mark_is_read_past_and_only_authored_materials_warn_of_metal() {
+    let dir = temp_dir("bom");
+    let uri = format!("data:application/octet-stream;base64,{}", encode_base64(&triangle_bytes()));
+    let text = gltf(&uri, 1, 1, 0, "");
+    let path = dir.join("bom.gltf");
+    std::fs::write(&path, [b"\xEF\xBB\xBF".as_slice(), text.as_bytes()].concat()).unwrap();
+    let content = vrao_render::scene::gltf::load_content(&path, 0).expect("a glTF behind a byte-order mark loads");
+    assert_eq!(content.meshes.len(), 1);
+    // No material: the default one's metallicFactor of 1 is the spec's, not the file's.
+    assert!(content.warnings.iter().all(|w| !w.contains("metallic")), "{:?}", content.warnings);
+    let metal = text.replace(r#""materials": []"#, r#""materials": [{"pbrMetallicRoughness": {"metallicFactor": 1}}]"#);
+    let metal =
+        metal.replace(r#"{"attributes": {"POSITION": 0}}"#, r#"{"attributes": {"POSITION": 0}, "material": 0}"#);
+    std::fs::write(&path, metal).unwrap();
+    let content = vrao_render::scene::gltf::load_content(&path, 0).unwrap();
+    assert!(content.warnings.iter().any(|w| w.contains("metallic-roughness")), "{:?}", content.warnings);
+}

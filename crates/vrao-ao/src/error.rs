@@ -28,7 +28,7 @@ pub enum Error {
     #[error("frame graph: {0}")]
     Plan(String),
     /// Building was cut short by the caller's cancellation token
-    /// ([`crate::gpu::Gpu::cancel_builds_on`]).
+    /// (`Gpu::cancel_builds_on`, of the renderer's face).
     #[error("interrupted")]
     Interrupted,
 }

@@ -11,11 +11,13 @@
 mod ao;
 mod driver;
 mod error;
+mod frame;
 mod gpu;
 mod graph;
 mod graph_targets;
 mod passes;
 pub mod plug;
+mod resource;
 mod sampling;
 mod settings;
 mod sh;
@@ -37,7 +39,7 @@ pub use error::{Error, Result};
 pub use graph::Plan;
 pub use passes::RightEyeTiles;
 pub use settings::{
-    AoSettings, Choice, Denoise, Foveation, GtaoSettings, March, Noise, Quality, Resolution, Technique, Temporal,
+    AoSettings, Choice, Denoise, Foveation, GtaoSettings, Noise, Quality, Resolution, Technique, Temporal,
     TemporalBlend,
 };
 pub use stereo::{Eye, EyePair, EyeSide, Fov, HeadPose, InvalidFov};

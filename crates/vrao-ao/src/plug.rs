@@ -9,6 +9,7 @@
 //! [`FINAL_AO`]) are the names a renderer's passes write for the chain and read from it.
 
 pub use crate::driver::{FrameParams, GraphDriver, Submission};
+pub use crate::frame::{ChainSettings, DeclareContext, FrameMotion, MoverBox};
 pub use crate::gpu::kernel::try_shader_module;
 pub use crate::gpu::kernel::{shader_module, Bind, Kernel, Shader, Slot, COMMON, IRRADIANCE, VISIBILITY};
 pub use crate::gpu::layered_target::LayeredTarget;
@@ -19,7 +20,7 @@ pub use crate::gpu::timing::{FrameTiming, PassTimer};
 pub use crate::gpu::uniforms::{ao_extent, FrameLighting, FrameUniforms, LightUniform};
 pub use crate::gpu::visibility::VisibilityMaps;
 pub use crate::gpu::{Capabilities, Gpu};
-pub use crate::graph::{plan, Kind, PassDecl, Resource, Size, Written, FINAL_AO, OCCLUSION, PIXEL_MOTION};
+pub use crate::graph::{plan, PassDecl};
 pub use crate::passes::blur::AO_BLURRED;
 pub use crate::passes::blur::NAME as BLUR_PASS;
 pub use crate::passes::inputs::{DEPTH, DIRECT_LIGHT, MOTION, NORMALS};
@@ -28,7 +29,8 @@ pub use crate::passes::temporal::AO_ACCUMULATED;
 pub use crate::passes::temporal::{HISTORY_POSITION, HISTORY_VALUE};
 pub use crate::passes::upsample::NAME as UPSAMPLE_PASS;
 pub use crate::passes::upsample::{reuses_left_eye_upsample, AO_FULL, JOINT_UPSAMPLE_WGSL};
-pub use crate::passes::{ao_chain, record, ChainSettings, DeclareContext, FrameMotion, MoverBox, Pass, RecordContext};
+pub use crate::passes::{ao_chain, record, Pass, RecordContext};
+pub use crate::resource::{Kind, Resource, Size, Written, FINAL_AO, OCCLUSION, PIXEL_MOTION};
 pub use crate::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
 pub use crate::settings::BounceForm;
 pub use crate::sh::{prefiltered_radiance, quadratic_in_view, sh9_quadratic};

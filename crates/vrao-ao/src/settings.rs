@@ -3,7 +3,6 @@
 //! passes can trust them; every default lives here.
 
 use crate::error::{Error, Result};
-pub use crate::passes::gtao::{GtaoSettings, March};
 pub use crate::technique::Technique;
 
 /// The occlusion radius of [`AoSettings::default`], in the host's world units.
@@ -507,5 +506,59 @@ impl AoSettings {
     /// True when the SSDO pass also gathers the bounce.
     pub fn bounce_active(&self) -> bool {
         self.technique.gathers_bounce() && self.bounce > 0.0
+    }
+}
+
+/// GTAO's default slab behind each depth sample, a fraction of the radius.
+const DEFAULT_THICKNESS: f32 = 0.75;
+/// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
+const DEFAULT_STEP_POWER: f32 = 1.5;
+/// GTAO's default: successive samples closer than this fraction of the radius are joined.
+const DEFAULT_CONNECT: f32 = 0.25;
+
+/// GTAO's own settings (`AoSettings::gtao`), and their command-line flags. The defaults
+/// are tuned against the reference (scripts/tune-gtao.py and docs/records/2026-11-29/gtao-tuning.md).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GtaoSettings {
+    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
+    /// radius (thin objects stop occluding behind themselves).
+    // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
+    // fewer halos (pixels beside depth edges too dark by > 0.1); 0.5 leaves fewer still
+    // but costs RMSE (docs/records/2026-11-29/measurements-in-code.md, gtao-thickness).
+    pub thickness: f32,
+    /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
+    /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
+    pub step_power: f32,
+    /// GTAO: successive samples whose distances differ by less than this fraction of the
+    /// radius lie on one continuous surface, which also blocks the angles between them
+    /// (0: never).
+    pub connect: f32,
+}
+
+impl Default for GtaoSettings {
+    fn default() -> Self {
+        GtaoSettings { thickness: DEFAULT_THICKNESS, step_power: DEFAULT_STEP_POWER, connect: DEFAULT_CONNECT }
+    }
+}
+
+impl GtaoSettings {
+    /// Refuses values outside their ranges, naming the value.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.thickness.is_finite() && (0.0..=100.0).contains(&self.thickness)) {
+            return Err(Error::input(format!(
+                "thickness {} is not within 0..=100 (a fraction of the radius)",
+                self.thickness
+            )));
+        }
+        if !(self.step_power.is_finite() && (1.0..=2.0).contains(&self.step_power)) {
+            return Err(Error::input(format!("step power {} is not within 1..=2", self.step_power)));
+        }
+        if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
+            return Err(Error::input(format!(
+                "connect {} is not within 0..=100 (a fraction of the radius)",
+                self.connect
+            )));
+        }
+        Ok(())
     }
 }

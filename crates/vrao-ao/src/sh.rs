@@ -3,7 +3,7 @@
 //! shaders evaluate (`frame.environment_quadratics`, irradiance.wgsl): the irradiance E(n)
 //! and the pre-filtered radiance SSDO weighs its unoccluded directions with. vrao's
 //! renderer builds them from its environment map; the AO engine from a host's
-//! coefficients ([`crate::ao::HostLight`]).
+//! coefficients ([`crate::HostLight`]).
 
 use glam::{Mat3, Vec3};
 use std::f32::consts::{PI, TAU};

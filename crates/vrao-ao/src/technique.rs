@@ -1,12 +1,10 @@
 //! The technique table: every occlusion technique's name, kind, composite mode, sample
 //! pattern, foveation rule and pass, in one place. Adding a technique is its folder under
 //! `src/passes/` (its Rust and WGSL), its variant below and its line in [`TECHNIQUES`];
-//! the chain ([`crate::passes::ao_chain`]), the uniforms ([`crate::gpu::uniforms`]), the
+//! the chain (`passes::ao_chain`), the uniforms (`gpu::uniforms`), the
 //! denoise and the composite read what they need from the entry.
 
 use crate::error::{Error, Result};
-use crate::gpu::Gpu;
-use crate::passes::{fetch_only, gtao, hbao, ssao, ssdo, Pass};
 
 /// The occlusion technique.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -94,9 +92,6 @@ pub enum FoveationRule {
     DirectionsThenSteps,
 }
 
-/// What makes a technique's pass for the engine's chain.
-pub(crate) type MakePass = fn(&Gpu) -> Box<dyn Pass>;
-
 /// One technique's line of the table.
 #[derive(Clone, Copy, Debug)]
 pub struct TechniqueEntry {
@@ -115,9 +110,9 @@ pub struct TechniqueEntry {
     pub samples: SamplePattern,
     /// What foveation thins.
     pub foveation: FoveationRule,
-    /// Makes its pass for the engine's chain; `None` where the engine has none (`none`,
-    /// or a light-gathering technique whose pass a renderer supplies).
-    pub pass: Option<MakePass>,
+    /// Whether the engine's chain has a pass for it (not `none`, nor a light-gathering
+    /// technique whose pass a renderer supplies): the chain (`passes::ao_chain`) makes it.
+    pub engine_pass: bool,
 }
 
 /// Every technique, in the order the CLI and the bench list them.
@@ -130,7 +125,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::Unoccluded,
         samples: SamplePattern::Nothing,
         foveation: FoveationRule::Unaffected,
-        pass: None,
+        engine_pass: false,
     },
     TechniqueEntry {
         technique: Technique::Ssao,
@@ -140,7 +135,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::HemisphereCosine,
         foveation: FoveationRule::Samples,
-        pass: Some(|gpu| Box::new(ssao::pass(gpu))),
+        engine_pass: true,
     },
     TechniqueEntry {
         technique: Technique::Hbao,
@@ -150,7 +145,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::Directions,
         foveation: FoveationRule::DirectionsThenSteps,
-        pass: Some(|gpu| Box::new(hbao::pass(gpu))),
+        engine_pass: true,
     },
     TechniqueEntry {
         technique: Technique::Gtao,
@@ -160,7 +155,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::Directions,
         foveation: FoveationRule::DirectionsThenSteps,
-        pass: Some(|gpu| Box::new(gtao::GtaoPass::new(gpu))),
+        engine_pass: true,
     },
     TechniqueEntry {
         technique: Technique::Ssdo,
@@ -170,7 +165,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::Directional,
         samples: SamplePattern::Directions,
         foveation: FoveationRule::DirectionsThenSteps,
-        pass: Some(|gpu| Box::new(ssdo::SsdoPass::new(gpu, Technique::Ssdo))),
+        engine_pass: true,
     },
     TechniqueEntry {
         technique: Technique::SsdoBounce,
@@ -180,7 +175,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::Directional,
         samples: SamplePattern::Directions,
         foveation: FoveationRule::DirectionsThenSteps,
-        pass: Some(|gpu| Box::new(ssdo::SsdoPass::new(gpu, Technique::SsdoBounce))),
+        engine_pass: true,
     },
     TechniqueEntry {
         technique: Technique::SsdoPoints,
@@ -190,7 +185,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::Directional,
         samples: SamplePattern::HemisphereUniform,
         foveation: FoveationRule::Samples,
-        pass: None,
+        engine_pass: false,
     },
     TechniqueEntry {
         technique: Technique::SsdoPointsBounce,
@@ -200,7 +195,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::Directional,
         samples: SamplePattern::HemisphereUniform,
         foveation: FoveationRule::Samples,
-        pass: None,
+        engine_pass: false,
     },
     TechniqueEntry {
         technique: Technique::FetchOnly,
@@ -210,7 +205,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         composite: CompositeMode::ScalarAo,
         samples: SamplePattern::HemisphereCosine,
         foveation: FoveationRule::Samples,
-        pass: Some(|gpu| Box::new(fetch_only::pass(gpu))),
+        engine_pass: true,
     },
 ];
 
@@ -284,7 +279,7 @@ impl Technique {
     /// Whether vrao's renderer supplies the technique's pass (the point-sampled SSDO,
     /// which the AO engine does not run).
     pub fn renderer_only(self) -> bool {
-        self.entry().pass.is_none() && self.entry().kind == TechniqueKind::LightGathering
+        !self.entry().engine_pass && self.entry().kind == TechniqueKind::LightGathering
     }
 
     /// Every technique, in the order the CLI and the bench list them ([`Technique::ALL`]).
@@ -379,7 +374,7 @@ mod tests {
             // The engine builds a pass for every technique but `none` and the point-sampled
             // SSDO, which a renderer supplies.
             let engine_pass = e.kind != TechniqueKind::Off && !e.name.starts_with("ssdo-points");
-            assert_eq!(e.pass.is_some(), engine_pass, "{}", e.name);
+            assert_eq!(e.engine_pass, engine_pass, "{}", e.name);
             let marches =
                 e.kind == TechniqueKind::HorizonMarch || (e.kind == TechniqueKind::LightGathering && engine_pass);
             assert_eq!(marches, e.samples == SamplePattern::Directions, "{}", e.name);

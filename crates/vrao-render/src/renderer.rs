@@ -77,6 +77,8 @@ pub enum TimingChoice {
     Serial,
 }
 
+vrao_ao::impl_choice!(TimingChoice);
+
 impl TimingChoice {
     /// Every choice, the default first.
     pub const ALL: [TimingChoice; 3] = [TimingChoice::Auto, TimingChoice::Pipelined, TimingChoice::Serial];

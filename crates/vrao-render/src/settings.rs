@@ -26,7 +26,7 @@ pub const DEFAULT_WHITE_POINT: f32 = 4.0;
 /// is that command's setting with no options. A constant, so that no default builds a
 /// scene; a test keeps it equal to the scene's suggestion.
 pub const DEFAULT_SCENE_AO_RADIUS: f32 = 0.675_763_25;
-/// The RSM gather radius the default scene suggests ([`crate::passes::shadow::suggested_rsm_radius`]).
+/// The RSM gather radius the default scene suggests (the shadow pass's `suggested_rsm_radius`).
 pub const DEFAULT_SCENE_RSM_RADIUS: f32 = 2.111_760_1;
 
 /// How the G-buffer reaches both eye layers.
@@ -54,7 +54,7 @@ impl StereoMode {
     }
 }
 
-vrao_ao::impl_choice!(StereoMode, DisplayMode, crate::renderer::TimingChoice, crate::gpu::open::BackendChoice);
+vrao_ao::impl_choice!(StereoMode, DisplayMode);
 
 /// What the desktop window shows (Belonogov 2018 §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -84,7 +84,7 @@ impl DisplayMode {
 /// Everything a frame is rendered with: the headset, the stereo path, tone mapping,
 /// occlusion and shadows. Start from [`Settings::default`] and change what you need;
 /// [`Settings::validate`] (also run by
-/// [`Renderer::new`](crate::renderer::Renderer::new)) rejects values out of range
+/// `Renderer::new`) rejects values out of range
 /// with a one-line error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -129,7 +129,7 @@ pub struct ShadowSettings {
 }
 
 /// Shadows on (2048² maps), no RSM; the RSM radius is the default scene's
-/// ([`crate::passes::shadow::suggested_rsm_radius`]), as `vrao render` sets it with no options.
+/// (the shadow pass's `suggested_rsm_radius`), as `vrao render` sets it with no options.
 impl Default for ShadowSettings {
     fn default() -> Self {
         ShadowSettings { enabled: true, size: 2048, rsm: false, rsm_samples: 64, rsm_radius: DEFAULT_SCENE_RSM_RADIUS }

@@ -189,9 +189,6 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
     Ok(BenchRun { file, radii, adapter })
 }
 
-/// Refuses a sweep before any GPU work: every case's settings must be valid and have an
-/// occlusion technique, and reflective-shadow-map rows need a directional light and a
-/// VPL count within 1..=1024.
 /// Refuses a list of the bench's options that names a value twice, naming it.
 fn named_once<T: PartialEq + std::fmt::Display>(what: &str, list: &[T]) -> Result<()> {
     match crate::measure::named_twice(list) {
@@ -200,6 +197,9 @@ fn named_once<T: PartialEq + std::fmt::Display>(what: &str, list: &[T]) -> Resul
     }
 }
 
+/// Refuses a sweep before any GPU work: every case's settings must be valid and have an
+/// occlusion technique, and reflective-shadow-map rows need a directional light and a
+/// VPL count within 1..=1024.
 fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: &[BenchCase]) -> Result<()> {
     crate::measure::check_frames(options.warmup, options.frames)?;
     // A value named twice would measure the same rows twice (the table refuses it too).
@@ -207,7 +207,9 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
     named_once("sample counts", &options.samples)?;
     named_once("radii", &options.radii)?;
     named_once("foveation levels", &options.foveation)?;
-    named_once("mask settings", &options.mask)?;
+    // The mask's values as the command line names them (`--mask on,off`).
+    let masks: Vec<&str> = options.mask.iter().map(|&on| if on { "on" } else { "off" }).collect();
+    named_once("mask settings", &masks)?;
     named_once("RSM sample counts", &options.rsm_samples)?;
     for case in cases {
         let mut s = base.clone();

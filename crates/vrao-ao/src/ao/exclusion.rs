@@ -42,7 +42,7 @@ const UINT_FORMATS: [wgpu::TextureFormat; 3] =
 /// (its stencil aspect for a depth-stencil texture); the error names what is wrong.
 pub(crate) fn mask_view(exclusion: &HostExclusion, config: &AoConfig) -> Result<wgpu::TextureView> {
     let texture = exclusion.texture;
-    super::import::check_texture("exclusion mask", texture, config)?;
+    super::host_texture::check_texture("exclusion mask", texture, config)?;
     let format = texture.format();
     let aspect = if STENCIL_FORMATS.contains(&format) {
         wgpu::TextureAspect::StencilOnly

@@ -6,6 +6,7 @@
 //! samples) is resolved here, each pixel taking its sample nearest the eye
 //! (import_msaa.wgsl): one read per sample instead of one per pixel, nothing else.
 
+use super::host_texture::{check_texture, check_texture_size};
 use super::{AoConfig, AoFrame, NormalEncoding, NormalSpace, Projection};
 use crate::error::{Error, Result};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, Slot};
@@ -152,39 +153,6 @@ impl ImportSource {
         self.params.near = near;
         self
     }
-}
-
-/// Refuses a texture of another size, too few layers, multisampled or not bindable.
-pub(crate) fn check_texture(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Result<()> {
-    check_texture_size(what, texture, config)?;
-    if texture.sample_count() != 1 {
-        return Err(Error::input(format!(
-            "{what}: {} samples per pixel; the engine resolves only the depth and normals, so resolve this one first",
-            texture.sample_count()
-        )));
-    }
-    Ok(())
-}
-
-/// Refuses a texture of another size, too few layers or not bindable.
-fn check_texture_size(what: &str, texture: &wgpu::Texture, config: &AoConfig) -> Result<()> {
-    let size = texture.size();
-    if (size.width, size.height) != (config.width, config.height) {
-        return Err(Error::input(format!(
-            "{what}: {}×{} does not match the engine's {}×{}",
-            size.width, size.height, config.width, config.height
-        )));
-    }
-    if size.depth_or_array_layers < config.views || texture.dimension() != wgpu::TextureDimension::D2 {
-        return Err(Error::input(format!(
-            "{what}: a 2D texture with {} layer(s) cannot hold {} view(s)",
-            size.depth_or_array_layers, config.views
-        )));
-    }
-    if !texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
-        return Err(Error::input(format!("{what}: the texture lacks TEXTURE_BINDING usage")));
-    }
-    Ok(())
 }
 
 /// The import pass of a host's engine.

@@ -22,6 +22,7 @@
 //! frame's [`DepthConvention`] says; one depth layer per view.
 
 pub(crate) mod exclusion;
+mod host_texture;
 pub(crate) mod import;
 pub(crate) mod light;
 mod pack;
@@ -393,7 +394,7 @@ impl AoEngine {
     fn import_direct_light<'f>(&mut self, frame: &AoFrame<'f>, layers: u32) -> Result<Option<&'f wgpu::Texture>> {
         let direct = frame.light.and_then(|l| l.direct);
         if let Some(texture) = direct {
-            import::check_texture("direct light", texture, &self.config)?;
+            host_texture::check_texture("direct light", texture, &self.config)?;
             if texture.format().sample_type(None, None) != Some(wgpu::TextureSampleType::Float { filterable: true })
                 && texture.format().sample_type(None, None)
                     != Some(wgpu::TextureSampleType::Float { filterable: false })

@@ -4,7 +4,7 @@
 
 use super::Gpu;
 use crate::error::{Error, Result};
-use crate::graph::Resource;
+use crate::resource::Resource;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::path::Path;
@@ -57,8 +57,7 @@ fn pipeline_key(label: &str, source: &str, entry: &str, constants: &[(&str, f64)
     hasher.finish()
 }
 
-/// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
-pub(crate) const TILE: u32 = 8;
+pub(crate) use super::support::TILE;
 
 /// One WGSL file, compiled into the binary so it runs from any directory; `path` is
 /// relative to the workspace root (for a shader directory, [`Gpu::set_shader_dir`]). Made by a crate-internal
@@ -200,7 +199,7 @@ fn module_of(device: &wgpu::Device, label: &str, source: String) -> wgpu::Shader
 
 /// One binding of a kernel, in binding order. A pass's binding list is the one place
 /// that says what the kernel binds: the bind group layout, the pass's reads and writes
-/// ([`PassDecl::bindings`](crate::graph::PassDecl::bindings)) and the resources
+/// (`PassDecl::bindings`) and the resources
 /// bound each frame all follow from it.
 #[derive(Clone, Copy, Debug)]
 pub enum Bind {

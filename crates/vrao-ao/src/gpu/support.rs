@@ -2,6 +2,9 @@
 //! pipeline is built: an adapter that cannot is refused with one line naming what it
 //! lacks, instead of a screen of validation errors from the first frame.
 
+/// Workgroup edge of every full-screen compute kernel (`@workgroup_size(8, 8, 1)`).
+pub(crate) const TILE: u32 = 8;
+
 /// Formats the compute kernels write as `texture_storage_2d_array<FORMAT, write>`
 /// (`Slot::Output`): colour, the AO targets and history, world positions, and the
 /// packed direct light. Checked when each kernel is made (`Kernel::with_constants`), so
@@ -89,7 +92,7 @@ const STORAGE_TEXTURES_PER_KERNEL: u32 = 3;
 pub(crate) fn missing_device_capabilities(support: &DeviceSupport) -> Vec<String> {
     let mut missing = Vec::new();
     let limits = &support.limits;
-    let tile = super::kernel::TILE;
+    let tile = TILE;
     if limits.max_compute_workgroups_per_dimension == 0 || limits.max_compute_invocations_per_workgroup < tile * tile {
         missing.push(format!("compute shaders with {tile}×{tile} workgroups"));
     }

@@ -1,7 +1,7 @@
 //! Per-frame uniforms shared by every pass (mirrors `Frame`, `Eye` and `Light` in
 //! shaders/common.wgsl), built in f64 and rounded once.
 
-use crate::passes::ChainSettings;
+use crate::frame::ChainSettings;
 use crate::sampling::{hbao_directions_steps, hemisphere_kernel_part, HemisphereDensity};
 use crate::settings::Noise;
 use crate::stereo::Eye;

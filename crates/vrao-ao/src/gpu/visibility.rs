@@ -5,7 +5,7 @@
 //! not every frame.
 
 use super::Gpu;
-use crate::passes::ChainSettings;
+use crate::frame::ChainSettings;
 use crate::stereo::Eye;
 use crate::visibility::{RateMap, VisibilityMask};
 

@@ -18,16 +18,30 @@ pub(crate) mod ssdo;
 pub(crate) mod temporal;
 pub(crate) mod upsample;
 
+pub(crate) use crate::frame::{ChainSettings, DeclareContext, FrameMotion, MoverBox};
 use crate::gpu::kernel::Bind;
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::timing::SpanRecorder;
 use crate::gpu::uniforms::{ao_extent, FrameUniforms};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource};
-use crate::settings::AoSettings;
-use crate::technique::{TechniqueKind, TECHNIQUES};
-use std::any::Any;
+use crate::technique::{Technique, TechniqueKind, TECHNIQUES};
 use std::collections::{BTreeMap, HashMap};
+
+/// The engine's pass of `technique` (the table says which have one:
+/// `TechniqueEntry::engine_pass`).
+fn engine_pass(gpu: &Gpu, technique: Technique) -> Option<Box<dyn Pass>> {
+    let pass: Box<dyn Pass> = match technique {
+        Technique::Ssao => Box::new(ssao::pass(gpu)),
+        Technique::Hbao => Box::new(hbao::pass(gpu)),
+        Technique::Gtao => Box::new(gtao::GtaoPass::new(gpu)),
+        Technique::Ssdo | Technique::SsdoBounce => Box::new(ssdo::SsdoPass::new(gpu, technique)),
+        Technique::FetchOnly => Box::new(fetch_only::pass(gpu)),
+        _ => return None,
+    };
+    debug_assert!(technique.entry().engine_pass, "{technique:?} has an engine pass the table does not list");
+    Some(pass)
+}
 
 /// The AO chain, in execution order: each technique of the table that has a pass (one
 /// runs; `TECHNIQUES`), then `light_gathering`
@@ -39,8 +53,8 @@ pub fn ao_chain(gpu: &Gpu, light_gathering: Vec<Box<dyn Pass>>) -> Vec<Box<dyn P
     let mut chain: Vec<Box<dyn Pass>> = Vec::new();
     let mut light_gathering = Some(light_gathering);
     for entry in &TECHNIQUES {
-        match entry.pass {
-            Some(make) => chain.push(make(gpu)),
+        match engine_pass(gpu, entry.technique) {
+            Some(pass) => chain.push(pass),
             // The renderer's light-gathering passes take the table's place for them.
             None if entry.kind == TechniqueKind::LightGathering => {
                 chain.extend(light_gathering.take().into_iter().flatten())
@@ -52,112 +66,6 @@ pub fn ao_chain(gpu: &Gpu, light_gathering: Vec<Box<dyn Pass>>) -> Vec<Box<dyn P
     chain.push(Box::new(blur::BlurPass::new(gpu)));
     chain.push(Box::new(upsample::UpsamplePass::new(gpu)));
     chain
-}
-
-/// What the AO chain's passes read of the settings: each view's size, the near plane and
-/// the AO settings. A renderer's own settings reach its passes as an extension
-/// ([`DeclareContext::extension`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ChainSettings {
-    /// Width of each view in pixels (full resolution).
-    pub width: u32,
-    /// Height of each view in pixels.
-    pub height: u32,
-    /// Near plane distance (reversed-Z, far plane at infinity).
-    pub near: f64,
-    /// The AO settings.
-    pub ao: AoSettings,
-}
-
-/// What passes may consult when declaring themselves for a frame.
-pub struct DeclareContext<'a> {
-    /// What a renderer's own passes read beyond the engine's (its scene, its uploaded
-    /// scene, its settings), found by type ([`DeclareContext::extension`]); empty in the AO
-    /// engine.
-    pub extensions: &'a [&'a dyn Any],
-    /// Whether the normals' w marks alpha-tested surfaces (cards) that GTAO samples as
-    /// thin planes (a renderer's scene with alpha-tested materials; never a host's).
-    pub alpha_cards: bool,
-    /// The f64 origin that view-from-anchored matrices start from (the scene's anchor;
-    /// the world origin for a host's views).
-    pub anchor: glam::DVec3,
-    /// This frame's settings.
-    pub settings: &'a ChainSettings,
-    /// 2 for stereo, 1 for a mono view.
-    pub views: u32,
-    /// Whether the G-buffer draws both layers in one multiview pass.
-    pub multiview: bool,
-    /// Frames this renderer has rendered before this one (turns sampling patterns).
-    pub frame_index: u64,
-    /// This frame's views (empty when only planning).
-    pub current_views: &'a [crate::stereo::Eye],
-    /// The previous frame's views, when it had as many as this one (temporal reuse).
-    pub previous_views: Option<&'a [crate::stereo::Eye]>,
-    /// What moves this frame ([`FrameMotion::STILL`] in a still scene).
-    pub motion: &'a FrameMotion,
-}
-
-/// What moved since the previous frame, for temporal accumulation.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FrameMotion {
-    /// Whether [`inputs::MOTION`] holds each pixel's motion this frame (the scene
-    /// moves, or a host handed its motion vectors to the AO engine).
-    pub vectors: bool,
-    /// Boxes around every moving object, where it is and where it was in the previous
-    /// frame: the AO of what lies within the AO radius of them changes although the
-    /// surface itself does not move.
-    pub movers: Vec<MoverBox>,
-    /// What turns a motion texel's xy into the uv offset to the previous frame
-    /// (1, 1 for the G-buffer's).
-    pub uv_scale: [f32; 2],
-    /// Whether the motion's z holds the change in distance and w its validity (the
-    /// G-buffer's); a host's 2D vectors leave the distance to the eyes' motion.
-    pub with_distance: bool,
-}
-
-/// An oriented box around a moving object (`MoverBox` of temporal.wgsl): a point p of
-/// the anchored frame lies inside when |rows · (p, 1)| ≤ half_extents on each axis.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct MoverBox {
-    /// The box's frame from the anchored world frame: three rows of an affine map whose
-    /// rotation is orthonormal, so distances stay in metres.
-    pub box_from_anchored: [[f32; 4]; 3],
-    /// Half the box's size along its axes (metres); w unused.
-    pub half_extents: [f32; 4],
-}
-
-impl MoverBox {
-    /// The box `local` (min and max corners in a node's frame) placed by `world` (world from local,
-    /// rotation and scale without shear), relative to `anchor`.
-    pub fn of(local: (glam::DVec3, glam::DVec3), world: &glam::DMat4, anchor: glam::DVec3) -> MoverBox {
-        let (min, max) = local;
-        let m = glam::DMat3::from_mat4(*world);
-        let axes = [m.x_axis, m.y_axis, m.z_axis];
-        let half = (max - min) * 0.5;
-        let centre = world.transform_point3((min + max) * 0.5) - anchor;
-        let mut rows = [[0.0f32; 4]; 3];
-        let mut half_extents = [0.0f32; 4];
-        for (i, axis) in axes.iter().enumerate() {
-            let length = axis.length();
-            let unit = if length > 0.0 && length.is_finite() { *axis / length } else { glam::DVec3::ZERO };
-            rows[i] = [unit.x as f32, unit.y as f32, unit.z as f32, -unit.dot(centre) as f32];
-            half_extents[i] = (half[i] * length) as f32;
-        }
-        MoverBox { box_from_anchored: rows, half_extents }
-    }
-}
-
-impl FrameMotion {
-    /// Nothing moves but the eyes.
-    pub const STILL: FrameMotion =
-        FrameMotion { vectors: false, movers: Vec::new(), uv_scale: [1.0; 2], with_distance: true };
-}
-
-impl Default for FrameMotion {
-    fn default() -> Self {
-        FrameMotion::STILL
-    }
 }
 
 /// Everything a pass records with.
@@ -184,14 +92,6 @@ pub struct RecordContext<'a> {
     pub timer: &'a dyn SpanRecorder,
     /// What the passes were declared with.
     pub setup: &'a DeclareContext<'a>,
-}
-
-impl<'a> DeclareContext<'a> {
-    /// The extension of type `T` the driver of the graph put in [`DeclareContext::extensions`]
-    /// (a renderer's scene for its own passes), if any.
-    pub fn extension<T: Any>(&self) -> Option<&'a T> {
-        self.extensions.iter().find_map(|e| e.downcast_ref::<T>())
-    }
 }
 
 impl<'a> RecordContext<'a> {

@@ -22,6 +22,8 @@ pub enum BackendChoice {
     Gl,
 }
 
+vrao_ao::impl_choice!(BackendChoice);
+
 impl BackendChoice {
     /// Every choice, the default first.
     pub const ALL: [BackendChoice; 3] = [BackendChoice::Auto, BackendChoice::Vulkan, BackendChoice::Gl];

@@ -7,67 +7,12 @@
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
 use super::right_eye_list::RightEyeList;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
-use crate::error::{Error, Result};
 use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::Technique;
 use bytemuck::{Pod, Zeroable};
-
-/// GTAO's default slab behind each depth sample, a fraction of the radius.
-const DEFAULT_THICKNESS: f32 = 0.75;
-/// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
-const DEFAULT_STEP_POWER: f32 = 1.5;
-/// GTAO's default: successive samples closer than this fraction of the radius are joined.
-const DEFAULT_CONNECT: f32 = 0.25;
-
-/// GTAO's own settings (`AoSettings::gtao`), and their command-line flags. The defaults
-/// are tuned against the reference (scripts/tune-gtao.py and docs/records/2026-11-29/gtao-tuning.md).
-#[derive(Clone, Debug, PartialEq)]
-pub struct GtaoSettings {
-    /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
-    /// radius (thin objects stop occluding behind themselves).
-    // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
-    // fewer halos (pixels beside depth edges too dark by > 0.1); 0.5 leaves fewer still
-    // but costs RMSE (docs/records/2026-11-29/measurements-in-code.md, gtao-thickness).
-    pub thickness: f32,
-    /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
-    /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
-    pub step_power: f32,
-    /// GTAO: successive samples whose distances differ by less than this fraction of the
-    /// radius lie on one continuous surface, which also blocks the angles between them
-    /// (0: never).
-    pub connect: f32,
-}
-
-impl Default for GtaoSettings {
-    fn default() -> Self {
-        GtaoSettings { thickness: DEFAULT_THICKNESS, step_power: DEFAULT_STEP_POWER, connect: DEFAULT_CONNECT }
-    }
-}
-
-impl GtaoSettings {
-    /// Refuses values outside their ranges, naming the value.
-    pub fn validate(&self) -> Result<()> {
-        if !(self.thickness.is_finite() && (0.0..=100.0).contains(&self.thickness)) {
-            return Err(Error::input(format!(
-                "thickness {} is not within 0..=100 (a fraction of the radius)",
-                self.thickness
-            )));
-        }
-        if !(self.step_power.is_finite() && (1.0..=2.0).contains(&self.step_power)) {
-            return Err(Error::input(format!("step power {} is not within 1..=2", self.step_power)));
-        }
-        if !(self.connect.is_finite() && (0.0..=100.0).contains(&self.connect)) {
-            return Err(Error::input(format!(
-                "connect {} is not within 0..=100 (a fraction of the radius)",
-                self.connect
-            )));
-        }
-        Ok(())
-    }
-}
 
 /// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
 /// layers for the right eye's dispatches (gtao.wgsl `left_occlusion`, `left_geometry`),
@@ -91,7 +36,7 @@ const GTAO_FILES: [Shader; 5] =
 /// after it, the file of its light hooks: gtao_light.wgsl for GTAO), its bindings
 /// (`BINDINGS` and its own after them), its extra pipeline constants, and what it
 /// adds to its declaration.
-pub struct March {
+pub(crate) struct March {
     /// The technique (its pass runs when it is chosen).
     pub technique: Technique,
     /// The pipelines' label.

@@ -7,7 +7,7 @@
 //! towards the pixel, in colour (rgb: the irradiance the composite multiplies by albedo/π).
 //!
 //! The environment comes from the frame's SH quadratics (`frame.environment_quadratics`,
-//! a renderer's environment or a host's [`crate::ao::HostLight`]); the bounce's senders
+//! a renderer's environment or a host's [`crate::HostLight`]); the bounce's senders
 //! from [`DIRECT_LIGHT`] (the renderer's direct-light pass, or the host's radiance packed
 //! by the engine). Without either, SSDO is GTAO's AO with no light in rgb.
 

@@ -94,6 +94,8 @@ pub struct Content {
     pub lights: Vec<Light>,
     /// The first camera's pose, if the default scene has a camera.
     pub camera: Option<HeadPose>,
+    /// What the file asks for that vrao leaves out, one line each (also logged).
+    pub warnings: Vec<String>,
 }
 
 /// A glTF file as a scene: its camera as the head pose (else framed as a bare OBJ), its
@@ -141,7 +143,10 @@ pub fn load_content_within(
     } else {
         (bytes, None)
     };
-    let mut root: json::Root = json::deserialize::from_slice(&json_bytes)
+    // A UTF-8 byte-order mark is not JSON (and glTF asks files to go without one), but
+    // editors write it: read past it, as the sample viewer does.
+    let json_text = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&json_bytes);
+    let mut root: json::Root = json::deserialize::from_slice(json_text)
         .map_err(|e| Error::in_file(path, format!("not valid glTF JSON: {e}")))?;
     drop(json_bytes);
 
@@ -179,9 +184,12 @@ pub fn load_content_within(
         primitives: HashMap::new(),
         budget: used,
     };
-    let content = loader.build()?;
+    let mut content = loader.build()?;
     check_limits(path, &content)?;
-    loader.warnings.emit(path);
+    content.warnings = loader.warnings.lines(path);
+    for line in &content.warnings {
+        log::warn!("{line}");
+    }
     Ok(content)
 }
 
@@ -297,15 +305,18 @@ struct Warnings {
 }
 
 impl Warnings {
-    fn emit(&self, path: &Path) {
+    /// One line for the unsupported extensions, one for the other features left out.
+    fn lines(&self, path: &Path) -> Vec<String> {
+        let mut lines = Vec::new();
         if !self.extensions.is_empty() {
             let list: Vec<&str> = self.extensions.iter().map(String::as_str).collect();
-            log::warn!("{}: optional extensions not supported (ignored): {}", path.display(), list.join(", "));
+            lines.push(format!("{}: optional extensions not supported (ignored): {}", path.display(), list.join(", ")));
         }
         if !self.ignored.is_empty() {
             let list: Vec<&str> = self.ignored.iter().copied().collect();
-            log::warn!("{}: not supported (ignored): {}", path.display(), list.join("; "));
+            lines.push(format!("{}: not supported (ignored): {}", path.display(), list.join("; ")));
         }
+        lines
     }
 }
 
@@ -426,8 +437,14 @@ impl Loader<'_> {
             self.warnings.ignored.insert("skins (drawn in the bind pose)");
         }
 
-        let mut content =
-            Content { meshes: Vec::new(), materials: Vec::new(), nodes: Vec::new(), lights: Vec::new(), camera: None };
+        let mut content = Content {
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            nodes: Vec::new(),
+            lights: Vec::new(),
+            camera: None,
+            warnings: Vec::new(),
+        };
         let mut visited = vec![false; document.nodes().len()];
         let mut stack: Vec<(::gltf::Node, Parent)> =
             roots.into_iter().rev().map(|n| (n, Parent { world: DMat4::IDENTITY, node: None })).collect();
@@ -787,7 +804,9 @@ impl Loader<'_> {
             None => "default".to_string(),
         };
         let pbr = material.pbr_metallic_roughness();
-        if pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some() {
+        // The default material's metallicFactor is 1 by the spec, not by the file: no warning.
+        let authored = material.index().is_some();
+        if authored && (pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some()) {
             self.warnings.ignored.insert("metallic-roughness (vrao shades the base colour as diffuse)");
         }
         let factor = pbr.base_color_factor();
