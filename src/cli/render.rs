@@ -104,6 +104,8 @@ pub(crate) fn run(backend: BackendChoice, args: RenderArgs) -> Result<()> {
         out: args.out,
         time: args.time,
         trail: trail.interruptible(interrupt),
+        // As `vrao run` and the bench take it from the simulated headset's profile.
+        mask: settings.ao.mask.then(|| vrao::xr::profiles::visibility_mask(&settings.profile)),
     };
     let still = render_still(&scene, &settings, &options)?;
     println!("{}", still.summary);

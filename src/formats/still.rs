@@ -33,6 +33,9 @@ pub struct StillOptions {
     /// (between frames, pipeline builds, files) and returns `Error::Interrupted` with
     /// everything it wrote removed again.
     pub trail: OutputTrail,
+    /// The headset's visibility mask (the caller's, from the headset profile) when the
+    /// settings' `mask` is on: what the lens hides is skipped and stays black.
+    pub mask: Option<vrao_ao::VisibilityMask>,
 }
 
 /// What [`render_still`] did.
@@ -72,6 +75,7 @@ fn render_and_write(scene: &Scene, settings: &Settings, options: &StillOptions) 
     interrupted()?;
     let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
     renderer.set_timing(options.timing.resolve(&gpu));
+    renderer.set_visibility_mask(options.mask.clone().filter(|_| settings.ao.mask));
     renderer.set_scene_time(options.time);
     let eyes = settings.profile.eyes(&scene.head.pose_at(options.time), settings.near);
     let outputs = crate::formats::output::outputs(settings, options.debug);
