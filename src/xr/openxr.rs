@@ -317,6 +317,18 @@ const LOADER_NAMES: [&str; 2] = ["libopenxr_loader.so", "libopenxr_loader.so.1"]
 /// Opens the OpenXR loader.
 #[cfg(feature = "xr")]
 pub fn load_entry() -> Result<openxr::Entry, Unavailable> {
+    // The loader reads XR_RUNTIME_JSON's manifest unbounded (a device such as /dev/zero
+    // is read forever): vrao checks it first, as it reads every file a user names.
+    if let Some(manifest) = std::env::var_os("XR_RUNTIME_JSON").filter(|v| !v.is_empty()) {
+        let manifest = std::path::PathBuf::from(manifest);
+        if let Err(e) = vrao_render::files::read_regular_file_to_string(&manifest, vrao_render::files::MAX_TEXT_BYTES) {
+            let shown = manifest.display();
+            return Err(Unavailable::NoRuntime(format!(
+                "XR_RUNTIME_JSON manifest {shown} cannot be read: {}",
+                e.problem
+            )));
+        }
+    }
     // The loader prints its own multi-line errors to stderr when no runtime is installed;
     // vrao says why in one line instead. XR_LOADER_DEBUG set by the user still wins.
     if std::env::var_os("XR_LOADER_DEBUG").is_none() {

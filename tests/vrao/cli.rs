@@ -628,7 +628,15 @@ fn an_unusable_openxr_runtime_names_its_manifest_not_the_gpu() {
     let missing = dir.join("missing.json").to_str().unwrap().to_string();
     let broken = write(&dir, "broken.json", "{ not json");
     let gone = write(&dir, "gone.json", r#"{"runtime": {"library_path": "./libgone.so"}}"#);
-    for (manifest, cause) in [(&missing, "cannot be read"), (&broken, "does not parse"), (&gone, "does not exist")] {
+    // A device is refused before the loader reads it (the loader read /dev/zero forever).
+    let device = "/dev/zero".to_string();
+    let cases = [
+        (&missing, "cannot be read"),
+        (&broken, "does not parse"),
+        (&gone, "does not exist"),
+        (&device, "cannot be read"),
+    ];
+    for (manifest, cause) in cases {
         let out = Command::new(env!("CARGO_BIN_EXE_vrao"))
             .args(["run", "--headset", "openxr", "--display", "none", "--frames", "1"])
             .env("XR_RUNTIME_JSON", manifest)
