@@ -299,7 +299,6 @@ impl AoArgs {
     }
 }
 
-/// `X,Y,Z` in metres, each finite.
 /// The largest scene time the options take (seconds: about 11.6 days).
 pub(crate) const MAX_SCENE_TIME_S: f64 = 1e6;
 
@@ -312,6 +311,8 @@ pub(crate) fn parse_scene_time(s: &str) -> Result<f64, String> {
     Ok(t)
 }
 
+/// `X,Y,Z` in metres, each finite and within the scene's coordinate bound (a pose a
+/// scene file would refuse is refused here too, not rendered as sky).
 pub(crate) fn parse_vec3(s: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
@@ -322,6 +323,9 @@ pub(crate) fn parse_vec3(s: &str) -> Result<DVec3, String> {
         *slot = part.parse::<f64>().map_err(|_| format!("'{part}' in '{s}' is not a number"))?;
         if !slot.is_finite() {
             return Err(format!("'{part}' in '{s}' is not finite"));
+        }
+        if let Some(trouble) = vrao_render::scene::limits::coordinate_trouble(&format!("'{part}' in '{s}'"), *slot) {
+            return Err(trouble);
         }
     }
     Ok(DVec3::from_array(v))

@@ -109,6 +109,8 @@ fn out_of_range_values_exit_2() {
         &["render", "--exposure", "0"],
         &["render", "--eye", "1,2", "--look-at", "0,0,0"],
         &["render", "--eye", "0,0,0", "--look-at", "0,0,0"],
+        // As far as a scene file's pose is refused (it rendered the sky alone).
+        &["render", "--eye", "2e6,1,0", "--look-at", "0,0,0"],
         &["render", "--stereo", "sideways"],
         &["render", "--scene", "builtin:nope"],
     ] {
