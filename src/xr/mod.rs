@@ -53,7 +53,10 @@ pub fn missed_refreshes(period_ms: f64, refresh_ms: f64) -> u64 {
 /// The display's refresh period as a runtime tells it, and the refreshes missed between
 /// the frames it hands out. The refresh rate the runtime reports (XR_FB_display_refresh_rate)
 /// wins; without one, the shortest predicted display period seen so far stands for it,
-/// never a longer one (a runtime stretches its predicted period when frames are late).
+/// never a longer one (a runtime stretches its predicted period when frames are late),
+/// and never the period predicted for the first frame, before any frame was shown
+/// (Monado predicts 16 ms there and 50 ms after it on its 20 Hz display: the budget
+/// locked at 16 ms and counted every frame late).
 /// Pure bookkeeping: the OpenXR headset feeds it each frame's predicted display time and
 /// period.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -62,7 +65,7 @@ pub struct DisplayRate {
     reported_hz: Option<f64>,
     /// The shortest predicted display period seen (ms).
     shortest_ms: Option<f64>,
-    /// The previous frame's predicted display time (ns).
+    /// The previous frame's predicted display time (ns); `None` before the first frame.
     last_display_ns: Option<i64>,
     /// Refreshes missed so far.
     missed: u64,
@@ -86,7 +89,8 @@ impl DisplayRate {
     /// Returns the refreshes missed since the previous frame (the gap between their
     /// display times in refreshes, beyond one).
     pub fn frame(&mut self, display_time_ns: i64, predicted_period_ns: i64) -> u64 {
-        if predicted_period_ns > 0 {
+        // The first frame's period is a guess made before the display ran.
+        if predicted_period_ns > 0 && self.last_display_ns.is_some() {
             let ms = predicted_period_ns as f64 / 1e6;
             self.shortest_ms = Some(self.shortest_ms.map_or(ms, |s| s.min(ms)));
         }
@@ -255,7 +259,10 @@ mod tests {
         // Without XR_FB_display_refresh_rate: Monado-like, 50 ms, then stretched to 100 ms.
         let mut rate = DisplayRate::new();
         assert_eq!((rate.period_ms(), rate.source()), (None, None), "nothing before the first frame");
-        assert_eq!(rate.frame(1000 * MS, 50 * MS), 0);
+        // Monado predicts 16 ms for its first frame, before its display ran.
+        assert_eq!(rate.frame(950 * MS, 16 * MS), 0);
+        assert_eq!(rate.period_ms(), None, "the first frame's guess is not the display's period");
+        assert_eq!(rate.frame(1000 * MS, 50 * MS), 0, "50 ms after the first frame: nothing missed");
         assert_eq!(rate.period_ms(), Some(50.0));
         assert_eq!(rate.frame(1050 * MS, 50 * MS), 0);
         // Frames late: the runtime predicts 100 ms and displays 100 ms apart.
