@@ -99,6 +99,18 @@ impl GeometryBudget {
     }
 }
 
+/// One-line trouble when a scene's distinct images hold more than [`MAX_TEXTURE_BYTES`]
+/// of decoded texels (`what` brought them to `bytes`).
+pub fn texture_budget_trouble(what: &str, bytes: u64) -> Option<String> {
+    (bytes > MAX_TEXTURE_BYTES).then(|| {
+        format!(
+            "{what} brings the scene's textures to {} MiB of texels, over vrao's budget of {} MiB",
+            bytes >> 20,
+            MAX_TEXTURE_BYTES >> 20
+        )
+    })
+}
+
 /// `what` (a colour times its intensity, per channel) as one-line trouble when some
 /// channel is brighter than [`RADIANCE_MAX`].
 pub fn radiance_trouble(what: &str, brightest: f64) -> Option<String> {
@@ -287,6 +299,14 @@ mod tests {
         assert_eq!(mesh_trouble(&mesh), None);
         mesh.origin = DVec3::new(3e38, 0.0, 0.0);
         assert!(mesh_trouble(&mesh).unwrap().contains("vertex 1 of mesh"), "{:?}", mesh_trouble(&mesh));
+    }
+
+    #[test]
+    fn the_texture_budget_takes_one_largest_image_and_refuses_more() {
+        let largest = u64::from(MAX_TEXTURE_SIDE) * u64::from(MAX_TEXTURE_SIDE) * 4;
+        assert_eq!(texture_budget_trouble("image 0", largest.min(MAX_TEXTURE_BYTES)), None);
+        let e = texture_budget_trouble("image 3", MAX_TEXTURE_BYTES + 4).unwrap();
+        assert_eq!(e, "image 3 brings the scene's textures to 1024 MiB of texels, over vrao's budget of 1024 MiB");
     }
 
     #[test]

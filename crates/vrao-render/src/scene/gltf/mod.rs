@@ -929,12 +929,8 @@ impl Loader<'_> {
         };
         let texture = decode_image(&bytes).map_err(|Problem(m)| self.error(format!("{what}: {m}")))?;
         self.texture_bytes += texture.rgba8.len() as u64;
-        if self.texture_bytes > super::limits::MAX_TEXTURE_BYTES {
-            return Err(self.error(format!(
-                "{what} brings the scene's textures to {} MiB of texels, over vrao's budget of {} MiB",
-                self.texture_bytes >> 20,
-                super::limits::MAX_TEXTURE_BYTES >> 20
-            )));
+        if let Some(trouble) = super::limits::texture_budget_trouble(&what, self.texture_bytes) {
+            return Err(self.error(trouble));
         }
         self.images.insert(source, texture.clone());
         Ok(texture)
