@@ -51,7 +51,7 @@ pub struct DeclareContext<'a> {
 /// What moved since the previous frame, for temporal accumulation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameMotion {
-    /// Whether [`inputs::MOTION`] holds each pixel's motion this frame (the scene
+    /// Whether [`MOTION`](crate::plug::MOTION) holds each pixel's motion this frame (the scene
     /// moves, or a host handed its motion vectors to the AO engine).
     pub vectors: bool,
     /// Boxes around every moving object, where it is and where it was in the previous
