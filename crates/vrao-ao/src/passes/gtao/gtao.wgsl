@@ -51,13 +51,13 @@ override INNER_BAND: bool = false;
 // see (its outer side, disocclusions). Its outputs are bound as one-layer views
 // (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layers of AoRaw and
 // AoGeometry (common.wgsl `left_eye_value`). First `classify_right_eye` copies every
-// pixel it can and lists the pixels that must march; then `main` with LISTED_TILES runs
+// pixel it can and lists the pixels that must march; then `main` with LISTED_PIXELS runs
 // over the listed pixels alone, 64 to a workgroup (a tile), by an indirect dispatch: the
 // right eye pays for the pixels the left eye cannot give, not for every warp that holds
 // one of them (listing 8×8 tiles of the image instead dispatched every tile a silhouette
 // crosses: a quarter of Sibenik's right eye).
 override RIGHT_EYE: bool = false;
-override LISTED_TILES: bool = false;
+override LISTED_PIXELS: bool = false;
 
 // Set when the scene has alpha-tested materials. A depth sample on one (the G-buffer's
 // normal w, gbuffer.wgsl) is a card — a leaf, a grille, a fence — with no depth behind
@@ -107,7 +107,7 @@ struct RightEyeList {
 // The occlusion pixel of invocation `id` (in workgroup `group`, at `local` within it) in
 // this dispatch's part of the image, or none (x = ao_size.x) past its part's width.
 fn dispatch_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
-    if (RIGHT_EYE && LISTED_TILES) {
+    if (RIGHT_EYE && LISTED_PIXELS) {
         let i = group.x * 64u + local;
         if (i >= atomicLoad(&right_list.count)) {
             return vec3<u32>(ao.ao_size.x, 0u, 1u);

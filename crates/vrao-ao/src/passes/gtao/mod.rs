@@ -104,7 +104,7 @@ impl Kernels {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
                 ("RIGHT_EYE", f64::from(right)),
-                ("LISTED_TILES", f64::from(right)),
+                ("LISTED_PIXELS", f64::from(right)),
                 ("SINGLE_LAYER_OUTPUT", f64::from(right)),
                 ("THIN_CARDS", f64::from(thin_cards)),
             ];
