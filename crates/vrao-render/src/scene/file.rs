@@ -268,6 +268,12 @@ impl Failure {
     }
 }
 
+impl From<super::limits::Trouble> for Failure {
+    fn from(trouble: super::limits::Trouble) -> Failure {
+        Failure::from(trouble.0)
+    }
+}
+
 impl From<String> for Failure {
     fn from(message: String) -> Failure {
         Failure::Here(message)

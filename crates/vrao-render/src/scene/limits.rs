@@ -43,6 +43,35 @@ pub const MAX_TEXTURE_BYTES: u64 = 1 << 30;
 /// The largest texture side in texels, for every image a scene names.
 pub const MAX_TEXTURE_SIDE: u32 = 16_384;
 
+/// Why a value or a file's content is refused, in one line, before the caller names the
+/// file (and line) it came from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Trouble(pub String);
+
+impl std::fmt::Display for Trouble {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl From<String> for Trouble {
+    fn from(message: String) -> Trouble {
+        Trouble(message)
+    }
+}
+
+impl From<&str> for Trouble {
+    fn from(message: &str) -> Trouble {
+        Trouble(message.to_string())
+    }
+}
+
+impl From<Trouble> for String {
+    fn from(trouble: Trouble) -> String {
+        trouble.0
+    }
+}
+
 /// The triangles and vertices a scene holds so far, checked against [`MAX_TRIANGLES`] and
 /// [`MAX_VERTICES`] as each part is added (so that a file placed many times is refused
 /// before the memory for all of them is spent).
@@ -68,14 +97,14 @@ impl GeometryBudget {
 
     /// This budget with `more` added, or one-line trouble (naming what `what` adds) when
     /// the sum passes either limit.
-    pub fn plus(self, more: GeometryBudget, what: &str) -> std::result::Result<GeometryBudget, String> {
+    pub fn plus(self, more: GeometryBudget, what: &str) -> std::result::Result<GeometryBudget, Trouble> {
         let sum = GeometryBudget {
             triangles: self.triangles.saturating_add(more.triangles),
             vertices: self.vertices.saturating_add(more.vertices),
             meshes: self.meshes.saturating_add(more.meshes),
         };
         match sum.trouble() {
-            Some(trouble) => Err(format!("{what} brings the scene to {trouble}")),
+            Some(trouble) => Err(format!("{what} brings the scene to {trouble}").into()),
             None => Ok(sum),
         }
     }
@@ -183,15 +212,15 @@ pub fn texture_decoder_limits() -> image::Limits {
 /// Decodes an image file's bytes (PNG, JPEG, TGA, BMP, by content) under
 /// [`texture_decoder_limits`]: a side over [`MAX_TEXTURE_SIDE`] is refused from the header,
 /// before any texel is decoded.
-pub fn decode_texture(bytes: &[u8]) -> std::result::Result<image::DynamicImage, String> {
+pub fn decode_texture(bytes: &[u8]) -> std::result::Result<image::DynamicImage, Trouble> {
     let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format();
     let (width, height) = reader().map_err(|e| e.to_string())?.into_dimensions().map_err(|e| e.to_string())?;
     if let Some(trouble) = texture_side_trouble(width, height) {
-        return Err(trouble);
+        return Err(trouble.into());
     }
     let mut reader = reader().map_err(|e| e.to_string())?;
     reader.limits(texture_decoder_limits());
-    reader.decode().map_err(|e| e.to_string())
+    reader.decode().map_err(|e| e.to_string().into())
 }
 
 /// One-line trouble when some vertex of `mesh` (static, in world space) lies beyond
@@ -313,10 +342,10 @@ mod tests {
     fn one_budget_for_the_scene_and_every_builtin_within_it() {
         let most = GeometryBudget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES, meshes: MAX_MESHES };
         assert_eq!(most.trouble(), None);
-        let e = most.plus(GeometryBudget { triangles: 0, vertices: 0, meshes: 1 }, "mesh 'a'").unwrap_err();
+        let e = most.plus(GeometryBudget { triangles: 0, vertices: 0, meshes: 1 }, "mesh 'a'").unwrap_err().0;
         assert!(e.starts_with("mesh 'a' brings the scene to 65537 meshes") && e.contains("merge primitives"), "{e}");
         let most = GeometryBudget { meshes: 0, ..most };
-        let e = most.plus(GeometryBudget { triangles: 1, vertices: 0, meshes: 0 }, "mesh obj 'a.obj'").unwrap_err();
+        let e = most.plus(GeometryBudget { triangles: 1, vertices: 0, meshes: 0 }, "mesh obj 'a.obj'").unwrap_err().0;
         assert_eq!(
             e,
             "mesh obj 'a.obj' brings the scene to 20000001 triangles and 20000000 vertices, more than vrao's limit \

@@ -4,7 +4,9 @@
 //! `openxr/mask.rs`'s.
 
 use super::*;
-use crate::xr::openxr::mask::{check_counts, skip_runtime_mask, view_mask, MaskMesh, SessionMask, MASK_VAR, VIEWS};
+use crate::xr::openxr::mask::{
+    check_counts, skip_runtime_mask, view_mask, MaskMesh, MaskTrouble, SessionMask, MASK_VAR, VIEWS,
+};
 use vrao_ao::ViewMask;
 
 /// How often the two-call idiom is tried again when the mask grows between its calls.
@@ -32,7 +34,8 @@ pub(super) fn initial(session: &xr::Session<xr::Vulkan>, enabled: bool) -> Sessi
         log::info!("OpenXR: visibility mask: Monado's default from each view's field of view ({why})");
         return SessionMask::from_field_of_view(&why);
     }
-    let reads: [std::result::Result<ViewMask, String>; VIEWS] = std::array::from_fn(|i| read_view(session, i as u32));
+    let reads: [std::result::Result<ViewMask, MaskTrouble>; VIEWS] =
+        std::array::from_fn(|i| read_view(session, i as u32));
     let (mask, problem) = SessionMask::from_runtime(reads);
     if let Some(problem) = problem {
         log::warn!("OpenXR: {problem}");
@@ -41,7 +44,7 @@ pub(super) fn initial(session: &xr::Session<xr::Vulkan>, enabled: bool) -> Sessi
 }
 
 /// One view's mask: its hidden triangle mesh, else (when that is empty) its visible one.
-pub(super) fn read_view(session: &xr::Session<xr::Vulkan>, view: u32) -> std::result::Result<ViewMask, String> {
+pub(super) fn read_view(session: &xr::Session<xr::Vulkan>, view: u32) -> std::result::Result<ViewMask, MaskTrouble> {
     view_mask(read_mesh(session, view, xr::VisibilityMaskTypeKHR::HIDDEN_TRIANGLE_MESH), || {
         read_mesh(session, view, xr::VisibilityMaskTypeKHR::VISIBLE_TRIANGLE_MESH)
     })
@@ -54,7 +57,7 @@ fn read_mesh(
     session: &xr::Session<xr::Vulkan>,
     view: u32,
     kind: xr::VisibilityMaskTypeKHR,
-) -> std::result::Result<MaskMesh, String> {
+) -> std::result::Result<MaskMesh, MaskTrouble> {
     const CALL: &str = "xrGetVisibilityMaskKHR";
     let Some(ext) = session.instance().exts().khr_visibility_mask.as_ref() else {
         return Err("XR_KHR_visibility_mask is not enabled".into());
@@ -73,7 +76,7 @@ fn read_mesh(
     // capacities 0 the runtime only writes the two counts into `info`.
     let result = unsafe { (ext.get_visibility_mask)(session.as_raw(), VIEW_TYPE, view, kind, &mut info) };
     if result.into_raw() < 0 {
-        return Err(super::super::xr_call_failed(CALL, result));
+        return Err(super::super::xr_call_failed(CALL, result).into());
     }
     for _ in 0..READ_TRIES {
         check_counts(info.vertex_count_output, info.index_count_output)?;
@@ -95,11 +98,11 @@ fn read_mesh(
             continue;
         }
         if result.into_raw() < 0 {
-            return Err(super::super::xr_call_failed(CALL, result));
+            return Err(super::super::xr_call_failed(CALL, result).into());
         }
         vertices.truncate(info.vertex_count_output as usize);
         indices.truncate(info.index_count_output as usize);
         return Ok(MaskMesh { vertices: vertices.iter().map(|v| glam::Vec2::new(v.x, v.y)).collect(), indices });
     }
-    Err(format!("{CALL}: the mask kept growing between the count and the read ({READ_TRIES} tries)"))
+    Err(format!("{CALL}: the mask kept growing between the count and the read ({READ_TRIES} tries)").into())
 }

@@ -888,7 +888,7 @@ impl Loader<'_> {
     fn texture(
         &mut self,
         texture: &::gltf::Texture,
-        placement: std::result::Result<Placement, String>,
+        placement: std::result::Result<Placement, super::limits::Trouble>,
         material: &str,
     ) -> Result<Texture> {
         let placement = placement.map_err(|m| self.error(m))?;
@@ -1129,7 +1129,7 @@ struct Placement {
 }
 
 /// A base-colour or emissive texture's placement (`textureInfo`).
-fn placement_of_info(info: &::gltf::texture::Info) -> std::result::Result<Placement, String> {
+fn placement_of_info(info: &::gltf::texture::Info) -> std::result::Result<Placement, super::limits::Trouble> {
     Ok(match info.texture_transform() {
         Some(t) => Placement {
             tex_coord: t.tex_coord().unwrap_or(info.tex_coord()),
@@ -1145,13 +1145,13 @@ fn placement_of_extension(
     extension: Option<&json::Value>,
     tex_coord: u32,
     material: &str,
-) -> std::result::Result<Placement, String> {
+) -> std::result::Result<Placement, super::limits::Trouble> {
     let Some(extension) = extension else {
         return Ok(Placement { tex_coord, transform: glam::Affine2::IDENTITY });
     };
     let bad =
         || format!("material '{material}': KHR_texture_transform {extension} is not offset/rotation/scale numbers");
-    let pair = |key: &str, default: [f32; 2]| -> std::result::Result<glam::Vec2, String> {
+    let pair = |key: &str, default: [f32; 2]| -> std::result::Result<glam::Vec2, super::limits::Trouble> {
         match extension.get(key) {
             None => Ok(default.into()),
             Some(json::Value::Array(v)) if v.len() == 2 => {
@@ -1159,10 +1159,10 @@ fn placement_of_extension(
                 if c.len() == 2 {
                     Ok(glam::Vec2::new(c[0], c[1]))
                 } else {
-                    Err(bad())
+                    Err(bad().into())
                 }
             }
-            _ => Err(bad()),
+            _ => Err(bad().into()),
         }
     };
     let rotation = match extension.get("rotation") {
