@@ -15,6 +15,7 @@
 
 use glam::Vec2;
 use vrao_ao::{Fov, ViewMask, VisibilityMask};
+use vrao_render::scene::limits::Trouble;
 
 /// Views of PRIMARY_STEREO: left, then right.
 pub const VIEWS: usize = 2;
@@ -65,34 +66,11 @@ pub fn skip_runtime_mask(runtime_name: &str, major: u16, choice: Option<&str>) -
     }
 }
 
-/// Why a view has no mask from the runtime, in one line (a failed call, a mesh vrao
-/// refuses).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct MaskTrouble(pub String);
-
-impl std::fmt::Display for MaskTrouble {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl From<String> for MaskTrouble {
-    fn from(message: String) -> MaskTrouble {
-        MaskTrouble(message)
-    }
-}
-
-impl From<&str> for MaskTrouble {
-    fn from(message: &str) -> MaskTrouble {
-        MaskTrouble(message.to_string())
-    }
-}
-
 /// Refuses counts above [`MAX_MESH_ELEMENTS`] before anything is allocated for them.
-pub fn check_counts(vertices: u32, indices: u32) -> Result<(), MaskTrouble> {
+pub fn check_counts(vertices: u32, indices: u32) -> Result<(), Trouble> {
     let (v, i) = (vertices as usize, indices as usize);
     if v > MAX_MESH_ELEMENTS || i > MAX_MESH_ELEMENTS {
-        return Err(MaskTrouble(format!(
+        return Err(Trouble(format!(
             "the mesh has {v} vertices and {i} indices (vrao takes at most {MAX_MESH_ELEMENTS} of each)"
         )));
     }
@@ -104,20 +82,20 @@ pub fn check_counts(vertices: u32, indices: u32) -> Result<(), MaskTrouble> {
 /// mesh [`ViewMask`] refuses (indices out of range, a vertex that is not finite) is the
 /// reason there is no mask.
 pub fn view_mask(
-    hidden: Result<MaskMesh, MaskTrouble>,
-    visible: impl FnOnce() -> Result<MaskMesh, MaskTrouble>,
-) -> Result<ViewMask, MaskTrouble> {
+    hidden: Result<MaskMesh, Trouble>,
+    visible: impl FnOnce() -> Result<MaskMesh, Trouble>,
+) -> Result<ViewMask, Trouble> {
     let hidden = hidden.map_err(|e| format!("hidden triangle mesh: {e}"))?;
     if !hidden.is_empty() {
         return ViewMask::from_hidden_mesh(&hidden.vertices, &hidden.indices, format!("{RUNTIME_SOURCE}, hidden mesh"))
-            .map_err(|e| MaskTrouble(format!("hidden triangle mesh: {e}")));
+            .map_err(|e| Trouble(format!("hidden triangle mesh: {e}")));
     }
     let visible = visible().map_err(|e| format!("the hidden triangle mesh is empty; visible triangle mesh: {e}"))?;
     if visible.is_empty() {
         return Err("the hidden and the visible triangle meshes are both empty".into());
     }
     ViewMask::from_visible_mesh(&visible.vertices, &visible.indices, format!("{RUNTIME_SOURCE}, visible mesh"))
-        .map_err(|e| MaskTrouble(format!("visible triangle mesh: {e}")))
+        .map_err(|e| Trouble(format!("visible triangle mesh: {e}")))
 }
 
 /// Where the session's mask comes from.
@@ -146,7 +124,7 @@ impl SessionMask {
     /// The mask read from the runtime at the start of the session, one read per view.
     /// Returns it and, when a view has no mask (the session then has none), one line
     /// saying why for the log.
-    pub fn from_runtime(reads: [Result<ViewMask, MaskTrouble>; VIEWS]) -> (SessionMask, Option<String>) {
+    pub fn from_runtime(reads: [Result<ViewMask, Trouble>; VIEWS]) -> (SessionMask, Option<String>) {
         let mut problems = Vec::new();
         let views = reads.map(|read| read.map_err(|e| problems.push(e)).ok());
         let mut mask = SessionMask { origin: Origin::Runtime, views, mask: None, changes: 0 };
@@ -209,12 +187,7 @@ impl SessionMask {
     /// A fresh mask replaces the view's; a failed read leaves the view without one, and
     /// the session without a mask (rendering pixels the lens hides is safe, hiding ones
     /// it shows is not). Returns one line for the log.
-    pub fn changed(
-        &mut self,
-        ours: bool,
-        view_index: u32,
-        read: impl FnOnce() -> Result<ViewMask, MaskTrouble>,
-    ) -> String {
+    pub fn changed(&mut self, ours: bool, view_index: u32, read: impl FnOnce() -> Result<ViewMask, Trouble>) -> String {
         if !ours {
             return format!("visibility mask of view {view_index} of another view configuration changed: ignored");
         }
@@ -298,7 +271,7 @@ mod tests {
     const Q: f32 = std::f32::consts::FRAC_PI_4;
     const FOV45: Fov = Fov { left: -Q, right: Q, up: Q, down: -Q };
 
-    fn read(mesh: MaskMesh) -> Result<ViewMask, MaskTrouble> {
+    fn read(mesh: MaskMesh) -> Result<ViewMask, Trouble> {
         view_mask(Ok(mesh), || panic!("the hidden mesh is not empty: no visible read"))
     }
 
@@ -409,7 +382,7 @@ mod tests {
 
     #[test]
     fn masks_hiding_nothing_are_no_mask() {
-        let nothing = || ViewMask::from_hidden_mesh(&[], &[], RUNTIME_SOURCE).map_err(|e| MaskTrouble(e.to_string()));
+        let nothing = || ViewMask::from_hidden_mesh(&[], &[], RUNTIME_SOURCE).map_err(|e| Trouble(e.to_string()));
         let (mask, problem) = SessionMask::from_runtime([nothing(), nothing()]);
         assert_eq!((mask.mask(), problem), (None, None));
     }

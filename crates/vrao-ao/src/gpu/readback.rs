@@ -20,18 +20,26 @@ fn texel_bytes(format: wgpu::TextureFormat) -> u32 {
     }
 }
 
-/// The bytes of `source` (which has `COPY_SRC`) once the work submitted so far has run.
-pub(crate) fn read_buffer(gpu: &Gpu, source: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+/// A buffer the GPU copies into and the CPU maps to read.
+fn staging_buffer(gpu: &Gpu, size: u64) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
-        size: source.size(),
+        size,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
+    })
+}
+
+/// Submits `encoder` (its copies into `staging`), waits for the device, maps `staging`
+/// and hands its bytes to `read`.
+fn submit_and_read<T>(
+    gpu: &Gpu,
+    encoder: wgpu::CommandEncoder,
+    staging: &wgpu::Buffer,
+    read: impl FnOnce(&[u8]) -> T,
+) -> Result<T> {
     gpu.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
+    let slice = staging.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -40,9 +48,19 @@ pub(crate) fn read_buffer(gpu: &Gpu, source: &wgpu::Buffer) -> Result<Vec<u8>> {
     rx.recv()
         .map_err(|_| Error::Gpu("readback callback never ran".into()))?
         .map_err(|e| Error::Gpu(format!("readback failed: {e}")))?;
-    let bytes = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?.to_vec();
-    buffer.unmap();
-    Ok(bytes)
+    let data = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?;
+    let value = read(&data);
+    drop(data);
+    staging.unmap();
+    Ok(value)
+}
+
+/// The bytes of `source` (which has `COPY_SRC`) once the work submitted so far has run.
+pub(crate) fn read_buffer(gpu: &Gpu, source: &wgpu::Buffer) -> Result<Vec<u8>> {
+    let staging = staging_buffer(gpu, source.size());
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(source, 0, &staging, 0, source.size());
+    submit_and_read(gpu, encoder, &staging, <[u8]>::to_vec)
 }
 
 /// Raw bytes of every layer, rows tightly packed (the 256-byte row padding removed).
@@ -51,12 +69,7 @@ pub fn read_layers(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<u8>>> {
     let row = target.width * bpt;
     let padded_row = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let layer_bytes = padded_row as u64 * target.height as u64;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: layer_bytes * target.layers as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
+    let buffer = staging_buffer(gpu, layer_bytes * target.layers as u64);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let aspect =
         if target.format.is_depth_stencil_format() { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All };
@@ -72,30 +85,18 @@ pub fn read_layers(gpu: &Gpu, target: &LayeredTarget) -> Result<Vec<Vec<u8>>> {
         },
         wgpu::Extent3d { width: target.width, height: target.height, depth_or_array_layers: target.layers },
     );
-    gpu.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    gpu.wait_idle()?;
-    rx.recv()
-        .map_err(|_| Error::Gpu("readback callback never ran".into()))?
-        .map_err(|e| Error::Gpu(format!("readback failed: {e}")))?;
-    let data = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?;
-    let layers = (0..target.layers as usize)
-        .map(|layer| {
-            let mut out = Vec::with_capacity((row * target.height) as usize);
-            for y in 0..target.height as usize {
-                let start = layer * layer_bytes as usize + y * padded_row as usize;
-                out.extend_from_slice(&data[start..start + row as usize]);
-            }
-            out
-        })
-        .collect();
-    drop(data);
-    buffer.unmap();
-    Ok(layers)
+    submit_and_read(gpu, encoder, &buffer, |data| {
+        (0..target.layers as usize)
+            .map(|layer| {
+                let mut out = Vec::with_capacity((row * target.height) as usize);
+                for y in 0..target.height as usize {
+                    let start = layer * layer_bytes as usize + y * padded_row as usize;
+                    out.extend_from_slice(&data[start..start + row as usize]);
+                }
+                out
+            })
+            .collect()
+    })
 }
 
 /// Every layer as f32 values (channels interleaved), for float, depth and 8-bit formats.

@@ -43,8 +43,8 @@ pub const MAX_TEXTURE_BYTES: u64 = 1 << 30;
 /// The largest texture side in texels, for every image a scene names.
 pub const MAX_TEXTURE_SIDE: u32 = 16_384;
 
-/// Why a value or a file's content is refused, in one line, before the caller names the
-/// file (and line) it came from.
+/// Why a value or a file's content (or a runtime's answer, such as a headset's mask) is
+/// refused, in one line, before the caller says where it came from.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Trouble(pub String);
 

@@ -4,10 +4,9 @@
 //! `openxr/mask.rs`'s.
 
 use super::*;
-use crate::xr::openxr::mask::{
-    check_counts, skip_runtime_mask, view_mask, MaskMesh, MaskTrouble, SessionMask, MASK_VAR, VIEWS,
-};
+use crate::xr::openxr::mask::{check_counts, skip_runtime_mask, view_mask, MaskMesh, SessionMask, MASK_VAR, VIEWS};
 use vrao_ao::ViewMask;
+use vrao_render::scene::limits::Trouble;
 
 /// How often the two-call idiom is tried again when the mask grows between its calls.
 const READ_TRIES: usize = 3;
@@ -34,8 +33,7 @@ pub(super) fn initial(session: &xr::Session<xr::Vulkan>, enabled: bool) -> Sessi
         log::info!("OpenXR: visibility mask: Monado's default from each view's field of view ({why})");
         return SessionMask::from_field_of_view(&why);
     }
-    let reads: [std::result::Result<ViewMask, MaskTrouble>; VIEWS] =
-        std::array::from_fn(|i| read_view(session, i as u32));
+    let reads: [std::result::Result<ViewMask, Trouble>; VIEWS] = std::array::from_fn(|i| read_view(session, i as u32));
     let (mask, problem) = SessionMask::from_runtime(reads);
     if let Some(problem) = problem {
         log::warn!("OpenXR: {problem}");
@@ -44,7 +42,7 @@ pub(super) fn initial(session: &xr::Session<xr::Vulkan>, enabled: bool) -> Sessi
 }
 
 /// One view's mask: its hidden triangle mesh, else (when that is empty) its visible one.
-pub(super) fn read_view(session: &xr::Session<xr::Vulkan>, view: u32) -> std::result::Result<ViewMask, MaskTrouble> {
+pub(super) fn read_view(session: &xr::Session<xr::Vulkan>, view: u32) -> std::result::Result<ViewMask, Trouble> {
     view_mask(read_mesh(session, view, xr::VisibilityMaskTypeKHR::HIDDEN_TRIANGLE_MESH), || {
         read_mesh(session, view, xr::VisibilityMaskTypeKHR::VISIBLE_TRIANGLE_MESH)
     })
@@ -57,7 +55,7 @@ fn read_mesh(
     session: &xr::Session<xr::Vulkan>,
     view: u32,
     kind: xr::VisibilityMaskTypeKHR,
-) -> std::result::Result<MaskMesh, MaskTrouble> {
+) -> std::result::Result<MaskMesh, Trouble> {
     const CALL: &str = "xrGetVisibilityMaskKHR";
     let Some(ext) = session.instance().exts().khr_visibility_mask.as_ref() else {
         return Err("XR_KHR_visibility_mask is not enabled".into());

@@ -19,7 +19,6 @@ use crate::gpu::kernel::{wgsl, Bind, COMMON, IRRADIANCE, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::Technique;
-use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
 /// GTAO's bindings and, at 11, the packed direct light (ssdo.wgsl `direct_layers`).
 const BINDINGS: [Bind; 12] = {
@@ -53,8 +52,6 @@ pub(crate) struct SsdoPass {
     plain: GtaoPass,
     /// The march with the bounce (`ssdo-bounce` only).
     bounce: Option<GtaoPass>,
-    /// Whether the last frame recorded ran the bounce's march.
-    last_recorded_bounce: AtomicBool,
 }
 
 impl SsdoPass {
@@ -82,12 +79,7 @@ impl SsdoPass {
             )
         };
         let bounce = (technique == Technique::SsdoBounce).then(|| march(Technique::SsdoBounce.name(), true));
-        SsdoPass {
-            technique,
-            plain: march(Technique::Ssdo.name(), false),
-            bounce,
-            last_recorded_bounce: AtomicBool::new(false),
-        }
+        SsdoPass { technique, plain: march(Technique::Ssdo.name(), false), bounce }
     }
 
     /// The march this frame runs.
@@ -126,15 +118,12 @@ impl Pass for SsdoPass {
     }
 
     fn record(&self, ctx: &mut RecordContext) {
-        let march = self.march(ctx.setup);
-        self.last_recorded_bounce.store(self.bounce.as_ref().is_some_and(|b| std::ptr::eq(b, march)), Relaxed);
-        march.record(ctx)
+        self.march(ctx.setup).record(ctx)
     }
 
+    /// The count of whichever march recorded last (each keeps its frame's index).
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
-        match (self.last_recorded_bounce.load(Relaxed), &self.bounce) {
-            (true, Some(bounce)) => bounce.right_eye_tiles(gpu),
-            _ => self.plain.right_eye_tiles(gpu),
-        }
+        let marches = std::iter::once(&self.plain).chain(&self.bounce);
+        marches.filter_map(|m| m.right_eye_tiles(gpu)).max_by_key(|t| t.frame)
     }
 }
