@@ -112,6 +112,18 @@ fn render_and_write(scene: &Scene, settings: &Settings, options: &StillOptions) 
         if settings.ao.resolution.is_half() { ", half resolution" } else { "" },
     );
     let mut explain = report.plan.to_string();
+    if let Some(traffic) = renderer.occlusion_traffic() {
+        let chain = if gpu.caps.scalar_chain && !settings.ao.technique.carries_light() {
+            "single-channel R16Float"
+        } else {
+            "four-channel Rgba16Float"
+        };
+        let _ = writeln!(
+            explain,
+            "occlusion passes: {:.1} bytes written and {:.1} read per pixel of each eye (declared textures; {chain} chain)",
+            traffic.written, traffic.read
+        );
+    }
     let _ = writeln!(
         explain,
         "timing over {frames} frame(s) after {warmup} warm-up, {} ({:?}):",

@@ -102,6 +102,19 @@ pub struct BudgetReport {
     /// same on every machine); absent when the right eye does not reuse the left's.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub right_eye_tiles: Vec<RightEyeTilesReport>,
+    /// Bytes per pixel of each eye the stereo frame's occlusion passes wrote and read,
+    /// counted from their declared textures (the same on every machine).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub occlusion_bytes_per_pixel: Option<TrafficReport>,
+}
+
+/// [`BudgetReport::occlusion_bytes_per_pixel`].
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct TrafficReport {
+    /// Bytes written per pixel of each eye.
+    pub written: f64,
+    /// Bytes read per pixel of each eye.
+    pub read: f64,
 }
 
 /// [`BudgetReport::right_eye_tiles`]: the right eye's computed tiles against all its tiles
@@ -171,6 +184,13 @@ impl BudgetReport {
                 cell(&encode[2])
             );
         }
+        if let Some(t) = &self.occlusion_bytes_per_pixel {
+            let _ = writeln!(
+                s,
+                "occlusion passes: {:.1} bytes written and {:.1} read per pixel of each eye (declared textures)",
+                t.written, t.read
+            );
+        }
         for t in &self.right_eye_tiles {
             let _ = writeln!(
                 s,
@@ -229,6 +249,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
     let mut encode: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut pass_order: Vec<String> = Vec::new();
     let mut right_eye_tiles = Vec::new();
+    let mut occlusion_bytes_per_pixel = None;
     for round in 0..how.warmup + how.frames {
         for (k, v) in views.iter().enumerate() {
             let report = renderer.render_and_wait(v, &[how.output])?;
@@ -236,6 +257,8 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
                 continue;
             }
             if k == 0 {
+                occlusion_bytes_per_pixel =
+                    renderer.occlusion_traffic().map(|t| TrafficReport { written: t.written, read: t.read });
                 right_eye_tiles = renderer
                     .right_eye_tiles()
                     .iter()
@@ -297,6 +320,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         cpu_encode,
         verdicts,
         right_eye_tiles,
+        occlusion_bytes_per_pixel,
     })
 }
 

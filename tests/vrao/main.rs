@@ -10,6 +10,7 @@ mod common;
 
 mod ao_engine;
 mod build_interrupt;
+mod chain_layout;
 mod foveation;
 mod gltf_materials;
 mod gltf_materials_reference;

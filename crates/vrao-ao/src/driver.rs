@@ -13,6 +13,7 @@ use crate::gpu::Gpu;
 use crate::graph::{self, Plan, Resource};
 use crate::graph_targets::GraphTargets;
 use crate::passes::{self, ChainSettings, DeclareContext, FrameMotion, Pass, RecordContext};
+use crate::resource::ChainLayout;
 use crate::stereo::Eye;
 use glam::DVec3;
 use std::any::Any;
@@ -37,6 +38,10 @@ pub struct FrameParams<'a> {
     /// The views' visibility mask (a headset's lens), applied when the settings' `mask`
     /// is on and it has one mask per view.
     pub mask: Option<&'a crate::visibility::VisibilityMask>,
+    /// Whether the device writes `R16Float` storage textures
+    /// ([`Capabilities::scalar_chain`](crate::gpu::Capabilities::scalar_chain)): then the
+    /// chain of a technique without light is single-channel.
+    pub scalar_chain: bool,
 }
 
 /// How the passes of one frame reach the GPU.
@@ -163,6 +168,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
             current_views: views,
             previous_views: self.previous_views(layers),
             motion: params.motion,
+            chain: ChainLayout::of(params.settings.ao.technique.carries_light(), params.scalar_chain),
         }
     }
 

@@ -46,6 +46,9 @@ pub struct DeclareContext<'a> {
     pub previous_views: Option<&'a [crate::stereo::Eye]>,
     /// What moves this frame ([`FrameMotion::STILL`] in a still scene).
     pub motion: &'a FrameMotion,
+    /// How the AO chain's targets hold a texel this frame: AO alone where the technique
+    /// carries no light and the device writes `R16Float` storage, else rgb light and AO.
+    pub chain: crate::resource::ChainLayout,
 }
 
 /// What moved since the previous frame, for temporal accumulation.

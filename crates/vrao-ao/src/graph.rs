@@ -13,6 +13,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::kernel::Bind;
+use crate::resource::ChainLayout;
 pub(crate) use crate::resource::{Kind, Resource, Size, Written, FINAL_AO, OCCLUSION, PIXEL_MOTION};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
@@ -173,6 +174,46 @@ impl Plan {
     /// The running passes that make up the occlusion's cost, in order.
     pub fn occlusion_passes(&self) -> Vec<&'static str> {
         self.decls.iter().filter(|d| d.occlusion_cost).map(|d| d.name).collect()
+    }
+}
+
+/// Bytes a frame's occlusion passes move per full-resolution pixel of one view, counted
+/// from their declared textures: each texture a pass writes once, each it reads once
+/// (the taps a kernel makes within a texture are not counted; the same on every machine).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelTraffic {
+    /// Bytes written per pixel.
+    pub written: f64,
+    /// Bytes read per pixel.
+    pub read: f64,
+}
+
+impl Plan {
+    /// The traffic of the passes counted as the occlusion's cost, with the chain laid out
+    /// as `chain` and the occlusion at half resolution when `half_res` (an
+    /// occlusion-sized texel then stands for four pixels).
+    pub fn occlusion_traffic(&self, chain: ChainLayout, half_res: bool) -> PixelTraffic {
+        let share = |r: &Resource| match r.kind() {
+            Kind::Texture { size: Size::Full, .. } | Kind::Imported => Some(1.0),
+            Kind::Texture { size: Size::Occlusion, .. } => Some(if half_res { 0.25 } else { 1.0 }),
+            Kind::Texture { size: Size::Half, .. } => Some(0.25),
+            // Light-space maps and named outputs have no per-pixel size.
+            Kind::Texture { size: Size::Computed(_), .. } | Kind::Alias { .. } => None,
+        };
+        let bytes = |r: &Resource| {
+            let texel = r
+                .format_in(chain)
+                .block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
+                .or_else(|| r.format_in(chain).block_copy_size(None));
+            share(r).zip(texel).map_or(0.0, |(share, texel)| share * f64::from(texel))
+        };
+        let mut traffic = PixelTraffic::default();
+        for decl in self.decls.iter().filter(|d| d.occlusion_cost) {
+            let resolved = decl.reads.iter().map(|r| decl.resolve(*r)).filter(|r| !decl.unbound.contains(r));
+            traffic.read += resolved.map(|r| bytes(&r)).sum::<f64>();
+            traffic.written += decl.writes.iter().map(bytes).sum::<f64>();
+        }
+        traffic
     }
 }
 

@@ -51,7 +51,7 @@ impl GraphTargets {
         let stale: Vec<Resource> = self
             .targets
             .iter()
-            .filter(|(r, t)| allocated(r) && t.extent() != extent_of(**r))
+            .filter(|(r, t)| allocated(r) && (t.extent() != extent_of(**r) || t.format != r.format_in(setup.chain)))
             .map(|(r, _)| *r)
             .collect();
         let mut changed = !stale.is_empty();
@@ -73,16 +73,17 @@ impl GraphTargets {
                             | wgpu::TextureUsages::COPY_DST
                     }
                 };
-                LayeredTarget::new(device, r.name(), r.format(), extent_of(r), usage)
+                LayeredTarget::new(device, r.name(), r.format_in(setup.chain), extent_of(r), usage)
             });
             // Names are the identity of textures: two declarations under one name must agree.
-            debug_assert_eq!(target.format, r.format(), "two textures are named {}", r.name());
+            debug_assert_eq!(target.format, r.format_in(setup.chain), "two textures are named {}", r.name());
         }
         for decl in &plan.decls {
             for r in &decl.unbound {
-                self.placeholders.entry(r.format()).or_insert_with(|| {
+                let format = r.format_in(setup.chain);
+                self.placeholders.entry(format).or_insert_with(|| {
                     changed = true;
-                    LayeredTarget::placeholder(device, "placeholder", r.format())
+                    LayeredTarget::placeholder(device, "placeholder", format)
                 });
             }
         }

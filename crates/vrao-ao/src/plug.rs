@@ -11,13 +11,14 @@
 // The frame graph: passes, their declarations, the driver that plans and records them.
 pub use crate::driver::{FrameParams, GraphDriver, Submission};
 pub use crate::frame::{ChainSettings, DeclareContext, FrameMotion, MoverBox};
-pub use crate::graph::{plan, PassDecl};
+pub use crate::graph::{plan, PassDecl, PixelTraffic};
 pub use crate::passes::{ao_chain, record, Pass, RecordContext};
-pub use crate::resource::{Kind, Resource, Size, Written};
+pub use crate::resource::{ChainLayout, Kind, Resource, Size, Written};
 
 // Compute kernels, their WGSL and the GPU helpers a pass records with.
 pub use crate::gpu::kernel::{
-    shader_module, try_shader_module, Bind, Kernel, Shader, Slot, COMMON, IRRADIANCE, VISIBILITY,
+    chain_prelude, shader_module, try_shader_module, Bind, ByChain, Kernel, Shader, Slot, COMMON, IRRADIANCE,
+    VISIBILITY,
 };
 pub use crate::gpu::layered_target::LayeredTarget;
 pub use crate::gpu::raster::{colour_and_depth_pass, fullscreen_pipeline, layer_views, uniform_entry};

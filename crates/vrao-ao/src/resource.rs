@@ -58,23 +58,77 @@ pub struct Resource {
     pub(crate) name: &'static str,
     pub(crate) format: wgpu::TextureFormat,
     pub(crate) kind: Kind,
+    /// A target of the AO chain, whose format follows the frame's [`ChainLayout`]
+    /// (`format` is its four-channel one).
+    pub(crate) chain: bool,
+}
+
+/// How the AO chain's targets (the raw occlusion, the denoise's, the accumulation's and
+/// the upsampling's) hold a texel this frame. Shaders see both alike through
+/// `chain_value` and `chain_texel` (shaders/chain_rgba.wgsl, chain_scalar.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ChainLayout {
+    /// rgb light and a AO in `Rgba16Float` (8 bytes): techniques that carry light (SSDO),
+    /// and every technique on a device that cannot write `R16Float` storage textures.
+    Rgba,
+    /// AO alone in `R16Float` (2 bytes): GTAO, SSAO and HBAO where the device writes it.
+    Scalar,
+}
+
+impl ChainLayout {
+    /// The chain targets' texel format.
+    pub const fn format(self) -> wgpu::TextureFormat {
+        match self {
+            ChainLayout::Rgba => wgpu::TextureFormat::Rgba16Float,
+            ChainLayout::Scalar => wgpu::TextureFormat::R16Float,
+        }
+    }
+
+    /// The layout for a technique that does or does not carry light, on a device that
+    /// can (`scalar_storage`) or cannot write `R16Float` storage textures.
+    pub const fn of(carries_light: bool, scalar_storage: bool) -> ChainLayout {
+        if scalar_storage && !carries_light {
+            ChainLayout::Scalar
+        } else {
+            ChainLayout::Rgba
+        }
+    }
+
+    /// Bytes a texel of a chain target.
+    pub const fn bytes_per_texel(self) -> u32 {
+        match self {
+            ChainLayout::Rgba => 8,
+            ChainLayout::Scalar => 2,
+        }
+    }
 }
 
 impl Resource {
     /// A texture written by compute kernels.
     pub const fn storage(name: &'static str, size: Size, format: wgpu::TextureFormat) -> Resource {
-        Resource { name, format, kind: Kind::Texture { size, written: Written::Storage } }
+        Resource { name, format, kind: Kind::Texture { size, written: Written::Storage }, chain: false }
+    }
+
+    /// A target of the AO chain, written by compute kernels: `Rgba16Float` or `R16Float`
+    /// as the frame's [`ChainLayout`] says.
+    pub const fn chain_storage(name: &'static str, size: Size) -> Resource {
+        Resource {
+            name,
+            format: ChainLayout::Rgba.format(),
+            kind: Kind::Texture { size, written: Written::Storage },
+            chain: true,
+        }
     }
 
     /// A texture written by render passes.
     pub const fn attachment(name: &'static str, size: Size, format: wgpu::TextureFormat) -> Resource {
-        Resource { name, format, kind: Kind::Texture { size, written: Written::Attachment } }
+        Resource { name, format, kind: Kind::Texture { size, written: Written::Attachment }, chain: false }
     }
 
     /// A texture imported from outside the graph each frame; `format` is the format its
     /// readers' layouts assume (depth: any depth format).
     pub const fn imported(name: &'static str, format: wgpu::TextureFormat) -> Resource {
-        Resource { name, format, kind: Kind::Imported }
+        Resource { name, format, kind: Kind::Imported, chain: false }
     }
 
     /// A named output whose textures all have `format`, falling back to another named
@@ -84,7 +138,12 @@ impl Resource {
         format: wgpu::TextureFormat,
         fallback: Option<&'static Resource>,
     ) -> Resource {
-        Resource { name, format, kind: Kind::Alias { fallback } }
+        Resource { name, format, kind: Kind::Alias { fallback }, chain: false }
+    }
+
+    /// A named output of the AO chain: its textures follow the frame's [`ChainLayout`].
+    pub const fn chain_alias(name: &'static str, fallback: Option<&'static Resource>) -> Resource {
+        Resource { name, format: ChainLayout::Rgba.format(), kind: Kind::Alias { fallback }, chain: true }
     }
 
     /// The name `--explain`, labels and error messages use (`ao-raw`, `color`, …).
@@ -92,9 +151,23 @@ impl Resource {
         self.name
     }
 
-    /// The texel format.
+    /// The texel format (a chain target's four-channel one: [`Resource::format_in`]).
     pub const fn format(self) -> wgpu::TextureFormat {
         self.format
+    }
+
+    /// The texel format in a frame whose chain is laid out as `chain`.
+    pub const fn format_in(self, chain: ChainLayout) -> wgpu::TextureFormat {
+        if self.chain {
+            chain.format()
+        } else {
+            self.format
+        }
+    }
+
+    /// Whether this is a target of the AO chain ([`ChainLayout`]).
+    pub const fn is_chain(self) -> bool {
+        self.chain
     }
 
     /// Texture or named output.
@@ -133,7 +206,7 @@ impl Ord for Resource {
 /// The occlusion at occlusion resolution as the AO chain has it so far: the technique
 /// provides its raw AO, temporal accumulation and the denoise each replace it. Layout as
 /// the techniques write it: rgb = SSDO's gathered irradiance, a = AO.
-pub const OCCLUSION: Resource = Resource::alias("occlusion", wgpu::TextureFormat::Rgba16Float, None);
+pub const OCCLUSION: Resource = Resource::chain_alias("occlusion", None);
 
 /// Each pixel's motion since the previous frame, as `MOTION` (passes/inputs.rs)
 /// lays it out: the G-buffer's in a scene that moves, or the motion vectors a host hands
@@ -143,4 +216,4 @@ pub const PIXEL_MOTION: Resource = Resource::alias("pixel-motion", wgpu::Texture
 /// The final AO at full resolution: the upsampled occlusion, or [`OCCLUSION`] itself
 /// when the occlusion runs at full resolution. What the outputs, the bench and the
 /// window's buffer view read.
-pub const FINAL_AO: Resource = Resource::alias("final-ao", wgpu::TextureFormat::Rgba16Float, Some(&OCCLUSION));
+pub const FINAL_AO: Resource = Resource::chain_alias("final-ao", Some(&OCCLUSION));

@@ -20,8 +20,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 use vrao_ao::plug::{
-    ao_chain, read_layers, read_layers_f32, ChainSettings, FrameMotion, FrameParams, FrameTiming, Gpu, GraphDriver,
-    LayeredTarget, MoverBox, Pass, PassTimer, Resource, Submission,
+    ao_chain, read_layers, read_layers_f32, ChainLayout, ChainSettings, FrameMotion, FrameParams, FrameTiming, Gpu,
+    GraphDriver, LayeredTarget, MoverBox, Pass, PassTimer, PixelTraffic, Resource, Submission,
 };
 use vrao_ao::{Error, Eye, Plan, Result, RightEyeTiles, VisibilityMask};
 
@@ -190,6 +190,7 @@ impl Renderer {
             multiview,
             motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },
             mask: None,
+            scalar_chain: gpu.caps.scalar_chain,
         };
         Ok(Renderer {
             gpu,
@@ -486,6 +487,14 @@ impl Renderer {
         self.driver.last_plan()
     }
 
+    /// The bytes per pixel the last frame's occlusion passes wrote and read, from their
+    /// declared textures in the layout the chain had ([`Plan::occlusion_traffic`]).
+    pub fn occlusion_traffic(&self) -> Option<PixelTraffic> {
+        let ao = &self.settings.ao;
+        let chain = ChainLayout::of(ao.technique.carries_light(), self.gpu.caps.scalar_chain);
+        Some(self.last_plan()?.occlusion_traffic(chain, ao.resolution.is_half()))
+    }
+
     /// Per pass, the right eye's tiles the AO chain computed rather than copied from the
     /// left eye in the last frame, read back from the GPU after it finished (blocking:
     /// for reports); empty when the right eye reuses nothing.
@@ -514,13 +523,21 @@ impl Renderer {
     }
 
     /// Values per layer (channels interleaved) of a float or depth resource; the packed
-    /// direct light decodes to rgba radiance (a = 0).
+    /// direct light decodes to rgba radiance (a = 0), and a target of a scalar AO chain
+    /// reads as the four-channel one would (rgb 0, a AO).
     pub fn read_f32(&self, r: Resource) -> Result<Vec<Vec<f32>>> {
         let target = self.kept_target(r).ok_or_else(|| Error::Gpu(format!("{} was not rendered", r.name())))?;
         if target.format == passes::direct::DIRECT.format() {
             return Ok(decode_direct(read_layers(&self.gpu, &target)?));
         }
-        read_layers_f32(&self.gpu, &target)
+        let layers = read_layers_f32(&self.gpu, &target)?;
+        if r.is_chain() && target.format == ChainLayout::Scalar.format() {
+            return Ok(layers
+                .into_iter()
+                .map(|ao| ao.into_iter().flat_map(|a| [0.0, 0.0, 0.0, a]).collect())
+                .collect());
+        }
+        Ok(layers)
     }
 }
 
@@ -574,6 +591,8 @@ struct FrameInputs {
     motion: FrameMotion,
     /// The headset's visibility mask ([`Renderer::set_visibility_mask`]).
     mask: Option<VisibilityMask>,
+    /// Whether the device writes the scalar chain's `R16Float` storage.
+    scalar_chain: bool,
 }
 
 impl FrameInputs {
@@ -588,6 +607,7 @@ impl FrameInputs {
             multiview: self.multiview,
             motion: &self.motion,
             mask: self.mask.as_ref(),
+            scalar_chain: self.scalar_chain,
         }
     }
 }

@@ -98,10 +98,22 @@ pub(crate) fn own_gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
 
 /// The shared GPU of the test binary, with the one-at-a-time lock.
 pub(crate) fn gpu() -> (Arc<Gpu>, MutexGuard<'static, ()>) {
-    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
     let guard = gpu_lock();
-    let gpu = GPU.get_or_init(|| Arc::new(new_gpu()));
-    (gpu.clone(), guard)
+    (shared_gpu(), guard)
+}
+
+fn shared_gpu() -> Arc<Gpu> {
+    static GPU: OnceLock<Arc<Gpu>> = OnceLock::new();
+    GPU.get_or_init(|| Arc::new(new_gpu())).clone()
+}
+
+/// The shared GPU and one of the caller's own whose AO chain keeps four channels for every
+/// technique (as on a device that cannot write `R16Float` storage), with the lock.
+pub(crate) fn shared_and_four_channel_gpus() -> (Arc<Gpu>, Arc<Gpu>, MutexGuard<'static, ()>) {
+    let guard = gpu_lock();
+    let mut four = new_gpu();
+    four.caps.scalar_chain = false;
+    (shared_gpu(), Arc::new(four), guard)
 }
 
 fn new_gpu() -> Gpu {

@@ -500,7 +500,7 @@ fn time_frames(
             prepass.record(device, &mut encoder, &views);
             if kind > 0 {
                 let format = if kind == 3 { AoOutputFormat::R8Unorm } else { AoOutputFormat::Rgba16Float };
-                engine.set_output_format(format);
+                engine.set_output_format(Some(format));
                 let frame = AoFrame {
                     depth: &prepass.depth,
                     depth_convention: convention,

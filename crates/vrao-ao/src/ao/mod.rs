@@ -169,6 +169,14 @@ pub struct AoOutput<'a> {
     pub view: &'a wgpu::TextureView,
 }
 
+impl AoOutput<'_> {
+    /// The texel format: `R16Float` holds the visibility in red, `R8Unorm` likewise, and
+    /// `Rgba16Float` in alpha (with SSDO's light in rgb).
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.texture.format()
+    }
+}
+
 /// vrao's AO chain over a host's depth: made once for the life of the host's window
 /// ([`AoEngine::resize`] follows it), recorded into the host's encoder each frame.
 pub struct AoEngine {
@@ -182,7 +190,7 @@ pub struct AoEngine {
     light_import: light::LightImportPass,
     /// The copy into a single-channel output, and the format chosen.
     pack: PackPass,
-    output_format: AoOutputFormat,
+    output_format: Option<AoOutputFormat>,
     /// Whether this frame has the host's motion vectors.
     motion: FrameMotion,
     /// The host's visibility mask, one per view ([`AoEngine::set_visibility_mask`]).
@@ -218,7 +226,7 @@ impl AoEngine {
             chain,
             driver,
             pack,
-            output_format: AoOutputFormat::default(),
+            output_format: None,
             motion: FrameMotion::STILL,
             mask: None,
         })
@@ -260,11 +268,14 @@ impl AoEngine {
         Ok(())
     }
 
-    /// The texel format of the AO the next frames return: `Rgba16Float` (the default, no
-    /// extra work), or the visibility alone in `R16Float` or `R8Unorm` for a quarter or
-    /// an eighth of the bytes a host's sample reads, at the cost of one full-screen draw
-    /// per view that reads the `Rgba16Float` AO once.
-    pub fn set_output_format(&mut self, format: AoOutputFormat) {
+    /// The texel format of the AO the next frames return: the visibility alone in
+    /// `R16Float` or `R8Unorm`, or `Rgba16Float` (visibility in alpha, SSDO's light in
+    /// rgb); `None` (the default) returns the chain's own final texture, which is
+    /// `R16Float` for GTAO, SSAO and HBAO on a device that writes `R16Float` storage and
+    /// `Rgba16Float` otherwise ([`AoOutput::format`]). Where the chain's final texture has
+    /// the asked format already it is returned as it is; otherwise one full-screen draw
+    /// per view copies it.
+    pub fn set_output_format(&mut self, format: Option<AoOutputFormat>) {
         self.output_format = format;
     }
 
@@ -347,6 +358,7 @@ impl AoEngine {
             multiview: false,
             motion: &self.motion,
             mask: self.mask.as_ref(),
+            scalar_chain: self.gpu.caps.scalar_chain,
         };
         let passes: Vec<&dyn Pass> = [&self.import as &dyn Pass, &self.light_import as &dyn Pass]
             .into_iter()
@@ -423,11 +435,17 @@ impl AoEngine {
             .targets
             .get(&output)
             .ok_or_else(|| Error::Plan(format!("{} was not allocated", output.name())))?;
-        if self.output_format == AoOutputFormat::Rgba16Float && receiving.is_none() {
+        let chain_own = if target.format == AoOutputFormat::R16Float.texture_format() {
+            AoOutputFormat::R16Float
+        } else {
+            AoOutputFormat::Rgba16Float
+        };
+        let format = self.output_format.unwrap_or(chain_own);
+        if format == chain_own && receiving.is_none() {
             return Ok(AoOutput { texture: &target.texture, view: &target.array_view });
         }
         let span = spans.map(|s| (s, s.begin(encoder, "pack")));
-        let packed = self.pack.record(&self.gpu, encoder, target, self.output_format, receiving);
+        let packed = self.pack.record(&self.gpu, encoder, target, format, receiving);
         if let Some((s, span)) = span {
             s.end(encoder, span);
         }

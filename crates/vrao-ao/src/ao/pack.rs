@@ -1,29 +1,36 @@
-//! The engine's output in the format the host chose ([`AoOutputFormat`]): the final AO
-//! as the chain leaves it (`Rgba16Float`, visibility in alpha), or its alpha alone in a
-//! single-channel texture that costs the host's lighting pass 2 or 1 bytes a pixel
-//! instead of 8, for one extra full-screen draw per view here. The same draw sets AO 1
-//! where the host's exclusion mask says a pixel receives none (then for `Rgba16Float`
-//! too).
+//! The engine's output in the format the host chose ([`AoOutputFormat`]). The chain's
+//! final AO is handed over as it is when its format is the one asked for (`R16Float`
+//! from a scalar chain, `Rgba16Float` from a four-channel one); otherwise one full-screen
+//! draw per view copies its visibility into a target of that format. The same draw sets
+//! AO 1 where the host's exclusion mask says a pixel receives none.
 
-use crate::gpu::kernel::{shader_module, wgsl, Slot};
+use crate::gpu::kernel::{chain_prelude, shader_module, wgsl, Slot};
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::raster::fullscreen_pipeline;
 use crate::gpu::Gpu;
+use crate::resource::ChainLayout;
 
 /// The texel format of the engine's output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum AoOutputFormat {
-    /// The chain's own target, no extra pass: `Rgba16Float`, the visibility in alpha
-    /// (rgb 0), 8 bytes a pixel.
+    /// `Rgba16Float`, the visibility in alpha (SSDO's light in rgb, else 0), 8 bytes a
+    /// pixel: the chain's own target when the chain has four channels (SSDO, or a device
+    /// without `R16Float` storage), one extra draw per view otherwise.
     #[default]
     Rgba16Float,
-    /// The visibility in red, 2 bytes a pixel; one extra draw per view.
+    /// The visibility in red, 2 bytes a pixel: the chain's own target when the chain is
+    /// scalar (GTAO, SSAO, HBAO on a device that writes `R16Float` storage), one extra
+    /// draw per view otherwise.
     R16Float,
     /// The visibility in red quantised to 1/255, 1 byte a pixel; one extra draw per view.
     R8Unorm,
 }
 
 impl AoOutputFormat {
+    /// Every output format.
+    pub const ALL: [AoOutputFormat; 3] =
+        [AoOutputFormat::Rgba16Float, AoOutputFormat::R16Float, AoOutputFormat::R8Unorm];
+
     /// The texture format.
     pub fn texture_format(self) -> wgpu::TextureFormat {
         match self {
@@ -42,7 +49,8 @@ impl AoOutputFormat {
 /// The pass that copies the final AO's visibility into a single-channel target.
 pub(crate) struct PackPass {
     layout: wgpu::BindGroupLayout,
-    pipelines: [(AoOutputFormat, wgpu::RenderPipeline); 3],
+    /// By the chain's layout (which the final AO's format says) and the output format.
+    pipelines: Vec<(ChainLayout, AoOutputFormat, wgpu::RenderPipeline)>,
     /// One uniform per view layer: the layer its draw reads.
     layer_uniforms: [wgpu::Buffer; 2],
     /// The output target and the format it was made for.
@@ -74,8 +82,8 @@ impl PackPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = shader_module(gpu, "pack", &[wgsl!("src/ao/pack.wgsl")]);
-        let pipeline = |format: AoOutputFormat| {
+        let pipeline = |chain: ChainLayout, format: AoOutputFormat| {
+            let module = shader_module(gpu, "pack", &[chain_prelude(chain), wgsl!("src/ao/pack.wgsl")]);
             let entry = if format == AoOutputFormat::Rgba16Float { "fs_rgba" } else { "fs_main" };
             let pipeline = fullscreen_pipeline(
                 device,
@@ -86,7 +94,7 @@ impl PackPass {
                 None,
                 None,
             );
-            (format, pipeline)
+            (chain, format, pipeline)
         };
         let layer_uniform = |layer: u32| {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -100,11 +108,10 @@ impl PackPass {
         };
         PackPass {
             layout,
-            pipelines: [
-                pipeline(AoOutputFormat::R16Float),
-                pipeline(AoOutputFormat::R8Unorm),
-                pipeline(AoOutputFormat::Rgba16Float),
-            ],
+            pipelines: [ChainLayout::Rgba, ChainLayout::Scalar]
+                .into_iter()
+                .flat_map(|chain| AoOutputFormat::ALL.map(|format| pipeline(chain, format)))
+                .collect(),
             layer_uniforms: [layer_uniform(0), layer_uniform(1)],
             target: None,
             bind_groups: None,
@@ -155,7 +162,10 @@ impl PackPass {
         }
         let (_, target) = self.target.as_ref().expect("made above");
         let (_, bind_groups) = self.bind_groups.as_ref().expect("made above");
-        let pipeline = &self.pipelines.iter().find(|(f, _)| *f == format).expect("every output format").1;
+        let chain =
+            if final_ao.format == ChainLayout::Scalar.format() { ChainLayout::Scalar } else { ChainLayout::Rgba };
+        let pipeline =
+            &self.pipelines.iter().find(|(c, f, _)| *c == chain && *f == format).expect("every layout and format").2;
         for (view, bind_group) in target.layer_views.iter().zip(bind_groups) {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("pack"),

@@ -25,7 +25,7 @@ fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
 
 // The final AO at `p`, its visibility 1 where the mask says the pixel receives none.
 fn final_at(p: vec2<i32>) -> vec4<f32> {
-    var texel = textureLoad(final_ao, p, i32(pack.layer), 0);
+    var texel = chain_value(textureLoad(final_ao, p, i32(pack.layer), 0));
     if (pack.receive_none != 0u && (textureLoad(host_mask, p, i32(pack.layer), 0).r & pack.receive_none) != 0u) {
         texel.a = 1.0;
     }

@@ -4,7 +4,7 @@
 
 use super::Gpu;
 use crate::error::{Error, Result};
-use crate::resource::Resource;
+use crate::resource::{ChainLayout, Resource};
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::path::Path;
@@ -89,6 +89,46 @@ pub const COMMON: Shader = wgsl!("shaders/common.wgsl");
 /// `irradiance.wgsl`: the environment's irradiance and radiance quadratics (SSDO, a
 /// renderer's composite).
 pub const IRRADIANCE: Shader = wgsl!("shaders/irradiance.wgsl");
+
+/// `chain_rgba.wgsl`: the AO chain's texel as rgb light and a AO ([`ChainLayout::Rgba`]).
+pub(crate) const CHAIN_RGBA: Shader = wgsl!("shaders/chain_rgba.wgsl");
+
+/// `chain_scalar.wgsl`: the AO chain's texel as AO alone ([`ChainLayout::Scalar`]).
+pub(crate) const CHAIN_SCALAR: Shader = wgsl!("shaders/chain_scalar.wgsl");
+
+/// The chain's WGSL prelude for `chain` (`ChainTarget`, `chain_value`, `chain_texel`):
+/// the first file of every kernel.
+pub fn chain_prelude(chain: ChainLayout) -> Shader {
+    match chain {
+        ChainLayout::Rgba => CHAIN_RGBA,
+        ChainLayout::Scalar => CHAIN_SCALAR,
+    }
+}
+
+/// One thing per AO chain layout a pass's frames may have (its kernels for each): the
+/// four-channel layout always, the scalar one where the device writes it
+/// ([`super::Capabilities::scalar_chain`]).
+pub struct ByChain<T> {
+    rgba: T,
+    scalar: Option<T>,
+}
+
+impl<T> ByChain<T> {
+    /// `make` for each layout the device can have.
+    pub fn new(gpu: &Gpu, make: impl Fn(ChainLayout) -> T) -> ByChain<T> {
+        ByChain { rgba: make(ChainLayout::Rgba), scalar: gpu.caps.scalar_chain.then(|| make(ChainLayout::Scalar)) }
+    }
+
+    /// The one for `chain` (a frame's `DeclareContext::chain`).
+    pub fn get(&self, chain: ChainLayout) -> &T {
+        match chain {
+            ChainLayout::Rgba => &self.rgba,
+            ChainLayout::Scalar => {
+                self.scalar.as_ref().expect("a frame's chain is scalar only where the device writes it")
+            }
+        }
+    }
+}
 
 /// `visibility.wgsl`: bind group 1 of every compute kernel, the visibility mask and
 /// foveation map (`tile_rate`, `pixel_shown`), for the kernels that read it.
@@ -225,7 +265,16 @@ pub enum Bind {
 }
 
 impl Bind {
-    /// The slot type this binding has in the layout.
+    /// The slot type this binding has in the layout of a kernel of a `chain` laid out so.
+    pub fn slot_in(self, chain: ChainLayout) -> Slot {
+        match self {
+            Bind::Write(r) => Slot::Output(r.format_in(chain)),
+            other => other.slot(),
+        }
+    }
+
+    /// The slot type this binding has in the layout (a chain target's as
+    /// [`ChainLayout::Rgba`]: [`Bind::slot_in`]).
     pub fn slot(self) -> Slot {
         match self {
             Bind::Frame | Bind::AoParams => Slot::Uniform,
@@ -429,15 +478,31 @@ impl Kernel {
         binds: &[Bind],
         constants: &[(&str, f64)],
     ) -> Kernel {
+        Self::in_chain(gpu, label, files, entry, binds, constants, ChainLayout::Rgba)
+    }
+
+    /// A kernel as [`Kernel::with_constants`] for a frame whose AO chain is laid out as
+    /// `chain`: its chain targets bind in that format and its WGSL starts with that
+    /// layout's prelude ([`chain_prelude`]).
+    pub fn in_chain(
+        gpu: &Gpu,
+        label: &str,
+        files: &[Shader],
+        entry: &str,
+        binds: &[Bind],
+        constants: &[(&str, f64)],
+        chain: ChainLayout,
+    ) -> Kernel {
         if gpu.builds_cancelled() {
             // The caller gave up on this build: a stand-in of no work compiles at once.
             let module = stand_in_module(&gpu.device, label, entry);
-            return Self::from_module(gpu, label, &module, entry, binds, &[]);
+            return Self::from_module_in(gpu, label, &module, entry, binds, &[], chain);
         }
         // The files are read now, so an unreadable one is the error of whoever makes the
         // kernel; a lazy kernel waits only for the compilation.
-        let source = source_or_recorded(gpu, files);
-        let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds);
+        let files: Vec<Shader> = std::iter::once(chain_prelude(chain)).chain(files.iter().copied()).collect();
+        let source = source_or_recorded(gpu, &files);
+        let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds, chain);
         let key = pipeline_key(label, &source, entry, constants, &slots);
         let recipe = Recipe {
             source,
@@ -479,7 +544,21 @@ impl Kernel {
         binds: &[Bind],
         constants: &[(&str, f64)],
     ) -> Kernel {
-        let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds);
+        Self::from_module_in(gpu, label, module, entry, binds, constants, ChainLayout::Rgba)
+    }
+
+    /// [`Kernel::from_module`] for a frame whose AO chain is laid out as `chain` (the
+    /// module was made with its prelude).
+    pub fn from_module_in(
+        gpu: &Gpu,
+        label: &str,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        binds: &[Bind],
+        constants: &[(&str, f64)],
+        chain: ChainLayout,
+    ) -> Kernel {
+        let (layout, pipeline_layout, slots) = Self::layouts(gpu, label, binds, chain);
         let pipeline = compute_pipeline(&gpu.device, label, &pipeline_layout, module, entry, constants);
         gpu.pipeline_counter().fetch_add(1, Ordering::Relaxed);
         Kernel {
@@ -494,15 +573,21 @@ impl Kernel {
     }
 
     /// The bind group layout, the pipeline layout and the slots of `binds`.
-    fn layouts(gpu: &Gpu, label: &str, binds: &[Bind]) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout, Vec<Slot>) {
+    fn layouts(
+        gpu: &Gpu,
+        label: &str,
+        binds: &[Bind],
+        chain: ChainLayout,
+    ) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout, Vec<Slot>) {
         let device = &gpu.device;
-        let slots: Vec<Slot> = binds.iter().map(|b| b.slot()).collect();
+        let slots: Vec<Slot> = binds.iter().map(|b| b.slot_in(chain)).collect();
         // The start-up check refuses adapters that cannot write these formats; a kernel
-        // writing another would fail on them only at its first frame.
+        // writing another would fail on them only at its first frame. The scalar chain's
+        // format is written only where the device said it can (`Capabilities::scalar_chain`).
         for slot in &slots {
             if let Slot::Output(format) = slot {
                 assert!(
-                    super::support::STORAGE_WRITE_FORMATS.contains(format),
+                    super::support::STORAGE_WRITE_FORMATS.contains(format) || *format == ChainLayout::Scalar.format(),
                     "kernel {label} writes {format:?}: add it to support::STORAGE_WRITE_FORMATS"
                 );
             }

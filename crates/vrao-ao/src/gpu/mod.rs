@@ -25,6 +25,11 @@ pub struct Capabilities {
     pub multiview_reliable: bool,
     /// Timestamp queries between passes (encoder-level writes).
     pub timestamps: bool,
+    /// The device writes `R16Float` storage textures (wgpu's
+    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`, which every desktop Vulkan GPU offers
+    /// for it, and a probe): the AO chain of GTAO, SSAO and HBAO is then single-channel,
+    /// 2 bytes a texel instead of 8. A renderer may turn it off to compare.
+    pub scalar_chain: bool,
 }
 
 /// The adapter, device and queue every pass shares.
@@ -152,6 +157,7 @@ impl Gpu {
             multiview_reliable: false,
             timestamps: features
                 .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
+            scalar_chain: support::writes_scalar_chain(device),
         }
     }
 

@@ -16,6 +16,28 @@ pub(crate) const STORAGE_WRITE_FORMATS: [wgpu::TextureFormat; 4] = [
     wgpu::TextureFormat::Rg32Uint,
 ];
 
+/// Whether `device` can write the scalar chain's `R16Float` as a storage texture: not a
+/// WebGPU core format for storage, so only with `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`
+/// on an adapter that supports it, which a 1×1 texture made under an error scope tells
+/// (the device alone does not say what its adapter's formats support).
+pub(crate) fn writes_scalar_chain(device: &wgpu::Device) -> bool {
+    if !device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+        return false;
+    }
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let _probe = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("scalar chain probe"),
+        size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: crate::resource::ChainLayout::Scalar.format(),
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    pollster::block_on(scope.pop()).is_none()
+}
+
 /// What an adapter reports that the renderer depends on, as plain data so the decision
 /// can be tested without one.
 #[derive(Clone, Debug)]

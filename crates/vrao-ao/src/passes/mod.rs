@@ -111,7 +111,10 @@ impl<'a> RecordContext<'a> {
     /// pass does not read it this frame).
     pub fn view(&self, r: Resource) -> wgpu::BindingResource<'a> {
         if self.decl.unbound.contains(&r) {
-            let placeholder = self.placeholders.get(&r.format()).expect("the renderer makes each unbound format's");
+            let placeholder = self
+                .placeholders
+                .get(&r.format_in(self.setup.chain))
+                .expect("the renderer makes each unbound format's");
             return wgpu::BindingResource::TextureView(&placeholder.array_view);
         }
         wgpu::BindingResource::TextureView(&self.target(r).array_view)

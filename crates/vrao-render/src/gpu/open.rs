@@ -96,6 +96,15 @@ pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'sta
     if timestamps {
         features |= wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
     }
+    // R16Float storage lets the AO chain of the techniques without light keep 2 bytes a
+    // texel instead of 8 (the engine probes for it: Capabilities::scalar_chain).
+    let scalar_storage = adapter
+        .get_texture_format_features(wgpu::TextureFormat::R16Float)
+        .flags
+        .contains(wgpu::TextureFormatFeatureFlags::STORAGE_WRITE_ONLY);
+    if scalar_storage && available.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+        features |= wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+    }
     // Ask for what the adapter has so full-size layered targets fit; keep the
     // downlevel defaults otherwise.
     let mut limits = wgpu::Limits::downlevel_defaults().using_resolution(adapter_limits.clone());

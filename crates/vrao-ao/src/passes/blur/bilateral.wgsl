@@ -10,7 +10,7 @@
 @group(0) @binding(1) var<uniform> ao: AoParams;
 @group(0) @binding(2) var geometry_layers: texture_2d_array<f32>;
 @group(0) @binding(3) var occlusion_in: texture_2d_array<f32>;
-@group(0) @binding(4) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(4) var occlusion_out: ChainTarget;
 
 fn blur(id: vec3<u32>, axis: vec2<i32>) {
     if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
@@ -22,19 +22,19 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
     let p = vec2<i32>(id.xy);
     if (tile_rate(id.xy, u32(layer), ao.scale) == 0.0) {
         // Hidden by the lens (visibility.wgsl): unoccluded, as the sky.
-        textureStore(occlusion_out, p, layers.y, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(occlusion_out, p, layers.y, chain_texel(vec4<f32>(0.0, 0.0, 0.0, 1.0)));
         return;
     }
-    let centre_value = textureLoad(occlusion_in, p, layer, 0);
+    let centre_value = chain_value(textureLoad(occlusion_in, p, layer, 0));
     let centre = textureLoad(geometry_layers, p, layer, 0);
     if (!(centre.w > 0.0) || ao.blur_radius == 0u) {
-        textureStore(occlusion_out, p, layers.y, centre_value);
+        textureStore(occlusion_out, p, layers.y, chain_texel(centre_value));
         return;
     }
     if (RIGHT_EYE) {
         let left = reused_from_left_eye(p, centre);
         if (left.found) {
-            textureStore(occlusion_out, p, layers.y, left.value);
+            textureStore(occlusion_out, p, layers.y, chain_texel(left.value));
             return;
         }
     }
@@ -60,7 +60,7 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         // offsets are NaN only for a degenerate centre: such a tap is skipped below.
         let w = exp(-kf * kf * inv_two_sigma2 - offset * offset) * normal_agreement(n, geometry.xyz);
         if (w == w) {
-            sum += textureLoad(occlusion_in, q, layer, 0) * w;
+            sum += chain_value(textureLoad(occlusion_in, q, layer, 0)) * w;
             total += w;
         }
     }
@@ -69,7 +69,7 @@ fn blur(id: vec3<u32>, axis: vec2<i32>) {
         result = sum / total;
     }
     result = vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
-    textureStore(occlusion_out, p, layers.y, result);
+    textureStore(occlusion_out, p, layers.y, chain_texel(result));
 }
 
 @compute @workgroup_size(8, 8, 1)

@@ -19,7 +19,7 @@
 @group(0) @binding(1) var<uniform> ao: AoParams;
 @group(0) @binding(2) var geometry_layers: texture_2d_array<f32>;
 @group(0) @binding(3) var occlusion_in: texture_2d_array<f32>;
-@group(0) @binding(4) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(4) var occlusion_out: ChainTarget;
 
 // Pixels filtered by one invocation, consecutive along the pass's axis: their windows
 // overlap, so 4 + 4 taps serve 4 pixels (2 taps per pixel instead of 5).
@@ -44,7 +44,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         for (var o = 0; o < RUN; o++) {
             let p = first + axis * o;
             if (all(p <= limit)) {
-                textureStore(occlusion_out, p, layers.y, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+                textureStore(occlusion_out, p, layers.y, chain_texel(vec4<f32>(0.0, 0.0, 0.0, 1.0)));
             }
         }
         return;
@@ -63,7 +63,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
             if (centre.w > 0.0) {
                 let left = reused_from_left_eye(p, centre);
                 if (left.found) {
-                    textureStore(occlusion_out, p, layers.y, left.value);
+                    textureStore(occlusion_out, p, layers.y, chain_texel(left.value));
                     reused |= 1u << u32(o);
                 }
             }
@@ -80,7 +80,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
     for (var j = 0; j < RUN + 4; j++) {
         let q = clamp(first + axis * (j - 2), vec2<i32>(0), limit);
         geometry[j] = textureLoad(geometry_layers, q, layer, 0);
-        let value = textureLoad(occlusion_in, q, layer, 0);
+        let value = chain_value(textureLoad(occlusion_in, q, layer, 0));
         occlusion[j] = value.a;
         light[j] = select(vec3<f32>(0.0), value.rgb, CARRIES_LIGHT);
     }
@@ -95,7 +95,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         let centre = geometry[o + 2];
         if (!(centre.w > 0.0)) {
             // Sky: passed through.
-            textureStore(occlusion_out, p, layers.y, vec4<f32>(light[o + 2], occlusion[o + 2]));
+            textureStore(occlusion_out, p, layers.y, chain_texel(vec4<f32>(light[o + 2], occlusion[o + 2])));
             continue;
         }
         let plane = tap_plane(eye, vec2<u32>(p), centre, axis, ao.scale, frame.size, ao.blur_plane_sigma);
@@ -132,7 +132,7 @@ fn denoise(id: vec3<u32>, axis: vec2<i32>) {
         if (CARRIES_LIGHT) {
             light_result = finite_or_zero3(light_sum / max(light_total, 1e-20));
         }
-        textureStore(occlusion_out, p, layers.y, vec4<f32>(light_result, saturate_ao(result)));
+        textureStore(occlusion_out, p, layers.y, chain_texel(vec4<f32>(light_result, saturate_ao(result))));
     }
 }
 

@@ -25,7 +25,10 @@ fn reused_from_left_eye(p: vec2<i32>, centre: vec4<f32>) -> LeftEyeValue {
     let right = frame.eyes[1];
     let uv = pixel_uv(full_res_pixel(vec2<u32>(p), ao.scale, frame.size), frame.size);
     let position = view_position_from_distance(uv, centre.w, right.tangents);
-    return left_eye_value(
+    var left = left_eye_value(
         position, right, frame.eyes[0], depth_layers, left_filtered, geometry_layers, ao.scale, frame.size, frame.near,
     );
+    // left_eye_value blends raw texels; the chain's decoding is linear, so decode after.
+    left.value = chain_value(left.value);
+    return left;
 }

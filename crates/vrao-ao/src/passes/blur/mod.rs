@@ -7,9 +7,10 @@
 use super::inputs::DEPTH;
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
+use crate::gpu::kernel::{wgsl, Bind, ByChain, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
+use crate::resource::ChainLayout;
 use crate::settings::{Denoise, Technique};
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
@@ -17,11 +18,10 @@ use crate::settings::{Denoise, Technique};
 pub const NAME: &str = "blur";
 
 /// Horizontally denoised occlusion (first half of the separable filter).
-pub(crate) const AO_BLUR_H: Resource =
-    Resource::storage("ao-blur-h", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+pub(crate) const AO_BLUR_H: Resource = Resource::chain_storage("ao-blur-h", Size::Occlusion);
 
 /// The denoised occlusion, at AO resolution.
-pub const AO_BLURRED: Resource = Resource::storage("ao-blurred", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+pub const AO_BLURRED: Resource = Resource::chain_storage("ao-blurred", Size::Occlusion);
 
 /// Bindings of both denoise shaders with the occlusion in and the horizontal result
 /// out: frame, AO parameters, geometry, input, output, depth and, at 6, the output's
@@ -59,14 +59,21 @@ struct DenoiseKernels {
 }
 
 impl DenoiseKernels {
-    /// `constants`: the shader's pipeline constants besides `RIGHT_EYE`.
-    fn new(gpu: &Gpu, shader: Shader, horizontal: &str, vertical: &str, constants: &[(&str, f64)]) -> Self {
+    /// `constants`: the shader's pipeline constants besides `RIGHT_EYE`; `chain`: the
+    /// layout of the occlusion it filters.
+    fn new(
+        gpu: &Gpu,
+        shader: Shader,
+        (horizontal, vertical): (&str, &str),
+        constants: &[(&str, f64)],
+        chain: ChainLayout,
+    ) -> Self {
         let files = [COMMON, VISIBILITY, wgsl!("src/passes/blur/denoise_stereo.wgsl"), shader];
         let kernel = |entry: &str, binds: &[Bind], right_eye: bool| {
             let mut constants = constants.to_vec();
             constants.push(("RIGHT_EYE", f64::from(right_eye)));
             let label = if right_eye { format!("{entry} right eye") } else { entry.to_string() };
-            Kernel::with_constants(gpu, &label, &files, entry, binds, &constants)
+            Kernel::in_chain(gpu, &label, &files, entry, binds, &constants, chain)
         };
         DenoiseKernels {
             horizontal: kernel(horizontal, &HORIZONTAL, false),
@@ -79,9 +86,10 @@ impl DenoiseKernels {
 /// The spatial denoise of the occlusion: the tile denoise or the separable bilateral blur
 /// (module docs).
 pub(crate) struct BlurPass {
-    /// The tile denoise by whether the occlusion carries light in rgb (SSDO) or AO alone.
+    /// The tile denoise by whether the occlusion carries light in rgb (SSDO) or AO alone,
+    /// each in the chain layout such a technique has.
     tile: [DenoiseKernels; 2],
-    bilateral: DenoiseKernels,
+    bilateral: ByChain<DenoiseKernels>,
 }
 
 impl BlurPass {
@@ -91,12 +99,13 @@ impl BlurPass {
             tile: [false, true].map(|carries_light| {
                 let constants = [("CARRIES_LIGHT", f64::from(carries_light))];
                 let shader = wgsl!("src/passes/blur/denoise.wgsl");
-                DenoiseKernels::new(gpu, shader, "denoise_horizontal", "denoise_vertical", &constants)
+                let chain = ChainLayout::of(carries_light, gpu.caps.scalar_chain);
+                DenoiseKernels::new(gpu, shader, ("denoise_horizontal", "denoise_vertical"), &constants, chain)
             }),
-            bilateral: {
+            bilateral: ByChain::new(gpu, |chain| {
                 let shader = wgsl!("src/passes/blur/bilateral.wgsl");
-                DenoiseKernels::new(gpu, shader, "blur_horizontal", "blur_vertical", &[])
-            },
+                DenoiseKernels::new(gpu, shader, ("blur_horizontal", "blur_vertical"), &[], chain)
+            }),
         }
     }
 }
@@ -117,7 +126,7 @@ impl Pass for BlurPass {
         let ao = &ctx.setup.settings.ao;
         let kernels = match ao.denoise {
             Denoise::Tile => &self.tile[usize::from(ao.technique.carries_light())],
-            Denoise::Bilateral => &self.bilateral,
+            Denoise::Bilateral => self.bilateral.get(ctx.setup.chain),
         };
         // The tile denoise filters runs of `DENOISE_RUN` pixels along each pass's axis.
         let (w, h, layers) = ctx.ao_extent();

@@ -376,7 +376,9 @@ fn reused_from_left_eye(id: vec3<u32>, r: Receiver) -> bool {
         r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
     );
     if (left.found) {
-        store_occlusion(id, vec4<f32>(reused_light(left.value), left.value.a));
+        // left_eye_value blends raw texels; the chain's decoding is linear, so decode after.
+        let value = chain_value(left.value);
+        store_occlusion(id, vec4<f32>(reused_light(value), value.a));
     }
     return left.found;
 }

@@ -11,6 +11,7 @@ use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
+use crate::resource::ChainLayout;
 use crate::settings::Technique;
 use bytemuck::{Pod, Zeroable};
 
@@ -109,7 +110,8 @@ impl Kernels {
                 ("THIN_CARDS", f64::from(thin_cards)),
             ];
             constants.extend_from_slice(&march.constants);
-            Kernel::with_constants(gpu, march.label, &march.files, entry, march.binds, &constants)
+            let chain = ChainLayout::of(march.technique.carries_light(), gpu.caps.scalar_chain);
+            Kernel::in_chain(gpu, march.label, &march.files, entry, march.binds, &constants, chain)
         };
         Kernels {
             interior: kernel("main", false, false),

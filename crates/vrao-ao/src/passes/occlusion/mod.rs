@@ -9,11 +9,12 @@ use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::passes::inputs::{DEPTH, NORMALS};
+use crate::resource::ChainLayout;
 use crate::settings::Technique;
 
 /// Occlusion as computed (at AO resolution): rgb = SSDO's gathered irradiance
 /// (environment through unblocked directions plus the bounce), a = AO.
-pub const AO_RAW: Resource = Resource::storage("ao-raw", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+pub const AO_RAW: Resource = Resource::chain_storage("ao-raw", Size::Occlusion);
 
 /// Normal (xyz) and view distance (w, 0 on the sky) at each occlusion pixel, written by
 /// the technique so the denoise and upsample need one fetch per tap instead of depth,
@@ -79,7 +80,10 @@ impl TechniquePass {
     /// The pass of `technique`, whose WGSL is `shader`.
     pub(crate) fn new(gpu: &Gpu, technique: Technique, shader: Shader) -> Self {
         let files = [COMMON, VISIBILITY, OCCLUSION_WGSL, shader];
-        TechniquePass { technique, kernel: Kernel::new(gpu, technique.name(), &files, "main", &BINDINGS) }
+        // The technique decides the chain's layout (technique.carries_light()).
+        let chain = ChainLayout::of(technique.carries_light(), gpu.caps.scalar_chain);
+        let kernel = Kernel::in_chain(gpu, technique.name(), &files, "main", &BINDINGS, &[], chain);
+        TechniquePass { technique, kernel }
     }
 }
 

@@ -6,7 +6,7 @@
 @group(0) @binding(2) var<storage, read> kernel: array<vec4<f32>>;
 @group(0) @binding(3) var depth_layers: texture_depth_2d_array;
 @group(0) @binding(4) var normal_layers: texture_2d_array<f32>;
-@group(0) @binding(5) var ao_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(5) var ao_out: ChainTarget;
 @group(0) @binding(6) var geometry_out: texture_storage_2d_array<rgba16float, write>;
 
 // Whether the outputs are bound as one-layer views of the receiver's layer (GTAO's
@@ -120,7 +120,7 @@ fn neighbour_step(pixel: vec2<u32>, axis: vec2<i32>, layer: u32, eye: Eye, posit
 }
 
 fn store_occlusion(id: vec3<u32>, value: vec4<f32>) {
-    textureStore(ao_out, vec2<i32>(id.xy), output_layer(id), value);
+    textureStore(ao_out, vec2<i32>(id.xy), output_layer(id), chain_texel(value));
 }
 
 // Whether the surface found by `probe` occludes a sample for a receiver at `position`

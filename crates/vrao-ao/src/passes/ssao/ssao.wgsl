@@ -34,5 +34,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let visibility = 1.0 - occlusion / f32(samples);
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(0.0, 0.0, 0.0, result));
+    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), chain_texel(vec4<f32>(0.0, 0.0, 0.0, result)));
 }

@@ -6,10 +6,11 @@
 
 use super::occlusion::AO_GEOMETRY;
 use super::{DeclareContext, MoverBox, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
+use crate::gpu::kernel::{wgsl, Bind, ByChain, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::layered_target::LayeredTarget;
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION, PIXEL_MOTION};
+use crate::resource::ChainLayout;
 use crate::settings::{Technique, TemporalBlend};
 use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
@@ -21,13 +22,12 @@ pub(crate) const NAME: &str = "temporal";
 
 /// Occlusion accumulated over frames by reverse reprojection, at AO resolution, laid out
 /// as the raw occlusion.
-pub const AO_ACCUMULATED: Resource =
-    Resource::storage("ao-accumulated", Size::Occlusion, wgpu::TextureFormat::Rgba16Float);
+pub const AO_ACCUMULATED: Resource = Resource::chain_storage("ao-accumulated", Size::Occlusion);
 
 /// The history's accumulated values, a ping-pong pair the pass keeps (not the graph's).
 pub const HISTORY_VALUE: [Resource; 2] = [
-    Resource::storage("history-value-a", Size::Occlusion, wgpu::TextureFormat::Rgba16Float),
-    Resource::storage("history-value-b", Size::Occlusion, wgpu::TextureFormat::Rgba16Float),
+    Resource::chain_storage("history-value-a", Size::Occlusion),
+    Resource::chain_storage("history-value-b", Size::Occlusion),
 ];
 
 /// The history's world positions relative to the scene anchor, with the accumulated
@@ -44,7 +44,8 @@ const MAX_MOVERS: usize = 16;
 
 /// temporal.wgsl's bindings: frame, AO parameters, the pass's uniform, the occlusion
 /// and its geometry, last frame's history (value, position), the accumulation out,
-/// this frame's history out (value, position) and the pixels' motion.
+/// this frame's history out (value, position) and the pixels' motion. The history's value
+/// out is in the chain's layout: [`bindings_in`].
 const BINDINGS: [Bind; 11] = [
     Bind::Frame,
     Bind::AoParams,
@@ -58,6 +59,13 @@ const BINDINGS: [Bind; 11] = [
     Bind::Own(Slot::Output(HISTORY_POSITION[0].format())),
     Bind::Read(PIXEL_MOTION),
 ];
+
+/// [`BINDINGS`] with the history's value out in `chain`'s format.
+fn bindings_in(chain: ChainLayout) -> [Bind; 11] {
+    let mut binds = BINDINGS;
+    binds[8] = Bind::Own(Slot::Output(HISTORY_VALUE[0].format_in(chain)));
+    binds
+}
 
 /// The pass's WGSL files, in order.
 const FILES: [Shader; 3] = [COMMON, VISIBILITY, wgsl!("src/passes/temporal/temporal.wgsl")];
@@ -87,7 +95,7 @@ struct TemporalUniform {
 
 /// Temporal accumulation of the occlusion by reverse reprojection (module docs).
 pub(crate) struct TemporalPass {
-    kernel: Kernel,
+    kernel: ByChain<Kernel>,
     uniform: wgpu::Buffer,
     /// [value a, value b, position a, position b], made at the occlusion's size.
     history: Mutex<Vec<LayeredTarget>>,
@@ -97,7 +105,9 @@ impl TemporalPass {
     /// Builds the pass's pipelines.
     pub(crate) fn new(gpu: &Gpu) -> TemporalPass {
         TemporalPass {
-            kernel: Kernel::new(gpu, "temporal", &FILES, "main", &BINDINGS),
+            kernel: ByChain::new(gpu, |chain| {
+                Kernel::in_chain(gpu, "temporal", &FILES, "main", &bindings_in(chain), &[], chain)
+            }),
             uniform: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("temporal"),
                 size: std::mem::size_of::<TemporalUniform>() as u64,
@@ -108,11 +118,13 @@ impl TemporalPass {
         }
     }
 
-    /// The history targets at `extent`, made (zeroed) when they are missing or of another
-    /// size; `true` when they were just made and hold no history.
-    fn history_at(&self, gpu: &Gpu, extent: (u32, u32, u32)) -> (Vec<LayeredTarget>, bool) {
+    /// The history targets at `extent` in `chain`'s layout, made (zeroed) when they are
+    /// missing or of another size or layout; `true` when they were just made and hold no
+    /// history.
+    fn history_at(&self, gpu: &Gpu, extent: (u32, u32, u32), chain: ChainLayout) -> (Vec<LayeredTarget>, bool) {
         let mut history = self.history.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        let fresh = history.first().is_none_or(|t| t.extent() != extent);
+        let fresh =
+            history.first().is_none_or(|t| t.extent() != extent || t.format != HISTORY_VALUE[0].format_in(chain));
         if fresh {
             // COPY_DST: tests poison the history by writing it.
             let usage = wgpu::TextureUsages::STORAGE_BINDING
@@ -121,7 +133,7 @@ impl TemporalPass {
             *history = HISTORY_VALUE
                 .iter()
                 .chain(&HISTORY_POSITION)
-                .map(|r| LayeredTarget::new(&gpu.device, r.name(), r.format(), extent, usage))
+                .map(|r| LayeredTarget::new(&gpu.device, r.name(), r.format_in(chain), extent, usage))
                 .collect();
             gpu.invalidate_bind_groups();
         }
@@ -187,7 +199,7 @@ impl Pass for TemporalPass {
             TemporalBlend::Confidence => 1,
         };
         let extent = ctx.ao_extent();
-        let (history, fresh) = self.history_at(ctx.gpu, extent);
+        let (history, fresh) = self.history_at(ctx.gpu, extent, setup.chain);
         u.history_valid = (setup.previous_views.is_some() && !fresh) as u32;
         // The frame's own views (an OpenXR runtime's, every frame), not the profile's.
         let [l, r, _, _] = current.first().map_or([-1.0, 1.0, 1.0, -1.0], |eye| eye.fov.tangents());
@@ -208,7 +220,13 @@ impl Pass for TemporalPass {
         ];
         // The history views live in `history` (clones of the pass's handles) until the dispatch.
         let resources = ctx.bind(&BINDINGS, &own);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, extent);
+        self.kernel.get(setup.chain).dispatch(
+            &ctx.gpu.device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            extent,
+        );
     }
 
     fn kept_target(&self, r: Resource) -> Option<LayeredTarget> {

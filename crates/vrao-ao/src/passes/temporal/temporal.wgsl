@@ -67,8 +67,8 @@ const MIN_MOTION_WINDOW: f32 = 4.0;
 @group(0) @binding(4) var current_layers: texture_2d_array<f32>;
 @group(0) @binding(5) var history_value: texture_2d_array<f32>;
 @group(0) @binding(6) var history_position: texture_2d_array<f32>;
-@group(0) @binding(7) var accumulated_out: texture_storage_2d_array<rgba16float, write>;
-@group(0) @binding(8) var history_value_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(7) var accumulated_out: ChainTarget;
+@group(0) @binding(8) var history_value_out: ChainTarget;
 @group(0) @binding(9) var history_position_out: texture_storage_2d_array<rgba32float, write>;
 @group(0) @binding(10) var motion: texture_2d_array<f32>;
 
@@ -99,17 +99,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let layer = i32(id.z);
     if (tile_rate(id.xy, id.z, ao.scale) == 0.0) {
         // Hidden by the lens (visibility.wgsl): unoccluded, as the sky, and no history.
-        textureStore(accumulated_out, p, layer, vec4<f32>(0.0, 0.0, 0.0, 1.0));
-        textureStore(history_value_out, p, layer, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(accumulated_out, p, layer, chain_texel(vec4<f32>(0.0, 0.0, 0.0, 1.0)));
+        textureStore(history_value_out, p, layer, chain_texel(vec4<f32>(0.0, 0.0, 0.0, 1.0)));
         textureStore(history_position_out, p, layer, vec4<f32>(0.0));
         return;
     }
-    let current = textureLoad(current_layers, p, layer, 0);
+    let current = chain_value(textureLoad(current_layers, p, layer, 0));
     let geometry = textureLoad(geometry_layers, p, layer, 0);
     if (!(geometry.w > 0.0)) {
         // Sky: nothing to accumulate.
-        textureStore(accumulated_out, p, layer, current);
-        textureStore(history_value_out, p, layer, current);
+        textureStore(accumulated_out, p, layer, chain_texel(current));
+        textureStore(history_value_out, p, layer, chain_texel(current));
         textureStore(history_position_out, p, layer, vec4<f32>(0.0));
         return;
     }
@@ -151,7 +151,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (all(previous_uv >= vec2<f32>(0.0)) && all(previous_uv < vec2<f32>(1.0))) {
             let q = min(vec2<i32>(previous_uv * vec2<f32>(ao.ao_size)), vec2<i32>(ao.ao_size) - vec2<i32>(1));
             let stored = textureLoad(history_position, q, layer, 0);
-            let value = textureLoad(history_value, q, layer, 0);
+            let value = chain_value(textureLoad(history_value, q, layer, 0));
             let footprint = geometry.w * temporal.pixel_tangent;
             let same_point = distance(stored.xyz, previous_world) <= temporal.epsilon + 2.0 * footprint;
             if (stored.w >= 1.0 && same_point && all_finite4(stored) && all_finite4(value)) {
@@ -170,7 +170,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     for (var dy = -1; dy <= 1; dy++) {
                         for (var dx = -1; dx <= 1; dx++) {
                             let n = clamp(p + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(ao.ao_size) - vec2<i32>(1));
-                            let v = textureLoad(current_layers, n, layer, 0);
+                            let v = chain_value(textureLoad(current_layers, n, layer, 0));
                             low = min(low, v);
                             high = max(high, v);
                         }
@@ -196,7 +196,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     result = vec4<f32>(finite_or_zero3(result.rgb), saturate_ao(result.a));
     let next_count = min(count + 1.0, temporal.max_frames);
-    textureStore(accumulated_out, p, layer, result);
-    textureStore(history_value_out, p, layer, result);
+    textureStore(accumulated_out, p, layer, chain_texel(result));
+    textureStore(history_value_out, p, layer, chain_texel(result));
     textureStore(history_position_out, p, layer, vec4<f32>(world, next_count));
 }

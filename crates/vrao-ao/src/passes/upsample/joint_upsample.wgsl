@@ -46,7 +46,7 @@ fn low_res_sample(
     s.valid = select(0.0, 1.0, all(q == clamped) && geometry.w > 0.0);
     s.position = view_position_from_distance(pixel_uv(fq, frame.size), geometry.w, tangents);
     s.normal = geometry.xyz;
-    s.value = textureLoad(value_low, clamped, i32(layer), 0);
+    s.value = chain_value(textureLoad(value_low, clamped, i32(layer), 0));
     return s;
 }
 
@@ -216,10 +216,10 @@ fn upsample_quad(
 // but an edge there may take a little of the other side's occlusion.
 fn foveated_quad(value_low: texture_2d_array<f32>, b: vec2<i32>, layer: u32) -> array<vec4<f32>, 4> {
     let limit = vec2<i32>(textureDimensions(value_low)) - vec2<i32>(1);
-    let v00 = textureLoad(value_low, min(b, limit), i32(layer), 0);
-    let v10 = textureLoad(value_low, min(b + vec2<i32>(1, 0), limit), i32(layer), 0);
-    let v01 = textureLoad(value_low, min(b + vec2<i32>(0, 1), limit), i32(layer), 0);
-    let v11 = textureLoad(value_low, min(b + vec2<i32>(1, 1), limit), i32(layer), 0);
+    let v00 = chain_value(textureLoad(value_low, min(b, limit), i32(layer), 0));
+    let v10 = chain_value(textureLoad(value_low, min(b + vec2<i32>(1, 0), limit), i32(layer), 0));
+    let v01 = chain_value(textureLoad(value_low, min(b + vec2<i32>(0, 1), limit), i32(layer), 0));
+    let v11 = chain_value(textureLoad(value_low, min(b + vec2<i32>(1, 1), limit), i32(layer), 0));
     return array<vec4<f32>, 4>(
         distance_weighted(v00, v10, v01, v11, 0),
         distance_weighted(v00, v10, v01, v11, 1),
@@ -249,6 +249,8 @@ fn distance_weighted(v00: vec4<f32>, v10: vec4<f32>, v01: vec4<f32>, v11: vec4<f
 // resolution although the denoise already reuses the left eye).
 // The nearest left pixel, not a bilinear blend: two loads per pixel, fewer than its own
 // upsample's, and the shift is under a full-res pixel of a field the denoise smoothed.
+// The AO in a texel of `left_final` comes from the includer's `left_final_ao` (the
+// upsampling's is a chain texture, the composite's its HDR colour with AO in alpha).
 struct LeftEyeFinal {
     ao: f32,
     found: bool,
@@ -264,7 +266,7 @@ fn left_eye_final(px: UpsamplePixel, depth_layers: texture_depth_2d_array, left_
     }
     let point = left_eye_point(px.position, frame.eyes[1], frame.eyes[0], depth_layers, frame.size, frame.near);
     if (point.seen) {
-        result.ao = textureLoad(left_final, vec2<i32>(point.pixel), 0, 0).a;
+        result.ao = left_final_ao(textureLoad(left_final, vec2<i32>(point.pixel), 0, 0));
         result.found = true;
     }
     return result;

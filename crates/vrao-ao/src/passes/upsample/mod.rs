@@ -9,10 +9,11 @@ use super::occlusion::AO_GEOMETRY;
 use super::right_eye_list::RightEyeList;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::gpu::kernel::TILE;
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
+use crate::gpu::kernel::{wgsl, Bind, ByChain, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
 use crate::passes::ChainSettings;
+use crate::resource::ChainLayout;
 use crate::settings::Technique;
 use std::sync::Mutex;
 
@@ -21,7 +22,7 @@ use std::sync::Mutex;
 pub const NAME: &str = "upsample";
 
 /// The occlusion upsampled from half to full resolution.
-pub const AO_FULL: Resource = Resource::storage("ao-full", Size::Full, wgpu::TextureFormat::Rgba16Float);
+pub const AO_FULL: Resource = Resource::chain_storage("ao-full", Size::Full);
 
 /// joint_upsample.wgsl: the 3×3 joint bilateral weights and the right eye's reuse of the
 /// left eye's result, shared with the composite.
@@ -59,9 +60,10 @@ pub fn reuses_left_eye_upsample(settings: &ChainSettings, layers: u32) -> bool {
 
 /// Joint bilateral upsampling of half-resolution occlusion to full resolution (module docs).
 pub(crate) struct UpsamplePass {
-    kernel: Kernel,
+    kernel: ByChain<Kernel>,
     /// The right eye's dispatch that reuses the left eye's result and lists the quads
-    /// it cannot, and the indirect one over those.
+    /// it cannot, and the indirect one over those: in the chain layout of the AO-only
+    /// techniques, the only ones that reuse ([`reuses_left_eye_upsample`]).
     right_eye: Kernel,
     right_eye_fallback: Kernel,
     fallback: Mutex<RightEyeList>,
@@ -71,14 +73,15 @@ impl UpsamplePass {
     /// Builds the pass's pipelines.
     pub(crate) fn new(gpu: &Gpu) -> Self {
         let files = [COMMON, VISIBILITY, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/upsample/upsample.wgsl")];
-        let kernel = |label: &str, right_eye: bool, fallback: bool| {
+        let kernel = |label: &str, right_eye: bool, fallback: bool, chain: ChainLayout| {
             let constants = [("RIGHT_EYE", f64::from(right_eye)), ("FALLBACK", f64::from(fallback))];
-            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
+            Kernel::in_chain(gpu, label, &files, "main", &BINDINGS, &constants, chain)
         };
+        let ao_only = ChainLayout::of(false, gpu.caps.scalar_chain);
         UpsamplePass {
-            kernel: kernel("upsample", false, false),
-            right_eye: kernel("upsample right eye", true, false),
-            right_eye_fallback: kernel("upsample right eye fallback", true, true),
+            kernel: ByChain::new(gpu, |chain| kernel("upsample", false, false, chain)),
+            right_eye: kernel("upsample right eye", true, false, ao_only),
+            right_eye_fallback: kernel("upsample right eye fallback", true, true, ao_only),
             fallback: Mutex::new(RightEyeList::new(gpu, "upsample right-eye quads")),
         }
     }
@@ -104,7 +107,7 @@ impl Pass for UpsamplePass {
         let (w, h, layers) = ctx.quad_extent();
         let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
-        self.kernel.dispatch(
+        self.kernel.get(ctx.setup.chain).dispatch(
             device,
             ctx.encoder,
             ctx.visibility.bind_group(),

@@ -15,9 +15,14 @@
 @group(0) @binding(3) var normal_layers: texture_2d_array<f32>;
 @group(0) @binding(4) var geometry_low: texture_2d_array<f32>;
 @group(0) @binding(5) var occlusion_low: texture_2d_array<f32>;
-@group(0) @binding(6) var occlusion_out: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(6) var occlusion_out: ChainTarget;
 // AoFull's left-eye layer in the right eye's dispatch (any array texture otherwise).
 @group(0) @binding(7) var left_final: texture_2d_array<f32>;
+
+// The AO in a texel of the left eye's upsampled AO (joint_upsample.wgsl `left_eye_final`).
+fn left_final_ao(texel: vec4<f32>) -> f32 {
+    return chain_value(texel).a;
+}
 
 override RIGHT_EYE: bool = false;
 override FALLBACK: bool = false;
@@ -60,7 +65,7 @@ fn main(
         for (var k = 0u; k < 4u; k++) {
             let pixel = id.xy * 2u + vec2<u32>(k & 1u, k >> 1u);
             if (all(pixel < frame.size)) {
-                textureStore(occlusion_out, vec2<i32>(pixel), i32(out_layer), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+                textureStore(occlusion_out, vec2<i32>(pixel), i32(out_layer), chain_texel(vec4<f32>(0.0, 0.0, 0.0, 1.0)));
             }
         }
         return;
@@ -93,6 +98,6 @@ fn main(
 fn store(px: UpsamplePixel, layer: u32, value: vec4<f32>) {
     if (all(px.pixel < frame.size)) {
         let sky = px.depth <= 0.0;
-        textureStore(occlusion_out, vec2<i32>(px.pixel), i32(layer), select(value, vec4<f32>(0.0, 0.0, 0.0, 1.0), sky));
+        textureStore(occlusion_out, vec2<i32>(px.pixel), i32(layer), chain_texel(select(value, vec4<f32>(0.0, 0.0, 0.0, 1.0), sky)));
     }
 }

@@ -37,6 +37,12 @@
 @group(0) @binding(12) var rsm_geometry: texture_2d_array<f32>;
 // The output's left-eye layer in the right eye's dispatch (any array texture otherwise).
 @group(0) @binding(13) var left_hdr: texture_2d_array<f32>;
+
+// The AO the left eye's composite left in its colour's alpha for the right eye
+// (joint_upsample.wgsl `left_eye_final`).
+fn left_final_ao(texel: vec4<f32>) -> f32 {
+    return texel.a;
+}
 // The lighting's normals (the normal texture's where a material has one; `normal_layers`
 // are the surface's own, which the upsampling weighs by).
 @group(0) @binding(15) var lighting_normal_layers: texture_2d_array<f32>;
@@ -172,7 +178,7 @@ fn main(
 
 // The full-resolution occlusion at a quad pixel.
 fn full_res_occlusion(px: UpsamplePixel, layer: u32) -> vec4<f32> {
-    return textureLoad(occlusion_layers, vec2<i32>(px.texel), i32(layer), 0);
+    return chain_value(textureLoad(occlusion_layers, vec2<i32>(px.texel), i32(layer), 0));
 }
 
 // Shades a quad pixel of `layer` and stores it (with its AO) at `out_layer` of the

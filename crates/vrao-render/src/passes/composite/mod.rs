@@ -17,8 +17,8 @@ use super::{scene_of, settings_of};
 use crate::gpu::kernel::wgsl;
 use std::sync::Mutex;
 use vrao_ao::plug::{
-    reuses_left_eye_upsample, Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource, Size, Slot,
-    AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION, VISIBILITY,
+    reuses_left_eye_upsample, Bind, ByChain, ChainLayout, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext,
+    Resource, Size, Slot, AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION, VISIBILITY,
 };
 use vrao_ao::Technique;
 use wgpu::util::DeviceExt;
@@ -35,7 +35,7 @@ pub const HDR: Resource = Resource::storage("hdr", Size::Full, wgpu::TextureForm
 pub struct CompositePass {
     /// Variants by (half resolution, RSM bounce): pipeline constants, so a frame without
     /// them runs none of their code.
-    kernels: [[Kernel; 2]; 2],
+    kernels: ByChain<[[Kernel; 2]; 2]>,
     /// The right eye's half-resolution dispatches, by RSM bounce: reusing the left eye's
     /// AO (listing the quads it cannot), and over the listed quads.
     right_eye: [Kernel; 2],
@@ -80,7 +80,7 @@ impl CompositePass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu) -> Self {
         let files = [COMMON, VISIBILITY, IRRADIANCE, JOINT_UPSAMPLE_WGSL, wgsl!("src/passes/composite/composite.wgsl")];
-        let variant = |half_res: bool, rsm: bool, right_eye: bool, fallback: bool| {
+        let variant = |half_res: bool, rsm: bool, right_eye: bool, fallback: bool, chain: ChainLayout| {
             let constants = [
                 ("HALF_RES", f64::from(half_res)),
                 ("RSM", f64::from(rsm)),
@@ -92,8 +92,10 @@ impl CompositePass {
                 (true, false) => "composite right eye",
                 (true, true) => "composite right eye fallback",
             };
-            Kernel::with_constants(gpu, label, &files, "main", &BINDINGS, &constants)
+            Kernel::in_chain(gpu, label, &files, "main", &BINDINGS, &constants, chain)
         };
+        // The right eye reuses the left eye's AO only for the techniques without light.
+        let ao_only = ChainLayout::of(false, gpu.caps.scalar_chain);
         let fallback_header = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("composite fallback header"),
             // No workgroups yet (x = 0), y = z = 1, no quads listed; room for a list of
@@ -109,9 +111,11 @@ impl CompositePass {
         });
         CompositePass {
             fallback_args,
-            kernels: [false, true].map(|half_res| [false, true].map(|rsm| variant(half_res, rsm, false, false))),
-            right_eye: [false, true].map(|rsm| variant(true, rsm, true, false)),
-            right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true)),
+            kernels: ByChain::new(gpu, |chain| {
+                [false, true].map(|half_res| [false, true].map(|rsm| variant(half_res, rsm, false, false, chain)))
+            }),
+            right_eye: [false, true].map(|rsm| variant(true, rsm, true, false, ao_only)),
+            right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true, ao_only)),
             fallback: Mutex::new(None),
             fallback_header,
         }
@@ -147,7 +151,7 @@ impl Pass for CompositePass {
         let (w, h, layers) = ctx.quad_extent();
         let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
-        let kernel = &self.kernels[half_res as usize][rsm as usize];
+        let kernel = &self.kernels.get(ctx.setup.chain)[half_res as usize][rsm as usize];
         kernel.dispatch(
             device,
             ctx.encoder,

@@ -162,5 +162,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let direct_occlusion = mix(unoccluded, unoccluded * share, clamp(ao.strength, 0.0, 1.0));
     let irradiance = direct_occlusion + bounce * ao.bounce;
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), vec4<f32>(finite_or_zero3(irradiance), result));
+    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), chain_texel(vec4<f32>(finite_or_zero3(irradiance), result)));
 }

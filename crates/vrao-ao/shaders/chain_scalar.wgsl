@@ -1,0 +1,14 @@
+// The AO chain's texel for the techniques without light (GTAO, SSAO, HBAO): AO alone in
+// R16Float, 2 bytes instead of 8. The values stay vec4 (rgb light 0, a AO) inside the
+// kernels, so every pass reads and writes both layouts through the same names.
+alias ChainTarget = texture_storage_2d_array<r16float, write>;
+
+// A chain texel as read (textureLoad, r = AO) to the chain's value: no light, a AO.
+fn chain_value(texel: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(0.0, 0.0, 0.0, texel.r);
+}
+
+// A chain value (a AO) to the texel textureStore writes (r).
+fn chain_texel(value: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(value.a, 0.0, 0.0, 1.0);
+}
