@@ -98,7 +98,7 @@ pub(crate) const CHAIN_SCALAR: Shader = wgsl!("shaders/chain_scalar.wgsl");
 
 /// The chain's WGSL prelude for `chain` (`ChainTarget`, `chain_value`, `chain_texel`):
 /// the first file of every kernel.
-pub fn chain_prelude(chain: ChainLayout) -> Shader {
+pub(crate) fn chain_prelude(chain: ChainLayout) -> Shader {
     match chain {
         ChainLayout::Rgba => CHAIN_RGBA,
         ChainLayout::Scalar => CHAIN_SCALAR,
