@@ -51,7 +51,9 @@ pub enum Submission {
     OneEncoder,
     /// Each pass but the last submitted on its own (true per-pass times where the device
     /// finishes one submission before the next one's timestamps, as lavapipe does), and
-    /// waited for when `wait` is set (then its wall-clock time is reported).
+    /// waited for when `wait` is set (then its wall-clock time is reported). A measurement
+    /// tool's (the `measurement` feature), never a host's: it stalls the frame.
+    #[cfg(feature = "measurement")]
     PerPass {
         /// Wait for each pass and report its wall-clock milliseconds.
         wait: bool,
@@ -261,8 +263,11 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
             };
             passes::record(passes[index], &mut ctx);
             recorded.cpu_encode_ms += encode_start.elapsed().as_secs_f64() * 1e3;
-            let last = step + 1 == plan.run.len();
-            if let (Submission::PerPass { wait }, false) = (submission, last) {
+            // Without the measurement feature every pass goes into the caller's encoder.
+            #[cfg(not(feature = "measurement"))]
+            let _ = (submission, name);
+            #[cfg(feature = "measurement")]
+            if let (Submission::PerPass { wait }, false) = (submission, step + 1 == plan.run.len()) {
                 let finished = std::mem::replace(encoder, gpu.device.create_command_encoder(&Default::default()));
                 let submitted = Instant::now();
                 gpu.queue.submit([finished.finish()]);

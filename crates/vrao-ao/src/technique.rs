@@ -32,7 +32,9 @@ pub enum Technique {
     SsdoPoints,
     /// [`Technique::SsdoPoints`] plus the seeds' point-sampled bounce (eq. 2).
     SsdoPointsBounce,
-    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic.
+    /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic. Only
+    /// with the `measurement` feature (vrao's bench), not for hosts.
+    #[cfg(feature = "measurement")]
     FetchOnly,
 }
 
@@ -116,7 +118,22 @@ pub struct TechniqueEntry {
 }
 
 /// Every technique, in the order the CLI and the bench list them.
-pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
+pub(crate) const TECHNIQUES: [TechniqueEntry; OCCLUSION_TECHNIQUES.len() + BASELINES.len()] = {
+    let mut all = [OCCLUSION_TECHNIQUES[0]; OCCLUSION_TECHNIQUES.len() + BASELINES.len()];
+    let mut i = 0;
+    while i < all.len() {
+        all[i] = if i < OCCLUSION_TECHNIQUES.len() {
+            OCCLUSION_TECHNIQUES[i]
+        } else {
+            BASELINES[i - OCCLUSION_TECHNIQUES.len()]
+        };
+        i += 1;
+    }
+    all
+};
+
+/// The techniques that estimate something (and none).
+const OCCLUSION_TECHNIQUES: [TechniqueEntry; 8] = [
     TechniqueEntry {
         technique: Technique::None,
         name: "none",
@@ -197,17 +214,24 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; 9] = [
         foveation: FoveationRule::Samples,
         engine_pass: false,
     },
-    TechniqueEntry {
-        technique: Technique::FetchOnly,
-        name: "fetch-only",
-        help: "the benchmark baseline with SSAO's depth taps and no occlusion arithmetic",
-        kind: TechniqueKind::Baseline,
-        composite: CompositeMode::ScalarAo,
-        samples: SamplePattern::HemisphereCosine,
-        foveation: FoveationRule::Samples,
-        engine_pass: true,
-    },
 ];
+
+/// The bench's cost baselines, with the `measurement` feature only.
+#[cfg(feature = "measurement")]
+const BASELINES: [TechniqueEntry; 1] = [TechniqueEntry {
+    technique: Technique::FetchOnly,
+    name: "fetch-only",
+    help: "the benchmark baseline with SSAO's depth taps and no occlusion arithmetic",
+    kind: TechniqueKind::Baseline,
+    composite: CompositeMode::ScalarAo,
+    samples: SamplePattern::HemisphereCosine,
+    foveation: FoveationRule::Samples,
+    engine_pass: true,
+}];
+
+/// No baselines without the `measurement` feature.
+#[cfg(not(feature = "measurement"))]
+const BASELINES: [TechniqueEntry; 0] = [];
 
 impl Technique {
     /// Every technique, in the order the CLI and the bench list them (the table's).
@@ -332,6 +356,7 @@ mod tests {
             Technique::SsdoBounce,
             Technique::SsdoPoints,
             Technique::SsdoPointsBounce,
+            #[cfg(feature = "measurement")]
             Technique::FetchOnly,
         ] {
             match t {
@@ -342,8 +367,9 @@ mod tests {
                 | Technique::Ssdo
                 | Technique::SsdoBounce
                 | Technique::SsdoPoints
-                | Technique::SsdoPointsBounce
-                | Technique::FetchOnly => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
+                | Technique::SsdoPointsBounce => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
+                #[cfg(feature = "measurement")]
+                Technique::FetchOnly => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
             }
         }
     }

@@ -7,6 +7,7 @@
 //! trait (vrao-render's G-buffer, lights, SSDO and composite).
 
 pub(crate) mod blur;
+#[cfg(feature = "measurement")]
 pub(crate) mod fetch_only;
 pub(crate) mod gtao;
 pub(crate) mod hbao;
@@ -36,6 +37,7 @@ fn engine_pass(gpu: &Gpu, technique: Technique) -> Option<Box<dyn Pass>> {
         Technique::Hbao => Box::new(hbao::pass(gpu)),
         Technique::Gtao => Box::new(gtao::GtaoPass::new(gpu)),
         Technique::Ssdo | Technique::SsdoBounce => Box::new(ssdo::SsdoPass::new(gpu, technique)),
+        #[cfg(feature = "measurement")]
         Technique::FetchOnly => Box::new(fetch_only::pass(gpu)),
         _ => return None,
     };
