@@ -209,7 +209,7 @@ impl Plan {
         };
         let mut traffic = PixelTraffic::default();
         for decl in self.decls.iter().filter(|d| d.occlusion_cost) {
-            let resolved = decl.reads.iter().map(|r| decl.resolve(*r)).filter(|r| !decl.unbound.contains(r));
+            let resolved = decl.reads.iter().filter(|r| !decl.unbound.contains(r)).map(|r| decl.resolve(*r));
             traffic.read += resolved.map(|r| bytes(&r)).sum::<f64>();
             traffic.written += decl.writes.iter().map(bytes).sum::<f64>();
         }
