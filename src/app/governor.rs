@@ -491,8 +491,8 @@ impl Governor {
         }
         let c = &self.config;
         let reason = format!(
-            "{} frames < {:.0} % of {:.2} ms (slowest {:.2} ms); predicted {:.2} ms < {:.0} % of {:.2} ms",
-            c.calm_frames_to_raise,
+            "{} < {:.0} % of {:.2} ms (slowest {:.2} ms); predicted {:.2} ms < {:.0} % of {:.2} ms",
+            crate::formats::output::count(c.calm_frames_to_raise as u64, "frame"),
             c.raise_below * 100.0,
             period,
             slowest,

@@ -215,9 +215,10 @@ pub fn refresh_with_openxr(hz: f64, offered: &[f32], current: Option<f32>) -> (l
     if offered.iter().copied().any(near) && current.is_some_and(near) {
         return (log::Level::Info, format!("--refresh {hz} Hz: asked of the OpenXR runtime, which offers it"));
     }
+    // Either way a whole clause: the display's rate is what sets the budget.
     let runs_at = match current {
-        Some(rate) => format!("the runtime's display runs at {rate} Hz"),
-        None => "the runtime's display rate".into(),
+        Some(rate) => format!("the runtime's display runs at {rate} Hz, which sets the budget"),
+        None => "the runtime's display rate sets the budget".into(),
     };
     let offers = if offered.is_empty() {
         "it offers no rate to choose (no XR_FB_display_refresh_rate)".to_string()
@@ -227,7 +228,7 @@ pub fn refresh_with_openxr(hz: f64, offered: &[f32], current: Option<f32>) -> (l
     };
     (
         log::Level::Warn,
-        format!("--refresh {hz} Hz is the simulated headset's and is not used with OpenXR: {runs_at} and sets the budget ({offers})"),
+        format!("--refresh {hz} Hz is the simulated headset's and is not used with OpenXR: {runs_at} ({offers})"),
     )
 }
 
@@ -403,11 +404,14 @@ mod tests {
         let (level, line) = refresh_with_openxr(90.0, &[20.0], Some(20.0));
         assert_eq!(level, log::Level::Warn);
         assert!(line.starts_with("--refresh 90 Hz is the simulated headset's"), "{line}");
-        assert!(line.contains("runs at 20 Hz") && line.contains("offers 20 Hz") && !line.contains('\n'), "{line}");
+        assert!(line.contains("runs at 20 Hz, which sets the budget") && line.contains("offers 20 Hz"), "{line}");
+        assert!(!line.contains('\n'), "{line}");
         // No XR_FB_display_refresh_rate.
         let (level, line) = refresh_with_openxr(72.0, &[], None);
         assert_eq!(level, log::Level::Warn);
         assert!(line.contains("no XR_FB_display_refresh_rate"), "{line}");
+        // The clause without a rate still has its verb.
+        assert!(line.contains("the runtime's display rate sets the budget"), "{line}");
         // A runtime offering the rate was asked for it: said at the info level.
         let (level, line) = refresh_with_openxr(72.0, &[72.0, 90.0, 120.0], Some(72.0));
         assert_eq!(level, log::Level::Info);

@@ -2,7 +2,7 @@
 
 use crate::app::governor::GovernorChange;
 use crate::app::{FrameLoop, SERIAL_EVERY};
-use crate::formats::output::significant;
+use crate::formats::output::{count, significant};
 use crate::formats::spans::summarize;
 use crate::stats;
 use std::sync::atomic::Ordering;
@@ -238,8 +238,10 @@ impl RunSummary {
         if let Some(x) = &self.openxr {
             // Only what OpenXR says: nothing here is "presented" or "reprojected".
             frames += &format!(
-                "; OpenXR: {} layers submitted, {} frames the runtime said not to render, {} display periods missed (from predicted display times)",
-                x.layers_submitted, x.not_rendered, x.missed_display_periods
+                "; OpenXR: {} submitted, {} the runtime said not to render, {} missed (from predicted display times)",
+                count(x.layers_submitted, "layer"),
+                count(x.not_rendered, "frame"),
+                count(x.missed_display_periods, "display period")
             );
         }
         if let Some(c) = &self.counters {
@@ -250,14 +252,18 @@ impl RunSummary {
             );
         }
         let stretched = if self.stretched_frames > 0 {
-            format!("; {} frames at a display period stretched over missed refreshes", self.stretched_frames)
+            format!("; {} at a display period stretched over missed refreshes", count(self.stretched_frames, "frame"))
         } else {
             String::new()
         };
         let budget = if self.budget_changes > 0 {
             format!(
-                "a {:.2} ms budget ({:.2}..{:.2} ms, {} changes) from {}",
-                self.budget_ms, self.budget_ms_min, self.budget_ms_max, self.budget_changes, self.budget_source
+                "a {:.2} ms budget ({:.2}..{:.2} ms, {}) from {}",
+                self.budget_ms,
+                self.budget_ms_min,
+                self.budget_ms_max,
+                count(self.budget_changes, "change"),
+                self.budget_source
             )
         } else {
             format!("a {:.2} ms budget from {}", self.budget_ms, self.budget_source)
@@ -273,13 +279,13 @@ impl RunSummary {
             _ => String::new(),
         };
         format!(
-            "governor {}: {} changes, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
+            "governor {}: {}, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
-            self.governor_changes.len(),
+            count(self.governor_changes.len() as u64, "change"),
             self.final_ao_setting,
             self.gpu_frame_ms_median,
             self.over_budget_frames,
-            self.timed_frames,
+            count(self.timed_frames, "timed frame"),
             self.cpu_encode_ms_median,
             100.0 * self.cpu_encode_share_of_gpu,
             self.timing,

@@ -12,7 +12,7 @@ use vrao::xr::simulated::motion::HeadMotion;
 use vrao::xr::simulated::reproject::ReprojectionMode;
 use vrao::{Error, Result};
 use vrao_render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
-use vrao_render::settings::DisplayMode;
+use vrao_render::settings::{DisplayMode, EYE_SIDE_MAX};
 use vrao_render::{BackendChoice, Scene, Settings};
 
 #[derive(Args)]
@@ -52,11 +52,15 @@ pub(crate) struct RunArgs {
     refresh: Option<f64>,
     /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).
-    #[arg(long, allow_negative_numbers = true)]
+    // Checked here, alone: checked with the other side filled in, a bad value was named
+    // with a profile's size that OpenXR never uses.
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=EYE_SIDE_MAX as i64))]
     width: Option<u32>,
     /// Per-eye height to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).
-    #[arg(long, allow_negative_numbers = true)]
+    // Checked here, alone: checked with the other side filled in, a bad value was named
+    // with a profile's size that OpenXR never uses.
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=EYE_SIDE_MAX as i64))]
     height: Option<u32>,
     /// Budget governor: on (choose the AO setting by error per millisecond so that each
     /// frame's GPU time stays under the display period) or off (keep the settings).
@@ -94,6 +98,9 @@ pub(crate) fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     for output in [&args.report, &args.screenshot].into_iter().flatten() {
         vrao::formats::output::check_output_file(output)?;
     }
+    // The OpenXR mask's variable is an input like `--mask`: a bad value is refused before
+    // any work, whichever headset answers (the simulated one would never read it).
+    vrao::xr::openxr::mask::MaskChoice::from_env().map_err(|e| Error::input(e.to_string()))?;
     let scene = Scene::load(&args.scene)?;
     // The session replaces the profile with the one --profile names.
     let settings =

@@ -339,7 +339,12 @@ fn command_line_names_are_the_names_reports_print() {
 /// Runs vrao and asserts the bad-input contract: exit 2, an `error:` line containing
 /// every one of `names`, no panic and no path into the cargo registry. Returns the text.
 fn refused(args: &[&str], names: &[&str]) -> String {
-    let out = vrao(args);
+    refused_with(&[], args, names)
+}
+
+/// [`refused`] with the environment variables `env` set for vrao.
+fn refused_with(env: &[(&str, &str)], args: &[&str], names: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_vrao")).args(args).envs(env.iter().copied()).output().expect("vrao runs");
     let t = text(&out);
     assert_eq!(out.status.code(), Some(2), "{args:?}: {t}");
     assert!(!t.contains("panicked") && !t.contains(".cargo/registry"), "{args:?}: {t}");
@@ -367,6 +372,19 @@ fn count_and_time_options_are_bounded_and_say_so_in_help() {
     refused(&[&run[..], &["--virtual-time", "5,NaN"]].concat(), &["--virtual-time", "NaN"]);
     refused(&[&run[..], &["--refresh", "5"]].concat(), &["--refresh", "10..=500 Hz"]);
     refused(&[&run[..], &["--refresh", "1e300"]].concat(), &["--refresh", "10..=500 Hz"]);
+    // vrao's own variable for the OpenXR mask is refused like `--mask bogus`, whichever
+    // headset the run would have.
+    for headset in ["simulated", "auto"] {
+        let env = [("VRAO_OPENXR_VISIBILITY_MASK", "bogus")];
+        let args = ["run", "--headset", headset, "--display", "none", "--frames", "1"];
+        refused_with(&env, &args, &["VRAO_OPENXR_VISIBILITY_MASK=bogus", "`runtime`", "`fov`"]);
+    }
+    // Each side alone: the message names the option and its bound, never a profile's
+    // other side (1200, the Vive's height) that OpenXR would not use.
+    for (option, value) in [("--width", "0"), ("--height", "0"), ("--width", "8193")] {
+        let t = refused(&[&run[..], &[option, value]].concat(), &[option, value, "1..=8192"]);
+        assert!(!t.contains("1200") && !t.contains("1080"), "{t}");
+    }
     for (command, bounds) in [
         ("budget", &["0..=1000", "1..=100000"][..]),
         ("bench", &["0..=1000", "1..=100000", "1..=65536", "1..=64"]),

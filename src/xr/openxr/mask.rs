@@ -49,20 +49,48 @@ impl MaskMesh {
 /// runtime is, `fov` takes Monado's default from the field of view instead.
 pub const MASK_VAR: &str = "VRAO_OPENXR_VISIBILITY_MASK";
 
+/// What [`MASK_VAR`] asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaskChoice {
+    /// The runtime's mask, whatever the runtime is (`runtime`).
+    Runtime,
+    /// Monado's default from the field of view, never the runtime's (`fov`).
+    Fov,
+}
+
+impl MaskChoice {
+    /// The choice a value of [`MASK_VAR`] names: unset or blank is `None` (vrao chooses);
+    /// any other value than `runtime` or `fov` is refused, as `--mask` refuses one.
+    pub fn parse(value: Option<&str>) -> Result<Option<MaskChoice>, Trouble> {
+        match value.map(str::trim) {
+            None | Some("") => Ok(None),
+            Some("runtime") => Ok(Some(MaskChoice::Runtime)),
+            Some("fov") => Ok(Some(MaskChoice::Fov)),
+            Some(other) => Err(Trouble(format!("{MASK_VAR}={other} is neither `runtime` nor `fov` (or unset)"))),
+        }
+    }
+
+    /// The choice the environment holds now ([`MaskChoice::parse`]); a value that is not
+    /// UTF-8 is refused like any other unknown one.
+    pub fn from_env() -> Result<Option<MaskChoice>, Trouble> {
+        let value = std::env::var_os(MASK_VAR).map(|v| v.to_string_lossy().into_owned());
+        MaskChoice::parse(value.as_deref())
+    }
+}
+
 /// Why vrao does not call `xrGetVisibilityMaskKHR` on a runtime that offers the extension
-/// (`None`: it does), from the runtime's name, its version's major number and the value
-/// of [`MASK_VAR`] (`runtime`, `fov`; anything else counts as unset). Monado up to 24
-/// is skipped: see the module comment.
-pub fn skip_runtime_mask(runtime_name: &str, major: u16, choice: Option<&str>) -> Option<String> {
-    match choice.map(str::trim) {
-        Some("runtime") => None,
-        Some("fov") => Some(format!("{MASK_VAR}=fov")),
-        _ if runtime_name.starts_with("Monado") && major <= 24 => Some(format!(
+/// (`None`: it does), from the runtime's name, its version's major number and the choice
+/// [`MASK_VAR`] made. Monado up to 24 is skipped: see the module comment.
+pub fn skip_runtime_mask(runtime_name: &str, major: u16, choice: Option<MaskChoice>) -> Option<String> {
+    match choice {
+        Some(MaskChoice::Runtime) => None,
+        Some(MaskChoice::Fov) => Some(format!("{MASK_VAR}=fov")),
+        None if runtime_name.starts_with("Monado") && major <= 24 => Some(format!(
             "not read from Monado {major}: its in-process runtime crashes in xrGetVisibilityMaskKHR for a device \
              without a mask of its own, such as its simulated HMD, and gives such a device this one; \
              {MASK_VAR}=runtime reads it anyway"
         )),
-        _ => None,
+        None => None,
     }
 }
 
@@ -365,19 +393,28 @@ mod tests {
         let monado = "Monado(XRT) by Collabora et al 'v24.0.0-2403-g59c34e17b'";
         let why = skip_runtime_mask(monado, 24, None).unwrap();
         assert!(why.contains("Monado 24") && why.contains(MASK_VAR), "{why}");
-        assert_eq!(skip_runtime_mask(monado, 24, Some("runtime")), None);
+        assert_eq!(skip_runtime_mask(monado, 24, Some(MaskChoice::Runtime)), None);
         assert_eq!(skip_runtime_mask(monado, 25, None), None, "a later Monado is asked");
         assert_eq!(skip_runtime_mask("SteamVR/OpenXR", 2, None), None);
         assert_eq!(
-            skip_runtime_mask("SteamVR/OpenXR", 2, Some("fov")).as_deref(),
+            skip_runtime_mask("SteamVR/OpenXR", 2, Some(MaskChoice::Fov)).as_deref(),
             Some("VRAO_OPENXR_VISIBILITY_MASK=fov")
         );
-        assert_eq!(skip_runtime_mask("SteamVR/OpenXR", 2, Some("sometimes")), None, "an unknown value is unset");
         // The reason ends up in the mask's source.
         let mut mask = SessionMask::from_field_of_view(&why);
         mask.follow_fov([FOV45, FOV45]);
         assert!(mask.mask().unwrap().views[1].source.contains("not read from Monado 24"));
         assert!(!mask.from_the_runtime());
+    }
+
+    #[test]
+    fn the_variable_is_runtime_fov_or_unset_and_anything_else_is_refused() {
+        assert_eq!(MaskChoice::parse(None), Ok(None));
+        assert_eq!(MaskChoice::parse(Some("  ")), Ok(None), "blank is unset");
+        assert_eq!(MaskChoice::parse(Some("runtime")), Ok(Some(MaskChoice::Runtime)));
+        assert_eq!(MaskChoice::parse(Some(" fov ")), Ok(Some(MaskChoice::Fov)));
+        let refused = MaskChoice::parse(Some("bogus")).unwrap_err().to_string();
+        assert_eq!(refused, "VRAO_OPENXR_VISIBILITY_MASK=bogus is neither `runtime` nor `fov` (or unset)");
     }
 
     #[test]

@@ -546,7 +546,10 @@ impl Headset for OpenXrHeadset {
             self.end_empty(pending.display_time);
         }
         if self.budget.reached() && !self.machine.exit_wanted() && !self.machine.is_over() {
-            self.note(&format!("{} frames rendered: exit requested", self.budget.rendered));
+            self.note(&format!(
+                "{} rendered: exit requested",
+                crate::formats::output::count(self.budget.rendered, "frame")
+            ));
             self.feed(Event::FramesReached);
         }
         loop {
