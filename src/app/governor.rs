@@ -51,7 +51,9 @@ pub const BUILTIN_RADIUS_M: f32 = 0.3;
 /// One setting on the frontier.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Level {
-    /// [`BenchRecord::setting`], e.g. "gtao N=24 r=0.3 m half".
+    /// [`BenchRecord::setting`] at the radius the run applies (a level keeps the host's
+    /// radius: [`Level::apply`]), e.g. "gtao N=24 r=0.51 m half" from a bench measured at
+    /// 0.3 m: the label says what is rendered, [`Frontier::radius_m`] what was measured.
     pub setting: String,
     /// The technique of the setting.
     pub technique: Technique,
@@ -95,7 +97,8 @@ pub struct Frontier {
 
 impl Frontier {
     /// The Pareto-optimal rows of `file` at its radius nearest to `radius` (errors only
-    /// compare within one radius). Rows without a finite error or a positive cost, depth-
+    /// compare within one radius), labelled at `radius`, the radius a run applies with
+    /// them. Rows without a finite error or a positive cost, depth-
     /// peeled rows (a [`Level`] cannot express peeling) and non-occlusion techniques
     /// (none, fetch-only, rsm) are left out. A bench without such rows is `Error::Input`.
     pub fn from_bench(file: &BenchFile, radius: f32) -> Result<Frontier> {
@@ -133,8 +136,10 @@ impl Frontier {
             if levels.last().is_some_and(|l| rmse >= l.ao_rmse || ms <= l.ms_per_eye) {
                 continue;
             }
+            // Labelled with the radius rendered, not the bench's (a level never sets it).
+            let applied = BenchRecord { radius_m: radius, ..r.clone() };
             levels.push(Level {
-                setting: r.setting(),
+                setting: applied.setting(),
                 technique,
                 samples: r.samples,
                 half_res: r.resolution.is_half(),
@@ -154,10 +159,38 @@ impl Frontier {
         Frontier::from_bench(&file, radius).map_err(|e| Error::in_file(origin, e.to_string()))
     }
 
-    /// The frontier of the bench committed at `assets/governor/frontier.json`.
+    /// The frontier of the bench committed at `assets/governor/frontier.json`, labelled
+    /// at the radius it was measured at.
     pub fn builtin() -> Frontier {
-        Frontier::from_json(BUILTIN_JSON, Path::new(BUILTIN_PATH), BUILTIN_RADIUS_M)
-            .expect("the built-in frontier parses")
+        Frontier::builtin_at(BUILTIN_RADIUS_M)
+    }
+
+    /// The built-in frontier for a run at `radius`: the levels measured at
+    /// [`BUILTIN_RADIUS_M`], labelled at `radius` (see [`Frontier::from_bench`]).
+    pub fn builtin_at(radius: f32) -> Frontier {
+        Frontier::from_json(BUILTIN_JSON, Path::new(BUILTIN_PATH), radius).expect("the built-in frontier parses")
+    }
+
+    /// The level nearest the setting `ao` asks for, where the governor starts: the level
+    /// with the same technique, samples, resolution and temporal accumulation if there is
+    /// one; else the nearest by, in order, technique (a technique is what the user chose
+    /// first), samples (by their ratio), resolution, then temporal accumulation; equal
+    /// candidates go to the cheaper level (a start over budget costs a dropped frame, one
+    /// under it a raise later).
+    pub fn nearest(&self, ao: &AoSettings) -> usize {
+        let key = |l: &Level| {
+            let samples = (f64::from(l.samples.max(1)) / f64::from(ao.samples.max(1))).log2().abs();
+            (l.technique != ao.technique, samples, l.half_res != ao.resolution.is_half(), l.temporal != ao.temporal.enabled)
+        };
+        // `min_by` keeps the first of equals, and levels run cheapest first.
+        self.levels
+            .iter()
+            .enumerate()
+            .min_by(|(_, a), (_, b)| {
+                let (a, b) = (key(a), key(b));
+                a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)).then(a.3.cmp(&b.3))
+            })
+            .map_or(0, |(i, _)| i)
     }
 
     /// Every level, cheapest (most error) first.

@@ -312,8 +312,9 @@ fn end_before_frames(
 fn log_governor(governor: &Governor) {
     let frontier = governor.frontier();
     log::info!(
-        "governor: on, {} levels from {} to {}; starting at {}",
+        "governor: on, {} levels (measured at r={} m) from {} to {}; starting at {}",
         frontier.len(),
+        crate::formats::output::significant(f64::from(frontier.radius_m()), 2),
         frontier.levels()[0].setting,
         frontier.levels()[frontier.top()].setting,
         governor.current().setting
@@ -369,27 +370,19 @@ fn session_settings(
     Ok((settings, size))
 }
 
-/// The governor of a session: its frontier (the bench file given, or the built-in one)
-/// at the frame budget of the profile, starting at the level nearest the asked setting.
+/// The governor of a session: its frontier (the bench file given, or the built-in one),
+/// labelled at the radius the run applies, at the frame budget of the profile, starting
+/// at the level nearest the asked setting ([`Frontier::nearest`]).
 fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
+    let radius = settings.ao.radius;
     let frontier = match &options.governor_frontier {
         Some(path) => {
             let text = vrao_render::files::read_regular_file_to_string(path, vrao_render::files::MAX_TEXT_BYTES)?;
-            Frontier::from_json(&text, path, settings.ao.radius)?
+            Frontier::from_json(&text, path, radius)?
         }
-        None => Frontier::builtin(),
+        None => Frontier::builtin_at(radius),
     };
-    let ao = &settings.ao;
-    let start = frontier
-        .levels()
-        .iter()
-        .position(|l| {
-            l.technique == ao.technique
-                && l.samples == ao.samples
-                && l.half_res == ao.resolution.is_half()
-                && l.temporal == ao.temporal.enabled
-        })
-        .unwrap_or(frontier.top());
+    let start = frontier.nearest(&settings.ao);
     let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
     Governor::new(frontier, config, start)
 }
