@@ -816,6 +816,46 @@ fn a_window_without_a_display_is_refused_before_the_headset_opens_and_the_report
 }
 
 #[test]
+fn every_refused_run_writes_its_report_and_a_refused_report_path_writes_nothing() {
+    // Issue 50: some refusals wrote the report and others (the scene, the screenshot's
+    // path) did not. Now every refusal after the report's own path is accepted does.
+    let dir = temp_dir("refused-reports");
+    let frontier = dir.join("frontier.json");
+    std::fs::write(&frontier, "{}").unwrap();
+    let frontier = frontier.to_str().unwrap().to_string();
+    let missing_folder = dir.join("no-such-folder").join("shot.png");
+    let missing_folder = missing_folder.to_str().unwrap().to_string();
+    let base = ["run", "--headset", "simulated", "--display", "none", "--frames", "1", "--width", "8", "--height", "8"];
+    let cases: [(&str, Vec<&str>, Option<(&str, &str)>, &str); 5] = [
+        ("scene", vec!["--scene", "no-such-scene.obj"], None, "no-such-scene.obj"),
+        ("screenshot", vec!["--screenshot", &missing_folder], None, "shot.png"),
+        ("variable", vec![], Some(("VRAO_OPENXR_VISIBILITY_MASK", "bogus")), "VRAO_OPENXR_VISIBILITY_MASK"),
+        ("window", vec!["--show", "ao"], None, "--show ao"),
+        ("frontier", vec!["--governor-frontier", &frontier], None, "frontier.json"),
+    ];
+    for (name, extra, env, named) in cases {
+        let report = dir.join(format!("{name}.json"));
+        let mut args: Vec<&str> = base.to_vec();
+        args.extend(extra);
+        args.extend(["--report", report.to_str().unwrap()]);
+        let out = Command::new(env!("CARGO_BIN_EXE_vrao")).args(&args).envs(env).output().unwrap();
+        let t = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{name}: {t}");
+        let errors = error_lines(&out);
+        assert!(errors.len() == 1 && errors[0].contains(named), "{name}: {t}");
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert!(errors[0].contains(json["refused"].as_str().unwrap()), "{name}: the report says why: {json}");
+        assert_eq!(json["frames_rendered"], 0, "{name}: {json}");
+    }
+    // The report's own path refused: nothing is written, wherever else the run fails.
+    let report = dir.join("no-such-folder").join("report.json");
+    let out = vrao(&[&base[..], &["--scene", "no-such-scene.obj", "--report", report.to_str().unwrap()]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(error_lines(&out)[0].contains("report.json"), "the report's path is checked first: {}", text(&out));
+    assert!(!report.exists() && !dir.join("no-such-folder").exists());
+}
+
+#[test]
 fn an_interrupted_render_leaves_nothing_behind() {
     // Issue 39: a render interrupted by Ctrl-C left an empty output folder.
     let dir = temp_dir("render-interrupted");
