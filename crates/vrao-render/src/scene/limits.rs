@@ -234,20 +234,14 @@ pub fn mesh_trouble(mesh: &Mesh) -> Option<String> {
     })
 }
 
-/// One-line trouble when a moving mesh (one that hangs from a node of `nodes`) reaches
-/// beyond [`COORDINATE_MAX_M`] over its animation: its local bounds' corners at 65 times
-/// over the loop (as [`Scene::swept_corners`] samples them for the scene's bounds), each
-/// key's value already in range but their product (a far key times a large scale, a large
-/// placement of a moving root) not.
+/// One-line trouble when a moving mesh (one that hangs from a node of `nodes`) can reach
+/// beyond [`COORDINATE_MAX_M`] over its animation: its local bounds carried up its chain
+/// of nodes through every value their tracks take ([`super::animation::reach_in_world`]:
+/// bounded from the keys, a cubic spline's overshoot between keys included, never
+/// sampled), each key's value already in range but their product (a far key times a large
+/// scale, a large placement of a moving root, a spline's tangents) not. The bound is
+/// conservative: an animated rotation counts as any rotation.
 pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> {
-    const SAMPLES: usize = 64;
-    if !meshes.iter().any(|m| m.node.is_some()) {
-        return None;
-    }
-    let period = nodes.iter().map(|n| n.tracks.end()).fold(0.0, f64::max);
-    let times: Vec<f64> = (0..=SAMPLES).map(|k| period * k as f64 / SAMPLES as f64).collect();
-    let transforms: Vec<Vec<glam::DMat4>> =
-        times.iter().map(|&t| super::animation::world_transforms(nodes, t)).collect();
     for mesh in meshes {
         let Some(node) = mesh.node else { continue };
         let mut local = super::Aabb::EMPTY;
@@ -255,24 +249,15 @@ pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> 
         if local.is_empty() {
             continue;
         }
-        for (world, t) in transforms.iter().zip(&times) {
-            let Some(world) = world.get(node) else { continue };
-            for corner in 0..8 {
-                let pick = |bit: usize, lo: f64, hi: f64| if corner & bit == 0 { lo } else { hi };
-                let c = glam::DVec3::new(
-                    pick(1, local.min.x, local.max.x),
-                    pick(2, local.min.y, local.max.y),
-                    pick(4, local.min.z, local.max.z),
-                );
-                let farthest = world.transform_point3(c).abs().max_element();
-                if farthest.is_nan() || farthest > COORDINATE_MAX_M {
-                    return Some(format!(
-                        "moving mesh '{}' reaches {} m from the origin at t = {t} s, farther than {COORDINATE_MAX_M:e} m",
-                        mesh.name,
-                        shortest(farthest)
-                    ));
-                }
-            }
+        let world = super::animation::reach_in_world(nodes, node, &local);
+        let farthest = world.min.abs().max(world.max.abs()).max_element();
+        if world.min.is_nan() || world.max.is_nan() || !(farthest <= COORDINATE_MAX_M) {
+            let reach = if farthest.is_nan() || world.min.is_nan() { "NaN".to_string() } else { shortest(farthest) };
+            return Some(format!(
+                "moving mesh '{}' can reach {reach} m from the origin over its animation (bounded from its keys and \
+                 their spline tangents), farther than {COORDINATE_MAX_M:e} m",
+                mesh.name
+            ));
         }
     }
     None
