@@ -347,6 +347,38 @@ mod tests {
     }
 
     #[test]
+    fn a_splines_overshoot_between_keys_is_within_the_motion_bound() {
+        use crate::scene::{Interpolation, Node, NodeTracks, Track, Trs};
+        // Keys at 0, 10 and 640 s, every value 0: 65 samples over the loop fall every
+        // 10 s, on the keys, and saw nothing; the first segment's tangents (±9e5 m/s, each
+        // in range) carry the mesh 2.25e6 m out at t = 5 s.
+        let node = |b0: f64| Node {
+            name: "thrown".into(),
+            parent: None,
+            base: glam::DMat4::IDENTITY,
+            rest: Trs::IDENTITY,
+            tracks: NodeTracks {
+                translation: Some(Track {
+                    interpolation: Interpolation::CubicSpline,
+                    times: vec![0.0, 10.0, 640.0],
+                    values: [0.0, 0.0, b0, -b0, 0.0, 0.0, 0.0, 0.0, 0.0].map(|x| DVec3::new(x, 0.0, 0.0)).to_vec(),
+                }),
+                ..Default::default()
+            },
+        };
+        let mut mesh = crate::scene::builtin::load("box").unwrap().meshes.remove(0);
+        mesh.node = Some(0);
+        let thrown = node(9e5);
+        let peak = thrown.tracks.translation.as_ref().unwrap().sample(5.0).x;
+        assert!((peak - 2.25e6).abs() < 1.0, "{peak}");
+        let e = motion_trouble(std::slice::from_ref(&mesh), &[thrown]).unwrap();
+        assert!(e.starts_with(&format!("moving mesh '{}' can reach 3", mesh.name)), "{e}");
+        assert!(e.ends_with("farther than 1e6 m"), "{e}");
+        // A tenth of the tangent: 2.25e5 m at most, within.
+        assert_eq!(motion_trouble(std::slice::from_ref(&mesh), &[node(9e4)]), None);
+    }
+
+    #[test]
     fn a_texture_over_the_device_limit_is_refused_naming_its_file_and_the_limit() {
         let mut scene = crate::scene::builtin::load("plane").unwrap();
         let mut material = Material::plain("wide", Vec3::ONE);
