@@ -302,6 +302,8 @@ fn first_line(message: &str) -> String {
 struct Warnings {
     extensions: BTreeSet<String>,
     ignored: BTreeSet<&'static str>,
+    /// Primitives whose TANGENT was degenerate and left out, each with its first bad vertex.
+    derived_tangents: Vec<String>,
 }
 
 impl Warnings {
@@ -315,6 +317,18 @@ impl Warnings {
         if !self.ignored.is_empty() {
             let list: Vec<&str> = self.ignored.iter().copied().collect();
             lines.push(format!("{}: not supported (ignored): {}", path.display(), list.join("; ")));
+        }
+        if !self.derived_tangents.is_empty() {
+            let more = match self.derived_tangents.len() {
+                n if n > 4 => format!(" and {} more", n - 4),
+                _ => String::new(),
+            };
+            lines.push(format!(
+                "{}: TANGENT zero or parallel to NORMAL in {}{more}: those primitives' tangents are derived from \
+                 their texture coordinates instead",
+                path.display(),
+                self.derived_tangents[..self.derived_tangents.len().min(4)].join(", ")
+            ));
         }
         lines
     }
@@ -705,7 +719,15 @@ impl Loader<'_> {
                 self.warnings.ignored.insert("morph targets (drawn in the bind pose)");
             }
             let attributes = self.read_attributes(&primitive, &what)?;
-            let (geometry, extras) = self.with_normals(&primitive, attributes, &what)?;
+            let (geometry, mut extras) = self.with_normals(&primitive, attributes, &what)?;
+            // A tangent along the normal leaves no direction once the shader takes the
+            // normal out of it (noise, seen as stripes): the whole primitive then uses the
+            // frame derived from its texture coordinates, as it does without TANGENT
+            // (mixing the two would seam where they meet).
+            if let Some(vertex) = degenerate_tangent(&extras.tangents, &geometry.normals) {
+                extras.tangents.clear();
+                self.warnings.derived_tangents.push(format!("{what} (vertex {vertex})"));
+            }
             let material = self.material(&primitive.material())?;
             let name = match mesh.primitives().len() {
                 1 => mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string),
@@ -1079,6 +1101,24 @@ impl Loader<'_> {
         self.warn_hidden_nodes(&tracks);
         Ok(tracks)
     }
+}
+
+/// The sine of the angle under which a TANGENT counts as parallel to its vertex's normal:
+/// 0.01 (0.57°). Authored tangents are orthogonal to the normal (MikkTSpace makes them
+/// so) or near it; one this close leaves, after the shader removes the normal's part,
+/// a remainder of the size of the 16-bit vertex quantisation.
+const TANGENT_PARALLEL_SINE: f32 = 0.01;
+
+/// The first vertex whose tangent (xyz of `tangents`, one per vertex of `normals`) is zero,
+/// not finite, or parallel to its unit normal within [`TANGENT_PARALLEL_SINE`]; `None`
+/// when every one gives a direction (or there are no tangents).
+fn degenerate_tangent(tangents: &[Vec4], normals: &[Vec3]) -> Option<usize> {
+    tangents.iter().zip(normals).position(|(t, n)| {
+        let t = t.truncate();
+        let length = t.length();
+        let across = (t - *n * n.dot(t)).length();
+        !(length.is_finite() && length > 1e-6 && across > TANGENT_PARALLEL_SINE * length)
+    })
 }
 
 /// `values` (one per source vertex, or empty) for the vertices made from `sources`.
