@@ -17,7 +17,10 @@
 //! predict a frame slower than one refresh and keep the application at half rate. A frame
 //! whose predicted period spans more than one refresh ([`Governor::observe_paced`]) missed
 //! refreshes: it is a reason to drop (once the frames after a change had time to reach the
-//! runtime's pacing) and never counts as calm.
+//! runtime's pacing) and never counts as calm. So is a frame that missed its predicted
+//! display time on the headset's clock ([`Observation::late_ms`], the frame loop's
+//! estimate from when it was submitted and its GPU time): what the runtime shows late,
+//! whatever the GPU time says against the period.
 //!
 //! ## Prediction model
 //! A frame's GPU time is T = R + A: the AO passes A and everything else R. At level i
@@ -322,6 +325,21 @@ pub struct GovernorChange {
     pub predicted_ms: Option<f64>,
 }
 
+/// What the frame loop knows of one frame once its GPU time is back.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Observation {
+    /// The whole frame's GPU time (both eyes), ms.
+    pub gpu_ms: f64,
+    /// The AO passes' share of it, when measured.
+    pub ao_ms: Option<f64>,
+    /// The display period the headset predicted for the frame (OpenXR's
+    /// predictedDisplayPeriod), ms.
+    pub predicted_period_ms: Option<f64>,
+    /// How far (ms) the frame's GPU work finished after its predicted display time on the
+    /// headset's clock (positive: it missed it); `None` where the headset has no clock.
+    pub late_ms: Option<f64>,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Sample {
     frame: u64,
@@ -329,6 +347,8 @@ struct Sample {
     ao_ms: Option<f64>,
     /// The display period the headset predicted for the frame (ms), if it said.
     predicted_period_ms: Option<f64>,
+    /// By how much the frame missed its display time (ms, > 0), if it did.
+    late_ms: Option<f64>,
 }
 
 impl Sample {
@@ -450,9 +470,20 @@ impl Governor {
         ao_ms: Option<f64>,
         predicted_period_ms: Option<f64>,
     ) -> Option<GovernorChange> {
-        let ao_ms = ao_ms.filter(|ms| ms.is_finite()).map(|ms| ms.clamp(0.0, gpu_ms.max(0.0)));
-        let predicted_period_ms = predicted_period_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
-        self.observe_sample(Sample { frame, gpu_ms, ao_ms, predicted_period_ms })
+        self.observe_frame(frame, Observation { gpu_ms, ao_ms, predicted_period_ms, late_ms: None })
+    }
+
+    /// [`Governor::observe_paced`] with whether the frame missed its predicted display
+    /// time on the headset's clock ([`Observation::late_ms`] above 0): a late frame
+    /// drops like one over 90 % (unless within [`GovernorConfig::stretch_settle_frames`]
+    /// of a change: the frames queued before it still finish late) and never counts as
+    /// calm.
+    pub fn observe_frame(&mut self, frame: u64, o: Observation) -> Option<GovernorChange> {
+        let gpu_ms = o.gpu_ms;
+        let ao_ms = o.ao_ms.filter(|ms| ms.is_finite()).map(|ms| ms.clamp(0.0, gpu_ms.max(0.0)));
+        let predicted_period_ms = o.predicted_period_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
+        let late_ms = o.late_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
+        self.observe_sample(Sample { frame, gpu_ms, ao_ms, predicted_period_ms, late_ms })
     }
 
     /// The frame time predicted at level `to` from a frame `s` measured at the current
@@ -495,6 +526,10 @@ impl Governor {
                 );
                 return Some(self.change(s.frame, to, reason, None));
             }
+            if let (true, Some(late)) = (settled, s.late_ms) {
+                let reason = format!("frame {:.2} ms missed its display time by {late:.2} ms (headset clock)", s.gpu_ms);
+                return Some(self.change(s.frame, to, reason, None));
+            }
             if let Some(reason) = self.trend_overrun() {
                 return Some(self.change(s.frame, to, reason, None));
             }
@@ -502,14 +537,15 @@ impl Governor {
         let c = &self.config;
         let to = (self.level + c.raise_step).min(self.frontier.top());
         // Calm: under 70 % of the display's period, and shown at the display's rate (a
-        // stretched period means refreshes were missed, whatever the GPU time).
+        // stretched period or a late frame means refreshes were missed, whatever the GPU
+        // time).
         let calm = self.recent.len() >= c.calm_frames_to_raise
             && self
                 .recent
                 .iter()
                 .rev()
                 .take(c.calm_frames_to_raise)
-                .all(|r| r.gpu_ms < calm_ms && r.missed(period) == 0);
+                .all(|r| r.gpu_ms < calm_ms && r.missed(period) == 0 && r.late_ms.is_none());
         let spaced = self.last_change_frame.is_none_or(|f| s.frame >= f + c.min_frames_between_raises);
         if to == self.level || !calm || !spaced {
             return None;

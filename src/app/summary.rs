@@ -43,6 +43,14 @@ pub struct RunSummary {
     pub over_budget_frames: u64,
     /// Frames whose GPU time came back.
     pub timed_frames: u64,
+    /// Timed frames whose GPU work finished, at the earliest, after their predicted
+    /// display time on the headset's clock: shown late (or dropped) by the runtime,
+    /// whatever their GPU time against the budget.
+    pub late_frames: u64,
+    /// Timed frames judged so: 0 where the headset gives no clock (`late_clock` says why).
+    pub clocked_frames: u64,
+    /// The clock frames were judged late against, or why none was.
+    pub late_clock: String,
     /// Medians over the run ([`crate::stats`]; 0 when no frame was timed): GPU
     /// time per frame (both eyes), CPU encode time per frame, and their ratio.
     pub gpu_frame_ms_median: f64,
@@ -114,6 +122,14 @@ impl RunSummary {
             stretched_frames: frame_loop.stretched_frames,
             over_budget_frames: frame_loop.over_budget_frames,
             timed_frames: frame_loop.timed_frames,
+            late_frames: frame_loop.late_frames,
+            clocked_frames: frame_loop.clocked_frames,
+            late_clock: if frame_loop.headset.now().is_some() {
+                "the headset's clock (a frame's work starts no earlier than its submission and the frame before)"
+                    .into()
+            } else {
+                format!("none: {}", frame_loop.headset.no_clock_reason())
+            },
             gpu_frame_ms_median,
             cpu_encode_ms_median,
             cpu_encode_share_of_gpu: if gpu_frame_ms_median > 0.0 {
@@ -190,6 +206,9 @@ impl RunSummary {
             stretched_frames: 0,
             over_budget_frames: 0,
             timed_frames: 0,
+            late_frames: 0,
+            clocked_frames: 0,
+            late_clock: "none: no frame was rendered".into(),
             gpu_frame_ms_median: 0.0,
             cpu_encode_ms_median: 0.0,
             cpu_encode_share_of_gpu: 0.0,
@@ -256,6 +275,15 @@ impl RunSummary {
         } else {
             String::new()
         };
+        let late = if self.clocked_frames > 0 {
+            format!(
+                "; {} of {} late (finished after their predicted display time on the headset's clock)",
+                self.late_frames,
+                count(self.clocked_frames, "frame")
+            )
+        } else {
+            format!("; late frames not judged ({})", self.late_clock)
+        };
         let budget = if self.budget_changes > 0 {
             format!(
                 "a {:.2} ms budget ({:.2}..{:.2} ms, {}) from {}",
@@ -279,7 +307,7 @@ impl RunSummary {
             _ => String::new(),
         };
         format!(
-            "governor {}: {}, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
+            "governor {}: {}, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} over{stretched}{late}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
             count(self.governor_changes.len() as u64, "change"),
             self.final_ao_setting,

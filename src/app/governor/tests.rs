@@ -629,3 +629,38 @@ fn the_governor_starts_at_the_level_nearest_the_asked_setting() {
     let temporal_half = AoSettings { temporal: vrao_ao::Temporal { enabled: true, ..Default::default() }, ..half };
     assert_eq!(synthetic.nearest(&temporal_half), 3, "temporal accumulation matters least");
 }
+
+#[test]
+fn a_frame_that_missed_its_display_time_lowers_the_level_and_is_never_calm() {
+    // Issue 50: at 80x60 Monado logged 53-64 late or dropped frames per 200 while every
+    // GPU time fitted the budget and the governor raised. Here every frame takes 5 ms of
+    // an 11.1 ms period (calm by its GPU time alone).
+    let frontier = synthetic();
+    let late = |ms: f64| Observation { gpu_ms: 5.0, late_ms: Some(ms), ..Observation::default() };
+    let mut g = Governor::new(frontier.clone(), GovernorConfig::default(), 3).unwrap();
+    // On time (finished before the display time: late_ms <= 0) it raises after the calm frames.
+    for frame in 0..12 {
+        g.observe_frame(frame, late(-2.0));
+    }
+    assert_eq!(g.level(), 4, "{:?}", g.changes());
+    // A frame that missed its display time by 3 ms drops two levels at once.
+    let drop = g.observe_frame(30, late(3.0)).expect("a late frame drops");
+    assert_eq!(g.level(), 2);
+    assert_eq!(drop.reason, "frame 5.00 ms missed its display time by 3.00 ms (headset clock)");
+    // The frames queued behind it, late too, do not drop again before they had time to
+    // reach the new level.
+    for frame in 31..=38 {
+        assert_eq!(g.observe_frame(frame, late(1.0)), None, "frame {frame}");
+    }
+    assert!(g.observe_frame(39, late(1.0)).is_some(), "settled: late again drops");
+    assert_eq!(g.level(), 0);
+    // Late frames are never calm: no raise however small their GPU time.
+    let mut g = Governor::new(frontier, GovernorConfig::default(), 0).unwrap();
+    for frame in 0..40 {
+        assert_eq!(g.observe_frame(frame, late(0.5)), None, "frame {frame}");
+    }
+    assert_eq!(g.level(), 0);
+    // Without a clock (late_ms None) a frame is judged by its GPU time alone.
+    let mut g = Governor::new(synthetic(), GovernorConfig::default(), 4).unwrap();
+    assert_eq!(g.observe_frame(0, Observation { gpu_ms: 5.0, ..Observation::default() }), None);
+}

@@ -657,6 +657,22 @@ impl Headset for OpenXrHeadset {
         }
     }
 
+    fn now(&self) -> Option<f64> {
+        match (&self.fallback, &self.xr) {
+            (Some(simulated), _) => Headset::now(simulated),
+            // The runtime's XrTime, the clock of its predicted display times.
+            (None, Some(xr)) if xr.clock => xr.instance.now().ok().map(|t| t.as_nanos() as f64 / 1e9),
+            _ => None,
+        }
+    }
+
+    fn no_clock_reason(&self) -> String {
+        match &self.fallback {
+            Some(simulated) => simulated.no_clock_reason(),
+            None => "the OpenXR runtime offers no XR_KHR_convert_timespec_time to read its clock".into(),
+        }
+    }
+
     fn session_state(&self) -> String {
         match (&self.fallback, self.machine.states().last()) {
             (Some(simulated), _) => format!("{} (after the OpenXR session was lost)", simulated.session_state()),
