@@ -183,7 +183,12 @@ impl Frontier {
     pub fn nearest(&self, ao: &AoSettings) -> usize {
         let key = |l: &Level| {
             let samples = (f64::from(l.samples.max(1)) / f64::from(ao.samples.max(1))).log2().abs();
-            (l.technique != ao.technique, samples, l.half_res != ao.resolution.is_half(), l.temporal != ao.temporal.enabled)
+            (
+                l.technique != ao.technique,
+                samples,
+                l.half_res != ao.resolution.is_half(),
+                l.temporal != ao.temporal.enabled,
+            )
         };
         // `min_by` keeps the first of equals, and levels run cheapest first.
         self.levels
@@ -527,7 +532,8 @@ impl Governor {
                 return Some(self.change(s.frame, to, reason, None));
             }
             if let (true, Some(late)) = (settled, s.late_ms) {
-                let reason = format!("frame {:.2} ms missed its display time by {late:.2} ms (headset clock)", s.gpu_ms);
+                let reason =
+                    format!("frame {:.2} ms missed its display time by {late:.2} ms (headset clock)", s.gpu_ms);
                 return Some(self.change(s.frame, to, reason, None));
             }
             if let Some(reason) = self.trend_overrun() {

@@ -125,8 +125,7 @@ impl RunSummary {
             late_frames: frame_loop.late_frames,
             clocked_frames: frame_loop.clocked_frames,
             late_clock: if frame_loop.headset.now().is_some() {
-                "the headset's clock (a frame's work starts no earlier than its submission and the frame before)"
-                    .into()
+                "the headset's clock (a frame's work starts no earlier than its submission and the frame before)".into()
             } else {
                 format!("none: {}", frame_loop.headset.no_clock_reason())
             },

@@ -344,7 +344,8 @@ fn refused(args: &[&str], names: &[&str]) -> String {
 
 /// [`refused`] with the environment variables `env` set for vrao.
 fn refused_with(env: &[(&str, &str)], args: &[&str], names: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_vrao")).args(args).envs(env.iter().copied()).output().expect("vrao runs");
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_vrao")).args(args).envs(env.iter().copied()).output().expect("vrao runs");
     let t = text(&out);
     assert_eq!(out.status.code(), Some(2), "{args:?}: {t}");
     assert!(!t.contains("panicked") && !t.contains(".cargo/registry"), "{args:?}: {t}");
@@ -826,7 +827,9 @@ fn every_refused_run_writes_its_report_and_a_refused_report_path_writes_nothing(
     let missing_folder = dir.join("no-such-folder").join("shot.png");
     let missing_folder = missing_folder.to_str().unwrap().to_string();
     let base = ["run", "--headset", "simulated", "--display", "none", "--frames", "1", "--width", "8", "--height", "8"];
-    let cases: [(&str, Vec<&str>, Option<(&str, &str)>, &str); 5] = [
+    // (name, extra arguments, an environment variable, what the error names)
+    type Case<'a> = (&'a str, Vec<&'a str>, Option<(&'a str, &'a str)>, &'a str);
+    let cases: [Case; 5] = [
         ("scene", vec!["--scene", "no-such-scene.obj"], None, "no-such-scene.obj"),
         ("screenshot", vec!["--screenshot", &missing_folder], None, "shot.png"),
         ("variable", vec![], Some(("VRAO_OPENXR_VISIBILITY_MASK", "bogus")), "VRAO_OPENXR_VISIBILITY_MASK"),

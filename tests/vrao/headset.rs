@@ -151,7 +151,10 @@ fn the_run_report_counts_rendered_frames_frames_in_flight_and_the_governors_chan
     assert!(on["late_frames"].as_u64().unwrap() <= 12, "{on}");
     assert!(on["late_clock"].as_str().unwrap().starts_with("the headset's clock"), "{on}");
     let virtual_time = run_report(&dir, "virtual.json", &["--virtual-time", "5"]);
-    assert_eq!((&virtual_time["clocked_frames"], &virtual_time["late_frames"]), (&serde_json::json!(0), &serde_json::json!(0)));
+    assert_eq!(
+        (&virtual_time["clocked_frames"], &virtual_time["late_frames"]),
+        (&serde_json::json!(0), &serde_json::json!(0))
+    );
     assert!(virtual_time["late_clock"].as_str().unwrap().starts_with("none: virtual time"), "{virtual_time}");
     assert_eq!(on["governor"], "on");
     for change in on["governor_changes"].as_array().unwrap() {

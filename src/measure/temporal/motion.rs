@@ -341,8 +341,14 @@ mod tests {
         let table = to_markdown(&points);
         let lower = table.to_lowercase();
         assert!(!lower.contains("nan") && !lower.contains("inf"), "{table}");
-        assert!(table.contains("| temporal off | 1.000 % | 1.000 % | 2.00 % | 10.00 % | 0.0500 | - | +0.0200 |"), "{table}");
-        assert!(table.contains("| temporal, motion vectors | 1.000 % | 1.000 % | 2.00 % | 10.00 % | - | - | - |"), "{table}");
+        assert!(
+            table.contains("| temporal off | 1.000 % | 1.000 % | 2.00 % | 10.00 % | 0.0500 | - | +0.0200 |"),
+            "{table}"
+        );
+        assert!(
+            table.contains("| temporal, motion vectors | 1.000 % | 1.000 % | 2.00 % | 10.00 % | - | - | - |"),
+            "{table}"
+        );
         assert!(table.contains("more --rays"), "{table}");
         // With a frozen error the ratio is there, and no note.
         let points = [point("frozen scene, temporal", 0.02, 0.0), point("temporal off", 0.05, 0.0)];

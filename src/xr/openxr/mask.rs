@@ -466,7 +466,10 @@ mod tests {
             skip_runtime_mask("SteamVR/OpenXR", 2, Some(MaskChoice::Fov)).as_deref(),
             Some("VRAO_OPENXR_VISIBILITY_MASK=fov")
         );
-        assert_eq!(skip_runtime_mask(&build("v24.0.0"), 24, Some(MaskChoice::Fov)).as_deref(), Some("VRAO_OPENXR_VISIBILITY_MASK=fov"));
+        assert_eq!(
+            skip_runtime_mask(&build("v24.0.0"), 24, Some(MaskChoice::Fov)).as_deref(),
+            Some("VRAO_OPENXR_VISIBILITY_MASK=fov")
+        );
         // The reason ends up in the mask's source.
         let mut mask = SessionMask::from_field_of_view(&why);
         mask.follow_fov([FOV45, FOV45]);

@@ -275,7 +275,11 @@ impl Node {
         let rotated = match &self.tracks.rotation {
             Some(_) => {
                 // f64::max would drop a NaN: kept, so that a bad value is still refused.
-                let r = scaled.corners().iter().map(|c| c.length()).fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) });
+                let r = scaled
+                    .corners()
+                    .iter()
+                    .map(|c| c.length())
+                    .fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) });
                 Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) }
             }
             None => scaled.transformed(&DMat4::from_quat(self.rest.rotation)),

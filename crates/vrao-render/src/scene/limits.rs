@@ -251,7 +251,7 @@ pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> 
         }
         let world = super::animation::reach_in_world(nodes, node, &local);
         let farthest = world.min.abs().max(world.max.abs()).max_element();
-        if world.min.is_nan() || world.max.is_nan() || !(farthest <= COORDINATE_MAX_M) {
+        if world.min.is_nan() || world.max.is_nan() || farthest.is_nan() || farthest > COORDINATE_MAX_M {
             let reach = if farthest.is_nan() || world.min.is_nan() { "NaN".to_string() } else { shortest(farthest) };
             return Some(format!(
                 "moving mesh '{}' can reach {reach} m from the origin over its animation (bounded from its keys and \

@@ -274,7 +274,11 @@ impl Aabb {
     pub fn corners(&self) -> [DVec3; 8] {
         std::array::from_fn(|i| {
             let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
-            DVec3::new(pick(1, self.min.x, self.max.x), pick(2, self.min.y, self.max.y), pick(4, self.min.z, self.max.z))
+            DVec3::new(
+                pick(1, self.min.x, self.max.x),
+                pick(2, self.min.y, self.max.y),
+                pick(4, self.min.z, self.max.z),
+            )
         })
     }
     /// The bounds of this box's corners moved by `m`: a box holding the moved box.

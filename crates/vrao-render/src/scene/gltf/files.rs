@@ -417,7 +417,10 @@ mod tests {
             let mesh = &content.meshes[0];
             if derived {
                 assert_eq!(lines.len(), 1, "{name}: {:?}", content.warnings);
-                assert!(lines[0].contains("mesh 'tri' primitive 0 (vertex 0)") && lines[0].contains("derived"), "{lines:?}");
+                assert!(
+                    lines[0].contains("mesh 'tri' primitive 0 (vertex 0)") && lines[0].contains("derived"),
+                    "{lines:?}"
+                );
                 assert!(mesh.tangents.is_empty(), "{name}: the shader derives the frame");
             } else {
                 assert!(lines.is_empty(), "{name}: {lines:?}");
