@@ -3,7 +3,7 @@
 //! eyes; the headset gets colour and depth. The desktop window (`window.rs`) drives the
 //! same loop one step per redraw.
 
-use crate::app::governor::Governor;
+use crate::app::governor::{Governor, Observation};
 use crate::app::{BufferView, PassHistory};
 use crate::error::{Error, Result};
 use crate::xr::{FrameRequest, Headset, SubmittedFrame};
@@ -59,6 +59,16 @@ pub struct FrameLoop {
     pub over_budget_frames: u64,
     /// Frames whose GPU time has come back (the denominator of `over_budget_frames`).
     pub timed_frames: u64,
+    /// Frames whose GPU work finished after their predicted display time on the headset's
+    /// clock (at the earliest: [`crate::xr::earliest_finish`]), of the timed frames the
+    /// headset's clock was read for (`clocked_frames`): what the runtime shows late, or
+    /// drops, whatever the GPU time against the budget.
+    pub late_frames: u64,
+    /// Timed frames whose submission was read on the headset's clock (the denominator of
+    /// `late_frames`; 0 where the headset has no clock: [`Headset::now`]).
+    pub clocked_frames: u64,
+    /// The previous timed frame's earliest finish on the headset's clock (s).
+    previous_finish: Option<f64>,
     /// Every frame's GPU time and CPU encode time (ms), for the run's medians.
     pub gpu_frame_ms: Vec<f64>,
     /// Every frame's CPU encode time (ms).
@@ -93,6 +103,9 @@ struct InFlight {
     /// The display period the headset predicted for the frame (the governor lowers on
     /// one stretched over several refreshes).
     predicted_period_ms: Option<f64>,
+    /// The frame's predicted display time and when its work was submitted, both on the
+    /// headset's clock (s); `None` without a clock.
+    deadline: Option<(f64, f64)>,
     serial: bool,
     occlusion_passes: Vec<&'static str>,
 }
@@ -152,6 +165,9 @@ impl FrameLoop {
             display_period_seen,
             over_budget_frames: 0,
             timed_frames: 0,
+            late_frames: 0,
+            clocked_frames: 0,
+            previous_finish: None,
             gpu_frame_ms: Vec::new(),
             cpu_encode_ms: Vec::new(),
             exit_requested: Arc::new(AtomicBool::new(false)),
@@ -194,6 +210,8 @@ impl FrameLoop {
         let serial = self.cpu_adapter && self.renderer.frame_index().is_multiple_of(SERIAL_EVERY);
         self.renderer.set_timing(if serial { Timing::Serial } else { Timing::Pipelined });
         let report = self.render(&request)?;
+        // The frame's work is on the GPU's queue from here (submitted, not waited for).
+        let submitted_at = self.headset.now().filter(|t| t.is_finite());
         let color = self.renderer.target(COLOR).ok_or_else(|| Error::gpu("no eye colour"))?;
         let depth = self.renderer.target(DEPTH).ok_or_else(|| Error::gpu("no eye depth"))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
@@ -210,6 +228,7 @@ impl FrameLoop {
             frame: report.frame,
             budget_ms: self.budget_ms,
             predicted_period_ms: request.display_period_ms,
+            deadline: submitted_at.map(|at| (request.display_time, at)),
             serial,
             occlusion_passes: report.plan.occlusion_passes(),
         });
@@ -269,14 +288,26 @@ impl FrameLoop {
             timing.serial = sent.is_some_and(|f| f.serial);
             let budget_ms = sent.map_or(self.budget_ms, |f| f.budget_ms);
             let predicted_ms = sent.and_then(|f| f.predicted_period_ms);
+            let deadline = sent.and_then(|f| f.deadline);
             let passes = sent.map(|f| f.occlusion_passes.clone());
             let ao_ms = passes.and_then(|passes| self.occlusion_ms(&timing, &passes));
             self.timed_frames += 1;
             if timing.total_ms > budget_ms {
                 self.over_budget_frames += 1;
             }
+            let late_ms = deadline.map(|(display_time, submitted_at)| {
+                let finish = crate::xr::earliest_finish(submitted_at, self.previous_finish, timing.total_ms);
+                self.previous_finish = Some(finish);
+                (finish - display_time) * 1e3
+            });
+            if let Some(late_ms) = late_ms {
+                self.clocked_frames += 1;
+                self.late_frames += u64::from(late_ms > 0.0);
+            }
             self.gpu_frame_ms.push(timing.total_ms);
-            self.govern(&timing, ao_ms, predicted_ms);
+            let observation =
+                Observation { gpu_ms: timing.total_ms, ao_ms, predicted_period_ms: predicted_ms, late_ms };
+            self.govern(timing.frame, observation);
             self.history.push(timing);
         }
     }
@@ -296,11 +327,11 @@ impl FrameLoop {
         }
     }
 
-    /// Feeds a frame's times and the display period the headset predicted for it to the
-    /// governor and applies the level it picks.
-    fn govern(&mut self, timing: &FrameTiming, ao_ms: Option<f64>, predicted_ms: Option<f64>) {
+    /// Feeds what is known of a frame (its times, the display period the headset predicted
+    /// for it, whether it was late) to the governor and applies the level it picks.
+    fn govern(&mut self, frame: u64, observation: Observation) {
         let Some(governor) = &mut self.governor else { return };
-        let change = governor.observe_paced(timing.frame, timing.total_ms, ao_ms, predicted_ms);
+        let change = governor.observe_frame(frame, observation);
         let Some(change) = change else { return };
         log::debug!("governor, frame {}: {} -> {} ({})", change.frame, change.from, change.to, change.reason);
         let mut settings = self.renderer.settings().clone();

@@ -17,7 +17,10 @@
 //! predict a frame slower than one refresh and keep the application at half rate. A frame
 //! whose predicted period spans more than one refresh ([`Governor::observe_paced`]) missed
 //! refreshes: it is a reason to drop (once the frames after a change had time to reach the
-//! runtime's pacing) and never counts as calm.
+//! runtime's pacing) and never counts as calm. So is a frame that missed its predicted
+//! display time on the headset's clock ([`Observation::late_ms`], the frame loop's
+//! estimate from when it was submitted and its GPU time): what the runtime shows late,
+//! whatever the GPU time says against the period.
 //!
 //! ## Prediction model
 //! A frame's GPU time is T = R + A: the AO passes A and everything else R. At level i
@@ -51,7 +54,9 @@ pub const BUILTIN_RADIUS_M: f32 = 0.3;
 /// One setting on the frontier.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Level {
-    /// [`BenchRecord::setting`], e.g. "gtao N=24 r=0.3 m half".
+    /// [`BenchRecord::setting`] at the radius the run applies (a level keeps the host's
+    /// radius: [`Level::apply`]), e.g. "gtao N=24 r=0.51 m half" from a bench measured at
+    /// 0.3 m: the label says what is rendered, [`Frontier::radius_m`] what was measured.
     pub setting: String,
     /// The technique of the setting.
     pub technique: Technique,
@@ -95,7 +100,8 @@ pub struct Frontier {
 
 impl Frontier {
     /// The Pareto-optimal rows of `file` at its radius nearest to `radius` (errors only
-    /// compare within one radius). Rows without a finite error or a positive cost, depth-
+    /// compare within one radius), labelled at `radius`, the radius a run applies with
+    /// them. Rows without a finite error or a positive cost, depth-
     /// peeled rows (a [`Level`] cannot express peeling) and non-occlusion techniques
     /// (none, fetch-only, rsm) are left out. A bench without such rows is `Error::Input`.
     pub fn from_bench(file: &BenchFile, radius: f32) -> Result<Frontier> {
@@ -133,8 +139,10 @@ impl Frontier {
             if levels.last().is_some_and(|l| rmse >= l.ao_rmse || ms <= l.ms_per_eye) {
                 continue;
             }
+            // Labelled with the radius rendered, not the bench's (a level never sets it).
+            let applied = BenchRecord { radius_m: radius, ..r.clone() };
             levels.push(Level {
-                setting: r.setting(),
+                setting: applied.setting(),
                 technique,
                 samples: r.samples,
                 half_res: r.resolution.is_half(),
@@ -154,10 +162,43 @@ impl Frontier {
         Frontier::from_bench(&file, radius).map_err(|e| Error::in_file(origin, e.to_string()))
     }
 
-    /// The frontier of the bench committed at `assets/governor/frontier.json`.
+    /// The frontier of the bench committed at `assets/governor/frontier.json`, labelled
+    /// at the radius it was measured at.
     pub fn builtin() -> Frontier {
-        Frontier::from_json(BUILTIN_JSON, Path::new(BUILTIN_PATH), BUILTIN_RADIUS_M)
-            .expect("the built-in frontier parses")
+        Frontier::builtin_at(BUILTIN_RADIUS_M)
+    }
+
+    /// The built-in frontier for a run at `radius`: the levels measured at
+    /// [`BUILTIN_RADIUS_M`], labelled at `radius` (see [`Frontier::from_bench`]).
+    pub fn builtin_at(radius: f32) -> Frontier {
+        Frontier::from_json(BUILTIN_JSON, Path::new(BUILTIN_PATH), radius).expect("the built-in frontier parses")
+    }
+
+    /// The level nearest the setting `ao` asks for, where the governor starts: the level
+    /// with the same technique, samples, resolution and temporal accumulation if there is
+    /// one; else the nearest by, in order, technique (a technique is what the user chose
+    /// first), samples (by their ratio), resolution, then temporal accumulation; equal
+    /// candidates go to the cheaper level (a start over budget costs a dropped frame, one
+    /// under it a raise later).
+    pub fn nearest(&self, ao: &AoSettings) -> usize {
+        let key = |l: &Level| {
+            let samples = (f64::from(l.samples.max(1)) / f64::from(ao.samples.max(1))).log2().abs();
+            (
+                l.technique != ao.technique,
+                samples,
+                l.half_res != ao.resolution.is_half(),
+                l.temporal != ao.temporal.enabled,
+            )
+        };
+        // `min_by` keeps the first of equals, and levels run cheapest first.
+        self.levels
+            .iter()
+            .enumerate()
+            .min_by(|(_, a), (_, b)| {
+                let (a, b) = (key(a), key(b));
+                a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)).then(a.3.cmp(&b.3))
+            })
+            .map_or(0, |(i, _)| i)
     }
 
     /// Every level, cheapest (most error) first.
@@ -289,6 +330,21 @@ pub struct GovernorChange {
     pub predicted_ms: Option<f64>,
 }
 
+/// What the frame loop knows of one frame once its GPU time is back.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Observation {
+    /// The whole frame's GPU time (both eyes), ms.
+    pub gpu_ms: f64,
+    /// The AO passes' share of it, when measured.
+    pub ao_ms: Option<f64>,
+    /// The display period the headset predicted for the frame (OpenXR's
+    /// predictedDisplayPeriod), ms.
+    pub predicted_period_ms: Option<f64>,
+    /// How far (ms) the frame's GPU work finished after its predicted display time on the
+    /// headset's clock (positive: it missed it); `None` where the headset has no clock.
+    pub late_ms: Option<f64>,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Sample {
     frame: u64,
@@ -296,6 +352,8 @@ struct Sample {
     ao_ms: Option<f64>,
     /// The display period the headset predicted for the frame (ms), if it said.
     predicted_period_ms: Option<f64>,
+    /// By how much the frame missed its display time (ms, > 0), if it did.
+    late_ms: Option<f64>,
 }
 
 impl Sample {
@@ -417,9 +475,20 @@ impl Governor {
         ao_ms: Option<f64>,
         predicted_period_ms: Option<f64>,
     ) -> Option<GovernorChange> {
-        let ao_ms = ao_ms.filter(|ms| ms.is_finite()).map(|ms| ms.clamp(0.0, gpu_ms.max(0.0)));
-        let predicted_period_ms = predicted_period_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
-        self.observe_sample(Sample { frame, gpu_ms, ao_ms, predicted_period_ms })
+        self.observe_frame(frame, Observation { gpu_ms, ao_ms, predicted_period_ms, late_ms: None })
+    }
+
+    /// [`Governor::observe_paced`] with whether the frame missed its predicted display
+    /// time on the headset's clock ([`Observation::late_ms`] above 0): a late frame
+    /// drops like one over 90 % (unless within [`GovernorConfig::stretch_settle_frames`]
+    /// of a change: the frames queued before it still finish late) and never counts as
+    /// calm.
+    pub fn observe_frame(&mut self, frame: u64, o: Observation) -> Option<GovernorChange> {
+        let gpu_ms = o.gpu_ms;
+        let ao_ms = o.ao_ms.filter(|ms| ms.is_finite()).map(|ms| ms.clamp(0.0, gpu_ms.max(0.0)));
+        let predicted_period_ms = o.predicted_period_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
+        let late_ms = o.late_ms.filter(|ms| ms.is_finite() && *ms > 0.0);
+        self.observe_sample(Sample { frame, gpu_ms, ao_ms, predicted_period_ms, late_ms })
     }
 
     /// The frame time predicted at level `to` from a frame `s` measured at the current
@@ -462,6 +531,11 @@ impl Governor {
                 );
                 return Some(self.change(s.frame, to, reason, None));
             }
+            if let (true, Some(late)) = (settled, s.late_ms) {
+                let reason =
+                    format!("frame {:.2} ms missed its display time by {late:.2} ms (headset clock)", s.gpu_ms);
+                return Some(self.change(s.frame, to, reason, None));
+            }
             if let Some(reason) = self.trend_overrun() {
                 return Some(self.change(s.frame, to, reason, None));
             }
@@ -469,14 +543,15 @@ impl Governor {
         let c = &self.config;
         let to = (self.level + c.raise_step).min(self.frontier.top());
         // Calm: under 70 % of the display's period, and shown at the display's rate (a
-        // stretched period means refreshes were missed, whatever the GPU time).
+        // stretched period or a late frame means refreshes were missed, whatever the GPU
+        // time).
         let calm = self.recent.len() >= c.calm_frames_to_raise
             && self
                 .recent
                 .iter()
                 .rev()
                 .take(c.calm_frames_to_raise)
-                .all(|r| r.gpu_ms < calm_ms && r.missed(period) == 0);
+                .all(|r| r.gpu_ms < calm_ms && r.missed(period) == 0 && r.late_ms.is_none());
         let spaced = self.last_change_frame.is_none_or(|f| s.frame >= f + c.min_frames_between_raises);
         if to == self.level || !calm || !spaced {
             return None;
@@ -491,8 +566,8 @@ impl Governor {
         }
         let c = &self.config;
         let reason = format!(
-            "{} frames < {:.0} % of {:.2} ms (slowest {:.2} ms); predicted {:.2} ms < {:.0} % of {:.2} ms",
-            c.calm_frames_to_raise,
+            "{} < {:.0} % of {:.2} ms (slowest {:.2} ms); predicted {:.2} ms < {:.0} % of {:.2} ms",
+            crate::formats::output::count(c.calm_frames_to_raise as u64, "frame"),
             c.raise_below * 100.0,
             period,
             slowest,

@@ -193,8 +193,11 @@ fn frame_rates_ui(ui: &mut egui::Ui, rates: [f64; 3], info: &PanelInfo, counters
     match &info.openxr {
         // OpenXR does not say what its compositor presented or reprojected.
         Some(x) => ui.label(format!(
-            "OpenXR: {} layers submitted, {} not to render, {} display periods missed; period {:.2} ms",
-            x.layers_submitted, x.not_rendered, x.missed_display_periods, x.display_period_ms
+            "OpenXR: {} submitted, {} not to render, {} missed; period {:.2} ms",
+            crate::formats::output::count(x.layers_submitted, "layer"),
+            x.not_rendered,
+            crate::formats::output::count(x.missed_display_periods, "display period"),
+            x.display_period_ms
         )),
         None => {
             let [presented, reprojected, dropped] = rates;

@@ -215,9 +215,10 @@ pub fn refresh_with_openxr(hz: f64, offered: &[f32], current: Option<f32>) -> (l
     if offered.iter().copied().any(near) && current.is_some_and(near) {
         return (log::Level::Info, format!("--refresh {hz} Hz: asked of the OpenXR runtime, which offers it"));
     }
+    // Either way a whole clause: the display's rate is what sets the budget.
     let runs_at = match current {
-        Some(rate) => format!("the runtime's display runs at {rate} Hz"),
-        None => "the runtime's display rate".into(),
+        Some(rate) => format!("the runtime's display runs at {rate} Hz, which sets the budget"),
+        None => "the runtime's display rate sets the budget".into(),
     };
     let offers = if offered.is_empty() {
         "it offers no rate to choose (no XR_FB_display_refresh_rate)".to_string()
@@ -227,7 +228,7 @@ pub fn refresh_with_openxr(hz: f64, offered: &[f32], current: Option<f32>) -> (l
     };
     (
         log::Level::Warn,
-        format!("--refresh {hz} Hz is the simulated headset's and is not used with OpenXR: {runs_at} and sets the budget ({offers})"),
+        format!("--refresh {hz} Hz is the simulated headset's and is not used with OpenXR: {runs_at} ({offers})"),
     )
 }
 
@@ -311,8 +312,9 @@ fn end_before_frames(
 fn log_governor(governor: &Governor) {
     let frontier = governor.frontier();
     log::info!(
-        "governor: on, {} levels from {} to {}; starting at {}",
+        "governor: on, {} levels (measured at r={} m) from {} to {}; starting at {}",
         frontier.len(),
+        crate::formats::output::significant(f64::from(frontier.radius_m()), 2),
         frontier.levels()[0].setting,
         frontier.levels()[frontier.top()].setting,
         governor.current().setting
@@ -368,27 +370,19 @@ fn session_settings(
     Ok((settings, size))
 }
 
-/// The governor of a session: its frontier (the bench file given, or the built-in one)
-/// at the frame budget of the profile, starting at the level nearest the asked setting.
+/// The governor of a session: its frontier (the bench file given, or the built-in one),
+/// labelled at the radius the run applies, at the frame budget of the profile, starting
+/// at the level nearest the asked setting ([`Frontier::nearest`]).
 fn governor_for(options: &RunOptions, settings: &Settings) -> Result<Governor> {
+    let radius = settings.ao.radius;
     let frontier = match &options.governor_frontier {
         Some(path) => {
             let text = vrao_render::files::read_regular_file_to_string(path, vrao_render::files::MAX_TEXT_BYTES)?;
-            Frontier::from_json(&text, path, settings.ao.radius)?
+            Frontier::from_json(&text, path, radius)?
         }
-        None => Frontier::builtin(),
+        None => Frontier::builtin_at(radius),
     };
-    let ao = &settings.ao;
-    let start = frontier
-        .levels()
-        .iter()
-        .position(|l| {
-            l.technique == ao.technique
-                && l.samples == ao.samples
-                && l.half_res == ao.resolution.is_half()
-                && l.temporal == ao.temporal.enabled
-        })
-        .unwrap_or(frontier.top());
+    let start = frontier.nearest(&settings.ao);
     let config = GovernorConfig::for_refresh_hz(settings.profile.refresh_hz);
     Governor::new(frontier, config, start)
 }
@@ -403,11 +397,14 @@ mod tests {
         let (level, line) = refresh_with_openxr(90.0, &[20.0], Some(20.0));
         assert_eq!(level, log::Level::Warn);
         assert!(line.starts_with("--refresh 90 Hz is the simulated headset's"), "{line}");
-        assert!(line.contains("runs at 20 Hz") && line.contains("offers 20 Hz") && !line.contains('\n'), "{line}");
+        assert!(line.contains("runs at 20 Hz, which sets the budget") && line.contains("offers 20 Hz"), "{line}");
+        assert!(!line.contains('\n'), "{line}");
         // No XR_FB_display_refresh_rate.
         let (level, line) = refresh_with_openxr(72.0, &[], None);
         assert_eq!(level, log::Level::Warn);
         assert!(line.contains("no XR_FB_display_refresh_rate"), "{line}");
+        // The clause without a rate still has its verb.
+        assert!(line.contains("the runtime's display rate sets the budget"), "{line}");
         // A runtime offering the rate was asked for it: said at the info level.
         let (level, line) = refresh_with_openxr(72.0, &[72.0, 90.0, 120.0], Some(72.0));
         assert_eq!(level, log::Level::Info);

@@ -2,7 +2,7 @@
 
 use crate::app::governor::GovernorChange;
 use crate::app::{FrameLoop, SERIAL_EVERY};
-use crate::formats::output::significant;
+use crate::formats::output::{count, significant};
 use crate::formats::spans::summarize;
 use crate::stats;
 use std::sync::atomic::Ordering;
@@ -43,6 +43,14 @@ pub struct RunSummary {
     pub over_budget_frames: u64,
     /// Frames whose GPU time came back.
     pub timed_frames: u64,
+    /// Timed frames whose GPU work finished, at the earliest, after their predicted
+    /// display time on the headset's clock: shown late (or dropped) by the runtime,
+    /// whatever their GPU time against the budget.
+    pub late_frames: u64,
+    /// Timed frames judged so: 0 where the headset gives no clock (`late_clock` says why).
+    pub clocked_frames: u64,
+    /// The clock frames were judged late against, or why none was.
+    pub late_clock: String,
     /// Medians over the run ([`crate::stats`]; 0 when no frame was timed): GPU
     /// time per frame (both eyes), CPU encode time per frame, and their ratio.
     pub gpu_frame_ms_median: f64,
@@ -114,6 +122,13 @@ impl RunSummary {
             stretched_frames: frame_loop.stretched_frames,
             over_budget_frames: frame_loop.over_budget_frames,
             timed_frames: frame_loop.timed_frames,
+            late_frames: frame_loop.late_frames,
+            clocked_frames: frame_loop.clocked_frames,
+            late_clock: if frame_loop.headset.now().is_some() {
+                "the headset's clock (a frame's work starts no earlier than its submission and the frame before)".into()
+            } else {
+                format!("none: {}", frame_loop.headset.no_clock_reason())
+            },
             gpu_frame_ms_median,
             cpu_encode_ms_median,
             cpu_encode_share_of_gpu: if gpu_frame_ms_median > 0.0 {
@@ -190,6 +205,9 @@ impl RunSummary {
             stretched_frames: 0,
             over_budget_frames: 0,
             timed_frames: 0,
+            late_frames: 0,
+            clocked_frames: 0,
+            late_clock: "none: no frame was rendered".into(),
             gpu_frame_ms_median: 0.0,
             cpu_encode_ms_median: 0.0,
             cpu_encode_share_of_gpu: 0.0,
@@ -238,8 +256,10 @@ impl RunSummary {
         if let Some(x) = &self.openxr {
             // Only what OpenXR says: nothing here is "presented" or "reprojected".
             frames += &format!(
-                "; OpenXR: {} layers submitted, {} frames the runtime said not to render, {} display periods missed (from predicted display times)",
-                x.layers_submitted, x.not_rendered, x.missed_display_periods
+                "; OpenXR: {} submitted, {} the runtime said not to render, {} missed (from predicted display times)",
+                count(x.layers_submitted, "layer"),
+                count(x.not_rendered, "frame"),
+                count(x.missed_display_periods, "display period")
             );
         }
         if let Some(c) = &self.counters {
@@ -250,14 +270,27 @@ impl RunSummary {
             );
         }
         let stretched = if self.stretched_frames > 0 {
-            format!("; {} frames at a display period stretched over missed refreshes", self.stretched_frames)
+            format!("; {} at a display period stretched over missed refreshes", count(self.stretched_frames, "frame"))
         } else {
             String::new()
         };
+        let late = if self.clocked_frames > 0 {
+            format!(
+                "; {} of {} late (finished after their predicted display time on the headset's clock)",
+                self.late_frames,
+                count(self.clocked_frames, "frame")
+            )
+        } else {
+            format!("; late frames not judged ({})", self.late_clock)
+        };
         let budget = if self.budget_changes > 0 {
             format!(
-                "a {:.2} ms budget ({:.2}..{:.2} ms, {} changes) from {}",
-                self.budget_ms, self.budget_ms_min, self.budget_ms_max, self.budget_changes, self.budget_source
+                "a {:.2} ms budget ({:.2}..{:.2} ms, {}) from {}",
+                self.budget_ms,
+                self.budget_ms_min,
+                self.budget_ms_max,
+                count(self.budget_changes, "change"),
+                self.budget_source
             )
         } else {
             format!("a {:.2} ms budget from {}", self.budget_ms, self.budget_source)
@@ -273,13 +306,13 @@ impl RunSummary {
             _ => String::new(),
         };
         format!(
-            "governor {}: {} changes, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} timed frames over{stretched}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
+            "governor {}: {}, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} over{stretched}{late}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
-            self.governor_changes.len(),
+            count(self.governor_changes.len() as u64, "change"),
             self.final_ao_setting,
             self.gpu_frame_ms_median,
             self.over_budget_frames,
-            self.timed_frames,
+            count(self.timed_frames, "timed frame"),
             self.cpu_encode_ms_median,
             100.0 * self.cpu_encode_share_of_gpu,
             self.timing,

@@ -12,7 +12,7 @@ use vrao::xr::simulated::motion::HeadMotion;
 use vrao::xr::simulated::reproject::ReprojectionMode;
 use vrao::{Error, Result};
 use vrao_render::renderer::DEFAULT_FRAMES_IN_FLIGHT;
-use vrao_render::settings::DisplayMode;
+use vrao_render::settings::{DisplayMode, EYE_SIDE_MAX};
 use vrao_render::{BackendChoice, Scene, Settings};
 
 #[derive(Args)]
@@ -52,11 +52,15 @@ pub(crate) struct RunArgs {
     refresh: Option<f64>,
     /// Per-eye width to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).
-    #[arg(long, allow_negative_numbers = true)]
+    // Checked here, alone: checked with the other side filled in, a bad value was named
+    // with a profile's size that OpenXR never uses.
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=EYE_SIDE_MAX as i64))]
     width: Option<u32>,
     /// Per-eye height to render at, 1..=8192 (default: the profile's; with OpenXR, the
     /// runtime's).
-    #[arg(long, allow_negative_numbers = true)]
+    // Checked here, alone: checked with the other side filled in, a bad value was named
+    // with a profile's size that OpenXR never uses.
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=EYE_SIDE_MAX as i64))]
     height: Option<u32>,
     /// Budget governor: on (choose the AO setting by error per millisecond so that each
     /// frame's GPU time stays under the display period) or off (keep the settings).
@@ -79,8 +83,9 @@ pub(crate) struct RunArgs {
     /// filter), depth or normals; the panel can change it.
     #[arg(long, default_value = "eyes", hide_possible_values = true)]
     show: BufferView,
-    /// Write the frame counters and per-pass medians to this JSON file (also when the
-    /// run is refused before it starts: `refused` then says why).
+    /// Write the frame counters and per-pass medians to this JSON file; also whenever the
+    /// run is refused (exit 2), `refused` then saying why (not when this path itself is
+    /// refused, nor after a GPU failure, exit 1).
     #[arg(long)]
     report: Option<PathBuf>,
     #[command(flatten)]
@@ -91,13 +96,12 @@ pub(crate) fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
     // Before anything that takes time or opens a session: a Ctrl-C (or SIGTERM) from
     // here on ends the run cleanly, with its report.
     let interrupt = interrupt_on_ctrl_c();
-    for output in [&args.report, &args.screenshot].into_iter().flatten() {
-        vrao::formats::output::check_output_file(output)?;
+    // The report's own path first: a report that could not be written refuses the run
+    // before anything else, and nothing is written.
+    if let Some(report) = &args.report {
+        vrao::formats::output::check_output_file(report)?;
     }
-    let scene = Scene::load(&args.scene)?;
-    // The session replaces the profile with the one --profile names.
-    let settings =
-        Settings { ao: args.ao.settings(&scene), shadows: args.ao.lights.settings(&scene), ..Settings::default() };
+    let (scene, ao, report) = (args.scene, args.ao, args.report);
     let options = RunOptions {
         backend,
         headset: args.headset,
@@ -117,15 +121,15 @@ pub(crate) fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         screenshot: args.screenshot,
         show: args.show,
     };
-    let summary = match run_session(&scene, &settings, &options, interrupt) {
+    let summary = match session(&scene, &ao, &options, interrupt) {
         Ok(summary) => summary,
         Err(error) => {
-            let refusal = error.is_refusal();
-            let error = name_the_option(error);
-            // A refused run still leaves its report, saying why, for whoever reads it.
-            if let (true, Some(path)) = (refusal, &args.report) {
-                let report = refused_summary(&options, &error.to_string());
-                if let Err(e) = vrao::formats::output::write_json(path, &report) {
+            // Every refusal (exit 2) once the report's path is accepted leaves the report,
+            // saying why, whatever refused it (an input, a file, the window, the
+            // headset); a run that failed on the GPU (exit 1) leaves none.
+            if let (vrao::error::EXIT_INPUT, Some(path)) = (error.exit_code(), &report) {
+                let refused = refused_summary(&options, &error.to_string());
+                if let Err(e) = vrao::formats::output::write_json(path, &refused) {
                     log::warn!("{e}");
                 }
             }
@@ -133,10 +137,30 @@ pub(crate) fn run(backend: BackendChoice, args: RunArgs) -> Result<()> {
         }
     };
     println!("{}", summary.to_text());
-    match &args.report {
+    match &report {
         Some(path) => vrao::formats::output::write_json(path, &summary),
         None => Ok(()),
     }
+}
+
+/// The session of `vrao run` after its report's path was accepted: the other inputs
+/// checked, the scene loaded, the headset run.
+fn session(
+    scene: &str,
+    ao: &AoArgs,
+    options: &RunOptions,
+    interrupt: Arc<AtomicBool>,
+) -> Result<vrao::app::RunSummary> {
+    if let Some(screenshot) = &options.screenshot {
+        vrao::formats::output::check_output_file(screenshot)?;
+    }
+    // The OpenXR mask's variable is an input like `--mask`: a bad value is refused before
+    // any work, whichever headset answers (the simulated one would never read it).
+    vrao::xr::openxr::mask::MaskChoice::from_env().map_err(|e| Error::input(e.to_string()))?;
+    let scene = Scene::load(scene)?;
+    // The session replaces the profile with the one --profile names.
+    let settings = Settings { ao: ao.settings(&scene), shadows: ao.lights.settings(&scene), ..Settings::default() };
+    run_session(&scene, &settings, options, interrupt).map_err(name_the_option)
 }
 
 /// A flag that the first Ctrl-C (SIGINT) or SIGTERM sets, which ends the session cleanly

@@ -57,10 +57,10 @@ pub(crate) fn run(backend: BackendChoice, args: TemporalArgs) -> Result<()> {
         let sequence = Sequence { start: args.start, scored: args.scored, every: args.every };
         let study = motion_study(backend, &scene, &base, sequence, args.rays, &default_cache_dir())?;
         println!(
-            "'{}' moving from t = {} s, {} frames scored every {} at 90 Hz, {}x{} per eye, {} N={} r = {} m, on {}",
+            "'{}' moving from t = {} s, {} scored every {} at 90 Hz, {}x{} per eye, {} N={} r = {} m, on {}",
             scene.name,
             args.start,
-            args.scored,
+            vrao::formats::output::count(u64::from(args.scored), "frame"),
             args.every,
             args.width,
             args.height,

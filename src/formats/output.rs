@@ -318,9 +318,26 @@ pub fn significant(x: f64, digits: i32) -> String {
     }
 }
 
+/// `n` and `noun`, the noun in the plural unless `n` is 1: "1 frame", "0 frames",
+/// "3 changes" (regular plurals only: every noun counted in vrao's text takes an s).
+pub fn count(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn counts_take_the_plural_unless_one() {
+        assert_eq!(count(1, "frame"), "1 frame");
+        assert_eq!(count(0, "frame"), "0 frames");
+        assert_eq!(count(3, "change"), "3 changes");
+    }
 
     #[test]
     fn an_output_trail_removes_what_it_made_and_nothing_else() {

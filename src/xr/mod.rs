@@ -143,6 +143,15 @@ pub struct SubmittedFrame<'a> {
     pub near: f64,
 }
 
+/// The time (headset clock, s) by which a frame's GPU work was finished at the earliest:
+/// its work started no earlier than it was submitted (`submitted_at`) and than the frame
+/// before it finished (`previous_finish`: the GPU runs frames one after another), and took
+/// `gpu_ms`. A lower bound, so that a frame counted late surely was.
+pub fn earliest_finish(submitted_at: f64, previous_finish: Option<f64>, gpu_ms: f64) -> f64 {
+    let start = previous_finish.filter(|f| f.is_finite()).map_or(submitted_at, |f| f.max(submitted_at));
+    start + gpu_ms.max(0.0) / 1e3
+}
+
 /// Frame timing counters, as SteamVR's frame timing reports them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct FrameCounters {
@@ -222,6 +231,18 @@ pub trait Headset {
     /// runtime's reported rate or shortest predicted period, the simulated headset's
     /// refresh interval; `None` before it knows.
     fn refresh_period_ms(&self) -> Option<f64>;
+    /// The headset's clock now, in seconds on the clock of [`FrameRequest::display_time`]
+    /// (an OpenXR runtime's XrTime through XR_KHR_convert_timespec_time, the simulated
+    /// headset's real-time clock), against which a frame's lateness is judged; `None`
+    /// where it cannot be read, or is not the clock the GPU's work runs on (the simulated
+    /// headset in virtual time, whose compositor judges its frames itself).
+    fn now(&self) -> Option<f64> {
+        None
+    }
+    /// Where [`Headset::now`] is `None`: why, for the report.
+    fn no_clock_reason(&self) -> String {
+        "the headset gives no clock".into()
+    }
     /// What the OpenXR session did (`None` for headsets that are not OpenXR). An
     /// OpenXR headset that fell back to the simulated one still reports, with the loss.
     fn openxr_report(&self) -> Option<crate::xr::openxr::OpenXrReport> {
@@ -287,6 +308,16 @@ mod tests {
         assert_eq!(rate.period_ms(), Some(50.0), "a rate of 0 is ignored");
         rate.set_reported_hz(Some(40.0));
         assert_eq!(rate.period_ms(), Some(25.0), "a change event moves it");
+    }
+
+    #[test]
+    fn a_frame_finishes_no_earlier_than_its_submission_and_the_frame_before_plus_its_gpu_time() {
+        // Submitted at 1.000 s, 8 ms of GPU work, the GPU idle: done at 1.008 s.
+        assert!((earliest_finish(1.0, None, 8.0) - 1.008).abs() < 1e-12);
+        assert!((earliest_finish(1.0, Some(0.99), 8.0) - 1.008).abs() < 1e-12);
+        // Queued behind a frame finishing at 1.010 s: done at 1.018 s.
+        assert!((earliest_finish(1.0, Some(1.010), 8.0) - 1.018).abs() < 1e-12);
+        assert_eq!(earliest_finish(1.0, Some(f64::NAN), -3.0), 1.0, "no negative time, no NaN");
     }
 
     #[test]

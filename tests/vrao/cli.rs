@@ -339,7 +339,13 @@ fn command_line_names_are_the_names_reports_print() {
 /// Runs vrao and asserts the bad-input contract: exit 2, an `error:` line containing
 /// every one of `names`, no panic and no path into the cargo registry. Returns the text.
 fn refused(args: &[&str], names: &[&str]) -> String {
-    let out = vrao(args);
+    refused_with(&[], args, names)
+}
+
+/// [`refused`] with the environment variables `env` set for vrao.
+fn refused_with(env: &[(&str, &str)], args: &[&str], names: &[&str]) -> String {
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_vrao")).args(args).envs(env.iter().copied()).output().expect("vrao runs");
     let t = text(&out);
     assert_eq!(out.status.code(), Some(2), "{args:?}: {t}");
     assert!(!t.contains("panicked") && !t.contains(".cargo/registry"), "{args:?}: {t}");
@@ -367,6 +373,19 @@ fn count_and_time_options_are_bounded_and_say_so_in_help() {
     refused(&[&run[..], &["--virtual-time", "5,NaN"]].concat(), &["--virtual-time", "NaN"]);
     refused(&[&run[..], &["--refresh", "5"]].concat(), &["--refresh", "10..=500 Hz"]);
     refused(&[&run[..], &["--refresh", "1e300"]].concat(), &["--refresh", "10..=500 Hz"]);
+    // vrao's own variable for the OpenXR mask is refused like `--mask bogus`, whichever
+    // headset the run would have.
+    for headset in ["simulated", "auto"] {
+        let env = [("VRAO_OPENXR_VISIBILITY_MASK", "bogus")];
+        let args = ["run", "--headset", headset, "--display", "none", "--frames", "1"];
+        refused_with(&env, &args, &["VRAO_OPENXR_VISIBILITY_MASK=bogus", "`runtime`", "`fov`"]);
+    }
+    // Each side alone: the message names the option and its bound, never a profile's
+    // other side (1200, the Vive's height) that OpenXR would not use.
+    for (option, value) in [("--width", "0"), ("--height", "0"), ("--width", "8193")] {
+        let t = refused(&[&run[..], &[option, value]].concat(), &[option, value, "1..=8192"]);
+        assert!(!t.contains("1200") && !t.contains("1080"), "{t}");
+    }
     for (command, bounds) in [
         ("budget", &["0..=1000", "1..=100000"][..]),
         ("bench", &["0..=1000", "1..=100000", "1..=65536", "1..=64"]),
@@ -795,6 +814,48 @@ fn a_window_without_a_display_is_refused_before_the_headset_opens_and_the_report
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert!(json["refused"].is_null() && json["stretched_frames"] == 0, "{json}");
     assert!(json["budget_source"].as_str().unwrap().contains("simulated headset"), "{json}");
+}
+
+#[test]
+fn every_refused_run_writes_its_report_and_a_refused_report_path_writes_nothing() {
+    // Issue 50: some refusals wrote the report and others (the scene, the screenshot's
+    // path) did not. Now every refusal after the report's own path is accepted does.
+    let dir = temp_dir("refused-reports");
+    let frontier = dir.join("frontier.json");
+    std::fs::write(&frontier, "{}").unwrap();
+    let frontier = frontier.to_str().unwrap().to_string();
+    let missing_folder = dir.join("no-such-folder").join("shot.png");
+    let missing_folder = missing_folder.to_str().unwrap().to_string();
+    let base = ["run", "--headset", "simulated", "--display", "none", "--frames", "1", "--width", "8", "--height", "8"];
+    // (name, extra arguments, an environment variable, what the error names)
+    type Case<'a> = (&'a str, Vec<&'a str>, Option<(&'a str, &'a str)>, &'a str);
+    let cases: [Case; 5] = [
+        ("scene", vec!["--scene", "no-such-scene.obj"], None, "no-such-scene.obj"),
+        ("screenshot", vec!["--screenshot", &missing_folder], None, "shot.png"),
+        ("variable", vec![], Some(("VRAO_OPENXR_VISIBILITY_MASK", "bogus")), "VRAO_OPENXR_VISIBILITY_MASK"),
+        ("window", vec!["--show", "ao"], None, "--show ao"),
+        ("frontier", vec!["--governor-frontier", &frontier], None, "frontier.json"),
+    ];
+    for (name, extra, env, named) in cases {
+        let report = dir.join(format!("{name}.json"));
+        let mut args: Vec<&str> = base.to_vec();
+        args.extend(extra);
+        args.extend(["--report", report.to_str().unwrap()]);
+        let out = Command::new(env!("CARGO_BIN_EXE_vrao")).args(&args).envs(env).output().unwrap();
+        let t = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{name}: {t}");
+        let errors = error_lines(&out);
+        assert!(errors.len() == 1 && errors[0].contains(named), "{name}: {t}");
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert!(errors[0].contains(json["refused"].as_str().unwrap()), "{name}: the report says why: {json}");
+        assert_eq!(json["frames_rendered"], 0, "{name}: {json}");
+    }
+    // The report's own path refused: nothing is written, wherever else the run fails.
+    let report = dir.join("no-such-folder").join("report.json");
+    let out = vrao(&[&base[..], &["--scene", "no-such-scene.obj", "--report", report.to_str().unwrap()]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(error_lines(&out)[0].contains("report.json"), "the report's path is checked first: {}", text(&out));
+    assert!(!report.exists() && !dir.join("no-such-folder").exists());
 }
 
 #[test]

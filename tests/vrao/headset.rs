@@ -145,6 +145,17 @@ fn the_run_report_counts_rendered_frames_frames_in_flight_and_the_governors_chan
     // over-budget frame is one of them.
     assert_eq!(on["timed_frames"], 12, "{on}");
     assert!(on["over_budget_frames"].as_u64().unwrap() <= 12, "{on}");
+    // In real time each timed frame is judged against its display time on the headset's
+    // clock (issue 50); in virtual time none is, and the report says why.
+    assert_eq!(on["clocked_frames"], 12, "{on}");
+    assert!(on["late_frames"].as_u64().unwrap() <= 12, "{on}");
+    assert!(on["late_clock"].as_str().unwrap().starts_with("the headset's clock"), "{on}");
+    let virtual_time = run_report(&dir, "virtual.json", &["--virtual-time", "5"]);
+    assert_eq!(
+        (&virtual_time["clocked_frames"], &virtual_time["late_frames"]),
+        (&serde_json::json!(0), &serde_json::json!(0))
+    );
+    assert!(virtual_time["late_clock"].as_str().unwrap().starts_with("none: virtual time"), "{virtual_time}");
     assert_eq!(on["governor"], "on");
     for change in on["governor_changes"].as_array().unwrap() {
         assert!(change["reason"].as_str().unwrap().contains("ms"), "{change}");

@@ -216,6 +216,51 @@ fn an_object_hidden_by_a_scale_of_zero_leaves_the_rest_of_the_frame_as_it_was() 
 }
 
 #[test]
+fn gltf_meshes_too_small_in_the_world_say_so_in_one_warning_line() {
+    // Issue 50: scales that are each fine (1e-3) multiplied to 1e-9 along three nodes, and
+    // tiny positions at scale 1, drew nothing without the warning one tiny scale gets.
+    let dir = temp_dir("world-size");
+    let render = |file: &Path| {
+        let (out, _) =
+            vrao(&["render", "--scene", path(file), "--width", "16", "--height", "16", "--out", path(&dir.join("o"))]);
+        let t = text(&out);
+        assert!(out.status.success(), "{t}");
+        let warnings: Vec<String> = t.lines().filter(|l| l.contains("in the world")).map(str::to_string).collect();
+        assert!(!t.contains("scaled below"), "no single node is tiny: {t}");
+        warnings
+    };
+    let milli = r#""scale":[1e-3,1e-3,1e-3]"#;
+    let nested = triangle_gltf(None, None).replace(
+        r#""nodes":[{"mesh":0}]"#,
+        &format!(r#""nodes":[{{"children":[1],{milli}}},{{"children":[2],{milli}}},{{"mesh":0,{milli}}}]"#),
+    );
+    let file = dir.join("nested.gltf");
+    std::fs::write(&file, nested).unwrap();
+    let warnings = render(&file);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("nested.gltf: node 2 (1.0e-9 m across) smaller than 1e-6 m in the world")
+            && warnings[0].contains("not drawn"),
+        "{warnings:?}"
+    );
+    // The same triangle 10 nm across by its positions.
+    let floats: [f32; 9] = [0.0, 0.0, 0.0, 1e-8, 0.0, 0.0, 0.0, 1e-8, 0.0];
+    std::fs::write(dir.join("tiny.bin"), floats.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
+    let tiny = triangle_gltf(Some("tiny.bin"), None).replace(r#""max":[1,1,0]"#, r#""max":[1e-8,1e-8,0]"#);
+    let file = dir.join("tiny.gltf");
+    std::fs::write(&file, tiny).unwrap();
+    let warnings = render(&file);
+    assert!(warnings.len() == 1 && warnings[0].contains("tiny.gltf: node 0 (1.0e-8 m across)"), "{warnings:?}");
+    // 1e-3 and 1e-2: 10 µm across, drawn, and nothing said.
+    let centi = r#""scale":[1e-2,1e-2,1e-2]"#;
+    let drawn = triangle_gltf(None, None)
+        .replace(r#""nodes":[{"mesh":0}]"#, &format!(r#""nodes":[{{"children":[1],{milli}}},{{"mesh":0,{centi}}}]"#));
+    let file = dir.join("drawn.gltf");
+    std::fs::write(&file, drawn).unwrap();
+    assert!(render(&file).is_empty());
+}
+
+#[test]
 fn a_gltf_node_of_scale_zero_draws_the_rest_and_says_so_in_one_warning_line() {
     let dir = temp_dir("node-scale");
     let gltf = triangle_gltf(None, None)

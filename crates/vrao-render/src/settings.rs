@@ -170,12 +170,15 @@ impl Default for Settings {
     }
 }
 
+/// The widest and tallest eye image, in pixels, the renderer takes.
+pub const EYE_SIDE_MAX: u32 = 8192;
+
 impl Settings {
     /// Checks every value; the error names the setting and the value.
     pub fn validate(&self) -> Result<()> {
         let p = &self.profile;
-        if p.width == 0 || p.height == 0 || p.width > 8192 || p.height > 8192 {
-            return Err(Error::input(format!("eye size {}x{} is not within 1..=8192", p.width, p.height)));
+        if !(1..=EYE_SIDE_MAX).contains(&p.width) || !(1..=EYE_SIDE_MAX).contains(&p.height) {
+            return Err(Error::input(format!("eye size {}x{} is not within 1..={EYE_SIDE_MAX}", p.width, p.height)));
         }
         if !(p.ipd.is_finite() && (0.0..=1.0).contains(&p.ipd)) {
             return Err(Error::input(format!("ipd {} m is not within 0..=1 m", p.ipd)));

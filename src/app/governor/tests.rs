@@ -373,7 +373,8 @@ fn the_frontier_keeps_the_strictly_pareto_optimal_rows_of_the_nearest_radius() {
     ]);
     let f = Frontier::from_bench(&file, 0.45).unwrap();
     let settings: Vec<&str> = f.levels().iter().map(|l| l.setting.as_str()).collect();
-    assert_eq!(settings, ["ssao temporal N=12 r=0.5 m half", "gtao N=12 r=0.5 m half", "gtao N=24 r=0.5 m full"]);
+    // Measured at 0.5 m, labelled at the 0.45 m a run applies with them.
+    assert_eq!(settings, ["ssao temporal N=12 r=0.45 m half", "gtao N=12 r=0.45 m half", "gtao N=24 r=0.45 m full"]);
     assert_eq!(f.radius_m(), 0.5);
     let l = &f.levels()[1];
     assert_eq!((l.technique, l.samples, l.half_res, l.temporal, l.ms_per_eye), (Technique::Gtao, 12, true, false, 1.2));
@@ -582,4 +583,84 @@ fn a_stretched_period_lowers_and_is_never_calm() {
     let raise = (settle + 60..settle + 80).find_map(|frame| g.observe_paced(frame, 10.0, None, Some(70.0)));
     let raise = raise.expect("calm frames at the display's rate raise");
     assert!(raise.predicted_ms.is_some_and(|p| p < 45.0), "{raise:?}");
+}
+
+#[test]
+fn the_labels_carry_the_radius_the_run_applies() {
+    // The built-in bench measured 0.3 m; a scene's radius of 0.512 m is what renders.
+    let f = Frontier::builtin_at(0.512);
+    assert_eq!(f.radius_m(), BUILTIN_RADIUS_M);
+    assert_eq!(f.len(), Frontier::builtin().len());
+    for level in f.levels() {
+        assert!(level.setting.contains(" r=0.51 m ") && !level.setting.contains("r=0.3 m"), "{}", level.setting);
+    }
+    let ao = AoSettings { radius: 0.512, ..AoSettings::default() };
+    assert_eq!(f.levels()[0].apply(&ao).radius, 0.512, "a level never sets the radius its label names");
+}
+
+#[test]
+fn the_governor_starts_at_the_level_nearest_the_asked_setting() {
+    let f = Frontier::builtin();
+    let name = |i: usize| f.levels()[i].setting.clone();
+    // The default setting (gtao N=24 full, no temporal) is not on the frontier: the
+    // nearest is gtao N=24 at half resolution, never the most expensive level.
+    let default = AoSettings::default();
+    assert_eq!((default.technique, default.samples), (Technique::Gtao, 24));
+    let start = f.nearest(&default);
+    assert_ne!(start, f.top());
+    assert_eq!(name(start), "gtao N=24 r=0.3 m half");
+    // A setting on the frontier starts there.
+    for (i, level) in f.levels().iter().enumerate() {
+        let asked = level.apply(&default);
+        assert_eq!(f.nearest(&asked), i, "{}", level.setting);
+    }
+    // The technique first: hbao at 64 samples keeps hbao (the frontier has it at 12).
+    let hbao = AoSettings { technique: Technique::Hbao, samples: 64, ..AoSettings::default() };
+    assert!(name(f.nearest(&hbao)).starts_with("hbao "), "{}", name(f.nearest(&hbao)));
+    // Then the samples by ratio: gtao N=48 full is nearer N=36 or N=64 than N=24.
+    let gtao48 = AoSettings { samples: 48, ..AoSettings::default() };
+    let n = f.levels()[f.nearest(&gtao48)].samples;
+    assert!(n == 36 || n == 64, "{}", name(f.nearest(&gtao48)));
+    // On the synthetic frontier (hbao is dominated): gtao N=24 half is level 3, full 4.
+    let synthetic = synthetic();
+    let half = AoSettings { resolution: Resolution::Half, ..AoSettings::default() };
+    assert_eq!(synthetic.nearest(&half), 3);
+    assert_eq!(synthetic.nearest(&AoSettings::default()), 4);
+    let temporal_half = AoSettings { temporal: vrao_ao::Temporal { enabled: true, ..Default::default() }, ..half };
+    assert_eq!(synthetic.nearest(&temporal_half), 3, "temporal accumulation matters least");
+}
+
+#[test]
+fn a_frame_that_missed_its_display_time_lowers_the_level_and_is_never_calm() {
+    // Issue 50: at 80x60 Monado logged 53-64 late or dropped frames per 200 while every
+    // GPU time fitted the budget and the governor raised. Here every frame takes 5 ms of
+    // an 11.1 ms period (calm by its GPU time alone).
+    let frontier = synthetic();
+    let late = |ms: f64| Observation { gpu_ms: 5.0, late_ms: Some(ms), ..Observation::default() };
+    let mut g = Governor::new(frontier.clone(), GovernorConfig::default(), 3).unwrap();
+    // On time (finished before the display time: late_ms <= 0) it raises after the calm frames.
+    for frame in 0..12 {
+        g.observe_frame(frame, late(-2.0));
+    }
+    assert_eq!(g.level(), 4, "{:?}", g.changes());
+    // A frame that missed its display time by 3 ms drops two levels at once.
+    let drop = g.observe_frame(30, late(3.0)).expect("a late frame drops");
+    assert_eq!(g.level(), 2);
+    assert_eq!(drop.reason, "frame 5.00 ms missed its display time by 3.00 ms (headset clock)");
+    // The frames queued behind it, late too, do not drop again before they had time to
+    // reach the new level.
+    for frame in 31..=38 {
+        assert_eq!(g.observe_frame(frame, late(1.0)), None, "frame {frame}");
+    }
+    assert!(g.observe_frame(39, late(1.0)).is_some(), "settled: late again drops");
+    assert_eq!(g.level(), 0);
+    // Late frames are never calm: no raise however small their GPU time.
+    let mut g = Governor::new(frontier, GovernorConfig::default(), 0).unwrap();
+    for frame in 0..40 {
+        assert_eq!(g.observe_frame(frame, late(0.5)), None, "frame {frame}");
+    }
+    assert_eq!(g.level(), 0);
+    // Without a clock (late_ms None) a frame is judged by its GPU time alone.
+    let mut g = Governor::new(synthetic(), GovernorConfig::default(), 4).unwrap();
+    assert_eq!(g.observe_frame(0, Observation { gpu_ms: 5.0, ..Observation::default() }), None);
 }

@@ -260,7 +260,10 @@ fn box_distance(b: &MoverBox, p: DVec3) -> f32 {
 }
 
 /// A Markdown table: per configuration, the worst and mean ghost share, the mean RMSE and
-/// bias over the scored frames, and the mean RMSE's ratio to the frozen scene's.
+/// bias over the scored frames, and the mean RMSE's ratio to the frozen scene's. A figure
+/// that is not a finite number is "-": a mean over frames without a surface, or the ratio
+/// where the frozen scene's error is 0 (within the reference's noise at few rays), with a
+/// line under the table saying why.
 pub fn to_markdown(points: &[MotionPoint]) -> String {
     let frozen: Vec<&MotionPoint> = points.iter().filter(|p| p.configuration.starts_with("frozen")).collect();
     let mut s = String::from(
@@ -272,23 +275,84 @@ pub fn to_markdown(points: &[MotionPoint]) -> String {
             names.push(&p.configuration);
         }
     }
+    // The ratio of the means: a frame's own ratio swings where both errors are small.
+    let frozen_mean = frozen.iter().map(|f| f.ao_rmse).sum::<f64>() / frozen.len().max(1) as f64;
+    let mut no_ratio = false;
     for name in names {
         let rows: Vec<&MotionPoint> = points.iter().filter(|p| p.configuration == name).collect();
         let n = rows.len().max(1) as f64;
         let worst_ghosts = rows.iter().map(|r| r.ghost_share).fold(0.0, f64::max);
         let mean = |f: fn(&MotionPoint) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
-        // The ratio of the means: a frame's own ratio swings where both errors are small.
-        let frozen_mean = frozen.iter().map(|f| f.ao_rmse).sum::<f64>() / frozen.len().max(1) as f64;
-        let ratio = mean(|r| r.ao_rmse) / frozen_mean;
+        // A zero frozen error has no ratio (x / 0 is inf, 0 / 0 NaN).
+        let ratio = if frozen_mean > 0.0 { mean(|r| r.ao_rmse) / frozen_mean } else { f64::NAN };
+        no_ratio |= !ratio.is_finite();
         s += &format!(
-            "| {name} | {:.3} % | {:.3} % | {:.2} % | {:.2} % | {:.4} | {ratio:.3} | {:+.4} |\n",
-            100.0 * worst_ghosts,
-            100.0 * mean(|r| r.ghost_share),
-            100.0 * mean(|r| r.off_share),
-            100.0 * mean(|r| r.near_motion_share),
-            mean(|r| r.ao_rmse),
-            mean(|r| r.ao_bias),
+            "| {name} | {} | {} | {} | {} | {} | {} | {} |\n",
+            shown(100.0 * worst_ghosts, |x| format!("{x:.3} %")),
+            shown(100.0 * mean(|r| r.ghost_share), |x| format!("{x:.3} %")),
+            shown(100.0 * mean(|r| r.off_share), |x| format!("{x:.2} %")),
+            shown(100.0 * mean(|r| r.near_motion_share), |x| format!("{x:.2} %")),
+            shown(mean(|r| r.ao_rmse), |x| format!("{x:.4}")),
+            shown(ratio, |x| format!("{x:.3}")),
+            shown(mean(|r| r.ao_bias), |x| format!("{x:+.4}")),
         );
     }
+    if no_ratio {
+        s += "\n\"-\": no figure (no ratio where the frozen scene's error is 0, within the reference's noise: more --rays give one).\n";
+    }
     s
+}
+
+/// `x` written by `write`, or "-" when it is not a finite number.
+fn shown(x: f64, write: impl Fn(f64) -> String) -> String {
+    if x.is_finite() {
+        write(x)
+    } else {
+        "-".into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(configuration: &str, ao_rmse: f64, ao_bias: f64) -> MotionPoint {
+        MotionPoint {
+            configuration: configuration.into(),
+            frame: 16,
+            time: 0.2,
+            ao_rmse,
+            ao_bias,
+            ghost_share: 0.01,
+            off_share: 0.02,
+            near_motion_share: 0.1,
+        }
+    }
+
+    #[test]
+    fn the_table_never_prints_nan_or_inf() {
+        // At one ray a pixel the frozen scene's error is within the reference's noise (0
+        // once the noise is taken out), and a frame without a surface has no error.
+        let points = [
+            point("frozen scene, temporal", 0.0, 0.01),
+            point("temporal off", 0.05, 0.02),
+            point("temporal, motion vectors", f64::NAN, f64::NAN),
+        ];
+        let table = to_markdown(&points);
+        let lower = table.to_lowercase();
+        assert!(!lower.contains("nan") && !lower.contains("inf"), "{table}");
+        assert!(
+            table.contains("| temporal off | 1.000 % | 1.000 % | 2.00 % | 10.00 % | 0.0500 | - | +0.0200 |"),
+            "{table}"
+        );
+        assert!(
+            table.contains("| temporal, motion vectors | 1.000 % | 1.000 % | 2.00 % | 10.00 % | - | - | - |"),
+            "{table}"
+        );
+        assert!(table.contains("more --rays"), "{table}");
+        // With a frozen error the ratio is there, and no note.
+        let points = [point("frozen scene, temporal", 0.02, 0.0), point("temporal off", 0.05, 0.0)];
+        let table = to_markdown(&points);
+        assert!(table.contains("| 0.0500 | 2.500 |") && !table.contains("more --rays"), "{table}");
+    }
 }

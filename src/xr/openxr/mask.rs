@@ -6,12 +6,18 @@
 //! corners cut off) following the field of view the frames are rendered with. Pure
 //! bookkeeping, so the event path is tested without a runtime.
 //!
-//! Monado 24's in-process runtime (at least 59c34e17b4d9, December 2024) crashes in
-//! `xrGetVisibilityMaskKHR` for a device without a mask of its own, its simulated HMD
-//! among them: its `xrt_device_get_visibility_mask` calls the device's function pointer
-//! without the NULL check it once had (dropped in "xrt: remove function pointer check",
-//! 1473430ee). vrao does not call it there ([`skip_runtime_mask`]) and takes the default
-//! Monado itself would give such a device; [`MASK_VAR`] overrides the choice.
+//! Some Monado builds' in-process runtime crashes in `xrGetVisibilityMaskKHR` for a device
+//! without a mask of its own, its simulated HMD among them: `xrt_device_get_visibility_mask`
+//! calls the device's function pointer, which such a device leaves NULL. Upstream, the
+//! interface came without a NULL check (69afb6274, 2023-11-08), got one with Monado's
+//! default mask behind it (2639d830b, "Fixes crash bug in xrGetVisibilityMaskKHR for
+//! in-process builds", 2024-05-15) and lost it again ("xrt: remove function pointer
+//! check", 1473430ee, 2024-11-13; still so at the end of 2024). Monado's runtime name
+//! carries its `git describe` ("Monado(XRT) by Collabora et al 'v24.0.0-2403-g59c34e17b'",
+//! 59c34e17b4d9 being 33 commits after 1473430ee), which places a build: vrao does not
+//! call it on the builds with the bug ([`monado_lacks_mask_check`]) and takes the default
+//! Monado itself gives such a device; everywhere else (a device with a mask of its own
+//! keeps it) it asks. [`MASK_VAR`] overrides the choice.
 
 use glam::Vec2;
 use vrao_ao::{Fov, ViewMask, VisibilityMask};
@@ -49,20 +55,92 @@ impl MaskMesh {
 /// runtime is, `fov` takes Monado's default from the field of view instead.
 pub const MASK_VAR: &str = "VRAO_OPENXR_VISIBILITY_MASK";
 
+/// What [`MASK_VAR`] asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaskChoice {
+    /// The runtime's mask, whatever the runtime is (`runtime`).
+    Runtime,
+    /// Monado's default from the field of view, never the runtime's (`fov`).
+    Fov,
+}
+
+impl MaskChoice {
+    /// The choice a value of [`MASK_VAR`] names: unset or blank is `None` (vrao chooses);
+    /// any other value than `runtime` or `fov` is refused, as `--mask` refuses one.
+    pub fn parse(value: Option<&str>) -> Result<Option<MaskChoice>, Trouble> {
+        match value.map(str::trim) {
+            None | Some("") => Ok(None),
+            Some("runtime") => Ok(Some(MaskChoice::Runtime)),
+            Some("fov") => Ok(Some(MaskChoice::Fov)),
+            Some(other) => Err(Trouble(format!("{MASK_VAR}={other} is neither `runtime` nor `fov` (or unset)"))),
+        }
+    }
+
+    /// The choice the environment holds now ([`MaskChoice::parse`]); a value that is not
+    /// UTF-8 is refused like any other unknown one.
+    pub fn from_env() -> Result<Option<MaskChoice>, Trouble> {
+        let value = std::env::var_os(MASK_VAR).map(|v| v.to_string_lossy().into_owned());
+        MaskChoice::parse(value.as_deref())
+    }
+}
+
+/// Commits after v24.0.0 at which Monado's NULL check was removed again (1473430ee):
+/// 59c34e17b4d9, `v24.0.0-2403`, is 33 commits after it.
+pub const MONADO_24_CHECK_REMOVED_AT: u32 = 2403 - 33;
+
+/// Whether the Monado build `runtime_name` and `major` (XrInstanceProperties) name calls
+/// the device's mask function without a NULL check (see the module comment):
+/// - a v24 development build at or after [`MONADO_24_CHECK_REMOVED_AT`] commits;
+/// - a v21 development build (the version Monado reported until June 2024, the mask
+///   interface's first half year, without the check until May 2024; where in that span
+///   a build lies its name does not tell reliably, so all of them);
+/// - a build whose name carries no `git describe` but reports major 21 or 24 with a
+///   suffix vrao cannot read.
+///
+/// Not the v24.0.0 release itself (tagged with the check in place), nor Monado 25 and
+/// later, nor any other runtime.
+pub fn monado_lacks_mask_check(runtime_name: &str, major: u16) -> bool {
+    if !runtime_name.starts_with("Monado") {
+        return false;
+    }
+    match (major, monado_commits_after_tag(runtime_name)) {
+        (24, Some(Some(commits))) => commits >= MONADO_24_CHECK_REMOVED_AT,
+        (24, Some(None)) => false,
+        (21, Some(Some(_))) => true,
+        (21 | 24, None) => true,
+        _ => false,
+    }
+}
+
+/// The commits after the release tag in a Monado runtime name's `git describe` ('vX.Y.Z',
+/// 'vX.Y.Z-N-gHASH', either perhaps with '-dirty'): `Some(None)` for the tag itself,
+/// `None` when the name has no such quoted description.
+fn monado_commits_after_tag(runtime_name: &str) -> Option<Option<u32>> {
+    let describe = runtime_name.split('\'').nth(1)?.strip_prefix('v')?;
+    let mut parts = describe.split('-');
+    let version = parts.next()?;
+    if version.split('.').any(|n| n.parse::<u32>().is_err()) {
+        return None;
+    }
+    match parts.next() {
+        None | Some("dirty") => Some(None),
+        Some(n) => n.parse().ok().map(Some),
+    }
+}
+
 /// Why vrao does not call `xrGetVisibilityMaskKHR` on a runtime that offers the extension
-/// (`None`: it does), from the runtime's name, its version's major number and the value
-/// of [`MASK_VAR`] (`runtime`, `fov`; anything else counts as unset). Monado up to 24
-/// is skipped: see the module comment.
-pub fn skip_runtime_mask(runtime_name: &str, major: u16, choice: Option<&str>) -> Option<String> {
-    match choice.map(str::trim) {
-        Some("runtime") => None,
-        Some("fov") => Some(format!("{MASK_VAR}=fov")),
-        _ if runtime_name.starts_with("Monado") && major <= 24 => Some(format!(
-            "not read from Monado {major}: its in-process runtime crashes in xrGetVisibilityMaskKHR for a device \
-             without a mask of its own, such as its simulated HMD, and gives such a device this one; \
+/// (`None`: it does), from the runtime's name, its version's major number and the choice
+/// [`MASK_VAR`] made: the Monado builds of [`monado_lacks_mask_check`].
+pub fn skip_runtime_mask(runtime_name: &str, major: u16, choice: Option<MaskChoice>) -> Option<String> {
+    match choice {
+        Some(MaskChoice::Runtime) => None,
+        Some(MaskChoice::Fov) => Some(format!("{MASK_VAR}=fov")),
+        None if monado_lacks_mask_check(runtime_name, major) => Some(format!(
+            "not read from this Monado {major} build: its in-process runtime crashes in xrGetVisibilityMaskKHR for a \
+             device without a mask of its own, such as its simulated HMD, and gives such a device this one; \
              {MASK_VAR}=runtime reads it anyway"
         )),
-        _ => None,
+        None => None,
     }
 }
 
@@ -361,23 +439,52 @@ mod tests {
     }
 
     #[test]
-    fn monado_24_is_not_asked_unless_the_variable_says_so() {
+    fn only_monado_builds_without_the_null_check_are_not_asked() {
         let monado = "Monado(XRT) by Collabora et al 'v24.0.0-2403-g59c34e17b'";
         let why = skip_runtime_mask(monado, 24, None).unwrap();
         assert!(why.contains("Monado 24") && why.contains(MASK_VAR), "{why}");
-        assert_eq!(skip_runtime_mask(monado, 24, Some("runtime")), None);
-        assert_eq!(skip_runtime_mask(monado, 25, None), None, "a later Monado is asked");
+        assert_eq!(skip_runtime_mask(monado, 24, Some(MaskChoice::Runtime)), None);
+        // 1473430ee itself and after lack the check; the builds before it and the
+        // release tag have it, so a device with its own mask keeps it there.
+        let build = |describe: &str| format!("Monado(XRT) by Collabora et al '{describe}'");
+        assert!(monado_lacks_mask_check(&build("v24.0.0-2370-g1473430ee"), 24));
+        assert!(monado_lacks_mask_check(&build("v24.0.0-2403-g59c34e17b-dirty"), 24));
+        assert!(!monado_lacks_mask_check(&build("v24.0.0-2369-g31fdb0bcd"), 24), "the commit before the removal");
+        assert!(!monado_lacks_mask_check(&build("v24.0.0-120-gabcdef012"), 24), "a summer 2024 build");
+        assert!(!monado_lacks_mask_check(&build("v24.0.0"), 24), "the v24.0.0 release");
+        assert_eq!(skip_runtime_mask(&build("v24.0.0"), 24, None), None);
+        // Before June 2024 Monado said 21: the interface's first months had no check.
+        assert!(monado_lacks_mask_check(&build("v21.0.0-4100-g69afb6274"), 21));
+        assert!(!monado_lacks_mask_check(&build("v21.0.0"), 21), "the 2021 release has no mask interface");
+        // A name vrao cannot read, from a version with the bug, is not asked.
+        assert!(monado_lacks_mask_check("Monado(XRT) by Collabora et al 'something'", 24));
+        assert!(monado_lacks_mask_check("Monado(XRT)", 24));
+        assert!(!monado_lacks_mask_check(&build("v25.0.0-12-g0123456789"), 25), "a later Monado is asked");
         assert_eq!(skip_runtime_mask("SteamVR/OpenXR", 2, None), None);
+        assert!(!monado_lacks_mask_check("SteamVR/OpenXR 'v24.0.0-2403-g59c34e17b'", 24), "only Monado");
         assert_eq!(
-            skip_runtime_mask("SteamVR/OpenXR", 2, Some("fov")).as_deref(),
+            skip_runtime_mask("SteamVR/OpenXR", 2, Some(MaskChoice::Fov)).as_deref(),
             Some("VRAO_OPENXR_VISIBILITY_MASK=fov")
         );
-        assert_eq!(skip_runtime_mask("SteamVR/OpenXR", 2, Some("sometimes")), None, "an unknown value is unset");
+        assert_eq!(
+            skip_runtime_mask(&build("v24.0.0"), 24, Some(MaskChoice::Fov)).as_deref(),
+            Some("VRAO_OPENXR_VISIBILITY_MASK=fov")
+        );
         // The reason ends up in the mask's source.
         let mut mask = SessionMask::from_field_of_view(&why);
         mask.follow_fov([FOV45, FOV45]);
-        assert!(mask.mask().unwrap().views[1].source.contains("not read from Monado 24"));
+        assert!(mask.mask().unwrap().views[1].source.contains("not read from this Monado 24 build"));
         assert!(!mask.from_the_runtime());
+    }
+
+    #[test]
+    fn the_variable_is_runtime_fov_or_unset_and_anything_else_is_refused() {
+        assert_eq!(MaskChoice::parse(None), Ok(None));
+        assert_eq!(MaskChoice::parse(Some("  ")), Ok(None), "blank is unset");
+        assert_eq!(MaskChoice::parse(Some("runtime")), Ok(Some(MaskChoice::Runtime)));
+        assert_eq!(MaskChoice::parse(Some(" fov ")), Ok(Some(MaskChoice::Fov)));
+        let refused = MaskChoice::parse(Some("bogus")).unwrap_err().to_string();
+        assert_eq!(refused, "VRAO_OPENXR_VISIBILITY_MASK=bogus is neither `runtime` nor `fov` (or unset)");
     }
 
     #[test]

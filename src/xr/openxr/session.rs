@@ -546,7 +546,10 @@ impl Headset for OpenXrHeadset {
             self.end_empty(pending.display_time);
         }
         if self.budget.reached() && !self.machine.exit_wanted() && !self.machine.is_over() {
-            self.note(&format!("{} frames rendered: exit requested", self.budget.rendered));
+            self.note(&format!(
+                "{} rendered: exit requested",
+                crate::formats::output::count(self.budget.rendered, "frame")
+            ));
             self.feed(Event::FramesReached);
         }
         loop {
@@ -651,6 +654,22 @@ impl Headset for OpenXrHeadset {
         match &self.fallback {
             Some(simulated) => simulated.refresh_period_ms(),
             None => self.display.period_ms(),
+        }
+    }
+
+    fn now(&self) -> Option<f64> {
+        match (&self.fallback, &self.xr) {
+            (Some(simulated), _) => Headset::now(simulated),
+            // The runtime's XrTime, the clock of its predicted display times.
+            (None, Some(xr)) if xr.clock => xr.instance.now().ok().map(|t| t.as_nanos() as f64 / 1e9),
+            _ => None,
+        }
+    }
+
+    fn no_clock_reason(&self) -> String {
+        match &self.fallback {
+            Some(simulated) => simulated.no_clock_reason(),
+            None => "the OpenXR runtime offers no XR_KHR_convert_timespec_time to read its clock".into(),
         }
     }
 

@@ -431,6 +431,15 @@ impl Headset for SimulatedHeadset {
         Some(self.options.profile.budget_ms())
     }
 
+    fn now(&self) -> Option<f64> {
+        // Virtual time runs apart from the GPU's real milliseconds.
+        matches!(self.clock, Clock::Real { .. }).then(|| self.clock.now())
+    }
+
+    fn no_clock_reason(&self) -> String {
+        "virtual time: the simulated compositor's counters say which frames it reprojected".into()
+    }
+
     fn request_exit(&mut self) {
         self.exit_requested = true;
     }

@@ -140,6 +140,34 @@ impl<T: Keyframed> Track<T> {
     }
 }
 
+impl Track<DVec3> {
+    /// Per-axis bounds (lowest, highest) of every value the track takes at any time,
+    /// found from the keys, never by sampling: a step or linear track stays within its
+    /// keys' values; a cubic spline's segment between keys i and i + 1 is the Bézier
+    /// curve of v_i, v_i + b_i·dt/3, v_(i+1) − a_(i+1)·dt/3 and v_(i+1) (its out- and
+    /// in-tangents b and a, over dt seconds), which lies in the hull of those four points:
+    /// its overshoot between keys included. NaN on both sides when a value is not finite.
+    pub fn value_bounds(&self) -> (DVec3, DVec3) {
+        let mut points: Vec<DVec3> = Vec::with_capacity(self.values.len());
+        match self.interpolation {
+            Interpolation::CubicSpline => {
+                for i in 0..self.times.len() {
+                    let value = self.values[3 * i + 1];
+                    points.push(value);
+                    if let Some(next_time) = self.times.get(i + 1) {
+                        let dt = next_time - self.times[i];
+                        points.push(value + self.values[3 * i + 2] * (dt / 3.0));
+                        points.push(self.values[3 * (i + 1) + 1] - self.values[3 * (i + 1)] * (dt / 3.0));
+                    }
+                }
+            }
+            Interpolation::Step | Interpolation::Linear => points.extend_from_slice(&self.values),
+        }
+        let bounds = super::Aabb::around(&points);
+        (bounds.min, bounds.max)
+    }
+}
+
 /// A local transform: translation, rotation and scale (applied scale first).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Trs {
@@ -223,6 +251,58 @@ impl Node {
     }
 }
 
+impl Node {
+    /// A box holding `within` (a box in this node's frame) carried by the node's local
+    /// transform at every time of its animation, from the tracks' value bounds
+    /// ([`Track::value_bounds`]), never by sampling: per-axis intervals through the scale
+    /// and the translation; a ball of the box's farthest corner where the rotation is
+    /// animated (any rotation), the rest rotation and `base` exactly otherwise. NaN where a
+    /// value is not finite.
+    pub fn reach(&self, within: &super::Aabb) -> super::Aabb {
+        use super::Aabb;
+        let still = |v: DVec3| (v, v);
+        let (scale_lo, scale_hi) = self.tracks.scale.as_ref().map_or(still(self.rest.scale), Track::value_bounds);
+        // Each axis: the interval product of the box's side and the scale's range, as the
+        // box of the two corners that span it.
+        let span = |axis: usize| {
+            let (b, s) = ([within.min[axis], within.max[axis]], [scale_lo[axis], scale_hi[axis]]);
+            let products = [b[0] * s[0], b[0] * s[1], b[1] * s[0], b[1] * s[1]];
+            let lowest = products.iter().copied().fold(f64::INFINITY, f64::min);
+            (lowest, products.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+        };
+        let [x, y, z] = [span(0), span(1), span(2)];
+        let scaled = Aabb::around(&[DVec3::new(x.0, y.0, z.0), DVec3::new(x.1, y.1, z.1)]);
+        let rotated = match &self.tracks.rotation {
+            Some(_) => {
+                // f64::max would drop a NaN: kept, so that a bad value is still refused.
+                let r = scaled
+                    .corners()
+                    .iter()
+                    .map(|c| c.length())
+                    .fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) });
+                Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) }
+            }
+            None => scaled.transformed(&DMat4::from_quat(self.rest.rotation)),
+        };
+        let (move_lo, move_hi) =
+            self.tracks.translation.as_ref().map_or(still(self.rest.translation), Track::value_bounds);
+        Aabb { min: rotated.min + move_lo, max: rotated.max + move_hi }.transformed(&self.base)
+    }
+}
+
+/// A box holding `within` (a box in node `node`'s frame) in the world at every time of
+/// the animation: [`Node::reach`] up the chain of parents.
+pub fn reach_in_world(nodes: &[Node], node: usize, within: &super::Aabb) -> super::Aabb {
+    let mut bounds = *within;
+    let mut at = Some(node);
+    while let Some(i) = at.filter(|&i| i < nodes.len()) {
+        bounds = nodes[i].reach(&bounds);
+        // Parents come first (a smaller index): anything else would loop.
+        at = nodes[i].parent.filter(|&p| p < i);
+    }
+    bounds
+}
+
 /// World-from-local transforms of every node at `t` (already wrapped), parents first.
 pub fn world_transforms(nodes: &[Node], t: f64) -> Vec<DMat4> {
     let mut world: Vec<DMat4> = Vec::with_capacity(nodes.len());
@@ -265,6 +345,74 @@ mod tests {
             assert!((line.sample(t).x - (1.0 + 3.0 * t)).abs() < 1e-12);
         }
         assert!(line.is_well_formed() && !track(Interpolation::Linear, &[1.0, 1.0], &[0.0, 1.0]).is_well_formed());
+    }
+
+    #[test]
+    fn a_cubic_splines_bounds_hold_its_overshoot_between_keys() {
+        // Both keys at 0 with tangents of ±9e5 m/s over 10 s: the curve rises to
+        // 9e6 · (s − s²), 2.25e6 m at s = 0.5, between keys that both say 0.
+        let bump = track(Interpolation::CubicSpline, &[0.0, 10.0], &[0.0, 0.0, 9e5, -9e5, 0.0, 0.0]);
+        assert_eq!((bump.key(0).x, bump.key(1).x), (0.0, 0.0));
+        let highest = (0..=1000).map(|k| bump.sample(k as f64 / 100.0).x).fold(0.0, f64::max);
+        assert!((highest - 2.25e6).abs() < 1.0, "{highest}");
+        let (lo, hi) = bump.value_bounds();
+        assert!(lo.x <= 0.0 && hi.x >= highest && hi.x <= 3e6 + 1e-6, "{lo} {hi}");
+        // Every sample of random splines lies within their bounds.
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..50 {
+            let values: Vec<f64> = (0..12).map(|_| 10.0 * next()).collect();
+            let spline = track(Interpolation::CubicSpline, &[0.0, 0.5, 2.0, 2.2], &values);
+            let (lo, hi) = spline.value_bounds();
+            for k in 0..=2200 {
+                let v = spline.sample(k as f64 / 1000.0).x;
+                assert!(lo.x - 1e-9 <= v && v <= hi.x + 1e-9, "{v} outside {lo} {hi}");
+            }
+        }
+        // Linear and step tracks: their keys.
+        let linear = track(Interpolation::Linear, &[0.0, 1.0, 2.0], &[1.0, -3.0, 2.0]);
+        assert_eq!(linear.value_bounds(), (DVec3::splat(-3.0), DVec3::splat(2.0)));
+        let broken = track(Interpolation::Linear, &[0.0, 1.0], &[1.0, f64::NAN]);
+        assert!(broken.value_bounds().0.is_nan());
+    }
+
+    #[test]
+    fn a_nodes_reach_holds_the_box_at_every_time() {
+        let spin = Track {
+            interpolation: Interpolation::Linear,
+            times: vec![0.0, 1.0],
+            values: vec![DQuat::IDENTITY, DQuat::from_rotation_y(3.0)],
+        };
+        let grow = track(Interpolation::CubicSpline, &[0.0, 1.0], &[0.0, 1.0, 4.0, -4.0, 2.0, 0.0]);
+        let slide = track(Interpolation::CubicSpline, &[0.0, 1.0], &[0.0, -1.0, 6.0, 6.0, 3.0, 0.0]);
+        let nodes = vec![
+            Node {
+                name: "arm".into(),
+                parent: None,
+                base: DMat4::from_translation(DVec3::new(0.0, 5.0, 0.0)),
+                rest: Trs::IDENTITY,
+                tracks: NodeTracks { rotation: Some(spin), translation: Some(slide), ..Default::default() },
+            },
+            Node {
+                name: "hand".into(),
+                parent: Some(0),
+                base: DMat4::IDENTITY,
+                rest: Trs { translation: DVec3::new(2.0, 0.0, 0.0), ..Trs::IDENTITY },
+                tracks: NodeTracks { scale: Some(grow), ..Default::default() },
+            },
+        ];
+        let local = super::super::Aabb { min: DVec3::new(-0.5, 0.0, -0.1), max: DVec3::new(0.5, 1.0, 0.1) };
+        let reach = reach_in_world(&nodes, 1, &local);
+        for k in 0..=500 {
+            let world = world_transforms(&nodes, k as f64 / 500.0)[1];
+            for c in local.corners() {
+                let p = world.transform_point3(c);
+                assert!(p.cmpge(reach.min - 1e-9).all() && p.cmple(reach.max + 1e-9).all(), "{p} outside {reach:?}");
+            }
+        }
     }
 
     #[test]

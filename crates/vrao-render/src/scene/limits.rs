@@ -234,20 +234,14 @@ pub fn mesh_trouble(mesh: &Mesh) -> Option<String> {
     })
 }
 
-/// One-line trouble when a moving mesh (one that hangs from a node of `nodes`) reaches
-/// beyond [`COORDINATE_MAX_M`] over its animation: its local bounds' corners at 65 times
-/// over the loop (as [`Scene::swept_corners`] samples them for the scene's bounds), each
-/// key's value already in range but their product (a far key times a large scale, a large
-/// placement of a moving root) not.
+/// One-line trouble when a moving mesh (one that hangs from a node of `nodes`) can reach
+/// beyond [`COORDINATE_MAX_M`] over its animation: its local bounds carried up its chain
+/// of nodes through every value their tracks take ([`super::animation::reach_in_world`]:
+/// bounded from the keys, a cubic spline's overshoot between keys included, never
+/// sampled), each key's value already in range but their product (a far key times a large
+/// scale, a large placement of a moving root, a spline's tangents) not. The bound is
+/// conservative: an animated rotation counts as any rotation.
 pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> {
-    const SAMPLES: usize = 64;
-    if !meshes.iter().any(|m| m.node.is_some()) {
-        return None;
-    }
-    let period = nodes.iter().map(|n| n.tracks.end()).fold(0.0, f64::max);
-    let times: Vec<f64> = (0..=SAMPLES).map(|k| period * k as f64 / SAMPLES as f64).collect();
-    let transforms: Vec<Vec<glam::DMat4>> =
-        times.iter().map(|&t| super::animation::world_transforms(nodes, t)).collect();
     for mesh in meshes {
         let Some(node) = mesh.node else { continue };
         let mut local = super::Aabb::EMPTY;
@@ -255,24 +249,15 @@ pub fn motion_trouble(meshes: &[Mesh], nodes: &[super::Node]) -> Option<String> 
         if local.is_empty() {
             continue;
         }
-        for (world, t) in transforms.iter().zip(&times) {
-            let Some(world) = world.get(node) else { continue };
-            for corner in 0..8 {
-                let pick = |bit: usize, lo: f64, hi: f64| if corner & bit == 0 { lo } else { hi };
-                let c = glam::DVec3::new(
-                    pick(1, local.min.x, local.max.x),
-                    pick(2, local.min.y, local.max.y),
-                    pick(4, local.min.z, local.max.z),
-                );
-                let farthest = world.transform_point3(c).abs().max_element();
-                if farthest.is_nan() || farthest > COORDINATE_MAX_M {
-                    return Some(format!(
-                        "moving mesh '{}' reaches {} m from the origin at t = {t} s, farther than {COORDINATE_MAX_M:e} m",
-                        mesh.name,
-                        shortest(farthest)
-                    ));
-                }
-            }
+        let world = super::animation::reach_in_world(nodes, node, &local);
+        let farthest = world.min.abs().max(world.max.abs()).max_element();
+        if world.min.is_nan() || world.max.is_nan() || farthest.is_nan() || farthest > COORDINATE_MAX_M {
+            let reach = if farthest.is_nan() || world.min.is_nan() { "NaN".to_string() } else { shortest(farthest) };
+            return Some(format!(
+                "moving mesh '{}' can reach {reach} m from the origin over its animation (bounded from its keys and \
+                 their spline tangents), farther than {COORDINATE_MAX_M:e} m",
+                mesh.name
+            ));
         }
     }
     None
@@ -359,6 +344,38 @@ mod tests {
         assert!(key_scale_trouble("s", 0.0).is_none() && key_scale_trouble("s", 1e6).is_none());
         assert!(key_scale_trouble("s", -1e-7).unwrap().contains("not 0"));
         assert!(key_scale_trouble("s", 2e6).unwrap().contains("larger than 1e6"));
+    }
+
+    #[test]
+    fn a_splines_overshoot_between_keys_is_within_the_motion_bound() {
+        use crate::scene::{Interpolation, Node, NodeTracks, Track, Trs};
+        // Keys at 0, 10 and 640 s, every value 0: 65 samples over the loop fall every
+        // 10 s, on the keys, and saw nothing; the first segment's tangents (±9e5 m/s, each
+        // in range) carry the mesh 2.25e6 m out at t = 5 s.
+        let node = |b0: f64| Node {
+            name: "thrown".into(),
+            parent: None,
+            base: glam::DMat4::IDENTITY,
+            rest: Trs::IDENTITY,
+            tracks: NodeTracks {
+                translation: Some(Track {
+                    interpolation: Interpolation::CubicSpline,
+                    times: vec![0.0, 10.0, 640.0],
+                    values: [0.0, 0.0, b0, -b0, 0.0, 0.0, 0.0, 0.0, 0.0].map(|x| DVec3::new(x, 0.0, 0.0)).to_vec(),
+                }),
+                ..Default::default()
+            },
+        };
+        let mut mesh = crate::scene::builtin::load("box").unwrap().meshes.remove(0);
+        mesh.node = Some(0);
+        let thrown = node(9e5);
+        let peak = thrown.tracks.translation.as_ref().unwrap().sample(5.0).x;
+        assert!((peak - 2.25e6).abs() < 1.0, "{peak}");
+        let e = motion_trouble(std::slice::from_ref(&mesh), &[thrown]).unwrap();
+        assert!(e.starts_with(&format!("moving mesh '{}' can reach 3", mesh.name)), "{e}");
+        assert!(e.ends_with("farther than 1e6 m"), "{e}");
+        // A tenth of the tangent: 2.25e5 m at most, within.
+        assert_eq!(motion_trouble(std::slice::from_ref(&mesh), &[node(9e4)]), None);
     }
 
     #[test]

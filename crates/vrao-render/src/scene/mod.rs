@@ -260,6 +260,31 @@ impl Aabb {
     pub fn union(&self, o: &Aabb) -> Aabb {
         Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
+    /// The bounds of `points`; NaN on both sides when one of them has a NaN (an empty
+    /// list gives [`Aabb::EMPTY`]).
+    pub fn around(points: &[DVec3]) -> Aabb {
+        if points.iter().any(|p| p.is_nan()) {
+            return Aabb { min: DVec3::NAN, max: DVec3::NAN };
+        }
+        let mut b = Aabb::EMPTY;
+        points.iter().for_each(|&p| b.extend(p));
+        b
+    }
+    /// The eight corners.
+    pub fn corners(&self) -> [DVec3; 8] {
+        std::array::from_fn(|i| {
+            let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
+            DVec3::new(
+                pick(1, self.min.x, self.max.x),
+                pick(2, self.min.y, self.max.y),
+                pick(4, self.min.z, self.max.z),
+            )
+        })
+    }
+    /// The bounds of this box's corners moved by `m`: a box holding the moved box.
+    pub fn transformed(&self, m: &DMat4) -> Aabb {
+        Aabb::around(&self.corners().map(|c| m.transform_point3(c)))
+    }
     /// The centre point.
     pub fn center(&self) -> DVec3 {
         (self.min + self.max) * 0.5

@@ -4,7 +4,7 @@
 //! `openxr/mask.rs`'s.
 
 use super::*;
-use crate::xr::openxr::mask::{check_counts, skip_runtime_mask, view_mask, MaskMesh, SessionMask, MASK_VAR, VIEWS};
+use crate::xr::openxr::mask::{check_counts, skip_runtime_mask, view_mask, MaskChoice, MaskMesh, SessionMask, VIEWS};
 use vrao_ao::ViewMask;
 use vrao_render::scene::limits::Trouble;
 
@@ -16,12 +16,14 @@ const READ_TRIES: usize = 3;
 /// mask), else, or where vrao does not call it (`skip_runtime_mask`), Monado's default
 /// from the fields of view of the frames.
 pub(super) fn initial(session: &xr::Session<xr::Vulkan>, enabled: bool) -> SessionMask {
-    let choice = std::env::var(MASK_VAR).ok();
-    if let Some(value) = choice.as_deref().filter(|v| !matches!(v.trim(), "runtime" | "fov" | "")) {
-        log::warn!("OpenXR: {MASK_VAR}={value} is neither `runtime` nor `fov`: not used");
-    }
+    // `vrao run` refuses a bad value before any session opens; a caller that did not
+    // check gets vrao's own choice, said once.
+    let choice = MaskChoice::from_env().unwrap_or_else(|e| {
+        log::warn!("OpenXR: {e}: not used");
+        None
+    });
     let skipped = match session.instance().properties() {
-        Ok(props) => skip_runtime_mask(&props.runtime_name, props.runtime_version.major(), choice.as_deref()),
+        Ok(props) => skip_runtime_mask(&props.runtime_name, props.runtime_version.major(), choice),
         Err(_) => None,
     };
     let why = match (enabled, skipped) {

@@ -389,6 +389,47 @@ mod tests {
     }
 
     #[test]
+    fn a_tangent_along_the_normal_or_zero_gives_way_to_the_derived_frame_with_one_warning() {
+        // Issue 50: a TANGENT parallel to the NORMAL striped the shading.
+        let dir = scratch("tangents");
+        let gltf = |tangent: [f32; 4]| {
+            let mut floats: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+            floats.extend([0.0, 0.0, 1.0].repeat(3));
+            floats.extend(tangent.repeat(3));
+            let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+            format!(
+                r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"name":"tri","primitives":[{{"attributes":{{"POSITION":0,"NORMAL":1,"TANGENT":2}}}}]}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}},{{"bufferView":2,"componentType":5126,"count":3,"type":"VEC4"}}],"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":36}},{{"buffer":0,"byteOffset":72,"byteLength":48}}],"buffers":[{{"byteLength":120,"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+                base64(&bytes)
+            )
+        };
+        let cases: [(&str, [f32; 4], bool); 5] = [
+            ("along", [0.0, 0.0, 1.0, 1.0], true),
+            ("zero", [0.0; 4], true),
+            ("nearly", [0.005, 0.0, 1.0, 1.0], true),
+            ("across", [1.0, 0.0, 0.0, 1.0], false),
+            ("tilted", [1.0, 0.0, 0.5, -1.0], false),
+        ];
+        for (name, tangent, derived) in cases {
+            let file = dir.join(format!("{name}.gltf"));
+            std::fs::write(&file, gltf(tangent)).unwrap();
+            let content = super::super::load_content(&file, 0).unwrap();
+            let lines: Vec<&String> = content.warnings.iter().filter(|l| l.contains("TANGENT")).collect();
+            let mesh = &content.meshes[0];
+            if derived {
+                assert_eq!(lines.len(), 1, "{name}: {:?}", content.warnings);
+                assert!(
+                    lines[0].contains("mesh 'tri' primitive 0 (vertex 0)") && lines[0].contains("derived"),
+                    "{lines:?}"
+                );
+                assert!(mesh.tangents.is_empty(), "{name}: the shader derives the frame");
+            } else {
+                assert!(lines.is_empty(), "{name}: {lines:?}");
+                assert_eq!(mesh.tangents.len(), 3, "{name}");
+            }
+        }
+    }
+
+    #[test]
     fn tiny_node_scales_hide_the_mesh_and_zero_scale_keys_keep_every_value_finite() {
         let dir = scratch("tiny");
         // A static node of scale 0, 1e-30, or a zero matrix: the file loads, its mesh

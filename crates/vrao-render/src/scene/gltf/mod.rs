@@ -302,6 +302,8 @@ fn first_line(message: &str) -> String {
 struct Warnings {
     extensions: BTreeSet<String>,
     ignored: BTreeSet<&'static str>,
+    /// Primitives whose TANGENT was degenerate and left out, each with its first bad vertex.
+    derived_tangents: Vec<String>,
 }
 
 impl Warnings {
@@ -315,6 +317,18 @@ impl Warnings {
         if !self.ignored.is_empty() {
             let list: Vec<&str> = self.ignored.iter().copied().collect();
             lines.push(format!("{}: not supported (ignored): {}", path.display(), list.join("; ")));
+        }
+        if !self.derived_tangents.is_empty() {
+            let more = match self.derived_tangents.len() {
+                n if n > 4 => format!(" and {} more", n - 4),
+                _ => String::new(),
+            };
+            lines.push(format!(
+                "{}: TANGENT zero or parallel to NORMAL in {}{more}: those primitives' tangents are derived from \
+                 their texture coordinates instead",
+                path.display(),
+                self.derived_tangents[..self.derived_tangents.len().min(4)].join(", ")
+            ));
         }
         lines
     }
@@ -446,22 +460,38 @@ impl Loader<'_> {
             warnings: Vec::new(),
         };
         let mut visited = vec![false; document.nodes().len()];
-        let mut stack: Vec<(::gltf::Node, Parent)> =
-            roots.into_iter().rev().map(|n| (n, Parent { world: DMat4::IDENTITY, node: None })).collect();
+        // Each node with its parent's frame and whether a node above (or it) is scaled
+        // below SCALE_MIN on its own (`warn_hidden_nodes` names those).
+        let mut stack: Vec<(::gltf::Node, Parent, bool)> =
+            roots.into_iter().rev().map(|n| (n, Parent { world: DMat4::IDENTITY, node: None }, false)).collect();
         // The world transform of every vrao node at time 0, for lights and the camera.
         let mut node_rest_world: Vec<DMat4> = Vec::new();
-        while let Some((node, parent)) = stack.pop() {
+        // Static mesh nodes too small in the world to draw, with why.
+        let mut too_small: Vec<(usize, String)> = Vec::new();
+        while let Some((node, parent, tiny_above)) = stack.pop() {
             let index = node.index();
             if std::mem::replace(&mut visited[index], true) {
                 return Err(self.error(format!("node {index} is reached twice (a cycle, or a node with two parents)")));
             }
+            let tiny = tiny_above || is_tiny(&node, tracks.get(&index));
             let here = self.node_frame(&node, &parent, tracks.get(&index), &mut content.nodes)?;
             let world_at_rest = world_at_rest(&content.nodes, &mut node_rest_world, &parent, &here);
+            let before = content.meshes.len();
             self.attach(&node, &here, &world_at_rest, &mut content)?;
+            // Scales that are each fine can multiply to nothing (1e-3 three times), and
+            // positions can be tiny at any scale: judged on the mesh in the world, after
+            // the whole chain of transforms. Moving meshes are left out (their scale may
+            // animate).
+            if here.node.is_none() && !tiny {
+                if let Some(why) = too_small_to_draw(&content.meshes[before..]) {
+                    too_small.push((index, why));
+                }
+            }
             for child in node.children().collect::<Vec<_>>().into_iter().rev() {
-                stack.push((child, here));
+                stack.push((child, here, tiny));
             }
         }
+        self.warn_too_small(&too_small);
         // Nodes without meshes below them are kept: cheap, and their indices stay simple.
         content.materials = std::mem::take(&mut self.materials);
         if content.meshes.is_empty() {
@@ -573,16 +603,8 @@ impl Loader<'_> {
     fn warn_hidden_nodes(&self, tracks: &HashMap<usize, NodeTracks>) {
         use super::limits::SCALE_MIN;
         let nodes: Vec<::gltf::Node> = self.document.nodes().collect();
-        let tiny = |node: &::gltf::Node| {
-            let scale = match node.transform() {
-                ::gltf::scene::Transform::Matrix { matrix } => {
-                    matrix_scale(&DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))))
-                }
-                ::gltf::scene::Transform::Decomposed { scale, .. } => DVec3::from(scale.map(f64::from)).abs(),
-            };
-            scale.min_element() < SCALE_MIN && tracks.get(&node.index()).is_none_or(|t| t.scale.is_none())
-        };
-        let hidden: Vec<usize> = nodes.iter().filter(|n| tiny(n)).map(|n| n.index()).collect();
+        let hidden: Vec<usize> =
+            nodes.iter().filter(|n| is_tiny(n, tracks.get(&n.index()))).map(|n| n.index()).collect();
         if hidden.is_empty() {
             return;
         }
@@ -614,6 +636,25 @@ impl Loader<'_> {
             if named.len() == 1 { "" } else { "s" },
             named[..named.len().min(8)].join(", "),
             if named.len() == 1 { "it" } else { "them" }
+        );
+    }
+
+    /// One warning line naming the static mesh nodes `too_small` lists (node, why) that
+    /// no single node's scale hides ([`Loader::warn_hidden_nodes`]) but whose world
+    /// transform or positions leave their meshes under [`super::limits::SCALE_MIN`] metres.
+    fn warn_too_small(&self, too_small: &[(usize, String)]) {
+        use super::limits::SCALE_MIN;
+        if too_small.is_empty() {
+            return;
+        }
+        let named: Vec<String> = too_small.iter().take(8).map(|(node, why)| format!("{node} ({why})")).collect();
+        let more = if too_small.len() > 8 { format!(" and {} more", too_small.len() - 8) } else { String::new() };
+        log::warn!(
+            "{}: node{} {}{more} smaller than {SCALE_MIN:e} m in the world (the scales of the nodes above \
+             multiplied, or the positions): the meshes are not drawn",
+            self.path.display(),
+            if too_small.len() == 1 { "" } else { "s" },
+            named.join(", "),
         );
     }
 
@@ -678,7 +719,15 @@ impl Loader<'_> {
                 self.warnings.ignored.insert("morph targets (drawn in the bind pose)");
             }
             let attributes = self.read_attributes(&primitive, &what)?;
-            let (geometry, extras) = self.with_normals(&primitive, attributes, &what)?;
+            let (geometry, mut extras) = self.with_normals(&primitive, attributes, &what)?;
+            // A tangent along the normal leaves no direction once the shader takes the
+            // normal out of it (noise, seen as stripes): the whole primitive then uses the
+            // frame derived from its texture coordinates, as it does without TANGENT
+            // (mixing the two would seam where they meet).
+            if let Some(vertex) = degenerate_tangent(&extras.tangents, &geometry.normals) {
+                extras.tangents.clear();
+                self.warnings.derived_tangents.push(format!("{what} (vertex {vertex})"));
+            }
             let material = self.material(&primitive.material())?;
             let name = match mesh.primitives().len() {
                 1 => mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string),
@@ -1054,12 +1103,58 @@ impl Loader<'_> {
     }
 }
 
+/// The sine of the angle under which a TANGENT counts as parallel to its vertex's normal:
+/// 0.01 (0.57°). Authored tangents are orthogonal to the normal (MikkTSpace makes them
+/// so) or near it; one this close leaves, after the shader removes the normal's part,
+/// a remainder of the size of the 16-bit vertex quantisation.
+const TANGENT_PARALLEL_SINE: f32 = 0.01;
+
+/// The first vertex whose tangent (xyz of `tangents`, one per vertex of `normals`) is zero,
+/// not finite, or parallel to its unit normal within [`TANGENT_PARALLEL_SINE`]; `None`
+/// when every one gives a direction (or there are no tangents).
+fn degenerate_tangent(tangents: &[Vec4], normals: &[Vec3]) -> Option<usize> {
+    tangents.iter().zip(normals).position(|(t, n)| {
+        let t = t.truncate();
+        let length = t.length();
+        let across = (t - *n * n.dot(t)).length();
+        !(length.is_finite() && length > 1e-6 && across > TANGENT_PARALLEL_SINE * length)
+    })
+}
+
 /// `values` (one per source vertex, or empty) for the vertices made from `sources`.
 fn follow<T: Copy>(sources: &[u32], values: &[T]) -> Vec<T> {
     if values.is_empty() {
         return Vec::new();
     }
     sources.iter().map(|&v| values[v as usize]).collect()
+}
+
+/// Whether `node`'s own scale is below [`super::limits::SCALE_MIN`] on some axis (0
+/// included) and not animated (`tracks`): what hangs below it collapses.
+fn is_tiny(node: &::gltf::Node, tracks: Option<&NodeTracks>) -> bool {
+    let scale = match node.transform() {
+        ::gltf::scene::Transform::Matrix { matrix } => {
+            matrix_scale(&DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))))
+        }
+        ::gltf::scene::Transform::Decomposed { scale, .. } => DVec3::from(scale.map(f64::from)).abs(),
+    };
+    scale.min_element() < super::limits::SCALE_MIN && tracks.is_none_or(|t| t.scale.is_none())
+}
+
+/// Why `meshes`, baked into world space, are too small to draw, or `None`: their largest
+/// side under [`super::limits::SCALE_MIN`] metres (1 µm: not a pixel at any framing vrao
+/// gives), whether the nodes' scales multiplied down to it or the positions are tiny. A
+/// mesh flattened on one axis keeps its other sides and is drawn.
+fn too_small_to_draw(meshes: &[Mesh]) -> Option<String> {
+    use super::limits::SCALE_MIN;
+    if meshes.is_empty() {
+        return None;
+    }
+    let mut bounds = super::Aabb::EMPTY;
+    meshes.iter().flat_map(|m| m.positions.iter()).for_each(|p| bounds.extend(p.as_dvec3()));
+    let size = if bounds.is_empty() { 0.0 } else { bounds.size().max_element() };
+    // Two digits: the size comes out of f32 positions (1e-9 reads 1.0000002e-9).
+    (size < SCALE_MIN).then(|| format!("{size:.1e} m across"))
 }
 
 /// The size of each axis of a matrix's linear part (its columns' lengths).
