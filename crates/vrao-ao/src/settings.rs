@@ -326,6 +326,16 @@ pub struct AoSettings {
     /// Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer, and a sample
     /// occludes only between the first and second layer (inside an object). Off by default.
     pub depth_peeling: bool,
+    /// Depth layers the occlusion reads, 1 or 2. With 2, where a second layer is given
+    /// (the next surface behind the first, at least `layer_separation` behind it: the
+    /// renderer's depth peel, or a host's), GTAO's (and SSDO's) samples occlude only
+    /// between the two surfaces instead of a slab `gtao.thickness` deep; the thickness
+    /// stays where the second layer has no surface. 1 (the default) reads one layer.
+    pub layers: u32,
+    /// The second layer's minimum separation behind the first, as a fraction of the
+    /// radius (0..=1; the renderer's peel also keeps 0.1 % of the distance against
+    /// rounding).
+    pub layer_separation: f32,
     /// Which spatial denoise runs.
     pub denoise: Denoise,
     /// The bilateral blur's radius in full-resolution pixels (5 = 11×11; at half
@@ -438,6 +448,8 @@ impl Default for AoSettings {
             noise: Noise::Halton,
             resolution: Resolution::Full,
             depth_peeling: false,
+            layers: 1,
+            layer_separation: DEFAULT_LAYER_SEPARATION,
             denoise: Denoise::Tile,
             blur_radius: 5,
             blur_plane_sigma: 0.02,
@@ -487,6 +499,15 @@ impl AoSettings {
         if !(self.blur_plane_sigma.is_finite() && (0.0..=10.0).contains(&self.blur_plane_sigma)) {
             return Err(Error::input(format!("blur plane sigma {} is not within 0..=10", self.blur_plane_sigma)));
         }
+        if !(1..=2).contains(&self.layers) {
+            return Err(Error::input(format!("layers {} is not 1 or 2", self.layers)));
+        }
+        if !(self.layer_separation.is_finite() && (0.0..=1.0).contains(&self.layer_separation)) {
+            return Err(Error::input(format!(
+                "layer separation {} is not within 0..=1 (a fraction of the radius)",
+                self.layer_separation
+            )));
+        }
         self.gtao.validate()?;
         if self.blur_radius > 16 {
             return Err(Error::input(format!("blur radius {} px is not within 0..=16", self.blur_radius)));
@@ -508,6 +529,10 @@ impl AoSettings {
         self.technique.gathers_bounce() && self.bounce > 0.0
     }
 }
+
+/// The second depth layer's default minimum separation behind the first, a fraction of
+/// the radius (`AoSettings::layer_separation`).
+const DEFAULT_LAYER_SEPARATION: f32 = 0.0;
 
 /// GTAO's default slab behind each depth sample, a fraction of the radius.
 const DEFAULT_THICKNESS: f32 = 0.75;

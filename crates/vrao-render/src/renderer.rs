@@ -186,6 +186,8 @@ impl Renderer {
             settings: chain_settings(settings),
             // The scene is fixed for the renderer's life, so are its materials.
             alpha_cards: scene.has_alpha_test(),
+            shell: crate::scene::shell::ConvexShell::of(scene),
+            second_layer: true,
             anchor: gpu_scene.anchor,
             multiview,
             motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },
@@ -395,6 +397,8 @@ impl Renderer {
         self.throttle()?;
         let layers = views.len() as u32;
         self.update_motion(layers);
+        self.inputs.second_layer =
+            self.inputs.shell.as_ref().is_none_or(|shell| !views.iter().all(|eye| shell.contains(eye.pose.position)));
         // Borrowed field by field: the driver is changed while the passes and what they
         // consult are read.
         let Renderer { gpu, scene, gpu_scene, settings, driver, inputs, passes, .. } = self;
@@ -566,6 +570,12 @@ struct FrameInputs {
     settings: ChainSettings,
     /// Whether the scene has alpha-tested materials (GTAO's cards).
     alpha_cards: bool,
+    /// The convex shell the scene's triangles bound, if they do: from inside it nothing
+    /// lies behind the first depth layer (scene/shell.rs).
+    shell: Option<crate::scene::shell::ConvexShell>,
+    /// Whether this frame's views can see a surface behind another (not both inside
+    /// `shell`): the depth peel runs only then.
+    second_layer: bool,
     /// Where the scene's geometry was uploaded relative to.
     anchor: DVec3,
     /// Whether the G-buffer draws both eyes in one multiview pass.
@@ -584,6 +594,7 @@ impl FrameInputs {
             settings: &self.settings,
             extensions,
             alpha_cards: self.alpha_cards,
+            second_layer: self.second_layer,
             anchor: self.anchor,
             multiview: self.multiview,
             motion: &self.motion,
