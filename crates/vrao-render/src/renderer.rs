@@ -182,12 +182,15 @@ impl Renderer {
         gpu.take_shader_error()?;
         gpu.take_error()?;
         let mover_bounds = mover_bounds(scene, &gpu_scene);
+        let shell = crate::scene::shell::ConvexShell::of(scene);
         let inputs = FrameInputs {
             settings: chain_settings(settings),
             // The scene is fixed for the renderer's life, so are its materials.
             alpha_cards: scene.has_alpha_test(),
-            shell: crate::scene::shell::ConvexShell::of(scene),
-            second_layer: true,
+            shell: shell.clone(),
+            // Until a frame's views say otherwise (plans made before the first frame),
+            // the scene's own head at time 0.
+            second_layer: second_layer_visible(shell.as_ref(), &settings.profile.eyes(&scene.head.pose_at(0.0), settings.near).eyes),
             anchor: gpu_scene.anchor,
             multiview,
             motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },
@@ -397,8 +400,7 @@ impl Renderer {
         self.throttle()?;
         let layers = views.len() as u32;
         self.update_motion(layers);
-        self.inputs.second_layer =
-            self.inputs.shell.as_ref().is_none_or(|shell| !views.iter().all(|eye| shell.contains(eye.pose.position)));
+        self.inputs.second_layer = second_layer_visible(self.inputs.shell.as_ref(), views);
         // Borrowed field by field: the driver is changed while the passes and what they
         // consult are read.
         let Renderer { gpu, scene, gpu_scene, settings, driver, inputs, passes, .. } = self;
@@ -601,6 +603,12 @@ impl FrameInputs {
             mask: self.mask.as_ref(),
         }
     }
+}
+
+/// Whether `views` may see a surface behind another: not every eye inside the scene's
+/// convex shell (scene/shell.rs), or the scene is none.
+fn second_layer_visible(shell: Option<&crate::scene::shell::ConvexShell>, views: &[Eye]) -> bool {
+    shell.is_none_or(|shell| !views.iter().all(|eye| shell.contains(eye.pose.position)))
 }
 
 /// What the engine's chain reads of the renderer's settings.

@@ -110,10 +110,13 @@ impl Pass for DepthPeelPass {
         let ssdo = matches!(ao.technique, Technique::SsdoPoints | Technique::SsdoPointsBounce);
         let peeled_ssdo = ssdo && ao.depth_peeling;
         let two_layers = ao.layers == 2 && ao.technique.reads_second_layer();
-        let reason = if ao.layers == 2 {
-            format!("technique is {}, which reads one depth layer", ao.technique.name())
+        let name = ao.technique.name();
+        let reason = if ao.depth_peeling && !ssdo && ao.layers == 1 {
+            format!("technique is {name}: only the point-sampled SSDO peels (--depth-peeling), and --layers is 1")
+        } else if ao.layers == 2 {
+            format!("technique is {name}, which reads one depth layer")
         } else if ssdo {
-            "one depth layer (--layers 1) and depth peeling is off".to_string()
+            "depth peeling is off and --layers is 1".to_string()
         } else {
             "one depth layer (--layers 1)".to_string()
         };
