@@ -144,7 +144,12 @@ pub(crate) struct GtaoArgs {
 impl GtaoArgs {
     /// GTAO's own settings as given.
     pub(crate) fn settings(&self) -> GtaoSettings {
-        GtaoSettings { thickness: self.thickness, step_power: self.step_power, connect: self.connect }
+        GtaoSettings {
+            thickness: self.thickness,
+            step_power: self.step_power,
+            connect: self.connect,
+            ..GtaoSettings::default()
+        }
     }
 
     pub(crate) fn apply(&self, ao: &mut AoSettings) {

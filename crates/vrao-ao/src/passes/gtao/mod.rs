@@ -208,12 +208,13 @@ impl Pass for GtaoPass {
         let (slices, steps) = gtao_slices_steps(ao.samples);
         let own = &ao.gtao;
         let band = gtao_inner_band(width);
+        let second = reads_second_layer(ctx.setup);
         let params = GtaoUniform {
             slices,
             steps,
             thickness: own.thickness,
             step_power: own.step_power,
-            connect: own.connect,
+            connect: if second { own.connect_two_layers } else { own.connect },
             inner_band: band,
             padding: [0; 2],
         };
@@ -221,7 +222,6 @@ impl Pass for GtaoPass {
         // caller's interrupt cuts builds short, kernels built now would be stand-ins for
         // good: the last frames of an ending session take samples as solid instead.
         let cards = ctx.setup.alpha_cards;
-        let second = reads_second_layer(ctx.setup);
         let layer = usize::from(second);
         let solid = || self.solid[layer].get_or_init(|| Kernels::new(ctx.gpu, &self.march, false, second));
         let kernels = match self.thin_cards[layer].get() {
