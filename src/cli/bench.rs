@@ -61,6 +61,11 @@ pub(crate) struct BenchArgs {
     /// techniques never peel).
     #[arg(long, default_value = "off", hide_possible_values = true)]
     depth_peeling: Sweep,
+    /// Depth layers to sweep, comma-separated: 1, 2 (two: the renderer peels a second
+    /// layer and GTAO and SSDO read it; other techniques get no 2-layer rows). Every row
+    /// scored against the reference also gets the two-layer limit.
+    #[arg(long, value_delimiter = ',', default_values_t = [1u32], value_parser = clap::value_parser!(u32).range(1..=2))]
+    layers: Vec<u32>,
     /// Temporal accumulation: off, on or both (the error of a temporal row is its
     /// converged value after warm-up + frames with a static head).
     #[arg(long, default_value = "off", hide_possible_values = true)]
@@ -169,6 +174,7 @@ pub(crate) fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
                     Resolution::Both => vec![false, true],
                 },
                 depth_peeling: args.depth_peeling.values(),
+                layers: args.layers.clone(),
                 temporal: args.temporal.values(),
                 foveation: args.foveation.clone(),
                 mask: args.mask.iter().map(|m| m.on()).collect(),

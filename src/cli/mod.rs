@@ -135,17 +135,27 @@ pub(crate) struct GtaoArgs {
     /// the upsampled AO, or SSDO's denoise).
     #[arg(long)]
     independent_eyes: bool,
+    /// With two depth layers: the second layer's minimum separation behind the first, as a
+    /// fraction of the radius, 0..=1 (0: the next surface, a closed object's own back).
+    #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().layer_separation)]
+    layer_separation: f32,
 }
 
 impl GtaoArgs {
     /// GTAO's own settings as given.
     pub(crate) fn settings(&self) -> GtaoSettings {
-        GtaoSettings { thickness: self.thickness, step_power: self.step_power, connect: self.connect }
+        GtaoSettings {
+            thickness: self.thickness,
+            step_power: self.step_power,
+            connect: self.connect,
+            ..GtaoSettings::default()
+        }
     }
 
     pub(crate) fn apply(&self, ao: &mut AoSettings) {
         ao.gtao = self.settings();
         ao.stereo_reuse = !self.independent_eyes;
+        ao.layer_separation = self.layer_separation;
     }
 }
 
@@ -195,6 +205,12 @@ pub(crate) struct AoArgs {
     /// halos of thin objects in front of a background. Assumes closed geometry.
     #[arg(long)]
     depth_peeling: bool,
+    /// Depth layers the occlusion reads, 1 or 2. With 2 the renderer peels a second layer
+    /// per eye (the next surface behind the first, --layer-separation behind it) and GTAO
+    /// and SSDO count a sample as solid only between the two, not a slab --thickness deep
+    /// (kept where nothing lies behind). Costs a depth-only pass per eye and 4 bytes a pixel.
+    #[arg(long, default_value_t = AoSettings::default().layers, value_parser = clap::value_parser!(u32).range(1..=2))]
+    layers: u32,
     /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
     /// bilateral (separable, --blur px either side).
     #[arg(value_parser = choice::<Denoise>(), long, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
@@ -279,6 +295,8 @@ impl AoArgs {
             noise: self.noise,
             resolution: vrao_ao::Resolution::from_half_res(self.half_res),
             depth_peeling: self.depth_peeling,
+            layers: self.layers,
+            layer_separation: self.gtao.layer_separation,
             denoise: self.denoise,
             blur_radius: self.blur,
             blur_plane_sigma: self.blur_sigma,

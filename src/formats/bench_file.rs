@@ -69,6 +69,13 @@ pub struct BenchRecord {
     /// Mean (limit − reference) AO: > 0 the screen-space limit is too light.
     #[serde(default)]
     pub limit_bias: Option<f64>,
+    /// The two-layer screen-space limit's RMSE against the reference (the march with the
+    /// renderer's second depth layer; the same for every row of a radius).
+    #[serde(default)]
+    pub limit_two_layer_rmse: Option<f64>,
+    /// The two-layer limit's mean bias against the reference.
+    #[serde(default)]
+    pub limit_two_layer_bias: Option<f64>,
     /// RMSE within 40 px of the outer, top and bottom borders (`measure::bench::ErrorFigures::ao_rmse_outer_border`).
     #[serde(default)]
     pub ao_rmse_outer_border: Option<f64>,
@@ -99,6 +106,10 @@ pub struct BenchRecord {
     /// SSDO with depth peeling; its second-layer pass is in `occlusion_ms_per_eye`.
     #[serde(default)]
     pub depth_peeling: bool,
+    /// Depth layers the occlusion read (1 or 2; 1 in files written before two existed);
+    /// with 2 the peel of the second layer is in `occlusion_ms_per_eye`.
+    #[serde(default = "one_layer")]
+    pub layers: u32,
     /// Median GPU ms per eye of the depth-peeling pass (0 without peeling).
     #[serde(default)]
     pub peel_ms_per_eye: f64,
@@ -149,10 +160,19 @@ pub struct BenchRecord {
     pub other_ms_per_eye: Option<f64>,
 }
 
+/// Bench files written before two depth layers read one.
+fn one_layer() -> u32 {
+    1
+}
+
 impl BenchRecord {
     /// The row's setting in one line, e.g. `ssao N=16 r=0.5 m full`, for tables and logs.
     pub fn setting(&self) -> String {
-        let peel = if self.depth_peeling { " peeled" } else { "" };
+        let peel = match (self.depth_peeling, self.layers) {
+            (true, _) => " peeled",
+            (false, 2) => " 2 layers",
+            _ => "",
+        };
         let temporal = if self.temporal { " temporal" } else { "" };
         let r = crate::formats::output::significant(self.radius_m as f64, 2);
         let foveation = match self.foveation {

@@ -15,9 +15,10 @@ use crate::measure::stereo_consistency::{stereo_consistency, EyeImages, StereoCo
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::sync::Arc;
-use vrao_ao::plug::{FrameTiming, Gpu, DEPTH, FINAL_AO, NORMALS};
+use vrao_ao::plug::{FrameTiming, Gpu, DEPTH, DEPTH_LAYER_2, FINAL_AO, NORMALS};
 use vrao_ao::{Foveation, Technique};
 use vrao_render::passes::composite::HDR;
+use vrao_render::passes::peel;
 use vrao_render::passes::rsm::{self, RSM_INDIRECT};
 use vrao_render::passes::shadow;
 use vrao_render::renderer::{Renderer, Timing};
@@ -49,6 +50,9 @@ pub struct BenchCase {
     pub half_res: bool,
     /// SSDO with depth peeling (a second depth layer; its pass counts as occlusion cost).
     pub depth_peeling: bool,
+    /// Depth layers the occlusion reads (1 or 2; 2 only for techniques that read a
+    /// second layer, whose peel then counts as occlusion cost).
+    pub layers: u32,
     /// Temporal accumulation (its pass counts as occlusion cost; the error is taken
     /// after the warm-up and measured frames, with a static head: converged).
     pub temporal: bool,
@@ -156,11 +160,21 @@ pub fn measure(
     for _ in 0..how.frames {
         run.timed_frame()?;
     }
-    let limit = match reference {
-        Some(reference) => Some(run.screen_limit(reference)?),
+    let limits = match reference {
+        Some(reference) => Some(run.screen_limits(reference)?),
         None => None,
     };
-    run.finish(reference, limit.as_ref())
+    run.finish(reference, limits.as_ref())
+}
+
+/// A frame's screen-space limits for one radius: with one depth layer, and with two
+/// (the one-layer limit again where the scene can have nothing behind its first layer).
+#[derive(Clone, Debug)]
+pub struct Limits {
+    /// The one-layer limit (`limit_rmse`).
+    pub one: ScreenLimit,
+    /// The two-layer limit (`limit_two_layer_rmse`).
+    pub two: ScreenLimit,
 }
 
 /// One case being measured: its renderer, and the per-pass times of its frames so far.
@@ -188,6 +202,7 @@ impl CaseRun {
         settings.ao.radius = case.radius;
         settings.ao.resolution = vrao_ao::Resolution::from_half_res(case.half_res);
         settings.ao.depth_peeling = case.depth_peeling;
+        settings.ao.layers = case.layers;
         settings.ao.temporal.enabled = case.temporal;
         settings.ao.foveation = case.foveation;
         settings.ao.mask = case.mask;
@@ -237,16 +252,57 @@ impl CaseRun {
         Ok(())
     }
 
-    /// The screen-space limit of the last frame for the radius and grid of `reference`
-    /// (the march over its depth buffer and normals, [`screen_space_limit`]).
-    fn screen_limit(&self, reference: &ReferenceImage) -> Result<ScreenLimit> {
+    /// The screen-space limits of the last frame for the radius and grid of `reference`
+    /// (the march over its depth buffer and normals, [`screen_space_limit`]): with one
+    /// depth layer, and with the second layer the renderer peels for two (the one-layer
+    /// limit again where the scene can have nothing behind its first layer).
+    fn screen_limits(&mut self, reference: &ReferenceImage) -> Result<Limits> {
         let depth = self.renderer.read_f32(DEPTH)?;
         let normals = self.renderer.read_f32(NORMALS)?;
+        let second = self.second_layer()?;
         let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
-            .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: self.eyes.eyes[k].fov, direct: None })
+            .map(|k| EyeBuffers {
+                depth: &depth[k],
+                normals: &normals[k],
+                fov: self.eyes.eyes[k].fov,
+                direct: None,
+                second: None,
+            })
             .collect();
         let settings = LimitSettings::for_reference(reference, self.case.radius as f64, self.eyes.near);
-        screen_space_limit(&buffers, (reference.width, reference.height), &settings)
+        let size = (reference.width, reference.height);
+        let one = screen_space_limit(&buffers, size, &settings)?;
+        let two = match &second {
+            Some(second) => {
+                let buffers: Vec<EyeBuffers> =
+                    buffers.iter().zip(second).map(|(eye, second)| EyeBuffers { second: Some(second), ..*eye }).collect();
+                screen_space_limit(&buffers, size, &settings)?
+            }
+            None => one.clone(),
+        };
+        Ok(Limits { one, two })
+    }
+
+    /// The second depth layer of this case's frame, as two layers would peel it with the
+    /// case's separation; `None` when the scene can have nothing behind the first layer.
+    /// A case that peels it already is read; any other renders one frame that does
+    /// (GTAO with two layers), then one of its own again, so that what it reads next is
+    /// its own frame.
+    fn second_layer(&mut self) -> Result<Option<Vec<Vec<f32>>>> {
+        let peels = |report: &vrao_render::renderer::FrameReport| report.plan.names.contains(&peel::NAME);
+        if self.case.layers == 2 && self.settings.ao.technique.reads_second_layer() {
+            let ran = self.renderer.last_plan().is_some_and(|plan| plan.names.contains(&peel::NAME));
+            return if ran { Ok(Some(self.renderer.read_f32(DEPTH_LAYER_2)?)) } else { Ok(None) };
+        }
+        let mut two = self.settings.clone();
+        two.ao.layers = 2;
+        two.ao.technique = Technique::Gtao;
+        self.renderer.set_settings(&two)?;
+        let report = self.renderer.render_and_wait(&self.eyes.eyes, &[DEPTH_LAYER_2])?;
+        let second = if peels(&report) { Some(self.renderer.read_f32(DEPTH_LAYER_2)?) } else { None };
+        self.renderer.set_settings(&self.settings)?;
+        self.frame()?;
+        Ok(second)
     }
 
     /// The bounce's screen-space limit of the last frame (the limit's march with this
@@ -261,6 +317,7 @@ impl CaseRun {
                 normals: &normals[k],
                 fov: self.eyes.eyes[k].fov,
                 direct: Some(&direct[k]),
+                second: None,
             })
             .collect();
         let settings = LimitSettings::for_reference(reference, self.case.radius as f64, self.eyes.near);
@@ -276,7 +333,8 @@ impl CaseRun {
 
     /// The row: medians of the measured frames, the last frame's stereo consistency, and
     /// with a reference its error (against the screen-space `limit` too when given).
-    fn finish(mut self, reference: Option<&ReferenceImage>, limit: Option<&ScreenLimit>) -> Result<BenchRow> {
+    fn finish(mut self, reference: Option<&ReferenceImage>, limits: Option<&Limits>) -> Result<BenchRow> {
+        let limit = limits.map(|l| &l.one);
         let (settings, output) = (&self.settings, self.output);
         // The measured frames' plan, before the bounce below renders a frame of another.
         let plan = self.renderer.last_plan().cloned().ok_or_else(|| Error::gpu("no frame was measured"))?;
@@ -289,6 +347,10 @@ impl CaseRun {
             // Scored where the eye can see; with the mask off also over the whole rectangle.
             let visible = reference.visible_only(&self.coverage);
             let mut figures = score(self.case.technique, &occlusion, &visible, limit, ppd, &fovs);
+            if let Some(limits) = limits {
+                (figures.limit_two_layer_rmse, figures.limit_two_layer_bias) =
+                    limit_against_reference(&limits.two, &visible);
+            }
             let traced_whole = reference.layers.iter().flatten().filter(|p| p.hit).count()
                 > visible.layers.iter().flatten().filter(|p| p.hit).count();
             if !self.case.mask && traced_whole {
@@ -414,6 +476,7 @@ pub fn measure_rsm(
         radius,
         half_res: true,
         depth_peeling: false,
+        layers: 1,
         temporal: false,
         foveation: Foveation::Off,
         mask: settings.ao.mask,
@@ -582,7 +645,7 @@ pub fn sweep(
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
-    let mut limits: Vec<(f32, ScreenLimit)> = Vec::new();
+    let mut limits: Vec<(f32, Limits)> = Vec::new();
     for group in cases.chunks(how.interleave.max(1)) {
         let mut runs = Vec::with_capacity(group.len());
         for case in group {
@@ -597,13 +660,14 @@ pub fn sweep(
                 run.timed_frame()?;
             }
         }
-        for run in runs {
+        for mut run in runs {
             let reference = references.iter().find(|(r, _)| *r == run.case.radius).map(|(_, image)| image);
-            // The limit depends only on the frame's depth and normals (the same G-buffer
-            // for every case) and the radius: marched once per radius, for its first row.
+            // The limits depend only on the frame's depth layers and normals (the same
+            // G-buffer for every case; the second layer with the sweep's one separation)
+            // and the radius: marched once per radius, for its first row.
             if let Some(reference) = reference {
                 if !limits.iter().any(|(r, _)| *r == run.case.radius) {
-                    limits.push((run.case.radius, run.screen_limit(reference)?));
+                    limits.push((run.case.radius, run.screen_limits(reference)?));
                 }
             }
             let limit = limits.iter().find(|(r, _)| *r == run.case.radius).map(|(_, l)| l);

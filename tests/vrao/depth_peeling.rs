@@ -9,9 +9,8 @@ use crate::common;
 use glam::{DVec3, Vec3};
 use vrao::measure::bench::error_figures;
 use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
-use vrao_ao::plug::{Resource, DEPTH, FINAL_AO};
+use vrao_ao::plug::{Resource, DEPTH, DEPTH_LAYER_2, FINAL_AO};
 use vrao_ao::{AoSettings, Technique};
-use vrao_render::passes::peel::DEPTH_LAYER_2;
 use vrao_render::passes::tonemap::COLOR;
 use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 

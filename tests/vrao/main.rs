@@ -26,6 +26,8 @@ mod cli;
 mod content;
 #[cfg(feature = "app")]
 mod depth_peeling;
+#[cfg(feature = "app")]
+mod two_layers;
 #[cfg(feature = "gltf")]
 mod fuzz_loaders;
 #[cfg(feature = "app")]

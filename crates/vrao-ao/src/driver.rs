@@ -29,6 +29,8 @@ pub struct FrameParams<'a> {
     pub extensions: &'a [&'a dyn Any],
     /// Whether the normals' w marks alpha-tested cards ([`DeclareContext::alpha_cards`]).
     pub alpha_cards: bool,
+    /// Whether a second depth layer can be had ([`DeclareContext::second_layer`]).
+    pub second_layer: bool,
     /// The f64 origin of the anchored frame.
     pub anchor: DVec3,
     /// Whether a raster pass draws both layers at once.
@@ -82,6 +84,9 @@ struct PlanKey<K> {
     /// a previous frame of as many views.
     odd_frame: bool,
     has_history: bool,
+    /// Whether a second depth layer can be had (the renderer's views may leave a convex
+    /// scene's inside from one frame to the next).
+    second_layer: bool,
 }
 
 /// Runs one frame graph frame after frame: plan cache, targets, uniforms, record loop and
@@ -162,6 +167,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
         DeclareContext {
             extensions: params.extensions,
             alpha_cards: params.alpha_cards,
+            second_layer: params.second_layer,
             anchor: params.anchor,
             settings: params.settings,
             views: layers,
@@ -205,6 +211,7 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
             outputs: outputs.to_vec(),
             imported: imported.to_vec(),
             odd_frame: self.frame_index % 2 == 1,
+            second_layer: params.second_layer,
             has_history: self.previous_views(layers).is_some(),
         };
         if let Some((cached, plan)) = &self.plan_cache {

@@ -29,6 +29,10 @@ pub struct DeclareContext<'a> {
     /// Whether the normals' w marks alpha-tested surfaces (cards) that GTAO samples as
     /// thin planes (a renderer's scene with alpha-tested materials; never a host's).
     pub alpha_cards: bool,
+    /// Whether a second depth layer ([`DEPTH_LAYER_2`](crate::plug::DEPTH_LAYER_2)) can be
+    /// had: a renderer peels one (its scene can have a surface behind another) or a host
+    /// gave one. False: the occlusion reads one layer whatever the settings' `layers`.
+    pub second_layer: bool,
     /// The f64 origin that view-from-anchored matrices start from (the scene's anchor;
     /// the world origin for a host's views).
     pub anchor: glam::DVec3,

@@ -234,6 +234,13 @@ const BASELINES: [TechniqueEntry; 1] = [TechniqueEntry {
 const BASELINES: [TechniqueEntry; 0] = [];
 
 impl Technique {
+    /// Whether the technique reads a second depth layer when the settings ask for two
+    /// (`AoSettings::layers`): the marches on GTAO's bitmask (GTAO, SSDO), whose samples
+    /// then block the span between the layers instead of a slab.
+    pub fn reads_second_layer(self) -> bool {
+        matches!(self, Technique::Gtao | Technique::Ssdo | Technique::SsdoBounce)
+    }
+
     /// Every technique, in the order the CLI and the bench list them (the table's).
     pub const ALL: [Technique; TECHNIQUES.len()] = {
         let mut all = [Technique::None; TECHNIQUES.len()];

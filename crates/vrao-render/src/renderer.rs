@@ -182,10 +182,15 @@ impl Renderer {
         gpu.take_shader_error()?;
         gpu.take_error()?;
         let mover_bounds = mover_bounds(scene, &gpu_scene);
+        let shell = crate::scene::shell::ConvexShell::of(scene);
         let inputs = FrameInputs {
             settings: chain_settings(settings),
             // The scene is fixed for the renderer's life, so are its materials.
             alpha_cards: scene.has_alpha_test(),
+            shell: shell.clone(),
+            // Until a frame's views say otherwise (plans made before the first frame),
+            // the scene's own head at time 0.
+            second_layer: second_layer_visible(shell.as_ref(), &settings.profile.eyes(&scene.head.pose_at(0.0), settings.near).eyes),
             anchor: gpu_scene.anchor,
             multiview,
             motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },
@@ -396,6 +401,7 @@ impl Renderer {
         self.throttle()?;
         let layers = views.len() as u32;
         self.update_motion(layers);
+        self.inputs.second_layer = second_layer_visible(self.inputs.shell.as_ref(), views);
         // Borrowed field by field: the driver is changed while the passes and what they
         // consult are read.
         let Renderer { gpu, scene, gpu_scene, settings, driver, inputs, passes, .. } = self;
@@ -583,6 +589,12 @@ struct FrameInputs {
     settings: ChainSettings,
     /// Whether the scene has alpha-tested materials (GTAO's cards).
     alpha_cards: bool,
+    /// The convex shell the scene's triangles bound, if they do: from inside it nothing
+    /// lies behind the first depth layer (scene/shell.rs).
+    shell: Option<crate::scene::shell::ConvexShell>,
+    /// Whether this frame's views can see a surface behind another (not both inside
+    /// `shell`): the depth peel runs only then.
+    second_layer: bool,
     /// Where the scene's geometry was uploaded relative to.
     anchor: DVec3,
     /// Whether the G-buffer draws both eyes in one multiview pass.
@@ -603,6 +615,7 @@ impl FrameInputs {
             settings: &self.settings,
             extensions,
             alpha_cards: self.alpha_cards,
+            second_layer: self.second_layer,
             anchor: self.anchor,
             multiview: self.multiview,
             motion: &self.motion,
@@ -610,6 +623,12 @@ impl FrameInputs {
             scalar_chain: self.scalar_chain,
         }
     }
+}
+
+/// Whether `views` may see a surface behind another: not every eye inside the scene's
+/// convex shell (scene/shell.rs), or the scene is none.
+fn second_layer_visible(shell: Option<&crate::scene::shell::ConvexShell>, views: &[Eye]) -> bool {
+    shell.is_none_or(|shell| !views.iter().all(|eye| shell.contains(eye.pose.position)))
 }
 
 /// What the engine's chain reads of the renderer's settings.

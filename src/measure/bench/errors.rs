@@ -49,6 +49,14 @@ pub struct ErrorFigures {
     pub limit_rmse: Option<f64>,
     /// The screen-space limit's mean bias against the reference.
     pub limit_bias: Option<f64>,
+    /// The two-layer screen-space limit's RMSE against the reference (the march with the
+    /// renderer's second depth layer, `screen_limit`; noise taken out as for
+    /// `limit_rmse`): what a second layer leaves. Set by the bench, `None` otherwise.
+    #[serde(default)]
+    pub limit_two_layer_rmse: Option<f64>,
+    /// The two-layer limit's mean bias against the reference.
+    #[serde(default)]
+    pub limit_two_layer_bias: Option<f64>,
     /// RMSE (noise not taken out) over the pixels within [`BORDER_PX`] of an eye's outer,
     /// top or bottom border, where samples that leave the image count as open: with
     /// `ao_rmse`, what a guard band could win. `None` when no such pixel is covered.
@@ -165,7 +173,40 @@ pub fn score(
         ao_rmse_vs_limit,
         limit_rmse,
         limit_bias,
+        limit_two_layer_rmse: None,
+        limit_two_layer_bias: None,
     }
+}
+
+/// A screen-space limit's (RMSE, bias) against `reference` over the cells both hit, the
+/// reference's noise taken out of the RMSE in quadrature (as `limit_rmse`); `None` when
+/// the grids differ or no cell is hit.
+pub fn limit_against_reference(limit: &ScreenLimit, reference: &ReferenceImage) -> (Option<f64>, Option<f64>) {
+    if limit.grid_size() != reference.grid_size() || limit.layers.len() < reference.layers.len() {
+        return (None, None);
+    }
+    let (gw, gh) = reference.grid_size();
+    let (mut n, mut sum, mut sum_sq, mut noise2) = (0usize, 0f64, 0f64, 0f64);
+    for layer in 0..reference.layers.len() {
+        for j in 0..gh {
+            for i in 0..gw {
+                let (r, l) = (reference.get(layer, i, j), limit.get(layer, i, j));
+                if !(r.hit && l.hit) {
+                    continue;
+                }
+                let d = l.ao as f64 - r.ao as f64;
+                n += 1;
+                sum += d;
+                sum_sq += d * d;
+                noise2 += (r.ao_std_error as f64).powi(2);
+            }
+        }
+    }
+    if n == 0 {
+        return (None, None);
+    }
+    let n = n as f64;
+    (Some(metrics::noise_corrected_rmse((sum_sq / n).sqrt(), (noise2 / n).sqrt())), Some(sum / n))
 }
 
 /// One traced cell of the reference grid beside what the frame (and the screen-space

@@ -36,6 +36,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 ao_rmse_vs_limit: row.error.as_ref().and_then(|e| e.ao_rmse_vs_limit),
                 limit_rmse: row.error.as_ref().and_then(|e| e.limit_rmse),
                 limit_bias: row.error.as_ref().and_then(|e| e.limit_bias),
+                limit_two_layer_rmse: row.error.as_ref().and_then(|e| e.limit_two_layer_rmse),
+                limit_two_layer_bias: row.error.as_ref().and_then(|e| e.limit_two_layer_bias),
                 ao_rmse_outer_border: row.error.as_ref().and_then(|e| e.ao_rmse_outer_border),
                 halo_share: row.error.as_ref().and_then(|e| e.halo_share),
                 flip_mean: row.error.as_ref().and_then(|e| e.flip_mean),
@@ -46,6 +48,7 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
                 pareto: false,
                 depth_peeling: c.depth_peeling,
+                layers: c.layers,
                 peel_ms_per_eye: per_eye(peel::NAME),
                 bounce_rel_rmse: row.bounce.map(|b| b.rel_rmse),
                 bounce_rel_bias: row.bounce.map(|b| b.rel_bias),
@@ -86,8 +89,8 @@ fn full_resolution_partner<'a>(records: &'a [BenchRecord], half: &BenchRecord) -
 
 /// A record's sweep axes but its resolution, foveation and mask, which the partner
 /// lookups (the same case at full resolution, the same case unfoveated and unmasked) vary.
-fn sweep_case(r: &BenchRecord) -> (&str, u32, f32, bool, bool) {
-    (r.technique.as_str(), r.samples, r.radius_m, r.depth_peeling, r.temporal)
+fn sweep_case(r: &BenchRecord) -> (&str, u32, f32, bool, u32, bool) {
+    (r.technique.as_str(), r.samples, r.radius_m, r.depth_peeling, r.layers, r.temporal)
 }
 
 /// Marks each record on the Pareto front of AO RMSE against occlusion ms per eye. Each
@@ -195,6 +198,13 @@ const COLUMNS: &[Column] = &[
         optional: true,
     },
     Column {
+        name: "layers",
+        header: "layers",
+        csv: |r| r.layers.to_string(),
+        markdown: |r| r.layers.to_string(),
+        optional: false,
+    },
+    Column {
         name: "mask",
         header: "mask",
         csv: |r| if r.mask { "on" } else { "off" }.to_string(),
@@ -216,6 +226,8 @@ const COLUMNS: &[Column] = &[
     figure_column!(ao_rmse_vs_limit, "RMSE vs limit", false),
     figure_column!(limit_rmse, "limit RMSE", false),
     figure_column!(limit_bias, "limit bias", false),
+    figure_column!(limit_two_layer_rmse, "2-layer limit RMSE", true),
+    figure_column!(limit_two_layer_bias, "2-layer limit bias", true),
     figure_column!(ao_rmse_outer_border, "RMSE outer border", false),
     share_column!(halo_share, "halo"),
     figure_column!(flip_mean, "FLIP", false),
@@ -265,7 +277,7 @@ const COLUMNS: &[Column] = &[
         name: "peel_ms_per_eye",
         header: "peel ms",
         csv: |r| format!("{:.3}", r.peel_ms_per_eye),
-        markdown: |r| if r.depth_peeling { format!("{:.1}", r.peel_ms_per_eye) } else { String::new() },
+        markdown: |r| if r.depth_peeling || r.layers == 2 { format!("{:.1}", r.peel_ms_per_eye) } else { String::new() },
         optional: true,
     },
     figure_column!(bounce_rel_rmse, "bounce rel. RMSE", true),

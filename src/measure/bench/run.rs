@@ -33,6 +33,8 @@ pub struct BenchOptions {
     pub half_res: Vec<bool>,
     /// Depth peeling off/on to sweep (SSDO techniques only).
     pub depth_peeling: Vec<bool>,
+    /// Depth layers to sweep (1, 2; 2 only for the techniques that read a second layer).
+    pub layers: Vec<u32>,
     /// Temporal accumulation off/on to sweep.
     pub temporal: Vec<bool>,
     /// Foveation levels to sweep.
@@ -81,7 +83,8 @@ pub struct BenchRun {
 }
 
 /// The cases of a sweep, in order: technique × samples × radius × resolution × depth
-/// peeling (SSDO only) × temporal × foveation.
+/// peeling (SSDO only) × layers (2 for GTAO and SSDO only) × temporal × mask × foveation.
+/// Layers sit next to each other, so `--interleave 2` times 1 and 2 layers together.
 pub fn cases(options: &BenchOptions, radii: &[f32]) -> Vec<BenchCase> {
     let mut cases = Vec::new();
     for &technique in &options.techniques {
@@ -92,19 +95,25 @@ pub fn cases(options: &BenchOptions, radii: &[f32]) -> Vec<BenchCase> {
                         if depth_peeling && !technique.carries_light() {
                             continue;
                         }
-                        for &temporal in &options.temporal {
-                            for &mask in &options.mask {
-                                for &foveation in &options.foveation {
-                                    cases.push(BenchCase {
-                                        technique,
-                                        samples,
-                                        radius,
-                                        half_res,
-                                        depth_peeling,
-                                        temporal,
-                                        foveation,
-                                        mask,
-                                    });
+                        for &layers in &options.layers {
+                            if layers == 2 && !technique.reads_second_layer() {
+                                continue;
+                            }
+                            for &temporal in &options.temporal {
+                                for &mask in &options.mask {
+                                    for &foveation in &options.foveation {
+                                        cases.push(BenchCase {
+                                            technique,
+                                            samples,
+                                            radius,
+                                            half_res,
+                                            depth_peeling,
+                                            layers,
+                                            temporal,
+                                            foveation,
+                                            mask,
+                                        });
+                                    }
                                 }
                             }
                         }
@@ -207,18 +216,23 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
     named_once("sample counts", &options.samples)?;
     named_once("radii", &options.radii)?;
     named_once("foveation levels", &options.foveation)?;
+    named_once("layer counts", &options.layers)?;
+    if let Some(n) = options.layers.iter().find(|n| !(1..=2).contains(*n)) {
+        return Err(Error::input(format!("layers {n} is not 1 or 2")));
+    }
     // The mask's values as the command line names them (`--mask on,off`).
     let masks: Vec<&str> = options.mask.iter().map(|&on| if on { "on" } else { "off" }).collect();
     named_once("mask settings", &masks)?;
     named_once("RSM sample counts", &options.rsm_samples)?;
     for case in cases {
         let mut s = base.clone();
-        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.resolution, s.ao.depth_peeling) = (
+        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.resolution, s.ao.depth_peeling, s.ao.layers) = (
             case.technique,
             case.samples,
             case.radius,
             vrao_ao::Resolution::from_half_res(case.half_res),
             case.depth_peeling,
+            case.layers,
         );
         s.validate()?;
         if case.technique == Technique::None {
@@ -258,11 +272,12 @@ fn progress_line(done: usize, total: usize, row: &BenchRow, elapsed: f64) -> Str
     let mut error = row.error.as_ref().map_or(String::new(), |e| {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
         format!(
-            "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}) FLIP {}",
+            "  RMSE {:.3} bias {:+.3} vs limit {} (limit {}, 2-layer {}) FLIP {}",
             e.ao_rmse,
             e.ao_bias,
             opt(e.ao_rmse_vs_limit),
             opt(e.limit_rmse),
+            opt(e.limit_two_layer_rmse),
             opt(e.flip_mean)
         )
     });
@@ -271,7 +286,12 @@ fn progress_line(done: usize, total: usize, row: &BenchRow, elapsed: f64) -> Str
     }
     format!(
         "[{done:>3}/{total}] {:<12} N={:<3} r={:<7} {:<4} {:>9.3} ms/eye{error}   (elapsed {elapsed:.0} s, eta {eta:.0} s)",
-        format!("{}{}", row.case.technique.name(), if row.case.depth_peeling { "+peel" } else { "" }),
+        format!(
+            "{}{}{}",
+            row.case.technique.name(),
+            if row.case.depth_peeling { "+peel" } else { "" },
+            if row.case.layers == 2 { "+2L" } else { "" }
+        ),
         row.case.samples,
         row.case.radius,
         format!(

@@ -42,6 +42,18 @@
 //! it; the default is r / 4 (six steps at S = 24), scaled with r rather than fixed in
 //! metres so that it stays above that floor for any radius and stays small next to the
 //! region the occlusion integrates over.
+//!
+//! The *two-layer limit* ([`EyeBuffers::second`]): with a second depth layer (the next
+//! surface behind the visible one, at least a minimum separation behind it, as the
+//! renderer's depth peel writes it), what lies behind a visible surface is no longer a
+//! guess where that layer has a surface: a step Q counts as inside where, at its pixel,
+//! its path lies between the first surface and the second (the back of a closed object,
+//! or the next object behind). Those spans can be far thinner than a step (a 6 mm slat's
+//! back face), so there the test is the step's *segment*: the distances the ray covers
+//! from the previous step (or the receiver) to Q overlap the span, where a point test
+//! would step over it. Where the second layer has no surface (nothing behind, or the sky)
+//! the thickness guess and the point test apply exactly as in the one-layer limit, so
+//! the two limits differ only at pixels with a second surface.
 
 use super::shading::{concentric_disk, orthonormal_basis, pixel_seed, stratified_points, Rng};
 use super::{grid_size, pixel_of, ReferenceImage};
@@ -127,6 +139,9 @@ pub struct EyeBuffers<'a> {
     /// The direct light leaving each pixel's surface (RGBA, a unused), for the bounce's
     /// limit; `None`: no bounce.
     pub direct: Option<&'a [f32]>,
+    /// The second depth layer (reversed-Z, one value a pixel, 0 where nothing lies behind
+    /// the first): `Some` marches the two-layer limit (module docs), `None` the one-layer.
+    pub second: Option<&'a [f32]>,
 }
 
 /// The limit at one grid pixel.
@@ -179,6 +194,7 @@ pub fn screen_space_limit(eyes: &[EyeBuffers], size: (u32, u32), settings: &Limi
         if eye.depth.len() != pixels
             || eye.normals.len() != pixels * 4
             || eye.direct.is_some_and(|d| d.len() != pixels * 4)
+            || eye.second.is_some_and(|d| d.len() != pixels)
         {
             return Err(Error::input(format!(
                 "screen-space limit: eye {layer} has {} depth and {} normal values for {}×{} pixels",
@@ -232,6 +248,15 @@ impl<'a> Marcher<'a> {
         (d.is_finite() && d > 0.0).then_some(d)
     }
 
+    /// The view distance of the second layer at a pixel whose first surface lies at
+    /// `first` m, `None` where it has no surface behind the first (or none is given).
+    fn second_distance(&self, x: u32, y: u32, first: f64) -> Option<f64> {
+        let second = self.eye.second?;
+        let d = second[y as usize * self.size.0 as usize + x as usize] as f64;
+        let distance = self.settings.near / d;
+        (d.is_finite() && d > 0.0 && distance > first).then_some(distance)
+    }
+
     /// The view-space surface point at the centre of pixel (x, y) with depth `d`.
     fn position(&self, x: u32, y: u32, d: f64) -> DVec3 {
         let uv = [(x as f64 + 0.5) / self.size.0 as f64, (y as f64 + 0.5) / self.size.1 as f64];
@@ -282,16 +307,28 @@ impl<'a> Marcher<'a> {
             let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
             let dir = (t * dx + b * dy + n * dz).normalize();
             let jitter = rng.next_f64();
+            // The distance of the ray's previous step (the receiver's before the first).
+            let mut previous_distance = -p.z;
             for step in 0..s.steps {
                 let q = p + dir * (s.radius * (step as f64 + jitter) / s.steps as f64);
+                let from = std::mem::replace(&mut previous_distance, -q.z);
                 let Some((qx, qy)) = self.project(q) else {
                     break; // off the image (or in front of the near plane): open
                 };
                 let Some(surface_depth) = self.depth(qx, qy) else {
                     continue; // the sky: nothing in front of Q
                 };
-                let behind = -q.z - s.near / surface_depth;
-                if behind <= 0.0 || behind >= s.thickness {
+                let first = s.near / surface_depth;
+                let inside = match self.second_distance(qx, qy, first) {
+                    // The segment from the previous step to Q overlaps the span between
+                    // the layers (module docs: a span may be thinner than a step).
+                    Some(back) => from.min(-q.z) < back && from.max(-q.z) > first,
+                    None => {
+                        let behind = -q.z - first;
+                        behind > 0.0 && behind < s.thickness
+                    }
+                };
+                if !inside {
                     continue;
                 }
                 let surface = self.position(qx, qy, surface_depth);
@@ -365,9 +402,28 @@ mod tests {
         (depth, normals)
     }
 
+    /// The second depth layer of `rects` as the renderer's peel writes it: through each
+    /// pixel centre, the nearest surface farther than the first by `separation` of its
+    /// distance (reversed-Z, 0 where there is none).
+    fn second_layer(rects: &[Rect], size: (u32, u32), separation: f64) -> Vec<f32> {
+        let [l, r, u, d] = fov().tangents();
+        let mut second = Vec::new();
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let (s, t) = ((x as f64 + 0.5) / size.0 as f64, (y as f64 + 0.5) / size.1 as f64);
+                let dir = DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0);
+                let hits: Vec<f64> = rects.iter().filter_map(|rect| rect.hit(DVec3::ZERO, dir)).collect();
+                let first = hits.iter().copied().fold(f64::INFINITY, f64::min);
+                let next = hits.iter().copied().filter(|&t| t > first * (1.0 + separation)).fold(f64::INFINITY, f64::min);
+                second.push(if next.is_finite() { (NEAR / next) as f32 } else { 0.0 });
+            }
+        }
+        second
+    }
+
     fn limit(rects: &[Rect], size: (u32, u32), settings: LimitSettings) -> (ScreenLimit, Vec<f32>) {
         let (depth, normals) = rasterise(rects, size);
-        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None };
+        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None, second: None };
         (screen_space_limit(&[eye], size, &settings).unwrap(), depth)
     }
 
@@ -493,10 +549,84 @@ mod tests {
     }
 
     #[test]
+    fn a_second_layer_frees_the_space_under_a_thin_slab_that_one_layer_fills() {
+        // The eye looks straight down at a floor 3 m away; a closed slab 4 cm thick (its
+        // top 0.5 m above the floor) covers x > 0. One layer sees only the slab's top and
+        // takes r / 4 = 0.25 m behind it as solid: floor receivers beside the slab lose
+        // the rays that pass under it. The second layer is the slab's underside, so the
+        // two-layer limit blocks only the 4 cm the slab fills, as the ray tracer does.
+        let floor = Rect {
+            corner: DVec3::new(-20.0, -20.0, -3.0),
+            u: DVec3::new(40.0, 0.0, 0.0),
+            v: DVec3::new(0.0, 40.0, 0.0),
+        };
+        let top =
+            Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(20.0, 0.0, 0.0), v: DVec3::new(0.0, 40.0, 0.0) };
+        let bottom = Rect { corner: DVec3::new(0.0, -20.0, -2.54), ..top };
+        let side =
+            Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(0.0, 0.0, -0.04), v: DVec3::new(0.0, 40.0, 0.0) };
+        let scene = [floor, top, bottom, side];
+        let (size, stride, radius) = ((96, 96), 2, 1.0);
+        let settings = LimitSettings { rays_per_pixel: 256, steps: 24, ..LimitSettings::new(radius, stride, NEAR) };
+        let (depth, normals) = rasterise(&scene, size);
+        let second = second_layer(&scene, size, 1e-3);
+        let one = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None, second: None };
+        let two = EyeBuffers { second: Some(&second), ..one };
+        let one = screen_space_limit(&[one], size, &settings).unwrap();
+        let two = screen_space_limit(&[two], size, &settings).unwrap();
+        let (gw, gh) = one.grid_size();
+        let (mut n, mut one_error, mut two_error, mut one_bias) = (0, 0.0, 0.0, 0.0);
+        for j in 0..gh {
+            for i in 0..gw {
+                let p = position(&depth, size, stride, i, j);
+                // Floor receivers within 0.3 m of the slab's edge, near the image centre row.
+                if (p.z + 3.0).abs() > 1e-4 || !(-0.3..-0.02).contains(&p.x) || p.y.abs() > 0.5 {
+                    continue;
+                }
+                let truth = visibility_by_ray_casting(p, DVec3::Z, radius, false, 400, |o, d| first_hit(&scene, o, d));
+                n += 1;
+                one_error += (one.get(0, i, j).ao as f64 - truth).abs();
+                one_bias += one.get(0, i, j).ao as f64 - truth;
+                two_error += (two.get(0, i, j).ao as f64 - truth).abs();
+            }
+        }
+        assert!(n > 10, "{n} receivers");
+        let (one_error, two_error, one_bias) = (one_error / n as f64, two_error / n as f64, one_bias / n as f64);
+        assert!(two_error < 0.03, "two layers: mean |limit − truth| {two_error}");
+        assert!(one_bias < -0.05, "one layer should over-occlude under the slab: bias {one_bias}");
+        assert!(one_error > 2.0 * two_error, "one layer {one_error} against two {two_error}");
+    }
+
+    #[test]
+    fn without_a_surface_behind_the_two_layer_limit_is_the_one_layer_limit() {
+        // A crease (floor and wall) has nothing behind either: an all-empty second layer
+        // falls back to the thickness at every step, pixel for pixel.
+        let floor =
+            Rect { corner: DVec3::new(-20.0, 0.0, 0.0), u: DVec3::new(40.0, 0.0, 0.0), v: DVec3::new(0.0, 0.0, 20.0) };
+        let wall =
+            Rect { corner: DVec3::new(-20.0, 0.0, 0.0), u: DVec3::new(40.0, 0.0, 0.0), v: DVec3::new(0.0, 20.0, 0.0) };
+        let pose = vrao_ao::HeadPose::look_at(DVec3::new(0.0, 1.0, 1.0), DVec3::ZERO).unwrap();
+        let scene = into_view(&[floor, wall], &pose);
+        let size = (40, 36);
+        let (depth, normals) = rasterise(&scene, size);
+        let second = second_layer(&scene, size, 1e-3);
+        assert!(second.iter().all(|&d| d == 0.0));
+        let one = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None, second: None };
+        let two = EyeBuffers { second: Some(&second), ..one };
+        let settings = LimitSettings::new(0.6, 2, NEAR);
+        assert_eq!(
+            screen_space_limit(&[one], size, &settings).unwrap(),
+            screen_space_limit(&[two], size, &settings).unwrap()
+        );
+        let short = EyeBuffers { second: Some(&second[..10]), ..one };
+        assert!(screen_space_limit(&[short], size, &settings).is_err());
+    }
+
+    #[test]
     fn the_sky_is_open_and_mismatched_buffers_are_refused() {
         let size = (8, 6);
         let (depth, normals) = (vec![0.0; 48], vec![0.0; 192]);
-        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None };
+        let eye = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None, second: None };
         let limit = screen_space_limit(&[eye, eye], size, &LimitSettings::new(1.0, 1, NEAR)).unwrap();
         assert!(limit.layers.iter().flatten().all(|p| !p.hit && p.ao == 1.0));
         let short = EyeBuffers { depth: &depth[..40], ..eye };

@@ -354,6 +354,8 @@ impl AoEngine {
             settings: &settings,
             extensions: &[&light_inputs],
             alpha_cards: false,
+            // The engine takes one depth layer from a host.
+            second_layer: false,
             anchor: glam::DVec3::ZERO,
             multiview: false,
             motion: &self.motion,

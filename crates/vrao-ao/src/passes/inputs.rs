@@ -17,3 +17,8 @@ pub const MOTION: Resource = Resource::attachment("motion", Size::Full, wgpu::Te
 /// occluding sample. vrao's renderer writes it (its direct-light pass); the AO engine
 /// packs a host's radiance texture into it.
 pub const DIRECT_LIGHT: Resource = Resource::storage("direct", Size::Full, wgpu::TextureFormat::Rg32Uint);
+/// The second depth layer (reversed-Z, `Depth32Float`): the nearest surface at least the
+/// settings' `layer_separation` behind [`DEPTH`], 0 where nothing lies behind it. vrao's
+/// renderer peels it (its depth-peel pass) when the occlusion reads two layers.
+pub const DEPTH_LAYER_2: Resource =
+    Resource::attachment("depth-layer-2", Size::Full, wgpu::TextureFormat::Depth32Float);

@@ -17,6 +17,7 @@ pub mod gltf;
 pub mod limits;
 pub mod normals;
 pub mod obj;
+pub mod shell;
 pub mod texture;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};

@@ -66,6 +66,14 @@ override LISTED_PIXELS: bool = false;
 // (the floor under its holes far darker than the reference's; docs/records/2026-11-29/measurements-in-code.md,
 // gtao-thin-cards). Off, no pixel pays the normal's fetch.
 override THIN_CARDS: bool = false;
+// Set when a second depth layer is bound (`AoSettings::layers` = 2, and one can be had:
+// passes/gtao/mod.rs): each depth sample also fetches the second layer at its pixel, and
+// where it holds a surface the sample blocks the span from the first surface to it
+// (`add_sample`), the thickness only where it holds none. Off, no pixel pays the fetch
+// and the march is today's to the bit.
+override SECOND_LAYER: bool = false;
+@group(0) @binding(11) var second_depth_layers: texture_depth_2d_array;
+
 // AoRaw's and AoGeometry's left-eye layers in the right eye's dispatch (any array
 // textures otherwise).
 @group(0) @binding(7) var left_occlusion: texture_2d_array<f32>;
@@ -278,7 +286,8 @@ fn usable_card_end(end: vec3<f32>, p: vec3<f32>, radius2: f32) -> bool {
 
 // Marks the sectors that the depth sample `surface` (view space, w = 0 when none) blocks
 // for the receiver at `p` on half `side` (+1 towards `t`, −1 away) of the slice: the
-// slab from the visible surface back to `thickness` behind it, joined to the previous
+// slab from the visible surface back to `thickness` behind it (with `SECOND_LAYER` and
+// w > 1, back to the second layer's surface at w × its distance along its view ray), joined to the previous
 // sample when both lie on one continuous surface. A sample on a card has no depth behind
 // it: it blocks its stratum's footprint on the card's plane instead, so where a stratum
 // is part hole, part card, the holes' share of the samples blocks nothing and over the
@@ -320,7 +329,12 @@ fn add_sample(
         let ray = normalize(surface.xyz);
         let along = dot(front, ray);
         let to_sphere = -along + sqrt(max(along * along - front2 + limits.radius2, 0.0));
-        end_b = front + ray * min(limits.thickness, to_sphere);
+        var slab = limits.thickness;
+        if (SECOND_LAYER && surface.w > 1.0) {
+            // The span to the second layer: (w − 1) × the sample's distance from the eye.
+            slab = length(surface.xyz) * (surface.w - 1.0);
+        }
+        end_b = front + ray * min(slab, to_sphere);
     }
     // A front past V belongs to the other half: the pixel grid put the sample off the
     // slice, across the view plane (a short step from an off-centre pixel), typically
@@ -533,8 +547,18 @@ fn main(
                         card.ray_b = view_position_from_distance(qb / size, 1.0, r.eye.tangents);
                     }
                 }
+                // w: 0 on the sky, 1 for a surface of unknown thickness, and with a second
+                // layer behind it the ratio of its distance to the first's (d / d₂ in
+                // reversed Z), > 1.
+                var sample = select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0);
+                if (SECOND_LAYER && d > 0.0) {
+                    let d2 = textureLoad(second_depth_layers, vec2<i32>(pixel), i32(r.layer), 0);
+                    if (d2 > 0.0 && d2 < d) {
+                        sample.w = d / d2;
+                    }
+                }
                 let covered = march.occluded;
-                add_sample(&march, slice, sign, p, select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0), card, limits);
+                add_sample(&march, slice, sign, p, sample, card, limits);
                 gather_sample(&light, march.occluded & ~covered, pixel, r.layer, surface, p);
             }
             let towards_inner = near_inner_border && sign * omega.x * inner > 0.0;

@@ -6,6 +6,7 @@
 
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
 use super::right_eye_list::RightEyeList;
+use super::inputs::DEPTH_LAYER_2;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
@@ -17,14 +18,23 @@ use bytemuck::{Pod, Zeroable};
 
 /// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
 /// layers for the right eye's dispatches (gtao.wgsl `left_occlusion`, `left_geometry`),
-/// at 9 GTAO's own parameters and at 10 the right eye's list of pixels to march. A march
-/// that gathers light (SSDO) binds more after these ([`March::binds`]).
-pub(crate) const BINDINGS: [Bind; 11] = occlusion::bindings_and([
+/// at 9 GTAO's own parameters, at 10 the right eye's list of pixels to march and at 11
+/// the second depth layer (unbound with one layer). A march that gathers light (SSDO)
+/// binds more after these ([`March::binds`]).
+pub(crate) const BINDINGS: [Bind; 12] = occlusion::bindings_and([
     Bind::Own(Slot::Layers),
     Bind::Own(Slot::Layers),
     Bind::Own(Slot::Uniform),
     Bind::Own(Slot::ReadWriteBuffer),
+    Bind::Read(DEPTH_LAYER_2),
 ]);
+
+/// Whether this frame's march reads the second depth layer: two asked for, a technique
+/// that reads it, and one to be had (a renderer that peels it, a host that gave it).
+pub(crate) fn reads_second_layer(setup: &DeclareContext) -> bool {
+    let ao = &setup.settings.ao;
+    ao.layers == 2 && ao.technique.reads_second_layer() && setup.second_layer
+}
 
 /// gtao.wgsl: the march over slices and sectors that GTAO and SSDO share.
 pub(crate) const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
@@ -89,7 +99,8 @@ pub(crate) fn gtao_inner_band(width: u32) -> u32 {
 }
 
 /// GTAO's pipelines (module docs) of one variant: solid occluders only, or with
-/// alpha-tested surfaces taken as thin cards (gtao.wgsl `THIN_CARDS`).
+/// alpha-tested surfaces taken as thin cards (gtao.wgsl `THIN_CARDS`); one depth layer,
+/// or two (gtao.wgsl `SECOND_LAYER`).
 struct Kernels {
     interior: Kernel,
     inner_band: Kernel,
@@ -100,7 +111,7 @@ struct Kernels {
 }
 
 impl Kernels {
-    fn new(gpu: &Gpu, march: &March, thin_cards: bool) -> Self {
+    fn new(gpu: &Gpu, march: &March, thin_cards: bool, second_layer: bool) -> Self {
         let kernel = |entry: &str, band: bool, right: bool| {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
@@ -108,6 +119,7 @@ impl Kernels {
                 ("LISTED_PIXELS", f64::from(right)),
                 ("SINGLE_LAYER_OUTPUT", f64::from(right)),
                 ("THIN_CARDS", f64::from(thin_cards)),
+                ("SECOND_LAYER", f64::from(second_layer)),
             ];
             constants.extend_from_slice(&march.constants);
             let chain = ChainLayout::of(march.technique.carries_light(), gpu.caps.scalar_chain);
@@ -126,10 +138,12 @@ impl Kernels {
 /// marches the same slices (SSDO).
 pub(crate) struct GtaoPass {
     march: March,
-    /// Built when the pass is made for an eager [`March`], else on its first frame.
-    solid: std::sync::OnceLock<Kernels>,
-    /// Built on the first frame of a scene with alpha-tested materials.
-    thin_cards: std::sync::OnceLock<Kernels>,
+    /// By [one layer, two]: built when the pass is made for an eager [`March`] with one
+    /// layer, else on the first frame that runs them.
+    solid: [std::sync::OnceLock<Kernels>; 2],
+    /// By [one layer, two]: built on the first frame of a scene with alpha-tested
+    /// materials.
+    thin_cards: [std::sync::OnceLock<Kernels>; 2],
     params: wgpu::Buffer,
     right_eye: std::sync::Mutex<RightEyeList>,
 }
@@ -159,12 +173,13 @@ impl GtaoPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let solid = std::sync::OnceLock::new();
+        let solid = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
         if march.eager {
-            let _ = solid.set(Kernels::new(gpu, &march, false));
+            let _ = solid[0].set(Kernels::new(gpu, &march, false, false));
         }
         let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu, "gtao right-eye pixels"));
-        GtaoPass { march, solid, thin_cards: std::sync::OnceLock::new(), params, right_eye }
+        let thin_cards = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+        GtaoPass { march, solid, thin_cards, params, right_eye }
     }
 }
 
@@ -173,6 +188,14 @@ impl Pass for GtaoPass {
         let technique = self.march.technique;
         let decl = technique_decl(self.march.label, self.march.binds, &[technique], setup);
         let decl = (self.march.declare)(decl, setup);
+        let ao = &setup.settings.ao;
+        let decl = if reads_second_layer(setup) {
+            decl.note("two depth layers: a sample blocks the span to the second layer (the thickness where it has none)")
+        } else if ao.layers == 2 && ao.technique.reads_second_layer() {
+            decl.unbind(DEPTH_LAYER_2).note("one depth layer: none can lie behind the first this frame (see depth-peel)")
+        } else {
+            decl.unbind(DEPTH_LAYER_2)
+        };
         if setup.alpha_cards {
             decl.note("alpha-tested samples are cards: each blocks its footprint on the card, not a slab")
         } else {
@@ -187,12 +210,13 @@ impl Pass for GtaoPass {
         let (slices, steps) = gtao_slices_steps(ao.samples);
         let own = &ao.gtao;
         let band = gtao_inner_band(width);
+        let second = reads_second_layer(ctx.setup);
         let params = GtaoUniform {
             slices,
             steps,
             thickness: own.thickness,
             step_power: own.step_power,
-            connect: own.connect,
+            connect: if second { own.connect_two_layers } else { own.connect },
             inner_band: band,
             padding: [0; 2],
         };
@@ -200,11 +224,12 @@ impl Pass for GtaoPass {
         // caller's interrupt cuts builds short, kernels built now would be stand-ins for
         // good: the last frames of an ending session take samples as solid instead.
         let cards = ctx.setup.alpha_cards;
-        let solid = || self.solid.get_or_init(|| Kernels::new(ctx.gpu, &self.march, false));
-        let kernels = match self.thin_cards.get() {
+        let layer = usize::from(second);
+        let solid = || self.solid[layer].get_or_init(|| Kernels::new(ctx.gpu, &self.march, false, second));
+        let kernels = match self.thin_cards[layer].get() {
             Some(kernels) if cards => kernels,
             None if cards && !ctx.gpu.builds_cancelled() => {
-                self.thin_cards.get_or_init(|| Kernels::new(ctx.gpu, &self.march, true))
+                self.thin_cards[layer].get_or_init(|| Kernels::new(ctx.gpu, &self.march, true, second))
             }
             _ => solid(),
         };

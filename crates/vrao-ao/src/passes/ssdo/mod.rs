@@ -20,9 +20,9 @@ use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::Technique;
 
-/// GTAO's bindings and, at 11, the packed direct light (ssdo.wgsl `direct_layers`).
-const BINDINGS: [Bind; 12] = {
-    let mut all = [Bind::Read(DIRECT_LIGHT); 12];
+/// GTAO's bindings and, at 12, the packed direct light (ssdo.wgsl `direct_layers`).
+const BINDINGS: [Bind; 13] = {
+    let mut all = [Bind::Read(DIRECT_LIGHT); 13];
     let mut i = 0;
     while i < GTAO_BINDINGS.len() {
         all[i] = GTAO_BINDINGS[i];

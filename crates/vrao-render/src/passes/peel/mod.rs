@@ -1,8 +1,14 @@
-//! Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
-//! surface behind the G-buffer's depth (peel.wgsl). With it SSDO counts a sample
-//! as an occluder only between the first and second layer, inside an object, so thin
-//! objects in front of a background no longer cast a halo onto it. An optional quality
-//! mode (`ao.depth_peeling`): the pass exists only while SSDO runs with peeling on.
+//! Depth peeling (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
+//! surface behind the G-buffer's depth (peel.wgsl), the engine's `DEPTH_LAYER_2`. Two readers:
+//! - the point-sampled SSDO's quality mode (`ao.depth_peeling`), which counts a sample as
+//!   an occluder only between the first and second layer;
+//! - GTAO and SSDO on its bitmask with `ao.layers` = 2, whose samples then block the span
+//!   between the layers instead of a slab `gtao.thickness` deep. For them the layer keeps a
+//!   minimum separation behind the first, `ao.layer_separation` × the radius (deep
+//!   G-buffers, Mara et al. 2016), so that it can skip a surface's own back face.
+//!
+//! The pass runs only for one of them, and not where nothing can lie behind the first
+//! layer (the scene is one convex shell seen from inside, scene/shell.rs).
 //!
 //! One depth-only render pass per eye layer, whatever the G-buffer uses: multiview is
 //! unreliable on lavapipe, and each pass reads its own layer of the first depth.
@@ -12,8 +18,7 @@ use crate::gpu::kernel::wgsl;
 use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MeshPipelines, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
 use vrao_ao::plug::{
-    shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, Resource, Size,
-    COMMON, DEPTH,
+    shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, COMMON, DEPTH, DEPTH_LAYER_2,
 };
 use vrao_ao::Technique;
 use wgpu::util::DeviceExt;
@@ -22,10 +27,6 @@ use wgpu::util::DeviceExt;
 /// look its cost up by.
 pub const NAME: &str = "depth-peel";
 
-/// Depth peeling's second layer (SSDO's quality mode): the nearest surface behind
-/// [`DEPTH`], reversed-Z, 0 where nothing lies behind.
-pub const DEPTH_LAYER_2: Resource =
-    Resource::attachment("depth-layer-2", Size::Full, wgpu::TextureFormat::Depth32Float);
 
 /// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
@@ -33,7 +34,8 @@ pub struct DepthPeelPass {
     pipelines: MeshPipelines,
     frame_group: wgpu::BindGroup,
     eye_layout: wgpu::BindGroupLayout,
-    /// The eye index (0 left, 1 right) each per-eye pass binds.
+    /// `PeelEye` of peel.wgsl for each per-eye pass: the eye index (0 left, 1 right) and
+    /// the minimum separation in metres.
     eye_index: [wgpu::Buffer; 2],
 }
 
@@ -43,7 +45,8 @@ impl DepthPeelPass {
         let device = &gpu.device;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth peel frame"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+            // The fragment stage reads the near plane (the minimum separation in metres).
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
         });
         let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth peel eye"),
@@ -94,7 +97,7 @@ impl DepthPeelPass {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("depth peel eye"),
                 contents: bytemuck::cast_slice(&[eye, 0, 0, 0]),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             })
         });
         DepthPeelPass { pipelines, frame_group, eye_layout, eye_index }
@@ -105,22 +108,39 @@ impl Pass for DepthPeelPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let ao = &settings_of(setup).ao;
         let ssdo = matches!(ao.technique, Technique::SsdoPoints | Technique::SsdoPointsBounce);
+        let peeled_ssdo = ssdo && ao.depth_peeling;
+        let two_layers = ao.layers == 2 && ao.technique.reads_second_layer();
+        let name = ao.technique.name();
+        let reason = if ao.depth_peeling && !ssdo && ao.layers == 1 {
+            format!("technique is {name}: only the point-sampled SSDO peels (--depth-peeling), and --layers is 1")
+        } else if ao.layers == 2 {
+            format!("technique is {name}, which reads one depth layer")
+        } else if ssdo {
+            "depth peeling is off and --layers is 1".to_string()
+        } else {
+            "one depth layer (--layers 1)".to_string()
+        };
         PassDecl::new(NAME)
             .read(DEPTH)
             .write(DEPTH_LAYER_2)
             .occlusion_cost()
-            .disabled_if(!ao.depth_peeling, "depth peeling is off (a point-sampled SSDO quality mode)")
+            .disabled_if(!peeled_ssdo && !two_layers, reason)
             .disabled_if(
-                !ssdo,
-                format!(
-                    "technique is {}: only the point-sampled SSDO tests occluders against a second depth layer",
-                    ao.technique.name()
-                ),
+                !setup.second_layer,
+                "nothing can lie behind the first depth layer: the scene's triangles bound one convex \
+                 region (an open plane, an empty box room) and both eyes are inside it",
             )
     }
 
     fn record(&self, ctx: &mut RecordContext) {
         let gpu_scene = gpu_scene_of(ctx.setup);
+        let ao = &settings_of(ctx.setup).ao;
+        // The minimum separation is GTAO's (two layers); SSDO's peeling keeps the gap alone.
+        let separation = if ao.layers == 2 { ao.layer_separation * ao.radius } else { 0.0 };
+        for (eye, buffer) in self.eye_index.iter().enumerate() {
+            let uniform: [u32; 4] = [eye as u32, separation.to_bits(), 0, 0];
+            ctx.gpu.queue.write_buffer(buffer, 0, bytemuck::cast_slice(&uniform));
+        }
         let first = ctx.view(DEPTH);
         let second = ctx.target(DEPTH_LAYER_2);
         for layer in 0..ctx.setup.views as usize {

@@ -11,6 +11,9 @@
 
 struct PeelEye {
     index: u32,
+    // The minimum separation behind the first layer in metres (two layers for GTAO:
+    // `ao.layer_separation` × r; 0 for SSDO's peeling, which keeps PEEL_GAP alone).
+    separation: f32,
 };
 @group(2) @binding(0) var<uniform> peel_eye: PeelEye;
 @group(2) @binding(1) var first_layer: texture_depth_2d_array;
@@ -45,6 +48,10 @@ fn fs_peel(in: PeelVertexOut) {
     // depth 0) nothing is behind.
     let first = textureLoad(first_layer, vec2<i32>(p.xy), i32(peel_eye.index), 0);
     if (!(p.z * (1.0 + PEEL_GAP) < first)) {
+        discard;
+    }
+    // At least `separation` farther: distance near / z > near / first + separation.
+    if (peel_eye.separation > 0.0 && !(p.z * (frame.near / first + peel_eye.separation) < frame.near)) {
         discard;
     }
 }

@@ -7,12 +7,11 @@
 //! occlusion-only frame.
 
 use super::direct::DIRECT;
-use super::peel::DEPTH_LAYER_2;
 use super::settings_of;
 use crate::gpu::kernel::wgsl;
 use vrao_ao::plug::{
     bindings_and, technique_decl, Bind, BounceForm, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, COMMON,
-    IRRADIANCE, OCCLUSION_WGSL, VISIBILITY,
+    DEPTH_LAYER_2, IRRADIANCE, OCCLUSION_WGSL, VISIBILITY,
 };
 use vrao_ao::Technique;
 

@@ -1,0 +1,157 @@
+//! Two depth layers (`AoSettings::layers`): GTAO's samples block the span between the
+//! first layer and the renderer's peeled second layer instead of a slab `thickness` deep.
+//! Checked against the reference tracer on a thin board in front of a wall (a slab as
+//! deep as the gap makes the board a block standing on the wall, which the second layer
+//! frees); one layer is GTAO as
+//! before, bit for bit, wherever the second layer is left out; the peel runs only where a
+//! technique reads it and the scene can have something behind its first layer.
+
+use crate::common;
+
+use glam::{DVec3, Vec3};
+use vrao::measure::bench::error_figures;
+use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
+use vrao_ao::plug::{DEPTH_LAYER_2, FINAL_AO};
+use vrao_ao::{AoSettings, Technique};
+use vrao_render::passes::tonemap::COLOR;
+use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
+
+const SIZE: (u32, u32) = (96, 108);
+const RADIUS: f32 = 0.5;
+const WALL_Z: f64 = -3.0;
+
+fn settings(layers: u32) -> Settings {
+    let ao = AoSettings { technique: Technique::Gtao, radius: RADIUS, layers, mask: false, ..AoSettings::default() };
+    Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ao, ..Settings::default() }
+}
+
+/// A 1.2 m × 1.2 m board, 2 cm thick, whose back face is `gap` metres in front of a
+/// 10 m wall at z = −3, seen head-on from the origin.
+fn board_scene(gap: f64) -> Scene {
+    common::bare_scene(vec![
+        common::square("wall", DVec3::new(0.0, 0.0, WALL_Z), 10.0, 0),
+        common::cuboid("board", DVec3::new(0.0, 0.0, WALL_Z + gap + 0.01), Vec3::new(1.2, 1.2, 0.02), 0),
+    ])
+}
+
+/// One frame's final occlusion per eye (RGBA) and whether the peel ran.
+fn render(scene: &Scene, s: &Settings) -> (Vec<Vec<f32>>, bool) {
+    let (gpu, _one_at_a_time) = common::gpu();
+    let mut renderer = Renderer::new(gpu, scene, s).unwrap();
+    let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
+    let report = renderer.render(&eyes.eyes, &[FINAL_AO]).unwrap();
+    let ao = renderer.read_f32(FINAL_AO).unwrap();
+    for px in ao.iter().flat_map(|l| l.chunks(4)) {
+        assert!(px.iter().all(|v| v.is_finite()) && (0.0..=1.0).contains(&px[3]), "{px:?}");
+    }
+    (ao, report.plan.runs("depth-peel"))
+}
+
+/// Mean GPU AO and mean reference AO over the wall cells within `reach` grid cells of
+/// a board cell (both eyes): where a slab behind the board darkens the wall.
+fn beside_board(ao: &[Vec<f32>], reference: &ReferenceImage, reach: i64) -> (f64, f64, usize) {
+    let (gw, gh) = reference.grid_size();
+    let on_board = |l: usize, i: i64, j: i64| {
+        i >= 0 && j >= 0 && i < gw as i64 && j < gh as i64 && {
+            let p = reference.get(l, i as u32, j as u32);
+            p.hit && p.depth < (-WALL_Z as f32) - 0.05
+        }
+    };
+    let (mut ours, mut truth, mut n) = (0.0, 0.0, 0);
+    for (layer, image) in ao.iter().enumerate() {
+        for j in 0..gh {
+            for i in 0..gw {
+                let p = reference.get(layer, i, j);
+                let near_board = (-reach..=reach)
+                    .any(|dj| (-reach..=reach).any(|di| on_board(layer, i as i64 + di, j as i64 + dj)));
+                if !p.hit || on_board(layer, i as i64, j as i64) || !near_board {
+                    continue;
+                }
+                let (x, y) = reference.pixel_of(i, j);
+                ours += image[((y * SIZE.0 + x) * 4 + 3) as usize] as f64;
+                truth += p.ao as f64;
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 0, "no wall cell beside the board");
+    (ours / n as f64, truth / n as f64, n)
+}
+
+#[test]
+fn a_second_layer_frees_the_wall_behind_a_thin_board() {
+    // The board's back is 0.3 m in front of the wall: within the radius, so the wall
+    // beside it is partly occluded, but one layer's slab (0.75 r = 0.375 m behind the
+    // board's front) reaches the wall and makes the board a block standing on it. The
+    // second layer is the board's back face: the 30 cm between board and wall stay open.
+    let scene = board_scene(0.3);
+    let s = settings(1);
+    let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
+    let rs = ReferenceSettings { radius: RADIUS as f64, rays_per_pixel: 256, stride: 2, near: s.near };
+    let reference = trace(&scene, &eyes.eyes, SIZE, &rs, &mut |_| {}).unwrap();
+    let mut results = Vec::new();
+    for layers in [1, 2] {
+        let (ao, peeled) = render(&scene, &settings(layers));
+        assert_eq!(peeled, layers == 2);
+        let (ours, truth, n) = beside_board(&ao, &reference, 2);
+        let e = error_figures(Technique::Gtao, &ao, &reference);
+        println!(
+            "board 0.3 m in front of a wall, {layers} layer(s): wall beside the board AO {ours:.3} (reference \
+             {truth:.3}, {n} cells); AO RMSE {:.4}, bias {:+.4}",
+            e.ao_rmse, e.ao_bias
+        );
+        results.push((ours, truth, e.ao_rmse));
+    }
+    let (one, two) = (results[0], results[1]);
+    assert!(one.0 < one.1 - 0.03, "one layer's slab should darken the wall beside the board: {results:?}");
+    assert!(two.0 > one.0 + 0.05, "two layers must free what the slab darkened: {results:?}");
+    // GTAO's own estimate of a thin board is light (its few samples on the board); the
+    // second layer leaves it as far above the reference as the slab left it below
+    // (docs/records/2026-11-29/two-layers.md).
+    assert!(two.0 > two.1 - 0.01 && two.0 < two.1 + 0.06, "two layers: {results:?}");
+    assert!(two.2 < 0.02 && one.2 < 0.02, "{results:?}");
+}
+
+#[test]
+fn one_layer_is_gtao_as_before_wherever_the_second_is_left_out() {
+    // The crease (a floor and a wall) bounds one convex region with the eyes inside it:
+    // nothing lies behind its first layer, so two layers peel nothing and run the
+    // one-layer march, bit for bit; likewise SSAO, which reads one layer.
+    let scene = Scene::load("builtin:crease").unwrap();
+    let (one, peeled) = render(&scene, &settings(1));
+    assert!(!peeled);
+    let (two, peeled) = render(&scene, &settings(2));
+    assert!(!peeled, "the crease has nothing behind its first layer");
+    assert!(one == two, "two layers with none to read must be one layer's image");
+    let ssao = |layers| Settings { ao: AoSettings { technique: Technique::Ssao, ..settings(layers).ao }, ..settings(1) };
+    let board = board_scene(0.3);
+    assert!(render(&board, &ssao(1)).0 == render(&board, &ssao(2)).0);
+}
+
+#[test]
+fn the_peel_runs_only_where_the_ao_reads_it_and_explain_says_why() {
+    let (gpu, _one_at_a_time) = common::gpu();
+    let plan = |scene: &Scene, technique, layers| {
+        let s = Settings { ao: AoSettings { technique, ..settings(layers).ao }, ..settings(1) };
+        Renderer::new(gpu.clone(), scene, &s).unwrap().plan(2, &[COLOR]).unwrap()
+    };
+    let reason = |p: &vrao_ao::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
+    let board = board_scene(0.3);
+    for technique in [Technique::Gtao, Technique::Ssdo, Technique::SsdoBounce] {
+        let two = plan(&board, technique, 2);
+        assert!(two.runs("depth-peel") && two.resources.contains(&DEPTH_LAYER_2), "{two}");
+        let one = plan(&board, technique, 1);
+        assert!(!one.runs("depth-peel"), "{one}");
+        assert!(reason(&one).unwrap().contains("--layers 1"), "{one}");
+    }
+    for technique in [Technique::Ssao, Technique::Hbao] {
+        let p = plan(&board, technique, 2);
+        assert!(!p.runs("depth-peel"), "{p}");
+        assert!(reason(&p).unwrap().contains("reads one depth layer"), "{p}");
+    }
+    for name in ["builtin:plane", "builtin:crease"] {
+        let p = plan(&Scene::load(name).unwrap(), Technique::Gtao, 2);
+        assert!(!p.runs("depth-peel"), "{name}: {p}");
+        assert!(reason(&p).unwrap().contains("convex"), "{name}: {p}");
+    }
+}
