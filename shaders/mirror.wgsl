@@ -42,6 +42,14 @@ fn fs_occlusion(in: VertexOut) -> @location(0) vec4<f32> {
     return vec4<f32>(vec3<f32>(ao), 1.0);
 }
 
+// Occlusion of a single-channel AO chain (R16Float: the AO in red) as grey.
+@fragment
+fn fs_occlusion_red(in: VertexOut) -> @location(0) vec4<f32> {
+    let texel = buffer_texel(textureDimensions(float_buffer), in.uv);
+    let ao = clamp(textureLoad(float_buffer, texel, 0).r, 0.0, 1.0);
+    return vec4<f32>(vec3<f32>(ao), 1.0);
+}
+
 // View-space normals, xyz from [-1, 1] to [0, 1].
 @fragment
 fn fs_normals(in: VertexOut) -> @location(0) vec4<f32> {

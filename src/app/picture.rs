@@ -13,6 +13,7 @@ use vrao_ao::plug::{fullscreen_pipeline, try_shader_module, Gpu};
 pub(super) struct Blit {
     eye: wgpu::RenderPipeline,
     occlusion: wgpu::RenderPipeline,
+    occlusion_red: wgpu::RenderPipeline,
     normals: wgpu::RenderPipeline,
     depth: wgpu::RenderPipeline,
     eye_layout: wgpu::BindGroupLayout,
@@ -74,6 +75,7 @@ impl Blit {
         Ok(Blit {
             eye: pipeline(&eye_layout, "fs_main"),
             occlusion: pipeline(&float_layout, "fs_occlusion"),
+            occlusion_red: pipeline(&float_layout, "fs_occlusion_red"),
             normals: pipeline(&float_layout, "fs_normals"),
             depth: pipeline(&depth_layout, "fs_depth"),
             eye_layout,
@@ -83,9 +85,12 @@ impl Blit {
         })
     }
 
-    pub(super) fn pipeline(&self, shown: BufferView) -> &wgpu::RenderPipeline {
+    /// The pipeline that draws `shown` from `view` (occlusion: in alpha, or in red for a
+    /// single-channel AO chain).
+    pub(super) fn pipeline(&self, shown: BufferView, view: &wgpu::TextureView) -> &wgpu::RenderPipeline {
         match shown {
             BufferView::Eyes => &self.eye,
+            BufferView::FinalAo | BufferView::RawAo if view.texture().format().components() == 1 => &self.occlusion_red,
             BufferView::FinalAo | BufferView::RawAo => &self.occlusion,
             BufferView::Normals => &self.normals,
             BufferView::Depth => &self.depth,

@@ -436,7 +436,7 @@ impl WindowState {
                 })
                 .forget_lifetime();
             let count = bind_groups.len().max(1) as f32;
-            for (i, group) in bind_groups.iter().enumerate() {
+            for (i, (group, image)) in bind_groups.iter().zip(&images).enumerate() {
                 // Each image gets an equal slot; within it, the largest rectangle of its
                 // aspect.
                 let mono = self.panel.mode == DisplayMode::SinglePass && shown == BufferView::Eyes;
@@ -447,7 +447,7 @@ impl WindowState {
                 let x = ax + slot_w * i as f32 + (slot_w - w) * 0.5;
                 let y = ay + (slot_h - h) * 0.5;
                 pass.set_viewport(x, y, w.max(1.0), h.max(1.0), 0.0, 1.0);
-                pass.set_pipeline(self.blit.pipeline(shown));
+                pass.set_pipeline(self.blit.pipeline(shown, image));
                 pass.set_bind_group(0, group, &[]);
                 pass.draw(0..3, 0..1);
             }

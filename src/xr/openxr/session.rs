@@ -546,10 +546,9 @@ impl Headset for OpenXrHeadset {
             self.end_empty(pending.display_time);
         }
         if self.budget.reached() && !self.machine.exit_wanted() && !self.machine.is_over() {
-            self.note(&format!(
-                "{} rendered: exit requested",
-                crate::formats::output::count(self.budget.rendered, "frame")
-            ));
+            // xr imports only the leaves, so not formats::output::count.
+            let frames = self.budget.rendered;
+            self.note(&format!("{frames} frame{} rendered: exit requested", if frames == 1 { "" } else { "s" }));
             self.feed(Event::FramesReached);
         }
         loop {

@@ -31,12 +31,19 @@ struct LowResSample {
     value: vec4<f32>,
 };
 
+// A texel of `value_low` as a value: decoded as the AO chain's (`chain_value`) when
+// `chain` says it is one (the occlusion), as it is otherwise (the RSM's light).
+fn low_res_value(texel: vec4<f32>, chain: bool) -> vec4<f32> {
+    return select(texel, chain_value(texel), chain);
+}
+
 fn low_res_sample(
     geometry_low: texture_2d_array<f32>,
     value_low: texture_2d_array<f32>,
     q: vec2<i32>,
     layer: u32,
     tangents: vec4<f32>,
+    chain: bool,
 ) -> LowResSample {
     let last = vec2<i32>(textureDimensions(value_low)) - 1;
     let clamped = clamp(q, vec2<i32>(0), last);
@@ -46,7 +53,7 @@ fn low_res_sample(
     s.valid = select(0.0, 1.0, all(q == clamped) && geometry.w > 0.0);
     s.position = view_position_from_distance(pixel_uv(fq, frame.size), geometry.w, tangents);
     s.normal = geometry.xyz;
-    s.value = chain_value(textureLoad(value_low, clamped, i32(layer), 0));
+    s.value = low_res_value(textureLoad(value_low, clamped, i32(layer), 0), chain);
     return s;
 }
 
@@ -173,7 +180,8 @@ fn upsampled(px: UpsamplePixel, nearest: vec4<f32>) -> vec4<f32> {
 
 // The upsampled values of the four pixels of `quad`, the quad of low-res sample `b`:
 // the 2×2 samples b + {0, 1}² first; where any pixel disagrees with them (an edge), the
-// rest of the 3×3 around b for the pixels that do.
+// rest of the 3×3 around b for the pixels that do. `chain`: `value_low` is a texture of
+// the AO chain (`low_res_value`).
 fn upsample_quad(
     geometry_low: texture_2d_array<f32>,
     value_low: texture_2d_array<f32>,
@@ -181,23 +189,24 @@ fn upsample_quad(
     b: vec2<i32>,
     layer: u32,
     tangents: vec4<f32>,
+    chain: bool,
 ) -> array<vec4<f32>, 4> {
     if (tile_rate(vec2<u32>(b), layer, 2u) <= THIN_BELOW_RATE) {
-        return foveated_quad(value_low, b, layer);
+        return foveated_quad(value_low, b, layer, chain);
     }
     let every = vec4<bool>(true);
-    let nearest = low_res_sample(geometry_low, value_low, b, layer, tangents);
+    let nearest = low_res_sample(geometry_low, value_low, b, layer, tangents, chain);
     var pixels = add_to_quad(quad, nearest, vec2<i32>(0, 0), every);
-    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 0), layer, tangents), vec2<i32>(1, 0), every);
-    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(0, 1), layer, tangents), vec2<i32>(0, 1), every);
-    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 1), layer, tangents), vec2<i32>(1, 1), every);
+    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 0), layer, tangents, chain), vec2<i32>(1, 0), every);
+    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(0, 1), layer, tangents, chain), vec2<i32>(0, 1), every);
+    pixels = add_to_quad(pixels, low_res_sample(geometry_low, value_low, b + vec2<i32>(1, 1), layer, tangents, chain), vec2<i32>(1, 1), every);
     // Which pixels take the 3×3, decided before any of it is added.
     let edge = vec4<f32>(pixels[0].agree, pixels[1].agree, pixels[2].agree, pixels[3].agree) < vec4<f32>(EDGE_AGREEMENT);
     if (any(edge)) {
         for (var i = 0; i < 5; i++) {
             // (-1,-1) (0,-1) (1,-1) (-1,0) (-1,1): the rest of the 3×3.
             let offset = select(vec2<i32>(-1, i - 2), vec2<i32>(i - 1, -1), i < 3);
-            let s = low_res_sample(geometry_low, value_low, b + offset, layer, tangents);
+            let s = low_res_sample(geometry_low, value_low, b + offset, layer, tangents, chain);
             pixels = add_to_quad(pixels, s, offset, edge);
         }
     }
@@ -214,12 +223,12 @@ fn upsample_quad(
 // distance alone, four value fetches and no geometry, instead of four to nine samples of
 // both weighed by the surface. Smooth as the joint weights are, so the eyes still agree,
 // but an edge there may take a little of the other side's occlusion.
-fn foveated_quad(value_low: texture_2d_array<f32>, b: vec2<i32>, layer: u32) -> array<vec4<f32>, 4> {
+fn foveated_quad(value_low: texture_2d_array<f32>, b: vec2<i32>, layer: u32, chain: bool) -> array<vec4<f32>, 4> {
     let limit = vec2<i32>(textureDimensions(value_low)) - vec2<i32>(1);
-    let v00 = chain_value(textureLoad(value_low, min(b, limit), i32(layer), 0));
-    let v10 = chain_value(textureLoad(value_low, min(b + vec2<i32>(1, 0), limit), i32(layer), 0));
-    let v01 = chain_value(textureLoad(value_low, min(b + vec2<i32>(0, 1), limit), i32(layer), 0));
-    let v11 = chain_value(textureLoad(value_low, min(b + vec2<i32>(1, 1), limit), i32(layer), 0));
+    let v00 = low_res_value(textureLoad(value_low, min(b, limit), i32(layer), 0), chain);
+    let v10 = low_res_value(textureLoad(value_low, min(b + vec2<i32>(1, 0), limit), i32(layer), 0), chain);
+    let v01 = low_res_value(textureLoad(value_low, min(b + vec2<i32>(0, 1), limit), i32(layer), 0), chain);
+    let v11 = low_res_value(textureLoad(value_low, min(b + vec2<i32>(1, 1), limit), i32(layer), 0), chain);
     return array<vec4<f32>, 4>(
         distance_weighted(v00, v10, v01, v11, 0),
         distance_weighted(v00, v10, v01, v11, 1),
@@ -303,7 +312,8 @@ fn right_eye_quad(
     tangents: vec4<f32>,
 ) -> array<vec4<f32>, 4> {
     let left = left_eye_quad(depth_layers, left_final, quad);
-    let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents);
+    // The occlusion: a texture of the AO chain.
+    let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents, true);
     return array<vec4<f32>, 4>(
         select(own[0], left.values[0], left.found.x),
         select(own[1], left.values[1], left.found.y),

@@ -86,7 +86,7 @@ fn main(
     } else if (RIGHT_EYE) {
         values = right_eye_quad(depth_layers, left_final, geometry_low, occlusion_low, quad, vec2<i32>(id.xy), eye.tangents);
     } else {
-        values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents);
+        values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents, true);
     }
     store(quad[0], out_layer, values[0]);
     store(quad[1], out_layer, values[1]);

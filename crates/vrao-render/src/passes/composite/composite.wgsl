@@ -155,7 +155,7 @@ fn main(
         } else if (HALF_RES && RIGHT_EYE) {
             occlusion = right_eye_quad(depth_layers, left_hdr, geometry_low, occlusion_layers, quad, vec2<i32>(b), eye.tangents);
         } else if (HALF_RES) {
-            occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents);
+            occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents, true);
         } else {
             occlusion = array<vec4<f32>, 4>(
                 full_res_occlusion(quad[0], layer),
@@ -166,7 +166,7 @@ fn main(
         }
     }
     if (RSM) {
-        let up = upsample_quad(rsm_geometry, rsm_indirect, quad, vec2<i32>(b), layer, eye.tangents);
+        let up = upsample_quad(rsm_geometry, rsm_indirect, quad, vec2<i32>(b), layer, eye.tangents, false);
         let none = vec3<f32>(0.0);
         bounce = array<vec3<f32>, 4>(max(up[0].rgb, none), max(up[1].rgb, none), max(up[2].rgb, none), max(up[3].rgb, none));
     }
