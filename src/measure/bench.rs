@@ -274,8 +274,11 @@ impl CaseRun {
         let one = screen_space_limit(&buffers, size, &settings)?;
         let two = match &second {
             Some(second) => {
-                let buffers: Vec<EyeBuffers> =
-                    buffers.iter().zip(second).map(|(eye, second)| EyeBuffers { second: Some(second), ..*eye }).collect();
+                let buffers: Vec<EyeBuffers> = buffers
+                    .iter()
+                    .zip(second)
+                    .map(|(eye, second)| EyeBuffers { second: Some(second), ..*eye })
+                    .collect();
                 screen_space_limit(&buffers, size, &settings)?
             }
             None => one.clone(),

@@ -439,7 +439,13 @@ fn limit_and_default(
     let depth = renderer.read_f32(DEPTH)?;
     let normals = renderer.read_f32(NORMALS)?;
     let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
-        .map(|k| EyeBuffers { depth: &depth[k], normals: &normals[k], fov: eyes.eyes[k].fov, direct: None, second: None })
+        .map(|k| EyeBuffers {
+            depth: &depth[k],
+            normals: &normals[k],
+            fov: eyes.eyes[k].fov,
+            direct: None,
+            second: None,
+        })
         .collect();
     let settings = LimitSettings::for_reference(reference, base.ao.radius as f64, eyes.near);
     let limit = screen_space_limit(&buffers, (reference.width, reference.height), &settings)?;

@@ -25,8 +25,6 @@ mod cli;
 mod content;
 #[cfg(feature = "app")]
 mod depth_peeling;
-#[cfg(feature = "app")]
-mod two_layers;
 #[cfg(feature = "gltf")]
 mod fuzz_loaders;
 #[cfg(feature = "app")]
@@ -77,5 +75,7 @@ mod ssdo_light;
 mod table;
 #[cfg(feature = "app")]
 mod temporal;
+#[cfg(feature = "app")]
+mod two_layers;
 #[cfg(feature = "app")]
 mod window;

@@ -62,8 +62,8 @@ fn beside_board(ao: &[Vec<f32>], reference: &ReferenceImage, reach: i64) -> (f64
         for j in 0..gh {
             for i in 0..gw {
                 let p = reference.get(layer, i, j);
-                let near_board = (-reach..=reach)
-                    .any(|dj| (-reach..=reach).any(|di| on_board(layer, i as i64 + di, j as i64 + dj)));
+                let near_board =
+                    (-reach..=reach).any(|dj| (-reach..=reach).any(|di| on_board(layer, i as i64 + di, j as i64 + dj)));
                 if !p.hit || on_board(layer, i as i64, j as i64) || !near_board {
                     continue;
                 }
@@ -123,7 +123,8 @@ fn one_layer_is_gtao_as_before_wherever_the_second_is_left_out() {
     let (two, peeled) = render(&scene, &settings(2));
     assert!(!peeled, "the crease has nothing behind its first layer");
     assert!(one == two, "two layers with none to read must be one layer's image");
-    let ssao = |layers| Settings { ao: AoSettings { technique: Technique::Ssao, ..settings(layers).ao }, ..settings(1) };
+    let ssao =
+        |layers| Settings { ao: AoSettings { technique: Technique::Ssao, ..settings(layers).ao }, ..settings(1) };
     let board = board_scene(0.3);
     assert!(render(&board, &ssao(1)).0 == render(&board, &ssao(2)).0);
 }

@@ -190,7 +190,10 @@ impl Renderer {
             shell: shell.clone(),
             // Until a frame's views say otherwise (plans made before the first frame),
             // the scene's own head at time 0.
-            second_layer: second_layer_visible(shell.as_ref(), &settings.profile.eyes(&scene.head.pose_at(0.0), settings.near).eyes),
+            second_layer: second_layer_visible(
+                shell.as_ref(),
+                &settings.profile.eyes(&scene.head.pose_at(0.0), settings.near).eyes,
+            ),
             anchor: gpu_scene.anchor,
             multiview,
             motion: FrameMotion { vectors: gpu_scene.has_moving_objects(), ..FrameMotion::STILL },

@@ -277,7 +277,13 @@ const COLUMNS: &[Column] = &[
         name: "peel_ms_per_eye",
         header: "peel ms",
         csv: |r| format!("{:.3}", r.peel_ms_per_eye),
-        markdown: |r| if r.depth_peeling || r.layers == 2 { format!("{:.1}", r.peel_ms_per_eye) } else { String::new() },
+        markdown: |r| {
+            if r.depth_peeling || r.layers == 2 {
+                format!("{:.1}", r.peel_ms_per_eye)
+            } else {
+                String::new()
+            }
+        },
         optional: true,
     },
     figure_column!(bounce_rel_rmse, "bounce rel. RMSE", true),

@@ -414,7 +414,8 @@ mod tests {
                 let dir = DVec3::new(l + (r - l) * s, u + (d - u) * t, -1.0);
                 let hits: Vec<f64> = rects.iter().filter_map(|rect| rect.hit(DVec3::ZERO, dir)).collect();
                 let first = hits.iter().copied().fold(f64::INFINITY, f64::min);
-                let next = hits.iter().copied().filter(|&t| t > first * (1.0 + separation)).fold(f64::INFINITY, f64::min);
+                let next =
+                    hits.iter().copied().filter(|&t| t > first * (1.0 + separation)).fold(f64::INFINITY, f64::min);
                 second.push(if next.is_finite() { (NEAR / next) as f32 } else { 0.0 });
             }
         }
@@ -563,8 +564,11 @@ mod tests {
         let top =
             Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(20.0, 0.0, 0.0), v: DVec3::new(0.0, 40.0, 0.0) };
         let bottom = Rect { corner: DVec3::new(0.0, -20.0, -2.54), ..top };
-        let side =
-            Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(0.0, 0.0, -0.04), v: DVec3::new(0.0, 40.0, 0.0) };
+        let side = Rect {
+            corner: DVec3::new(0.0, -20.0, -2.5),
+            u: DVec3::new(0.0, 0.0, -0.04),
+            v: DVec3::new(0.0, 40.0, 0.0),
+        };
         let scene = [floor, top, bottom, side];
         let (size, stride, radius) = ((96, 96), 2, 1.0);
         let settings = LimitSettings { rays_per_pixel: 256, steps: 24, ..LimitSettings::new(radius, stride, NEAR) };

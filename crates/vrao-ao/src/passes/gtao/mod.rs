@@ -4,9 +4,9 @@
 //! eye's values where it sees the same point. A scene with alpha-tested materials gets
 //! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
+use super::inputs::DEPTH_LAYER_2;
 use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
 use super::right_eye_list::RightEyeList;
-use super::inputs::DEPTH_LAYER_2;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
@@ -188,9 +188,12 @@ impl Pass for GtaoPass {
         let decl = (self.march.declare)(decl, setup);
         let ao = &setup.settings.ao;
         let decl = if reads_second_layer(setup) {
-            decl.note("two depth layers: a sample blocks the span to the second layer (the thickness where it has none)")
+            decl.note(
+                "two depth layers: a sample blocks the span to the second layer (the thickness where it has none)",
+            )
         } else if ao.layers == 2 && ao.technique.reads_second_layer() {
-            decl.unbind(DEPTH_LAYER_2).note("one depth layer: none can lie behind the first this frame (see depth-peel)")
+            decl.unbind(DEPTH_LAYER_2)
+                .note("one depth layer: none can lie behind the first this frame (see depth-peel)")
         } else {
             decl.unbind(DEPTH_LAYER_2)
         };

@@ -18,7 +18,8 @@ use crate::gpu::kernel::wgsl;
 use crate::gpu::raster::{mesh_pipeline, MeshPipeline, MeshPipelines, MESH_ATTRIBUTES};
 use crate::gpu::scene::{GpuScene, MESH_WGSL};
 use vrao_ao::plug::{
-    shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, COMMON, DEPTH, DEPTH_LAYER_2,
+    shader_module, uniform_entry, DeclareContext, FrameUniforms, Gpu, Pass, PassDecl, RecordContext, COMMON, DEPTH,
+    DEPTH_LAYER_2,
 };
 use vrao_ao::Technique;
 use wgpu::util::DeviceExt;
@@ -26,7 +27,6 @@ use wgpu::util::DeviceExt;
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
 pub const NAME: &str = "depth-peel";
-
 
 /// Depth peeling's second depth layer of each eye (module docs).
 pub struct DepthPeelPass {
