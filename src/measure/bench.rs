@@ -191,7 +191,8 @@ fn second_layer(
     case: &BenchCase,
     how: Measurement,
 ) -> Result<Option<Vec<Vec<f32>>>> {
-    let two = BenchCase { technique: Technique::Gtao, layers: 2, temporal: false, depth_peeling: false, ..case.clone() };
+    let two =
+        BenchCase { technique: Technique::Gtao, layers: 2, temporal: false, depth_peeling: false, ..case.clone() };
     let mut run = CaseRun::new(gpu, scene, base, &two, how)?;
     let report = run.frame()?;
     if report.plan.runs(peel::NAME) {
