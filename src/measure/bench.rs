@@ -161,7 +161,10 @@ pub fn measure(
         run.timed_frame()?;
     }
     let limits = match reference {
-        Some(reference) => Some(run.screen_limits(reference)?),
+        Some(reference) => {
+            let second = second_layer(gpu, scene, base, case, how)?;
+            Some(run.screen_limits(reference, second.as_deref())?)
+        }
         None => None,
     };
     run.finish(reference, limits.as_ref())
@@ -175,6 +178,28 @@ pub struct Limits {
     pub one: ScreenLimit,
     /// The two-layer limit (`limit_two_layer_rmse`).
     pub two: ScreenLimit,
+}
+
+/// The second depth layer of `case`'s frame as two layers peel it (the case's scene,
+/// pose, size, mask and separation; GTAO with `layers` 2 on a renderer of its own, so
+/// that the case's own renderer, its history included, is not touched), or `None` when
+/// the scene can have nothing behind its first layer (the peel is left out).
+fn second_layer(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    base: &Settings,
+    case: &BenchCase,
+    how: Measurement,
+) -> Result<Option<Vec<Vec<f32>>>> {
+    let two =
+        BenchCase { technique: Technique::Gtao, layers: 2, temporal: false, depth_peeling: false, ..case.clone() };
+    let mut run = CaseRun::new(gpu, scene, base, &two, how)?;
+    let report = run.frame()?;
+    if report.plan.runs(peel::NAME) {
+        Ok(Some(run.renderer.read_f32(DEPTH_LAYER_2)?))
+    } else {
+        Ok(None)
+    }
 }
 
 /// One case being measured: its renderer, and the per-pass times of its frames so far.
@@ -256,10 +281,9 @@ impl CaseRun {
     /// (the march over its depth buffer and normals, [`screen_space_limit`]): with one
     /// depth layer, and with the second layer the renderer peels for two (the one-layer
     /// limit again where the scene can have nothing behind its first layer).
-    fn screen_limits(&mut self, reference: &ReferenceImage) -> Result<Limits> {
+    fn screen_limits(&self, reference: &ReferenceImage, second: Option<&[Vec<f32>]>) -> Result<Limits> {
         let depth = self.renderer.read_f32(DEPTH)?;
         let normals = self.renderer.read_f32(NORMALS)?;
-        let second = self.second_layer()?;
         let buffers: Vec<EyeBuffers> = (0..depth.len().min(normals.len()))
             .map(|k| EyeBuffers {
                 depth: &depth[k],
@@ -272,7 +296,7 @@ impl CaseRun {
         let settings = LimitSettings::for_reference(reference, self.case.radius as f64, self.eyes.near);
         let size = (reference.width, reference.height);
         let one = screen_space_limit(&buffers, size, &settings)?;
-        let two = match &second {
+        let two = match second {
             Some(second) => {
                 let buffers: Vec<EyeBuffers> = buffers
                     .iter()
@@ -284,28 +308,6 @@ impl CaseRun {
             None => one.clone(),
         };
         Ok(Limits { one, two })
-    }
-
-    /// The second depth layer of this case's frame, as two layers would peel it with the
-    /// case's separation; `None` when the scene can have nothing behind the first layer.
-    /// A case that peels it already is read; any other renders one frame that does
-    /// (GTAO with two layers), then one of its own again, so that what it reads next is
-    /// its own frame.
-    fn second_layer(&mut self) -> Result<Option<Vec<Vec<f32>>>> {
-        let peels = |report: &vrao_render::renderer::FrameReport| report.plan.names.contains(&peel::NAME);
-        if self.case.layers == 2 && self.settings.ao.technique.reads_second_layer() {
-            let ran = self.renderer.last_plan().is_some_and(|plan| plan.names.contains(&peel::NAME));
-            return if ran { Ok(Some(self.renderer.read_f32(DEPTH_LAYER_2)?)) } else { Ok(None) };
-        }
-        let mut two = self.settings.clone();
-        two.ao.layers = 2;
-        two.ao.technique = Technique::Gtao;
-        self.renderer.set_settings(&two)?;
-        let report = self.renderer.render_and_wait(&self.eyes.eyes, &[DEPTH_LAYER_2])?;
-        let second = if peels(&report) { Some(self.renderer.read_f32(DEPTH_LAYER_2)?) } else { None };
-        self.renderer.set_settings(&self.settings)?;
-        self.frame()?;
-        Ok(second)
     }
 
     /// The bounce's screen-space limit of the last frame (the limit's march with this
@@ -663,14 +665,15 @@ pub fn sweep(
                 run.timed_frame()?;
             }
         }
-        for mut run in runs {
+        for run in runs {
             let reference = references.iter().find(|(r, _)| *r == run.case.radius).map(|(_, image)| image);
             // The limits depend only on the frame's depth layers and normals (the same
             // G-buffer for every case; the second layer with the sweep's one separation)
             // and the radius: marched once per radius, for its first row.
             if let Some(reference) = reference {
                 if !limits.iter().any(|(r, _)| *r == run.case.radius) {
-                    limits.push((run.case.radius, run.screen_limits(reference)?));
+                    let second = second_layer(gpu, scene, base, &run.case, how)?;
+                    limits.push((run.case.radius, run.screen_limits(reference, second.as_deref())?));
                 }
             }
             let limit = limits.iter().find(|(r, _)| *r == run.case.radius).map(|(_, l)| l);

@@ -201,8 +201,9 @@ const COLUMNS: &[Column] = &[
         name: "layers",
         header: "layers",
         csv: |r| r.layers.to_string(),
-        markdown: |r| r.layers.to_string(),
-        optional: false,
+        // Shown where some row read two (one layer is every row before them).
+        markdown: |r| if r.layers == 2 { "2".to_string() } else { String::new() },
+        optional: true,
     },
     Column {
         name: "mask",

@@ -116,13 +116,13 @@ fn csv_markdown_and_json_hold_every_row() {
     let recs = records(&rows);
     let csv = to_csv(&recs);
     assert_eq!(csv.lines().count(), 3);
-    // technique, N, r, resolution, foveation, mask, ms/eye, RMSE, central RMSE, whole-rectangle RMSE, bias,
-    // bias (ref < 0.8), vs limit,
-    // limit RMSE, limit bias, outer border RMSE, halo, FLIP, stereo shares, falloff
+    // technique, N, r, resolution, foveation, layers, mask, ms/eye, RMSE, central RMSE, whole-rectangle RMSE,
+    // bias, bias (ref < 0.8), vs limit,
+    // limit RMSE, limit bias, two-layer limit RMSE and bias (none here), outer border RMSE, halo, FLIP, stereo shares, falloff
     // RMSE, SSIM, ambient, …
     assert!(
         csv.lines().nth(2).unwrap().starts_with(
-            "hbao,12,0.5,full,off,off,7.000,0.2000,0.2000,,-0.0500,-0.1000,0.0600,0.0400,0.0100,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
+            "hbao,12,0.5,full,off,1,off,7.000,0.2000,0.2000,,-0.0500,-0.1000,0.0600,0.0400,0.0100,,,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
         ),
         "{csv}"
     );
