@@ -114,9 +114,12 @@ fn wgsl_layout(source: &str, name: &str) -> Result<(u32, u32, Vec<Member>), Stri
 
 /// The differences between `mirror` and its WGSL struct, one line each.
 pub fn differences(mirror: &Mirror) -> Vec<String> {
-    // The pipeline's composition (`kernel::shader_source` without a shader directory):
-    // each file's text and a newline, in order.
-    let source: String = mirror.files.iter().map(|(_, text)| format!("{text}\n")).collect();
+    // The pipeline's composition (`Kernel::in_chain` without a shader directory): the
+    // chain's prelude (its layouts declare no struct), then each file's text and a
+    // newline, in order.
+    let prelude = super::kernel::CHAIN_RGBA.source;
+    let source: String =
+        std::iter::once(prelude).chain(mirror.files.iter().map(|(_, text)| *text)).map(|t| format!("{t}\n")).collect();
     let paths: Vec<&str> = mirror.files.iter().map(|(path, _)| *path).collect();
     let here = format!("{} vs `{}` of [{}]", mirror.rust, mirror.wgsl, paths.join(", "));
     let (size, align, members) = match wgsl_layout(&source, mirror.wgsl) {
