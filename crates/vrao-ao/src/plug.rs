@@ -17,7 +17,7 @@ pub use crate::resource::{ChainLayout, Kind, Resource, Size, Written};
 
 // Compute kernels, their WGSL and the GPU helpers a pass records with.
 pub use crate::gpu::kernel::{
-    shader_module, try_shader_module, Bind, ByChain, Kernel, Shader, Slot, COMMON, IRRADIANCE, VISIBILITY,
+    shader_module, try_shader_module, Bind, Kernel, Shader, Slot, COMMON, IRRADIANCE, VISIBILITY,
 };
 pub use crate::gpu::layered_target::LayeredTarget;
 pub use crate::gpu::raster::{colour_and_depth_pass, fullscreen_pipeline, layer_views, uniform_entry};

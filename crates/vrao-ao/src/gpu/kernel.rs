@@ -108,19 +108,19 @@ pub(crate) fn chain_prelude(chain: ChainLayout) -> Shader {
 /// One thing per AO chain layout a pass's frames may have (its kernels for each): the
 /// four-channel layout always, the scalar one where the device writes it
 /// ([`super::Capabilities::scalar_chain`]).
-pub struct ByChain<T> {
+pub(crate) struct ByChain<T> {
     rgba: T,
     scalar: Option<T>,
 }
 
 impl<T> ByChain<T> {
     /// `make` for each layout the device can have.
-    pub fn new(gpu: &Gpu, make: impl Fn(ChainLayout) -> T) -> ByChain<T> {
+    pub(crate) fn new(gpu: &Gpu, make: impl Fn(ChainLayout) -> T) -> ByChain<T> {
         ByChain { rgba: make(ChainLayout::Rgba), scalar: gpu.caps.scalar_chain.then(|| make(ChainLayout::Scalar)) }
     }
 
     /// The one for `chain` (a frame's `DeclareContext::chain`).
-    pub fn get(&self, chain: ChainLayout) -> &T {
+    pub(crate) fn get(&self, chain: ChainLayout) -> &T {
         match chain {
             ChainLayout::Rgba => &self.rgba,
             ChainLayout::Scalar => {

@@ -117,7 +117,8 @@ pub fn differences(mirror: &Mirror) -> Vec<String> {
     // The pipeline's composition (`Kernel::in_chain` without a shader directory): the
     // chain's prelude (its layouts declare no struct), then each file's text and a
     // newline, in order.
-    let prelude = super::kernel::CHAIN_RGBA.source;
+    // (Read here, not through `kernel`: the embed example's tests include this file alone.)
+    let prelude = include_str!("../../shaders/chain_rgba.wgsl");
     let source: String =
         std::iter::once(prelude).chain(mirror.files.iter().map(|(_, text)| *text)).map(|t| format!("{t}\n")).collect();
     let paths: Vec<&str> = mirror.files.iter().map(|(path, _)| *path).collect();

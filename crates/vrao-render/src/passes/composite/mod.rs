@@ -17,8 +17,8 @@ use super::{scene_of, settings_of};
 use crate::gpu::kernel::wgsl;
 use std::sync::Mutex;
 use vrao_ao::plug::{
-    reuses_left_eye_upsample, Bind, ByChain, ChainLayout, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext,
-    Resource, Size, Slot, AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION, VISIBILITY,
+    reuses_left_eye_upsample, Bind, ChainLayout, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource,
+    Size, Slot, AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION, VISIBILITY,
 };
 use vrao_ao::Technique;
 use wgpu::util::DeviceExt;
@@ -35,7 +35,9 @@ pub const HDR: Resource = Resource::storage("hdr", Size::Full, wgpu::TextureForm
 pub struct CompositePass {
     /// Variants by (half resolution, RSM bounce): pipeline constants, so a frame without
     /// them runs none of their code.
-    kernels: ByChain<[[Kernel; 2]; 2]>,
+    /// By the AO chain's layout it reads (the scalar one only where the device has it),
+    /// then half resolution and RSM.
+    kernels: Vec<(ChainLayout, [[Kernel; 2]; 2])>,
     /// The right eye's half-resolution dispatches, by RSM bounce: reusing the left eye's
     /// AO (listing the quads it cannot), and over the listed quads.
     right_eye: [Kernel; 2],
@@ -111,9 +113,17 @@ impl CompositePass {
         });
         CompositePass {
             fallback_args,
-            kernels: ByChain::new(gpu, |chain| {
-                [false, true].map(|half_res| [false, true].map(|rsm| variant(half_res, rsm, false, false, chain)))
-            }),
+            kernels: [ChainLayout::Rgba, ChainLayout::Scalar]
+                .into_iter()
+                .filter(|chain| *chain == ChainLayout::Rgba || gpu.caps.scalar_chain)
+                .map(|chain| {
+                    (
+                        chain,
+                        [false, true]
+                            .map(|half_res| [false, true].map(|rsm| variant(half_res, rsm, false, false, chain))),
+                    )
+                })
+                .collect(),
             right_eye: [false, true].map(|rsm| variant(true, rsm, true, false, ao_only)),
             right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true, ao_only)),
             fallback: Mutex::new(None),
@@ -151,7 +161,9 @@ impl Pass for CompositePass {
         let (w, h, layers) = ctx.quad_extent();
         let reuse = reuses_left_eye_upsample(ctx.setup.settings, layers);
         let device = &ctx.gpu.device;
-        let kernel = &self.kernels.get(ctx.setup.chain)[half_res as usize][rsm as usize];
+        let by_layout =
+            self.kernels.iter().find(|(chain, _)| *chain == ctx.setup.chain).expect("the frame's chain layout");
+        let kernel = &by_layout.1[half_res as usize][rsm as usize];
         kernel.dispatch(
             device,
             ctx.encoder,
