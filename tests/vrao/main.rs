@@ -10,7 +10,6 @@ mod common;
 
 mod ao_engine;
 mod build_interrupt;
-mod chain_layout;
 mod foveation;
 mod gltf_materials;
 mod gltf_materials_reference;
@@ -20,6 +19,8 @@ mod pipelines;
 mod presets;
 mod visibility_mask;
 
+#[cfg(feature = "app")]
+mod chain_layout;
 #[cfg(feature = "app")]
 mod cli;
 #[cfg(all(feature = "app", feature = "gltf"))]

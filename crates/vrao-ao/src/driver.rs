@@ -63,7 +63,7 @@ pub enum Submission {
 }
 
 /// What recording a frame cost on the CPU, and the passes' wall-clock times when
-/// [`Submission::PerPass`] waited for them.
+/// `Submission::PerPass` (the `measurement` feature) waited for them.
 #[derive(Clone, Debug, Default)]
 pub struct Recorded {
     /// CPU milliseconds spent encoding the passes.
@@ -237,7 +237,8 @@ impl<K: Clone + PartialEq> GraphDriver<K> {
 
     /// Records the plan's passes into `encoder`, each in a span of `spans` (the driver's
     /// own timer when `None`); `environment` is what [`crate::gpu::kernel::Bind::Environment`]
-    /// binds. With [`Submission::PerPass`] each pass but the last is submitted on its own.
+    /// binds. With `Submission::PerPass` (the `measurement` feature) each pass but the last
+    /// is submitted on its own.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,

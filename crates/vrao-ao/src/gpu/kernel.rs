@@ -483,7 +483,7 @@ impl Kernel {
 
     /// A kernel as [`Kernel::with_constants`] for a frame whose AO chain is laid out as
     /// `chain`: its chain targets bind in that format and its WGSL starts with that
-    /// layout's prelude ([`chain_prelude`]).
+    /// layout's prelude (shaders/chain_rgba.wgsl, chain_scalar.wgsl).
     pub fn in_chain(
         gpu: &Gpu,
         label: &str,
