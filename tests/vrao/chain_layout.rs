@@ -5,10 +5,9 @@
 use crate::common;
 
 use common::occlusion::{ao, render, settings};
-use vrao_ao::plug::FINAL_AO;
+use vrao_ao::plug::{ChainLayout, FINAL_AO};
 use vrao_ao::{AoSettings, Denoise, Resolution, Technique};
 use vrao_render::scene::Scene;
-use vrao_render::Renderer;
 
 /// The chain's variants a frame can take: every technique without light at full and half
 /// resolution, with the tile denoise, the bilateral blur and temporal accumulation.
@@ -33,20 +32,19 @@ fn the_scalar_chain_holds_the_four_channel_chains_ao_to_the_bit_in_a_quarter_of_
     let head = scene.head.pose_at(0.0);
     for ao in variants() {
         let s = settings(48, 40, ao.clone());
-        let a = render(&scalar, &scene, &s, &head, &[FINAL_AO]);
-        let b = render(&four, &scene, &s, &head, &[FINAL_AO]);
-        let (a, b) = (&a.outputs[&FINAL_AO], &b.outputs[&FINAL_AO]);
+        let frame_a = render(&scalar, &scene, &s, &head, &[FINAL_AO]);
+        let frame_b = render(&four, &scene, &s, &head, &[FINAL_AO]);
+        let (a, b) = (&frame_a.outputs[&FINAL_AO], &frame_b.outputs[&FINAL_AO]);
         let differing = a.iter().flatten().zip(b.iter().flatten()).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
         assert_eq!(differing, 0, "{ao:?}: {differing} values differ between the chain layouts");
         let open = a.iter().flatten().skip(3).step_by(4).filter(|v| **v < 0.99).count();
         assert!(open > 100, "{ao:?}: the frame has occlusion to compare ({open} occluded pixels)");
-        // The declared traffic: each chain texture a quarter of the bytes.
-        let traffic = |gpu| {
-            let mut renderer = Renderer::new(std::sync::Arc::clone(gpu), &scene, &s).unwrap();
-            renderer.render(&s.profile.eyes(&head, s.near).eyes, &[FINAL_AO]).unwrap();
-            renderer.occlusion_traffic().unwrap()
-        };
-        let (small, large) = (traffic(&scalar), traffic(&four));
+        // The declared traffic of the frames just rendered: each chain texture a quarter of
+        // the bytes (the plans are the same; the layouts differ).
+        let half = ao.resolution.is_half();
+        let layout = |gpu: &vrao_ao::plug::Gpu| ChainLayout::of(ao.technique.carries_light(), gpu.caps.scalar_chain);
+        let small = frame_a.report.plan.occlusion_traffic(layout(&scalar), half);
+        let large = frame_b.report.plan.occlusion_traffic(layout(&four), half);
         eprintln!("{:?} {:?}: {small:?} vs {large:?}", ao.technique, ao.resolution);
         assert!(small.written < 0.5 * large.written && small.read < large.read, "{small:?} vs {large:?}");
     }

@@ -155,6 +155,17 @@ impl PartialEq for Plan {
     }
 }
 
+/// Bytes a frame's occlusion passes move per full-resolution pixel of one view, counted
+/// from their declared textures: each texture a pass writes once, each it reads once
+/// (the taps a kernel makes within a texture are not counted; the same on every machine).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelTraffic {
+    /// Bytes written per pixel.
+    pub written: f64,
+    /// Bytes read per pixel.
+    pub read: f64,
+}
+
 impl Plan {
     /// Whether the pass of this name runs.
     pub fn runs(&self, name: &str) -> bool {
@@ -175,20 +186,7 @@ impl Plan {
     pub fn occlusion_passes(&self) -> Vec<&'static str> {
         self.decls.iter().filter(|d| d.occlusion_cost).map(|d| d.name).collect()
     }
-}
 
-/// Bytes a frame's occlusion passes move per full-resolution pixel of one view, counted
-/// from their declared textures: each texture a pass writes once, each it reads once
-/// (the taps a kernel makes within a texture are not counted; the same on every machine).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelTraffic {
-    /// Bytes written per pixel.
-    pub written: f64,
-    /// Bytes read per pixel.
-    pub read: f64,
-}
-
-impl Plan {
     /// The traffic of the passes counted as the occlusion's cost, with the chain laid out
     /// as `chain` and the occlusion at half resolution when `half_res` (an
     /// occlusion-sized texel then stands for four pixels).
@@ -200,11 +198,9 @@ impl Plan {
             // Light-space maps and named outputs have no per-pixel size.
             Kind::Texture { size: Size::Computed(_), .. } | Kind::Alias { .. } => None,
         };
+        // A depth-stencil format counts its depth; colour formats ignore the aspect.
         let bytes = |r: &Resource| {
-            let texel = r
-                .format_in(chain)
-                .block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
-                .or_else(|| r.format_in(chain).block_copy_size(None));
+            let texel = r.format_in(chain).block_copy_size(Some(wgpu::TextureAspect::DepthOnly));
             share(r).zip(texel).map_or(0.0, |(share, texel)| share * f64::from(texel))
         };
         let mut traffic = PixelTraffic::default();

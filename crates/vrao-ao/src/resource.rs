@@ -93,14 +93,6 @@ impl ChainLayout {
             ChainLayout::Rgba
         }
     }
-
-    /// Bytes a texel of a chain target.
-    pub const fn bytes_per_texel(self) -> u32 {
-        match self {
-            ChainLayout::Rgba => 8,
-            ChainLayout::Scalar => 2,
-        }
-    }
 }
 
 impl Resource {

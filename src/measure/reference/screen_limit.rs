@@ -509,13 +509,9 @@ mod tests {
         assert!(darkest < 0.65, "the crease darkens: {darkest}");
     }
 
-    #[test]
-    fn a_thin_slab_stops_occluding_behind_itself_within_the_thickness() {
-        // The eye looks straight down at a floor 3 m away; a thin horizontal plate 0.5 m
-        // above the floor covers x > 0. Receivers on the floor just beside the plate see it
-        // overhead on one side. Ray traced, only the rays that cross the plate are blocked;
-        // with a thickness above the plate's height the depth buffer makes it a solid block
-        // down to the floor, which also blocks the rays passing under it.
+    /// The thin-slab scenes: a floor 3 m below the eye (looking straight down) and the top
+    /// of a plate 0.5 m above it covering x > 0.
+    fn floor_and_plate_top() -> (Rect, Rect) {
         let floor = Rect {
             corner: DVec3::new(-20.0, -20.0, -3.0),
             u: DVec3::new(40.0, 0.0, 0.0),
@@ -523,6 +519,22 @@ mod tests {
         };
         let plate =
             Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(20.0, 0.0, 0.0), v: DVec3::new(0.0, 40.0, 0.0) };
+        (floor, plate)
+    }
+
+    /// Floor receivers within 0.3 m of the plate's edge, near the image centre row.
+    fn beside_the_plate(p: DVec3) -> bool {
+        (p.z + 3.0).abs() <= 1e-4 && (-0.3..-0.02).contains(&p.x) && p.y.abs() <= 0.5
+    }
+
+    #[test]
+    fn a_thin_slab_stops_occluding_behind_itself_within_the_thickness() {
+        // The eye looks straight down at a floor 3 m away; a thin horizontal plate 0.5 m
+        // above the floor covers x > 0. Receivers on the floor just beside the plate see it
+        // overhead on one side. Ray traced, only the rays that cross the plate are blocked;
+        // with a thickness above the plate's height the depth buffer makes it a solid block
+        // down to the floor, which also blocks the rays passing under it.
+        let (floor, plate) = floor_and_plate_top();
         let (size, stride, radius) = ((96, 96), 2, 1.0);
         let base = LimitSettings { rays_per_pixel: 256, steps: 48, ..LimitSettings::new(radius, stride, NEAR) };
         let (thin, depth) = limit(&[floor, plate], size, LimitSettings { thickness: 0.05, ..base });
@@ -532,8 +544,7 @@ mod tests {
         for j in 0..gh {
             for i in 0..gw {
                 let p = position(&depth, size, stride, i, j);
-                // Floor receivers within 0.3 m of the plate's edge, near the image centre row.
-                if (p.z + 3.0).abs() > 1e-4 || !(-0.3..-0.02).contains(&p.x) || p.y.abs() > 0.5 {
+                if !beside_the_plate(p) {
                     continue;
                 }
                 let truth =
@@ -556,13 +567,7 @@ mod tests {
         // takes r / 4 = 0.25 m behind it as solid: floor receivers beside the slab lose
         // the rays that pass under it. The second layer is the slab's underside, so the
         // two-layer limit blocks only the 4 cm the slab fills, as the ray tracer does.
-        let floor = Rect {
-            corner: DVec3::new(-20.0, -20.0, -3.0),
-            u: DVec3::new(40.0, 0.0, 0.0),
-            v: DVec3::new(0.0, 40.0, 0.0),
-        };
-        let top =
-            Rect { corner: DVec3::new(0.0, -20.0, -2.5), u: DVec3::new(20.0, 0.0, 0.0), v: DVec3::new(0.0, 40.0, 0.0) };
+        let (floor, top) = floor_and_plate_top();
         let bottom = Rect { corner: DVec3::new(0.0, -20.0, -2.54), ..top };
         let side = Rect {
             corner: DVec3::new(0.0, -20.0, -2.5),
@@ -583,8 +588,7 @@ mod tests {
         for j in 0..gh {
             for i in 0..gw {
                 let p = position(&depth, size, stride, i, j);
-                // Floor receivers within 0.3 m of the slab's edge, near the image centre row.
-                if (p.z + 3.0).abs() > 1e-4 || !(-0.3..-0.02).contains(&p.x) || p.y.abs() > 0.5 {
+                if !beside_the_plate(p) {
                     continue;
                 }
                 let truth = visibility_by_ray_casting(p, DVec3::Z, radius, false, 400, |o, d| first_hit(&scene, o, d));

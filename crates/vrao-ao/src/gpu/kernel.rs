@@ -265,17 +265,9 @@ pub enum Bind {
 }
 
 impl Bind {
-    /// The slot type this binding has in the layout of a kernel of a `chain` laid out so.
+    /// The slot type this binding has in the layout of a kernel whose AO chain is laid out
+    /// as `chain` (what a chain target's storage binding is written as).
     pub fn slot_in(self, chain: ChainLayout) -> Slot {
-        match self {
-            Bind::Write(r) => Slot::Output(r.format_in(chain)),
-            other => other.slot(),
-        }
-    }
-
-    /// The slot type this binding has in the layout (a chain target's as
-    /// [`ChainLayout::Rgba`]: [`Bind::slot_in`]).
-    pub fn slot(self) -> Slot {
         match self {
             Bind::Frame | Bind::AoParams => Slot::Uniform,
             Bind::SampleKernel | Bind::Lights => Slot::ReadBuffer,
@@ -286,7 +278,7 @@ impl Bind {
                 Slot::UintLayers
             }
             Bind::Read(_) => Slot::Layers,
-            Bind::Write(r) => Slot::Output(r.format()),
+            Bind::Write(r) => Slot::Output(r.format_in(chain)),
             Bind::Own(slot) => slot,
         }
     }
@@ -549,7 +541,7 @@ impl Kernel {
 
     /// [`Kernel::from_module`] for a frame whose AO chain is laid out as `chain` (the
     /// module was made with its prelude).
-    pub fn from_module_in(
+    fn from_module_in(
         gpu: &Gpu,
         label: &str,
         module: &wgpu::ShaderModule,
