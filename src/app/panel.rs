@@ -5,9 +5,9 @@
 use super::governor::Governor;
 use super::{BufferView, PassHistory};
 use crate::xr::FrameCounters;
-use vrao_ao::plug::BounceForm;
 use vrao_ao::{AoSettings, Foveation, Quality, Resolution, Technique};
 use vrao_render::settings::{DisplayMode, Settings};
+use vrao_render::{BounceForm, PointSsdoSettings};
 
 /// Width of the egui side panel in points.
 pub(super) const PANEL_WIDTH: f32 = 300.0;
@@ -78,7 +78,8 @@ fn pass_colour(i: usize) -> egui::Color32 {
 /// display mode, frame rates, the governor and the profiler graph. Returns whether a
 /// setting changed.
 pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelInfo, counters: &FrameCounters) -> bool {
-    let before = (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone());
+    let edited = |p: &PanelState| (p.settings.ao.clone(), p.settings.point_ssdo, p.quality, p.settings.shadows.clone());
+    let before = edited(panel);
     egui::Panel::left("vrao panel").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
         ui.heading("vrao");
         settings_ui(ui, panel);
@@ -92,7 +93,7 @@ pub(super) fn panel_ui(ui: &mut egui::Ui, panel: &mut PanelState, info: &PanelIn
         ui.separator();
         profiler_ui(ui, info);
     });
-    (panel.settings.ao.clone(), panel.quality, panel.settings.shadows.clone()) != before
+    edited(panel) != before
 }
 
 /// The settings the panel edits: technique, its parameters, bounce and shadows.
@@ -101,7 +102,7 @@ fn settings_ui(ui: &mut egui::Ui, panel: &mut PanelState) {
     technique_ui(ui, ao);
     let any = ao.technique != Technique::None;
     ui.add_enabled_ui(any, |ui| ao_parameters_ui(ui, ao, &mut panel.quality));
-    bounce_ui(ui, ao);
+    bounce_ui(ui, ao, &mut panel.settings.point_ssdo);
     ui.checkbox(&mut panel.settings.shadows.enabled, "shadows (directional lights)");
     ui.checkbox(&mut panel.settings.shadows.rsm, "reflective shadow maps (sun bounce)");
 }
@@ -157,18 +158,18 @@ fn mask_ui(ui: &mut egui::Ui, hidden_share: &[f64]) {
 
 /// The SSDO settings: bounce strength and form, and depth peeling (disabled for the
 /// techniques that do not use them).
-fn bounce_ui(ui: &mut egui::Ui, ao: &mut AoSettings) {
+fn bounce_ui(ui: &mut egui::Ui, ao: &mut AoSettings, point_ssdo: &mut PointSsdoSettings) {
     let points = matches!(ao.technique, Technique::SsdoPoints | Technique::SsdoPointsBounce);
     let bounce = ao.technique.gathers_bounce();
     ui.add_enabled(bounce, egui::Slider::new(&mut ao.bounce, 0.0..=4.0).text("bounce"));
-    let mut patch = ao.bounce_form == BounceForm::Patch;
+    let mut patch = point_ssdo.bounce_form == BounceForm::Patch;
     if ui
         .add_enabled(bounce && points, egui::Checkbox::new(&mut patch, "bounce as Ritschel et al.'s patches"))
         .changed()
     {
-        ao.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
+        point_ssdo.bounce_form = if patch { BounceForm::Patch } else { BounceForm::Direction };
     }
-    ui.add_enabled(points, egui::Checkbox::new(&mut ao.depth_peeling, "depth peeling (point-sampled SSDO)"));
+    ui.add_enabled(points, egui::Checkbox::new(&mut point_ssdo.depth_peeling, "depth peeling (point-sampled SSDO)"));
 }
 
 /// The display mode and the buffer view shown of each eye.

@@ -8,11 +8,10 @@ use vrao::measure::bench::{replot, run_bench, write_outputs, BenchOptions, Refer
 use vrao::measure::reference::default_cache_dir;
 use vrao::measure::{MEASURED_FRAMES_MAX, WARMUP_MAX};
 use vrao::Result;
-use vrao_ao::plug::BounceForm;
 use vrao_ao::{AoSettings, Denoise, Foveation, Quality, Technique};
 use vrao_render::renderer::TimingChoice;
 use vrao_render::scene::RENDER_DEFAULT;
-use vrao_render::{BackendChoice, HeadsetProfile, Scene, Settings};
+use vrao_render::{BackendChoice, BounceForm, HeadsetProfile, PointSsdoSettings, Scene, Settings};
 
 /// A sweep over a switch: off, on or both.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -94,7 +93,7 @@ pub(crate) struct BenchArgs {
     warmup: u32,
     /// How ssdo-bounce rows weigh their senders: direction or patch (Ritschel et al. 2009
     /// eq. 2).
-    #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
+    #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = PointSsdoSettings::default().bounce_form, hide_possible_values = true)]
     bounce_form: BounceForm,
     #[command(flatten)]
     gtao: GtaoArgs,
@@ -160,7 +159,7 @@ pub(crate) fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
             let scene = Scene::load(&args.scene)?;
             let mut base =
                 Settings { profile: HeadsetProfile::with_size("vive", args.width, args.height), ..Settings::default() };
-            base.ao.bounce_form = args.bounce_form;
+            base.point_ssdo.bounce_form = args.bounce_form;
             args.gtao.apply(&mut base.ao);
             (base.ao.denoise, base.ao.blur_radius) = (args.denoise, args.blur);
             let options = BenchOptions {

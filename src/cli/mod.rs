@@ -45,13 +45,12 @@ pub(crate) fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValu
 
 use clap::Args;
 use glam::DVec3;
-use vrao_ao::plug::BounceForm;
 use vrao_ao::{
     AoSettings, Choice, Denoise, Foveation, GtaoSettings, Noise, Quality, Technique, Temporal, TemporalBlend,
 };
 use vrao_render::passes::shadow::suggested_rsm_radius;
 use vrao_render::settings::{ShadowSettings, AO_RADIUS_MAX, AO_RADIUS_MIN, AO_RADIUS_OF_DIAGONAL};
-use vrao_render::{HeadsetProfile, Scene, Settings};
+use vrao_render::{BounceForm, HeadsetProfile, PointSsdoSettings, Scene, Settings};
 
 /// Help heading of the shadow options (part of every command that renders).
 const SHADOW_HEADING: &str = "Shadows and reflective shadow maps";
@@ -186,7 +185,7 @@ pub(crate) struct AoArgs {
     /// How ssdo-points-bounce weighs a blocking sample's sender: direction (its solid angle 2π/N ×
     /// the receiver cosine) or patch (Ritschel et al. 2009 eq. 2: area π r²/N, both
     /// cosines, 1/d²).
-    #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = AoSettings::default().bounce_form, hide_possible_values = true)]
+    #[arg(value_parser = choice::<BounceForm>(), long, default_value_t = PointSsdoSettings::default().bounce_form, hide_possible_values = true)]
     bounce_form: BounceForm,
     /// Compute occlusion at half resolution per axis and upsample it.
     #[arg(long)]
@@ -277,9 +276,15 @@ impl AoArgs {
         Settings {
             profile: HeadsetProfile::with_size("vive", width, height),
             ao: self.settings(scene),
+            point_ssdo: self.point_ssdo(),
             shadows: self.lights.settings(scene),
             ..Settings::default()
         }
+    }
+
+    /// The point-sampled SSDO's options (`--bounce-form`, `--depth-peeling`).
+    pub(crate) fn point_ssdo(&self) -> PointSsdoSettings {
+        PointSsdoSettings { bounce_form: self.bounce_form, depth_peeling: self.depth_peeling }
     }
 
     pub(crate) fn settings(&self, scene: &Scene) -> AoSettings {
@@ -291,10 +296,8 @@ impl AoArgs {
             bias: self.bias,
             range_check: !self.no_range_check,
             bounce: self.bounce,
-            bounce_form: self.bounce_form,
             noise: self.noise,
             resolution: vrao_ao::Resolution::from_half_res(self.half_res),
-            depth_peeling: self.depth_peeling,
             layers: self.layers,
             layer_separation: self.gtao.layer_separation,
             denoise: self.denoise,

@@ -77,6 +77,7 @@ impl RenderArgs {
             exposure: self.exposure,
             white_point: self.white_point,
             ao: self.ao.settings(scene),
+            point_ssdo: self.ao.point_ssdo(),
             shadows: self.ao.lights.settings(scene),
             ..Settings::default()
         }

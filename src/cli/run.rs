@@ -159,7 +159,12 @@ fn session(
     vrao::xr::openxr::mask::MaskChoice::from_env().map_err(|e| Error::input(e.to_string()))?;
     let scene = Scene::load(scene)?;
     // The session replaces the profile with the one --profile names.
-    let settings = Settings { ao: ao.settings(&scene), shadows: ao.lights.settings(&scene), ..Settings::default() };
+    let settings = Settings {
+        ao: ao.settings(&scene),
+        point_ssdo: ao.point_ssdo(),
+        shadows: ao.lights.settings(&scene),
+        ..Settings::default()
+    };
     run_session(&scene, &settings, options, interrupt).map_err(name_the_option)
 }
 

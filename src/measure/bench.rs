@@ -226,7 +226,7 @@ impl CaseRun {
         settings.ao.samples = case.samples;
         settings.ao.radius = case.radius;
         settings.ao.resolution = vrao_ao::Resolution::from_half_res(case.half_res);
-        settings.ao.depth_peeling = case.depth_peeling;
+        settings.point_ssdo.depth_peeling = case.depth_peeling;
         settings.ao.layers = case.layers;
         settings.ao.temporal.enabled = case.temporal;
         settings.ao.foveation = case.foveation;

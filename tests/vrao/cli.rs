@@ -288,11 +288,10 @@ fn main_rs_is_a_thin_dispatcher() {
 #[test]
 fn command_line_names_are_the_names_reports_print() {
     use clap::ValueEnum;
-    use vrao_ao::plug::BounceForm;
     use vrao_ao::{Choice, Denoise, Foveation, Noise, Quality, Technique, TemporalBlend};
     use vrao_render::renderer::TimingChoice;
     use vrao_render::settings::{DisplayMode, StereoMode};
-    use vrao_render::BackendChoice;
+    use vrao_render::{BackendChoice, BounceForm};
     // The engine's and the renderer's settings (no clap there): every name distinct,
     // lower-case words joined by '-', and read back as the value it names.
     fn check_choice<T: Choice + std::fmt::Display>() {

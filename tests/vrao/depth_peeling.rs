@@ -12,18 +12,19 @@ use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
 use vrao_ao::plug::{Resource, DEPTH, DEPTH_LAYER_2, FINAL_AO};
 use vrao_ao::{AoSettings, Technique};
 use vrao_render::passes::tonemap::COLOR;
-use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_render::{HeadsetProfile, PointSsdoSettings, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 144);
 const RADIUS: f32 = 0.5;
 const WALL_Z: f64 = -3.0;
 
-fn settings(ao: AoSettings) -> Settings {
-    Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ao, ..Settings::default() }
+fn settings(ao: AoSettings, depth_peeling: bool) -> Settings {
+    let point_ssdo = PointSsdoSettings { depth_peeling, ..PointSsdoSettings::default() };
+    Settings { profile: HeadsetProfile::with_size("test", SIZE.0, SIZE.1), ao, point_ssdo, ..Settings::default() }
 }
 
-fn ssdo(depth_peeling: bool) -> AoSettings {
-    AoSettings { technique: Technique::SsdoPoints, samples: 36, radius: RADIUS, depth_peeling, ..AoSettings::default() }
+fn ssdo() -> AoSettings {
+    AoSettings { technique: Technique::SsdoPoints, samples: 36, radius: RADIUS, ..AoSettings::default() }
 }
 
 /// A 1.2 m × 1.2 m board, 2 cm thick, whose back face is `gap` metres in front of a
@@ -44,7 +45,7 @@ fn render(scene: &Scene, s: &Settings) -> Vec<Vec<f32>> {
     let mut renderer = Renderer::new(gpu, scene, s).unwrap();
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     let report = renderer.render(&eyes.eyes, &[output]).unwrap();
-    assert_eq!(report.plan.runs("depth-peel"), s.ao.depth_peeling, "{}", report.plan);
+    assert_eq!(report.plan.runs("depth-peel"), s.point_ssdo.depth_peeling, "{}", report.plan);
     let layers = renderer.read_f32(output).unwrap();
     for (layer, image) in layers.iter().enumerate() {
         for (i, px) in image.chunks(4).enumerate() {
@@ -56,7 +57,7 @@ fn render(scene: &Scene, s: &Settings) -> Vec<Vec<f32>> {
 }
 
 fn trace_reference(scene: &Scene, stride: u32) -> ReferenceImage {
-    let s = settings(ssdo(false));
+    let s = settings(ssdo(), false);
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     let rs = ReferenceSettings { radius: RADIUS as f64, rays_per_pixel: 256, stride, near: s.near };
     trace(scene, &eyes.eyes, SIZE, &rs, &mut |_| {}).unwrap()
@@ -123,7 +124,7 @@ fn a_thin_board_far_in_front_of_a_wall_casts_a_halo_only_without_peeling() {
     let band = halo_band(&reference, 1);
     let mut results = Vec::new();
     for (peel, range_check) in [(false, false), (true, false), (true, true)] {
-        let ao = render(&scene, &settings(AoSettings { range_check, ..ssdo(peel) }));
+        let ao = render(&scene, &settings(AoSettings { range_check, ..ssdo() }, peel));
         let (ours, truth, n) = mean_over(&ao, &reference, &band);
         let e = error_figures(Technique::SsdoPoints, &ao, &reference);
         println!(
@@ -146,7 +147,7 @@ fn a_thin_board_far_in_front_of_a_wall_casts_a_halo_only_without_peeling() {
 fn a_closed_box_still_occludes_the_floor_beside_it_with_peeling() {
     let scene = Scene::load("builtin:box").unwrap();
     let reference = trace_reference(&scene, 2);
-    let s = settings(ssdo(false));
+    let s = settings(ssdo(), false);
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     // Floor cells between `near` and `far` metres from the unit box's centre line (its
     // sides stand at x, z = ±0.5).
@@ -162,7 +163,7 @@ fn a_closed_box_still_occludes_the_floor_beside_it_with_peeling() {
     };
     let mut results = Vec::new();
     for peel in [false, true] {
-        let ao = render(&scene, &settings(ssdo(peel)));
+        let ao = render(&scene, &settings(ssdo(), peel));
         let (beside, truth, n) = mean_over(&ao, &reference, floor(0.5, 0.75));
         let (open, _, _) = mean_over(&ao, &reference, floor(3.0, 6.0));
         let e = error_figures(Technique::SsdoPoints, &ao, &reference);
@@ -185,7 +186,7 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
     let (gpu, _one_at_a_time) = common::gpu();
     let scene = board_scene(1.0);
     let plan = |technique, depth_peeling, outputs: &[Resource]| {
-        let s = settings(AoSettings { technique, depth_peeling, ..AoSettings::default() });
+        let s = settings(AoSettings { technique, ..AoSettings::default() }, depth_peeling);
         Renderer::new(gpu.clone(), &scene, &s).unwrap().plan(2, outputs).unwrap()
     };
     let reason = |p: &vrao_ao::Plan| p.left_out.iter().find(|(n, _)| *n == "depth-peel").map(|(_, r)| r.clone());
@@ -218,8 +219,7 @@ fn the_peel_pass_runs_only_for_ssdo_with_peeling_on() {
 fn peeling_at_half_resolution_with_the_bounce_stays_finite() {
     let scene = Scene::load("builtin:room").unwrap();
     for technique in [Technique::SsdoPoints, Technique::SsdoPointsBounce] {
-        let s =
-            settings(AoSettings { resolution: vrao_ao::Resolution::Half, ..AoSettings { technique, ..ssdo(true) } });
+        let s = settings(AoSettings { resolution: vrao_ao::Resolution::Half, technique, ..ssdo() }, true);
         render(&scene, &s);
     }
 }
@@ -229,7 +229,7 @@ fn peeling_with_extreme_radii_and_sample_counts_stays_finite() {
     let scene = board_scene(0.3);
     for (radius, samples) in [(1e-6, 1), (1e-6, 256), (1e6, 1), (1e6, 256), (0.5, 1)] {
         for range_check in [false, true] {
-            render(&scene, &settings(AoSettings { radius, samples, range_check, ..ssdo(true) }));
+            render(&scene, &settings(AoSettings { radius, samples, range_check, ..ssdo() }, true));
         }
     }
 }

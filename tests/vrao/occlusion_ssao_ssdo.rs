@@ -13,11 +13,12 @@ use common::crease::{assert_bins, assert_falls_towards_the_edge, measure_crease,
 use common::occlusion::{ao, mean, render, settings, Frame};
 use glam::{DVec3, Vec3};
 use vrao::measure::analytic;
-use vrao_ao::plug::{BounceForm, AO_RAW};
+use vrao_ao::plug::AO_RAW;
 use vrao_ao::{HeadPose, Technique};
 use vrao_render::passes::composite::HDR;
 use vrao_render::scene::builtin::{ROOM_MAX, ROOM_MIN};
 use vrao_render::scene::{environment, Environment, Scene};
+use vrao_render::BounceForm;
 
 // ---------------------------------------------------------------------------------------
 // 90° crease (tests/common/crease.rs)
@@ -297,8 +298,9 @@ impl RedWallFrames {
         let run_form = |technique: Technique, bounce: f32, form: BounceForm| {
             let mut a = ao(technique, 64, 1.0);
             a.bounce = bounce;
-            a.bounce_form = form;
-            render(gpu, &scene, &settings(128, 144, a), &head, &[HDR, AO_RAW])
+            let mut s = settings(128, 144, a);
+            s.point_ssdo.bounce_form = form;
+            render(gpu, &scene, &s, &head, &[HDR, AO_RAW])
         };
         let run = |technique: Technique, bounce: f32| run_form(technique, bounce, BounceForm::Direction);
         let ssdo = run(plain, 1.0);

@@ -5,9 +5,9 @@ use crate::common;
 
 use vrao::measure::bench::{error_figures, ErrorFigures};
 use vrao::measure::reference::{trace, ReferenceSettings};
-use vrao_ao::plug::{BounceForm, FINAL_AO};
+use vrao_ao::plug::FINAL_AO;
 use vrao_ao::Technique;
-use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
+use vrao_render::{BounceForm, HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (128, 112);
 const RADIUS: f32 = 0.5;
@@ -24,7 +24,7 @@ fn errors(
     settings.ao.technique = technique;
     settings.ao.samples = samples;
     settings.ao.radius = RADIUS;
-    settings.ao.bounce_form = form;
+    settings.point_ssdo.bounce_form = form;
     let output = FINAL_AO;
     let mut renderer = Renderer::new(gpu, &scene, &settings).unwrap();
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);

@@ -38,6 +38,5 @@ pub use crate::resource::{FINAL_AO, OCCLUSION, PIXEL_MOTION};
 
 // What a renderer's light and the measurement's oracle read of the engine's numerics.
 pub use crate::sampling::{hbao_directions_steps, hemisphere_kernel, HemisphereDensity};
-pub use crate::settings::BounceForm;
 pub use crate::sh::{prefiltered_radiance, quadratic_in_view, sh9_quadratic};
 pub use crate::stereo::DEFAULT_NEAR;

@@ -49,7 +49,7 @@ macro_rules! impl_choice {
     )*};
 }
 
-crate::impl_choice!(Technique, Quality, BounceForm, Denoise, Foveation, TemporalBlend, Resolution);
+crate::impl_choice!(Technique, Quality, Denoise, Foveation, TemporalBlend, Resolution);
 
 /// The resolution the occlusion runs at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -165,35 +165,6 @@ impl Noise {
         match self {
             Noise::Tiled5x5 => "tiled",
             Noise::Halton => "halton",
-        }
-    }
-}
-
-/// How SSDO's bounce weighs a blocking sample's sender.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum BounceForm {
-    /// Ritschel et al. 2009 eq. 2: a patch of area π r²/N × strength at the sender pixel,
-    /// weighted by the sender and receiver cosines over d² (as a disc's solid angle, so a
-    /// sender touching the receiver stays bounded).
-    Patch,
-    /// The sender's radiance through the blocked direction's share of the hemisphere,
-    /// 2π/N, × the receiver's cosine towards the sender, as eq. 1 treats unblocked
-    /// directions: for diffuse senders the radiance arriving along a direction does not
-    /// depend on the sender's orientation or distance. Against the reference's bounce it
-    /// roughly halves eq. 2's low bias and error (red wall, crease, Cornell box), and it
-    /// needs no sender normal.
-    #[default]
-    Direction,
-}
-
-impl BounceForm {
-    /// Both forms, the default first.
-    pub const ALL: [BounceForm; 2] = [BounceForm::Direction, BounceForm::Patch];
-    /// The form's command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            BounceForm::Patch => "patch",
-            BounceForm::Direction => "direction",
         }
     }
 }
@@ -317,15 +288,10 @@ pub struct AoSettings {
     pub range_check: bool,
     /// SSDO bounce strength (scales each sender's weight); 0 turns the bounce off.
     pub bounce: f32,
-    /// How the bounce weighs its senders.
-    pub bounce_form: BounceForm,
     /// Where each pixel's kernel rotation comes from.
     pub noise: Noise,
     /// The resolution the occlusion runs at (half: per axis, then upsampled).
     pub resolution: Resolution,
-    /// Depth peeling for SSDO (Ritschel et al. 2009 §4): a second depth layer, and a sample
-    /// occludes only between the first and second layer (inside an object). Off by default.
-    pub depth_peeling: bool,
     /// Depth layers the occlusion reads, 1 or 2. With 2, where a second layer is given
     /// (the next surface behind the first, at least `layer_separation` behind it: the
     /// renderer's depth peel, or a host's), GTAO's (and SSDO's) samples occlude only
@@ -444,10 +410,8 @@ impl Default for AoSettings {
             bias: 0.02,
             range_check: true,
             bounce: 1.0,
-            bounce_form: BounceForm::Direction,
             noise: Noise::Halton,
             resolution: Resolution::Full,
-            depth_peeling: false,
             layers: 1,
             layer_separation: DEFAULT_LAYER_SEPARATION,
             denoise: Denoise::Tile,

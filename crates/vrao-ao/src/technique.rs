@@ -28,9 +28,13 @@ pub enum Technique {
     /// covered sectors (Ritschel et al. 2009 eq. 2 on sectors, Therrien et al. 2023).
     SsdoBounce,
     /// The seeds' point-sampled SSDO (Ritschel et al. 2009 eq. 1, a hemisphere of sample
-    /// points), kept as a measured baseline; vrao's renderer supplies its pass.
+    /// points), kept as a measured baseline; vrao's renderer supplies its pass (the engine
+    /// has none). Only with the `measurement` feature, not for hosts.
+    #[cfg(feature = "measurement")]
     SsdoPoints,
-    /// [`Technique::SsdoPoints`] plus the seeds' point-sampled bounce (eq. 2).
+    /// `SsdoPoints` plus the seeds' point-sampled bounce (eq. 2). Only with the
+    /// `measurement` feature, not for hosts.
+    #[cfg(feature = "measurement")]
     SsdoPointsBounce,
     /// Benchmark baseline, not an occlusion: SSAO's depth taps with no arithmetic. Only
     /// with the `measurement` feature (vrao's bench), not for hosts.
@@ -133,7 +137,7 @@ pub(crate) const TECHNIQUES: [TechniqueEntry; OCCLUSION_TECHNIQUES.len() + BASEL
 };
 
 /// The techniques that estimate something (and none).
-const OCCLUSION_TECHNIQUES: [TechniqueEntry; 8] = [
+const OCCLUSION_TECHNIQUES: [TechniqueEntry; 6] = [
     TechniqueEntry {
         technique: Technique::None,
         name: "none",
@@ -194,6 +198,12 @@ const OCCLUSION_TECHNIQUES: [TechniqueEntry; 8] = [
         foveation: FoveationRule::DirectionsThenSteps,
         engine_pass: true,
     },
+];
+
+/// What vrao's measurements compare against, with the `measurement` feature only: the
+/// seeds' point-sampled SSDO (its pass is the renderer's) and the bench's cost baseline.
+#[cfg(feature = "measurement")]
+const BASELINES: [TechniqueEntry; 3] = [
     TechniqueEntry {
         technique: Technique::SsdoPoints,
         name: "ssdo-points",
@@ -214,20 +224,17 @@ const OCCLUSION_TECHNIQUES: [TechniqueEntry; 8] = [
         foveation: FoveationRule::Samples,
         engine_pass: false,
     },
+    TechniqueEntry {
+        technique: Technique::FetchOnly,
+        name: "fetch-only",
+        help: "the benchmark baseline with SSAO's depth taps and no occlusion arithmetic",
+        kind: TechniqueKind::Baseline,
+        composite: CompositeMode::ScalarAo,
+        samples: SamplePattern::HemisphereCosine,
+        foveation: FoveationRule::Samples,
+        engine_pass: true,
+    },
 ];
-
-/// The bench's cost baselines, with the `measurement` feature only.
-#[cfg(feature = "measurement")]
-const BASELINES: [TechniqueEntry; 1] = [TechniqueEntry {
-    technique: Technique::FetchOnly,
-    name: "fetch-only",
-    help: "the benchmark baseline with SSAO's depth taps and no occlusion arithmetic",
-    kind: TechniqueKind::Baseline,
-    composite: CompositeMode::ScalarAo,
-    samples: SamplePattern::HemisphereCosine,
-    foveation: FoveationRule::Samples,
-    engine_pass: true,
-}];
 
 /// No baselines without the `measurement` feature.
 #[cfg(not(feature = "measurement"))]
@@ -294,7 +301,7 @@ impl Technique {
     /// Whether the technique gathers a bounce of direct light (`ssdo-bounce`,
     /// `ssdo-points-bounce`).
     pub fn gathers_bounce(self) -> bool {
-        matches!(self, Technique::SsdoBounce | Technique::SsdoPointsBounce)
+        self.without_bounce() != self
     }
 
     /// The same technique without its bounce (itself when it has none): what the bench
@@ -302,13 +309,14 @@ impl Technique {
     pub fn without_bounce(self) -> Technique {
         match self {
             Technique::SsdoBounce => Technique::Ssdo,
+            #[cfg(feature = "measurement")]
             Technique::SsdoPointsBounce => Technique::SsdoPoints,
             other => other,
         }
     }
 
-    /// Whether vrao's renderer supplies the technique's pass (the point-sampled SSDO,
-    /// which the AO engine does not run).
+    /// Whether vrao's renderer supplies the technique's pass (the point-sampled SSDO of
+    /// the `measurement` feature, which the AO engine does not run); never without it.
     pub fn renderer_only(self) -> bool {
         !self.entry().engine_pass && self.entry().kind == TechniqueKind::LightGathering
     }
@@ -361,7 +369,9 @@ mod tests {
             Technique::Gtao,
             Technique::Ssdo,
             Technique::SsdoBounce,
+            #[cfg(feature = "measurement")]
             Technique::SsdoPoints,
+            #[cfg(feature = "measurement")]
             Technique::SsdoPointsBounce,
             #[cfg(feature = "measurement")]
             Technique::FetchOnly,
@@ -372,11 +382,11 @@ mod tests {
                 | Technique::Hbao
                 | Technique::Gtao
                 | Technique::Ssdo
-                | Technique::SsdoBounce
-                | Technique::SsdoPoints
-                | Technique::SsdoPointsBounce => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
+                | Technique::SsdoBounce => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
                 #[cfg(feature = "measurement")]
-                Technique::FetchOnly => assert!(Technique::ALL.contains(&t), "{t:?} has no line"),
+                Technique::SsdoPoints | Technique::SsdoPointsBounce | Technique::FetchOnly => {
+                    assert!(Technique::ALL.contains(&t), "{t:?} has no line")
+                }
             }
         }
     }

@@ -25,4 +25,4 @@ pub use gpu::open::{open, BackendChoice};
 pub use headset::HeadsetProfile;
 pub use renderer::{FrameReport, Renderer};
 pub use scene::Scene;
-pub use settings::{Settings, StereoMode};
+pub use settings::{BounceForm, PointSsdoSettings, Settings, StereoMode};

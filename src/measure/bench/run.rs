@@ -226,7 +226,7 @@ fn check_options(scene: &Scene, base: &Settings, options: &BenchOptions, cases: 
     named_once("RSM sample counts", &options.rsm_samples)?;
     for case in cases {
         let mut s = base.clone();
-        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.resolution, s.ao.depth_peeling, s.ao.layers) = (
+        (s.ao.technique, s.ao.samples, s.ao.radius, s.ao.resolution, s.point_ssdo.depth_peeling, s.ao.layers) = (
             case.technique,
             case.samples,
             case.radius,

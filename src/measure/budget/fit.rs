@@ -38,6 +38,8 @@ pub struct BudgetOptions {
 pub struct Fit {
     /// The AO settings of the chosen row.
     pub ao: AoSettings,
+    /// Whether the chosen row's point-sampled SSDO peeled a second layer.
+    pub depth_peeling: bool,
     /// Doubts about the bench file (measured at another size).
     pub warnings: Vec<String>,
     /// Which row was chosen, and why ("fit: ...").
@@ -86,6 +88,7 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
         Some((file, path)) => {
             let fit = fit_setting(&file, path, &gpu, &settings, budget_ms, options.occlusion_only, measure)?;
             settings.ao = fit.ao.clone();
+            settings.point_ssdo.depth_peeling = fit.depth_peeling;
             Some(fit)
         }
         None => None,
@@ -140,8 +143,7 @@ pub fn fit_setting(
     ao.samples = chosen.samples;
     ao.radius = chosen.radius_m;
     ao.resolution = chosen.resolution;
-    ao.depth_peeling = chosen.depth_peeling;
-    Ok(Fit { ao, warnings, notes })
+    Ok(Fit { ao, depth_peeling: chosen.depth_peeling, warnings, notes })
 }
 
 /// The bench row with the least AO error among those at the bench radius nearest to

@@ -14,7 +14,7 @@
 //! gives it ([`AoFrame::light`]: the direct light per view, the environment's SH): the
 //! output's rgb is then the ambient irradiance (environment through the unoccluded
 //! directions plus one bounce) to multiply by albedo/π; without it SSDO is an AO
-//! technique. The point-sampled SSDO (`ssdo-points`) needs vrao's renderer.
+//! technique.
 //!
 //! Conventions (what [`AoFrame`] must hold): right-handed view space (x right, y up,
 //! looking down −z, as glam's `camera::rh::view::look_at_mat4`); perspective projections with clip w = −z
@@ -495,8 +495,8 @@ fn pipeline_errors_as_device<T>(gpu: &Gpu, record: impl FnOnce() -> T) -> Result
 pub(crate) const MAX_SIDE: u32 = 8192;
 
 /// The renderer settings the engine's passes read: the host's AO settings, its size as
-/// the profile's, and its near plane. The point-sampled SSDO is refused (see the
-/// module's notes).
+/// the profile's, and its near plane. A technique whose pass only vrao's renderer has
+/// (the `measurement` feature's point-sampled SSDO) is refused.
 fn host_settings(config: &AoConfig, near: f64) -> Result<ChainSettings> {
     if config.views == 0 || config.views > 2 {
         return Err(Error::input(format!("the AO engine renders 1 or 2 views, not {}", config.views)));

@@ -1,6 +1,6 @@
 //! Depth peeling (Ritschel et al. 2009 §4): a second depth layer per eye, the nearest
 //! surface behind the G-buffer's depth (peel.wgsl), the engine's `DEPTH_LAYER_2`. Two readers:
-//! - the point-sampled SSDO's quality mode (`ao.depth_peeling`), which counts a sample as
+//! - the point-sampled SSDO's quality mode (`point_ssdo.depth_peeling`), which counts a sample as
 //!   an occluder only between the first and second layer;
 //! - GTAO and SSDO on its bitmask with `ao.layers` = 2, whose samples then block the span
 //!   between the layers instead of a slab `gtao.thickness` deep. For them the layer keeps a
@@ -106,12 +106,13 @@ impl DepthPeelPass {
 
 impl Pass for DepthPeelPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
-        let ao = &settings_of(setup).ao;
+        let settings = settings_of(setup);
+        let (ao, depth_peeling) = (&settings.ao, settings.point_ssdo.depth_peeling);
         let ssdo = matches!(ao.technique, Technique::SsdoPoints | Technique::SsdoPointsBounce);
-        let peeled_ssdo = ssdo && ao.depth_peeling;
+        let peeled_ssdo = ssdo && depth_peeling;
         let two_layers = ao.layers == 2 && ao.technique.reads_second_layer();
         let name = ao.technique.name();
-        let reason = if ao.depth_peeling && !ssdo && ao.layers == 1 {
+        let reason = if depth_peeling && !ssdo && ao.layers == 1 {
             format!("technique is {name}: only the point-sampled SSDO peels (--depth-peeling), and --layers is 1")
         } else if ao.layers == 2 {
             format!("technique is {name}, which reads one depth layer")

@@ -9,8 +9,9 @@
 use super::direct::DIRECT;
 use super::settings_of;
 use crate::gpu::kernel::wgsl;
+use crate::settings::BounceForm;
 use vrao_ao::plug::{
-    bindings_and, technique_decl, Bind, BounceForm, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, COMMON,
+    bindings_and, technique_decl, Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, COMMON,
     DEPTH_LAYER_2, IRRADIANCE, OCCLUSION_WGSL, VISIBILITY,
 };
 use vrao_ao::Technique;
@@ -50,7 +51,8 @@ impl SsdoPass {
 
 impl Pass for SsdoPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
-        let ao = &settings_of(setup).ao;
+        let settings = settings_of(setup);
+        let ao = &settings.ao;
         let runs_for = [Technique::SsdoPoints, Technique::SsdoPointsBounce];
         let name = if ao.bounce_active() { Technique::SsdoPointsBounce.name() } else { Technique::SsdoPoints.name() };
         let mut decl = technique_decl(name, &BINDINGS, &runs_for, setup);
@@ -60,7 +62,7 @@ impl Pass for SsdoPass {
                 decl = decl.note("bounce left out: bounce strength is 0");
             }
         }
-        if ao.depth_peeling {
+        if settings.point_ssdo.depth_peeling {
             decl.note("depth peeling: occluders only between the first and second depth layer")
         } else {
             decl.unbind(DEPTH_LAYER_2)
@@ -68,13 +70,14 @@ impl Pass for SsdoPass {
     }
 
     fn record(&self, ctx: &mut RecordContext) {
-        let ao = &settings_of(ctx.setup).ao;
-        let form = match (ao.bounce_active(), ao.bounce_form) {
+        let settings = settings_of(ctx.setup);
+        let point_ssdo = settings.point_ssdo;
+        let form = match (settings.ao.bounce_active(), point_ssdo.bounce_form) {
             (false, _) => 0,
             (true, BounceForm::Direction) => 1,
             (true, BounceForm::Patch) => 2,
         };
-        let kernel = &self.kernels[ao.depth_peeling as usize][form];
+        let kernel = &self.kernels[point_ssdo.depth_peeling as usize][form];
         let resources = ctx.bind(&BINDINGS, &[]);
         kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.ao_extent());
     }
