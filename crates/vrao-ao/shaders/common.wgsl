@@ -1,5 +1,5 @@
-// Shared by every pass: the frame uniforms, the lights and the one depth → view-space
-// position helper (mirrors `stereo::view_position_from_depth`).
+// Shared by every pass: the frame uniforms and the one depth → view-space position
+// helper (mirrors `stereo::view_position_from_depth`).
 
 struct Eye {
     // Clip from the scene's anchor frame (geometry is stored relative to an f64 anchor).
@@ -19,10 +19,7 @@ struct Frame {
     eyes: array<Eye, 2>,
     size: vec2<u32>,
     layers: u32,
-    light_count: u32,
     near: f32,
-    exposure: f32,
-    white_point: f32,
     has_environment: u32,
     // The environment light as quadratic polynomials in a view-space direction,
     // [a, bx, by, bz, qxx, qyy, qzz, qxy, qxz, qyz] with rgb in xyz, turned into each
@@ -30,17 +27,6 @@ struct Frame {
     // of eye 0 and eye 1, then the pre-filtered radiance (SH bands 0 and 1, so its
     // second-order terms are 0) of eye 0 and eye 1 (SSDO); irradiance.wgsl reads them.
     environment_quadratics: array<array<vec4<f32>, 10>, 4>,
-};
-
-// A light in one eye's view space. kind: 0 directional (dir = direction light travels),
-// 1 point (pos = view-space position). radiance = colour × intensity.
-struct Light {
-    pos_or_dir: vec4<f32>,
-    radiance: vec4<f32>,
-    kind: vec4<u32>,
-    // Spot lights (kind.x == 2): the cone's view-space axis, and (cos outer, ramp scale).
-    spot_direction: vec4<f32>,
-    cone: vec4<f32>,
 };
 
 const PI: f32 = 3.14159265358979;

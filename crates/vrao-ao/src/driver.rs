@@ -102,12 +102,11 @@ pub struct GraphDriver<K> {
 }
 
 impl<K: Clone + PartialEq> GraphDriver<K> {
-    /// A driver whose uniforms hold up to `lights_per_view` lights per view, timing its
-    /// passes with `timer`.
-    pub fn new(gpu: &Gpu, lights_per_view: usize, timer: PassTimer) -> Self {
+    /// A driver timing its passes with `timer`.
+    pub fn new(gpu: &Gpu, timer: PassTimer) -> Self {
         GraphDriver {
             targets: GraphTargets::default(),
-            uniforms: FrameUniforms::new(&gpu.device, lights_per_view),
+            uniforms: FrameUniforms::new(&gpu.device),
             visibility: VisibilityMaps::new(gpu),
             timer,
             plan_cache: None,

@@ -23,7 +23,7 @@ pub use crate::gpu::layered_target::LayeredTarget;
 pub use crate::gpu::raster::{colour_and_depth_pass, fullscreen_pipeline, layer_views, uniform_entry};
 pub use crate::gpu::readback::{read_layers, read_layers_f32};
 pub use crate::gpu::timing::{FrameTiming, PassTimer};
-pub use crate::gpu::uniforms::{ao_extent, FrameLighting, FrameUniforms, LightUniform};
+pub use crate::gpu::uniforms::{ao_extent, FrameLighting, FrameUniforms};
 pub use crate::gpu::visibility::VisibilityMaps;
 pub use crate::gpu::{Capabilities, Gpu};
 

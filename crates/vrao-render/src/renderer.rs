@@ -169,7 +169,7 @@ impl Renderer {
             }
         };
         let gpu_scene = GpuScene::upload(&gpu, scene);
-        let driver = GraphDriver::new(&gpu, scene.lights.len(), PassTimer::new(&gpu)?);
+        let driver = GraphDriver::new(&gpu, PassTimer::new(&gpu)?);
         let passes = RendererPasses {
             scene: passes::scene_passes(&gpu, scene, &gpu_scene, driver.uniforms()),
             ao_chain: ao_chain(&gpu, vec![Box::new(passes::ssdo::SsdoPass::new(&gpu))]),
@@ -412,6 +412,7 @@ impl Renderer {
         let params = inputs.params(&extensions);
         let plan = driver.plan(settings, &passes.all(), &params, layers, outputs, &[])?;
         let lighting = ViewLighting::new(scene, gpu_scene.anchor, views, settings);
+        lighting.write(&gpu.queue, &gpu_scene.shading, views.len());
         driver.prepare(gpu, &plan, &params, &lighting.frame_lighting(), views);
         Ok(plan)
     }

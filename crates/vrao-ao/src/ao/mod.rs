@@ -213,7 +213,7 @@ impl AoEngine {
         let import = ImportPass::new(&gpu);
         let light_import = light::LightImportPass::new(&gpu);
         let pack = PackPass::new(&gpu);
-        let driver = GraphDriver::new(&gpu, 0, PassTimer::disabled(&gpu)?);
+        let driver = GraphDriver::new(&gpu, PassTimer::disabled(&gpu)?);
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("the AO engine's pipelines: {error}")));
         }

@@ -249,8 +249,6 @@ pub enum Bind {
     AoParams,
     /// The occlusion's hemisphere kernel (storage, read).
     SampleKernel,
-    /// Both eyes' lights (storage, read).
-    Lights,
     /// The scene's environment map (`texture_2d<f32>`, filterable).
     Environment,
     /// The environment's filtering sampler.
@@ -270,7 +268,7 @@ impl Bind {
     pub fn slot_in(self, chain: ChainLayout) -> Slot {
         match self {
             Bind::Frame | Bind::AoParams => Slot::Uniform,
-            Bind::SampleKernel | Bind::Lights => Slot::ReadBuffer,
+            Bind::SampleKernel => Slot::ReadBuffer,
             Bind::Environment => Slot::Texture2d,
             Bind::EnvironmentSampler => Slot::Sampler,
             Bind::Read(r) if r.format().is_depth_stencil_format() => Slot::Depth,

@@ -35,37 +35,17 @@ pub(crate) struct FrameUniform {
     pub size: [u32; 2],
     /// Layers of the targets: 2 for stereo, 1 for mono.
     pub layers: u32,
-    /// Lights per eye in the light buffer.
-    pub light_count: u32,
     /// Near plane in metres (reversed-Z, far plane at infinity).
     pub near: f32,
-    /// Linear exposure before tone mapping.
-    pub exposure: f32,
-    /// Reinhard's L_white: the smallest exposed luminance mapped to white.
-    pub white_point: f32,
     /// 1 when the scene has an environment light, else 0.
     pub has_environment: u32,
+    /// Places the quadratics at a multiple of 16 bytes, as WGSL aligns them.
+    pub padding: [u32; 3],
     /// The environment light as quadratics in each eye's view-space direction
     /// (`quadratic_in_view`; zero without an environment): [irradiance of eye 0, of
     /// eye 1 (`Environment::irradiance_quadratic`), pre-filtered radiance of eye 0, of
     /// eye 1 (`Environment::radiance_quadratic`, SSDO)].
     pub environment_quadratics: [[[f32; 4]; 10]; 4],
-}
-
-/// One light in one eye's view space (`Light` of common.wgsl; layout must match).
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub struct LightUniform {
-    /// Directional: the direction the light travels; point: view-space position (m).
-    pub pos_or_dir: [f32; 4],
-    /// Colour × intensity in rgb.
-    pub radiance: [f32; 4],
-    /// x: 0 directional, 1 point, 2 spot.
-    pub kind: [u32; 4],
-    /// Spot: the view-space unit direction of the cone's axis in xyz.
-    pub spot_direction: [f32; 4],
-    /// Spot: cos(outer cone) and the falloff ramp's scale (vrao-render's `scene::spot_ramp`).
-    pub cone: [f32; 4],
 }
 
 /// The occlusion passes' parameters (`AoParams` of common.wgsl; layout must match).
@@ -113,42 +93,31 @@ pub(crate) struct AoParamsUniform {
 pub(crate) const MAX_KERNEL_SAMPLES: usize = 256;
 
 /// What of a scene the frame uniforms carry: the anchor the geometry is stored relative
-/// to, the lights and the environment in each view's space, and the tone mapping. A
-/// renderer computes them from its scene for this frame's views; the AO engine has
-/// [`FrameLighting::NONE`].
+/// to and the environment in each view's space. A renderer computes them from its scene
+/// for this frame's views (its lights and tone mapping are its own); the AO engine has
+/// [`FrameLighting::NONE`] or the host's environment.
 #[derive(Clone, Copy)]
 pub struct FrameLighting<'a> {
     /// The f64 origin of the anchored frame.
     pub anchor: DVec3,
-    /// Each view's lights in its view space, the views one after the other (as many
-    /// per view as `lights.len() / views`).
-    pub lights: &'a [LightUniform],
     /// The environment's quadratics in each view's space, as
     /// `environment_quadratics` holds them; `None` without one.
     pub environment: Option<&'a [[[f32; 4]; 10]; 4]>,
-    /// Linear exposure before tone mapping.
-    pub exposure: f32,
-    /// Reinhard's L_white.
-    pub white_point: f32,
 }
 
 impl FrameLighting<'_> {
-    /// No lights, no environment, the world origin as the anchor (a host's views).
-    pub const NONE: FrameLighting<'static> =
-        FrameLighting { anchor: DVec3::ZERO, lights: &[], environment: None, exposure: 1.0, white_point: 4.0 };
+    /// No environment, the world origin as the anchor (a host's views).
+    pub const NONE: FrameLighting<'static> = FrameLighting { anchor: DVec3::ZERO, environment: None };
 }
 
-/// The uniform and light buffers of one frame.
+/// The uniform buffers of one frame.
 pub struct FrameUniforms {
     /// The `FrameUniform`.
     pub frame: wgpu::Buffer,
-    /// [`LightUniform`]s of both eyes (at least one element: wgpu rejects empty bindings).
-    pub lights: wgpu::Buffer,
     /// `AoParams` of common.wgsl.
     pub ao: wgpu::Buffer,
     /// The hemisphere kernel: one [x, y, z, length] per sample.
     pub kernel: wgpu::Buffer,
-    light_capacity: usize,
 }
 
 /// Occlusion targets' size: half per axis (rounded up, so odd sizes keep their last
@@ -162,21 +131,13 @@ pub fn ao_extent(width: u32, height: u32, half_res: bool) -> (u32, u32) {
 }
 
 impl FrameUniforms {
-    /// Allocates the buffers, with room for `light_count` lights per eye; the renderer fills them each frame.
-    pub fn new(device: &wgpu::Device, light_count: usize) -> FrameUniforms {
-        // Both eyes' copies; at least one element since wgpu rejects empty bindings.
-        let light_capacity = (light_count * 2).max(1);
+    /// Allocates the buffers; the driver fills them each frame.
+    pub fn new(device: &wgpu::Device) -> FrameUniforms {
         FrameUniforms {
             frame: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame uniforms"),
                 size: std::mem::size_of::<FrameUniform>() as u64,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            lights: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("lights"),
-                size: (light_capacity * std::mem::size_of::<LightUniform>()) as u64,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             ao: device.create_buffer(&wgpu::BufferDescriptor {
@@ -191,7 +152,6 @@ impl FrameUniforms {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            light_capacity,
         }
     }
 
@@ -245,9 +205,9 @@ impl FrameUniforms {
         queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
     }
 
-    /// Writes this frame's views (1 or 2), their lights and environment, and settings.
+    /// Writes this frame's views (1 or 2), their environment, and settings.
     pub fn update(&self, queue: &wgpu::Queue, lighting: &FrameLighting, views: &[Eye], settings: &ChainSettings) {
-        let FrameLighting { anchor, lights, environment, exposure, white_point } = *lighting;
+        let FrameLighting { anchor, environment } = *lighting;
         let to_cols = |m: Mat4| m.to_cols_array_2d();
         let mut eyes = [EyeUniform::zeroed(); 2];
         for (index, (slot, eye)) in eyes.iter_mut().zip(views).enumerate() {
@@ -261,23 +221,16 @@ impl FrameUniforms {
                 other_from_view: to_cols(other_from_view(views, index)),
             };
         }
-        let light_count = lights.len().checked_div(views.len()).unwrap_or(0);
-        debug_assert!(lights.len() <= self.light_capacity, "more lights than FrameUniforms::new made room for");
         let uniform = FrameUniform {
             eyes,
             size: [settings.width, settings.height],
             layers: views.len() as u32,
-            light_count: light_count as u32,
             near: settings.near as f32,
-            exposure,
-            white_point,
             has_environment: environment.is_some() as u32,
+            padding: [0; 3],
             environment_quadratics: environment.copied().unwrap_or([[[0.0; 4]; 10]; 4]),
         };
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniform));
-        if !lights.is_empty() {
-            queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
-        }
     }
 }
 
@@ -318,8 +271,7 @@ mod tests {
         #[rustfmt::skip]
         layout_check::check(&[
             mirror!(EyeUniform, [COMMON], "Eye", [clip_from_anchored, view_from_anchored, world_from_view, tangents, other_from_view]),
-            mirror!(FrameUniform, [COMMON], "Frame", [eyes, size, layers, light_count, near, exposure, white_point, has_environment, environment_quadratics]),
-            mirror!(LightUniform, [COMMON], "Light", [pos_or_dir, radiance, kind, spot_direction, cone]),
+            mirror!(FrameUniform, [COMMON], "Frame", [eyes, size, layers, near, has_environment, padding, environment_quadratics]),
             mirror!(AoParamsUniform, [COMMON], "AoParams", [ao_size, scale, samples, directions, steps, technique, noise, radius, strength, bias, range_check, bounce, frame_angle, blur_radius, blur_plane_sigma, range_scale, padding]),
         ]);
     }

@@ -160,7 +160,6 @@ impl<'a> RecordContext<'a> {
                 Bind::Frame => self.frame.frame.as_entire_binding(),
                 Bind::AoParams => self.frame.ao.as_entire_binding(),
                 Bind::SampleKernel => self.frame.kernel.as_entire_binding(),
-                Bind::Lights => self.frame.lights.as_entire_binding(),
                 Bind::Environment => wgpu::BindingResource::TextureView(self.environment().0),
                 Bind::EnvironmentSampler => wgpu::BindingResource::Sampler(self.environment().1),
                 Bind::Read(r) | Bind::Write(r) => self.view(r),

@@ -11,6 +11,7 @@
 use super::kernel::wgsl;
 use super::raster::{DrawKind, MeshPipelines};
 use super::textures::{self, Encoding, Samplers};
+use crate::lighting::ShadingBuffers;
 use crate::scene::{Environment, Material, Scene, Texture};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
@@ -145,6 +146,8 @@ pub struct GpuScene {
     pub environment: wgpu::TextureView,
     /// Sampler of the environment (repeats around, clamps at the poles).
     pub sampler: wgpu::Sampler,
+    /// The lights and the tone mapping, written each frame in the views' space.
+    pub shading: ShadingBuffers,
 }
 
 impl GpuScene {
@@ -230,6 +233,7 @@ impl GpuScene {
             normal_mapped,
             environment: environment_texture(gpu, scene.environment.as_ref()),
             sampler: bindings.sampler,
+            shading: ShadingBuffers::new(device, scene.lights.len()),
         }
     }
 }

@@ -16,6 +16,7 @@
 @group(0) @binding(7) var<uniform> shadows: Shadows;
 @group(0) @binding(8) var shadow_map: texture_depth_2d_array;
 @group(0) @binding(9) var shadow_sampler: sampler_comparison;
+@group(0) @binding(10) var<uniform> shading: Shading;
 
 // Fraction of directional light `i` reaching view-space `position` (normal `n`) of `eye`:
 // its shadow map's 3×3 PCF when it has one, else 1.
@@ -52,8 +53,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         n = textureLoad(normal_layers, p, i32(layer), 0).xyz;
         let albedo = textureLoad(albedo_layers, p, i32(layer), 0).rgb;
         var irradiance = vec3<f32>(0.0);
-        for (var i = 0u; i < frame.light_count; i++) {
-            let light = lights[layer * frame.light_count + i];
+        for (var i = 0u; i < shading.light_count; i++) {
+            let light = lights[layer * shading.light_count + i];
             if (light.kind.x == 0u) {
                 let cos_l = max(dot(n, -light.pos_or_dir.xyz), 0.0);
                 if (cos_l > 0.0) {

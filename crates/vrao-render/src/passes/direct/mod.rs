@@ -5,8 +5,9 @@
 
 use super::gbuffer::{ALBEDO, EMISSION, LIGHTING_NORMALS};
 use super::shadow::{shadows_active, LightSpace, SHADOW_MAP, SHADOW_WGSL};
-use super::{scene_of, settings_of};
+use super::{gpu_scene_of, scene_of, settings_of};
 use crate::gpu::kernel::wgsl;
+use crate::lighting::LIGHTING_WGSL;
 use std::sync::Arc;
 use vrao_ao::plug::{
     Bind, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource, Slot, COMMON, DEPTH, VISIBILITY,
@@ -21,11 +22,12 @@ pub const NAME: &str = "direct";
 /// the depth test plus sender radiance of SSDO's bounce in a single fetch.
 pub const DIRECT: Resource = vrao_ao::plug::DIRECT_LIGHT;
 
-/// direct.wgsl's bindings: the G-buffer in, the direct light out, and the shadows
-/// (their `Shadows` uniform, every light's map, the comparison sampler).
-const BINDINGS: [Bind; 10] = [
+/// direct.wgsl's bindings: the lights, the G-buffer in, the direct light out, the
+/// shadows (their `Shadows` uniform, every light's map, the comparison sampler) and the
+/// lights' count (`Shading`).
+const BINDINGS: [Bind; 11] = [
     Bind::Frame,
-    Bind::Lights,
+    Bind::Own(Slot::ReadBuffer),
     Bind::Read(DEPTH),
     Bind::Read(LIGHTING_NORMALS),
     Bind::Read(ALBEDO),
@@ -34,6 +36,7 @@ const BINDINGS: [Bind; 10] = [
     Bind::Own(Slot::Uniform),
     Bind::Read(SHADOW_MAP),
     Bind::Own(Slot::ComparisonSampler),
+    Bind::Own(Slot::Uniform),
 ];
 
 /// Direct light of every light, shadowed where shadow maps exist (module docs).
@@ -45,7 +48,7 @@ pub struct DirectLightPass {
 impl DirectLightPass {
     /// Builds the pass's pipelines.
     pub fn new(gpu: &Gpu, light_space: Arc<LightSpace>) -> Self {
-        let files = [COMMON, VISIBILITY, SHADOW_WGSL, wgsl!("src/passes/direct/direct.wgsl")];
+        let files = [COMMON, VISIBILITY, LIGHTING_WGSL, SHADOW_WGSL, wgsl!("src/passes/direct/direct.wgsl")];
         DirectLightPass { kernel: Kernel::new(gpu, "direct", &files, "main", &BINDINGS), light_space }
     }
 }
@@ -64,7 +67,13 @@ impl Pass for DirectLightPass {
         // Shadows (shadow.wgsl): every light's map, or no light and a placeholder map.
         let shadowed = shadows_active(scene_of(ctx.setup), settings_of(ctx.setup));
         let shadows = if shadowed { &self.light_space.uniform } else { &self.light_space.none };
-        let own = [shadows.as_entire_binding(), wgpu::BindingResource::Sampler(&self.light_space.comparison)];
+        let shading = &gpu_scene_of(ctx.setup).shading;
+        let own = [
+            shading.lights.as_entire_binding(),
+            shadows.as_entire_binding(),
+            wgpu::BindingResource::Sampler(&self.light_space.comparison),
+            shading.shading.as_entire_binding(),
+        ];
         let resources = ctx.bind(&BINDINGS, &own);
         self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.extent());
     }

@@ -4,6 +4,7 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var hdr_layers: texture_2d_array<f32>;
 @group(0) @binding(2) var color_out: texture_storage_2d_array<rgba8unorm, write>;
+@group(0) @binding(3) var<uniform> shading: Shading;
 
 fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
@@ -22,9 +23,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let p = vec2<i32>(id.xy);
     let hdr = max(finite_or_zero3(textureLoad(hdr_layers, p, i32(id.z), 0).rgb), vec3<f32>(0.0));
-    let scaled = hdr * frame.exposure;
+    let scaled = hdr * shading.exposure;
     let l = luminance(scaled);
-    let white2 = frame.white_point * frame.white_point;
+    let white2 = shading.white_point * shading.white_point;
     // L_d = L (1 + L / L_white²) / (1 + L); colour keeps its chromaticity.
     let ld = l * (1.0 + l / white2) / (1.0 + l);
     var ldr = vec3<f32>(0.0);
