@@ -838,8 +838,20 @@ fn layered_ao(
     samples: u32,
     second: Second,
 ) -> vrao_ao::Result<(Vec<Vec<f32>>, vrao_ao::Plan)> {
+    layered_ao_in(gpu, ao, meshes, (eyes, HostDepth::ReversedInfinite), samples, second)
+}
+
+/// [`layered_ao`] with the host's depth stored as `kind` says.
+fn layered_ao_in(
+    gpu: &vrao_ao::plug::Gpu,
+    ao: &AoSettings,
+    meshes: &[host::HostMesh],
+    (eyes, kind): (&[Eye], HostDepth),
+    samples: u32,
+    second: Second,
+) -> vrao_ao::Result<(Vec<Vec<f32>>, vrao_ao::Plan)> {
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let (kind, views) = (HostDepth::ReversedInfinite, eyes.len() as u32);
+    let views = eyes.len() as u32;
     let prepass = |meshes| DepthPrepass::multisampled(device, meshes, kind, (WIDTH, HEIGHT), views, samples);
     let first = prepass(meshes);
     let back = matches!(second, Second::BackFaces).then(|| prepass(meshes).back_faces(device));
@@ -853,7 +865,10 @@ fn layered_ao(
     }
     let frame = AoFrame {
         depth: &first.depth,
-        depth_convention: DepthConvention::REVERSED_INFINITE,
+        depth_convention: match kind {
+            HostDepth::ReversedInfinite => DepthConvention::REVERSED_INFINITE,
+            HostDepth::StandardFinite { .. } => DepthConvention::STANDARD_FINITE,
+        },
         second_layer: match second {
             Second::None => None,
             Second::BackFaces => back.as_ref().map(|b| &b.depth),
@@ -879,7 +894,7 @@ fn layered_ao(
 /// shelf or a table top: one layer's slab behind the board reaches the floor.
 fn demo_with_board() -> Vec<host::HostMesh> {
     let mut meshes = demo_geometry();
-    meshes.push(host::cuboid(glam::Vec3::new(-0.6, 0.18, -1.5), glam::Vec3::new(0.6, 0.02, 0.5)));
+    meshes.push(host::cuboid(glam::Vec3::new(-0.4, 0.2, -1.2), glam::Vec3::new(1.0, 0.02, 0.8)));
     meshes
 }
 
@@ -912,7 +927,8 @@ fn a_host_second_layer_frees_the_floor_around_a_thin_board_as_the_renderer_s_pee
     assert!(gtao_note.is_some_and(|n| n.contains("two depth layers")), "{plan}");
 
     let size = (WIDTH, HEIGHT);
-    let around_board = around(&covered_pixels(&gpu, &meshes, &demo_geometry(), size), size, 6);
+    let covered = covered_pixels(&gpu, &meshes, &demo_geometry(), size);
+    let around_board = around(&covered, size, 3);
     let (one_mean, two_mean) = (mean_where(&one, &around_board), mean_where(&two, &around_board));
     eprintln!("around the board: mean AO {one_mean:.3} with one layer, {two_mean:.3} with the host's second");
     assert!(two_mean > one_mean + 0.03, "the second layer must free the floor around the board");
@@ -926,7 +942,13 @@ fn a_host_second_layer_frees_the_floor_around_a_thin_board_as_the_renderer_s_pee
     let (same_peel, own_peel) = (rmse(&over_peel, &reference), rmse(&two, &reference));
     eprintln!("two layers against the renderer's: RMSE {same_peel:.2e} over its peel, {own_peel:.2e} over the host's");
     assert!(same_peel <= 1e-3, "the engine over the renderer's peel: RMSE {same_peel}");
-    assert!(own_peel <= 0.01, "the engine over the host's peel: RMSE {own_peel}");
+    assert!(own_peel <= 5e-3, "the engine over the host's peel: RMSE {own_peel}");
+    // The same peel in standard-Z Depth24Plus (nothing behind at 1, not 0).
+    let standard = (&eyes()[..], HostDepth::StandardFinite { far: 50.0 });
+    let (standard, _) = layered_ao_in(&gpu, &two_layers, &meshes, standard, 1, Second::BackFaces).unwrap();
+    let error = rmse(&standard, &two);
+    eprintln!("two layers, standard-Z Depth24Plus against reversed-Z Depth32Float: RMSE {error:.4}");
+    assert!(error <= 5e-3, "standard-Z: RMSE {error}");
     gpu.take_error().unwrap();
 }
 
@@ -1041,17 +1063,17 @@ fn cleared_colour(device: &wgpu::Device, format: wgpu::TextureFormat) -> wgpu::T
 }
 
 /// A multisampled host's second layer is read at the sample its depth's resolve took:
-/// away from silhouettes the two-layer AO is the single-sampled one.
+/// away from silhouettes the two-layer AO is the single-sampled one, and the second
+/// layer changes the AO as much as it does single-sampled.
 #[test]
 fn a_multisampled_second_layer_gives_the_single_sample_ao_away_from_silhouettes() {
     let (gpu, _lock) = common::gpu();
     let meshes = demo_with_board();
-    let two_layers = AoSettings { layers: 2, ..AoSettings::default() };
+    let (one_layer, two_layers) = (AoSettings::default(), AoSettings { layers: 2, ..AoSettings::default() });
     let eye = &eyes()[..1];
-    let (single, _) = layered_ao(&gpu, &two_layers, &meshes, eye, 1, Second::BackFaces).unwrap();
-    let (multi, plan) = layered_ao(&gpu, &two_layers, &meshes, eye, 4, Second::BackFaces).unwrap();
-    assert!(plan.resources.contains(&DEPTH_LAYER_2), "{plan}");
-    let (one, _) = layered_ao(&gpu, &AoSettings::default(), &meshes, eye, 4, Second::None).unwrap();
+    let run = |ao, samples, second| layered_ao(&gpu, ao, &meshes, eye, samples, second).unwrap().0;
+    let (single, single_one) = (run(&two_layers, 1, Second::BackFaces), run(&one_layer, 1, Second::None));
+    let (multi, multi_one) = (run(&two_layers, 4, Second::BackFaces), run(&one_layer, 4, Second::None));
     let prepass = DepthPrepass::with_layers(&gpu.device, &meshes, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     prepass.record(&gpu.device, &mut encoder, &host_views(eye, HostDepth::ReversedInfinite));
@@ -1060,8 +1082,15 @@ fn a_multisampled_second_layer_gives_the_single_sample_ao_away_from_silhouettes(
     let away: Vec<Vec<bool>> =
         vec![near_silhouettes(&read_layers_f32(&gpu, &depth).unwrap()[0]).iter().map(|e| !e).collect()];
     let error = rmse_where(&multi, &single, &away);
-    let layers_apart = rmse_where(&multi, &one, &away);
-    eprintln!("4x MSAA two layers against 1x away from silhouettes: RMSE {error:.4} (one layer: {layers_apart:.4})");
-    assert!(error <= 0.01 && layers_apart > 2.0 * error, "RMSE {error}, {layers_apart} from one layer");
+    let (effect_multi, effect_single) = (rmse(&multi, &multi_one), rmse(&single, &single_one));
+    eprintln!(
+        "4x MSAA two layers against 1x away from silhouettes: RMSE {error:.4}; the second layer changes the AO by \
+         RMSE {effect_multi:.4} at 4x, {effect_single:.4} at 1x"
+    );
+    assert!(error <= 0.01, "4x against 1x away from silhouettes: RMSE {error}");
+    assert!(
+        effect_single > 0.01 && (effect_multi / effect_single - 1.0).abs() < 0.5,
+        "{effect_multi} vs {effect_single}"
+    );
     gpu.take_error().unwrap();
 }
