@@ -1032,19 +1032,18 @@ fn a_bad_second_layer_is_a_typed_error_naming_it() {
     let small = DepthPrepass::new(device, &meshes, HostDepth::ReversedInfinite, (WIDTH, HEIGHT / 2));
     // Checked whether or not this frame reads it.
     for ao in [&two_layers, &AoSettings::default()] {
-        let e = layered_ao(&gpu, ao, &meshes, &eyes(), 1, Second::Given(&small.depth)).err().expect("another size");
+        let e = layered_ao(&gpu, ao, &meshes, &eyes(), 1, Second::Given(&small.depth)).expect_err("another size");
         assert!(matches!(e, Error::Input { .. }), "{e}");
         assert!(e.to_string().contains("second layer") && e.to_string().contains("does not match"), "{e}");
     }
     let colour = cleared_colour(device, wgpu::TextureFormat::R32Float);
-    let e = layered_ao(&gpu, &two_layers, &meshes, &eyes(), 1, Second::Given(&colour)).err().expect("a colour format");
+    let e = layered_ao(&gpu, &two_layers, &meshes, &eyes(), 1, Second::Given(&colour)).expect_err("a colour format");
     assert!(e.to_string().contains("second layer: format R32Float"), "{e}");
     // A multisampled second layer behind a single-sampled depth (one view: a multisampled
     // array needs a device feature).
     let multi = DepthPrepass::multisampled(device, &meshes, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1, 4);
     let e = layered_ao(&gpu, &two_layers, &meshes, &eyes()[..1], 1, Second::Given(&multi.depth))
-        .err()
-        .expect("another sample count");
+        .expect_err("another sample count");
     assert!(e.to_string().contains("second layer: sample count 4 where the depth's is 1"), "{e}");
 }
 
