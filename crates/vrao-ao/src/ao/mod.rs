@@ -8,8 +8,9 @@
 //!
 //! What the engine runs, in order: [`import`] (the host's depth in any convention into
 //! reversed-Z infinite-far `Depth32Float`, likewise its second depth layer when two are
-//! read, and its normals, or normals rebuilt from the depth, into view space), the chosen technique, temporal accumulation, the denoise and
-//! the upsampling from half resolution, each left out when the settings do not need it.
+//! read, and its normals, or normals rebuilt from the depth, into view space), the chosen
+//! technique, temporal accumulation, the denoise and the upsampling from half resolution,
+//! each left out when the settings do not need it.
 //! SSDO (`ssdo`, `ssdo-bounce`) gathers the host's light beside the AO when the frame
 //! gives it ([`AoFrame::light`]: the direct light per view, the environment's SH): the
 //! output's rgb is then the ambient irradiance (environment through the unoccluded
@@ -135,7 +136,7 @@ pub struct AoFrame<'a> {
     /// as a peel cleared to the far plane leaves it; the thickness then stays, as it
     /// does wherever the second layer does not lie behind the first. The engine does not
     /// peel: a minimum separation behind the first (`AoSettings::layer_separation`, the
-    /// renderer's) is the host's peel's to keep.
+    /// renderer's) is the host's peel's to keep. Checked whenever given.
     pub second_layer: Option<&'a wgpu::Texture>,
     /// The host's normals, or `None` to rebuild them from the depth.
     pub normals: Option<HostNormals<'a>>,
