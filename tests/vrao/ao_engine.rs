@@ -8,7 +8,7 @@ mod host;
 
 use glam::DVec3;
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
-use vrao_ao::plug::{read_layers_f32, LayeredTarget, FINAL_AO};
+use vrao_ao::plug::{read_layers_f32, LayeredTarget, DEPTH_LAYER_2, FINAL_AO};
 use vrao_ao::Error;
 use vrao_ao::{
     AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostMotion, HostNormals, NormalEncoding, NormalSpace,
@@ -54,7 +54,12 @@ fn host_views(eyes: &[Eye], depth: HostDepth) -> Vec<ViewMatrices> {
 
 /// The same geometry as a vrao scene, for the renderer.
 fn scene() -> vrao_render::Scene {
-    let meshes = demo_geometry()
+    scene_of(demo_geometry())
+}
+
+/// The host's `meshes` as a vrao scene.
+fn scene_of(meshes: Vec<host::HostMesh>) -> vrao_render::Scene {
+    let meshes = meshes
         .into_iter()
         .enumerate()
         .map(|(i, m)| Mesh {
@@ -107,6 +112,7 @@ fn engine_ao(gpu: &vrao_ao::plug::Gpu, ao: &AoSettings, depth: HostDepth, with_n
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: convention,
+        second_layer: None,
         normals: with_normals.then_some(normals),
         views: &views,
         motion: None,
@@ -208,6 +214,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
     let frame = AoFrame {
         depth: &small.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: None,
         views: &views,
         motion: None,
@@ -221,6 +228,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
     let frame = AoFrame {
         depth: &right.depth,
         depth_convention: DepthConvention::STANDARD_FINITE,
+        second_layer: None,
         normals: None,
         views: &views,
         motion: None,
@@ -235,6 +243,7 @@ fn bad_host_input_is_a_typed_error_naming_it() {
     let frame = AoFrame {
         depth: &right.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: None,
         views: &scaled,
         motion: None,
@@ -289,6 +298,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
             let frame = AoFrame {
                 depth: &prepass.depth,
                 depth_convention: DepthConvention::REVERSED_INFINITE,
+                second_layer: None,
                 normals: None,
                 views: &views,
                 motion,
@@ -320,6 +330,7 @@ fn host_motion_vectors_reach_temporal_accumulation() {
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: None,
         views: &views,
         motion: Some(HostMotion { texture: &small, to_previous_uv: [1.0, 1.0] }),
@@ -343,6 +354,7 @@ fn reversed_z_frame(
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: None,
         views,
         motion: None,
@@ -491,6 +503,7 @@ fn ssdo_in_the_engine_gathers_the_host_s_light_beside_gtao_s_ao() {
         let frame = AoFrame {
             depth: &prepass.depth,
             depth_convention: DepthConvention::REVERSED_INFINITE,
+            second_layer: None,
             normals: Some(normals),
             views: &views,
             motion: None,
@@ -561,6 +574,7 @@ fn mono_engine_output(
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: with_normals.then_some(normals),
         views: &views,
         motion: None,
@@ -623,6 +637,7 @@ fn multisampled_inputs_the_engine_does_not_resolve_are_refused_naming_them() {
     let frame = AoFrame {
         depth: &multi.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: Some(mixed),
         views: &views,
         motion: None,
@@ -667,6 +682,7 @@ fn excluded_ao(
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
         normals: Some(normals),
         views: &views,
         motion: None,
@@ -799,4 +815,281 @@ fn a_hand_marked_cast_none_leaves_the_table_as_without_it_and_receive_none_gives
     }
     let nothing_marked = excluded_ao(&gpu, &with_hand, size, Some((&covered, r8, 4, 8)));
     assert_eq!(nothing_marked, hand_casting, "bits that mark no pixel leave the AO bit-identical");
+}
+
+/// The host's second depth layer in a test.
+#[derive(Clone, Copy)]
+enum Second<'a> {
+    None,
+    /// The host's prepass of the same meshes drawing back faces: its depth peel of closed
+    /// meshes.
+    BackFaces,
+    /// A texture of the host's own.
+    Given(&'a wgpu::Texture),
+}
+
+/// One engine frame (reversed-Z depth and host normals drawn with `samples` per pixel)
+/// over `meshes` seen from `eyes`, with `second`: each view's AO and the frame's plan.
+fn layered_ao(
+    gpu: &vrao_ao::plug::Gpu,
+    ao: &AoSettings,
+    meshes: &[host::HostMesh],
+    eyes: &[Eye],
+    samples: u32,
+    second: Second,
+) -> vrao_ao::Result<(Vec<Vec<f32>>, vrao_ao::Plan)> {
+    layered_ao_in(gpu, ao, meshes, (eyes, HostDepth::ReversedInfinite), samples, second)
+}
+
+/// [`layered_ao`] with the host's depth stored as `kind` says.
+fn layered_ao_in(
+    gpu: &vrao_ao::plug::Gpu,
+    ao: &AoSettings,
+    meshes: &[host::HostMesh],
+    (eyes, kind): (&[Eye], HostDepth),
+    samples: u32,
+    second: Second,
+) -> vrao_ao::Result<(Vec<Vec<f32>>, vrao_ao::Plan)> {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let views = eyes.len() as u32;
+    let prepass = |meshes| DepthPrepass::multisampled(device, meshes, kind, (WIDTH, HEIGHT), views, samples);
+    let first = prepass(meshes);
+    let back = matches!(second, Second::BackFaces).then(|| prepass(meshes).back_faces(device));
+    let matrices = host_views(eyes, kind);
+    let config = AoConfig { settings: ao.clone(), width: WIDTH, height: HEIGHT, views };
+    let mut engine = AoEngine::new(device, queue, &config)?;
+    let mut encoder = device.create_command_encoder(&Default::default());
+    first.record(device, &mut encoder, &matrices);
+    if let Some(back) = &back {
+        back.record(device, &mut encoder, &matrices);
+    }
+    let frame = AoFrame {
+        depth: &first.depth,
+        depth_convention: match kind {
+            HostDepth::ReversedInfinite => DepthConvention::REVERSED_INFINITE,
+            HostDepth::StandardFinite { .. } => DepthConvention::STANDARD_FINITE,
+        },
+        second_layer: match second {
+            Second::None => None,
+            Second::BackFaces => back.as_ref().map(|b| &b.depth),
+            Second::Given(texture) => Some(texture),
+        },
+        normals: Some(HostNormals {
+            texture: &first.normals,
+            space: NormalSpace::View,
+            encoding: NormalEncoding::Signed,
+        }),
+        views: &matrices,
+        motion: None,
+        light: None,
+        exclusion: None,
+    };
+    let texture = engine.record(&mut encoder, &frame)?.texture.clone();
+    queue.submit([encoder.finish()]);
+    let ao = (0..views).map(|layer| host::read_alpha(device, queue, &texture, layer)).collect();
+    Ok((ao, engine.last_plan().unwrap().clone()))
+}
+
+/// The demo room with a thin board (60 × 2 × 50 cm) hovering 17 cm over the floor, as a
+/// shelf or a table top: one layer's slab behind the board reaches the floor.
+fn demo_with_board() -> Vec<host::HostMesh> {
+    let mut meshes = demo_geometry();
+    meshes.push(host::cuboid(glam::Vec3::new(-0.4, 0.2, -1.2), glam::Vec3::new(1.0, 0.02, 0.8)));
+    meshes
+}
+
+/// The mean of `ao` over the pixels `region` marks.
+fn mean_where(ao: &[Vec<f32>], region: &[Vec<bool>]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (ao, region) in ao.iter().zip(region) {
+        for (a, _) in ao.iter().zip(region).filter(|(_, inside)| **inside) {
+            sum += f64::from(*a);
+            n += 1;
+        }
+    }
+    assert!(n > 100, "the region holds {n} pixels");
+    sum / n as f64
+}
+
+/// Two layers ([`AoFrame::second_layer`]): the host's peel of a thin board over the floor
+/// frees the floor around it that one layer's slab darkens, and the engine over the
+/// renderer's own peeled layer gives the renderer's two-layer AO.
+#[test]
+fn a_host_second_layer_frees_the_floor_around_a_thin_board_as_the_renderer_s_peel_does() {
+    let (gpu, _lock) = common::gpu();
+    let meshes = demo_with_board();
+    let one_layer = AoSettings::default();
+    let two_layers = AoSettings { layers: 2, ..AoSettings::default() };
+    let (one, _) = layered_ao(&gpu, &one_layer, &meshes, &eyes(), 1, Second::None).unwrap();
+    let (two, plan) = layered_ao(&gpu, &two_layers, &meshes, &eyes(), 1, Second::BackFaces).unwrap();
+    assert!(plan.resources.contains(&DEPTH_LAYER_2), "{plan}");
+    let gtao_note = plan.notes.iter().find(|(pass, _)| *pass == "gtao").map(|(_, note)| note.as_str());
+    assert!(gtao_note.is_some_and(|n| n.contains("two depth layers")), "{plan}");
+
+    let size = (WIDTH, HEIGHT);
+    let covered = covered_pixels(&gpu, &meshes, &demo_geometry(), size);
+    let around_board = around(&covered, size, 3);
+    let (one_mean, two_mean) = (mean_where(&one, &around_board), mean_where(&two, &around_board));
+    eprintln!("around the board: mean AO {one_mean:.3} with one layer, {two_mean:.3} with the host's second");
+    assert!(two_mean > one_mean + 0.03, "the second layer must free the floor around the board");
+
+    let mut renderer = Renderer::new(gpu.clone(), &scene_of(meshes.clone()), &settings(&two_layers)).unwrap();
+    renderer.render_and_wait(&eyes(), &[FINAL_AO]).unwrap();
+    let reference: Vec<Vec<f32>> =
+        renderer.read_f32(FINAL_AO).unwrap().iter().map(|layer| layer.chunks(4).map(|t| t[3]).collect()).collect();
+    let peeled = &renderer.target(DEPTH_LAYER_2).expect("the renderer peeled").texture;
+    let (over_peel, _) = layered_ao(&gpu, &two_layers, &meshes, &eyes(), 1, Second::Given(peeled)).unwrap();
+    let (same_peel, own_peel) = (rmse(&over_peel, &reference), rmse(&two, &reference));
+    eprintln!("two layers against the renderer's: RMSE {same_peel:.2e} over its peel, {own_peel:.2e} over the host's");
+    assert!(same_peel <= 1e-3, "the engine over the renderer's peel: RMSE {same_peel}");
+    assert!(own_peel <= 5e-3, "the engine over the host's peel: RMSE {own_peel}");
+    // The same peel in standard-Z Depth24Plus (nothing behind at 1, not 0).
+    let standard = (&eyes()[..], HostDepth::StandardFinite { far: 50.0 });
+    let (standard, _) = layered_ao_in(&gpu, &two_layers, &meshes, standard, 1, Second::BackFaces).unwrap();
+    let error = rmse(&standard, &two);
+    eprintln!("two layers, standard-Z Depth24Plus against reversed-Z Depth32Float: RMSE {error:.4}");
+    assert!(error <= 5e-3, "standard-Z: RMSE {error}");
+    gpu.take_error().unwrap();
+}
+
+/// A host's second layer holding the far value everywhere (nothing behind), two layers
+/// asked for without one, and one given with one layer asked for: each is one layer's AO.
+#[test]
+fn a_second_layer_with_nothing_behind_or_none_read_is_one_layer() {
+    let (gpu, _lock) = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let meshes = demo_with_board();
+    let one_layer = AoSettings::default();
+    let (one, plan) = layered_ao(&gpu, &one_layer, &meshes, &eyes(), 1, Second::None).unwrap();
+    assert!(!plan.resources.contains(&DEPTH_LAYER_2), "{plan}");
+
+    // Asked for, not given: the plan says so and the march is one layer's, to the bit.
+    let two_layers = AoSettings { layers: 2, ..AoSettings::default() };
+    let (not_given, plan) = layered_ao(&gpu, &two_layers, &meshes, &eyes(), 1, Second::None).unwrap();
+    let import_note = plan.notes.iter().find(|(pass, _)| *pass == "ao-import").map(|(_, note)| note.as_str());
+    assert!(import_note.is_some_and(|n| n.contains("no second layer")), "{plan}");
+    assert!(not_given == one, "two layers without the host's second must be one layer's AO");
+    // Given, not asked for: not read.
+    let (not_asked, plan) = layered_ao(&gpu, &one_layer, &meshes, &eyes(), 1, Second::BackFaces).unwrap();
+    assert!(!plan.resources.contains(&DEPTH_LAYER_2) && not_asked == one, "{plan}");
+
+    // Read, holding nothing: the thickness stays everywhere. Two layers join samples by
+    // their own `connect`, so it is set to one layer's for the comparison.
+    let mut nothing_behind = two_layers.clone();
+    nothing_behind.gtao.connect_two_layers = nothing_behind.gtao.connect;
+    let far = cleared_depth(device, queue, wgpu::TextureFormat::Depth32Float, 0.0);
+    let (empty, plan) = layered_ao(&gpu, &nothing_behind, &meshes, &eyes(), 1, Second::Given(&far)).unwrap();
+    assert!(plan.resources.contains(&DEPTH_LAYER_2), "{plan}");
+    let worst = empty.iter().flatten().zip(one.iter().flatten()).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
+    eprintln!("a second layer with nothing behind against one layer: largest difference {worst:e}");
+    assert!(worst <= 1e-3, "a second layer with nothing behind differs from one layer by {worst}");
+    gpu.take_error().unwrap();
+}
+
+/// A 2-layer depth texture of `format` at the engine's size, cleared to `value`.
+fn cleared_depth(device: &wgpu::Device, queue: &wgpu::Queue, format: wgpu::TextureFormat, value: f32) -> wgpu::Texture {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host second layer"),
+        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    for layer in 0..2 {
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        });
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host second layer"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(value), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+    }
+    queue.submit([encoder.finish()]);
+    texture
+}
+
+#[test]
+fn a_bad_second_layer_is_a_typed_error_naming_it() {
+    let (gpu, _lock) = common::gpu();
+    let device = &gpu.device;
+    let meshes = demo_geometry();
+    let two_layers = AoSettings { layers: 2, ..AoSettings::default() };
+    let small = DepthPrepass::new(device, &meshes, HostDepth::ReversedInfinite, (WIDTH, HEIGHT / 2));
+    // Checked whether or not this frame reads it.
+    for ao in [&two_layers, &AoSettings::default()] {
+        let e = layered_ao(&gpu, ao, &meshes, &eyes(), 1, Second::Given(&small.depth)).expect_err("another size");
+        assert!(matches!(e, Error::Input { .. }), "{e}");
+        assert!(e.to_string().contains("second layer") && e.to_string().contains("does not match"), "{e}");
+    }
+    let colour = cleared_colour(device, wgpu::TextureFormat::R32Float);
+    let e = layered_ao(&gpu, &two_layers, &meshes, &eyes(), 1, Second::Given(&colour)).expect_err("a colour format");
+    assert!(e.to_string().contains("second layer: format R32Float"), "{e}");
+    // A multisampled second layer behind a single-sampled depth (one view: a multisampled
+    // array needs a device feature).
+    let multi = DepthPrepass::multisampled(device, &meshes, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1, 4);
+    let e = layered_ao(&gpu, &two_layers, &meshes, &eyes()[..1], 1, Second::Given(&multi.depth))
+        .expect_err("another sample count");
+    assert!(e.to_string().contains("second layer: sample count 4 where the depth's is 1"), "{e}");
+}
+
+/// A 2-layer colour texture of `format` at the engine's size.
+fn cleared_colour(device: &wgpu::Device, format: wgpu::TextureFormat) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("not a depth layer"),
+        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 2 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+/// A multisampled host's second layer is read at the sample its depth's resolve took:
+/// away from silhouettes the two-layer AO is the single-sampled one, and the second
+/// layer changes the AO as much as it does single-sampled.
+#[test]
+fn a_multisampled_second_layer_gives_the_single_sample_ao_away_from_silhouettes() {
+    let (gpu, _lock) = common::gpu();
+    let meshes = demo_with_board();
+    let (one_layer, two_layers) = (AoSettings::default(), AoSettings { layers: 2, ..AoSettings::default() });
+    let eye = &eyes()[..1];
+    let run = |ao, samples, second| layered_ao(&gpu, ao, &meshes, eye, samples, second).unwrap().0;
+    let (single, single_one) = (run(&two_layers, 1, Second::BackFaces), run(&one_layer, 1, Second::None));
+    let (multi, multi_one) = (run(&two_layers, 4, Second::BackFaces), run(&one_layer, 4, Second::None));
+    let prepass = DepthPrepass::with_layers(&gpu.device, &meshes, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    prepass.record(&gpu.device, &mut encoder, &host_views(eye, HostDepth::ReversedInfinite));
+    gpu.queue.submit([encoder.finish()]);
+    let depth = LayeredTarget::wrap(&prepass.depth, "host depth", wgpu::TextureAspect::DepthOnly, 1);
+    let away: Vec<Vec<bool>> =
+        vec![near_silhouettes(&read_layers_f32(&gpu, &depth).unwrap()[0]).iter().map(|e| !e).collect()];
+    let error = rmse_where(&multi, &single, &away);
+    let (effect_multi, effect_single) = (rmse(&multi, &multi_one), rmse(&single, &single_one));
+    eprintln!(
+        "4x MSAA two layers against 1x away from silhouettes: RMSE {error:.4}; the second layer changes the AO by \
+         RMSE {effect_multi:.4} at 4x, {effect_single:.4} at 1x"
+    );
+    assert!(error <= 0.01, "4x against 1x away from silhouettes: RMSE {error}");
+    assert!(
+        effect_single > 0.01 && (effect_multi / effect_single - 1.0).abs() < 0.5,
+        "{effect_multi} vs {effect_single}"
+    );
+    gpu.take_error().unwrap();
 }

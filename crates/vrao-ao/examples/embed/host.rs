@@ -192,7 +192,8 @@ impl DepthPrepass {
         let (vertices, indices) = merge_meshes(meshes);
         let (vertex_buffer, index_buffer) = upload_geometry(device, &vertices, &indices);
         let layout = view_layout(device);
-        let pipeline = prepass_pipeline(device, &layout, depth_kind, depth_kind.format(), samples, None);
+        let pipeline =
+            prepass_pipeline(device, &layout, depth_kind, depth_kind.format(), samples, None, wgpu::Face::Back);
         let target = |label, format| layered_target(device, label, format, (width, height), layers, samples);
         DepthPrepass {
             pipeline,
@@ -224,12 +225,23 @@ impl DepthPrepass {
         let scene_indices: u32 = meshes.iter().map(|m| m.indices.len() as u32).sum();
         let mark = wgpu::StencilFaceState { pass_op: wgpu::StencilOperation::Replace, ..Default::default() };
         let stencil = wgpu::StencilState { front: mark, back: mark, read_mask: 0xff, write_mask: 0xff };
-        prepass.pipeline = prepass_pipeline(device, &prepass.layout, depth_kind, format, 1, None);
-        let hand_pipeline = prepass_pipeline(device, &prepass.layout, depth_kind, format, 1, Some(stencil));
+        prepass.pipeline = prepass_pipeline(device, &prepass.layout, depth_kind, format, 1, None, wgpu::Face::Back);
+        let hand_pipeline =
+            prepass_pipeline(device, &prepass.layout, depth_kind, format, 1, Some(stencil), wgpu::Face::Back);
         prepass.hand = Some((hand_pipeline, scene_indices..prepass.index_count));
         prepass.index_count = scene_indices;
         prepass.depth = layered_target(device, "host depth", format, size, 2, 1);
         prepass
+    }
+
+    /// This prepass drawing back faces instead of front faces: its depth is then each
+    /// pixel's nearest back face, which for closed meshes seen from outside is the surface
+    /// behind the first one, a host's depth peel (`AoFrame::second_layer`).
+    pub(crate) fn back_faces(mut self, device: &wgpu::Device) -> Self {
+        let (format, samples) = (self.depth.format(), self.depth.sample_count());
+        self.pipeline =
+            prepass_pipeline(device, &self.layout, self.depth_kind, format, samples, None, wgpu::Face::Front);
+        self
     }
 
     /// Draws every eye's depth and normals: one render pass per layer.
@@ -350,8 +362,8 @@ fn view_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 /// The stencil value the host's hand is drawn with (the engine's `cast_none` bit).
 pub(crate) const HAND_STENCIL: u32 = 1;
 
-/// The prepass pipeline: back-face culled meshes into `depth_kind`'s depth (of `format`)
-/// and `Rgba16Float` view-space normals, writing `stencil` when given.
+/// The prepass pipeline: meshes with their `cull` faces culled into `depth_kind`'s depth
+/// (of `format`) and `Rgba16Float` view-space normals, writing `stencil` when given.
 fn prepass_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
@@ -359,6 +371,7 @@ fn prepass_pipeline(
     format: wgpu::TextureFormat,
     samples: u32,
     stencil: Option<wgpu::StencilState>,
+    cull: wgpu::Face,
 ) -> wgpu::RenderPipeline {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("host prepass"),
@@ -382,7 +395,7 @@ fn prepass_pipeline(
                 attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
             })],
         },
-        primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+        primitive: wgpu::PrimitiveState { cull_mode: Some(cull), ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format,
             depth_write_enabled: Some(true),

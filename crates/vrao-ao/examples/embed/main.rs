@@ -268,6 +268,7 @@ fn run(args: &Args) -> Result<(), Failure> {
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: convention,
+        second_layer: None,
         normals: with_normals.then_some(normals),
         views: &views,
         // The example's geometry stands still.
@@ -424,6 +425,7 @@ fn time_setup(
         let frame = AoFrame {
             depth,
             depth_convention: convention,
+            second_layer: None,
             normals: None,
             views,
             motion: None,
@@ -504,6 +506,7 @@ fn time_frames(
                 let frame = AoFrame {
                     depth: &prepass.depth,
                     depth_convention: convention,
+                    second_layer: None,
                     normals: (kind != 2).then_some(normals),
                     views: &views,
                     motion: None,

@@ -5,6 +5,11 @@
 //! (four more depth reads when the normals are rebuilt). A multisampled host (2, 4 or 8
 //! samples) is resolved here, each pixel taking its sample nearest the eye
 //! (import_msaa.wgsl): one read per sample instead of one per pixel, nothing else.
+//!
+//! A host's second depth layer ([`HOST_DEPTH_LAYER_2`]), where the occlusion reads two,
+//! becomes [`DEPTH_LAYER_2`] in a depth-only pass per view after the first
+//! (import.wgsl `import_second_layer`): the same conversion, at the sample the first
+//! layer's resolve took.
 
 use super::host_texture::{check_texture, check_texture_size};
 use super::{AoConfig, AoFrame, NormalEncoding, NormalSpace, Projection};
@@ -12,7 +17,8 @@ use crate::error::{Error, Result};
 use crate::gpu::kernel::{shader_module, wgsl, Shader, Slot};
 use crate::gpu::{raster, Gpu};
 use crate::graph::{PassDecl, Resource, PIXEL_MOTION};
-use crate::passes::inputs::{DEPTH, NORMALS};
+use crate::passes::gtao::reads_second_layer;
+use crate::passes::inputs::{DEPTH, DEPTH_LAYER_2, NORMALS};
 use crate::passes::{DeclareContext, Pass, RecordContext};
 use bytemuck::{Pod, Zeroable};
 use std::sync::{Mutex, OnceLock};
@@ -22,6 +28,10 @@ pub(crate) const NAME: &str = "ao-import";
 
 /// The host's depth buffer (any depth format; its readers bind it as depth).
 pub(crate) const HOST_DEPTH: Resource = Resource::imported("host-depth", wgpu::TextureFormat::Depth32Float);
+
+/// The host's second depth layer (any depth format, the depth's convention and samples).
+pub(crate) const HOST_DEPTH_LAYER_2: Resource =
+    Resource::imported("host-depth-layer-2", wgpu::TextureFormat::Depth32Float);
 
 /// The host's normals (any float-sampled format).
 pub(crate) const HOST_NORMALS: Resource = Resource::imported("host-normals", wgpu::TextureFormat::Rgba16Float);
@@ -35,7 +45,7 @@ const SINGLE_WGSL: Shader = wgsl!("src/ao/import_single.wgsl");
 /// The reads of a multisampled host.
 const MSAA_WGSL: Shader = wgsl!("src/ao/import_msaa.wgsl");
 
-/// The sample counts the engine takes for the host's depth and normals.
+/// The sample counts the engine takes for the host's depth, second layer and normals.
 pub(crate) const SAMPLE_COUNTS: [u32; 4] = [1, 2, 4, 8];
 
 /// Depth formats the engine reads (the depth aspect of the depth-stencil ones).
@@ -81,6 +91,8 @@ pub(crate) struct ImportSource {
     samples: u32,
     /// Whether the host gave motion vectors.
     motion: bool,
+    /// Whether the host gave a second depth layer and the settings ask for two.
+    second_layer: bool,
 }
 
 impl ImportSource {
@@ -100,6 +112,9 @@ impl ImportSource {
                 "depth: format {:?} is not one of {DEPTH_FORMATS:?}",
                 frame.depth.format()
             )));
+        }
+        if let Some(second) = frame.second_layer {
+            check_second_layer(second, samples, config)?;
         }
         let mut params = ImportParams::zeroed();
         if let Some(normals) = &frame.normals {
@@ -145,7 +160,13 @@ impl ImportSource {
         params.size = [config.width, config.height];
         params.reversed = frame.depth_convention.reversed_z as u32;
         params.cast_none = frame.exclusion.map_or(0, |e| e.cast_none);
-        Ok(ImportSource { params, views: config.views, samples, motion: frame.motion.is_some() })
+        Ok(ImportSource {
+            params,
+            views: config.views,
+            samples,
+            motion: frame.motion.is_some(),
+            second_layer: frame.second_layer.is_some() && config.settings.layers == 2,
+        })
     }
 
     /// The engine's near plane (vrao depth = near / distance).
@@ -155,12 +176,34 @@ impl ImportSource {
     }
 }
 
+/// Refuses a second depth layer that does not follow the depth's rules (checked whether
+/// or not this frame reads it, so a bad one shows before the settings ask for two).
+fn check_second_layer(second: &wgpu::Texture, samples: u32, config: &AoConfig) -> Result<()> {
+    check_texture_size("second layer", second, config)?;
+    if second.sample_count() != samples {
+        return Err(Error::input(format!(
+            "second layer: sample count {} where the depth's is {samples}: give both with the same count",
+            second.sample_count()
+        )));
+    }
+    if !DEPTH_FORMATS.contains(&second.format()) {
+        return Err(Error::input(format!(
+            "second layer: format {:?} is not one of {DEPTH_FORMATS:?}",
+            second.format()
+        )));
+    }
+    Ok(())
+}
+
 /// The import pass of a host's engine.
 pub(crate) struct ImportPass {
     /// For a host with one sample per pixel.
     single: ImportPipeline,
     /// For a multisampled host: made at its first multisampled frame.
     msaa: OnceLock<MsaaImport>,
+    /// The second layer's depth-only pipelines, single-sample and multisampled: each
+    /// made at the first frame that reads such a second layer.
+    second_layer: [OnceLock<ImportPipeline>; 2],
     uniform: wgpu::Buffer,
     /// This frame's checked inputs (set by the engine before it plans the frame).
     source: Mutex<Option<ImportSource>>,
@@ -182,25 +225,44 @@ struct MsaaImport {
     no_normals: wgpu::TextureView,
 }
 
+/// A fragment-stage binding of `ty` at `binding`.
+fn fragment_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::FRAGMENT, ty, count: None }
+}
+
 impl ImportPipeline {
     /// The pipeline of import.wgsl over `reads` (the host's textures bound as `depth`
     /// and `normals`): one colour target for the normals, depth written as `frag_depth`.
     fn new(gpu: &Gpu, reads: Shader, depth: wgpu::BindingType, normals: wgpu::BindingType) -> ImportPipeline {
-        let device = &gpu.device;
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty,
-            count: None,
-        };
         let entries = [
             Slot::Uniform.layout_entry(0, wgpu::ShaderStages::FRAGMENT),
-            entry(1, depth),
-            entry(2, normals),
-            entry(3, super::exclusion::MASK_BINDING),
+            fragment_entry(1, depth),
+            fragment_entry(2, normals),
+            fragment_entry(3, super::exclusion::MASK_BINDING),
         ];
-        let layout =
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(NAME), entries: &entries });
+        Self::build(gpu, reads, &entries, "import_frame", &[Some(NORMALS.format().into())])
+    }
+
+    /// The depth-only pipeline of import.wgsl's `import_second_layer` over `reads`, the
+    /// host's depth and its second layer both bound as `depth`.
+    fn second_layer(gpu: &Gpu, reads: Shader, depth: wgpu::BindingType) -> ImportPipeline {
+        let entries = [
+            Slot::Uniform.layout_entry(0, wgpu::ShaderStages::FRAGMENT),
+            fragment_entry(1, depth),
+            fragment_entry(4, depth),
+        ];
+        Self::build(gpu, reads, &entries, "import_second_layer", &[])
+    }
+
+    fn build(
+        gpu: &Gpu,
+        reads: Shader,
+        entries: &[wgpu::BindGroupLayoutEntry],
+        fragment: &str,
+        targets: &[Option<wgpu::ColorTargetState>],
+    ) -> ImportPipeline {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(NAME), entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(NAME),
             bind_group_layouts: &[Some(&layout)],
@@ -227,9 +289,9 @@ impl ImportPipeline {
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
-                entry_point: Some("import_frame"),
+                entry_point: Some(fragment),
                 compilation_options: Default::default(),
-                targets: &[Some(NORMALS.format().into())],
+                targets,
             }),
             multiview_mask: None,
             cache: None,
@@ -238,13 +300,26 @@ impl ImportPipeline {
     }
 }
 
+/// A multisampled 2D binding of `sample_type` (one layer of a host's texture).
+fn multisampled(sample_type: wgpu::TextureSampleType) -> wgpu::BindingType {
+    wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: true }
+}
+
+/// A view of `texture`'s layer `layer` alone, of `aspect` (a multisampled binding takes
+/// no array).
+fn layer_view(texture: &wgpu::Texture, aspect: wgpu::TextureAspect, layer: u32) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(NAME),
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        aspect,
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
 impl MsaaImport {
     fn new(gpu: &Gpu) -> MsaaImport {
-        let multisampled = |sample_type| wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: true,
-        };
         let pipeline = ImportPipeline::new(
             gpu,
             MSAA_WGSL,
@@ -280,6 +355,7 @@ impl ImportPass {
         ImportPass {
             single,
             msaa: OnceLock::new(),
+            second_layer: [OnceLock::new(), OnceLock::new()],
             uniform,
             source: Mutex::new(None),
             mask: Mutex::new(None),
@@ -320,16 +396,6 @@ impl ImportPass {
             return (&self.single.pipeline, vec![single; source.views as usize]);
         }
         let msaa = self.msaa.get_or_init(|| MsaaImport::new(ctx.gpu));
-        let layer_view = |texture: &wgpu::Texture, aspect, layer| {
-            texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some(NAME),
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                aspect,
-                base_array_layer: layer,
-                array_layer_count: Some(1),
-                ..Default::default()
-            })
-        };
         let groups = (0..source.views)
             .map(|layer| {
                 let depth = layer_view(&ctx.target(HOST_DEPTH).texture, wgpu::TextureAspect::DepthOnly, layer);
@@ -346,11 +412,72 @@ impl ImportPass {
             .collect();
         (&msaa.pipeline.pipeline, groups)
     }
+
+    /// Converts the host's second layer into [`DEPTH_LAYER_2`]: one depth-only pass per
+    /// view, after the first layer's (the uniform is the one it wrote).
+    fn record_second_layer(&self, ctx: &mut RecordContext, source: &ImportSource) {
+        let msaa = source.samples > 1;
+        let pipeline = self.second_layer[usize::from(msaa)].get_or_init(|| match msaa {
+            false => ImportPipeline::second_layer(ctx.gpu, SINGLE_WGSL, Slot::Depth.binding_type()),
+            true => ImportPipeline::second_layer(ctx.gpu, MSAA_WGSL, multisampled(wgpu::TextureSampleType::Depth)),
+        });
+        let group = |depth: &wgpu::BindingResource, second: &wgpu::BindingResource| {
+            ctx.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(NAME),
+                layout: &pipeline.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: depth.clone() },
+                    wgpu::BindGroupEntry { binding: 4, resource: second.clone() },
+                ],
+            })
+        };
+        let bind_groups: Vec<wgpu::BindGroup> = if msaa {
+            let (depth, second) = (&ctx.target(HOST_DEPTH).texture, &ctx.target(HOST_DEPTH_LAYER_2).texture);
+            (0..source.views)
+                .map(|layer| {
+                    let depth = layer_view(depth, wgpu::TextureAspect::DepthOnly, layer);
+                    let second = layer_view(second, wgpu::TextureAspect::DepthOnly, layer);
+                    group(&wgpu::BindingResource::TextureView(&depth), &wgpu::BindingResource::TextureView(&second))
+                })
+                .collect()
+        } else {
+            vec![group(&ctx.view(HOST_DEPTH), &ctx.view(HOST_DEPTH_LAYER_2)); source.views as usize]
+        };
+        let target = ctx.target(DEPTH_LAYER_2);
+        for (layer, bind_group) in (0..source.views).zip(&bind_groups) {
+            let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(NAME),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &target.layer_views[layer as usize],
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, bind_group, &[]);
+            pass.draw(0..3, layer..layer + 1);
+        }
+    }
 }
 
 impl Pass for ImportPass {
-    fn declare(&self, _setup: &DeclareContext) -> PassDecl {
+    fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let decl = PassDecl::new(NAME).read(HOST_DEPTH).read(HOST_NORMALS).write(DEPTH).write(NORMALS);
+        let ao = &setup.settings.ao;
+        let decl = match self.source() {
+            Some(source) if source.second_layer && reads_second_layer(setup) => {
+                decl.read(HOST_DEPTH_LAYER_2).write(DEPTH_LAYER_2)
+            }
+            _ if ao.layers == 2 && ao.technique.reads_second_layer() => {
+                decl.note("one depth layer: the host gave no second layer (AoFrame::second_layer)")
+            }
+            _ => decl,
+        };
         // The host's motion goes to temporal accumulation as it is.
         let decl = match self.source() {
             Some(source) if source.motion => decl.read(HOST_MOTION).provide(PIXEL_MOTION, HOST_MOTION),
@@ -375,6 +502,9 @@ impl Pass for ImportPass {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, bind_group, &[]);
             pass.draw(0..3, layer..layer + 1);
+        }
+        if source.second_layer && reads_second_layer(ctx.setup) {
+            self.record_second_layer(ctx, &source);
         }
     }
 }

@@ -2,10 +2,11 @@
 // finite or infinite far) becomes vrao's reversed-Z infinite-far depth with the engine's
 // near plane, and the host's normals (view or world space, signed or unorm-packed), or
 // normals rebuilt from the depth, become view-space normals. One fullscreen triangle per
-// layer; the instance index is the layer. The host's textures are read through
-// `host_depth_sample` and `host_normal_sample`, which import_single.wgsl (one sample per
-// pixel, a layered view) or import_msaa.wgsl (a multisampled view of the drawn layer)
-// define.
+// layer; the instance index is the layer. The host's second depth layer, where two are
+// read, becomes vrao's `DEPTH_LAYER_2` alike (`import_second_layer`, a depth-only pass).
+// The host's textures are read through `host_depth_sample`, `host_normal_sample` and
+// `host_second_sample`, which import_single.wgsl (one sample per pixel, a layered view)
+// or import_msaa.wgsl (a multisampled view of the drawn layer) define.
 
 struct ImportLayer {
     // View from world (rotation part turns world-space normals).
@@ -158,4 +159,20 @@ fn import_frame(in: VertexOut) -> ImportOut {
     out.depth = min(params.near / distance, 1.0);
     out.normal = vec4<f32>(n, 0.0);
     return out;
+}
+
+// The host's second layer as vrao's: reversed-Z with the engine's near plane, read at the
+// sample the first layer's resolve took; 0 (nothing behind) on the sky, where the host's
+// holds its far value, and where its surface does not lie behind the first layer's (GTAO
+// then keeps the thickness there).
+@fragment
+fn import_second_layer(in: VertexOut) -> @builtin(frag_depth) f32 {
+    let p = vec2<i32>(in.position.xy);
+    let chosen = host_depth_sample(p, in.layer);
+    let first = distance_of(chosen.x, in.layer);
+    let second = distance_of(host_second_sample(p, in.layer, u32(chosen.y)), in.layer);
+    if (first == 0.0 || !(second > first)) {
+        return 0.0;
+    }
+    return min(params.near / second, 1.0);
 }

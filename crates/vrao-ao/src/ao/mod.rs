@@ -7,9 +7,10 @@
 //! ([`crate::driver::GraphDriver`]): one implementation.
 //!
 //! What the engine runs, in order: [`import`] (the host's depth in any convention into
-//! reversed-Z infinite-far `Depth32Float`, and its normals, or normals rebuilt from the
-//! depth, into view space), the chosen technique, temporal accumulation, the denoise and
-//! the upsampling from half resolution, each left out when the settings do not need it.
+//! reversed-Z infinite-far `Depth32Float`, likewise its second depth layer when two are
+//! read, and its normals, or normals rebuilt from the depth, into view space), the chosen
+//! technique, temporal accumulation, the denoise and the upsampling from half resolution,
+//! each left out when the settings do not need it.
 //! SSDO (`ssdo`, `ssdo-bounce`) gathers the host's light beside the AO when the frame
 //! gives it ([`AoFrame::light`]: the direct light per view, the environment's SH): the
 //! output's rgb is then the ambient irradiance (environment through the unoccluded
@@ -19,7 +20,8 @@
 //! Conventions (what [`AoFrame`] must hold): right-handed view space (x right, y up,
 //! looking down −z, as glam's `camera::rh::view::look_at_mat4`); perspective projections with clip w = −z
 //! and depth in 0..1 (wgpu's), standard or reversed, finite or infinite far, as the
-//! frame's [`DepthConvention`] says; one depth layer per view.
+//! frame's [`DepthConvention`] says; one depth layer per view, and a second one behind it
+//! where the host peels one ([`AoFrame::second_layer`]).
 
 pub(crate) mod exclusion;
 mod host_texture;
@@ -41,7 +43,7 @@ use crate::passes::{self, ChainSettings, FrameMotion, Pass, RightEyeTiles};
 use crate::settings::{AoSettings, Technique};
 use crate::stereo::{Eye, EyeSide, Fov, HeadPose};
 use glam::{DMat4, DQuat, Mat4};
-use import::{ImportPass, ImportSource, HOST_DEPTH, HOST_MOTION, HOST_NORMALS};
+use import::{ImportPass, ImportSource, HOST_DEPTH, HOST_DEPTH_LAYER_2, HOST_MOTION, HOST_NORMALS};
 use pack::PackPass;
 use std::sync::Arc;
 
@@ -123,6 +125,19 @@ pub struct AoFrame<'a> {
     pub depth: &'a wgpu::Texture,
     /// How `depth` maps distance to depth.
     pub depth_convention: DepthConvention,
+    /// The host's second depth layer (its own depth peel: the nearest surface behind
+    /// `depth`'s), or `None` for one layer. Read only when `AoSettings::layers` is 2, by
+    /// the techniques that read two layers (GTAO, SSDO): their samples then block the span
+    /// back to it instead of a slab `gtao.thickness` deep. The same rules as `depth`: a
+    /// depth format of that list, its convention, one layer per view, the engine's size,
+    /// `TEXTURE_BINDING`, and `depth`'s sample count (where that is more than one, each
+    /// pixel reads the second layer at the sample the depth's resolve took). Where nothing
+    /// lies behind, it must hold the convention's far value (1 standard, 0 reversed-Z),
+    /// as a peel cleared to the far plane leaves it; the thickness then stays, as it
+    /// does wherever the second layer does not lie behind the first. The engine does not
+    /// peel: a minimum separation behind the first (`AoSettings::layer_separation`, the
+    /// renderer's) is the host's peel's to keep. Checked whenever given.
+    pub second_layer: Option<&'a wgpu::Texture>,
     /// The host's normals, or `None` to rebuild them from the depth.
     pub normals: Option<HostNormals<'a>>,
     /// Each view's matrices, one per view (left eye first).
@@ -340,7 +355,9 @@ impl AoEngine {
         let source = ImportSource::check(frame, config, &projections)?;
         let settings = host_settings(config, projections[0].near)?;
         let layers = config.views;
-        self.import_host_buffers(frame, layers);
+        // The host's second layer counts only where two layers are asked for.
+        let second_layer = frame.second_layer.filter(|_| config.settings.layers == 2);
+        self.import_host_buffers(frame, second_layer, layers);
         let mask = frame.exclusion.as_ref().map(|e| exclusion::mask_view(e, &self.config)).transpose()?;
         let receive_none = frame.exclusion.map_or(0, |e| e.receive_none);
         self.import.set_source(source, mask.clone());
@@ -354,8 +371,7 @@ impl AoEngine {
             settings: &settings,
             extensions: &[&light_inputs],
             alpha_cards: false,
-            // The engine takes one depth layer from a host.
-            second_layer: false,
+            second_layer: second_layer.is_some(),
             anchor: glam::DVec3::ZERO,
             multiview: false,
             motion: &self.motion,
@@ -366,7 +382,7 @@ impl AoEngine {
             .into_iter()
             .chain(self.chain.iter().map(|p| p.as_ref()))
             .collect();
-        let imported = imported_resources(frame, direct.is_some());
+        let imported = imported_resources(frame, second_layer.is_some(), direct.is_some());
         let key = (settings.clone(), frame.motion.is_some(), direct.is_some());
         let plan = self.driver.plan(&key, &passes, &params, layers, &[FINAL_AO], &imported)?;
         self.driver.prepare(&self.gpu, &plan, &params, &lighting, &eyes);
@@ -381,11 +397,15 @@ impl AoEngine {
         self.output(encoder, &plan, spans, receiving)
     }
 
-    /// Imports the host's depth, and its normals and motion vectors when given, as this
-    /// frame's graph inputs, and notes whether the frame has motion vectors.
-    fn import_host_buffers(&mut self, frame: &AoFrame, layers: u32) {
+    /// Imports the host's depth, and its second depth layer (when read), normals and
+    /// motion vectors when given, as this frame's graph inputs, and notes whether the
+    /// frame has motion vectors.
+    fn import_host_buffers(&mut self, frame: &AoFrame, second_layer: Option<&wgpu::Texture>, layers: u32) {
         let targets = self.driver.targets_mut();
         targets.import(&self.gpu, HOST_DEPTH, frame.depth, wgpu::TextureAspect::DepthOnly, layers);
+        if let Some(second) = second_layer {
+            targets.import(&self.gpu, HOST_DEPTH_LAYER_2, second, wgpu::TextureAspect::DepthOnly, layers);
+        }
         if let Some(normals) = &frame.normals {
             targets.import(&self.gpu, HOST_NORMALS, normals.texture, wgpu::TextureAspect::All, layers);
         }
@@ -470,10 +490,11 @@ fn environment_quadratics(frame: &AoFrame, eyes: &[Eye]) -> Result<Option<[[[f32
     Ok(environment)
 }
 
-/// The graph inputs this frame imports from the host: its depth always, and its normals,
-/// motion vectors and direct light when given.
-fn imported_resources(frame: &AoFrame, direct: bool) -> Vec<crate::graph::Resource> {
+/// The graph inputs this frame imports from the host: its depth always, and its second
+/// depth layer (when read), normals, motion vectors and direct light when given.
+fn imported_resources(frame: &AoFrame, second_layer: bool, direct: bool) -> Vec<crate::graph::Resource> {
     let mut imported = vec![HOST_DEPTH];
+    imported.extend(second_layer.then_some(HOST_DEPTH_LAYER_2));
     imported.extend(frame.normals.is_some().then_some(HOST_NORMALS));
     imported.extend(frame.motion.is_some().then_some(HOST_MOTION));
     imported.extend(direct.then_some(light::HOST_DIRECT));

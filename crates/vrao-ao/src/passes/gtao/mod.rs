@@ -195,7 +195,7 @@ impl Pass for GtaoPass {
             )
         } else if ao.layers == 2 && ao.technique.reads_second_layer() {
             decl.unbind(DEPTH_LAYER_2)
-                .note("one depth layer: none can lie behind the first this frame (see depth-peel)")
+                .note("one depth layer: no second layer this frame (depth-peel or ao-import says why)")
         } else {
             decl.unbind(DEPTH_LAYER_2)
         };
