@@ -80,18 +80,21 @@ fn both_eyes_see_the_same_occlusion_on_the_same_surface() {
 }
 
 /// The right eye takes the left eye's value wherever the left eye sees the same surface
-/// point: GTAO's march, and at half resolution the AO-only techniques' upsample (SSDO's
-/// denoise, its vertical pass). The share of stereo-inconsistent points
-/// (the bench's measure: AO differing by more than 0.02 between the eyes,
-/// `vrao::measure::stereo_consistency`) falls below ½ of what it is with independent eyes
-/// (measured on the furnished room: GTAO full 1.8 → 0.9 %, half 3.3 → 0.5 %; SSAO half,
-/// where the march does not reuse, 3.1 → 0.3 %).
+/// point: every technique's march or samples, and at half resolution the AO-only
+/// techniques' upsample (SSDO's denoise, its vertical pass). The share of
+/// stereo-inconsistent points (the bench's measure: AO differing by more than 0.02
+/// between the eyes, `vrao::measure::stereo_consistency`) falls below 0.6 of what it is
+/// with independent eyes (measured on the furnished room: GTAO full 1.8 → 0.85 %, half
+/// 3.3 → 0.5 %; SSAO half 3.1 → 0.3 %; HBAO full 0.84 → 0.46 %: at full resolution what
+/// is left is each eye's own denoise).
 #[test]
 fn the_right_eye_reuses_the_left_eye_where_it_sees_the_same_point() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:furnished").unwrap();
     let head = scene.head.pose_at(0.0);
-    for (technique, half_res) in [(Technique::Gtao, false), (Technique::Gtao, true), (Technique::Ssao, true)] {
+    for (technique, half_res) in
+        [(Technique::Gtao, false), (Technique::Gtao, true), (Technique::Ssao, true), (Technique::Hbao, false)]
+    {
         let mut shares = [0.0; 2];
         for (i, reuse) in [false, true].into_iter().enumerate() {
             let mut a = ao(technique, 24, 0.3);
@@ -109,7 +112,7 @@ fn the_right_eye_reuses_the_left_eye_where_it_sees_the_same_point() {
         }
         let [independent, reused] = shares;
         assert!(
-            reused < 0.5 * independent,
+            reused < 0.6 * independent,
             "{technique:?}, half {half_res}: {:.1} % inconsistent with reuse, {:.1} % with independent eyes",
             100.0 * reused,
             100.0 * independent
@@ -212,7 +215,7 @@ fn marches_past_the_inner_border_continue_in_the_other_eye() {
     assert!(bias.abs() < 0.015, "the eye at its inner border disagrees with the other eye by {bias:+.4}");
 }
 
-/// The right eye computes only what the left eye cannot give it (gtao.wgsl
+/// The right eye computes only what the left eye cannot give it (right_eye.wgsl
 /// `classify_right_eye`, upsample.wgsl's FALLBACK): counted from the indirect dispatches'
 /// arguments, the work is a share of the right eye's tiles; two eyes at one place with
 /// one field of view need none of it; independent eyes report nothing.
@@ -223,20 +226,27 @@ fn the_right_eye_computes_only_the_tiles_the_left_eye_cannot_give() {
     let head = scene.head.pose_at(0.0);
     let counts = |s: &vrao_render::Settings| {
         let mut renderer = vrao_render::Renderer::new(gpu.clone(), &scene, s).unwrap();
-        renderer.render_and_wait(&s.profile.eyes(&head, s.near).eyes, &[AO_FULL]).unwrap();
+        let output = if s.ao.resolution.is_half() { AO_FULL } else { AO_BLURRED };
+        renderer.render_and_wait(&s.profile.eyes(&head, s.near).eyes, &[output]).unwrap();
         renderer.right_eye_tiles()
     };
+    // Every technique that estimates per pixel from depth, at half and full resolution.
+    for (technique, half_res) in [(Technique::Ssao, false), (Technique::Hbao, true), (Technique::Gtao, true)] {
+        let mut a = ao(technique, 24, 0.3);
+        a.resolution = vrao_ao::Resolution::from_half_res(half_res);
+        let tiles = counts(&settings(192, 216, a));
+        let passes: Vec<&str> = tiles.iter().map(|t| t.pass).collect();
+        let expected: &[&str] = if half_res { &[technique.name(), "upsample"] } else { &[technique.name()] };
+        assert_eq!(passes, expected, "{tiles:?}");
+        for t in &tiles {
+            eprintln!("{}: {} of {} tiles, {} items", t.pass, t.computed, t.total, t.items);
+            assert_eq!(t.computed, t.items.div_ceil(64), "64 listed items to a dispatched tile: {t:?}");
+            assert!(t.computed > 0 && t.share() < 0.35, "the right eye computes a part of its tiles: {t:?}");
+        }
+    }
     let mut a = ao(Technique::Gtao, 24, 0.3);
     a.resolution = vrao_ao::Resolution::Half;
     let stereo = settings(192, 216, a.clone());
-    let tiles = counts(&stereo);
-    let passes: Vec<&str> = tiles.iter().map(|t| t.pass).collect();
-    assert_eq!(passes, ["gtao", "upsample"], "{tiles:?}");
-    for t in &tiles {
-        eprintln!("{}: {} of {} tiles, {} items", t.pass, t.computed, t.total, t.items);
-        assert_eq!(t.computed, t.items.div_ceil(64), "64 listed items to a dispatched tile: {t:?}");
-        assert!(t.computed > 0 && t.share() < 0.35, "the right eye computes a part of its tiles: {t:?}");
-    }
     let mut one_place = stereo.clone();
     (one_place.profile.ipd, one_place.profile.fov_right) = (0.0, one_place.profile.fov_left);
     for t in counts(&one_place) {

@@ -4,7 +4,9 @@
 //! workgroup counts of a second, indirect dispatch over just those (64 to a workgroup).
 //! Nothing is read back in a frame; a report reads the last frame's counts.
 
+use super::occlusion::{AO_GEOMETRY, AO_RAW};
 use super::{RecordContext, RightEyeTiles};
+use crate::gpu::kernel::{Bind, Kernel, TILE};
 use crate::gpu::Gpu;
 use wgpu::util::DeviceExt;
 
@@ -77,6 +79,34 @@ impl RightEyeList {
     /// The indirect dispatch's arguments (at offset 0).
     pub(crate) fn arguments(&self) -> &wgpu::Buffer {
         &self.arguments
+    }
+
+    /// The right eye after the left (occlusion/right_eye.wgsl): `classify` copies what
+    /// the left eye gives and lists the occlusion pixels left to estimate, then `listed`
+    /// runs over those by an indirect dispatch. Both write layer 1 of the raw occlusion
+    /// and its geometry alone and read the left eye's layer 0 of both (bindings 7 and
+    /// 8), the list at 9; `after_list` fills the technique's own bindings after it.
+    pub(crate) fn record_right_eye(
+        &mut self,
+        ctx: &mut RecordContext,
+        binds: &[Bind],
+        after_list: &[wgpu::BindingResource],
+        [classify, listed]: [&Kernel; 2],
+        (width, height): (u32, u32),
+    ) {
+        let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
+        let (ao_right, geometry_right) = (ctx.layer_view(AO_RAW, 1), ctx.layer_view(AO_GEOMETRY, 1));
+        let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
+        let view = wgpu::BindingResource::TextureView;
+        let mut own = vec![view(&ao_left), view(&geometry_left), list.as_entire_binding()];
+        own.extend_from_slice(after_list);
+        let resources =
+            ctx.bind_overriding(binds, &own, &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))]);
+        let device = &ctx.gpu.device;
+        let visibility = ctx.visibility.bind_group();
+        classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
+        self.take_arguments(ctx.encoder, &list);
+        listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, &self.arguments, 0);
     }
 
     /// Marks a frame that did not reuse the left eye: nothing to report.

@@ -5,10 +5,9 @@
 //! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
 use super::inputs::DEPTH_LAYER_2;
-use super::occlusion::{self, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
+use super::occlusion::{self, technique_decl, OCCLUSION_WGSL, RIGHT_EYE_WGSL};
 use super::right_eye_list::RightEyeList;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
-use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
@@ -16,18 +15,19 @@ use crate::resource::ChainLayout;
 use crate::settings::Technique;
 use bytemuck::{Pod, Zeroable};
 
-/// The shared bindings, at 7 and 8 the raw occlusion's and its geometry's left-eye
-/// layers for the right eye's dispatches (gtao.wgsl `left_occlusion`, `left_geometry`),
-/// at 9 GTAO's own parameters, at 10 the right eye's list of pixels to march and at 11
-/// the second depth layer (unbound with one layer). A march that gathers light (SSDO)
-/// binds more after these ([`March::binds`]).
-pub(crate) const BINDINGS: [Bind; 12] = occlusion::bindings_and([
-    Bind::Own(Slot::Layers),
-    Bind::Own(Slot::Layers),
-    Bind::Own(Slot::Uniform),
-    Bind::Own(Slot::ReadWriteBuffer),
-    Bind::Read(DEPTH_LAYER_2),
-]);
+/// The shared bindings with the right eye's at 7–9 (occlusion::REUSING_BINDINGS), at 10
+/// GTAO's own parameters and at 11 the second depth layer (unbound with one layer). A
+/// march that gathers light (SSDO) binds more after these ([`March::binds`]).
+pub(crate) const BINDINGS: [Bind; 12] = {
+    let mut all = [Bind::Read(DEPTH_LAYER_2); 12];
+    let mut i = 0;
+    while i < occlusion::REUSING_BINDINGS.len() {
+        all[i] = occlusion::REUSING_BINDINGS[i];
+        i += 1;
+    }
+    all[10] = Bind::Own(Slot::Uniform);
+    all
+};
 
 /// Whether this frame's march reads the second depth layer: two asked for, a technique
 /// that reads it, and one to be had (a renderer that peels it, a host that gave it).
@@ -40,8 +40,8 @@ pub(crate) fn reads_second_layer(setup: &DeclareContext) -> bool {
 pub(crate) const GTAO_WGSL: Shader = wgsl!("src/passes/gtao/gtao.wgsl");
 
 /// GTAO's WGSL files, in order: gtao.wgsl's march and gtao_light.wgsl's light hooks.
-const GTAO_FILES: [Shader; 5] =
-    [COMMON, VISIBILITY, OCCLUSION_WGSL, GTAO_WGSL, wgsl!("src/passes/gtao/gtao_light.wgsl")];
+const GTAO_FILES: [Shader; 6] =
+    [COMMON, VISIBILITY, OCCLUSION_WGSL, RIGHT_EYE_WGSL, GTAO_WGSL, wgsl!("src/passes/gtao/gtao_light.wgsl")];
 
 /// One technique built on gtao.wgsl's march: its name, its WGSL files (the march and,
 /// after it, the file of its light hooks: gtao_light.wgsl for GTAO), its bindings
@@ -239,11 +239,11 @@ impl Pass for GtaoPass {
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts; with two
         // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
-        // Bindings 7, 8 and 10 are unused before the right eye's dispatches: the normals
-        // and the list's header stand in.
+        // Bindings 7 to 9 are unused before the right eye's dispatches: the normals and
+        // the list's header stand in.
         let normals = ctx.view(super::inputs::NORMALS);
         let header = self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).stand_in();
-        let stand_ins = [normals.clone(), normals, self.params.as_entire_binding(), header.as_entire_binding()];
+        let stand_ins = [normals.clone(), normals, header.as_entire_binding(), self.params.as_entire_binding()];
         let resources = ctx.bind(self.march.binds, &stand_ins);
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
@@ -262,7 +262,10 @@ impl Pass for GtaoPass {
             (band, height, marched_layers),
         );
         if reuse {
-            self.record_right_eye(ctx, kernels, (width, height));
+            let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
+            let kernels = [&kernels.right_classify, &kernels.right_listed];
+            let params = [self.params.as_entire_binding()];
+            right_eye.record_right_eye(ctx, self.march.binds, &params, kernels, (width, height));
         } else {
             self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).skip();
         }
@@ -271,31 +274,6 @@ impl Pass for GtaoPass {
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
         let right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
         right_eye.read(gpu, self.march.label)
-    }
-}
-
-impl GtaoPass {
-    /// The right eye after the left: a dispatch that copies what the left eye gives and
-    /// lists the pixels left to march, then an indirect dispatch over those, 64 to a
-    /// workgroup. Both
-    /// write layer 1 of the occlusion and its geometry alone and read the left eye's
-    /// layer 0 of both.
-    fn record_right_eye(&self, ctx: &mut RecordContext, kernels: &Kernels, (width, height): (u32, u32)) {
-        let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-        let list = right_eye.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
-        let (ao_right, geometry_right) = (ctx.layer_view(AO_RAW, 1), ctx.layer_view(AO_GEOMETRY, 1));
-        let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
-        let view = wgpu::BindingResource::TextureView;
-        let resources = ctx.bind_overriding(
-            self.march.binds,
-            &[view(&ao_left), view(&geometry_left), self.params.as_entire_binding(), list.as_entire_binding()],
-            &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))],
-        );
-        let device = &ctx.gpu.device;
-        let visibility = ctx.visibility.bind_group();
-        kernels.right_classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
-        right_eye.take_arguments(ctx.encoder, &list);
-        kernels.right_listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, right_eye.arguments(), 0);
     }
 }
 

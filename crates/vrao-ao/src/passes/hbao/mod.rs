@@ -8,5 +8,5 @@ use crate::settings::Technique;
 
 /// The occlusion pass of HBAO.
 pub(crate) fn pass(gpu: &Gpu) -> TechniquePass {
-    TechniquePass::new(gpu, Technique::Hbao, wgsl!("src/passes/hbao/hbao.wgsl"))
+    TechniquePass::reusing(gpu, Technique::Hbao, wgsl!("src/passes/hbao/hbao.wgsl"))
 }

@@ -1,11 +1,13 @@
 //! What the screen-space occlusion techniques share: the textures they write
 //! ([`AO_RAW`], [`AO_GEOMETRY`]), the binding layout of occlusion.wgsl, how a technique
-//! declares itself, and [`TechniquePass`], the pass of a technique that is one kernel
-//! of that layout (SSAO, HBAO, the fetch-only baseline). GTAO and SSDO, which bind more,
-//! are passes of their own in their folders.
+//! declares itself, the right eye's reuse of the left eye (right_eye.wgsl), and
+//! [`TechniquePass`], the pass of a technique that is one kernel of that layout (SSAO,
+//! HBAO, the fetch-only baseline). GTAO and SSDO, which bind more, are passes of their
+//! own in their folders.
 
-use super::{DeclareContext, Pass, RecordContext};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, COMMON, VISIBILITY};
+use super::right_eye_list::RightEyeList;
+use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::passes::inputs::{DEPTH, NORMALS};
@@ -39,6 +41,15 @@ pub(crate) const BINDINGS: [Bind; 7] = [
     Bind::Write(AO_GEOMETRY),
 ];
 
+/// right_eye.wgsl: the right eye's reuse of the left eye's raw occlusion, compiled after
+/// occlusion.wgsl by every technique that reuses (its includer defines `reused_light`).
+pub(crate) const RIGHT_EYE_WGSL: Shader = wgsl!("src/passes/occlusion/right_eye.wgsl");
+
+/// `BINDINGS` and right_eye.wgsl's: at 7 and 8 the raw occlusion's and its geometry's
+/// left-eye layers for the right eye's dispatches, at 9 its list of pixels to estimate.
+pub(crate) const REUSING_BINDINGS: [Bind; 10] =
+    bindings_and([Bind::Own(Slot::Layers), Bind::Own(Slot::Layers), Bind::Own(Slot::ReadWriteBuffer)]);
+
 /// `BINDINGS` followed by a technique's own bindings (from binding 7 on); `M` is the
 /// total, checked when the constant is made.
 pub const fn bindings_and<const N: usize, const M: usize>(own: [Bind; N]) -> [Bind; M] {
@@ -70,30 +81,102 @@ pub fn technique_decl(name: &'static str, binds: &[Bind], runs_for: &[Technique]
 }
 
 /// A technique that is one kernel of the shared layout: its WGSL defines the
-/// occlusion of one pixel, occlusion.wgsl the rest.
+/// occlusion of one pixel, occlusion.wgsl the rest. With two views and the stereo
+/// reuse, the right eye copies what the left eye gives and estimates the rest by a list
+/// (right_eye.wgsl), for the techniques made [`TechniquePass::reusing`].
 pub(crate) struct TechniquePass {
     technique: Technique,
+    /// Both eyes, or the left eye alone when the right eye reuses it.
     kernel: Kernel,
+    /// The right eye's copy-and-list and listed dispatches.
+    right_eye: Option<RightEyeKernels>,
+}
+
+/// A reusing technique's right-eye pipelines and its list.
+struct RightEyeKernels {
+    classify: Kernel,
+    listed: Kernel,
+    list: std::sync::Mutex<RightEyeList>,
 }
 
 impl TechniquePass {
-    /// The pass of `technique`, whose WGSL is `shader`.
+    /// The pass of `technique`, whose WGSL is `shader`, both eyes estimated alike (the
+    /// fetch-only baseline, whose cost stays that of two eyes).
+    #[cfg(feature = "measurement")]
     pub(crate) fn new(gpu: &Gpu, technique: Technique, shader: Shader) -> Self {
         let files = [COMMON, VISIBILITY, OCCLUSION_WGSL, shader];
-        // The technique decides the chain's layout (technique.carries_light()).
         let chain = ChainLayout::of(technique.carries_light(), gpu.caps.scalar_chain);
         let kernel = Kernel::in_chain(gpu, technique.name(), &files, "main", &BINDINGS, &[], chain);
-        TechniquePass { technique, kernel }
+        TechniquePass { technique, kernel, right_eye: None }
+    }
+
+    /// The pass of `technique`, whose WGSL (`shader`, compiled after right_eye.wgsl)
+    /// takes its pixel from `estimated_pixel` and writes through `store_occlusion`: the
+    /// right eye reuses the left eye.
+    pub(crate) fn reusing(gpu: &Gpu, technique: Technique, shader: Shader) -> Self {
+        let files = [COMMON, VISIBILITY, OCCLUSION_WGSL, RIGHT_EYE_WGSL, shader];
+        // The technique decides the chain's layout (technique.carries_light()).
+        let chain = ChainLayout::of(technique.carries_light(), gpu.caps.scalar_chain);
+        let kernel = |entry: &str, right: bool| {
+            let constants = [
+                ("RIGHT_EYE", f64::from(right)),
+                ("LISTED_PIXELS", f64::from(right)),
+                ("SINGLE_LAYER_OUTPUT", f64::from(right)),
+            ];
+            Kernel::in_chain(gpu, technique.name(), &files, entry, &REUSING_BINDINGS, &constants, chain)
+        };
+        TechniquePass {
+            technique,
+            kernel: kernel("main", false),
+            right_eye: Some(RightEyeKernels {
+                classify: kernel("classify_right_eye", true),
+                listed: kernel("main", true),
+                list: std::sync::Mutex::new(RightEyeList::new(gpu, technique.name())),
+            }),
+        }
     }
 }
 
 impl Pass for TechniquePass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
-        technique_decl(self.technique.name(), &BINDINGS, &[self.technique], setup)
+        let binds: &[Bind] = if self.right_eye.is_some() { &REUSING_BINDINGS } else { &BINDINGS };
+        technique_decl(self.technique.name(), binds, &[self.technique], setup)
     }
 
     fn record(&self, ctx: &mut RecordContext) {
-        let resources = ctx.bind(&BINDINGS, &[]);
-        self.kernel.dispatch(&ctx.gpu.device, ctx.encoder, ctx.visibility.bind_group(), &resources, ctx.ao_extent());
+        let (width, height, layers) = ctx.ao_extent();
+        let device = &ctx.gpu.device;
+        let Some(right_eye) = &self.right_eye else {
+            let resources = ctx.bind(&BINDINGS, &[]);
+            self.kernel.dispatch(device, ctx.encoder, ctx.visibility.bind_group(), &resources, (width, height, layers));
+            return;
+        };
+        let mut list = right_eye.list.lock().unwrap_or_else(|p| p.into_inner());
+        // Bindings 7 to 9 are unused before the right eye's dispatches: the normals and
+        // the list's header stand in.
+        let normals = ctx.view(NORMALS);
+        let header = list.stand_in();
+        let resources = ctx.bind(&REUSING_BINDINGS, &[normals.clone(), normals, header.as_entire_binding()]);
+        let reuse = ctx.setup.settings.ao.stereo_reuse && layers == 2;
+        let estimated_layers = if reuse { 1 } else { layers };
+        self.kernel.dispatch(
+            device,
+            ctx.encoder,
+            ctx.visibility.bind_group(),
+            &resources,
+            (width, height, estimated_layers),
+        );
+        if reuse {
+            let kernels = [&right_eye.classify, &right_eye.listed];
+            list.record_right_eye(ctx, &REUSING_BINDINGS, &[], kernels, (width, height));
+        } else {
+            list.skip();
+        }
+    }
+
+    fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
+        let right_eye = self.right_eye.as_ref()?;
+        let list = right_eye.list.lock().unwrap_or_else(|p| p.into_inner());
+        list.read(gpu, self.technique.name())
     }
 }

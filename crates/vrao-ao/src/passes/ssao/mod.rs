@@ -8,5 +8,5 @@ use crate::settings::Technique;
 
 /// The occlusion pass of SSAO.
 pub(crate) fn pass(gpu: &Gpu) -> TechniquePass {
-    TechniquePass::new(gpu, Technique::Ssao, wgsl!("src/passes/ssao/ssao.wgsl"))
+    TechniquePass::reusing(gpu, Technique::Ssao, wgsl!("src/passes/ssao/ssao.wgsl"))
 }

@@ -3,10 +3,21 @@
 // occluded when the depth buffer holds a surface in front of it. Applied to the ambient term
 // only.
 
-// Bindings and `begin_receiver`: occlusion.wgsl.
+// Bindings and `begin_receiver`: occlusion.wgsl; the right eye's reuse of the left eye:
+// occlusion/right_eye.wgsl.
+
+// A copied value carries no light (AO alone).
+fn reused_light(value: vec4<f32>) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
 
 @compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+fn main(
+    @builtin(global_invocation_id) invocation: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let id = estimated_pixel(invocation, group, local);
     let r = begin_receiver(id);
     if (!r.valid) {
         return;
@@ -34,5 +45,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let visibility = 1.0 - occlusion / f32(samples);
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
-    textureStore(ao_out, vec2<i32>(id.xy), i32(r.layer), chain_texel(vec4<f32>(0.0, 0.0, 0.0, result)));
+    store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, result));
 }

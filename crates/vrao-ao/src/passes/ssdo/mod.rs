@@ -13,7 +13,7 @@
 
 use super::gtao::{GtaoPass, March, BINDINGS as GTAO_BINDINGS, GTAO_WGSL};
 use super::inputs::DIRECT_LIGHT;
-use super::occlusion::OCCLUSION_WGSL;
+use super::occlusion::{OCCLUSION_WGSL, RIGHT_EYE_WGSL};
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::gpu::kernel::{wgsl, Bind, COMMON, IRRADIANCE, VISIBILITY};
 use crate::gpu::Gpu;
@@ -68,6 +68,7 @@ impl SsdoPass {
                         VISIBILITY,
                         IRRADIANCE,
                         OCCLUSION_WGSL,
+                        RIGHT_EYE_WGSL,
                         GTAO_WGSL,
                         wgsl!("src/passes/ssdo/ssdo.wgsl"),
                     ],

@@ -1,0 +1,92 @@
+// The right eye's reuse of the left eye's raw occlusion, shared by the techniques that
+// estimate per pixel from the depth buffer (GTAO, SSDO, SSAO, HBAO), after occlusion.wgsl.
+// With two views and `stereo_reuse` the left eye runs first; then a right-eye pixel whose
+// surface point the left eye sees takes the left eye's raw value there instead of its
+// own estimate. The visibility within r is a property of the surface point, not of the
+// eye, so the eyes then agree by construction, and the right eye estimates only what the
+// left eye cannot see (its outer side, disocclusions). Its outputs are bound as one-layer
+// views (occlusion.wgsl `SINGLE_LAYER_OUTPUT`), beside the left eye's layers of AoRaw
+// and AoGeometry (common.wgsl `left_eye_value`). First `classify_right_eye` copies every
+// pixel it can and lists the pixels left to estimate; then the technique's `main` with
+// LISTED_PIXELS runs over the listed pixels alone, 64 to a workgroup, by an indirect
+// dispatch: the right eye pays for the pixels the left eye cannot give, not for every
+// warp that holds one of them (listing 8×8 tiles of the image instead dispatched every
+// tile a silhouette crosses: a quarter of Sibenik's right eye).
+//
+// The includer defines `reused_light(value)`: the rgb a copied value carries (its
+// gathered light for SSDO, 0 for the AO-only techniques).
+
+override RIGHT_EYE: bool = false;
+override LISTED_PIXELS: bool = false;
+
+// AoRaw's and AoGeometry's left-eye layers in the right eye's dispatches (any array
+// textures otherwise).
+@group(0) @binding(7) var left_occlusion: texture_2d_array<f32>;
+@group(0) @binding(8) var left_geometry: texture_2d_array<f32>;
+
+// The right eye's pixels to estimate, listed by `classify_right_eye`, and the indirect
+// dispatch's workgroup counts over them (x grows by one per 64 pixels; y = z = 1).
+struct RightEyeList {
+    groups_x: atomic<u32>,
+    groups_y: u32,
+    groups_z: u32,
+    count: atomic<u32>,
+    // Occlusion pixel p packed as p.x | p.y << 16.
+    pixels: array<u32>,
+};
+@group(0) @binding(9) var<storage, read_write> right_list: RightEyeList;
+
+// The right-eye occlusion pixel of invocation `id` (in workgroup `group`, at `local`
+// within it): the listed pixel, or none (x = ao_size.x) past the list.
+fn right_eye_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
+    if (LISTED_PIXELS) {
+        let i = group.x * 64u + local;
+        if (i >= atomicLoad(&right_list.count)) {
+            return vec3<u32>(ao.ao_size.x, 0u, 1u);
+        }
+        let packed = right_list.pixels[i];
+        return vec3<u32>(packed & 0xffffu, packed >> 16u, 1u);
+    }
+    return vec3<u32>(id.x, id.y, 1u);
+}
+
+// The occlusion pixel of invocation `id` of a technique that runs the whole image in one
+// dispatch (SSAO, HBAO): itself, or in the right eye's dispatches the listed pixel.
+fn estimated_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
+    if (RIGHT_EYE) {
+        return right_eye_pixel(id, group, local);
+    }
+    return id;
+}
+
+// Right-eye pixel `id`'s value from the left eye where the left eye sees its surface
+// point (stored, true), else false; the sky and hidden tiles are stored as open (true).
+fn reused_from_left_eye(id: vec3<u32>, r: Receiver) -> bool {
+    if (!r.valid) {
+        return true;
+    }
+    let left = left_eye_value(
+        r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
+    );
+    if (left.found) {
+        // left_eye_value blends raw texels; the chain's decoding is linear, so decode after.
+        let value = chain_value(left.value);
+        store_occlusion(id, vec4<f32>(reused_light(value), value.a));
+    }
+    return left.found;
+}
+
+// The right eye's first dispatch: every pixel the left eye gives a value is stored, and
+// every other is listed for the technique's estimate.
+@compute @workgroup_size(8, 8, 1)
+fn classify_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
+    let id = vec3<u32>(invocation.xy, 1u);
+    if (reused_from_left_eye(id, begin_receiver(id))) {
+        return;
+    }
+    let i = atomicAdd(&right_list.count, 1u);
+    right_list.pixels[i] = id.x | (id.y << 16u);
+    if (i % 64u == 0u) {
+        atomicAdd(&right_list.groups_x, 1u);
+    }
+}
