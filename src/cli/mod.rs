@@ -130,8 +130,8 @@ pub(crate) struct GtaoArgs {
     #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().connect)]
     connect: f32,
     /// Compute both eyes on their own; by default the right eye takes the left eye's value
-    /// wherever the left eye sees the same surface point (GTAO's march; at half resolution
-    /// the upsampled AO, or SSDO's denoise).
+    /// wherever the left eye sees the same surface point (every technique's march or
+    /// samples; at half resolution the upsampled AO, or SSDO's denoise).
     #[arg(long)]
     independent_eyes: bool,
     /// With two depth layers: the second layer's minimum separation behind the first, as a

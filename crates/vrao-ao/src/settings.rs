@@ -316,8 +316,8 @@ pub struct AoSettings {
     /// GTAO's own parameters (passes/gtao).
     pub gtao: GtaoSettings,
     /// With two views, the right eye takes the left eye's value wherever the left eye
-    /// sees the same surface point: GTAO's march (the right eye marches only the rest and
-    /// costs a fraction) and, at half resolution, the AO-only techniques' upsample
+    /// sees the same surface point: every technique's march or samples (the right eye
+    /// estimates only the rest and costs a fraction) and, at half resolution, the AO-only techniques' upsample
     /// (`passes::upsample::reuses_left_eye_upsample`) or SSDO's denoise (its vertical pass).
     /// Off: each eye computes everything alone.
     pub stereo_reuse: bool,

@@ -7,7 +7,7 @@
 //! eyes, beside the AO, as `OUT/embed_ambient_left.png` and `OUT/embed_ambient_right.png`.
 //!
 //! ```text
-//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--msaa N] [--hand MODE] [--time] [--time-setup]
+//! cargo run --release -p vrao-ao --example embed -- [OUT] [--standard-depth] [--no-normals] [--msaa N] [--layers N] [--hand MODE] [--time] [--time-setup]
 //! ```
 //!
 //! The command line is handled like vrao's: `--help` prints the usage and exits 0; an
@@ -24,6 +24,9 @@
 //! renderer with MSAA does, and hands the engine the multisampled depth and normals, which
 //! it resolves itself (a 2-layer multisampled texture needs the adapter's
 //! `MULTISAMPLE_ARRAY`; the program says so when it lacks it).
+//! `--layers 2` also draws the host's depth peel (the same prepass drawing back faces:
+//! the surface behind each pixel's first one, for the example's closed boxes) and hands
+//! it to the engine as its second layer (`AoFrame::second_layer`, `AoSettings::layers`).
 //! It exits non-zero when the AO is not finite, outside 0..1, or shows no occlusion.
 //! `--time` also times whole frames at 1080×1200 per eye, interleaved: the host's prepass
 //! alone, and with the engine (host normals, rebuilt normals), median wall-clock ms.
@@ -53,6 +56,7 @@ Options:
   --standard-depth  Depth24Plus with a finite far plane instead of reversed-Z Depth32Float
   --no-normals      let the engine rebuild normals from depth
   --msaa N          draw the prepass with N samples per pixel (1, 2, 4 or 8; default 1)
+  --layers N        depth layers the engine reads: 1, or 2 with the host's back-face peel (default 1)
   --hand MODE       add a hand over the step: left-out (marked in the stencil, casting no AO) or casting
   --time            also time whole frames at 1080x1200 per eye (host prepass alone and with the engine)
   --time-setup      also time AoEngine::new, the first frame, a resize and the frame after it
@@ -67,6 +71,8 @@ struct Args {
     no_normals: bool,
     /// Samples per pixel of the host's prepass.
     msaa: u32,
+    /// Depth layers handed to the engine (2: with the host's back-face peel).
+    layers: u32,
     /// A hand over the step, left out of the AO through the stencil, or casting it.
     hand: Option<Hand>,
     time: bool,
@@ -124,6 +130,16 @@ impl<E: Into<Box<dyn std::error::Error>>> From<E> for Failure {
     }
 }
 
+/// The value of `--layers`: the depth layers the engine reads.
+fn parse_layers(value: Option<&str>) -> Result<u32, String> {
+    match value {
+        Some("1") => Ok(1),
+        Some("2") => Ok(2),
+        Some(other) => Err(format!("--layers {other}: the engine reads 1 or 2 depth layers")),
+        None => Err("--layers needs a count: 1 or 2".into()),
+    }
+}
+
 /// The value of `--msaa`: a sample count the engine takes.
 fn parse_msaa(value: Option<&str>) -> Result<u32, String> {
     let value = value.ok_or("--msaa needs a sample count: 1, 2, 4 or 8")?;
@@ -140,6 +156,7 @@ fn parse_args(args: &[String]) -> Result<Parsed, String> {
         standard_depth: false,
         no_normals: false,
         msaa: 1,
+        layers: 1,
         hand: None,
         time: false,
         time_setup: false,
@@ -151,6 +168,8 @@ fn parse_args(args: &[String]) -> Result<Parsed, String> {
             "-h" | "--help" => return Ok(Parsed::Help),
             "--msaa" => parsed.msaa = parse_msaa(args.next().map(String::as_str))?,
             flag if flag.starts_with("--msaa=") => parsed.msaa = parse_msaa(flag.strip_prefix("--msaa="))?,
+            "--layers" => parsed.layers = parse_layers(args.next().map(String::as_str))?,
+            flag if flag.starts_with("--layers=") => parsed.layers = parse_layers(flag.strip_prefix("--layers="))?,
             "--hand" => parsed.hand = Some(parse_hand(args.next().map(String::as_str))?),
             flag if flag.starts_with("--hand=") => parsed.hand = Some(parse_hand(flag.strip_prefix("--hand="))?),
             "--standard-depth" => parsed.standard_depth = true,
@@ -179,6 +198,9 @@ fn parse_args(args: &[String]) -> Result<Parsed, String> {
     }
     if parsed.hand.is_some() && parsed.msaa > 1 {
         return Err("--hand with --msaa: the example marks its hand in a single-sampled stencil".into());
+    }
+    if parsed.hand.is_some() && parsed.layers == 2 {
+        return Err("--hand with --layers 2: the example peels its room without the hand".into());
     }
     Ok(Parsed::Run(parsed))
 }
@@ -247,6 +269,10 @@ fn run(args: &Args) -> Result<(), Failure> {
             DepthPrepass::new(&device, &[demo_geometry(), vec![demo_hand()]].concat(), depth_kind, size)
         }
     };
+    // The host's depth peel for a second layer: the same geometry's back faces.
+    let peel = (args.layers == 2).then(|| {
+        DepthPrepass::multisampled(&device, &demo_geometry(), depth_kind, size, 2, args.msaa).back_faces(&device)
+    });
     let near = 0.05;
     let tangents = [[-1.2, 0.9, 1.1, -1.1], [-0.9, 1.2, 1.1, -1.1]];
     let views: Vec<ViewMatrices> = demo_eyes()
@@ -256,7 +282,8 @@ fn run(args: &Args) -> Result<(), Failure> {
         .collect();
 
     // vrao's AO engine on the host's device, with vrao's default (tuned GTAO) settings.
-    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 2 };
+    let settings = AoSettings { layers: args.layers, ..AoSettings::default() };
+    let config = AoConfig { settings, width: WIDTH, height: HEIGHT, views: 2 };
     let mut engine = AoEngine::new(&device, &queue, &config)?;
     let convention = match depth_kind {
         HostDepth::ReversedInfinite => DepthConvention::REVERSED_INFINITE,
@@ -265,10 +292,13 @@ fn run(args: &Args) -> Result<(), Failure> {
     let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
     let mut encoder = device.create_command_encoder(&Default::default());
     prepass.record(&device, &mut encoder, &views);
+    if let Some(peel) = &peel {
+        peel.record(&device, &mut encoder, &views);
+    }
     let frame = AoFrame {
         depth: &prepass.depth,
         depth_convention: convention,
-        second_layer: None,
+        second_layer: peel.as_ref().map(|p| &p.depth),
         normals: with_normals.then_some(normals),
         views: &views,
         // The example's geometry stands still.
@@ -549,6 +579,7 @@ mod tests {
                 standard_depth: true,
                 no_normals: true,
                 msaa: 1,
+                layers: 1,
                 hand: None,
                 time: true,
                 time_setup: true
@@ -566,6 +597,14 @@ mod tests {
         assert!(matches!(parse("--msaa=8"), Ok(Parsed::Run(Args { msaa: 8, .. }))));
         assert_eq!(parse("--msaa 3"), Err("--msaa 3: the sample count is 1, 2, 4 or 8".into()));
         assert_eq!(parse("--msaa"), Err("--msaa needs a sample count: 1, 2, 4 or 8".into()));
+        assert!(matches!(parse("--layers 2 --msaa 4"), Ok(Parsed::Run(Args { layers: 2, msaa: 4, .. }))));
+        assert!(matches!(parse("--layers=1"), Ok(Parsed::Run(Args { layers: 1, .. }))));
+        assert_eq!(parse("--layers 3"), Err("--layers 3: the engine reads 1 or 2 depth layers".into()));
+        assert_eq!(parse("--layers"), Err("--layers needs a count: 1 or 2".into()));
+        assert_eq!(
+            parse("--hand casting --layers 2"),
+            Err("--hand with --layers 2: the example peels its room without the hand".into())
+        );
         // --help anywhere prints the usage and renders nothing.
         assert_eq!(parse("--help"), Ok(Parsed::Help));
         assert_eq!(parse("dir -h --bogus"), Ok(Parsed::Help));
