@@ -301,6 +301,7 @@ impl FrameLoop {
                 (finish - display_time) * 1e3
             });
             if let Some(late_ms) = late_ms {
+                log::debug!("frame {}: finished {late_ms:+.2} ms from its predicted display time", timing.frame);
                 self.clocked_frames += 1;
                 self.late_frames += u64::from(late_ms > 0.0);
             }

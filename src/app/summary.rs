@@ -124,7 +124,8 @@ impl RunSummary {
             timed_frames: frame_loop.timed_frames,
             late_frames: frame_loop.late_frames,
             clocked_frames: frame_loop.clocked_frames,
-            late_clock: if frame_loop.headset.now().is_some() {
+            // Judged while the session ran: a runtime's clock is gone once it has ended.
+            late_clock: if frame_loop.clocked_frames > 0 {
                 "the headset's clock (a frame's work starts no earlier than its submission and the frame before)".into()
             } else {
                 format!("none: {}", frame_loop.headset.no_clock_reason())
