@@ -3,6 +3,7 @@
 //! eyes; the headset gets colour and depth. The desktop window (`window.rs`) drives the
 //! same loop one step per redraw.
 
+use crate::app::completion::CompletionWatcher;
 use crate::app::governor::{Governor, Observation};
 use crate::app::{BufferView, PassHistory};
 use crate::error::{Error, Result};
@@ -60,7 +61,8 @@ pub struct FrameLoop {
     /// Frames whose GPU time has come back (the denominator of `over_budget_frames`).
     pub timed_frames: u64,
     /// Frames whose GPU work finished after their predicted display time on the headset's
-    /// clock (at the earliest: [`crate::xr::earliest_finish`]), of the timed frames the
+    /// clock (when it was seen done, or else at the earliest:
+    /// [`crate::xr::earliest_finish`]), of the timed frames the
     /// headset's clock was read for (`clocked_frames`): what the runtime shows late, or
     /// drops, whatever the GPU time against the budget.
     pub late_frames: u64,
@@ -69,6 +71,10 @@ pub struct FrameLoop {
     pub clocked_frames: u64,
     /// The previous timed frame's earliest finish on the headset's clock (s).
     previous_finish: Option<f64>,
+    /// Sees each frame's work done, where the headset has a clock to judge it by.
+    completion: CompletionWatcher,
+    /// Frames seen done and the instant, until their GPU times come back.
+    done: VecDeque<(u64, std::time::Instant)>,
     /// Every frame's GPU time and CPU encode time (ms), for the run's medians.
     pub gpu_frame_ms: Vec<f64>,
     /// Every frame's CPU encode time (ms).
@@ -104,8 +110,8 @@ struct InFlight {
     /// one stretched over several refreshes).
     predicted_period_ms: Option<f64>,
     /// The frame's predicted display time and when its work was submitted, both on the
-    /// headset's clock (s); `None` without a clock.
-    deadline: Option<(f64, f64)>,
+    /// headset's clock (s), and the instant of the submission; `None` without a clock.
+    deadline: Option<(f64, f64, std::time::Instant)>,
     serial: bool,
     occlusion_passes: Vec<&'static str>,
 }
@@ -144,6 +150,7 @@ impl FrameLoop {
         let display_period_seen = budget_ms.is_some();
         let budget_ms = budget_ms.unwrap_or(settings.profile.budget_ms());
         let cpu_adapter = gpu.info.device_type == wgpu::DeviceType::Cpu;
+        let completion = CompletionWatcher::new(gpu.device.clone());
         FrameLoop {
             cpu_adapter,
             in_flight: VecDeque::new(),
@@ -168,6 +175,8 @@ impl FrameLoop {
             late_frames: 0,
             clocked_frames: 0,
             previous_finish: None,
+            completion,
+            done: VecDeque::new(),
             gpu_frame_ms: Vec::new(),
             cpu_encode_ms: Vec::new(),
             exit_requested: Arc::new(AtomicBool::new(false)),
@@ -212,10 +221,15 @@ impl FrameLoop {
         let report = self.render(&request)?;
         // The frame's work is on the GPU's queue from here (submitted, not waited for).
         let submitted_at = self.headset.now().filter(|t| t.is_finite());
+        let submitted_instant = std::time::Instant::now();
         let color = self.renderer.target(COLOR).ok_or_else(|| Error::gpu("no eye colour"))?;
         let depth = self.renderer.target(DEPTH).ok_or_else(|| Error::gpu("no eye depth"))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
         self.headset.submit(&self.gpu, &request, Some(frame))?;
+        if submitted_at.is_some() {
+            // An empty submission is done when every one before it is: the frame's end.
+            self.completion.watch(report.frame, self.gpu.queue.submit([]));
+        }
         self.frames += 1;
         self.cpu_encode_ms.push(report.cpu_encode_ms);
         self.history.push_cpu_encode(report.cpu_encode_ms);
@@ -228,7 +242,7 @@ impl FrameLoop {
             frame: report.frame,
             budget_ms: self.budget_ms,
             predicted_period_ms: request.display_period_ms,
-            deadline: submitted_at.map(|at| (request.display_time, at)),
+            deadline: submitted_at.map(|at| (request.display_time, at, submitted_instant)),
             serial,
             occlusion_passes: report.plan.occlusion_passes(),
         });
@@ -280,6 +294,7 @@ impl FrameLoop {
 
     /// Books the GPU times of frames that came back.
     fn take_timings(&mut self, finished: Vec<FrameTiming>) {
+        self.done.extend(self.completion.done());
         for mut timing in finished {
             while self.in_flight.front().is_some_and(|f| f.frame < timing.frame) {
                 self.in_flight.pop_front();
@@ -295,13 +310,25 @@ impl FrameLoop {
             if timing.total_ms > budget_ms {
                 self.over_budget_frames += 1;
             }
-            let late_ms = deadline.map(|(display_time, submitted_at)| {
-                let finish = crate::xr::earliest_finish(submitted_at, self.previous_finish, timing.total_ms);
+            while self.done.front().is_some_and(|&(frame, _)| frame < timing.frame) {
+                self.done.pop_front();
+            }
+            let seen_done = self.done.front().filter(|&&(frame, _)| frame == timing.frame).map(|&(_, at)| at);
+            let late_ms = deadline.map(|(display_time, submitted_at, submitted_instant)| {
+                let earliest = crate::xr::earliest_finish(submitted_at, self.previous_finish, timing.total_ms);
+                // Seen done: the instant on the headset's clock, from the submission's.
+                let finish = seen_done.map_or(earliest, |at| {
+                    submitted_at + at.saturating_duration_since(submitted_instant).as_secs_f64()
+                });
                 self.previous_finish = Some(finish);
                 (finish - display_time) * 1e3
             });
             if let Some(late_ms) = late_ms {
-                log::debug!("frame {}: finished {late_ms:+.2} ms from its predicted display time", timing.frame);
+                log::debug!(
+                    "frame {}: finished {late_ms:+.2} ms from its predicted display time ({})",
+                    timing.frame,
+                    if seen_done.is_some() { "seen done" } else { "estimated" }
+                );
                 self.clocked_frames += 1;
                 self.late_frames += u64::from(late_ms > 0.0);
             }

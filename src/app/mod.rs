@@ -2,6 +2,7 @@
 //! desktop window with its panel. Builds on `render` and `xr`, never on `measure`.
 
 mod buffer_view;
+mod completion;
 mod frame_loop;
 pub mod governor;
 mod headset;

@@ -43,9 +43,9 @@ pub struct RunSummary {
     pub over_budget_frames: u64,
     /// Frames whose GPU time came back.
     pub timed_frames: u64,
-    /// Timed frames whose GPU work finished, at the earliest, after their predicted
-    /// display time on the headset's clock: shown late (or dropped) by the runtime,
-    /// whatever their GPU time against the budget.
+    /// Timed frames whose GPU work finished (seen done, or else at the earliest) after
+    /// their predicted display time on the headset's clock: shown late (or dropped) by the
+    /// runtime, whatever their GPU time against the budget.
     pub late_frames: u64,
     /// Timed frames judged so: 0 where the headset gives no clock (`late_clock` says why).
     pub clocked_frames: u64,
@@ -126,7 +126,7 @@ impl RunSummary {
             clocked_frames: frame_loop.clocked_frames,
             // Judged while the session ran: a runtime's clock is gone once it has ended.
             late_clock: if frame_loop.clocked_frames > 0 {
-                "the headset's clock (a frame's work starts no earlier than its submission and the frame before)".into()
+                "the headset's clock (each frame's work seen done by a thread waiting on it)".into()
             } else {
                 format!("none: {}", frame_loop.headset.no_clock_reason())
             },
