@@ -106,6 +106,10 @@ pub struct BudgetReport {
     /// counted from their declared textures (the same on every machine).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub occlusion_bytes_per_pixel: Option<TrafficReport>,
+    /// The share of each eye's pixels the profile's lens hides and the passes skipped in
+    /// the stereo frame (`--mask on`); zeros with `--mask off`.
+    #[serde(default)]
+    pub hidden_share_per_eye: Vec<f64>,
 }
 
 /// [`BudgetReport::occlusion_bytes_per_pixel`].
@@ -184,6 +188,10 @@ impl BudgetReport {
                 cell(&encode[2])
             );
         }
+        if self.hidden_share_per_eye.iter().any(|&h| h > 0.0) {
+            let shares: Vec<String> = self.hidden_share_per_eye.iter().map(|h| format!("{:.1} %", 100.0 * h)).collect();
+            let _ = writeln!(s, "lens mask: {} of the pixels hidden and skipped (left, right)", shares.join(", "));
+        }
         if let Some(t) = &self.occlusion_bytes_per_pixel {
             let _ = writeln!(
                 s,
@@ -250,6 +258,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
     let mut pass_order: Vec<String> = Vec::new();
     let mut right_eye_tiles = Vec::new();
     let mut occlusion_bytes_per_pixel = None;
+    let mut hidden_share_per_eye = Vec::new();
     for round in 0..how.warmup + how.frames {
         for (k, v) in views.iter().enumerate() {
             let report = renderer.render_and_wait(v, &[how.output])?;
@@ -257,6 +266,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
                 continue;
             }
             if k == 0 {
+                hidden_share_per_eye = renderer.hidden_share().to_vec();
                 occlusion_bytes_per_pixel =
                     renderer.occlusion_traffic().map(|t| TrafficReport { written: t.written, read: t.read });
                 right_eye_tiles = renderer
@@ -321,6 +331,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         verdicts,
         right_eye_tiles,
         occlusion_bytes_per_pixel,
+        hidden_share_per_eye,
     })
 }
 

@@ -73,6 +73,14 @@ fn budget_passes_a_generous_budget_with_exit_0_and_fails_a_tiny_one_with_exit_3(
     }
     assert_eq!(report["verdicts"].as_array().unwrap().len(), 3);
     assert_eq!(report["cpu_encode"].as_array().unwrap().len(), 3);
+    // The profile's lens is applied (`--mask on`, the default) and skipped when told.
+    let hidden = |r: &serde_json::Value| -> Vec<f64> {
+        r["hidden_share_per_eye"].as_array().expect("hidden shares").iter().map(|h| h.as_f64().unwrap()).collect()
+    };
+    assert!(hidden(&report).len() == 2 && hidden(&report).iter().all(|&h| h > 0.05 && h < 0.5), "{report}");
+    assert!(t.contains("lens mask:"), "{t}");
+    let (_, unmasked) = budget(&dir, "1000001", &["--mask", "off"]);
+    assert!(hidden(&unmasked).iter().all(|&h| h == 0.0), "{unmasked}");
 
     let (out, report) = budget(&dir, "0.001", &[]);
     let t = text(&out);

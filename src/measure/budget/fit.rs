@@ -81,6 +81,8 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
             COLOR
         };
         let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
+        // The profile's lens, as a headset run has it (the passes skip it with `--mask on`).
+        renderer.set_visibility_mask(Some(crate::xr::profiles::visibility_mask(&settings.profile)));
         run(&mut renderer, &eyes, BudgetRun { timing, warmup: options.warmup, frames, budget_ms, output })
     };
     let mut settings = settings.clone();
