@@ -295,6 +295,10 @@ impl FrameLoop {
     /// Books the GPU times of frames that came back.
     fn take_timings(&mut self, finished: Vec<FrameTiming>) {
         self.done.extend(self.completion.done());
+        // Without timestamps no timing comes back to take them: keep the recent ones.
+        while self.done.len() > KEPT_IN_FLIGHT {
+            self.done.pop_front();
+        }
         for mut timing in finished {
             while self.in_flight.front().is_some_and(|f| f.frame < timing.frame) {
                 self.in_flight.pop_front();
