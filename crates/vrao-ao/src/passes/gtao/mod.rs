@@ -18,16 +18,8 @@ use bytemuck::{Pod, Zeroable};
 /// The shared bindings with the right eye's at 7–9 (occlusion::REUSING_BINDINGS), at 10
 /// GTAO's own parameters and at 11 the second depth layer (unbound with one layer). A
 /// march that gathers light (SSDO) binds more after these ([`March::binds`]).
-pub(crate) const BINDINGS: [Bind; 12] = {
-    let mut all = [Bind::Read(DEPTH_LAYER_2); 12];
-    let mut i = 0;
-    while i < occlusion::REUSING_BINDINGS.len() {
-        all[i] = occlusion::REUSING_BINDINGS[i];
-        i += 1;
-    }
-    all[10] = Bind::Own(Slot::Uniform);
-    all
-};
+pub(crate) const BINDINGS: [Bind; 12] =
+    occlusion::joined(occlusion::REUSING_BINDINGS, [Bind::Own(Slot::Uniform), Bind::Read(DEPTH_LAYER_2)]);
 
 /// Whether this frame's march reads the second depth layer: two asked for, a technique
 /// that reads it, and one to be had (a renderer that peels it, a host that gave it).
@@ -115,12 +107,10 @@ impl Kernels {
         let kernel = |entry: &str, band: bool, right: bool| {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
-                ("RIGHT_EYE", f64::from(right)),
-                ("LISTED_PIXELS", f64::from(right)),
-                ("SINGLE_LAYER_OUTPUT", f64::from(right)),
                 ("THIN_CARDS", f64::from(thin_cards)),
                 ("SECOND_LAYER", f64::from(second_layer)),
             ];
+            constants.extend_from_slice(&occlusion::right_eye_constants(right));
             constants.extend_from_slice(&march.constants);
             let chain = ChainLayout::of(march.technique.carries_light(), gpu.caps.scalar_chain);
             Kernel::in_chain(gpu, march.label, &march.files, entry, march.binds, &constants, chain)

@@ -53,14 +53,29 @@ pub(crate) const REUSING_BINDINGS: [Bind; 10] =
 /// `BINDINGS` followed by a technique's own bindings (from binding 7 on); `M` is the
 /// total, checked when the constant is made.
 pub const fn bindings_and<const N: usize, const M: usize>(own: [Bind; N]) -> [Bind; M] {
-    assert!(M == BINDINGS.len() + N, "M must be 7 + N");
-    let mut all = [Bind::Frame; M];
+    joined(BINDINGS, own)
+}
+
+/// `first`'s bindings followed by `then`'s (a layout built on another); `K` is the
+/// total, checked when the constant is made.
+pub(crate) const fn joined<const N: usize, const M: usize, const K: usize>(
+    first: [Bind; N],
+    then: [Bind; M],
+) -> [Bind; K] {
+    assert!(K == N + M, "K must be N + M");
+    let mut all = [Bind::Frame; K];
     let mut i = 0;
-    while i < M {
-        all[i] = if i < BINDINGS.len() { BINDINGS[i] } else { own[i - BINDINGS.len()] };
+    while i < K {
+        all[i] = if i < N { first[i] } else { then[i - N] };
         i += 1;
     }
     all
+}
+
+/// right_eye.wgsl's pipeline constants for the left eye's (or both eyes') dispatch
+/// (false) or the right eye's two (true): its pixels listed, its outputs one layer.
+pub(crate) fn right_eye_constants(right: bool) -> [(&'static str, f64); 3] {
+    [("RIGHT_EYE", f64::from(right)), ("LISTED_PIXELS", f64::from(right)), ("SINGLE_LAYER_OUTPUT", f64::from(right))]
 }
 
 /// A technique pass's declaration: its bindings (the G-buffer in, the raw occlusion and
@@ -118,11 +133,7 @@ impl TechniquePass {
         // The technique decides the chain's layout (technique.carries_light()).
         let chain = ChainLayout::of(technique.carries_light(), gpu.caps.scalar_chain);
         let kernel = |entry: &str, right: bool| {
-            let constants = [
-                ("RIGHT_EYE", f64::from(right)),
-                ("LISTED_PIXELS", f64::from(right)),
-                ("SINGLE_LAYER_OUTPUT", f64::from(right)),
-            ];
+            let constants = right_eye_constants(right);
             Kernel::in_chain(gpu, technique.name(), &files, entry, &REUSING_BINDINGS, &constants, chain)
         };
         TechniquePass {

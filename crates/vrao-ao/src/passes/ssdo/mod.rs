@@ -13,7 +13,7 @@
 
 use super::gtao::{GtaoPass, March, BINDINGS as GTAO_BINDINGS, GTAO_WGSL};
 use super::inputs::DIRECT_LIGHT;
-use super::occlusion::{OCCLUSION_WGSL, RIGHT_EYE_WGSL};
+use super::occlusion::{self, OCCLUSION_WGSL, RIGHT_EYE_WGSL};
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
 use crate::gpu::kernel::{wgsl, Bind, COMMON, IRRADIANCE, VISIBILITY};
 use crate::gpu::Gpu;
@@ -21,15 +21,7 @@ use crate::graph::PassDecl;
 use crate::settings::Technique;
 
 /// GTAO's bindings and, at 12, the packed direct light (ssdo.wgsl `direct_layers`).
-const BINDINGS: [Bind; 13] = {
-    let mut all = [Bind::Read(DIRECT_LIGHT); 13];
-    let mut i = 0;
-    while i < GTAO_BINDINGS.len() {
-        all[i] = GTAO_BINDINGS[i];
-        i += 1;
-    }
-    all
-};
+const BINDINGS: [Bind; 13] = occlusion::joined(GTAO_BINDINGS, [Bind::Read(DIRECT_LIGHT)]);
 
 /// What a host's frame gives SSDO beyond depth (the AO engine puts it among the frame's
 /// extensions; vrao's renderer, which always has its direct light, puts none).
