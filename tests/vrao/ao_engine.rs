@@ -8,7 +8,7 @@ mod host;
 
 use glam::DVec3;
 use host::{demo_eyes, demo_geometry, DepthPrepass, HostDepth};
-use vrao_ao::plug::{read_layers_f32, LayeredTarget, DEPTH_LAYER_2, FINAL_AO};
+use vrao_ao::plug::{layer_views, read_layers_f32, LayeredTarget, DEPTH_LAYER_2, FINAL_AO};
 use vrao_ao::Error;
 use vrao_ao::{
     AoConfig, AoEngine, AoFrame, DepthConvention, HostLight, HostMotion, HostNormals, NormalEncoding, NormalSpace,
@@ -553,6 +553,37 @@ fn near_silhouettes(depth: &[f32]) -> Vec<bool> {
         .collect()
 }
 
+/// The engine (`settings`) over one mono view of the host's `depth` (and `normals`), as
+/// `eye` sees it, recorded after what `before` records in the same encoder; its output.
+fn mono_output(
+    gpu: &vrao_ao::plug::Gpu,
+    settings: &AoSettings,
+    eye: Eye,
+    depth: &wgpu::Texture,
+    normals: Option<HostNormals>,
+    before: impl FnOnce(&mut wgpu::CommandEncoder, &[ViewMatrices]),
+) -> wgpu::Texture {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let views = host_views(&[eye], HostDepth::ReversedInfinite);
+    let config = AoConfig { settings: settings.clone(), width: WIDTH, height: HEIGHT, views: 1 };
+    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    before(&mut encoder, &views);
+    let frame = AoFrame {
+        depth,
+        depth_convention: DepthConvention::REVERSED_INFINITE,
+        second_layer: None,
+        normals,
+        views: &views,
+        motion: None,
+        light: None,
+        exclusion: None,
+    };
+    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
+    queue.submit([encoder.finish()]);
+    texture
+}
+
 /// The engine's output (default settings) for one mono view over the host's prepass drawn
 /// with `samples` samples, and the prepass (for its depth).
 fn mono_engine_output(
@@ -561,28 +592,13 @@ fn mono_engine_output(
     samples: u32,
     with_normals: bool,
 ) -> (wgpu::Texture, DepthPrepass) {
-    let (device, queue) = (&gpu.device, &gpu.queue);
-    let geometry = demo_geometry();
+    let device = &gpu.device;
     let prepass =
-        DepthPrepass::multisampled(device, &geometry, HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1, samples);
-    let views = host_views(&[eye], HostDepth::ReversedInfinite);
-    let config = AoConfig { settings: AoSettings::default(), width: WIDTH, height: HEIGHT, views: 1 };
-    let mut engine = AoEngine::new(device, queue, &config).unwrap();
+        DepthPrepass::multisampled(device, &demo_geometry(), HostDepth::ReversedInfinite, (WIDTH, HEIGHT), 1, samples);
     let normals = HostNormals { texture: &prepass.normals, space: NormalSpace::View, encoding: NormalEncoding::Signed };
-    let mut encoder = device.create_command_encoder(&Default::default());
-    prepass.record(device, &mut encoder, &views);
-    let frame = AoFrame {
-        depth: &prepass.depth,
-        depth_convention: DepthConvention::REVERSED_INFINITE,
-        second_layer: None,
-        normals: with_normals.then_some(normals),
-        views: &views,
-        motion: None,
-        light: None,
-        exclusion: None,
-    };
-    let texture = engine.record(&mut encoder, &frame).unwrap().texture.clone();
-    queue.submit([encoder.finish()]);
+    let record = |encoder: &mut wgpu::CommandEncoder, views: &[ViewMatrices]| prepass.record(device, encoder, views);
+    let texture =
+        mono_output(gpu, &AoSettings::default(), eye, &prepass.depth, with_normals.then_some(normals), record);
     (texture, prepass)
 }
 
@@ -988,24 +1004,9 @@ fn a_second_layer_with_nothing_behind_or_none_read_is_one_layer() {
 
 /// A 2-layer depth texture of `format` at the engine's size, cleared to `value`.
 fn cleared_depth(device: &wgpu::Device, queue: &wgpu::Queue, format: wgpu::TextureFormat, value: f32) -> wgpu::Texture {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("host second layer"),
-        size: wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 2 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    });
+    let texture = host::layered_target(device, "host second layer", format, (WIDTH, HEIGHT), 2, 1);
     let mut encoder = device.create_command_encoder(&Default::default());
-    for layer in 0..2 {
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2),
-            base_array_layer: layer,
-            array_layer_count: Some(1),
-            ..Default::default()
-        });
+    for view in layer_views(&texture, "host second layer", 2) {
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("host second layer"),
             color_attachments: &[],
@@ -1163,22 +1164,7 @@ mod resolve_rules {
             wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(WIDTH * 2), rows_per_image: Some(HEIGHT) },
             size,
         );
-        let views = host_views(&[eye], HostDepth::ReversedInfinite);
-        let config = AoConfig { settings: settings.clone(), width: WIDTH, height: HEIGHT, views: 1 };
-        let mut engine = AoEngine::new(device, queue, &config).unwrap();
-        let mut encoder = device.create_command_encoder(&Default::default());
-        let frame = AoFrame {
-            depth: &texture,
-            depth_convention: DepthConvention::REVERSED_INFINITE,
-            second_layer: None,
-            normals: None,
-            views: &views,
-            motion: None,
-            light: None,
-            exclusion: None,
-        };
-        let output = engine.record(&mut encoder, &frame).unwrap().texture.clone();
-        queue.submit([encoder.finish()]);
+        let output = mono_output(gpu, settings, eye, &texture, None, |_, _| {});
         host::read_alpha(device, queue, &output, 0)
     }
 
@@ -1189,7 +1175,8 @@ mod resolve_rules {
         let pixels = (WIDTH * HEIGHT) as usize;
         let moved = STANDARD_4X.map(|s| moved_to(eye, s));
         let reference = ReferenceSettings { radius: f64::from(radius), rays_per_pixel: 256, stride: 1, near: NEAR };
-        let traced = moved.map(|e| trace(&scene(), &[e], (WIDTH, HEIGHT), &reference, &mut |_| {}).unwrap());
+        let scene = scene();
+        let traced = moved.map(|e| trace(&scene, &[e], (WIDTH, HEIGHT), &reference, &mut |_| {}).unwrap());
         // The truth: the mean of the samples' traced AO (the sky is open).
         let sample_ao = |s: usize, i: usize| {
             let p = &traced[s].layers[0][i];

@@ -416,7 +416,7 @@ fn prepass_pipeline(
 }
 
 /// A render target of `format` with `layers` layers of `width` × `height`, also sampled.
-fn layered_target(
+pub(crate) fn layered_target(
     device: &wgpu::Device,
     label: &str,
     format: wgpu::TextureFormat,
