@@ -13,7 +13,10 @@ pub(crate) mod temporal;
 
 /// A flag that the first Ctrl-C (SIGINT) or SIGTERM sets, saying `first` on stderr, for
 /// the command to end cleanly; a second one runs `second` (its last cleaning up) and stops
-/// the process at once (130, as a shell reports an interrupted command).
+/// the process at once (130, as a shell reports an interrupted command). At once means
+/// `_exit`, not `exit`: `exit` runs the C libraries' destructors (Mesa's, LLVM's) while the
+/// main thread may still be tearing the device down, which killed vrao with a signal
+/// instead of 130 (seen once in four CI runs).
 pub(crate) fn interrupt_on_signals(
     first: &'static str,
     second: impl Fn() + Send + 'static,
@@ -24,7 +27,8 @@ pub(crate) fn interrupt_on_signals(
     let installed = ctrlc::set_handler(move || {
         if flag.swap(true, Ordering::Relaxed) {
             second();
-            std::process::exit(vrao::error::EXIT_INTERRUPTED);
+            // SAFETY: `_exit` only ends the process; it touches no state of this one.
+            unsafe { libc::_exit(vrao::error::EXIT_INTERRUPTED) };
         }
         eprintln!("interrupted: {first} (again to stop at once)");
     });
