@@ -110,6 +110,28 @@ fn upsample_pixel(
     return px;
 }
 
+// Pixel `k` of the quad of low-res sample `b` with its depth and view position alone:
+// what the right eye's reuse of the left eye's result reads (`left_eye_quad`), which
+// has no use for the normal (a quarter of an upsampled quad's loads).
+fn quad_position(depth_layers: texture_depth_2d_array, b: vec2<u32>, k: u32, layer: u32, eye: Eye) -> UpsamplePixel {
+    var px: UpsamplePixel;
+    px.pixel = b * 2u + vec2<u32>(k & 1u, k >> 1u);
+    px.texel = min(px.pixel, frame.size - vec2<u32>(1u));
+    px.depth = textureLoad(depth_layers, vec2<i32>(px.texel), i32(layer), 0);
+    px.position = load_view_position(max(px.depth, 1e-30), px.texel, eye, frame.size, frame.near);
+    return px;
+}
+
+// The four pixels of the quad of low-res sample `b`, as `quad_position` gives them.
+fn quad_positions(depth_layers: texture_depth_2d_array, b: vec2<u32>, layer: u32, eye: Eye) -> array<UpsamplePixel, 4> {
+    return array<UpsamplePixel, 4>(
+        quad_position(depth_layers, b, 0u, layer, eye),
+        quad_position(depth_layers, b, 1u, layer, eye),
+        quad_position(depth_layers, b, 2u, layer, eye),
+        quad_position(depth_layers, b, 3u, layer, eye),
+    );
+}
+
 // The four pixels of the quad of low-res sample `b`.
 fn quad_pixels(
     depth_layers: texture_depth_2d_array,

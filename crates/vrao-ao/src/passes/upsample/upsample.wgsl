@@ -70,9 +70,10 @@ fn main(
         }
         return;
     }
-    let quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
+    var quad: array<UpsamplePixel, 4>;
     var values: array<vec4<f32>, 4>;
     if (RIGHT_EYE && !FALLBACK) {
+        quad = quad_positions(depth_layers, id.xy, layer, eye);
         let left = left_eye_quad(depth_layers, left_final, quad);
         if (!all(left.found)) {
             let i = atomicAdd(&fallback.count, 1u);
@@ -84,8 +85,10 @@ fn main(
         }
         values = left.values;
     } else if (RIGHT_EYE) {
+        quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
         values = right_eye_quad(depth_layers, left_final, geometry_low, occlusion_low, quad, vec2<i32>(id.xy), eye.tangents);
     } else {
+        quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
         values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents, true);
     }
     store(quad[0], out_layer, values[0]);
