@@ -771,11 +771,10 @@ mod tests {
     use super::*;
 
     /// A work folder with `files` (name, bytes) in it.
-    fn work_dir(name: &str, files: &[(&str, Vec<u8>)]) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("vrao-peer-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+    fn work_dir(name: &str, files: &[(&str, Vec<u8>)]) -> vrao_render::test_dir::TestDir {
+        let dir = vrao_render::test_dir::TestDir::new(&format!("peer-{name}"));
         for (file, bytes) in files {
-            std::fs::write(dir.join(file), bytes).unwrap();
+            dir.write(file, bytes);
         }
         dir
     }

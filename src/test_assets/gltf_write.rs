@@ -908,10 +908,8 @@ mod tests {
     }
 
     /// `scene` written to a `.gltf` named `name` with `options`, read back as JSON.
-    fn written(scene: &Scene, name: &str, options: &WriteOptions) -> (Value, std::path::PathBuf) {
-        let dir = std::env::temp_dir().join(format!("vrao-gltf-write-{}-{name}", std::process::id()));
-        std::fs::remove_dir_all(&dir).ok();
-        std::fs::create_dir_all(&dir).unwrap();
+    fn written(scene: &Scene, name: &str, options: &WriteOptions) -> (Value, vrao_render::test_dir::TestDir) {
+        let dir = vrao_render::test_dir::TestDir::new(&format!("gltf-write-{name}"));
         let path = dir.join(format!("{name}.gltf"));
         write(scene, &path, options).unwrap();
         let bytes = std::fs::read(&path).unwrap();
@@ -1021,7 +1019,8 @@ mod tests {
         // A transform with shear has no offset, rotation and scale: refused, naming the material.
         let sheared = Affine2::from_cols_array(&[1.0, 0.0, 0.5, 1.0, 0.0, 0.0]);
         m.diffuse_texture = Some(texture(Sampling { transform: sheared, ..Sampling::default() }));
-        let path = std::env::temp_dir().join(format!("vrao-gltf-write-{}-sheared.gltf", std::process::id()));
+        let dir = vrao_render::test_dir::TestDir::new("gltf-write-sheared");
+        let path = dir.join("sheared.gltf");
         let e = write(&scene(vec![quad("q", 0, vec![], vec![])], vec![m]), &path, &Default::default()).unwrap_err();
         assert!(e.to_string().contains("'default'") && e.to_string().contains("shear"), "{e}");
     }

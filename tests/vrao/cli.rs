@@ -1,6 +1,5 @@
 //! The `vrao` binary as a user runs it: exit codes, messages, written files.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn vrao(args: &[&str]) -> Output {
@@ -11,11 +10,9 @@ fn text(out: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty directory for one test's files, removed when the test passes.
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("cli-{name}"))
 }
 
 #[test]

@@ -17,10 +17,8 @@ fn budget() -> Duration {
     Duration::from_secs_f64(seconds)
 }
 
-fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-fuzz-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("fuzz-{name}"))
 }
 
 fn seeds(target: Target) -> Vec<Vec<u8>> {
@@ -41,7 +39,8 @@ fn seeds(target: Target) -> Vec<Vec<u8>> {
         Target::Gltf => {
             seeds.push(VALID_GLTF_FILES.as_bytes().to_vec());
             // The same content as a .glb container, as vrao's writer makes it.
-            let glb = scratch("glb-seed").join("seed.glb");
+            let dir = scratch("glb-seed");
+            let glb = dir.join("seed.glb");
             let scene = vrao_render::scene::Scene::load("builtin:furnished").unwrap();
             vrao::test_assets::gltf_write::write(&scene, &glb, &Default::default()).unwrap();
             seeds.push(std::fs::read(glb).unwrap());

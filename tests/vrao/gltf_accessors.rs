@@ -12,11 +12,9 @@ use vrao::test_assets::fuzz::{load_bytes, Mutator, Target};
 use vrao::test_assets::gltf_write::encode_base64;
 use vrao_render::scene::Scene;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-test-{}-accessors-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty directory for one test's files, removed when the test passes.
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("accessors-{name}"))
 }
 
 /// A component type, as glTF numbers it.

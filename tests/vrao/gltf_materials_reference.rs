@@ -7,7 +7,6 @@
 #![cfg(all(feature = "app", feature = "gltf"))]
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
-use std::path::PathBuf;
 use vrao::measure::reference::{trace, world_position, ReferenceImage, ReferencePixel, ReferenceSettings};
 use vrao::test_assets::gltf_write::{write, WriteOptions};
 use vrao_ao::plug::DEFAULT_NEAR;
@@ -16,11 +15,9 @@ use vrao_render::scene::texture::uv_transform;
 use vrao_render::scene::{AlphaMode, Filter, HeadPath, Light, Material, Mesh, Sampling, Texture, Wrap};
 use vrao_render::{HeadsetProfile, Scene};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-gltf-materials-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty directory for one test's files, removed when the test passes.
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("gltf-materials-{name}"))
 }
 
 /// `scene` written as `NAME.glb` and loaded again, viewed from `head`.

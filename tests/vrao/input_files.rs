@@ -19,11 +19,9 @@ fn text(out: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-input-files-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty directory for one test's files, removed when the test passes.
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("input-files-{name}"))
 }
 
 fn path(p: &Path) -> &str {
@@ -109,7 +107,8 @@ fn triangle_gltf(buffer: Option<&str>, image: Option<&str>) -> String {
 fn gltf_uris_naming_devices_fifos_or_files_outside_its_folder_are_refused_naming_the_uri() {
     let outside = temp_dir("uri-outside");
     std::fs::write(outside.join("secret.png"), b"not read").unwrap();
-    let dir = temp_dir("uri").join("model");
+    let folder = temp_dir("uri");
+    let dir = folder.join("model");
     std::fs::create_dir_all(&dir).unwrap();
     std::os::unix::fs::symlink("/dev/zero", dir.join("zero.bin")).unwrap();
     std::os::unix::fs::symlink("/dev/urandom", dir.join("noise.png")).unwrap();

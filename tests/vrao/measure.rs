@@ -1,7 +1,6 @@
 //! `vrao budget` and `vrao bench` as a user runs them: verdicts, exit codes and the files
 //! they write. Small sizes: this checks the mechanism; the figures are for the reports.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::Mutex;
 
@@ -17,11 +16,9 @@ fn text(out: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-measure-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty directory for one test's files, removed when the test passes.
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("measure-{name}"))
 }
 
 fn budget(dir: &std::path::Path, budget_ms: &str, extra: &[&str]) -> (Output, serde_json::Value) {

@@ -19,10 +19,9 @@ fn bevy_on_an_open_plane_reads_its_known_084_against_a_reference_of_1() {
     let peer = std::env::var_os("VRAO_PEER_BEVY")
         .map(PathBuf::from)
         .expect("VRAO_PEER_BEVY names the peer program (bash .ci/peer builds it and sets it)");
-    let out = std::env::temp_dir().join(format!("vrao-peer-plane-{}", std::process::id()));
+    let out = crate::common::temp_dir("peer-plane");
     let scene = Scene::load("builtin:plane").unwrap();
     let base = Settings { profile: HeadsetProfile::with_size("vive", 96, 104), ..Settings::default() };
-    std::fs::create_dir_all(&out).unwrap();
     let gltf = out.join("plane.glb");
     vrao::test_assets::gltf_write::write(&scene_for_peer(&scene), &gltf, &Default::default()).unwrap();
     let options = PeerOptions {
@@ -36,7 +35,7 @@ fn bevy_on_an_open_plane_reads_its_known_084_against_a_reference_of_1() {
         frames: 1,
         rounds: 1,
         reference: ReferenceOptions { rays_per_pixel: 64, stride: 4, cache: out.join("cache") },
-        out: out.clone(),
+        out: out.to_path_buf(),
         gltf,
         interrupt: Default::default(),
     };
@@ -59,5 +58,4 @@ fn bevy_on_an_open_plane_reads_its_known_084_against_a_reference_of_1() {
     // vrao's GTAO sees the open plane as open.
     assert!(vrao.error.ao_bias.abs() < 0.03, "vrao's bias {}", vrao.error.ao_bias);
     assert!(bevy.ms_stereo > 0.0 && vrao.ms_stereo > 0.0);
-    let _ = std::fs::remove_dir_all(&out);
 }

@@ -2,16 +2,14 @@
 //! work: draws (primitive instances), bytes read (one read per file, however many buffers
 //! name it) and decoded images (one decode per source, however many slots name it).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 use vrao::test_assets::gltf_write::encode_base64;
 use vrao_render::scene::Scene;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-test-{}-bounds-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty directory for one test's files, removed when the test passes.
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("bounds-{name}"))
 }
 
 /// One triangle (positions only, 36 bytes) in `buffers` buffers that all name `uri`, its

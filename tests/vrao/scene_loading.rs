@@ -5,27 +5,12 @@ use glam::{DVec3, Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use vrao_render::scene::{builtin, Light, Scene};
 
-/// A scratch directory under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
+/// A scratch directory for one test, removed when it passes.
+struct TempDir;
 
 impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("vrao-scene-loading-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, contents: &str) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::write(&path, contents).unwrap();
-        path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
+    fn new(name: &str) -> crate::common::TestDir {
+        crate::common::temp_dir(&format!("scene-loading-{name}"))
     }
 }
 
@@ -152,7 +137,7 @@ fn emissive_material_becomes_a_point_light() {
 fn diffuse_texture_is_loaded_and_v_flipped() {
     let dir = TempDir::new("texture");
     let pixels = vec![255, 0, 0, 255, 0, 0, 255, 128];
-    image::RgbaImage::from_raw(2, 1, pixels.clone()).unwrap().save(dir.0.join("albedo.png")).unwrap();
+    image::RgbaImage::from_raw(2, 1, pixels.clone()).unwrap().save(dir.join("albedo.png")).unwrap();
     dir.write("m.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd albedo.png\n");
     let text = format!("mtllib m.mtl\n{SQUARE}vt 0 0\nvt 1 0\nvt 1 1\nusemtl tex\nf 1/1 2/2 3/3\n");
     let scene = load(&dir.write("m.obj", &text)).unwrap();
@@ -196,7 +181,7 @@ fn face_with_two_vertices_is_an_error() {
 #[test]
 fn missing_files_are_named() {
     let dir = TempDir::new("missing");
-    let obj = dir.0.join("nothing-here.obj");
+    let obj = dir.join("nothing-here.obj");
     assert!(error_of(&obj).contains("nothing-here.obj"));
     let scene = dir.write("s.toml", "[[mesh]]\nobj = \"also-missing.obj\"\n");
     let err = error_of(&scene);
@@ -210,10 +195,10 @@ fn malformed_mtl_number_names_mtl_file_and_line() {
     let err = error_of(&dir.write("m.obj", &format!("mtllib bad.mtl\n{SQUARE}f 1 2 3\n")));
     assert!(err.contains("bad.mtl:3:") && err.contains("'abc' is not a number"), "{err}");
     dir.write("bad.mtl", "newmtl a\nKe 1 -2 0\n");
-    let err = error_of(&dir.0.join("m.obj"));
+    let err = error_of(&dir.join("m.obj"));
     assert!(err.contains("bad.mtl:2:") && err.contains("negative"), "{err}");
     dir.write("bad.mtl", "newmtl a\nKd 0.5 0.5\n");
-    assert!(error_of(&dir.0.join("m.obj")).contains("bad.mtl:2: Kd needs 1 or 3 numbers"));
+    assert!(error_of(&dir.join("m.obj")).contains("bad.mtl:2: Kd needs 1 or 3 numbers"));
 }
 
 #[test]
@@ -366,10 +351,10 @@ fn scene_files_render_from_a_copy_of_assets_outside_the_repository() {
     let Some(scenes) = crate::common::public_scenes() else { return };
     let scenes = scenes.canonicalize().unwrap();
     let dir = TempDir::new("assets-copy");
-    copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets"), &dir.0.join("assets"));
+    copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets"), &dir.join("assets"));
     let vrao = |scene: &Path, vrao_scenes: Option<&Path>| {
         let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_vrao"));
-        command.args(["render", "--width", "64", "--height", "64", "--out"]).arg(dir.0.join("out"));
+        command.args(["render", "--width", "64", "--height", "64", "--out"]).arg(dir.join("out"));
         command.arg("--scene").arg(scene).env_remove("VRAO_SCENES");
         if let Some(v) = vrao_scenes {
             command.env("VRAO_SCENES", v);
@@ -378,7 +363,7 @@ fn scene_files_render_from_a_copy_of_assets_outside_the_repository() {
         let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
         (out.status.code(), text)
     };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.0.join("assets/scenes"))
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir.join("assets/scenes"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
@@ -390,7 +375,7 @@ fn scene_files_render_from_a_copy_of_assets_outside_the_repository() {
         assert_eq!(code, Some(0), "{}: {text}", file.display());
     }
     // Unset, the variable is named in one line with the file and line that needs it.
-    let cornell = dir.0.join("assets/scenes/cornell.toml");
+    let cornell = dir.join("assets/scenes/cornell.toml");
     let (code, text) = vrao(&cornell, None);
     assert_eq!(code, Some(2), "{text}");
     assert_eq!(text.lines().filter(|l| !l.trim().is_empty()).count(), 1, "{text}");

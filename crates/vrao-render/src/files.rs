@@ -163,11 +163,8 @@ pub fn read_regular_file_to_string(path: &Path, limit: u64) -> Result<String, Fi
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("vrao-files-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn scratch(name: &str) -> crate::test_dir::TestDir {
+        crate::test_dir::TestDir::new(&format!("files-{name}"))
     }
 
     #[test]
@@ -198,7 +195,7 @@ mod tests {
         let zero = dir.join("zero.bin");
         std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
         let started = std::time::Instant::now();
-        let mut cases = vec![(zero, "is a character device"), (dir.clone(), "is a directory")];
+        let mut cases = vec![(zero, "is a character device"), (dir.to_path_buf(), "is a directory")];
         if std::path::Path::new("/dev/urandom").exists() {
             cases.push((PathBuf::from("/dev/urandom"), "is a character device"));
         }

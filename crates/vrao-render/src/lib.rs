@@ -20,6 +20,8 @@ pub mod passes;
 pub mod renderer;
 pub mod scene;
 pub mod settings;
+#[doc(hidden)]
+pub mod test_dir;
 
 pub use gpu::open::{open, BackendChoice};
 pub use headset::HeadsetProfile;

@@ -448,10 +448,8 @@ fn scene_far_from_the_origin_gives_the_same_reference() {
     assert!(depth_diff < 1e-5, "relative depth difference {depth_diff}");
 }
 
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-reference-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    dir
+fn temp_dir(name: &str) -> vrao_render::test_dir::TestDir {
+    vrao_render::test_dir::TestDir::new(&format!("reference-{name}"))
 }
 
 #[test]

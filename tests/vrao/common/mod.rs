@@ -81,12 +81,11 @@ pub(crate) fn alone_in_a_process() -> bool {
     false
 }
 
-/// A fresh, empty directory for one test's files.
-pub(crate) fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("vrao-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+pub(crate) use vrao_render::test_dir::TestDir;
+
+/// A fresh, empty [`TestDir`] named `name`.
+pub(crate) fn temp_dir(name: &str) -> TestDir {
+    TestDir::new(name)
 }
 
 /// A GPU of the caller's own, for a test that changes a GPU for good (a cancellation

@@ -913,11 +913,8 @@ path = [{ t = 0, eye = [0, 1.6, 3], look_at = [0, 1, 0] }, { t = 2.5, eye = [1, 
         assert!(bounds.min.is_finite() && bounds.max.is_finite());
     }
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("vrao-scene-file-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn scratch(name: &str) -> crate::test_dir::TestDir {
+        crate::test_dir::TestDir::new(&format!("scene-file-{name}"))
     }
 
     #[cfg(unix)]

@@ -223,18 +223,16 @@ mod tests {
         assert!(percent_decode("bad%zz").is_none());
     }
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("vrao-gltf-files-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn scratch(name: &str) -> crate::test_dir::TestDir {
+        crate::test_dir::TestDir::new(&format!("gltf-files-{name}"))
     }
 
     #[test]
     fn uris_stay_in_the_gltfs_folder() {
         let outside = scratch("uri-outside");
         std::fs::write(outside.join("x.bin"), b"secret").unwrap();
-        let dir = scratch("uri").join("model");
+        let folder = scratch("uri");
+        let dir = folder.join("model");
         std::fs::create_dir_all(dir.join("sub")).unwrap();
         std::fs::write(dir.join("in.bin"), b"bytes").unwrap();
         let gltf = dir.join("model.gltf");
