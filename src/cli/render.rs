@@ -20,7 +20,8 @@ pub(crate) struct RenderArgs {
     /// Output directory.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Also write depth, normals and albedo per eye.
+    /// Also write depth, normals and albedo per eye, and the right eye with the pixels its
+    /// march computed (not taken from the left eye) in red: marched_right.png.
     #[arg(long)]
     debug: bool,
     /// Print which passes ran and why the others were left out.

@@ -197,7 +197,8 @@ impl OutputTrail {
 /// Writes `left.png` and `right.png` (or `mono.png` for one view) and, when a technique
 /// ran, the final AO as grey beside them (`ao_left.png`, `ao_right.png`): the picture of
 /// what the technique adds. With `debug` also the depth, normals, albedo and raw AO of
-/// each view. Returns the files written. `trail` records the folder it creates and each
+/// each view, and `marched_right.png`, the right eye's pixels its march computed rather
+/// than took from the left eye (`marched_over`). Returns the files written. `trail` records the folder it creates and each
 /// file, so that an interrupted command can remove them again.
 pub fn write_images(
     renderer: &Renderer,
@@ -217,8 +218,9 @@ pub fn write_images(
         written.push(path);
         Ok(())
     };
-    for (name, rgba) in names.iter().zip(renderer.read_bytes(COLOR)?) {
-        save_sized(format!("{name}.png"), (w, h), rgba)?;
+    let colours = renderer.read_bytes(COLOR)?;
+    for (name, rgba) in names.iter().zip(&colours) {
+        save_sized(format!("{name}.png"), (w, h), rgba.clone())?;
     }
     // The final AO first, then (with `debug`) the raw AO before blur or upsampling.
     for (label, r) in occlusion_written(settings, debug) {
@@ -239,8 +241,37 @@ pub fn write_images(
         for (name, albedo) in names.iter().zip(renderer.read_bytes(ALBEDO)?) {
             save_sized(format!("albedo_{name}.png"), (w, h), albedo)?;
         }
+        if let (Some((_, marched)), Some(right)) = (renderer.right_eye_marched(), colours.get(1)) {
+            let scale = if settings.ao.resolution.is_half() { 2 } else { 1 };
+            save_sized("marched_right.png".into(), (w, h), marched_over(right, (w, h), &marched, scale))?;
+        }
     }
     Ok(written)
+}
+
+/// The right eye's image `rgba` (`size`) in grey, with the pixels its march computed
+/// rather than copied from the left eye (`marched`, occlusion pixels of `scale`×`scale`
+/// image pixels each) in red: where the right eye paid, to look at beside its image for
+/// seams along the listed pixels.
+fn marched_over(rgba: &[u8], (w, h): (u32, u32), marched: &[[u32; 2]], scale: u32) -> Vec<u8> {
+    let mut out: Vec<u8> = rgba
+        .chunks_exact(4)
+        .flat_map(|p| {
+            let grey = ((u32::from(p[0]) * 2 + u32::from(p[1]) * 5 + u32::from(p[2])) / 8 * 3 / 4) as u8;
+            [grey, grey, grey, 255]
+        })
+        .collect();
+    for &[x, y] in marched {
+        for (dx, dy) in (0..scale * scale).map(|k| (k % scale, k / scale)) {
+            let (px, py) = (x * scale + dx, y * scale + dy);
+            if px < w && py < h {
+                let i = 4 * (py as usize * w as usize + px as usize);
+                out[i] = 255;
+                out[i + 2] /= 2;
+            }
+        }
+    }
+    out
 }
 
 /// Checks, before any work, that a file can be written at `path` (its folder exists and

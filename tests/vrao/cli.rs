@@ -72,6 +72,15 @@ fn render_writes_both_eyes_and_explains_the_graph() {
     let left = std::fs::read(out_dir.join("left.png")).unwrap();
     let right = std::fs::read(out_dir.join("right.png")).unwrap();
     assert_ne!(left, right, "the eyes see the scene from different places");
+    // The right eye's marched pixels in red over its grey image: some, not all, and
+    // mostly on its outer (right) side, which the left eye's frustum never sees.
+    let marched = image::open(out_dir.join("marched_right.png")).unwrap().to_rgb8();
+    assert_eq!(marched.dimensions(), (96, 108));
+    let red: Vec<u32> = marched.enumerate_pixels().filter(|(_, _, p)| p[0] != p[1]).map(|(x, _, _)| x).collect();
+    let share = red.len() as f64 / (96.0 * 108.0);
+    let outer = red.iter().filter(|&&x| x >= 48).count();
+    assert!((0.02..0.5).contains(&share), "the right eye marched {share:.3} of its pixels");
+    assert!(outer > 3 * (red.len() - outer), "marched pixels by side: {outer} outer, {} inner", red.len() - outer);
 }
 
 #[test]

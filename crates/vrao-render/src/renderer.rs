@@ -513,6 +513,14 @@ impl Renderer {
         RightEyeTiles::latest(&passes, &self.gpu)
     }
 
+    /// The right eye's occlusion pixels the last frame's march computed rather than
+    /// copied from the left eye, (x, y) at occlusion resolution, with the march's counts
+    /// (blocking: for debug images); `None` when the right eye reused nothing.
+    pub fn right_eye_marched(&self) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
+        let listed = self.passes.ao_chain.iter().filter_map(|p| p.right_eye_listed(&self.gpu));
+        listed.max_by_key(|(t, _)| t.frame)
+    }
+
     /// The target a previous frame wrote, if that frame needed it (a named output: its
     /// texture as the last frame resolved it).
     pub fn target(&self, r: Resource) -> Option<&LayeredTarget> {

@@ -229,6 +229,11 @@ pub trait Pass: Send + Sync {
     fn right_eye_tiles(&self, _gpu: &Gpu) -> Option<RightEyeTiles> {
         None
     }
+    /// [`Pass::right_eye_tiles`] with the items the right eye computed, (x, y) at
+    /// occlusion resolution (blocking; for the debug image of what the right eye marched).
+    fn right_eye_listed(&self, _gpu: &Gpu) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
+        None
+    }
 }
 
 /// How much of the right eye a pass computed rather than copied from the left eye, in

@@ -114,6 +114,17 @@ impl RightEyeList {
         self.tiles = 0;
     }
 
+    /// The last listing frame's counts and its listed items (occlusion pixels, or quads
+    /// for the upsampling, as (x, y)), read back (blocking; for debug images).
+    pub(crate) fn read_items(&self, gpu: &Gpu, pass: &'static str) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
+        let tiles = self.read(gpu, pass)?;
+        let bytes = crate::gpu::readback::read_buffer(gpu, self.list.as_ref()?).ok()?;
+        let words: Vec<u32> = bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
+        let first = (HEADER_BYTES / 4) as usize;
+        let listed = words.get(first..first + tiles.items as usize)?;
+        Some((tiles, listed.iter().map(|&packed| [packed & 0xffff, packed >> 16]).collect()))
+    }
+
     /// The last listing frame's counts, read back (blocking).
     pub(crate) fn read(&self, gpu: &Gpu, pass: &'static str) -> Option<RightEyeTiles> {
         if self.tiles == 0 {

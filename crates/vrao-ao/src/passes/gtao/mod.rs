@@ -265,6 +265,11 @@ impl Pass for GtaoPass {
         let right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
         right_eye.read(gpu, self.march.label)
     }
+
+    fn right_eye_listed(&self, gpu: &Gpu) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
+        let right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
+        right_eye.read_items(gpu, self.march.label)
+    }
 }
 
 #[cfg(test)]

@@ -190,4 +190,10 @@ impl Pass for TechniquePass {
         let list = right_eye.list.lock().unwrap_or_else(|p| p.into_inner());
         list.read(gpu, self.technique.name())
     }
+
+    fn right_eye_listed(&self, gpu: &Gpu) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
+        let right_eye = self.right_eye.as_ref()?;
+        let list = right_eye.list.lock().unwrap_or_else(|p| p.into_inner());
+        list.read_items(gpu, self.technique.name())
+    }
 }

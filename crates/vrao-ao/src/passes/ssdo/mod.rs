@@ -119,4 +119,9 @@ impl Pass for SsdoPass {
         let marches = std::iter::once(&self.plain).chain(&self.bounce);
         marches.filter_map(|m| m.right_eye_tiles(gpu)).max_by_key(|t| t.frame)
     }
+
+    fn right_eye_listed(&self, gpu: &Gpu) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
+        let marches = std::iter::once(&self.plain).chain(&self.bounce);
+        marches.filter_map(|m| m.right_eye_listed(gpu)).max_by_key(|(t, _)| t.frame)
+    }
 }
