@@ -6,12 +6,8 @@ use std::path::{Path, PathBuf};
 use vrao_render::scene::{builtin, Light, Scene};
 
 /// A scratch directory for one test, removed when it passes.
-struct TempDir;
-
-impl TempDir {
-    fn new(name: &str) -> crate::common::TestDir {
-        crate::common::temp_dir(&format!("scene-loading-{name}"))
-    }
+fn temp_dir(name: &str) -> crate::common::TestDir {
+    crate::common::temp_dir(&format!("scene-loading-{name}"))
 }
 
 fn load(path: &Path) -> vrao_ao::Result<Scene> {
@@ -20,7 +16,7 @@ fn load(path: &Path) -> vrao_ao::Result<Scene> {
 
 /// Loads a one-file OBJ scene from `text`.
 fn load_obj_text(test: &str, text: &str) -> Scene {
-    let dir = TempDir::new(test);
+    let dir = temp_dir(test);
     load(&dir.write("model.obj", text)).unwrap()
 }
 
@@ -94,12 +90,12 @@ fn unused_vertices_and_unknown_statements_are_harmless() {
 
 #[test]
 fn mtl_inline_comments_and_unknown_keys_are_accepted() {
-    let dir = TempDir::new("mtl-quirks");
+    let dir = temp_dir("mtl-quirks");
     dir.write(
         "m.mtl",
         "# materials\nnewmtl paint\n  Ns 10.0 # shiny\n  illum 2\n  Ka 0.1 0.1 0.1 # Red\n  Kd 0.5 0.25 0.125 # Red\n  v .1 0 0\n  Pr 0.5\n  map_Bump normal.png\nnewmtl grey\nKd 0.3\n",
     );
-    let path = dir.write("m.obj", &format!("mtllib m.mtl\n{SQUARE}usemtl paint\nf 1 2 3\nusemtl grey\nf 1 3 4\n"));
+    let path = dir.write("m.obj", format!("mtllib m.mtl\n{SQUARE}usemtl paint\nf 1 2 3\nusemtl grey\nf 1 3 4\n"));
     let scene = load(&path).unwrap();
     assert_eq!(scene.materials.len(), 2, "no default material needed");
     let material_of = |i: usize| &scene.materials[scene.meshes[i].material];
@@ -109,15 +105,15 @@ fn mtl_inline_comments_and_unknown_keys_are_accepted() {
 
 #[test]
 fn diffuse_outside_zero_to_one_is_clamped() {
-    let dir = TempDir::new("clamp");
+    let dir = temp_dir("clamp");
     dir.write("m.mtl", "newmtl hot\nKd 2 0.5 1\n");
-    let scene = load(&dir.write("m.obj", &format!("mtllib m.mtl\n{SQUARE}usemtl hot\nf 1 2 3\n"))).unwrap();
+    let scene = load(&dir.write("m.obj", format!("mtllib m.mtl\n{SQUARE}usemtl hot\nf 1 2 3\n"))).unwrap();
     assert_eq!(scene.materials[0].diffuse, Vec3::new(1.0, 0.5, 1.0));
 }
 
 #[test]
 fn emissive_material_becomes_a_point_light() {
-    let dir = TempDir::new("emissive");
+    let dir = temp_dir("emissive");
     dir.write("m.mtl", "newmtl lamp\nKd 0.8 0.8 0.8\nKe 17 12 4\nnewmtl wall\nKd 0.5 0.5 0.5\n");
     // A 1 m² lamp facing down at y = 2 over a floor.
     let text = "mtllib m.mtl\nv 0 2 0\nv 0 2 -1\nv 1 2 -1\nv 1 2 0\nusemtl lamp\nf 1 2 3 4\n\
@@ -135,7 +131,7 @@ fn emissive_material_becomes_a_point_light() {
 
 #[test]
 fn diffuse_texture_is_loaded_and_v_flipped() {
-    let dir = TempDir::new("texture");
+    let dir = temp_dir("texture");
     let pixels = vec![255, 0, 0, 255, 0, 0, 255, 128];
     image::RgbaImage::from_raw(2, 1, pixels.clone()).unwrap().save(dir.join("albedo.png")).unwrap();
     dir.write("m.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd albedo.png\n");
@@ -157,30 +153,30 @@ fn missing_mtl_file_warns_and_uses_grey() {
 
 #[test]
 fn nan_coordinate_names_file_and_line() {
-    let dir = TempDir::new("nan");
+    let dir = temp_dir("nan");
     let err = error_of(&dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 1\nf 1 2 3\n"));
     assert!(err.contains("bad.obj:3:") && err.contains("vertex coordinate 'nan' is not a finite number"), "{err}");
 }
 
 #[test]
 fn out_of_range_index_names_file_and_line() {
-    let dir = TempDir::new("range");
+    let dir = temp_dir("range");
     let err = error_of(&dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\nv 0 1 0\n"));
     assert!(err.ends_with("bad.obj:3: face index 9 is out of range (2 vertices defined so far)"), "{err}");
-    let normal = error_of(&dir.write("bad-normal.obj", &format!("{SQUARE}vn 0 1 0\nf 1//1 2//2 3//1\n")));
+    let normal = error_of(&dir.write("bad-normal.obj", format!("{SQUARE}vn 0 1 0\nf 1//1 2//2 3//1\n")));
     assert!(normal.contains("bad-normal.obj:6: normal index 2 is out of range (1 normals"), "{normal}");
 }
 
 #[test]
 fn face_with_two_vertices_is_an_error() {
-    let dir = TempDir::new("short-face");
-    let err = error_of(&dir.write("bad.obj", &format!("{SQUARE}f 1 2\n")));
+    let dir = temp_dir("short-face");
+    let err = error_of(&dir.write("bad.obj", format!("{SQUARE}f 1 2\n")));
     assert!(err.contains("bad.obj:5:") && err.contains("at least 3"), "{err}");
 }
 
 #[test]
 fn missing_files_are_named() {
-    let dir = TempDir::new("missing");
+    let dir = temp_dir("missing");
     let obj = dir.join("nothing-here.obj");
     assert!(error_of(&obj).contains("nothing-here.obj"));
     let scene = dir.write("s.toml", "[[mesh]]\nobj = \"also-missing.obj\"\n");
@@ -190,9 +186,9 @@ fn missing_files_are_named() {
 
 #[test]
 fn malformed_mtl_number_names_mtl_file_and_line() {
-    let dir = TempDir::new("bad-mtl");
+    let dir = temp_dir("bad-mtl");
     dir.write("bad.mtl", "newmtl a\nNs 10\nKd 0.5 abc 0.5\n");
-    let err = error_of(&dir.write("m.obj", &format!("mtllib bad.mtl\n{SQUARE}f 1 2 3\n")));
+    let err = error_of(&dir.write("m.obj", format!("mtllib bad.mtl\n{SQUARE}f 1 2 3\n")));
     assert!(err.contains("bad.mtl:3:") && err.contains("'abc' is not a number"), "{err}");
     dir.write("bad.mtl", "newmtl a\nKe 1 -2 0\n");
     let err = error_of(&dir.join("m.obj"));
@@ -203,15 +199,15 @@ fn malformed_mtl_number_names_mtl_file_and_line() {
 
 #[test]
 fn missing_texture_names_mtl_file_and_line() {
-    let dir = TempDir::new("no-texture");
+    let dir = temp_dir("no-texture");
     dir.write("m.mtl", "newmtl a\nKd 1 1 1\nmap_Kd missing.png\n");
-    let err = error_of(&dir.write("m.obj", &format!("mtllib m.mtl\n{SQUARE}usemtl a\nf 1 2 3\n")));
+    let err = error_of(&dir.write("m.obj", format!("mtllib m.mtl\n{SQUARE}usemtl a\nf 1 2 3\n")));
     assert!(err.contains("m.mtl:3:") && err.contains("missing.png"), "{err}");
 }
 
 #[test]
 fn malformed_toml_names_file_and_line() {
-    let dir = TempDir::new("bad-toml");
+    let dir = temp_dir("bad-toml");
     let err = error_of(&dir.write("broken.toml", "name = \"x\"\n\n[[mesh]]\nbuiltin = \"plane\nscale = 1\n"));
     assert!(err.contains("broken.toml:4:"), "{err}");
 }
@@ -247,8 +243,8 @@ fn furnished_scene_file_is_the_builtin_room() {
 
 #[test]
 fn scene_file_places_an_obj() {
-    let dir = TempDir::new("placed");
-    dir.write("square.obj", &format!("{SQUARE}f 1 2 3 4\n"));
+    let dir = temp_dir("placed");
+    dir.write("square.obj", format!("{SQUARE}f 1 2 3 4\n"));
     let text = "[[mesh]]\nobj = \"square.obj\"\ntranslate = [100000, 0, 0]\nrotate_deg = [90, 0, 0]\nscale = 2\n\
                 [head]\neye = [100001, 1, 3]\nlook_at = [100001, 1, 0]\n";
     let scene = load(&dir.write("scene.toml", text)).unwrap();
@@ -350,7 +346,7 @@ fn copy_dir(from: &Path, to: &Path) {
 fn scene_files_render_from_a_copy_of_assets_outside_the_repository() {
     let Some(scenes) = crate::common::public_scenes() else { return };
     let scenes = scenes.canonicalize().unwrap();
-    let dir = TempDir::new("assets-copy");
+    let dir = temp_dir("assets-copy");
     copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets"), &dir.join("assets"));
     let vrao = |scene: &Path, vrao_scenes: Option<&Path>| {
         let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_vrao"));
