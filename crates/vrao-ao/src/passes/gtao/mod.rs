@@ -77,8 +77,17 @@ struct GtaoUniform {
 /// directions anyway, while the occluders a sparse march steps over stay missed (a
 /// bias, not noise): at N = 24, 2×6 gave less error and bias than 3×4
 /// (docs/records/2026-11-29/measurements-in-code.md, gtao-slices-steps).
-pub(crate) fn gtao_slices_steps(samples: u32) -> (u32, u32) {
-    let slices = if samples < 128 { 2 } else { 4 };
+/// Reading a second layer (`two_layers`), under 32 taps take one slice: the layer's spans
+/// are objects' own depths, thinner than the slab, and twice the steps miss fewer of
+/// them (1×12 against 2×6: less error and dark bias on all three public scenes, more
+/// halos and stereo disagreement; one layer keeps two slices for those:
+/// docs/records/2026-11-29/two-layers.md, one slice).
+pub(crate) fn gtao_slices_steps(samples: u32, two_layers: bool) -> (u32, u32) {
+    let slices = match samples {
+        0..32 if two_layers => 1,
+        0..128 => 2,
+        _ => 4,
+    };
     (slices, (samples / (2 * slices)).max(1))
 }
 
@@ -200,10 +209,10 @@ impl Pass for GtaoPass {
         let (width, height, layers) = ctx.ao_extent();
         let device = &ctx.gpu.device;
         let ao = &ctx.setup.settings.ao;
-        let (slices, steps) = gtao_slices_steps(ao.samples);
+        let second = reads_second_layer(ctx.setup);
+        let (slices, steps) = gtao_slices_steps(ao.samples, second);
         let own = &ao.gtao;
         let band = gtao_inner_band(width);
-        let second = reads_second_layer(ctx.setup);
         let params = GtaoUniform {
             slices,
             steps,
@@ -288,7 +297,10 @@ mod tests {
     #[test]
     fn gtao_presets_spend_ssao_tap_counts() {
         for (samples, split) in [(12, (2, 3)), (24, (2, 6)), (36, (2, 9)), (64, (2, 16)), (1, (2, 1)), (256, (4, 32))] {
-            assert_eq!(gtao_slices_steps(samples), split);
+            assert_eq!(gtao_slices_steps(samples, false), split);
+        }
+        for (samples, split) in [(12, (1, 6)), (24, (1, 12)), (31, (1, 15)), (36, (2, 9)), (64, (2, 16)), (1, (1, 1))] {
+            assert_eq!(gtao_slices_steps(samples, true), split, "{samples} taps reading two layers");
         }
     }
 }
