@@ -3,7 +3,7 @@
 use crate::app::governor::GovernorChange;
 use crate::app::{FrameLoop, SERIAL_EVERY};
 use crate::formats::output::{count, significant};
-use crate::formats::spans::summarize;
+use crate::formats::spans::{summarize, RightEyeTilesReport};
 use crate::stats;
 use std::sync::atomic::Ordering;
 use vrao_ao::AoSettings;
@@ -91,6 +91,11 @@ pub struct RunSummary {
     /// The share of each eye's pixels the mask hid in the last frame (left, right; empty
     /// with `--mask off`, without a mask or without a frame).
     pub hidden_share_per_eye: Vec<f64>,
+    /// Per pass, the right eye's tiles computed rather than copied from the left eye in
+    /// the last frame, read back from the indirect dispatches once the run has ended;
+    /// empty where the right eye reused nothing.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub right_eye_tiles: Vec<RightEyeTilesReport>,
 }
 
 impl RunSummary {
@@ -156,6 +161,7 @@ impl RunSummary {
                 frame_loop.renderer.settings().ao.mask,
             ),
             hidden_share_per_eye: frame_loop.renderer.hidden_share().iter().copied().filter(|s| *s > 0.0).collect(),
+            right_eye_tiles: frame_loop.renderer.right_eye_tiles().iter().map(RightEyeTilesReport::from).collect(),
         }
     }
 
@@ -224,6 +230,7 @@ impl RunSummary {
             refused: None,
             visibility_mask: "none".into(),
             hidden_share_per_eye: Vec::new(),
+            right_eye_tiles: Vec::new(),
         }
     }
 
@@ -302,12 +309,19 @@ impl RunSummary {
             let shares: Vec<String> = self.hidden_share_per_eye.iter().map(|s| format!("{:.1} %", s * 100.0)).collect();
             format!("visibility mask {}; hidden per eye: {}\n", self.visibility_mask, shares.join(", "))
         };
+        let right_eye = if self.right_eye_tiles.is_empty() {
+            String::new()
+        } else {
+            let shares: Vec<String> =
+                self.right_eye_tiles.iter().map(|t| format!("{} {:.1} %", t.pass, t.share * 100.0)).collect();
+            format!("right eye computed (not copied from the left), share of its tiles: {}\n", shares.join(", "))
+        };
         let interrupted = match &self.interrupted_in {
             Some(state) if self.interrupted => format!("\ninterrupted in {state}"),
             _ => String::new(),
         };
         format!(
-            "governor {}: {}, AO setting at the end: {}\n{mask}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} over{stretched}{late}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
+            "governor {}: {}, AO setting at the end: {}\n{mask}{right_eye}{frames}\nGPU per frame: median {:.2} ms against {budget}, {} of {} over{stretched}{late}; CPU encode median {:.3} ms ({:.1} % of the GPU time)\npass medians (ms, both eyes, {} timing): {}{interrupted}",
             self.governor,
             count(self.governor_changes.len() as u64, "change"),
             self.final_ao_setting,

@@ -96,6 +96,17 @@ pub struct BenchRecord {
     /// [`Self::stereo_inconsistent`] farther than 40 px from every border.
     #[serde(default)]
     pub stereo_inconsistent_interior: Option<f64>,
+    /// The share of the right eye's tiles (workgroups of 64 occlusion pixels) its march
+    /// computed rather than took from the left eye, of the tiles a full eye dispatches,
+    /// read back from the indirect dispatch's arguments in the last measured frame: the
+    /// same on every machine. `None` where the right eye reused nothing (one view,
+    /// `--independent-eyes`, a technique without the reuse).
+    #[serde(default)]
+    pub right_eye_tiles_share: Option<f64>,
+    /// The same for the upsampling's right eye (quads it upsampled itself; half
+    /// resolution, when the final AO was upsampled by its own pass).
+    #[serde(default)]
+    pub right_eye_upsample_share: Option<f64>,
     /// Mean SSIM of the AO against the reference (1 = identical).
     pub ao_ssim: Option<f64>,
     /// RMSE of the ambient light's luminance relative to the reference's mean, the

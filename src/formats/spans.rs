@@ -68,3 +68,31 @@ mod tests {
         assert_eq!(s[1].median_ms, 30.0);
     }
 }
+
+/// The right eye's computed tiles against all its tiles in one pass (the left eye
+/// computes every one of its own), as `vrao budget`'s and `vrao run`'s reports give them.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct RightEyeTilesReport {
+    /// The pass.
+    pub pass: String,
+    /// Tiles (workgroups of 64 items) the right eye computed in the last stereo frame.
+    pub computed: u32,
+    /// The items it computed (pixels; quads of 2×2 for the upsampling); it copied the rest.
+    pub items: u32,
+    /// Tiles of the right eye's occlusion image.
+    pub total: u32,
+    /// `computed / total`: the right eye's share of the left eye's work, in tiles.
+    pub share: f64,
+}
+
+impl From<&vrao_ao::RightEyeTiles> for RightEyeTilesReport {
+    fn from(t: &vrao_ao::RightEyeTiles) -> RightEyeTilesReport {
+        RightEyeTilesReport {
+            pass: t.pass.to_string(),
+            computed: t.computed,
+            items: t.items,
+            total: t.total,
+            share: t.share(),
+        }
+    }
+}

@@ -100,6 +100,9 @@ pub struct BenchRow {
     /// How far the eyes' final AO disagree on the points both see (occlusion rows; no
     /// reference needed).
     pub stereo: Option<StereoConsistency>,
+    /// Per pass, the right eye's tiles computed rather than copied from the left eye in
+    /// the last measured frame (empty where the right eye reused nothing).
+    pub right_eye: Vec<vrao_ao::RightEyeTiles>,
 }
 
 impl BenchRow {
@@ -345,6 +348,7 @@ impl CaseRun {
         let plan = self.renderer.last_plan().cloned().ok_or_else(|| Error::gpu("no frame was measured"))?;
         let spans = summarize(&self.timings);
         check_timed(&plan.names, &spans)?;
+        let right_eye = self.renderer.right_eye_tiles();
         let occlusion = self.renderer.read_f32(output)?;
         let error = reference.map(|reference| {
             let fovs: Vec<_> = self.eyes.eyes.iter().map(|e| e.fov).collect();
@@ -411,6 +415,7 @@ impl CaseRun {
             error,
             bounce,
             stereo,
+            right_eye,
             case: self.case,
         })
     }
@@ -495,6 +500,7 @@ pub fn measure_rsm(
         error: None,
         bounce,
         stereo: None,
+        right_eye: Vec::new(),
     })
 }
 

@@ -9,7 +9,7 @@
 //! half the budget; the stereo frame passes when the sum of its passes fits the budget.
 
 use crate::error::Result;
-use crate::formats::spans::{summarize, SpanSummary};
+use crate::formats::spans::{summarize, RightEyeTilesReport, SpanSummary};
 use serde::{Deserialize, Serialize};
 use vrao_ao::plug::{FrameTiming, Resource};
 use vrao_ao::EyePair;
@@ -119,22 +119,6 @@ pub struct TrafficReport {
     pub written: f64,
     /// Bytes read per pixel of each eye.
     pub read: f64,
-}
-
-/// [`BudgetReport::right_eye_tiles`]: the right eye's computed tiles against all its tiles
-/// (the left eye computes every one of its own).
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct RightEyeTilesReport {
-    /// The pass.
-    pub pass: String,
-    /// Tiles (workgroups of 64 items) the right eye computed in the last stereo frame.
-    pub computed: u32,
-    /// The items it computed (pixels; quads of 2×2 for the upsampling); it copied the rest.
-    pub items: u32,
-    /// Tiles of the right eye's occlusion image.
-    pub total: u32,
-    /// `computed / total`: the right eye's share of the left eye's work, in tiles.
-    pub share: f64,
 }
 
 impl BudgetReport {
@@ -269,17 +253,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
                 hidden_share_per_eye = renderer.hidden_share().to_vec();
                 occlusion_bytes_per_pixel =
                     renderer.occlusion_traffic().map(|t| TrafficReport { written: t.written, read: t.read });
-                right_eye_tiles = renderer
-                    .right_eye_tiles()
-                    .iter()
-                    .map(|t| RightEyeTilesReport {
-                        pass: t.pass.to_string(),
-                        computed: t.computed,
-                        items: t.items,
-                        total: t.total,
-                        share: t.share(),
-                    })
-                    .collect();
+                right_eye_tiles = renderer.right_eye_tiles().iter().map(RightEyeTilesReport::from).collect();
             }
             let t = pass_times(&report, how.timing);
             for (name, _) in &t {

@@ -166,6 +166,17 @@ fn the_run_report_counts_rendered_frames_frames_in_flight_and_the_governors_chan
     assert_eq!(off["governor_changes"], serde_json::json!([]));
     // One frame in flight: each frame waits for the one before it.
     assert_eq!(off["frames_in_flight_max"], 1, "{off}");
+    // The right eye's share of its tiles that the last frame computed rather than copied
+    // from the left eye (issue 49): some, never all; none with independent eyes.
+    let shares: Vec<f64> = off["right_eye_tiles"]
+        .as_array()
+        .expect("right-eye tiles")
+        .iter()
+        .map(|t| t["share"].as_f64().unwrap())
+        .collect();
+    assert!(!shares.is_empty() && shares.iter().all(|s| *s > 0.0 && *s < 0.5), "{off}");
+    let independent = run_report(&dir, "independent.json", &["--governor", "off", "--independent-eyes"]);
+    assert!(independent.get("right_eye_tiles").is_none(), "{independent}");
 }
 
 #[test]

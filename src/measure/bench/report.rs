@@ -44,6 +44,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 stereo_inconsistent: row.stereo.and_then(|c| c.inconsistent),
                 stereo_inconsistent_inner_border: row.stereo.and_then(|c| c.inner_border),
                 stereo_inconsistent_interior: row.stereo.and_then(|c| c.interior),
+                right_eye_tiles_share: right_eye_share(row, |pass| pass != UPSAMPLE_PASS),
+                right_eye_upsample_share: right_eye_share(row, |pass| pass == UPSAMPLE_PASS),
                 ao_ssim: row.error.as_ref().map(|e| e.ao_ssim),
                 ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
                 pareto: false,
@@ -76,6 +78,12 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
     }
     mark_pareto(&mut out);
     out
+}
+
+/// The right eye's computed share of the first pass `which` takes among the row's
+/// right-eye counts (the march's, or the upsampling's).
+fn right_eye_share(row: &BenchRow, which: impl Fn(&str) -> bool) -> Option<f64> {
+    row.right_eye.iter().find(|t| which(t.pass)).map(|t| t.share())
 }
 
 /// The full-resolution record of the same technique and setting as `half`.
@@ -235,6 +243,20 @@ const COLUMNS: &[Column] = &[
     share_column!(stereo_inconsistent, "stereo ≠"),
     share_column!(stereo_inconsistent_inner_border, "≠ inner border"),
     share_column!(stereo_inconsistent_interior, "≠ interior"),
+    Column {
+        name: "right_eye_tiles_share",
+        header: "right-eye tiles",
+        csv: |r| fixed(r.right_eye_tiles_share, 4),
+        markdown: |r| percent(r.right_eye_tiles_share),
+        optional: true,
+    },
+    Column {
+        name: "right_eye_upsample_share",
+        header: "right-eye upsampling",
+        csv: |r| fixed(r.right_eye_upsample_share, 4),
+        markdown: |r| percent(r.right_eye_upsample_share),
+        optional: true,
+    },
     figure_column!(ao_rmse_falloff, "RMSE falloff", false),
     figure_column!(ao_ssim, "SSIM", false),
     figure_column!(ambient_rel_rmse, "ambient rel. RMSE", true),

@@ -57,6 +57,15 @@ fn row(technique: Technique, ms: f64, ao_rmse: f64) -> BenchRow {
             interior: Some(0.125),
             compared: 1000,
         }),
+        // The march listed 15 of the right eye's 100 tiles; the upsampling ran at full
+        // resolution, so it has no count.
+        right_eye: vec![vrao_ao::RightEyeTiles {
+            pass: technique.name(),
+            computed: 15,
+            total: 100,
+            items: 960,
+            frame: 3,
+        }],
     }
 }
 
@@ -118,11 +127,11 @@ fn csv_markdown_and_json_hold_every_row() {
     assert_eq!(csv.lines().count(), 3);
     // technique, N, r, resolution, foveation, layers, mask, ms/eye, RMSE, central RMSE, whole-rectangle RMSE,
     // bias, bias (ref < 0.8), vs limit,
-    // limit RMSE, limit bias, two-layer limit RMSE and bias (none here), outer border RMSE, halo, FLIP, stereo shares, falloff
-    // RMSE, SSIM, ambient, …
+    // limit RMSE, limit bias, two-layer limit RMSE and bias (none here), outer border RMSE, halo, FLIP, stereo shares,
+    // the right eye's march and upsampling shares (none here), falloff RMSE, SSIM, ambient, …
     assert!(
         csv.lines().nth(2).unwrap().starts_with(
-            "hbao,12,0.5,full,off,1,off,7.000,0.2000,0.2000,,-0.0500,-0.1000,0.0600,0.0400,0.0100,,,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
+            "hbao,12,0.5,full,off,1,off,7.000,0.2000,0.2000,,-0.0500,-0.1000,0.0600,0.0400,0.0100,,,0.0700,0.0625,0.1250,0.2500,0.5000,0.1250,0.1500,,0.3000,0.9000,,6.000,1.000,0.000,1.000,"
         ),
         "{csv}"
     );
@@ -135,10 +144,11 @@ fn csv_markdown_and_json_hold_every_row() {
     assert_eq!(markdown.lines().count(), 4);
     let hbao = markdown.lines().nth(3).unwrap();
     assert!(
-        hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.070 | 6.2 % | 0.125 | 25.0 % | 50.0 % | 12.5 % |"),
+        hbao.starts_with("| hbao | 12 | 0.5 | full | 7.0 | 0.200 | 0.200 | -0.050 | -0.100 | 0.060 | 0.040 | 0.010 | 0.070 | 6.2 % | 0.125 | 25.0 % | 50.0 % | 12.5 % | 15.0 % |"),
         "{hbao}"
     );
     assert!(!markdown.contains("peel") && !markdown.contains("bounce"), "{markdown}");
+    assert!(!markdown.contains("right-eye upsampling"), "no row has an upsampling count: {markdown}");
     let json = to_json(&file(recs.clone()));
     let back: BenchFile = serde_json::from_str(&json).unwrap();
     assert_eq!(back.records, recs);
