@@ -198,8 +198,9 @@ impl OutputTrail {
 /// ran, the final AO as grey beside them (`ao_left.png`, `ao_right.png`): the picture of
 /// what the technique adds. With `debug` also the depth, normals, albedo and raw AO of
 /// each view, and `marched_right.png`, the right eye's pixels its march computed rather
-/// than took from the left eye (`marched_over`). Returns the files written. `trail` records the folder it creates and each
-/// file, so that an interrupted command can remove them again.
+/// than took from the left eye (`marched_over`). Returns the files written. `trail`
+/// records the folder it creates and each file, so that an interrupted command can
+/// remove them again.
 pub fn write_images(
     renderer: &Renderer,
     out: &Path,
