@@ -505,7 +505,7 @@ const DEFAULT_STEP_POWER: f32 = 1.5;
 /// GTAO's default: successive samples closer than this fraction of the radius are joined.
 const DEFAULT_CONNECT: f32 = 0.25;
 /// The same where the march reads a second depth layer (`GtaoSettings::connect_two_layers`).
-const DEFAULT_CONNECT_TWO_LAYERS: f32 = 0.5;
+const DEFAULT_CONNECT_TWO_LAYERS: f32 = 0.35;
 
 /// GTAO's own settings (`AoSettings::gtao`), and their command-line flags. The defaults
 /// are tuned against the reference (scripts/tune-gtao.py and docs/records/2026-11-29/gtao-tuning.md).
@@ -526,8 +526,9 @@ pub struct GtaoSettings {
     pub connect: f32,
     /// GTAO with two depth layers: `connect` where the march reads the second layer. Its
     /// spans are the objects' own depths, far thinner than the slab, so the gaps between
-    /// successive samples of one surface are worth joining more generously (0.5 against
-    /// 0.25 lowered the RMSE on the furnished room, Sibenik and the Cornell box:
+    /// successive samples of one surface are worth joining more generously: 0.35, the
+    /// least mean RMSE over the furnished room, Sibenik and the Cornell box with the one
+    /// slice of twice the steps two layers march under 32 taps (0.5 was best with 2 × 6;
     /// docs/records/2026-11-29/two-layers.md).
     pub connect_two_layers: f32,
 }
