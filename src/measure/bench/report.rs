@@ -158,13 +158,13 @@ macro_rules! figure_column {
 
 /// A column of a share (`Option<f64>` in 0..1): 4 decimals in CSV, a percentage in Markdown.
 macro_rules! share_column {
-    ($field:ident, $header:literal) => {
+    ($field:ident, $header:literal, $optional:literal) => {
         Column {
             name: stringify!($field),
             header: $header,
             csv: |r| fixed(r.$field, 4),
             markdown: |r| percent(r.$field),
-            optional: false,
+            optional: $optional,
         }
     };
 }
@@ -238,25 +238,13 @@ const COLUMNS: &[Column] = &[
     figure_column!(limit_two_layer_rmse, "2-layer limit RMSE", true),
     figure_column!(limit_two_layer_bias, "2-layer limit bias", true),
     figure_column!(ao_rmse_outer_border, "RMSE outer border", false),
-    share_column!(halo_share, "halo"),
+    share_column!(halo_share, "halo", false),
     figure_column!(flip_mean, "FLIP", false),
-    share_column!(stereo_inconsistent, "stereo ≠"),
-    share_column!(stereo_inconsistent_inner_border, "≠ inner border"),
-    share_column!(stereo_inconsistent_interior, "≠ interior"),
-    Column {
-        name: "right_eye_tiles_share",
-        header: "right-eye tiles",
-        csv: |r| fixed(r.right_eye_tiles_share, 4),
-        markdown: |r| percent(r.right_eye_tiles_share),
-        optional: true,
-    },
-    Column {
-        name: "right_eye_upsample_share",
-        header: "right-eye upsampling",
-        csv: |r| fixed(r.right_eye_upsample_share, 4),
-        markdown: |r| percent(r.right_eye_upsample_share),
-        optional: true,
-    },
+    share_column!(stereo_inconsistent, "stereo ≠", false),
+    share_column!(stereo_inconsistent_inner_border, "≠ inner border", false),
+    share_column!(stereo_inconsistent_interior, "≠ interior", false),
+    share_column!(right_eye_tiles_share, "right-eye tiles", true),
+    share_column!(right_eye_upsample_share, "right-eye upsampling", true),
     figure_column!(ao_rmse_falloff, "RMSE falloff", false),
     figure_column!(ao_ssim, "SSIM", false),
     figure_column!(ambient_rel_rmse, "ambient rel. RMSE", true),
