@@ -116,13 +116,17 @@ impl RightEyeList {
 
     /// The last listing frame's counts and its listed items (occlusion pixels, or quads
     /// for the upsampling, as (x, y)), read back (blocking; for debug images).
+    /// One readback: the list begins with the header the arguments were copied from.
     pub(crate) fn read_items(&self, gpu: &Gpu, pass: &'static str) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
-        let tiles = self.read(gpu, pass)?;
+        if self.tiles == 0 {
+            return None;
+        }
         let bytes = crate::gpu::readback::read_buffer(gpu, self.list.as_ref()?).ok()?;
-        let words: Vec<u32> = bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
-        let first = (HEADER_BYTES / 4) as usize;
-        let listed = words.get(first..first + tiles.items as usize)?;
-        Some((tiles, listed.iter().map(|&packed| [packed & 0xffff, packed >> 16]).collect()))
+        let tiles = self.counts(&bytes, pass)?;
+        let first = HEADER_BYTES as usize;
+        let listed = bytes.get(first..first + 4 * tiles.items as usize)?;
+        let items = listed.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
+        Some((tiles, items.map(|packed| [packed & 0xffff, packed >> 16]).collect()))
     }
 
     /// The last listing frame's counts, read back (blocking).
@@ -130,7 +134,11 @@ impl RightEyeList {
         if self.tiles == 0 {
             return None;
         }
-        let header = crate::gpu::readback::read_buffer(gpu, &self.arguments).ok()?;
+        self.counts(&crate::gpu::readback::read_buffer(gpu, &self.arguments).ok()?, pass)
+    }
+
+    /// The counts in a header read back (its first `HEADER_BYTES`).
+    fn counts(&self, header: &[u8], pass: &'static str) -> Option<RightEyeTiles> {
         let word = |k: usize| Some(u32::from_le_bytes(header.get(4 * k..4 * k + 4)?.try_into().ok()?));
         Some(RightEyeTiles { pass, computed: word(0)?, items: word(3)?, total: self.tiles, frame: self.frame })
     }
