@@ -220,8 +220,16 @@ pub fn write_images(
         Ok(())
     };
     let colours = renderer.read_bytes(COLOR)?;
-    for (name, rgba) in names.iter().zip(&colours) {
-        save_sized(format!("{name}.png"), (w, h), rgba.clone())?;
+    // Drawn over the right eye's colour before that is handed to its file.
+    let marched = match (debug, colours.get(1)) {
+        (true, Some(right)) => renderer.right_eye_marched().map(|(_, marched)| {
+            let scale = if settings.ao.resolution.is_half() { 2 } else { 1 };
+            marched_over(right, (w, h), &marched, scale)
+        }),
+        _ => None,
+    };
+    for (name, rgba) in names.iter().zip(colours) {
+        save_sized(format!("{name}.png"), (w, h), rgba)?;
     }
     // The final AO first, then (with `debug`) the raw AO before blur or upsampling.
     for (label, r) in occlusion_written(settings, debug) {
@@ -242,9 +250,8 @@ pub fn write_images(
         for (name, albedo) in names.iter().zip(renderer.read_bytes(ALBEDO)?) {
             save_sized(format!("albedo_{name}.png"), (w, h), albedo)?;
         }
-        if let (Some((_, marched)), Some(right)) = (renderer.right_eye_marched(), colours.get(1)) {
-            let scale = if settings.ao.resolution.is_half() { 2 } else { 1 };
-            save_sized("marched_right.png".into(), (w, h), marched_over(right, (w, h), &marched, scale))?;
+        if let Some(rgba) = marched {
+            save_sized("marched_right.png".into(), (w, h), rgba)?;
         }
     }
     Ok(written)
