@@ -249,7 +249,9 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
             if round < how.warmup {
                 continue;
             }
-            if k == 0 {
+            // The last stereo frame's figures (the right eye's counts are a blocking
+            // readback: once, not every round).
+            if k == 0 && round + 1 == how.warmup + how.frames {
                 hidden_share_per_eye = renderer.hidden_share().to_vec();
                 occlusion_bytes_per_pixel =
                     renderer.occlusion_traffic().map(|t| TrafficReport { written: t.written, read: t.read });
