@@ -12,3 +12,9 @@ fn chain_value(texel: vec4<f32>) -> vec4<f32> {
 fn chain_texel(value: vec4<f32>) -> vec4<f32> {
     return value;
 }
+
+// The AO of the 2×2 texels around `corner` (a shared texel corner, in uv) of `layer`, in
+// textureGather's order: (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
+fn chain_gather_ao(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>, layer: i32) -> vec4<f32> {
+    return textureGather(3, t, s, corner, layer);
+}

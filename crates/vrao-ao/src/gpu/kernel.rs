@@ -253,6 +253,8 @@ pub enum Bind {
     Environment,
     /// The environment's filtering sampler.
     EnvironmentSampler,
+    /// A nearest sampler for `textureGather` (2×2 texels in one fetch), clamped to the edge.
+    GatherSampler,
     /// A texture of the graph the pass reads: `texture_depth_2d_array` for depth,
     /// `texture_2d_array<u32>` for unsigned formats, `texture_2d_array<f32>` otherwise.
     Read(Resource),
@@ -271,6 +273,7 @@ impl Bind {
             Bind::SampleKernel => Slot::ReadBuffer,
             Bind::Environment => Slot::Texture2d,
             Bind::EnvironmentSampler => Slot::Sampler,
+            Bind::GatherSampler => Slot::NonFilteringSampler,
             Bind::Read(r) if r.format().is_depth_stencil_format() => Slot::Depth,
             Bind::Read(r) if r.format().sample_type(None, None) == Some(wgpu::TextureSampleType::Uint) => {
                 Slot::UintLayers
@@ -297,6 +300,8 @@ pub enum Slot {
     Texture2d,
     /// A filtering sampler.
     Sampler,
+    /// A non-filtering sampler (gathers from depth and unfilterable textures).
+    NonFilteringSampler,
     /// A comparison sampler (`sampler_comparison`, shadow maps).
     ComparisonSampler,
     /// `texture_storage_2d_array<FORMAT, write>`.
@@ -344,6 +349,7 @@ impl Slot {
                 multisampled: false,
             },
             Slot::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            Slot::NonFilteringSampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
             Slot::ComparisonSampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
             Slot::Output(format) => wgpu::BindingType::StorageTexture {
                 access: wgpu::StorageTextureAccess::WriteOnly,

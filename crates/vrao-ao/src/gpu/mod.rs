@@ -57,6 +57,9 @@ pub struct Gpu {
     lazy_pipelines: bool,
     /// Compute pipelines compiled on this device so far.
     pipelines_built: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    /// A nearest, clamp-to-edge sampler for [`kernel::Bind::GatherSampler`]: kernels
+    /// fetch a 2×2 block of texels with one `textureGather` through it.
+    pub(crate) gather_sampler: wgpu::Sampler,
     /// The compute pipelines compiled so far, for kernels made again to reuse.
     pub(crate) compiled_pipelines: std::sync::Arc<kernel::CompiledPipelines>,
     /// Where shaders are read from instead of the compiled-in text ([`Gpu::set_shader_dir`]).
@@ -69,6 +72,13 @@ pub struct Gpu {
     /// Bind group 1 of every compute kernel: the visibility mask and foveation map
     /// (`bind_group_layout`).
     pub visibility_layout: wgpu::BindGroupLayout,
+}
+
+/// The sampler of [`Gpu::gather_sampler`]: nearest (a gather never filters, and depth and
+/// unfilterable formats take only a non-filtering sampler), clamped to the edge as a
+/// texel fetch clamped into the target is.
+fn gather_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor { label: Some("gather"), ..Default::default() })
 }
 
 impl Gpu {
@@ -95,6 +105,7 @@ impl Gpu {
         let visibility_layout = visibility::bind_group_layout(&device);
         Ok(Gpu {
             visibility_layout,
+            gather_sampler: gather_sampler(&device),
             caps: Self::capabilities_of(&device),
             instance: Some(instance),
             adapter: Some(adapter),
@@ -133,6 +144,7 @@ impl Gpu {
         refuse_missing(&info, support::missing_device_capabilities(&support::DeviceSupport::of(device)))?;
         Ok(Gpu {
             visibility_layout: visibility::bind_group_layout(device),
+            gather_sampler: gather_sampler(device),
             caps: Capabilities { multiview: false, ..Self::capabilities_of(device) },
             instance: None,
             adapter: None,

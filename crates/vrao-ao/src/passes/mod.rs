@@ -162,6 +162,7 @@ impl<'a> RecordContext<'a> {
                 Bind::SampleKernel => self.frame.kernel.as_entire_binding(),
                 Bind::Environment => wgpu::BindingResource::TextureView(self.environment().0),
                 Bind::EnvironmentSampler => wgpu::BindingResource::Sampler(self.environment().1),
+                Bind::GatherSampler => wgpu::BindingResource::Sampler(&self.gpu.gather_sampler),
                 Bind::Read(r) | Bind::Write(r) => self.view(r),
                 Bind::Own(_) => own.next().expect("one own resource per Bind::Own").clone(),
             })

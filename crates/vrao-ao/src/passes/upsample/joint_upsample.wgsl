@@ -110,25 +110,34 @@ fn upsample_pixel(
     return px;
 }
 
-// Pixel `k` of the quad of low-res sample `b` with its depth and view position alone:
-// what the right eye's reuse of the left eye's result reads (`left_eye_quad`), which
-// has no use for the normal (a quarter of an upsampled quad's loads).
-fn quad_position(depth_layers: texture_depth_2d_array, b: vec2<u32>, k: u32, layer: u32, eye: Eye) -> UpsamplePixel {
+// Pixel `k` of the quad of low-res sample `b` at stored depth `depth`, with its view
+// position alone: what the right eye's reuse of the left eye's result reads
+// (`left_eye_quad`), which has no use for the normal.
+fn quad_position(depth: f32, b: vec2<u32>, k: u32, eye: Eye) -> UpsamplePixel {
     var px: UpsamplePixel;
     px.pixel = b * 2u + vec2<u32>(k & 1u, k >> 1u);
     px.texel = min(px.pixel, frame.size - vec2<u32>(1u));
-    px.depth = textureLoad(depth_layers, vec2<i32>(px.texel), i32(layer), 0);
+    px.depth = depth;
     px.position = load_view_position(max(px.depth, 1e-30), px.texel, eye, frame.size, frame.near);
     return px;
 }
 
-// The four pixels of the quad of low-res sample `b`, as `quad_position` gives them.
-fn quad_positions(depth_layers: texture_depth_2d_array, b: vec2<u32>, layer: u32, eye: Eye) -> array<UpsamplePixel, 4> {
+// The uv of the corner that texels `p` and `p` + (1, 1) share: a gather there fetches
+// the 2×2 block from `p` (its coordinate lies half a texel inside each, far from any
+// rounding edge); clamped to the edge past the last row or column.
+fn gather_corner(p: vec2<u32>) -> vec2<f32> {
+    return vec2<f32>(p + vec2<u32>(1u)) / vec2<f32>(frame.size);
+}
+
+// The four pixels of the quad of low-res sample `b`, as `quad_position` gives them, their
+// depths from one gather instead of four loads (clamped at an odd edge, as `texel` is).
+fn quad_positions(depth_layers: texture_depth_2d_array, gather: sampler, b: vec2<u32>, layer: u32, eye: Eye) -> array<UpsamplePixel, 4> {
+    let depth = textureGather(depth_layers, gather, gather_corner(b * 2u), i32(layer));
     return array<UpsamplePixel, 4>(
-        quad_position(depth_layers, b, 0u, layer, eye),
-        quad_position(depth_layers, b, 1u, layer, eye),
-        quad_position(depth_layers, b, 2u, layer, eye),
-        quad_position(depth_layers, b, 3u, layer, eye),
+        quad_position(depth.w, b, 0u, eye),
+        quad_position(depth.z, b, 1u, eye),
+        quad_position(depth.x, b, 2u, eye),
+        quad_position(depth.y, b, 3u, eye),
     );
 }
 
@@ -310,13 +319,53 @@ struct LeftEyeQuad {
     found: vec4<bool>,
 };
 
-fn left_eye_quad(depth_layers: texture_depth_2d_array, left_final: texture_2d_array<f32>, quad: array<UpsamplePixel, 4>) -> LeftEyeQuad {
+// Whether the left eye sees right-eye pixel `px` (on a surface) at `pixel` where it holds
+// stored depth `there` (`left_eye_point`'s test, given the left depth).
+fn left_eye_holds(px_distance: f32, pixel: vec2<u32>, there: f32) -> bool {
+    let distance = -load_view_position(max(there, 1e-30), pixel, frame.eyes[0], frame.size, frame.near).z;
+    return there > 0.0 && abs(distance - px_distance) < 0.01 * px_distance;
+}
+
+// Where a smooth surface faces both eyes, the quad's four pixels land on a 2×2 block of
+// left pixels: then the left depths and AO come from one gather each (2 fetches instead
+// of 8). Elsewhere (an edge, the sky, the left image's border) each pixel is looked up
+// alone (`left_eye_final`). The left AO in a gather comes from the includer's
+// `left_final_gather_ao`, as one texel's from `left_final_ao`.
+fn left_eye_quad(depth_layers: texture_depth_2d_array, left_final: texture_2d_array<f32>, gather: sampler, quad: array<UpsamplePixel, 4>) -> LeftEyeQuad {
+    let right = frame.eyes[1];
+    let left = frame.eyes[0];
+    let in0 = in_other_eye(quad[0].position, right, left, frame.near);
+    let in1 = in_other_eye(quad[1].position, right, left, frame.near);
+    let in2 = in_other_eye(quad[2].position, right, left, frame.near);
+    let in3 = in_other_eye(quad[3].position, right, left, frame.near);
+    let size = vec2<f32>(frame.size);
+    let p0 = vec2<u32>(in0.xy * size);
+    let block = in0.w * in1.w * in2.w * in3.w > 0.0
+        && all(vec2<u32>(in1.xy * size) == p0 + vec2<u32>(1u, 0u))
+        && all(vec2<u32>(in2.xy * size) == p0 + vec2<u32>(0u, 1u))
+        && all(vec2<u32>(in3.xy * size) == p0 + vec2<u32>(1u, 1u))
+        && all(p0 + vec2<u32>(1u) < frame.size)
+        && quad[0].depth > 0.0 && quad[1].depth > 0.0 && quad[2].depth > 0.0 && quad[3].depth > 0.0;
+    var result: LeftEyeQuad;
+    if (block) {
+        let corner = gather_corner(p0);
+        let there = textureGather(depth_layers, gather, corner, 0);
+        let ao = left_final_gather_ao(left_final, gather, corner);
+        let none = vec3<f32>(0.0);
+        result.values = array<vec4<f32>, 4>(vec4<f32>(none, ao.w), vec4<f32>(none, ao.z), vec4<f32>(none, ao.x), vec4<f32>(none, ao.y));
+        result.found = vec4<bool>(
+            left_eye_holds(in0.z, p0, there.w),
+            left_eye_holds(in1.z, p0 + vec2<u32>(1u, 0u), there.z),
+            left_eye_holds(in2.z, p0 + vec2<u32>(0u, 1u), there.x),
+            left_eye_holds(in3.z, p0 + vec2<u32>(1u, 1u), there.y),
+        );
+        return result;
+    }
     let l0 = left_eye_final(quad[0], depth_layers, left_final);
     let l1 = left_eye_final(quad[1], depth_layers, left_final);
     let l2 = left_eye_final(quad[2], depth_layers, left_final);
     let l3 = left_eye_final(quad[3], depth_layers, left_final);
     let none = vec3<f32>(0.0);
-    var result: LeftEyeQuad;
     result.values = array<vec4<f32>, 4>(vec4<f32>(none, l0.ao), vec4<f32>(none, l1.ao), vec4<f32>(none, l2.ao), vec4<f32>(none, l3.ao));
     result.found = vec4<bool>(l0.found, l1.found, l2.found, l3.found);
     return result;
@@ -327,13 +376,14 @@ fn left_eye_quad(depth_layers: texture_depth_2d_array, left_final: texture_2d_ar
 fn right_eye_quad(
     depth_layers: texture_depth_2d_array,
     left_final: texture_2d_array<f32>,
+    gather: sampler,
     geometry_low: texture_2d_array<f32>,
     value_low: texture_2d_array<f32>,
     quad: array<UpsamplePixel, 4>,
     b: vec2<i32>,
     tangents: vec4<f32>,
 ) -> array<vec4<f32>, 4> {
-    let left = left_eye_quad(depth_layers, left_final, quad);
+    let left = left_eye_quad(depth_layers, left_final, gather, quad);
     // The occlusion: a texture of the AO chain.
     let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents, true);
     return array<vec4<f32>, 4>(

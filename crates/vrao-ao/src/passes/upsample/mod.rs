@@ -31,8 +31,8 @@ pub const JOINT_UPSAMPLE_WGSL: Shader = wgsl!("src/passes/upsample/joint_upsampl
 /// upsample.wgsl's bindings: frame, AO parameters, the G-buffer and the occlusion's
 /// geometry, the occlusion in, the full-resolution AO out and, for the right eye's
 /// dispatches, at 7 its left-eye layer (the geometry stands in before them) and at 8 the
-/// list of quads the left eye does not fully see.
-const BINDINGS: [Bind; 9] = [
+/// list of quads the left eye does not fully see; at 9 the sampler of its gathers.
+const BINDINGS: [Bind; 10] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::Read(DEPTH),
@@ -42,6 +42,7 @@ const BINDINGS: [Bind; 9] = [
     Bind::Write(AO_FULL),
     Bind::Own(Slot::Layers),
     Bind::Own(Slot::ReadWriteBuffer),
+    Bind::GatherSampler,
 ];
 
 /// Whether the right eye takes the left eye's upsampled AO instead of upsampling its own

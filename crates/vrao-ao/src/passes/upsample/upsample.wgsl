@@ -3,9 +3,10 @@
 // not need it (the composite upsamples inline); the AO engine, debug images and tests do.
 // With the stereo reuse (RIGHT_EYE) the right eye runs after the left, its output bound
 // as a one-layer view beside the left eye's layer: a dispatch takes the left eye's final
-// AO wherever the left eye sees the same point (joint_upsample.wgsl `left_eye_quad`) and
-// lists the quads it does not fully see; a second, indirect dispatch (FALLBACK) over
-// just those upsamples them (`right_eye_quad`), as the composite does. Computing the
+// AO wherever the left eye sees the same point (joint_upsample.wgsl `left_eye_quad`),
+// stores it, and lists the quads it does not fully see with the pixels it stored; a
+// second, indirect dispatch (FALLBACK) over just those upsamples the right eye's own
+// occlusion at the rest. Computing the
 // right eye's own upsample at every quad made this pass cost more than with independent
 // eyes (docs/records/2026-11-29/measurements-in-code.md, upsample-right-eye).
 
@@ -24,6 +25,11 @@ fn left_final_ao(texel: vec4<f32>) -> f32 {
     return chain_value(texel).a;
 }
 
+// The same for the 2×2 texels a gather at `corner` fetches (layer 0).
+fn left_final_gather_ao(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>) -> vec4<f32> {
+    return chain_gather_ao(t, s, corner, 0);
+}
+
 override RIGHT_EYE: bool = false;
 override FALLBACK: bool = false;
 
@@ -34,10 +40,23 @@ struct FallbackQuads {
     groups_y: u32,
     groups_z: u32,
     count: atomic<u32>,
-    // Quad b packed as b.x | b.y << 16.
+    // Quad b and the pixels k already stored from the left eye, packed by `pack_quad`.
     quads: array<u32>,
 };
 @group(0) @binding(8) var<storage, read_write> fallback: FallbackQuads;
+@group(0) @binding(9) var gather: sampler;
+
+// A listed quad: b.x and b.y in 14 bits each (a side of up to 32768 pixels, beyond any
+// device's texture limit), then bit k of `stored` for pixel k.
+fn pack_quad(b: vec2<u32>, stored: vec4<bool>) -> u32 {
+    return b.x | (b.y << 14u) | (quad_bits(stored) << 28u);
+}
+
+// Bit k set where `pixels[k]`.
+fn quad_bits(pixels: vec4<bool>) -> u32 {
+    let bits = select(vec4<u32>(0u), vec4<u32>(1u, 2u, 4u, 8u), pixels);
+    return bits.x | bits.y | bits.z | bits.w;
+}
 
 @compute @workgroup_size(8, 8, 1)
 fn main(
@@ -46,13 +65,16 @@ fn main(
     @builtin(local_invocation_index) local: u32,
 ) {
     var id = invocation;
+    // The pixels of the quad that this dispatch leaves as they are (bit k for pixel k).
+    var keep = 0u;
     if (FALLBACK) {
         let i = group.x * 64u + local;
         if (i >= atomicLoad(&fallback.count)) {
             return;
         }
         let packed = fallback.quads[i];
-        id = vec3<u32>(packed & 0xffffu, packed >> 16u, 0u);
+        id = vec3<u32>(packed & 0x3fffu, (packed >> 14u) & 0x3fffu, 0u);
+        keep = packed >> 28u;
     } else if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
@@ -73,33 +95,35 @@ fn main(
     var quad: array<UpsamplePixel, 4>;
     var values: array<vec4<f32>, 4>;
     if (RIGHT_EYE && !FALLBACK) {
-        quad = quad_positions(depth_layers, id.xy, layer, eye);
-        let left = left_eye_quad(depth_layers, left_final, quad);
+        quad = quad_positions(depth_layers, gather, id.xy, layer, eye);
+        let left = left_eye_quad(depth_layers, left_final, gather, quad);
+        values = left.values;
         if (!all(left.found)) {
             let i = atomicAdd(&fallback.count, 1u);
-            fallback.quads[i] = id.x | (id.y << 16u);
+            fallback.quads[i] = pack_quad(id.xy, left.found);
             if (i % 64u == 0u) {
                 atomicAdd(&fallback.groups_x, 1u);
             }
-            return;
+            keep = quad_bits(!left.found);
         }
-        values = left.values;
     } else if (RIGHT_EYE) {
+        // The right eye's own upsample, for the pixels the left eye does not see.
         quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
-        values = right_eye_quad(depth_layers, left_final, geometry_low, occlusion_low, quad, vec2<i32>(id.xy), eye.tangents);
+        values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents, true);
     } else {
         quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
         values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents, true);
     }
-    store(quad[0], out_layer, values[0]);
-    store(quad[1], out_layer, values[1]);
-    store(quad[2], out_layer, values[2]);
-    store(quad[3], out_layer, values[3]);
+    store(quad[0], out_layer, values[0], (keep & 1u) == 0u);
+    store(quad[1], out_layer, values[1], (keep & 2u) == 0u);
+    store(quad[2], out_layer, values[2], (keep & 4u) == 0u);
+    store(quad[3], out_layer, values[3], (keep & 8u) == 0u);
 }
 
-// Stores a quad pixel's value (unoccluded on the sky), unless it lies past an odd edge.
-fn store(px: UpsamplePixel, layer: u32, value: vec4<f32>) {
-    if (all(px.pixel < frame.size)) {
+// Stores a quad pixel's value (unoccluded on the sky) if `write`, unless it lies past an
+// odd edge.
+fn store(px: UpsamplePixel, layer: u32, value: vec4<f32>, write: bool) {
+    if (write && all(px.pixel < frame.size)) {
         let sky = px.depth <= 0.0;
         textureStore(occlusion_out, vec2<i32>(px.pixel), i32(layer), chain_texel(select(value, vec4<f32>(0.0, 0.0, 0.0, 1.0), sky)));
     }

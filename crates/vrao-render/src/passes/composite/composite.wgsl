@@ -43,6 +43,12 @@
 fn left_final_ao(texel: vec4<f32>) -> f32 {
     return texel.a;
 }
+
+// The same for the 2×2 texels a gather at `corner` fetches (layer 0).
+fn left_final_gather_ao(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>) -> vec4<f32> {
+    return textureGather(3, t, s, corner, 0);
+}
+@group(0) @binding(16) var gather: sampler;
 // The lighting's normals (the normal texture's where a material has one; `normal_layers`
 // are the surface's own, which the upsampling weighs by).
 @group(0) @binding(15) var lighting_normal_layers: texture_2d_array<f32>;
@@ -142,7 +148,7 @@ fn main(
     var bounce = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     if (ao.technique != COMPOSITE_UNOCCLUDED) {
         if (HALF_RES && RIGHT_EYE && !FALLBACK) {
-            let left = left_eye_quad(depth_layers, left_hdr, quad);
+            let left = left_eye_quad(depth_layers, left_hdr, gather, quad);
             if (!all(left.found)) {
                 let i = atomicAdd(&fallback.count, 1u);
                 fallback.quads[i] = b.x | (b.y << 16u);
@@ -153,7 +159,7 @@ fn main(
             }
             occlusion = left.values;
         } else if (HALF_RES && RIGHT_EYE) {
-            occlusion = right_eye_quad(depth_layers, left_hdr, geometry_low, occlusion_layers, quad, vec2<i32>(b), eye.tangents);
+            occlusion = right_eye_quad(depth_layers, left_hdr, gather, geometry_low, occlusion_layers, quad, vec2<i32>(b), eye.tangents);
         } else if (HALF_RES) {
             occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents, true);
         } else {

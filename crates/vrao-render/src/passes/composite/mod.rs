@@ -58,8 +58,8 @@ const FALLBACK_HEADER_BYTES: u64 = 16;
 /// composite.wgsl's bindings: frame, AO parameters, the G-buffer, the direct light, the
 /// occlusion, the environment, the HDR out, the occlusion's geometry, the RSM bounce and
 /// its geometry and, for the right eye's dispatches, the output's left-eye layer and the
-/// fallback list.
-const BINDINGS: [Bind; 16] = [
+/// fallback list; the lighting's normals; the sampler of the right eye's gathers.
+const BINDINGS: [Bind; 17] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::Read(DEPTH),
@@ -76,6 +76,7 @@ const BINDINGS: [Bind; 16] = [
     Bind::Own(Slot::Layers),
     Bind::Own(Slot::ReadWriteBuffer),
     Bind::Read(LIGHTING_NORMALS),
+    Bind::GatherSampler,
 ];
 
 impl CompositePass {
