@@ -148,8 +148,13 @@ fn in_other_eye(v: vec3<f32>, eye: Eye, other: Eye, near: f32) -> vec4<f32> {
 // The stereo reuse (GTAO's right-eye march, every technique's denoise): a right-eye
 // surface point the left eye also sees takes the left eye's value there. AO within r
 // belongs to the surface point, not to the eye, so the eyes then agree by construction.
+// Where the value lies: the 2×2 block of the left eye's occlusion pixels a gather at
+// `corner` fetches, and the weights of its texels (in gather order, summing to 1) whose
+// blend is the value (the chain's `chain_gather_blend`, which this file cannot name:
+// not every shader that includes it has an AO chain).
 struct LeftEyeValue {
-    value: vec4<f32>,
+    corner: vec2<f32>,
+    weights: vec4<f32>,
     // False where the left eye does not see the point: the right eye computes it.
     found: bool,
 };
@@ -193,14 +198,17 @@ fn left_eye_point(
 // (`left_eye_point`). Interpolated at the point among the four occlusion pixels around
 // it on the same surface (within 5 % in distance): the nearest pixel shifted the eyes'
 // AO by up to a pixel against each other, and a neighbour across a depth edge would
-// bring another surface's value.
+// bring another surface's value. Their distances come from one gather through `gather`
+// (a nearest sampler clamped to the edge, as a clamped load is); `grid` is the size of
+// the occlusion targets.
 fn left_eye_value(
     position: vec3<f32>,
     right: Eye,
     left: Eye,
     depth: texture_depth_2d_array,
-    left_values: texture_2d_array<f32>,
+    grid: vec2<u32>,
     left_geometry: texture_2d_array<f32>,
+    gather: sampler,
     scale: u32,
     full_size: vec2<u32>,
     near: f32,
@@ -214,24 +222,20 @@ fn left_eye_value(
     let uv = point.uv;
     let distance = point.distance;
     // Occlusion pixel k stands for the centre of its top-left full-res pixel.
-    let grid = textureDimensions(left_values);
     let f = uv * vec2<f32>(grid) - 0.5 / f32(scale);
-    let base = vec2<i32>(floor(f));
-    let t = f - floor(f);
-    let last = vec2<i32>(grid) - 1;
-    var sum = vec4<f32>(0.0);
-    var total = 0.0;
-    for (var k = 0; k < 4; k++) {
-        let corner = vec2<i32>(k & 1, k >> 1u);
-        let q = clamp(base + corner, vec2<i32>(0), last);
-        let there = textureLoad(left_geometry, q, 0, 0).w;
-        let bilinear = mix(1.0 - t.x, t.x, f32(corner.x)) * mix(1.0 - t.y, t.y, f32(corner.y));
-        let w = select(0.0, bilinear, there > 0.0 && abs(there - distance) < 0.05 * distance);
-        sum += w * textureLoad(left_values, q, 0, 0);
-        total += w;
-    }
+    let base = floor(f);
+    let t = f - base;
+    // Gathered at the corner pixels base and base + (1, 1) share: in gather order,
+    // base + (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
+    let corner = (base + vec2<f32>(1.0)) / vec2<f32>(grid);
+    let there = textureGather(3, left_geometry, gather, corner, 0);
+    let bilinear = vec4<f32>((1.0 - t.x) * t.y, t.x * t.y, t.x * (1.0 - t.y), (1.0 - t.x) * (1.0 - t.y));
+    let same = (there > vec4<f32>(0.0)) & (abs(there - vec4<f32>(distance)) < vec4<f32>(0.05 * distance));
+    let w = select(vec4<f32>(0.0), bilinear, same);
+    let total = dot(w, vec4<f32>(1.0));
     if (total > 1e-6) {
-        result.value = sum / total;
+        result.corner = corner;
+        result.weights = w / total;
         result.found = true;
     }
     return result;

@@ -25,8 +25,9 @@ pub const AO_BLURRED: Resource = Resource::chain_storage("ao-blurred", Size::Occ
 
 /// Bindings of both denoise shaders with the occlusion in and the horizontal result
 /// out: frame, AO parameters, geometry, input, output, depth and, at 6, the output's
-/// left-eye layer for the right eye's vertical dispatch (the geometry stands in before it).
-const HORIZONTAL: [Bind; 7] = [
+/// left-eye layer for the right eye's vertical dispatch (the geometry stands in before it)
+/// and at 7 the sampler its gathers go through.
+const HORIZONTAL: [Bind; 8] = [
     Bind::Frame,
     Bind::AoParams,
     Bind::Read(AO_GEOMETRY),
@@ -34,10 +35,11 @@ const HORIZONTAL: [Bind; 7] = [
     Bind::Write(AO_BLUR_H),
     Bind::Read(DEPTH),
     Bind::Own(Slot::Layers),
+    Bind::GatherSampler,
 ];
 
 /// [`HORIZONTAL`] with the horizontal result in and the denoised occlusion out.
-const VERTICAL: [Bind; 7] = [
+const VERTICAL: [Bind; 8] = [
     HORIZONTAL[0],
     HORIZONTAL[1],
     HORIZONTAL[2],
@@ -45,6 +47,7 @@ const VERTICAL: [Bind; 7] = [
     Bind::Write(AO_BLURRED),
     HORIZONTAL[5],
     HORIZONTAL[6],
+    HORIZONTAL[7],
 ];
 
 /// Pixels per invocation of the tile denoise (`RUN` in denoise.wgsl).

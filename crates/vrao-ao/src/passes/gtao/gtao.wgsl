@@ -60,7 +60,7 @@ override THIN_CARDS: bool = false;
 // (`add_sample`), the thickness only where it holds none. Off, no pixel pays the fetch
 // and the march is today's to the bit.
 override SECOND_LAYER: bool = false;
-@group(0) @binding(11) var second_depth_layers: texture_depth_2d_array;
+@group(0) @binding(12) var second_depth_layers: texture_depth_2d_array;
 
 // GTAO's own parameters (passes/gtao/mod.rs `GtaoUniform`).
 struct GtaoParams {
@@ -81,7 +81,7 @@ struct GtaoParams {
     _pad0: u32,
     _pad1: u32,
 };
-@group(0) @binding(10) var<uniform> gtao: GtaoParams;
+@group(0) @binding(11) var<uniform> gtao: GtaoParams;
 
 // The occlusion pixel of invocation `id` (in workgroup `group`, at `local` within it) in
 // this dispatch's part of the image, or none (x = ao_size.x) past its part's width.

@@ -15,10 +15,10 @@ use crate::resource::ChainLayout;
 use crate::settings::Technique;
 use bytemuck::{Pod, Zeroable};
 
-/// The shared bindings with the right eye's at 7–9 (occlusion::REUSING_BINDINGS), at 10
-/// GTAO's own parameters and at 11 the second depth layer (unbound with one layer). A
+/// The shared bindings with the right eye's at 7–10 (occlusion::REUSING_BINDINGS), at 11
+/// GTAO's own parameters and at 12 the second depth layer (unbound with one layer). A
 /// march that gathers light (SSDO) binds more after these ([`March::binds`]).
-pub(crate) const BINDINGS: [Bind; 12] =
+pub(crate) const BINDINGS: [Bind; 13] =
     occlusion::joined(occlusion::REUSING_BINDINGS, [Bind::Own(Slot::Uniform), Bind::Read(DEPTH_LAYER_2)]);
 
 /// Whether this frame's march reads the second depth layer: two asked for, a technique

@@ -46,9 +46,14 @@ pub(crate) const BINDINGS: [Bind; 7] = [
 pub(crate) const RIGHT_EYE_WGSL: Shader = wgsl!("src/passes/occlusion/right_eye.wgsl");
 
 /// `BINDINGS` and right_eye.wgsl's: at 7 and 8 the raw occlusion's and its geometry's
-/// left-eye layers for the right eye's dispatches, at 9 its list of pixels to estimate.
-pub(crate) const REUSING_BINDINGS: [Bind; 10] =
-    bindings_and([Bind::Own(Slot::Layers), Bind::Own(Slot::Layers), Bind::Own(Slot::ReadWriteBuffer)]);
+/// left-eye layers for the right eye's dispatches, at 9 its list of pixels to estimate,
+/// at 10 the sampler its gathers of the left eye's values go through.
+pub(crate) const REUSING_BINDINGS: [Bind; 11] = bindings_and([
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::Layers),
+    Bind::Own(Slot::ReadWriteBuffer),
+    Bind::GatherSampler,
+]);
 
 /// `BINDINGS` followed by a technique's own bindings (from binding 7 on); `M` is the
 /// total, checked when the constant is made.

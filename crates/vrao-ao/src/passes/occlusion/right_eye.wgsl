@@ -35,6 +35,8 @@ struct RightEyeList {
     pixels: array<u32>,
 };
 @group(0) @binding(9) var<storage, read_write> right_list: RightEyeList;
+// The nearest sampler the left eye's 2×2 blocks are gathered through.
+@group(0) @binding(10) var gather: sampler;
 
 // The right-eye occlusion pixel of invocation `id` (in workgroup `group`, at `local`
 // within it): the listed pixel, or none (x = ao_size.x) past the list.
@@ -66,11 +68,10 @@ fn reused_from_left_eye(id: vec3<u32>, r: Receiver) -> bool {
         return true;
     }
     let left = left_eye_value(
-        r.position, r.eye, frame.eyes[0], depth_layers, left_occlusion, left_geometry, ao.scale, frame.size, frame.near,
+        r.position, r.eye, frame.eyes[0], depth_layers, ao.ao_size, left_geometry, gather, ao.scale, frame.size, frame.near,
     );
     if (left.found) {
-        // left_eye_value blends raw texels; the chain's decoding is linear, so decode after.
-        let value = chain_value(left.value);
+        let value = chain_gather_blend(left_occlusion, gather, left.corner, 0, left.weights);
         store_occlusion(id, vec4<f32>(reused_light(value), value.a));
     }
     return left.found;

@@ -290,26 +290,87 @@ fn distance_weighted(v00: vec4<f32>, v10: vec4<f32>, v01: vec4<f32>, v11: vec4<f
 // The nearest left pixel, not a bilinear blend: two loads per pixel, fewer than its own
 // upsample's, and the shift is under a full-res pixel of a field the denoise smoothed.
 // The AO in a texel of `left_final` comes from the includer's `left_final_ao` (the
-// upsampling's is a chain texture, the composite's its HDR colour with AO in alpha).
-struct LeftEyeFinal {
-    ao: f32,
-    found: bool,
+// upsampling's is a chain texture, the composite's its HDR colour with AO in alpha), in
+// a gather's four texels from its `left_final_gather_ao`.
+
+// Where the four pixels of a right-eye quad land in the left eye, and which of them it
+// sees: depth alone, so the denoise can list the quads that fall back before any left
+// AO exists (passes/blur `classify_right_eye_quads`).
+struct QuadInLeftEye {
+    // The left pixel that pixel k lands on (meaningful where it is seen, off the sky).
+    pixels: array<vec2<u32>, 4>,
+    // Seen by the left eye (common.wgsl `left_eye_point`'s test), or on the sky, which
+    // takes nothing from it.
+    seen: vec4<bool>,
+    sky: vec4<bool>,
+    // All four on a surface and landing on the 2×2 block from pixels[0].
+    block: bool,
 };
 
-fn left_eye_final(px: UpsamplePixel, depth_layers: texture_depth_2d_array, left_final: texture_2d_array<f32>) -> LeftEyeFinal {
-    var result: LeftEyeFinal;
-    // The sky: nothing to upsample (its callers show it unoccluded).
-    result.ao = 1.0;
-    result.found = !(px.depth > 0.0);
-    if (result.found) {
-        return result;
+// Whether the left eye sees a right-eye point at `pixel` (from `in_other_eye`: uv,
+// distance, on its image) where it holds stored depth `there`.
+fn left_eye_holds(in_left: vec4<f32>, pixel: vec2<u32>, there: f32) -> bool {
+    let distance = -load_view_position(max(there, 1e-30), pixel, frame.eyes[0], frame.size, frame.near).z;
+    return in_left.w > 0.0 && there > 0.0 && abs(distance - in_left.z) < 0.01 * in_left.z;
+}
+
+// `left_eye_holds` with the left depth loaded at the pixel, for a point off any block.
+fn left_eye_holds_alone(in_left: vec4<f32>, pixel: vec2<u32>, depth_layers: texture_depth_2d_array, sky: bool) -> bool {
+    if (sky) {
+        return true;
     }
-    let point = left_eye_point(px.position, frame.eyes[1], frame.eyes[0], depth_layers, frame.size, frame.near);
-    if (point.seen) {
-        result.ao = left_final_ao(textureLoad(left_final, vec2<i32>(point.pixel), 0, 0));
-        result.found = true;
+    if (in_left.w == 0.0) {
+        return false;
     }
-    return result;
+    return left_eye_holds(in_left, pixel, textureLoad(depth_layers, vec2<i32>(pixel), 0, 0));
+}
+
+// Where a smooth surface faces both eyes, the quad's four pixels land on a 2×2 block of
+// left pixels: then their left depths come from one gather (and `left_eye_quad`'s AO
+// from another). Elsewhere (an edge, the sky, the left image's border) each pixel's
+// depth is loaded alone.
+fn quad_in_left_eye(depth_layers: texture_depth_2d_array, gather: sampler, quad: array<UpsamplePixel, 4>) -> QuadInLeftEye {
+    let right = frame.eyes[1];
+    let left = frame.eyes[0];
+    let in0 = in_other_eye(quad[0].position, right, left, frame.near);
+    let in1 = in_other_eye(quad[1].position, right, left, frame.near);
+    let in2 = in_other_eye(quad[2].position, right, left, frame.near);
+    let in3 = in_other_eye(quad[3].position, right, left, frame.near);
+    let size = vec2<f32>(frame.size);
+    let last = frame.size - vec2<u32>(1u);
+    var q: QuadInLeftEye;
+    q.pixels = array<vec2<u32>, 4>(
+        min(vec2<u32>(in0.xy * size), last),
+        min(vec2<u32>(in1.xy * size), last),
+        min(vec2<u32>(in2.xy * size), last),
+        min(vec2<u32>(in3.xy * size), last),
+    );
+    q.sky = !(vec4<f32>(quad[0].depth, quad[1].depth, quad[2].depth, quad[3].depth) > vec4<f32>(0.0));
+    let p0 = q.pixels[0];
+    q.block = all(vec4<f32>(in0.w, in1.w, in2.w, in3.w) > vec4<f32>(0.0))
+        && !any(q.sky)
+        && all(q.pixels[1] == p0 + vec2<u32>(1u, 0u))
+        && all(q.pixels[2] == p0 + vec2<u32>(0u, 1u))
+        && all(q.pixels[3] == p0 + vec2<u32>(1u, 1u))
+        && all(p0 + vec2<u32>(1u) < frame.size);
+    if (q.block) {
+        // Gather order: (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
+        let there = textureGather(depth_layers, gather, gather_corner(p0), 0);
+        q.seen = vec4<bool>(
+            left_eye_holds(in0, q.pixels[0], there.w),
+            left_eye_holds(in1, q.pixels[1], there.z),
+            left_eye_holds(in2, q.pixels[2], there.x),
+            left_eye_holds(in3, q.pixels[3], there.y),
+        );
+    } else {
+        q.seen = vec4<bool>(
+            left_eye_holds_alone(in0, q.pixels[0], depth_layers, q.sky.x),
+            left_eye_holds_alone(in1, q.pixels[1], depth_layers, q.sky.y),
+            left_eye_holds_alone(in2, q.pixels[2], depth_layers, q.sky.z),
+            left_eye_holds_alone(in3, q.pixels[3], depth_layers, q.sky.w),
+        );
+    }
+    return q;
 }
 
 // The left eye's final AO at the four pixels of a right-eye quad, and which of them the
@@ -319,55 +380,33 @@ struct LeftEyeQuad {
     found: vec4<bool>,
 };
 
-// Whether the left eye sees right-eye pixel `px` (on a surface) at `pixel` where it holds
-// stored depth `there` (`left_eye_point`'s test, given the left depth).
-fn left_eye_holds(px_distance: f32, pixel: vec2<u32>, there: f32) -> bool {
-    let distance = -load_view_position(max(there, 1e-30), pixel, frame.eyes[0], frame.size, frame.near).z;
-    return there > 0.0 && abs(distance - px_distance) < 0.01 * px_distance;
+// The left eye's AO at `pixel` where `take` (a seen point off the sky), else 1 (the
+// sky's; a point not seen takes nothing).
+fn left_final_at(left_final: texture_2d_array<f32>, pixel: vec2<u32>, take: bool) -> f32 {
+    if (take) {
+        return left_final_ao(textureLoad(left_final, vec2<i32>(pixel), 0, 0));
+    }
+    return 1.0;
 }
 
-// Where a smooth surface faces both eyes, the quad's four pixels land on a 2×2 block of
-// left pixels: then the left depths and AO come from one gather each (2 fetches instead
-// of 8). Elsewhere (an edge, the sky, the left image's border) each pixel is looked up
-// alone (`left_eye_final`). The left AO in a gather comes from the includer's
-// `left_final_gather_ao`, as one texel's from `left_final_ao`.
 fn left_eye_quad(depth_layers: texture_depth_2d_array, left_final: texture_2d_array<f32>, gather: sampler, quad: array<UpsamplePixel, 4>) -> LeftEyeQuad {
-    let right = frame.eyes[1];
-    let left = frame.eyes[0];
-    let in0 = in_other_eye(quad[0].position, right, left, frame.near);
-    let in1 = in_other_eye(quad[1].position, right, left, frame.near);
-    let in2 = in_other_eye(quad[2].position, right, left, frame.near);
-    let in3 = in_other_eye(quad[3].position, right, left, frame.near);
-    let size = vec2<f32>(frame.size);
-    let p0 = vec2<u32>(in0.xy * size);
-    let block = in0.w * in1.w * in2.w * in3.w > 0.0
-        && all(vec2<u32>(in1.xy * size) == p0 + vec2<u32>(1u, 0u))
-        && all(vec2<u32>(in2.xy * size) == p0 + vec2<u32>(0u, 1u))
-        && all(vec2<u32>(in3.xy * size) == p0 + vec2<u32>(1u, 1u))
-        && all(p0 + vec2<u32>(1u) < frame.size)
-        && quad[0].depth > 0.0 && quad[1].depth > 0.0 && quad[2].depth > 0.0 && quad[3].depth > 0.0;
-    var result: LeftEyeQuad;
-    if (block) {
-        let corner = gather_corner(p0);
-        let there = textureGather(depth_layers, gather, corner, 0);
-        let ao = left_final_gather_ao(left_final, gather, corner);
-        let none = vec3<f32>(0.0);
-        result.values = array<vec4<f32>, 4>(vec4<f32>(none, ao.w), vec4<f32>(none, ao.z), vec4<f32>(none, ao.x), vec4<f32>(none, ao.y));
-        result.found = vec4<bool>(
-            left_eye_holds(in0.z, p0, there.w),
-            left_eye_holds(in1.z, p0 + vec2<u32>(1u, 0u), there.z),
-            left_eye_holds(in2.z, p0 + vec2<u32>(0u, 1u), there.x),
-            left_eye_holds(in3.z, p0 + vec2<u32>(1u, 1u), there.y),
+    let q = quad_in_left_eye(depth_layers, gather, quad);
+    var ao: vec4<f32>;
+    if (q.block) {
+        ao = left_final_gather_ao(left_final, gather, gather_corner(q.pixels[0])).wzxy;
+    } else {
+        let take = q.seen & !q.sky;
+        ao = vec4<f32>(
+            left_final_at(left_final, q.pixels[0], take.x),
+            left_final_at(left_final, q.pixels[1], take.y),
+            left_final_at(left_final, q.pixels[2], take.z),
+            left_final_at(left_final, q.pixels[3], take.w),
         );
-        return result;
     }
-    let l0 = left_eye_final(quad[0], depth_layers, left_final);
-    let l1 = left_eye_final(quad[1], depth_layers, left_final);
-    let l2 = left_eye_final(quad[2], depth_layers, left_final);
-    let l3 = left_eye_final(quad[3], depth_layers, left_final);
     let none = vec3<f32>(0.0);
-    result.values = array<vec4<f32>, 4>(vec4<f32>(none, l0.ao), vec4<f32>(none, l1.ao), vec4<f32>(none, l2.ao), vec4<f32>(none, l3.ao));
-    result.found = vec4<bool>(l0.found, l1.found, l2.found, l3.found);
+    var result: LeftEyeQuad;
+    result.values = array<vec4<f32>, 4>(vec4<f32>(none, ao.x), vec4<f32>(none, ao.y), vec4<f32>(none, ao.z), vec4<f32>(none, ao.w));
+    result.found = q.seen;
     return result;
 }
 

@@ -20,7 +20,7 @@
 // AoFull's left-eye layer in the right eye's dispatch (any array texture otherwise).
 @group(0) @binding(7) var left_final: texture_2d_array<f32>;
 
-// The AO in a texel of the left eye's upsampled AO (joint_upsample.wgsl `left_eye_final`).
+// The AO in a texel of the left eye's upsampled AO (joint_upsample.wgsl `left_eye_quad`).
 fn left_final_ao(texel: vec4<f32>) -> f32 {
     return chain_value(texel).a;
 }

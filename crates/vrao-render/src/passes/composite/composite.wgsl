@@ -39,7 +39,7 @@
 @group(0) @binding(13) var left_hdr: texture_2d_array<f32>;
 
 // The AO the left eye's composite left in its colour's alpha for the right eye
-// (joint_upsample.wgsl `left_eye_final`).
+// (joint_upsample.wgsl `left_eye_quad`).
 fn left_final_ao(texel: vec4<f32>) -> f32 {
     return texel.a;
 }
