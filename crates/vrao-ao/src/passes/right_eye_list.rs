@@ -114,8 +114,9 @@ impl RightEyeList {
         self.tiles = 0;
     }
 
-    /// The last listing frame's counts and its listed items (occlusion pixels, or quads
-    /// for the upsampling, as (x, y)), read back (blocking; for debug images).
+    /// The last listing frame's counts and its listed occlusion pixels, as (x, y), read
+    /// back (blocking; for debug images). Not for the upsampling's quads, which carry a
+    /// mask beside their position (upsample.wgsl `pack_quad`).
     /// One readback: the list begins with the header the arguments were copied from.
     pub(crate) fn read_items(&self, gpu: &Gpu, pass: &'static str) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
         if self.tiles == 0 {
