@@ -287,15 +287,15 @@ fn distance_weighted(v00: vec4<f32>, v10: vec4<f32>, v01: vec4<f32>, v11: vec4<f
 // the left eye, instead of once per eye from two low-res grids that sample different
 // surface points (that double interpolation left the eyes disagreeing at half
 // resolution although the denoise already reuses the left eye).
-// The nearest left pixel, not a bilinear blend: two loads per pixel, fewer than its own
-// upsample's, and the shift is under a full-res pixel of a field the denoise smoothed.
+// The nearest left pixel, not a bilinear blend: far fewer fetches than its own upsample's
+// (three gathers a quad where it lands on a 2×2 block, `quad_in_left_eye`), and the
+// shift is under a full-res pixel of a field the denoise smoothed.
 // The AO in a texel of `left_final` comes from the includer's `left_final_ao` (the
 // upsampling's is a chain texture, the composite's its HDR colour with AO in alpha), in
 // a gather's four texels from its `left_final_gather_ao`.
 
 // Where the four pixels of a right-eye quad land in the left eye, and which of them it
-// sees: depth alone, so the denoise can list the quads that fall back before any left
-// AO exists (passes/blur `classify_right_eye_quads`).
+// sees: from depth alone (the left eye's AO is fetched after, where it is used).
 struct QuadInLeftEye {
     // The left pixel that pixel k lands on (meaningful where it is seen, off the sky).
     pixels: array<vec2<u32>, 4>,

@@ -6,9 +6,9 @@
 // AO wherever the left eye sees the same point (joint_upsample.wgsl `left_eye_quad`),
 // stores it, and lists the quads it does not fully see with the pixels it stored; a
 // second, indirect dispatch (FALLBACK) over just those upsamples the right eye's own
-// occlusion at the rest. Computing the
-// right eye's own upsample at every quad made this pass cost more than with independent
-// eyes (docs/records/2026-11-29/measurements-in-code.md, upsample-right-eye).
+// occlusion at the rest. Computing the right eye's own upsample at every quad made this
+// pass cost more than with independent eyes (docs/records/2026-11-29/measurements-in-code.md,
+// upsample-right-eye).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;

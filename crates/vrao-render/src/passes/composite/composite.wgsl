@@ -48,10 +48,12 @@ fn left_final_ao(texel: vec4<f32>) -> f32 {
 fn left_final_gather_ao(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>) -> vec4<f32> {
     return textureGather(3, t, s, corner, 0);
 }
-@group(0) @binding(16) var gather: sampler;
+
 // The lighting's normals (the normal texture's where a material has one; `normal_layers`
 // are the surface's own, which the upsampling weighs by).
 @group(0) @binding(15) var lighting_normal_layers: texture_2d_array<f32>;
+// The nearest sampler the right eye gathers the left eye's 2×2 blocks through.
+@group(0) @binding(16) var gather: sampler;
 
 override HALF_RES: bool = false;
 // A pipeline constant, not a uniform: lavapipe pays for the upsample code even when a
