@@ -410,25 +410,20 @@ fn left_eye_quad(depth_layers: texture_depth_2d_array, left_final: texture_2d_ar
     return result;
 }
 
-// The upsampled values of a right-eye quad: the left eye's final AO at the pixels where
-// the left eye sees the same point, its own upsample elsewhere.
-fn right_eye_quad(
-    depth_layers: texture_depth_2d_array,
-    left_final: texture_2d_array<f32>,
-    gather: sampler,
-    geometry_low: texture_2d_array<f32>,
-    value_low: texture_2d_array<f32>,
-    quad: array<UpsamplePixel, 4>,
-    b: vec2<i32>,
-    tangents: vec4<f32>,
-) -> array<vec4<f32>, 4> {
-    let left = left_eye_quad(depth_layers, left_final, gather, quad);
-    // The occlusion: a texture of the AO chain.
-    let own = upsample_quad(geometry_low, value_low, quad, b, 1u, tangents, true);
-    return array<vec4<f32>, 4>(
-        select(own[0], left.values[0], left.found.x),
-        select(own[1], left.values[1], left.found.y),
-        select(own[2], left.values[2], left.found.z),
-        select(own[3], left.values[3], left.found.w),
-    );
+// A right-eye quad that falls back, as its list holds it: b.x and b.y in 14 bits each (a
+// side of up to 32768 pixels, beyond any device's texture limit), then bit k set where
+// pixel k was already stored from the left eye (`found`).
+fn pack_quad(b: vec2<u32>, found: vec4<bool>) -> u32 {
+    return b.x | (b.y << 14u) | (quad_bits(found) << 28u);
+}
+
+// The quad `pack_quad` packed, and (z) the bits of the pixels already stored.
+fn unpack_quad(packed: u32) -> vec3<u32> {
+    return vec3<u32>(packed & 0x3fffu, (packed >> 14u) & 0x3fffu, packed >> 28u);
+}
+
+// Bit k set where `pixels[k]`.
+fn quad_bits(pixels: vec4<bool>) -> u32 {
+    let bits = select(vec4<u32>(0u), vec4<u32>(1u, 2u, 4u, 8u), pixels);
+    return bits.x | bits.y | bits.z | bits.w;
 }

@@ -40,23 +40,11 @@ struct FallbackQuads {
     groups_y: u32,
     groups_z: u32,
     count: atomic<u32>,
-    // Quad b and the pixels k already stored from the left eye, packed by `pack_quad`.
+    // Quad b and the pixels already stored from the left eye (joint_upsample.wgsl `pack_quad`).
     quads: array<u32>,
 };
 @group(0) @binding(8) var<storage, read_write> fallback: FallbackQuads;
 @group(0) @binding(9) var gather: sampler;
-
-// A listed quad: b.x and b.y in 14 bits each (a side of up to 32768 pixels, beyond any
-// device's texture limit), then bit k of `stored` for pixel k.
-fn pack_quad(b: vec2<u32>, stored: vec4<bool>) -> u32 {
-    return b.x | (b.y << 14u) | (quad_bits(stored) << 28u);
-}
-
-// Bit k set where `pixels[k]`.
-fn quad_bits(pixels: vec4<bool>) -> u32 {
-    let bits = select(vec4<u32>(0u), vec4<u32>(1u, 2u, 4u, 8u), pixels);
-    return bits.x | bits.y | bits.z | bits.w;
-}
 
 @compute @workgroup_size(8, 8, 1)
 fn main(
@@ -72,9 +60,9 @@ fn main(
         if (i >= atomicLoad(&fallback.count)) {
             return;
         }
-        let packed = fallback.quads[i];
-        id = vec3<u32>(packed & 0x3fffu, (packed >> 14u) & 0x3fffu, 0u);
-        keep = packed >> 28u;
+        let quad = unpack_quad(fallback.quads[i]);
+        id = vec3<u32>(quad.xy, 0u);
+        keep = quad.z;
     } else if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }

@@ -13,8 +13,9 @@
 // output's alpha wherever the left eye sees the same point (joint_upsample.wgsl
 // `left_eye_quad`); its output is bound as a one-layer view beside a sampled view of
 // the left eye's layer. A right-eye quad with any pixel the left eye does not see (the
-// outer side, disocclusions: a small share) is listed instead, and a second, indirect
-// dispatch (FALLBACK) over exactly those quads upsamples their own occlusion too. Done
+// outer side, disocclusions: a small share) is listed with the pixels it shaded, and a
+// second, indirect dispatch (FALLBACK) over exactly those quads upsamples their own
+// occlusion and shades the rest. Done
 // in one dispatch, every quad paid for both on lavapipe, which runs an untaken branch
 // anyway (docs/records/2026-11-29/measurements-in-code.md, composite-fallback), and on a GPU every warp
 // holding one such quad would.
@@ -70,7 +71,7 @@ struct FallbackQuads {
     groups_y: u32,
     groups_z: u32,
     count: atomic<u32>,
-    // Quad b packed as b.x | b.y << 16.
+    // Quad b and the pixels already shaded (joint_upsample.wgsl `pack_quad`).
     quads: array<u32>,
 };
 @group(0) @binding(14) var<storage, read_write> fallback: FallbackQuads;
@@ -118,13 +119,16 @@ fn main(
     @builtin(local_invocation_index) local: u32,
 ) {
     var b = id.xy;
+    // The pixels of the quad that this dispatch leaves as they are (bit k for pixel k).
+    var keep = 0u;
     if (FALLBACK) {
         let i = group.x * 64u + local;
         if (i >= atomicLoad(&fallback.count)) {
             return;
         }
-        let packed = fallback.quads[i];
-        b = vec2<u32>(packed & 0xffffu, packed >> 16u);
+        let listed = unpack_quad(fallback.quads[i]);
+        b = listed.xy;
+        keep = listed.z;
     } else if (id.x * 2u >= frame.size.x || id.y * 2u >= frame.size.y || id.z >= frame.layers) {
         return;
     }
@@ -151,17 +155,19 @@ fn main(
     if (ao.technique != COMPOSITE_UNOCCLUDED) {
         if (HALF_RES && RIGHT_EYE && !FALLBACK) {
             let left = left_eye_quad(depth_layers, left_hdr, gather, quad);
+            occlusion = left.values;
             if (!all(left.found)) {
+                // Shaded here where the left eye gives the AO, by the fallback elsewhere.
                 let i = atomicAdd(&fallback.count, 1u);
-                fallback.quads[i] = b.x | (b.y << 16u);
+                fallback.quads[i] = pack_quad(b, left.found);
                 if (i % 64u == 0u) {
                     atomicAdd(&fallback.groups_x, 1u);
                 }
-                return;
+                keep = quad_bits(!left.found);
             }
-            occlusion = left.values;
         } else if (HALF_RES && RIGHT_EYE) {
-            occlusion = right_eye_quad(depth_layers, left_hdr, gather, geometry_low, occlusion_layers, quad, vec2<i32>(b), eye.tangents);
+            // The right eye's own upsample, for the pixels the left eye does not see.
+            occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents, true);
         } else if (HALF_RES) {
             occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents, true);
         } else {
@@ -178,10 +184,18 @@ fn main(
         let none = vec3<f32>(0.0);
         bounce = array<vec3<f32>, 4>(max(up[0].rgb, none), max(up[1].rgb, none), max(up[2].rgb, none), max(up[3].rgb, none));
     }
-    shade_and_store(quad[0], layer, out_layer, eye, occlusion[0], bounce[0]);
-    shade_and_store(quad[1], layer, out_layer, eye, occlusion[1], bounce[1]);
-    shade_and_store(quad[2], layer, out_layer, eye, occlusion[2], bounce[2]);
-    shade_and_store(quad[3], layer, out_layer, eye, occlusion[3], bounce[3]);
+    if ((keep & 1u) == 0u) {
+        shade_and_store(quad[0], layer, out_layer, eye, occlusion[0], bounce[0]);
+    }
+    if ((keep & 2u) == 0u) {
+        shade_and_store(quad[1], layer, out_layer, eye, occlusion[1], bounce[1]);
+    }
+    if ((keep & 4u) == 0u) {
+        shade_and_store(quad[2], layer, out_layer, eye, occlusion[2], bounce[2]);
+    }
+    if ((keep & 8u) == 0u) {
+        shade_and_store(quad[3], layer, out_layer, eye, occlusion[3], bounce[3]);
+    }
 }
 
 // The full-resolution occlusion at a quad pixel.
