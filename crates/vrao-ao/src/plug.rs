@@ -32,6 +32,7 @@ pub use crate::gpu::{Capabilities, Gpu};
 pub use crate::passes::blur::{AO_BLURRED, NAME as BLUR_PASS};
 pub use crate::passes::inputs::{DEPTH, DEPTH_LAYER_2, DIRECT_LIGHT, MOTION, NORMALS};
 pub use crate::passes::occlusion::{bindings_and, technique_decl, AO_GEOMETRY, AO_RAW, OCCLUSION_WGSL};
+pub use crate::passes::right_eye_list::RightEyeList;
 pub use crate::passes::temporal::{AO_ACCUMULATED, HISTORY_POSITION, HISTORY_VALUE};
 pub use crate::passes::upsample::{reuses_left_eye_upsample, AO_FULL, JOINT_UPSAMPLE_WGSL, NAME as UPSAMPLE_PASS};
 pub use crate::resource::{FINAL_AO, OCCLUSION, PIXEL_MOTION};

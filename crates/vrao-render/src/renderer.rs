@@ -505,12 +505,11 @@ impl Renderer {
         Some(self.last_plan()?.occlusion_traffic(chain, ao.resolution.is_half()))
     }
 
-    /// Per pass, the right eye's tiles the AO chain computed rather than copied from the
-    /// left eye in the last frame, read back from the GPU after it finished (blocking:
-    /// for reports); empty when the right eye reuses nothing.
+    /// Per pass, the right eye's tiles the AO chain and the composite computed rather than
+    /// copied from the left eye in the last frame, read back from the GPU after it
+    /// finished (blocking: for reports); empty when the right eye reuses nothing.
     pub fn right_eye_tiles(&self) -> Vec<RightEyeTiles> {
-        let passes: Vec<&dyn Pass> = self.passes.ao_chain.iter().map(|p| p.as_ref()).collect();
-        RightEyeTiles::latest(&passes, &self.gpu)
+        RightEyeTiles::latest(&self.passes.all(), &self.gpu)
     }
 
     /// The right eye's occlusion pixels the last frame's march computed rather than

@@ -13,7 +13,7 @@ pub(crate) mod gtao;
 pub(crate) mod hbao;
 pub(crate) mod inputs;
 pub(crate) mod occlusion;
-mod right_eye_list;
+pub(crate) mod right_eye_list;
 pub(crate) mod ssao;
 pub(crate) mod ssdo;
 pub(crate) mod temporal;

@@ -2,7 +2,8 @@
 //! reuse the left eye's results: a first right-eye dispatch copies what it can and
 //! appends the rest (pixels or quads) to a list on the GPU, whose header holds the
 //! workgroup counts of a second, indirect dispatch over just those (64 to a workgroup).
-//! Nothing is read back in a frame; a report reads the last frame's counts.
+//! Nothing is read back in a frame; a report reads the last frame's counts. A renderer's
+//! pass that reuses the left eye (its composite) keeps its list in one too.
 
 use super::occlusion::{AO_GEOMETRY, AO_RAW};
 use super::{RecordContext, RightEyeTiles};
@@ -15,7 +16,7 @@ use wgpu::util::DeviceExt;
 const HEADER_BYTES: u64 = 16;
 
 /// One pass's list, kept from frame to frame.
-pub(crate) struct RightEyeList {
+pub struct RightEyeList {
     label: &'static str,
     /// The header, then room for every item of the frame.
     list: Option<wgpu::Buffer>,
@@ -32,7 +33,8 @@ pub(crate) struct RightEyeList {
 }
 
 impl RightEyeList {
-    pub(crate) fn new(gpu: &Gpu, label: &'static str) -> Self {
+    /// An empty list; `label` names its buffers.
+    pub fn new(gpu: &Gpu, label: &'static str) -> Self {
         let device = &gpu.device;
         let header = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
@@ -49,13 +51,13 @@ impl RightEyeList {
     }
 
     /// What binds in the list's place before the right eye's dispatches.
-    pub(crate) fn stand_in(&self) -> wgpu::Buffer {
+    pub fn stand_in(&self) -> wgpu::Buffer {
         self.header.clone()
     }
 
     /// Starts this frame's list, with room for `items`, over an image of `tiles` tiles;
     /// returns it (a clone of the one buffer: wgpu buffers are shared handles).
-    pub(crate) fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
+    pub fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
         let size = HEADER_BYTES + 4 * u64::from(items.max(1));
         if self.list.as_ref().is_none_or(|b| b.size() < size) {
             self.list = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -72,12 +74,12 @@ impl RightEyeList {
     }
 
     /// Copies the list's header (filled by the first dispatch) out for the indirect one.
-    pub(crate) fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder, list: &wgpu::Buffer) {
+    pub fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder, list: &wgpu::Buffer) {
         encoder.copy_buffer_to_buffer(list, 0, &self.arguments, 0, HEADER_BYTES);
     }
 
     /// The indirect dispatch's arguments (at offset 0).
-    pub(crate) fn arguments(&self) -> &wgpu::Buffer {
+    pub fn arguments(&self) -> &wgpu::Buffer {
         &self.arguments
     }
 
@@ -110,7 +112,7 @@ impl RightEyeList {
     }
 
     /// Marks a frame that did not reuse the left eye: nothing to report.
-    pub(crate) fn skip(&mut self) {
+    pub fn skip(&mut self) {
         self.tiles = 0;
     }
 
@@ -131,7 +133,7 @@ impl RightEyeList {
     }
 
     /// The last listing frame's counts, read back (blocking).
-    pub(crate) fn read(&self, gpu: &Gpu, pass: &'static str) -> Option<RightEyeTiles> {
+    pub fn read(&self, gpu: &Gpu, pass: &'static str) -> Option<RightEyeTiles> {
         if self.tiles == 0 {
             return None;
         }

@@ -7,7 +7,8 @@
 //! of half-resolution AO (`reuses_left_eye_upsample`) the left eye is composited first
 //! and the right eye, in a dispatch of its own, takes the left eye's AO from the output's
 //! alpha wherever the left eye sees the same point; the quads it does not fully see are
-//! listed on the GPU and composited by an indirect dispatch over just them.
+//! listed on the GPU (a [`RightEyeList`], whose counts reports read) and composited by an
+//! indirect dispatch over just them.
 
 use super::direct::DIRECT;
 use super::gbuffer::{ALBEDO, LIGHTING_NORMALS};
@@ -18,10 +19,10 @@ use crate::gpu::kernel::wgsl;
 use std::sync::Mutex;
 use vrao_ao::plug::{
     reuses_left_eye_upsample, Bind, ChainLayout, DeclareContext, Gpu, Kernel, Pass, PassDecl, RecordContext, Resource,
-    Size, Slot, AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION, VISIBILITY,
+    RightEyeList, Size, Slot, AO_GEOMETRY, COMMON, DEPTH, IRRADIANCE, JOINT_UPSAMPLE_WGSL, NORMALS, OCCLUSION,
+    VISIBILITY,
 };
-use vrao_ao::Technique;
-use wgpu::util::DeviceExt;
+use vrao_ao::{RightEyeTiles, Technique};
 
 /// The pass's name: its declaration in the graph, its timestamp span, and what reports
 /// look its cost up by.
@@ -42,18 +43,14 @@ pub struct CompositePass {
     /// AO (listing the quads it cannot), and over the listed quads.
     right_eye: [Kernel; 2],
     right_eye_fallback: [Kernel; 2],
-    /// The list of right-eye quads the left eye does not fully see, with the indirect
-    /// dispatch's arguments in front (composite.wgsl `FallbackQuads`), grown to the
-    /// frame's quads when needed; and the header it starts each frame from.
-    fallback: Mutex<Option<wgpu::Buffer>>,
-    fallback_header: wgpu::Buffer,
-    /// The indirect arguments copied out of the list (a buffer may not be both the
-    /// dispatch's read-write binding and its arguments).
-    fallback_args: wgpu::Buffer,
+    /// The list of right-eye quads the left eye does not fully see (composite.wgsl
+    /// `FallbackQuads`).
+    fallback: Mutex<RightEyeList>,
 }
 
-/// Bytes of `FallbackQuads` before its list: the indirect arguments (x, y, z) and the count.
-const FALLBACK_HEADER_BYTES: u64 = 16;
+/// Quads per side of the composite's 8×8 workgroups (composite.wgsl): what the right
+/// eye's share of tiles is counted in.
+const WORKGROUP_SIDE: u32 = 8;
 
 /// composite.wgsl's bindings: frame, AO parameters, the G-buffer, the direct light, the
 /// occlusion, the environment, the HDR out, the occlusion's geometry, the RSM bounce and
@@ -99,21 +96,7 @@ impl CompositePass {
         };
         // The right eye reuses the left eye's AO only for the techniques without light.
         let ao_only = ChainLayout::of(false, gpu.caps.scalar_chain);
-        let fallback_header = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("composite fallback header"),
-            // No workgroups yet (x = 0), y = z = 1, no quads listed; room for a list of
-            // one, so that it also binds where no list is used.
-            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0, 0, 0, 0]),
-            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::STORAGE,
-        });
-        let fallback_args = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("composite fallback dispatch"),
-            size: FALLBACK_HEADER_BYTES,
-            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         CompositePass {
-            fallback_args,
             kernels: [ChainLayout::Rgba, ChainLayout::Scalar]
                 .into_iter()
                 .filter(|chain| *chain == ChainLayout::Rgba || gpu.caps.scalar_chain)
@@ -127,8 +110,7 @@ impl CompositePass {
                 .collect(),
             right_eye: [false, true].map(|rsm| variant(true, rsm, true, false, ao_only)),
             right_eye_fallback: [false, true].map(|rsm| variant(true, rsm, true, true, ao_only)),
-            fallback: Mutex::new(None),
-            fallback_header,
+            fallback: Mutex::new(RightEyeList::new(gpu, "composite fallback quads")),
         }
     }
 }
@@ -156,7 +138,9 @@ impl Pass for CompositePass {
         let rsm = rsm_active(scene_of(ctx.setup), settings_of(ctx.setup));
         // The output's left-eye layer is unused before the right eye's dispatch: the
         // geometry (or its placeholder) stands in.
-        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), self.fallback_header.as_entire_binding()]);
+        let mut fallback = self.fallback.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let stand_in = fallback.stand_in();
+        let resources = ctx.bind(&BINDINGS, &[ctx.view(AO_GEOMETRY), stand_in.as_entire_binding()]);
         // One invocation per quad of 2×2 pixels (composite.wgsl): both eyes alike, or the
         // left eye, then the right eye reusing its AO, then the quads it listed.
         let (w, h, layers) = ctx.quad_extent();
@@ -172,52 +156,35 @@ impl Pass for CompositePass {
             &resources,
             (w, h, if reuse { 1 } else { layers }),
         );
-        if reuse {
-            let fallback = self.fallback_list(device, u64::from(w) * u64::from(h));
-            ctx.encoder.copy_buffer_to_buffer(&self.fallback_header, 0, &fallback, 0, FALLBACK_HEADER_BYTES);
-            // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists
-            // the quads it could not reuse in `fallback`.
-            let (right, left) = (ctx.layer_view(HDR, 1), ctx.layer_view(HDR, 0));
-            let resources = ctx.bind_overriding(
-                &BINDINGS,
-                &[wgpu::BindingResource::TextureView(&left), fallback.as_entire_binding()],
-                &[(HDR, wgpu::BindingResource::TextureView(&right))],
-            );
-            self.right_eye[rsm as usize].dispatch(
-                device,
-                ctx.encoder,
-                ctx.visibility.bind_group(),
-                &resources,
-                (w, h, 1),
-            );
-            ctx.encoder.copy_buffer_to_buffer(&fallback, 0, &self.fallback_args, 0, 12);
-            let args = &self.fallback_args;
-            self.right_eye_fallback[rsm as usize].dispatch_indirect(
-                device,
-                ctx.encoder,
-                ctx.visibility.bind_group(),
-                &resources,
-                args,
-                0,
-            );
+        if !reuse {
+            fallback.skip();
+            return;
         }
+        let tiles = w.div_ceil(WORKGROUP_SIDE) * h.div_ceil(WORKGROUP_SIDE);
+        let list = fallback.start(ctx, w * h, tiles);
+        // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists the
+        // quads it could not reuse.
+        let (right, left) = (ctx.layer_view(HDR, 1), ctx.layer_view(HDR, 0));
+        let resources = ctx.bind_overriding(
+            &BINDINGS,
+            &[wgpu::BindingResource::TextureView(&left), list.as_entire_binding()],
+            &[(HDR, wgpu::BindingResource::TextureView(&right))],
+        );
+        let device = &ctx.gpu.device;
+        let visibility = ctx.visibility.bind_group();
+        self.right_eye[rsm as usize].dispatch(device, ctx.encoder, visibility, &resources, (w, h, 1));
+        fallback.take_arguments(ctx.encoder, &list);
+        self.right_eye_fallback[rsm as usize].dispatch_indirect(
+            device,
+            ctx.encoder,
+            visibility,
+            &resources,
+            fallback.arguments(),
+            0,
+        );
     }
-}
 
-impl CompositePass {
-    /// The fallback list, room for `quads` (a clone of the one buffer: wgpu buffers are
-    /// shared handles).
-    fn fallback_list(&self, device: &wgpu::Device, quads: u64) -> wgpu::Buffer {
-        let size = FALLBACK_HEADER_BYTES + 4 * quads;
-        let mut list = self.fallback.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if list.as_ref().is_none_or(|b| b.size() < size) {
-            *list = Some(device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("composite fallback quads"),
-                size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
-        list.as_ref().expect("allocated above").clone()
+    fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
+        self.fallback.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).read(gpu, NAME)
     }
 }
