@@ -216,20 +216,21 @@ fn marches_past_the_inner_border_continue_in_the_other_eye() {
 }
 
 /// The right eye computes only what the left eye cannot give it (right_eye.wgsl
-/// `classify_right_eye`, upsample.wgsl's FALLBACK): counted from the indirect dispatches'
-/// arguments, the work is a share of the right eye's tiles; two eyes at one place with
-/// one field of view need none of it; independent eyes report nothing.
+/// `classify_right_eye`, the FALLBACK of upsample.wgsl and composite.wgsl): counted from
+/// the indirect dispatches' arguments, the work is a share of the right eye's tiles; two
+/// eyes at one place with one field of view need none of it; independent eyes report
+/// nothing.
 #[test]
 fn the_right_eye_computes_only_the_tiles_the_left_eye_cannot_give() {
     let (gpu, _guard) = common::gpu();
     let scene = Scene::load("builtin:furnished").unwrap();
     let head = scene.head.pose_at(0.0);
-    let counts = |s: &vrao_render::Settings| {
+    let counts_of = |s: &vrao_render::Settings, output| {
         let mut renderer = vrao_render::Renderer::new(gpu.clone(), &scene, s).unwrap();
-        let output = if s.ao.resolution.is_half() { AO_FULL } else { AO_BLURRED };
         renderer.render_and_wait(&s.profile.eyes(&head, s.near).eyes, &[output]).unwrap();
         renderer.right_eye_tiles()
     };
+    let counts = |s: &vrao_render::Settings| counts_of(s, if s.ao.resolution.is_half() { AO_FULL } else { AO_BLURRED });
     // Every technique that estimates per pixel from depth, at half and full resolution.
     for (technique, half_res) in [(Technique::Ssao, false), (Technique::Hbao, true), (Technique::Gtao, true)] {
         let mut a = ao(technique, 24, 0.3);
@@ -247,6 +248,12 @@ fn the_right_eye_computes_only_the_tiles_the_left_eye_cannot_give() {
     let mut a = ao(Technique::Gtao, 24, 0.3);
     a.resolution = vrao_ao::Resolution::Half;
     let stereo = settings(192, 216, a.clone());
+    // A frame upsamples in its composite, which lists the same quads as the upsampling.
+    let upsampled = counts(&stereo);
+    let framed = counts_of(&stereo, HDR);
+    let passes: Vec<&str> = framed.iter().map(|t| t.pass).collect();
+    assert_eq!(passes, ["gtao", "composite"], "{framed:?}");
+    assert_eq!((framed[1].computed, framed[1].items), (upsampled[1].computed, upsampled[1].items), "{framed:?}");
     let mut one_place = stereo.clone();
     (one_place.profile.ipd, one_place.profile.fov_right) = (0.0, one_place.profile.fov_left);
     for t in counts(&one_place) {
