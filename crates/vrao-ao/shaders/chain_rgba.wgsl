@@ -13,10 +13,8 @@ fn chain_texel(value: vec4<f32>) -> vec4<f32> {
     return value;
 }
 
-// The AO of the 2×2 texels around `corner` (a shared texel corner, in uv) of `layer`, in
-// textureGather's order: (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
-// The texels of the 2×2 block a gather at `corner` fetches from `layer`, weighed by `w`
-// (in gather order) and summed, decoded as `chain_value` decodes a texel: one gather
+// The texels of the 2×2 block a gather at `corner` (a shared texel corner, in uv) fetches
+// from `layer`, weighed by `w` (in gather order) and summed, decoded as `chain_value` decodes a texel: one gather
 // per channel.
 fn chain_gather_blend(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>, layer: i32, w: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(
@@ -27,6 +25,8 @@ fn chain_gather_blend(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>, l
     );
 }
 
+// The AO of the 2×2 texels around `corner` (a shared texel corner, in uv) of `layer`, in
+// textureGather's order: (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
 fn chain_gather_ao(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>, layer: i32) -> vec4<f32> {
     return textureGather(3, t, s, corner, layer);
 }
