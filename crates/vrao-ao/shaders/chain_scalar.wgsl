@@ -14,7 +14,8 @@ fn chain_texel(value: vec4<f32>) -> vec4<f32> {
 }
 
 // The texels of the 2×2 block a gather at `corner` (a shared texel corner, in uv) fetches
-// from `layer`, weighed by `w` (in gather order) and summed, decoded as `chain_value` decodes a texel.
+// from `layer`, weighed by `w` (in gather order) and summed, decoded as `chain_value`
+// decodes a texel.
 fn chain_gather_blend(t: texture_2d_array<f32>, s: sampler, corner: vec2<f32>, layer: i32, w: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(0.0, 0.0, 0.0, dot(textureGather(0, t, s, corner, layer), w));
 }
