@@ -130,7 +130,10 @@ fn assert_row_times_and_verdict(header: &[&str], rows: &[Vec<&str>], row: &[&str
     let verdict = row[column("verdict")];
     let pass = frame <= budget_ms;
     assert!(verdict.starts_with(if pass { "PASS (" } else { "FAIL (" }), "{frame} ms: {verdict}");
-    assert!(verdict.contains(&format!("{:.2}×", frame / budget_ms)), "{frame} ms: {verdict}");
+    // The verdict's ratio is rounded from the unrounded frame time, the table's frame to
+    // 3 decimals: at a rounding edge the two can differ in the last digit.
+    let said: f64 = verdict[6..].trim_end_matches("×)").parse().unwrap_or(f64::NAN);
+    assert!((said - frame / budget_ms).abs() <= 0.005 + 0.0005 / budget_ms + 1e-9, "{frame} ms: {verdict}");
 }
 
 #[test]
