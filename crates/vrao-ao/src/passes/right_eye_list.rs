@@ -9,6 +9,7 @@ use super::occlusion::{AO_GEOMETRY, AO_RAW};
 use super::{RecordContext, RightEyeTiles};
 use crate::gpu::kernel::{Bind, Kernel, TILE};
 use crate::gpu::Gpu;
+use crate::graph::Resource;
 use wgpu::util::DeviceExt;
 
 /// Bytes of the list's header: the indirect arguments (x, y, z), then the count (WGSL:
@@ -57,7 +58,7 @@ impl RightEyeList {
 
     /// Starts this frame's list, with room for `items`, over an image of `tiles` tiles;
     /// returns it (a clone of the one buffer: wgpu buffers are shared handles).
-    pub fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
+    fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
         let size = HEADER_BYTES + 4 * u64::from(items.max(1));
         if self.list.as_ref().is_none_or(|b| b.size() < size) {
             self.list = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -74,13 +75,8 @@ impl RightEyeList {
     }
 
     /// Copies the list's header (filled by the first dispatch) out for the indirect one.
-    pub fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder, list: &wgpu::Buffer) {
+    fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder, list: &wgpu::Buffer) {
         encoder.copy_buffer_to_buffer(list, 0, &self.arguments, 0, HEADER_BYTES);
-    }
-
-    /// The indirect dispatch's arguments (at offset 0).
-    pub fn arguments(&self) -> &wgpu::Buffer {
-        &self.arguments
     }
 
     /// The right eye after the left (occlusion/right_eye.wgsl): `classify` copies what
@@ -111,6 +107,31 @@ impl RightEyeList {
         listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, &self.arguments, 0);
     }
 
+    /// The right eye after the left, one invocation per quad of 2×2 pixels (the
+    /// upsampling's and the composite's reuse of the left eye's final AO): `copy` takes
+    /// what the left eye gives and lists the quads it cannot fully, then `fallback` runs
+    /// over those by an indirect dispatch. Both write layer 1 of `output` alone and read
+    /// its left-eye layer 0 and the list as the binding list's two `Bind::Own` entries,
+    /// in that order. `quads`: the image's quads, width × height.
+    pub fn record_right_eye_quads(
+        &mut self,
+        ctx: &mut RecordContext,
+        binds: &[Bind],
+        output: Resource,
+        [copy, fallback]: [&Kernel; 2],
+        (width, height): (u32, u32),
+    ) {
+        let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
+        let (right, left) = (ctx.layer_view(output, 1), ctx.layer_view(output, 0));
+        let view = wgpu::BindingResource::TextureView;
+        let resources = ctx.bind_overriding(binds, &[view(&left), list.as_entire_binding()], &[(output, view(&right))]);
+        let device = &ctx.gpu.device;
+        let visibility = ctx.visibility.bind_group();
+        copy.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
+        self.take_arguments(ctx.encoder, &list);
+        fallback.dispatch_indirect(device, ctx.encoder, visibility, &resources, &self.arguments, 0);
+    }
+
     /// Marks a frame that did not reuse the left eye: nothing to report.
     pub fn skip(&mut self) {
         self.tiles = 0;
@@ -118,7 +139,7 @@ impl RightEyeList {
 
     /// The last listing frame's counts and its listed occlusion pixels, as (x, y), read
     /// back (blocking; for debug images). Not for the upsampling's quads, which carry a
-    /// mask beside their position (upsample.wgsl `pack_quad`).
+    /// mask beside their position (joint_upsample.wgsl `pack_quad`).
     /// One readback: the list begins with the header the arguments were copied from.
     pub(crate) fn read_items(&self, gpu: &Gpu, pass: &'static str) -> Option<(RightEyeTiles, Vec<[u32; 2]>)> {
         if self.tiles == 0 {

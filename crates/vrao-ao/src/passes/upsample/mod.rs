@@ -8,7 +8,6 @@ use super::inputs::{DEPTH, NORMALS};
 use super::occlusion::AO_GEOMETRY;
 use super::right_eye_list::RightEyeList;
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
-use crate::gpu::kernel::TILE;
 use crate::gpu::kernel::{wgsl, Bind, ByChain, Kernel, Shader, Slot, COMMON, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, FINAL_AO, OCCLUSION};
@@ -46,7 +45,7 @@ const BINDINGS: [Bind; 10] = [
 ];
 
 /// Whether the right eye takes the left eye's upsampled AO instead of upsampling its own
-/// wherever the left eye sees the same point (joint_upsample.wgsl `right_eye_quad`): with
+/// wherever the left eye sees the same point (joint_upsample.wgsl `left_eye_quad`): with
 /// the stereo reuse, two views and half-resolution occlusion of an AO-only technique
 /// (SSDO's rgb carries gathered light, which the composite's alpha, where the left eye's
 /// AO waits for the right eye, cannot hold).
@@ -121,18 +120,7 @@ impl Pass for UpsamplePass {
         }
         // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists the
         // quads it could not reuse.
-        let list = fallback.start(ctx, w * h, w.div_ceil(TILE) * h.div_ceil(TILE));
-        let (right, left) = (ctx.layer_view(AO_FULL, 1), ctx.layer_view(AO_FULL, 0));
-        let resources = ctx.bind_overriding(
-            &BINDINGS,
-            &[wgpu::BindingResource::TextureView(&left), list.as_entire_binding()],
-            &[(AO_FULL, wgpu::BindingResource::TextureView(&right))],
-        );
-        let device = &ctx.gpu.device;
-        let visibility = ctx.visibility.bind_group();
-        self.right_eye.dispatch(device, ctx.encoder, visibility, &resources, (w, h, 1));
-        fallback.take_arguments(ctx.encoder, &list);
-        self.right_eye_fallback.dispatch_indirect(device, ctx.encoder, visibility, &resources, fallback.arguments(), 0);
+        fallback.record_right_eye_quads(ctx, &BINDINGS, AO_FULL, [&self.right_eye, &self.right_eye_fallback], (w, h));
     }
 
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {

@@ -48,10 +48,6 @@ pub struct CompositePass {
     fallback: Mutex<RightEyeList>,
 }
 
-/// Quads per side of the composite's 8×8 workgroups (composite.wgsl): what the right
-/// eye's share of tiles is counted in.
-const WORKGROUP_SIDE: u32 = 8;
-
 /// composite.wgsl's bindings: frame, AO parameters, the G-buffer, the direct light, the
 /// occlusion, the environment, the HDR out, the occlusion's geometry, the RSM bounce and
 /// its geometry and, for the right eye's dispatches, the output's left-eye layer and the
@@ -160,28 +156,10 @@ impl Pass for CompositePass {
             fallback.skip();
             return;
         }
-        let tiles = w.div_ceil(WORKGROUP_SIDE) * h.div_ceil(WORKGROUP_SIDE);
-        let list = fallback.start(ctx, w * h, tiles);
         // The right eye writes layer 1 alone, reads the left eye's layer 0 and lists the
         // quads it could not reuse.
-        let (right, left) = (ctx.layer_view(HDR, 1), ctx.layer_view(HDR, 0));
-        let resources = ctx.bind_overriding(
-            &BINDINGS,
-            &[wgpu::BindingResource::TextureView(&left), list.as_entire_binding()],
-            &[(HDR, wgpu::BindingResource::TextureView(&right))],
-        );
-        let device = &ctx.gpu.device;
-        let visibility = ctx.visibility.bind_group();
-        self.right_eye[rsm as usize].dispatch(device, ctx.encoder, visibility, &resources, (w, h, 1));
-        fallback.take_arguments(ctx.encoder, &list);
-        self.right_eye_fallback[rsm as usize].dispatch_indirect(
-            device,
-            ctx.encoder,
-            visibility,
-            &resources,
-            fallback.arguments(),
-            0,
-        );
+        let kernels = [&self.right_eye[rsm as usize], &self.right_eye_fallback[rsm as usize]];
+        fallback.record_right_eye_quads(ctx, &BINDINGS, HDR, kernels, (w, h));
     }
 
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
