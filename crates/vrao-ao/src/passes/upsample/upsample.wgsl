@@ -94,11 +94,9 @@ fn main(
             }
             keep = quad_bits(!left.found);
         }
-    } else if (RIGHT_EYE) {
-        // The right eye's own upsample, for the pixels the left eye does not see.
-        quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
-        values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents, true);
     } else {
+        // Either eye's own upsample (the right eye's FALLBACK: of the pixels the left eye
+        // does not see).
         quad = quad_pixels(depth_layers, normal_layers, id.xy, layer, eye);
         values = upsample_quad(geometry_low, occlusion_low, quad, vec2<i32>(id.xy), layer, eye.tangents, true);
     }

@@ -165,10 +165,9 @@ fn main(
                 }
                 keep = quad_bits(!left.found);
             }
-        } else if (HALF_RES && RIGHT_EYE) {
-            // The right eye's own upsample, for the pixels the left eye does not see.
-            occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents, true);
         } else if (HALF_RES) {
+            // Either eye's own upsample (the right eye's FALLBACK: of the pixels the left
+            // eye does not see).
             occlusion = upsample_quad(geometry_low, occlusion_layers, quad, vec2<i32>(b), layer, eye.tangents, true);
         } else {
             occlusion = array<vec4<f32>, 4>(
