@@ -104,7 +104,7 @@ pub struct BenchRecord {
     #[serde(default)]
     pub right_eye_tiles_share: Option<f64>,
     /// The same for the upsampling's right eye (quads it upsampled itself; half
-    /// resolution, when the final AO was upsampled by its own pass).
+    /// resolution: the upsample pass's, or in a whole frame the composite's).
     #[serde(default)]
     pub right_eye_upsample_share: Option<f64>,
     /// Mean SSIM of the AO against the reference (1 = identical).

@@ -44,8 +44,8 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
                 stereo_inconsistent: row.stereo.and_then(|c| c.inconsistent),
                 stereo_inconsistent_inner_border: row.stereo.and_then(|c| c.inner_border),
                 stereo_inconsistent_interior: row.stereo.and_then(|c| c.interior),
-                right_eye_tiles_share: right_eye_share(row, |pass| pass != UPSAMPLE_PASS),
-                right_eye_upsample_share: right_eye_share(row, |pass| pass == UPSAMPLE_PASS),
+                right_eye_tiles_share: right_eye_share(row, |pass| !upsamples(pass)),
+                right_eye_upsample_share: right_eye_share(row, upsamples),
                 ao_ssim: row.error.as_ref().map(|e| e.ao_ssim),
                 ambient_rel_rmse: row.error.as_ref().and_then(|e| e.ambient_rel_rmse),
                 pareto: false,
@@ -78,6 +78,12 @@ pub fn records(rows: &[BenchRow]) -> Vec<BenchRecord> {
     }
     mark_pareto(&mut out);
     out
+}
+
+/// Whether `pass` upsamples the half-resolution AO: its own pass, or in a whole frame
+/// (`--frame`) the composite, which upsamples inline and lists the same quads.
+fn upsamples(pass: &str) -> bool {
+    pass == UPSAMPLE_PASS || pass == composite::NAME
 }
 
 /// The right eye's computed share of the first pass `which` takes among the row's

@@ -119,6 +119,27 @@ fn the_pareto_front_keeps_rows_no_other_row_beats_in_both_time_and_error() {
     assert_eq!(pareto, [true, true, false]);
 }
 
+/// The upsampling's share is its pass's, or in a whole frame the composite's (which
+/// upsamples inline); the march's column never takes either.
+#[test]
+fn the_upsampling_share_is_the_upsample_pass_or_the_frames_composite() {
+    let counted = |pass| vrao_ao::RightEyeTiles { pass, computed: 20, total: 100, items: 1200, frame: 3 };
+    for upsampling in [UPSAMPLE_PASS, vrao_render::passes::composite::NAME] {
+        let mut r = row(Technique::Gtao, 10.0, 0.1);
+        r.right_eye.push(counted(upsampling));
+        let record = &records(&[r])[0];
+        assert_eq!(
+            (record.right_eye_tiles_share, record.right_eye_upsample_share),
+            (Some(0.15), Some(0.2)),
+            "{upsampling}"
+        );
+    }
+    let mut only_composite = row(Technique::Gtao, 10.0, 0.1);
+    only_composite.right_eye = vec![counted(vrao_render::passes::composite::NAME)];
+    let record = &records(&[only_composite])[0];
+    assert_eq!((record.right_eye_tiles_share, record.right_eye_upsample_share), (None, Some(0.2)));
+}
+
 #[test]
 fn csv_markdown_and_json_hold_every_row() {
     let rows = [row(Technique::Ssao, 10.0, 0.1), row(Technique::Hbao, 12.0, 0.2)];
