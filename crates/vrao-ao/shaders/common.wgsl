@@ -187,10 +187,17 @@ fn left_eye_point(
     point.uv = in_left.xy;
     point.distance = in_left.z;
     point.pixel = min(vec2<u32>(point.uv * vec2<f32>(full_size)), full_size - vec2<u32>(1u));
-    let d_there = textureLoad(depth, vec2<i32>(point.pixel), 0, 0);
-    let there = -load_view_position(max(d_there, 1e-30), point.pixel, left, full_size, near).z;
-    point.seen = d_there > 0.0 && abs(there - point.distance) < 0.01 * point.distance;
+    point.seen = depth_holds_distance(textureLoad(depth, vec2<i32>(point.pixel), 0, 0), point.distance, near);
     return point;
+}
+
+// Whether stored depth `depth` (reversed-Z, infinite far: its distance is near / depth)
+// holds a surface within 1 % of `distance`, the stereo reuse's test for the same surface:
+// |near / depth − distance| < 0.01 distance, multiplied through by depth (> 0) so that no
+// division is left (the right eye's copies make it at every pixel).
+fn depth_holds_distance(depth: f32, distance: f32, near: f32) -> bool {
+    let there = distance * depth;
+    return depth > 0.0 && abs(near - there) < 0.01 * there;
 }
 
 // The left eye's value (`left_values`, at occlusion resolution, layer 0; `left_geometry`

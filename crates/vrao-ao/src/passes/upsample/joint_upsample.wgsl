@@ -307,11 +307,10 @@ struct QuadInLeftEye {
     block: bool,
 };
 
-// Whether the left eye sees a right-eye point at `pixel` (from `in_other_eye`: uv,
-// distance, on its image) where it holds stored depth `there`.
-fn left_eye_holds(in_left: vec4<f32>, pixel: vec2<u32>, there: f32) -> bool {
-    let distance = -load_view_position(max(there, 1e-30), pixel, frame.eyes[0], frame.size, frame.near).z;
-    return in_left.w > 0.0 && there > 0.0 && abs(distance - in_left.z) < 0.01 * in_left.z;
+// Whether the left eye sees a right-eye point (from `in_other_eye`: uv, distance, on its
+// image) where it holds stored depth `there`.
+fn left_eye_holds(in_left: vec4<f32>, there: f32) -> bool {
+    return in_left.w > 0.0 && depth_holds_distance(there, in_left.z, frame.near);
 }
 
 // `left_eye_holds` with the left depth loaded at the pixel, for a point off any block.
@@ -322,7 +321,7 @@ fn left_eye_holds_alone(in_left: vec4<f32>, pixel: vec2<u32>, depth_layers: text
     if (in_left.w == 0.0) {
         return false;
     }
-    return left_eye_holds(in_left, pixel, textureLoad(depth_layers, vec2<i32>(pixel), 0, 0));
+    return left_eye_holds(in_left, textureLoad(depth_layers, vec2<i32>(pixel), 0, 0));
 }
 
 // Where a smooth surface faces both eyes, the quad's four pixels land on a 2×2 block of
@@ -357,10 +356,10 @@ fn quad_in_left_eye(depth_layers: texture_depth_2d_array, gather: sampler, quad:
         // Gather order: (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
         let there = textureGather(depth_layers, gather, gather_corner(p0), 0);
         q.seen = vec4<bool>(
-            left_eye_holds(in0, q.pixels[0], there.w),
-            left_eye_holds(in1, q.pixels[1], there.z),
-            left_eye_holds(in2, q.pixels[2], there.x),
-            left_eye_holds(in3, q.pixels[3], there.y),
+            left_eye_holds(in0, there.w),
+            left_eye_holds(in1, there.z),
+            left_eye_holds(in2, there.x),
+            left_eye_holds(in3, there.y),
         );
     } else {
         q.seen = vec4<bool>(
