@@ -11,6 +11,7 @@ pub(crate) mod blur;
 pub(crate) mod fetch_only;
 pub(crate) mod gtao;
 pub(crate) mod hbao;
+pub(crate) mod indirect_list;
 pub(crate) mod inputs;
 pub(crate) mod occlusion;
 pub(crate) mod right_eye_list;

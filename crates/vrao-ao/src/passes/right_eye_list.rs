@@ -1,32 +1,20 @@
 //! The right eye's list of work the left eye cannot give it, shared by the passes that
 //! reuse the left eye's results: a first right-eye dispatch copies what it can and
-//! appends the rest (pixels or quads) to a list on the GPU, whose header holds the
-//! workgroup counts of a second, indirect dispatch over just those (64 to a workgroup).
-//! Nothing is read back in a frame; a report reads the last frame's counts. A renderer's
-//! pass that reuses the left eye (its composite) keeps its list in one too.
+//! appends the rest (pixels or quads) to an [`IndirectList`], and a second, indirect
+//! dispatch runs over just those (64 to a workgroup). A report reads the last frame's
+//! counts. A renderer's pass that reuses the left eye (its composite) keeps its list in
+//! one too.
 
+use super::indirect_list::{IndirectList, HEADER_BYTES};
 use super::occlusion::{AO_GEOMETRY, AO_RAW};
 use super::{RecordContext, RightEyeTiles};
 use crate::gpu::kernel::{Bind, Kernel, TILE};
 use crate::gpu::Gpu;
 use crate::graph::Resource;
-use wgpu::util::DeviceExt;
-
-/// Bytes of the list's header: the indirect arguments (x, y, z), then the count (WGSL:
-/// `groups_x: atomic<u32>, groups_y, groups_z, count: atomic<u32>`, then the items).
-const HEADER_BYTES: u64 = 16;
 
 /// One pass's list, kept from frame to frame.
 pub struct RightEyeList {
-    label: &'static str,
-    /// The header, then room for every item of the frame.
-    list: Option<wgpu::Buffer>,
-    /// What each frame's header starts from (no items, y = z = 1) and one item: what
-    /// binds in the list's place for the dispatches that do not use it.
-    header: wgpu::Buffer,
-    /// The header copied out of the list (a buffer may not be both a dispatch's
-    /// read-write binding and its arguments).
-    arguments: wgpu::Buffer,
+    list: IndirectList,
     /// Tiles (8×8 workgroups) of the right eye's image in the last frame that listed
     /// items (0: none did), and that frame's index.
     tiles: u32,
@@ -36,47 +24,19 @@ pub struct RightEyeList {
 impl RightEyeList {
     /// An empty list; `label` names its buffers.
     pub fn new(gpu: &Gpu, label: &'static str) -> Self {
-        let device = &gpu.device;
-        let header = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0]),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        });
-        let arguments = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: HEADER_BYTES,
-            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        RightEyeList { label, list: None, header, arguments, tiles: 0, frame: 0 }
+        RightEyeList { list: IndirectList::new(gpu, label), tiles: 0, frame: 0 }
     }
 
     /// What binds in the list's place before the right eye's dispatches.
     pub fn stand_in(&self) -> wgpu::Buffer {
-        self.header.clone()
+        self.list.stand_in()
     }
 
     /// Starts this frame's list, with room for `items`, over an image of `tiles` tiles;
-    /// returns it (a clone of the one buffer: wgpu buffers are shared handles).
+    /// returns it.
     fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
-        let size = HEADER_BYTES + 4 * u64::from(items.max(1));
-        if self.list.as_ref().is_none_or(|b| b.size() < size) {
-            self.list = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(self.label),
-                size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
         (self.tiles, self.frame) = (tiles, ctx.setup.frame_index);
-        let list = self.list.clone().expect("made above");
-        ctx.encoder.copy_buffer_to_buffer(&self.header, 0, &list, 0, HEADER_BYTES);
-        list
-    }
-
-    /// Copies the list's header (filled by the first dispatch) out for the indirect one.
-    fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder, list: &wgpu::Buffer) {
-        encoder.copy_buffer_to_buffer(list, 0, &self.arguments, 0, HEADER_BYTES);
+        self.list.start(ctx, items)
     }
 
     /// The right eye after the left (occlusion/right_eye.wgsl): `classify` copies what
@@ -84,12 +44,17 @@ impl RightEyeList {
     /// runs over those by an indirect dispatch. Both write layer 1 of the raw occlusion
     /// and its geometry alone and read the left eye's layer 0 of both (bindings 7 and
     /// 8), the list at 9; `after_list` fills the technique's own bindings after it.
+    /// `deferred`: a kernel the listed dispatch hands some of its pixels to through a
+    /// list of its own (started by the caller, bound in `after_list`), run last over
+    /// those by an indirect dispatch with the same bindings (GTAO's marches that cross
+    /// the inner border).
     pub(crate) fn record_right_eye(
         &mut self,
         ctx: &mut RecordContext,
         binds: &[Bind],
         after_list: &[wgpu::BindingResource],
         [classify, listed]: [&Kernel; 2],
+        deferred: Option<(&Kernel, &IndirectList)>,
         (width, height): (u32, u32),
     ) {
         let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
@@ -103,8 +68,12 @@ impl RightEyeList {
         let device = &ctx.gpu.device;
         let visibility = ctx.visibility.bind_group();
         classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
-        self.take_arguments(ctx.encoder, &list);
-        listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, &self.arguments, 0);
+        self.list.take_arguments(ctx.encoder);
+        listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, self.list.arguments(), 0);
+        if let Some((kernel, list)) = deferred {
+            list.take_arguments(ctx.encoder);
+            kernel.dispatch_indirect(device, ctx.encoder, visibility, &resources, list.arguments(), 0);
+        }
     }
 
     /// The right eye after the left, one invocation per quad of 2×2 pixels (the
@@ -128,8 +97,8 @@ impl RightEyeList {
         let device = &ctx.gpu.device;
         let visibility = ctx.visibility.bind_group();
         copy.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
-        self.take_arguments(ctx.encoder, &list);
-        fallback.dispatch_indirect(device, ctx.encoder, visibility, &resources, &self.arguments, 0);
+        self.list.take_arguments(ctx.encoder);
+        fallback.dispatch_indirect(device, ctx.encoder, visibility, &resources, self.list.arguments(), 0);
     }
 
     /// Marks a frame that did not reuse the left eye: nothing to report.
@@ -145,7 +114,7 @@ impl RightEyeList {
         if self.tiles == 0 {
             return None;
         }
-        let bytes = crate::gpu::readback::read_buffer(gpu, self.list.as_ref()?).ok()?;
+        let bytes = crate::gpu::readback::read_buffer(gpu, self.list.buffer()?).ok()?;
         let tiles = self.counts(&bytes, pass)?;
         let first = HEADER_BYTES as usize;
         let listed = bytes.get(first..first + 4 * tiles.items as usize)?;
@@ -158,7 +127,7 @@ impl RightEyeList {
         if self.tiles == 0 {
             return None;
         }
-        self.counts(&crate::gpu::readback::read_buffer(gpu, &self.arguments).ok()?, pass)
+        self.counts(&crate::gpu::readback::read_buffer(gpu, self.list.arguments()).ok()?, pass)
     }
 
     /// The counts in a header read back (its first `HEADER_BYTES`).

@@ -26,8 +26,11 @@
 // eye's layer (occlusion.wgsl `surface_at`, guessing the last sample's distance). The
 // marching eye runs as two dispatches of this file: the band of `gtao.inner_band` columns
 // along its inner border with those lookups compiled in (INNER_BAND = true), and the
-// rest of the image without them, where a march that leaves the image stops (open). The
-// lookups' code, even never taken, made every pixel's march about half as slow again.
+// rest of the image without them. The lookups' code, even never taken, made every
+// pixel's march about half as slow again. A march from the rest of the image that would
+// cross the inner border (a surface so near that the radius spans more than the band) is
+// deferred: listed, and marched after by the band's code over the list (CROSSING), so
+// the band's edge leaves no seam however near the surface.
 // With two views and `stereo_reuse`, the right eye then runs as a classifying dispatch
 // and an indirect one over the pixels it listed (RIGHT_EYE).
 
@@ -62,6 +65,29 @@ override THIN_CARDS: bool = false;
 override SECOND_LAYER: bool = false;
 @group(0) @binding(12) var second_depth_layers: texture_depth_2d_array;
 
+// The deferred marches (module comment): appended by the dispatches without the band's
+// lookups, marched by the one with CROSSING over them (an indirect dispatch, 64 to a
+// workgroup; the same layout as right_eye.wgsl's list).
+override CROSSING: bool = false;
+struct DeferredMarches {
+    groups_x: atomic<u32>,
+    groups_y: u32,
+    groups_z: u32,
+    count: atomic<u32>,
+    // Occlusion pixel p of layer z packed as p.x | p.y << 15 | z << 30.
+    pixels: array<u32>,
+};
+@group(0) @binding(13) var<storage, read_write> deferred: DeferredMarches;
+
+// Lists pixel `id`'s march for the CROSSING dispatch.
+fn defer_march(id: vec3<u32>) {
+    let i = atomicAdd(&deferred.count, 1u);
+    deferred.pixels[i] = id.x | (id.y << 15u) | (id.z << 30u);
+    if (i % 64u == 0u) {
+        atomicAdd(&deferred.groups_x, 1u);
+    }
+}
+
 // GTAO's own parameters (passes/gtao/mod.rs `GtaoUniform`).
 struct GtaoParams {
     // Slices per pixel and depth samples along each half-slice (slices × 2 × steps ≈ N).
@@ -86,6 +112,14 @@ struct GtaoParams {
 // The occlusion pixel of invocation `id` (in workgroup `group`, at `local` within it) in
 // this dispatch's part of the image, or none (x = ao_size.x) past its part's width.
 fn dispatch_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
+    if (CROSSING) {
+        let i = group.x * 64u + local;
+        if (i >= atomicLoad(&deferred.count)) {
+            return vec3<u32>(ao.ao_size.x, 0u, 0u);
+        }
+        let packed = deferred.pixels[i];
+        return vec3<u32>(packed & 0x7fffu, (packed >> 15u) & 0x7fffu, packed >> 30u);
+    }
     if (RIGHT_EYE) {
         return right_eye_pixel(id, group, local);
     }
@@ -386,8 +420,12 @@ fn main(
     // max(march_px, steps) pixels out).
     let reach_px = max(march_px, f32(steps));
     let inner = other_eye_side(r.eye);
-    let near_inner_border = INNER_BAND
-        && ((inner > 0.0 && centre_px.x + reach_px >= size.x) || (inner < 0.0 && centre_px.x - reach_px < 0.0));
+    let crosses = (inner > 0.0 && centre_px.x + reach_px >= size.x) || (inner < 0.0 && centre_px.x - reach_px < 0.0);
+    if (crosses && !INNER_BAND) {
+        defer_march(id);
+        return;
+    }
+    let near_inner_border = INNER_BAND && crosses;
     // The tile is laid over occlusion pixels (at half resolution the full-res pixel has
     // even coordinates only, which would leave 4 of the 16 patterns).
     let rotation_noise = bayer4(stereo_noise_pixel(id.xy, ao.ao_size, r.layer, r.eye, p));

@@ -1,9 +1,11 @@
-//! GTAO with a visibility bitmask (gtao.wgsl) on the shared occlusion layout, in three
+//! GTAO with a visibility bitmask (gtao.wgsl) on the shared occlusion layout, in
 //! pipelines of one shader: the rest of the image, the band along each eye's inner
-//! border whose marches may look into the other eye, and the right eye reusing the left
-//! eye's values where it sees the same point. A scene with alpha-tested materials gets
-//! the same three taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
+//! border whose marches may look into the other eye (and, by an indirect dispatch, the
+//! marches from the rest that would cross that border), and the right eye reusing the
+//! left eye's values where it sees the same point. A scene with alpha-tested materials
+//! gets the same taking samples on them as cards (gtao.wgsl `THIN_CARDS`).
 
+use super::indirect_list::IndirectList;
 use super::inputs::DEPTH_LAYER_2;
 use super::occlusion::{self, technique_decl, OCCLUSION_WGSL, RIGHT_EYE_WGSL};
 use super::right_eye_list::RightEyeList;
@@ -16,10 +18,13 @@ use crate::settings::Technique;
 use bytemuck::{Pod, Zeroable};
 
 /// The shared bindings with the right eye's at 7–10 (occlusion::REUSING_BINDINGS), at 11
-/// GTAO's own parameters and at 12 the second depth layer (unbound with one layer). A
-/// march that gathers light (SSDO) binds more after these ([`March::binds`]).
-pub(crate) const BINDINGS: [Bind; 13] =
-    occlusion::joined(occlusion::REUSING_BINDINGS, [Bind::Own(Slot::Uniform), Bind::Read(DEPTH_LAYER_2)]);
+/// GTAO's own parameters, at 12 the second depth layer (unbound with one layer) and at 13
+/// the list of deferred marches (gtao.wgsl `deferred`). A march that gathers light (SSDO)
+/// binds more after these ([`March::binds`]).
+pub(crate) const BINDINGS: [Bind; 14] = occlusion::joined(
+    occlusion::REUSING_BINDINGS,
+    [Bind::Own(Slot::Uniform), Bind::Read(DEPTH_LAYER_2), Bind::Own(Slot::ReadWriteBuffer)],
+);
 
 /// Whether this frame's march reads the second depth layer: two asked for, a technique
 /// that reads it, and one to be had (a renderer that peels it, a host that gave it).
@@ -94,7 +99,8 @@ pub(crate) fn gtao_slices_steps(samples: u32, two_layers: bool) -> (u32, u32) {
 /// GTAO's inner-border band for occlusion targets `width` pixels wide: a quarter of the
 /// width (whole 8-pixel workgroups). Only marches from this band look past the inner
 /// border into the other eye; one from further in that would cross it (its radius spans
-/// more than a quarter of the image: a surface very near the eye) stops there instead.
+/// more than a quarter of the image: a surface near the eye) is deferred to the band's
+/// pipeline by an indirect dispatch.
 pub(crate) fn gtao_inner_band(width: u32) -> u32 {
     (width / 4).next_multiple_of(8).min(width)
 }
@@ -105,17 +111,23 @@ pub(crate) fn gtao_inner_band(width: u32) -> u32 {
 struct Kernels {
     interior: Kernel,
     inner_band: Kernel,
+    /// The band's march over the marches the rest deferred (an indirect dispatch).
+    crossing: Kernel,
     /// The right eye's copy of what the left eye gives, listing the pixels left to march.
     right_classify: Kernel,
     /// The right eye's march over the listed pixels (an indirect dispatch).
     right_listed: Kernel,
+    /// The band's march over the right eye's listed marches that it deferred.
+    right_crossing: Kernel,
 }
 
 impl Kernels {
     fn new(gpu: &Gpu, march: &March, thin_cards: bool, second_layer: bool) -> Self {
-        let kernel = |entry: &str, band: bool, right: bool| {
+        // A deferred march runs the band's code (`band`) over the list (`crossing`).
+        let kernel = |entry: &str, band: bool, right: bool, crossing: bool| {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
+                ("CROSSING", f64::from(crossing)),
                 ("THIN_CARDS", f64::from(thin_cards)),
                 ("SECOND_LAYER", f64::from(second_layer)),
             ];
@@ -125,10 +137,12 @@ impl Kernels {
             Kernel::in_chain(gpu, march.label, &march.files, entry, march.binds, &constants, chain)
         };
         Kernels {
-            interior: kernel("main", false, false),
-            inner_band: kernel("main", true, false),
-            right_classify: kernel("classify_right_eye", false, true),
-            right_listed: kernel("main", false, true),
+            interior: kernel("main", false, false, false),
+            inner_band: kernel("main", true, false, false),
+            crossing: kernel("main", true, false, true),
+            right_classify: kernel("classify_right_eye", false, true, false),
+            right_listed: kernel("main", false, true, false),
+            right_crossing: kernel("main", true, true, true),
         }
     }
 }
@@ -145,6 +159,9 @@ pub(crate) struct GtaoPass {
     thin_cards: [std::sync::OnceLock<Kernels>; 2],
     params: wgpu::Buffer,
     right_eye: std::sync::Mutex<RightEyeList>,
+    /// The marches deferred to the band's pipeline (gtao.wgsl `deferred`), the left eye's
+    /// (or both eyes' without the reuse) and then the right eye's.
+    deferred: std::sync::Mutex<IndirectList>,
 }
 
 impl GtaoPass {
@@ -178,7 +195,8 @@ impl GtaoPass {
         }
         let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu, "gtao right-eye pixels"));
         let thin_cards = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
-        GtaoPass { march, solid, thin_cards, params, right_eye }
+        let deferred = std::sync::Mutex::new(IndirectList::new(gpu, "gtao deferred marches"));
+        GtaoPass { march, solid, thin_cards, params, right_eye, deferred }
     }
 }
 
@@ -236,35 +254,36 @@ impl Pass for GtaoPass {
             _ => solid(),
         };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        // The left eye (or the only view) marches every pixel, in two parts; with two
-        // views and `stereo_reuse`, the right eye then reuses it, else it marches alike.
-        // Bindings 7 to 9 are unused before the right eye's dispatches: the normals and
-        // the list's header stand in.
+        // The left eye (or the only view) marches every pixel, in two parts and the marches
+        // the first part deferred; with two views and `stereo_reuse`, the right eye then
+        // reuses it, else it marches alike. Bindings 7 to 9 are unused before the right
+        // eye's dispatches: the normals and the list's header stand in.
         let normals = ctx.view(super::inputs::NORMALS);
         let header = self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).stand_in();
-        let stand_ins = [normals.clone(), normals, header.as_entire_binding(), self.params.as_entire_binding()];
-        let resources = ctx.bind(self.march.binds, &stand_ins);
+        let mut deferred = self.deferred.lock().unwrap_or_else(|p| p.into_inner());
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        kernels.interior.dispatch(
-            device,
-            ctx.encoder,
-            ctx.visibility.bind_group(),
-            &resources,
-            (width - band, height, marched_layers),
-        );
-        kernels.inner_band.dispatch(
-            device,
-            ctx.encoder,
-            ctx.visibility.bind_group(),
-            &resources,
-            (band, height, marched_layers),
-        );
+        let deferred_list = deferred.start(ctx, (width - band) * height * marched_layers);
+        let stand_ins = [
+            normals.clone(),
+            normals,
+            header.as_entire_binding(),
+            self.params.as_entire_binding(),
+            deferred_list.as_entire_binding(),
+        ];
+        let resources = ctx.bind(self.march.binds, &stand_ins);
+        let visibility = ctx.visibility.bind_group();
+        kernels.interior.dispatch(device, ctx.encoder, visibility, &resources, (width - band, height, marched_layers));
+        kernels.inner_band.dispatch(device, ctx.encoder, visibility, &resources, (band, height, marched_layers));
+        deferred.take_arguments(ctx.encoder);
+        kernels.crossing.dispatch_indirect(device, ctx.encoder, visibility, &resources, deferred.arguments(), 0);
         if reuse {
             let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-            let kernels = [&kernels.right_classify, &kernels.right_listed];
-            let params = [self.params.as_entire_binding()];
-            right_eye.record_right_eye(ctx, self.march.binds, &params, kernels, (width, height));
+            let deferred_list = deferred.start(ctx, width * height);
+            let own = [self.params.as_entire_binding(), deferred_list.as_entire_binding()];
+            let right_kernels = [&kernels.right_classify, &kernels.right_listed];
+            let then = Some((&kernels.right_crossing, &*deferred));
+            right_eye.record_right_eye(ctx, self.march.binds, &own, right_kernels, then, (width, height));
         } else {
             self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).skip();
         }

@@ -20,8 +20,8 @@ use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::settings::Technique;
 
-/// GTAO's bindings and, at 13, the packed direct light (ssdo.wgsl `direct_layers`).
-const BINDINGS: [Bind; 14] = occlusion::joined(GTAO_BINDINGS, [Bind::Read(DIRECT_LIGHT)]);
+/// GTAO's bindings and, at 14, the packed direct light (ssdo.wgsl `direct_layers`).
+const BINDINGS: [Bind; 15] = occlusion::joined(GTAO_BINDINGS, [Bind::Read(DIRECT_LIGHT)]);
 
 /// What a host's frame gives SSDO beyond depth (the AO engine puts it among the frame's
 /// extensions; vrao's renderer, which always has its direct light, puts none).

@@ -23,7 +23,7 @@
 // Output rgb: irradiance to multiply by albedo/π (the composite's directional mode).
 
 // The packed direct light (common.wgsl `pack_direct`): the bounce's senders.
-@group(0) @binding(13) var direct_layers: texture_2d_array<u32>;
+@group(0) @binding(14) var direct_layers: texture_2d_array<u32>;
 
 // Whether this pipeline gathers the bounce (bounce strength 0 builds the one without).
 override BOUNCE: bool = false;
