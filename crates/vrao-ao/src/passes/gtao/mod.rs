@@ -263,7 +263,9 @@ impl Pass for GtaoPass {
         let mut deferred = self.deferred.lock().unwrap_or_else(|p| p.into_inner());
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        let deferred_list = deferred.start(ctx, (width - band) * height * marched_layers);
+        // Room for every pixel of the marched layers: the left eye's (or both eyes') list
+        // and then the right eye's reuse one buffer.
+        let deferred_list = deferred.start(ctx, width * height * marched_layers);
         let stand_ins = [
             normals.clone(),
             normals,
@@ -279,7 +281,7 @@ impl Pass for GtaoPass {
         kernels.crossing.dispatch_indirect(device, ctx.encoder, visibility, &resources, deferred.arguments(), 0);
         if reuse {
             let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-            let deferred_list = deferred.start(ctx, width * height);
+            let deferred_list = deferred.start(ctx, width * height * marched_layers);
             let own = [self.params.as_entire_binding(), deferred_list.as_entire_binding()];
             let right_kernels = [&kernels.right_classify, &kernels.right_listed];
             let then = Some((&kernels.right_crossing, &*deferred));
