@@ -265,7 +265,8 @@ impl Pass for GtaoPass {
         let marched_layers = if reuse { 1 } else { layers };
         // Room for every pixel of the marched layers: the left eye's (or both eyes') list
         // and then the right eye's reuse one buffer.
-        let deferred_list = deferred.start(ctx, width * height * marched_layers);
+        let room = width * height * marched_layers;
+        let deferred_list = deferred.start(ctx, room);
         let stand_ins = [
             normals.clone(),
             normals,
@@ -281,7 +282,7 @@ impl Pass for GtaoPass {
         kernels.crossing.dispatch_indirect(device, ctx.encoder, visibility, &resources, deferred.arguments(), 0);
         if reuse {
             let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-            let deferred_list = deferred.start(ctx, width * height * marched_layers);
+            let deferred_list = deferred.start(ctx, room);
             let own = [self.params.as_entire_binding(), deferred_list.as_entire_binding()];
             let right_kernels = [&kernels.right_classify, &kernels.right_listed];
             let then = Some((&kernels.right_crossing, &*deferred));

@@ -15,10 +15,10 @@
 // the left eye's layer. A right-eye quad with any pixel the left eye does not see (the
 // outer side, disocclusions: a small share) is listed with the pixels it shaded, and a
 // second, indirect dispatch (FALLBACK) over exactly those quads upsamples their own
-// occlusion and shades the rest. Done
-// in one dispatch, every quad paid for both on lavapipe, which runs an untaken branch
-// anyway (docs/records/2026-11-29/measurements-in-code.md, composite-fallback), and on a GPU every warp
-// holding one such quad would.
+// occlusion and shades the rest. Done in one dispatch, every quad paid for both on
+// lavapipe, which runs an untaken branch anyway
+// (docs/records/2026-11-29/measurements-in-code.md, composite-fallback), and on a GPU
+// every warp holding one such quad would.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> ao: AoParams;
