@@ -138,6 +138,11 @@ pub(crate) struct BenchArgs {
     /// Skip the reference: time only, no error columns.
     #[arg(long)]
     no_reference: bool,
+    /// Also write OUT/images/ROW.png for every scored row: the left eye's AO beside the
+    /// one-layer limit, the two-layer limit and the reference (each traced pixel over its
+    /// stride), to see where the error lies.
+    #[arg(long, conflicts_with = "no_reference")]
+    images: bool,
     /// Directory of cached reference images (default: $XDG_CACHE_HOME/vrao or ~/.cache/vrao).
     #[arg(long)]
     cache: Option<PathBuf>,
@@ -189,6 +194,7 @@ pub(crate) fn run(backend: BackendChoice, args: BenchArgs) -> Result<()> {
                     cache: args.cache.clone().unwrap_or_else(default_cache_dir),
                 }),
                 command: command_line(),
+                images: args.images.then(|| args.out.join("images")),
             };
             run_bench(&scene, &base, &options)?
         }

@@ -11,6 +11,7 @@ use crate::measure::metrics::luminance;
 use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{ReferenceImage, ReferencePixel};
+use crate::measure::side_by_side::{grid_panel, save_panels};
 use crate::measure::stereo_consistency::{stereo_consistency, EyeImages, StereoConsistency, BORDER_PX};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -183,6 +184,29 @@ pub struct Limits {
     pub two: ScreenLimit,
 }
 
+/// The file a row's comparison image takes (`vrao bench --images`): its case, as
+/// `gtao-n24-r0.68-full-layers2.png` with `-mask`, `-peel`, `-temporal` and `-fov-LEVEL`
+/// where they apply.
+pub fn comparison_image_name(case: &BenchCase) -> String {
+    let mut name = format!(
+        "{}-n{}-r{}-{}-layers{}",
+        case.technique.name(),
+        case.samples,
+        significant(case.radius as f64, 3),
+        if case.half_res { "half" } else { "full" },
+        case.layers
+    );
+    for (on, part) in [(case.mask, "-mask"), (case.depth_peeling, "-peel"), (case.temporal, "-temporal")] {
+        if on {
+            name.push_str(part);
+        }
+    }
+    if case.foveation != Foveation::Off {
+        name.push_str(&format!("-fov-{}", case.foveation.name()));
+    }
+    name + ".png"
+}
+
 /// The second depth layer of `case`'s frame as two layers peel it (the case's scene,
 /// pose, size, mask and separation; GTAO with `layers` 2 on a renderer of its own, so
 /// that the case's own renderer, its history included, is not touched), or `None` when
@@ -337,6 +361,32 @@ impl CaseRun {
     fn pixels_per_degree(&self) -> f64 {
         let width = self.settings.profile.width;
         self.eyes.eyes.iter().map(|e| pixels_per_degree(&e.fov, width)).sum::<f64>() / self.eyes.eyes.len() as f64
+    }
+
+    /// Writes the left eye's final AO beside the one-layer limit, the two-layer limit and
+    /// the reference (each traced cell over its stride's pixels) into `folder`, as
+    /// [`comparison_image_name`]: where the row's error lies, to look at.
+    fn write_comparison(&self, folder: &std::path::Path, reference: &ReferenceImage, limits: &Limits) -> Result<()> {
+        let (w, h) = (self.settings.profile.width as usize, self.settings.profile.height as usize);
+        let estimate = self.renderer.read_f32(self.output)?.swap_remove(0).into_iter().skip(3).step_by(4).collect();
+        let grid = |cell: &dyn Fn(u32, u32) -> (bool, f32)| {
+            grid_panel(w, h, reference.stride, reference.grid_size(), |i, j| match cell(i, j) {
+                (true, ao) => ao,
+                (false, _) => 1.0,
+            })
+        };
+        let panels = [
+            estimate,
+            grid(&|i, j| (limits.one.get(0, i, j).hit, limits.one.get(0, i, j).ao)),
+            grid(&|i, j| (limits.two.get(0, i, j).hit, limits.two.get(0, i, j).ao)),
+            grid(&|i, j| (reference.get(0, i, j).hit, reference.get(0, i, j).ao)),
+        ];
+        std::fs::create_dir_all(folder)
+            .map_err(|e| Error::Output { path: folder.into(), message: format!("cannot create this folder: {e}") })?;
+        let path = folder.join(comparison_image_name(&self.case));
+        save_panels(&path, w, h, &panels)?;
+        log::info!("wrote {}", path.display());
+        Ok(())
     }
 
     /// The row: medians of the measured frames, the last frame's stereo consistency, and
@@ -645,7 +695,9 @@ pub fn estimate_seconds(
 /// case, and scores every row of that radius.
 /// `how.interleave` cases at a time are measured round-robin, one frame each per round, so
 /// that a slow drift of the machine (other load, clocks, heat) falls on all of them alike
-/// and their ratios stay fair; 1 measures each case on its own, in a row.
+/// and their ratios stay fair; 1 measures each case on its own, in a row. With `images`,
+/// each scored row's comparison image is written there ([`CaseRun::write_comparison`]).
+#[allow(clippy::too_many_arguments)]
 pub fn sweep(
     gpu: &Arc<Gpu>,
     scene: &Scene,
@@ -653,6 +705,7 @@ pub fn sweep(
     cases: &[BenchCase],
     how: Measurement,
     references: &[(f32, ReferenceImage)],
+    images: Option<&std::path::Path>,
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::with_capacity(cases.len());
@@ -683,6 +736,9 @@ pub fn sweep(
                 }
             }
             let limit = limits.iter().find(|(r, _)| *r == run.case.radius).map(|(_, l)| l);
+            if let (Some(folder), Some(reference), Some(limit)) = (images, reference, limit) {
+                run.write_comparison(folder, reference, limit)?;
+            }
             let row = run.finish(reference, limit)?;
             progress(rows.len() + 1, cases.len(), &row);
             rows.push(row);

@@ -14,6 +14,7 @@ pub mod peer;
 pub mod plot;
 pub mod reference;
 pub mod reprojection;
+pub mod side_by_side;
 pub mod stereo_consistency;
 pub mod table;
 pub mod temporal;

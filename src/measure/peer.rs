@@ -22,6 +22,7 @@ use crate::measure::bench::{
 use crate::measure::plot::{Point, ScatterPlot, Series};
 use crate::measure::reference::screen_limit::{screen_space_limit, EyeBuffers, LimitSettings, ScreenLimit};
 use crate::measure::reference::{trace_cached, ProgressBar, ReferenceImage, ReferenceSettings};
+use crate::measure::side_by_side::{grid_panel, save_panels};
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -242,7 +243,7 @@ pub fn run_peer(scene: &Scene, base: &Settings, options: &PeerOptions) -> Result
                 peer_rounds.push(result);
             } else if !side && !cases.is_empty() {
                 log::info!("peer: round {} of {}: vrao, {} cases", round + 1, options.rounds, cases.len());
-                vrao_rounds.push(sweep(&gpu, scene, base, &cases, how, &references, |done, total, row| {
+                vrao_rounds.push(sweep(&gpu, scene, base, &cases, how, &references, None, |done, total, row| {
                     log::info!(
                         "[{done}/{total}] vrao {} {:.3} ms/eye",
                         setting_name(&row.case),
@@ -624,35 +625,15 @@ fn write_side_by_side(
     let (w, h) = (run.width as usize, run.height as usize);
     let Some(last) = peer_rounds.last() else { return Ok(()) };
     let bevy = options.presets.iter().position(|p| p == "high").unwrap_or(options.presets.len() - 1);
-    let panels: [Vec<f32>; 3] = [last[bevy].1[0].1.clone(), vrao_default[0].clone(), {
-        let (gw, gh) = reference.grid_size();
-        let mut image = vec![1.0f32; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let (i, j) = (
-                    (x as u32 / reference.stride.max(1)).min(gw - 1),
-                    (y as u32 / reference.stride.max(1)).min(gh - 1),
-                );
-                let p = reference.get(0, i, j);
-                image[y * w + x] = if p.hit { p.ao } else { 1.0 };
-            }
+    let traced = grid_panel(w, h, reference.stride, reference.grid_size(), |i, j| {
+        let p = reference.get(0, i, j);
+        if p.hit {
+            p.ao
+        } else {
+            1.0
         }
-        image
-    }];
-    let mut pixels = vec![0u8; 3 * w * h];
-    for (k, panel) in panels.iter().enumerate() {
-        for y in 0..h {
-            for x in 0..w {
-                let v = panel.get(y * w + x).copied().unwrap_or(1.0);
-                pixels[y * 3 * w + k * w + x] = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-            }
-        }
-    }
-    let path = out.join("side_by_side_left.png");
-    image::GrayImage::from_raw((3 * w) as u32, h as u32, pixels)
-        .expect("3w × h pixels")
-        .save_with_format(&path, image::ImageFormat::Png)
-        .map_err(|e| Error::Output { path, message: e.to_string() })
+    });
+    save_panels(&out.join("side_by_side_left.png"), w, h, &[last[bevy].1[0].1.clone(), vrao_default[0].clone(), traced])
 }
 
 /// The row every ratio is taken against: Bevy's High, else its first preset, else the

@@ -330,3 +330,73 @@ fn sibenik_throughput() {
     bar.finish();
     eprintln!("{} ({:?}, r = {})", bar.summary(), image.stats, s.radius);
 }
+
+#[test]
+fn bench_images_show_each_row_beside_its_limits_and_the_reference() {
+    let dir = temp_dir("images");
+    let (out_dir, cache) = (dir.join("out"), dir.join("cache"));
+    let (w, h) = (48u32, 54u32);
+    let args = |extra: &[&str]| {
+        let mut args: Vec<String> = [
+            "bench",
+            "--scene",
+            "builtin:crease",
+            "--techniques",
+            "gtao",
+            "--samples",
+            "12",
+            "--radii",
+            "0.5",
+            "--resolution",
+            "full",
+            "--mask",
+            "off",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--width",
+            "48",
+            "--height",
+            "54",
+            "--stride",
+            "2",
+            "--rays",
+            "64",
+            "--images",
+        ]
+        .map(String::from)
+        .to_vec();
+        args.extend(["--cache", cache.to_str().unwrap(), "--out", out_dir.to_str().unwrap()].map(String::from));
+        args.extend(extra.iter().map(|s| s.to_string()));
+        args
+    };
+    let refused = vrao(&args(&["--no-reference"]).iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(refused.status.code(), Some(2), "--images without the reference: {}", text(&refused));
+    let out = vrao(&args(&[]).iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", text(&out));
+    let image = image::open(out_dir.join("images/gtao-n12-r0.5-full-layers1.png")).unwrap().to_luma8();
+    assert_eq!((image.width(), image.height()), (4 * w, h));
+    let panel = |k: u32| -> Vec<f64> {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| f64::from(image.get_pixel(k * w + x, y)[0]) / 255.0)
+            .collect()
+    };
+    // The row's AO, the one-layer limit, the two-layer limit and the reference. The
+    // crease has nothing behind its first layer, so its two limits are one image.
+    let (estimate, one, two, reference) = (panel(0), panel(1), panel(2), panel(3));
+    assert_eq!(one, two);
+    // Each traced pixel stands for its 2×2 block.
+    for y in (0..h as usize).step_by(2) {
+        for x in (0..w as usize).step_by(2) {
+            let v = reference[y * w as usize + x];
+            assert_eq!([reference[y * w as usize + x + 1], reference[(y + 1) * w as usize + x]], [v, v], "({x}, {y})");
+        }
+    }
+    // The crease darkens its corner, and the estimate is that frame's AO, not a copy.
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    assert!(reference.iter().any(|&v| v < 0.8) && estimate.iter().any(|&v| v < 0.8));
+    assert!((mean(&estimate) - mean(&reference)).abs() < 0.05, "{} vs {}", mean(&estimate), mean(&reference));
+    assert_ne!(estimate, reference);
+}

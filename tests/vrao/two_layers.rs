@@ -11,9 +11,10 @@ use crate::common;
 use glam::{DVec3, Vec3};
 use vrao::measure::bench::error_figures;
 use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
-use vrao_ao::plug::{DEPTH_LAYER_2, FINAL_AO};
+use vrao_ao::plug::{DEPTH, DEPTH_LAYER_2, FINAL_AO};
 use vrao_ao::{AoSettings, Technique};
 use vrao_render::passes::tonemap::COLOR;
+use vrao_render::scene::Material;
 use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
 
 const SIZE: (u32, u32) = (96, 108);
@@ -155,4 +156,50 @@ fn the_peel_runs_only_where_the_ao_reads_it_and_explain_says_why() {
         assert!(!p.runs("depth-peel"), "{name}: {p}");
         assert!(reason(&p).unwrap().contains("convex"), "{name}: {p}");
     }
+}
+
+#[test]
+fn a_single_sided_material_peels_only_its_back_faces() {
+    // A glTF material is single-sided unless marked double-sided, and its winding says
+    // which face is the back. Everything here uses such a material. Both objects stand
+    // 30 cm in front of the wall: a closed 2 cm board, whose second layer must be its own back face (not
+    // the wall, which would make the board a block standing on the wall), and a flat
+    // sheet, which has no back: behind it lies only the wall's front face, and the gap to
+    // it is air, so nothing is peeled there (the one-layer rule applies).
+    let mut scene = common::bare_scene(vec![
+        common::square("wall", DVec3::new(0.0, 0.0, WALL_Z), 10.0, 1),
+        common::cuboid("board", DVec3::new(-0.4, 0.0, WALL_Z + 0.31), Vec3::new(0.5, 0.5, 0.02), 1),
+        common::square("sheet", DVec3::new(0.4, 0.0, WALL_Z + 0.32), 0.5, 1),
+    ]);
+    let single_sided = Material { double_sided: false, ..Material::plain("single-sided", Vec3::splat(0.5)) };
+    scene.materials.push(single_sided);
+    let s = settings(2);
+    let (gpu, _one_at_a_time) = common::gpu();
+    let mut renderer = Renderer::new(gpu, &scene, &s).unwrap();
+    let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
+    let report = renderer.render(&eyes.eyes, &[FINAL_AO]).unwrap();
+    assert!(report.plan.runs("depth-peel"), "{}", report.plan);
+    let first = common::world_positions(&renderer.read_f32(DEPTH).unwrap(), &eyes.eyes, SIZE.0, SIZE.1, s.near);
+    let second =
+        common::world_positions(&renderer.read_f32(DEPTH_LAYER_2).unwrap(), &eyes.eyes, SIZE.0, SIZE.1, s.near);
+    let (mut board, mut sheet) = (Vec::new(), Vec::new());
+    for (first, second) in first.iter().zip(&second) {
+        for (p, behind) in first.iter().zip(second) {
+            // The objects' centres only: clear of their edges, where a pixel's centre may
+            // see past them.
+            let Some(p) = p.filter(|p| p.y.abs() < 0.15 && (p.x.abs() - 0.4).abs() < 0.15) else { continue };
+            if p.x < 0.0 && (p.z - (WALL_Z + 0.32)).abs() < 0.005 {
+                board.push(behind.map(|b| b.z));
+            } else if p.x > 0.0 && (p.z - (WALL_Z + 0.32)).abs() < 0.005 {
+                sheet.push(behind.map(|b| b.z));
+            }
+        }
+    }
+    assert!(board.len() > 20 && sheet.len() > 20, "board {} and sheet {} pixels", board.len(), sheet.len());
+    let back = WALL_Z + 0.30;
+    assert!(
+        board.iter().all(|z| z.is_some_and(|z| (z - back).abs() < 0.005)),
+        "behind the board its back face at z = {back}: {board:?}"
+    );
+    assert!(sheet.iter().all(Option::is_none), "nothing peeled behind a single-sided sheet: {sheet:?}");
 }

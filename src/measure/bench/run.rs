@@ -57,6 +57,9 @@ pub struct BenchOptions {
     pub reference: Option<ReferenceOptions>,
     /// The command line that ran the bench, kept in bench.json.
     pub command: String,
+    /// A folder for each scored row's comparison image ([`super::comparison_image_name`]):
+    /// `None` writes none.
+    pub images: Option<PathBuf>,
 }
 
 /// The reference each row is scored against.
@@ -173,9 +176,10 @@ pub fn run_bench(scene: &Scene, base: &Settings, options: &BenchOptions) -> Resu
     };
     log_estimate(&gpu, scene, base, &cases, how)?;
     let started = std::time::Instant::now();
-    let mut rows = sweep(&gpu, scene, base, &cases, how, &references, |done, total, row| {
-        log::info!("{}", progress_line(done, total, row, started.elapsed().as_secs_f64()));
-    })?;
+    let mut rows =
+        sweep(&gpu, scene, base, &cases, how, &references, options.images.as_deref(), |done, total, row| {
+            log::info!("{}", progress_line(done, total, row, started.elapsed().as_secs_f64()));
+        })?;
     rows.extend(rsm_rows(&gpu, scene, base, options, &radii, how, &references)?);
     let file = BenchFile {
         scene: scene.name.clone(),

@@ -39,8 +39,9 @@ pub struct MeshPipeline<'a> {
     /// Whether the fragment stage discards alpha-tested holes (mesh.wgsl's `ALPHA_TEST`
     /// override; the module must include mesh.wgsl and have a fragment stage).
     pub alpha_test: bool,
-    /// Whether back faces (clockwise on screen) are culled: single-sided materials.
-    pub cull: bool,
+    /// The faces culled: back faces (clockwise on screen) for a single-sided material's
+    /// surface; front faces where a pass wants what lies behind (the depth peel).
+    pub cull: Option<wgpu::Face>,
 }
 
 /// What a draw needs of its pipeline: an alpha test, back-face culling, both or neither.
@@ -88,9 +89,10 @@ impl MeshPipelines {
 
 /// A pipeline that draws the scene's meshes, writing depth: two-sided for double-sided
 /// materials (OBJ windings are not trusted: the G-buffer faces normals towards the eye,
-/// depth peeling wants the back faces, and both faces of a surface cast shadows); with
-/// `cull`, a single-sided material's back faces are gone in every pass, shadow maps
-/// included, as Unity's and Bevy's shadow casters follow the material's culling.
+/// depth peeling wants the back faces, and both faces of a surface cast shadows). A
+/// single-sided material's back faces are culled in every pass that draws its surface,
+/// shadow maps included, as Unity's and Bevy's shadow casters follow the material's
+/// culling; the depth peel culls its front faces instead (`peel/mod.rs`).
 pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipeline {
     let (format, compare) = p.depth;
     let alpha_constants = [("ALPHA_TEST", 1.0)];
@@ -107,11 +109,7 @@ pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipe
             compilation_options: Default::default(),
             buffers: &[Some(mesh_vertex_buffer(p.vertex.1))],
         },
-        primitive: wgpu::PrimitiveState {
-            front_face: wgpu::FrontFace::Ccw,
-            cull_mode: p.cull.then_some(wgpu::Face::Back),
-            ..Default::default()
-        },
+        primitive: wgpu::PrimitiveState { front_face: wgpu::FrontFace::Ccw, cull_mode: p.cull, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format,
             depth_write_enabled: Some(true),

@@ -230,7 +230,7 @@ fn pipeline(
             fragment: Some((fragment, &targets)),
             multiview_mask,
             alpha_test: kind.alpha_test,
-            cull: kind.cull,
+            cull: kind.cull.then_some(wgpu::Face::Back),
         },
     )
 }

@@ -78,13 +78,17 @@ impl DepthPeelPass {
                     layout: &layout,
                     module: &module,
                     vertex: ("vs_peel", &MESH_ATTRIBUTES),
-                    // Reversed Z; two-sided where the material is: the back faces are what
-                    // this pass is for (a single-sided surface has none).
+                    // Reversed Z. The back faces are what this pass is for: where a material
+                    // is single-sided its winding says which face is which, and only its
+                    // back faces are peeled (the back of a closed mesh; behind a sheet,
+                    // such as a leaf or a sign, a front face would be the next object and
+                    // the gap to it no part of the sheet). A double-sided material's
+                    // winding is not trusted (OBJ), so both faces are.
                     depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
                     fragment: Some(("fs_peel", &[])),
                     multiview_mask: None,
                     alpha_test: kind.alpha_test,
-                    cull: kind.cull,
+                    cull: kind.cull.then_some(wgpu::Face::Front),
                 },
             )
         });

@@ -1,9 +1,10 @@
 // Depth peeling (Ritschel et al. 2009 §4, Everitt 2001): the second depth layer of each eye,
 // the nearest surface lying behind the G-buffer's depth (the first layer). Depth only, one
 // render pass per eye layer; a fragment not farther than the first layer by PEEL_GAP is
-// discarded, so the depth test keeps the nearest of the rest. On closed geometry the
-// second layer is the back face of the object the first layer sees: SSDO then counts a
-// sample as an occluder only between the two (inside that object).
+// discarded, so the depth test keeps the nearest of the rest (of a single-sided material,
+// the nearest back face: peel/mod.rs). On closed geometry the second layer is the back
+// face of the object the first layer sees: SSDO and GTAO then count a sample as an
+// occluder only between the two (inside that object).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 

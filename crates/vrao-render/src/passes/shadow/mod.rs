@@ -376,7 +376,7 @@ fn pipeline(
             fragment,
             multiview_mask: None,
             alpha_test,
-            cull: kind.cull,
+            cull: kind.cull.then_some(wgpu::Face::Back),
         },
     )
 }
