@@ -54,6 +54,13 @@
 //! would step over it. Where the second layer has no surface (nothing behind, or the sky)
 //! the thickness guess and the point test apply exactly as in the one-layer limit, so
 //! the two limits differ only at pixels with a second surface.
+//!
+//! *Cards*: an alpha-tested surface (a leaf, a grille, a fence; the G-buffer marks it in
+//! its normal's w, as GTAO reads it) is a sheet with no inside, in both limits: a step
+//! counts as blocked there only where the ray's segment from the previous step crosses
+//! the card's plane (through its point at that pixel, with its G-buffer normal). Neither
+//! a thickness nor the span to a second layer (the floor under a grille) lies behind a
+//! card.
 
 use super::shading::{concentric_disk, orthonormal_basis, pixel_seed, stratified_points, Rng};
 use super::{grid_size, pixel_of, ReferenceImage};
@@ -132,7 +139,8 @@ impl LimitSettings {
 pub struct EyeBuffers<'a> {
     /// Reversed-Z depth, one value a pixel (0 on the sky).
     pub depth: &'a [f32],
-    /// View-space normals, four floats a pixel (w unused).
+    /// View-space normals, four floats a pixel; w > 0.5 marks a card (an alpha-tested
+    /// surface: module docs), as the G-buffer writes it.
     pub normals: &'a [f32],
     /// The eye's field of view (to turn pixels into view rays).
     pub fov: Fov,
@@ -257,6 +265,16 @@ impl<'a> Marcher<'a> {
         (d.is_finite() && d > 0.0 && distance > first).then_some(distance)
     }
 
+    /// Where the visible surface at a pixel with depth `d` is a card (the G-buffer
+    /// normal's w), its plane there: a point on it and its normal (`None` on solid
+    /// surfaces, and on a card whose normal is no direction).
+    fn card_plane(&self, x: u32, y: u32, d: f64) -> Option<(DVec3, DVec3)> {
+        let k = (y as usize * self.size.0 as usize + x as usize) * 4;
+        let n = &self.eye.normals[k..k + 4];
+        let normal = DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).try_normalize()?;
+        (n[3] > 0.5).then(|| (self.position(x, y, d), normal))
+    }
+
     /// The view-space surface point at the centre of pixel (x, y) with depth `d`.
     fn position(&self, x: u32, y: u32, d: f64) -> DVec3 {
         let uv = [(x as f64 + 0.5) / self.size.0 as f64, (y as f64 + 0.5) / self.size.1 as f64];
@@ -307,11 +325,11 @@ impl<'a> Marcher<'a> {
             let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
             let dir = (t * dx + b * dy + n * dz).normalize();
             let jitter = rng.next_f64();
-            // The distance of the ray's previous step (the receiver's before the first).
-            let mut previous_distance = -p.z;
+            // The ray's previous step (the receiver before the first).
+            let mut previous = p;
             for step in 0..s.steps {
                 let q = p + dir * (s.radius * (step as f64 + jitter) / s.steps as f64);
-                let from = std::mem::replace(&mut previous_distance, -q.z);
+                let from = std::mem::replace(&mut previous, q);
                 let Some((qx, qy)) = self.project(q) else {
                     break; // off the image (or in front of the near plane): open
                 };
@@ -319,13 +337,20 @@ impl<'a> Marcher<'a> {
                     continue; // the sky: nothing in front of Q
                 };
                 let first = s.near / surface_depth;
-                let inside = match self.second_distance(qx, qy, first) {
-                    // The segment from the previous step to Q overlaps the span between
-                    // the layers (module docs: a span may be thinner than a step).
-                    Some(back) => from.min(-q.z) < back && from.max(-q.z) > first,
-                    None => {
-                        let behind = -q.z - first;
-                        behind > 0.0 && behind < s.thickness
+                let (near_end, far_end) = ((-from.z).min(-q.z), (-from.z).max(-q.z));
+                let inside = if let Some((on_card, normal)) = self.card_plane(qx, qy, surface_depth) {
+                    // A card has no inside: the segment from the previous step to Q
+                    // crosses its plane (module docs).
+                    (from - on_card).dot(normal) * (q - on_card).dot(normal) <= 0.0
+                } else {
+                    match self.second_distance(qx, qy, first) {
+                        // The segment overlaps the span between the layers (module
+                        // docs: a span may be thinner than a step).
+                        Some(back) => near_end < back && far_end > first,
+                        None => {
+                            let behind = -q.z - first;
+                            behind > 0.0 && behind < s.thickness
+                        }
                     }
                 };
                 if !inside {
@@ -603,6 +628,55 @@ mod tests {
         assert!(two_error < 0.03, "two layers: mean |limit − truth| {two_error}");
         assert!(one_bias < -0.05, "one layer should over-occlude under the slab: bias {one_bias}");
         assert!(one_error > 2.0 * two_error, "one layer {one_error} against two {two_error}");
+    }
+
+    #[test]
+    fn a_card_blocks_only_the_rays_that_cross_it_with_one_layer_or_two() {
+        // The plate of the thin-slab scenes as a card (alpha-tested, no thickness: a
+        // grille's plate), 0.5 m over the floor. One layer would take r / 4 behind it as
+        // solid, two layers the whole span down to the floor (the peel's next surface);
+        // marked as a card in the normals' w, only the rays crossing it are blocked.
+        let (floor, plate) = floor_and_plate_top();
+        let scene = [floor, plate];
+        let (size, stride, radius) = ((96, 96), 2, 1.0);
+        let settings = LimitSettings { rays_per_pixel: 256, steps: 24, ..LimitSettings::new(radius, stride, NEAR) };
+        let (depth, solid_normals) = rasterise(&scene, size);
+        let second = second_layer(&scene, size, 1e-3);
+        let mut card_normals = solid_normals.clone();
+        for (n, &d) in card_normals.chunks_exact_mut(4).zip(&depth) {
+            n[3] = if d > 0.0 && (NEAR / d as f64 - 2.5).abs() < 1e-3 { 1.0 } else { 0.0 };
+        }
+        assert!(card_normals.chunks_exact(4).any(|n| n[3] == 1.0) && second.iter().any(|&d| d > 0.0));
+        let marches = [
+            (&solid_normals, None),
+            (&solid_normals, Some(&second[..])),
+            (&card_normals, None),
+            (&card_normals, Some(&second[..])),
+        ]
+        .map(|(normals, second)| {
+            let eye = EyeBuffers { depth: &depth, normals, fov: fov(), direct: None, second };
+            screen_space_limit(&[eye], size, &settings).unwrap()
+        });
+        let (gw, gh) = marches[0].grid_size();
+        let (mut n, mut bias) = (0, [0.0; 4]);
+        for j in 0..gh {
+            for i in 0..gw {
+                let p = position(&depth, size, stride, i, j);
+                if !beside_the_plate(p) {
+                    continue;
+                }
+                let truth = visibility_by_ray_casting(p, DVec3::Z, radius, false, 400, |o, d| first_hit(&scene, o, d));
+                n += 1;
+                for (b, limit) in bias.iter_mut().zip(&marches) {
+                    *b += limit.get(0, i, j).ao as f64 - truth;
+                }
+            }
+        }
+        assert!(n > 10, "{n} receivers");
+        let [solid_one, solid_two, card_one, card_two] = bias.map(|b| b / n as f64);
+        println!("beside a card 0.5 m up, limit − truth: as solid {solid_one:+.3} (one layer), {solid_two:+.3} (two); as a card {card_one:+.3}, {card_two:+.3}");
+        assert!(solid_one < -0.02 && solid_two < -0.1, "as solid, the plate over-occludes: {solid_one}, {solid_two}");
+        assert!(card_one.abs() < 0.03 && card_two.abs() < 0.03, "as a card: bias {card_one}, {card_two}");
     }
 
     #[test]
