@@ -298,6 +298,27 @@ impl<'a> Marcher<'a> {
         Some((x, y))
     }
 
+    /// Whether the step from `from` to `q` counts as inside what the depth buffer shows
+    /// at Q's pixel (`pixel`, depth `surface_depth`): crossing a card's plane, overlapping
+    /// the span to the second layer, or within the thickness behind the surface (module
+    /// docs).
+    fn inside(&self, from: DVec3, q: DVec3, (qx, qy): (u32, u32), surface_depth: f64) -> bool {
+        let first = self.settings.near / surface_depth;
+        if let Some((on_card, normal)) = self.card_plane(qx, qy, surface_depth) {
+            // A card has no inside: the segment from the previous step to Q crosses its plane.
+            return (from - on_card).dot(normal) * (q - on_card).dot(normal) <= 0.0;
+        }
+        match self.second_distance(qx, qy, first) {
+            // The segment overlaps the span between the layers (a span may be thinner
+            // than a step).
+            Some(back) => (-from.z).min(-q.z) < back && (-from.z).max(-q.z) > first,
+            None => {
+                let behind = -q.z - first;
+                behind > 0.0 && behind < self.settings.thickness
+            }
+        }
+    }
+
     fn pixel(&self, layer: u32, x: u32, y: u32, points: &mut Vec<(f64, f64)>) -> LimitPixel {
         let Some(d) = self.depth(x, y) else {
             return LimitPixel { hit: false, ao: 1.0, std_error: 0.0, bounce: [0.0; 3] };
@@ -336,24 +357,7 @@ impl<'a> Marcher<'a> {
                 let Some(surface_depth) = self.depth(qx, qy) else {
                     continue; // the sky: nothing in front of Q
                 };
-                let first = s.near / surface_depth;
-                let (near_end, far_end) = ((-from.z).min(-q.z), (-from.z).max(-q.z));
-                let inside = if let Some((on_card, normal)) = self.card_plane(qx, qy, surface_depth) {
-                    // A card has no inside: the segment from the previous step to Q
-                    // crosses its plane (module docs).
-                    (from - on_card).dot(normal) * (q - on_card).dot(normal) <= 0.0
-                } else {
-                    match self.second_distance(qx, qy, first) {
-                        // The segment overlaps the span between the layers (module
-                        // docs: a span may be thinner than a step).
-                        Some(back) => near_end < back && far_end > first,
-                        None => {
-                            let behind = -q.z - first;
-                            behind > 0.0 && behind < s.thickness
-                        }
-                    }
-                };
-                if !inside {
+                if !self.inside(from, q, (qx, qy), surface_depth) {
                     continue;
                 }
                 let surface = self.position(qx, qy, surface_depth);
