@@ -141,7 +141,7 @@ pub(crate) struct BenchArgs {
     /// Also write OUT/images/ROW.png for every scored row: the left eye's AO beside the
     /// one-layer limit, the two-layer limit and the reference (each traced pixel over its
     /// stride), to see where the error lies.
-    #[arg(long, conflicts_with = "no_reference")]
+    #[arg(long, conflicts_with_all = ["no_reference", "replot"])]
     images: bool,
     /// Directory of cached reference images (default: $XDG_CACHE_HOME/vrao or ~/.cache/vrao).
     #[arg(long)]

@@ -373,6 +373,8 @@ fn bench_images_show_each_row_beside_its_limits_and_the_reference() {
     };
     let refused = vrao(&args(&["--no-reference"]).iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(refused.status.code(), Some(2), "--images without the reference: {}", text(&refused));
+    let replot = vrao(&["bench", "--images", "--replot", "bench.json"]);
+    assert_eq!(replot.status.code(), Some(2), "--images with nothing measured: {}", text(&replot));
     let out = vrao(&args(&[]).iter().map(String::as_str).collect::<Vec<_>>());
     assert!(out.status.success(), "{}", text(&out));
     let image = image::open(out_dir.join("images/gtao-n12-r0.5-full-layers1.png")).unwrap().to_luma8();
