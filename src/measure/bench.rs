@@ -696,7 +696,7 @@ pub fn estimate_seconds(
 /// `how.interleave` cases at a time are measured round-robin, one frame each per round, so
 /// that a slow drift of the machine (other load, clocks, heat) falls on all of them alike
 /// and their ratios stay fair; 1 measures each case on its own, in a row. With `images`,
-/// each scored row's comparison image is written there ([`CaseRun::write_comparison`]).
+/// each scored row's comparison image is written there, named by [`comparison_image_name`].
 #[allow(clippy::too_many_arguments)]
 pub fn sweep(
     gpu: &Arc<Gpu>,

@@ -63,6 +63,8 @@ override THIN_CARDS: bool = false;
 // (`add_sample`), the thickness only where it holds none. Off, no pixel pays the fetch
 // and the march is today's to the bit.
 override SECOND_LAYER: bool = false;
+override FOOTPRINT: bool = false;
+override FOOTPRINT_SCALE: f32 = 1.0;
 @group(0) @binding(12) var second_depth_layers: texture_depth_2d_array;
 
 // The deferred marches (module comment): appended by the dispatches without the band's
@@ -270,6 +272,7 @@ fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
 // rays (any length) that bound the sample's share of the march, its stratum.
 struct Card {
     on_card: bool,
+    footprint: bool,
     normal: vec3<f32>,
     ray_a: vec3<f32>,
     ray_b: vec3<f32>,
@@ -351,6 +354,23 @@ fn add_sample(
     let u_b = select(u_b_raw, u_v, u_b_raw < 0.0);
     var lo = min(u_a, u_b);
     var hi = max(u_a, u_b);
+    if (FOOTPRINT && card.footprint) {
+        let plane = dot(surface.xyz, card.normal);
+        let a = card.ray_a * (plane / dot(card.ray_a, card.normal)) - p;
+        let b = card.ray_b * (plane / dot(card.ray_b, card.normal)) - p;
+        if (usable_card_end(a, p, limits.radius2)) {
+            let raw = sector_coordinate(slice, a, side);
+            let ua = select(raw, u_v, raw < 0.0);
+            lo = min(lo, ua);
+            hi = max(hi, ua);
+        }
+        if (usable_card_end(b, p, limits.radius2)) {
+            let raw = sector_coordinate(slice, b, side);
+            let ub = select(raw, u_v, raw < 0.0);
+            lo = min(lo, ub);
+            hi = max(hi, ub);
+        }
+    }
     if (on_card) {
         (*march).previous_u = -1.0;
         if (u_a_raw >= 0.0 || u_b_raw >= 0.0) {
@@ -495,13 +515,15 @@ fn main(
                 let surface = load_view_position(d, pixel, r.eye, frame.size, frame.near);
                 var card: Card;
                 card.on_card = false;
+                card.footprint = false;
                 // Only a sample within r and above the tangent plane can block: the
                 // others skip the normal's fetch.
                 let to_sample = surface - p;
-                if (THIN_CARDS && d > 0.0 && dot(to_sample, to_sample) < limits.radius2 && dot(to_sample, r.normal) > 0.0) {
+                if ((THIN_CARDS || FOOTPRINT) && d > 0.0 && dot(to_sample, to_sample) < limits.radius2 && dot(to_sample, r.normal) > 0.0) {
                     let n = textureLoad(normal_layers, vec2<i32>(pixel), i32(r.layer), 0);
-                    card.on_card = n.w > 0.5;
-                    if (card.on_card) {
+                    card.on_card = THIN_CARDS && n.w > 0.5;
+                    card.footprint = FOOTPRINT && !card.on_card;
+                    if (card.on_card || card.footprint) {
                         card.normal = n.xyz;
                         // The stratum's ends: where the step would lie with jitter 0 and 1,
                         // widened to a pixel about its middle where it is narrower (steps
@@ -510,8 +532,12 @@ fn main(
                         let first = step_offset_px(i, steps, 0.0, march_px);
                         let last = step_offset_px(i, steps, 1.0, march_px);
                         let widen = 0.5 * max(1.0 - (last - first), 0.0);
-                        let qa = centre_px + sign * omega * (first - widen);
-                        let qb = centre_px + sign * omega * (last + widen);
+                        var qa = centre_px + sign * omega * (first - widen);
+                        var qb = centre_px + sign * omega * (last + widen);
+                        if (card.footprint) {
+                            qa = mix(q, qa, FOOTPRINT_SCALE);
+                            qb = mix(q, qb, FOOTPRINT_SCALE);
+                        }
                         card.ray_a = view_position_from_distance(qa / size, 1.0, r.eye.tangents);
                         card.ray_b = view_position_from_distance(qb / size, 1.0, r.eye.tangents);
                     }
@@ -539,6 +565,7 @@ fn main(
                 // The other eye's samples count as solid: only its depth is looked up.
                 var solid: Card;
                 solid.on_card = false;
+                solid.footprint = false;
                 add_sample(&march, slice, sign, p, surface_at(q, r.layer, r.eye, march.previous_distance), solid, limits);
             }
         }

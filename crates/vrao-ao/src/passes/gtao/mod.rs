@@ -130,6 +130,8 @@ impl Kernels {
                 ("CROSSING", f64::from(crossing)),
                 ("THIN_CARDS", f64::from(thin_cards)),
                 ("SECOND_LAYER", f64::from(second_layer)),
+                ("FOOTPRINT", if std::env::var_os("VRAO_FOOTPRINT").is_some() { 1.0 } else { 0.0 }),
+                ("FOOTPRINT_SCALE", std::env::var("VRAO_FP_SCALE").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0)),
             ];
             constants.extend_from_slice(&occlusion::right_eye_constants(right));
             constants.extend_from_slice(&march.constants);
