@@ -124,6 +124,10 @@ pub(crate) struct GtaoArgs {
     /// radius (thin objects stop occluding behind themselves).
     #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().thickness)]
     thickness: f32,
+    /// GTAO: the share of its stratum a solid depth sample blocks on its own surface's
+    /// plane, 0..=1 (0: its point alone; few samples then step over thin occluders).
+    #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().footprint)]
+    footprint: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
     /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
     #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().step_power)]
@@ -149,6 +153,7 @@ impl GtaoArgs {
     pub(crate) fn settings(&self) -> GtaoSettings {
         GtaoSettings {
             thickness: self.thickness,
+            footprint: self.footprint,
             step_power: self.step_power,
             connect: self.connect,
             ..GtaoSettings::default()

@@ -12,7 +12,7 @@ use glam::{DVec3, Vec3};
 use vrao::measure::bench::error_figures;
 use vrao::measure::reference::{trace, ReferenceImage, ReferenceSettings};
 use vrao_ao::plug::{DEPTH, DEPTH_LAYER_2, FINAL_AO};
-use vrao_ao::{AoSettings, Technique};
+use vrao_ao::{AoSettings, GtaoSettings, Technique};
 use vrao_render::passes::tonemap::COLOR;
 use vrao_render::scene::Material;
 use vrao_render::{HeadsetProfile, Renderer, Scene, Settings};
@@ -82,17 +82,23 @@ fn beside_board(ao: &[Vec<f32>], reference: &ReferenceImage, reach: i64) -> (f64
 #[test]
 fn a_second_layer_frees_the_wall_behind_a_thin_board() {
     // The board's back is 0.3 m in front of the wall: within the radius, so the wall
-    // beside it is partly occluded, but one layer's slab (0.75 r = 0.375 m behind the
-    // board's front) reaches the wall and makes the board a block standing on it. The
-    // second layer is the board's back face: the 30 cm between board and wall stay open.
+    // beside it is partly occluded. One layer's slab, here as deep as the radius (0.5 m
+    // behind the board's front; the default 0.5 r with the footprint no longer reaches
+    // the wall visibly), makes the board a block standing on the wall. The second layer
+    // is the board's back face: the 30 cm between board and wall stay open.
     let scene = board_scene(0.3);
+    let deep_slab = |layers| {
+        let s = settings(layers);
+        let gtao = GtaoSettings { thickness: 1.0, ..s.ao.gtao.clone() };
+        Settings { ao: AoSettings { gtao, ..s.ao }, ..s }
+    };
     let s = settings(1);
     let eyes = s.profile.eyes(&scene.head.pose_at(0.0), s.near);
     let rs = ReferenceSettings { radius: RADIUS as f64, rays_per_pixel: 256, stride: 2, near: s.near };
     let reference = trace(&scene, &eyes.eyes, SIZE, &rs, &mut |_| {}).unwrap();
     let mut results = Vec::new();
     for layers in [1, 2] {
-        let (ao, peeled) = render(&scene, &settings(layers));
+        let (ao, peeled) = render(&scene, &deep_slab(layers));
         assert_eq!(peeled, layers == 2);
         let (ours, truth, n) = beside_board(&ao, &reference, 2);
         let e = error_figures(Technique::Gtao, &ao, &reference);

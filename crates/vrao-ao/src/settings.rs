@@ -499,7 +499,9 @@ impl AoSettings {
 const DEFAULT_LAYER_SEPARATION: f32 = 0.0;
 
 /// GTAO's default slab behind each depth sample, a fraction of the radius.
-const DEFAULT_THICKNESS: f32 = 0.75;
+const DEFAULT_THICKNESS: f32 = 0.5;
+/// GTAO's default share of its stratum a solid depth sample blocks on its own plane.
+const DEFAULT_FOOTPRINT: f32 = 0.5;
 /// GTAO's default spread of the samples along a half-slice (1 even, 2 quadratic).
 const DEFAULT_STEP_POWER: f32 = 1.5;
 /// GTAO's default: successive samples closer than this fraction of the radius are joined.
@@ -513,10 +515,17 @@ const DEFAULT_CONNECT_TWO_LAYERS: f32 = 0.35;
 pub struct GtaoSettings {
     /// GTAO: the slab behind each depth sample that counts as solid, as a fraction of the
     /// radius (thin objects stop occluding behind themselves).
-    // 0.75 × r, not the grid's 1.0: with 2 slices × 6 steps it costs no RMSE and leaves
-    // fewer halos (pixels beside depth edges too dark by > 0.1); 0.5 leaves fewer still
-    // but costs RMSE (docs/records/2026-11-29/measurements-in-code.md, gtao-thickness).
+    // 0.5 × r with the footprint below (0.75 without it, where 0.5 cost RMSE): the
+    // least mean RMSE over the furnished room, Sibenik and the Cornell box, and fewer
+    // halos on the furnished room (docs/records/2026-11-29/measurements-in-code.md,
+    // gtao-thickness).
     pub thickness: f32,
+    /// GTAO: the share of its stratum (the stretch of the half-slice its jittered
+    /// position stands for) that a solid depth sample blocks, on its own surface's plane
+    /// about it, 0..=1 (0: the sample's point alone). Few samples step over thin occluders
+    /// and read light; a sample that stands for its stratum blocks, in expectation, what
+    /// the stratum holds (docs/records/2026-11-29/measurements-in-code.md, gtao-footprint).
+    pub footprint: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at
     /// r · t ((2 − P) + (P − 1) t), even at 1, quadratic (crowded near the pixel) at 2.
     pub step_power: f32,
@@ -537,6 +546,7 @@ impl Default for GtaoSettings {
     fn default() -> Self {
         GtaoSettings {
             thickness: DEFAULT_THICKNESS,
+            footprint: DEFAULT_FOOTPRINT,
             step_power: DEFAULT_STEP_POWER,
             connect: DEFAULT_CONNECT,
             connect_two_layers: DEFAULT_CONNECT_TWO_LAYERS,
@@ -551,6 +561,12 @@ impl GtaoSettings {
             return Err(Error::input(format!(
                 "thickness {} is not within 0..=100 (a fraction of the radius)",
                 self.thickness
+            )));
+        }
+        if !(self.footprint.is_finite() && (0.0..=1.0).contains(&self.footprint)) {
+            return Err(Error::input(format!(
+                "footprint {} is not within 0..=1 (a share of the sample's stratum)",
+                self.footprint
             )));
         }
         if !(self.step_power.is_finite() && (1.0..=2.0).contains(&self.step_power)) {

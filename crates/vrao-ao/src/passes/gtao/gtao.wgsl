@@ -19,8 +19,11 @@
 // surface back to `thickness` × r behind it (clipped at r). Two successive samples on
 // one continuous surface (their distances closer than `connect` × r) also block the
 // angles between them: a ray that is in front of a continuous surface at one sample
-// and behind it at the next crosses it in between. A sample on an alpha-tested surface
-// (a card, `THIN_CARDS`) blocks its share of the march on the card's plane instead.
+// and behind it at the next crosses it in between. A solid sample also blocks the
+// middle `footprint` share of its stratum (the stretch of the half-slice its jittered
+// position stands for) on its own surface's plane: few samples step over thin occluders,
+// and a point alone read them light. A sample on an alpha-tested surface (a card,
+// `THIN_CARDS`) blocks its whole stratum on the card's plane instead, and no slab.
 //
 // Samples that leave the eye's image through its inner border are looked up in the other
 // eye's layer (occlusion.wgsl `surface_at`, guessing the last sample's distance). The
@@ -63,8 +66,6 @@ override THIN_CARDS: bool = false;
 // (`add_sample`), the thickness only where it holds none. Off, no pixel pays the fetch
 // and the march is today's to the bit.
 override SECOND_LAYER: bool = false;
-override FOOTPRINT: bool = false;
-override FOOTPRINT_SCALE: f32 = 1.0;
 @group(0) @binding(12) var second_depth_layers: texture_depth_2d_array;
 
 // The deferred marches (module comment): appended by the dispatches without the band's
@@ -105,9 +106,10 @@ struct GtaoParams {
     connect: f32,
     // Columns along each eye's inner border marched with the other-eye lookups.
     inner_band: u32,
+    // The share of its stratum a solid depth sample blocks on its own plane (`add_sample`).
+    footprint: f32,
     // Pads the struct to 32 bytes, a multiple of 16 (`padding` of GtaoUniform).
     _pad0: u32,
-    _pad1: u32,
 };
 @group(0) @binding(11) var<uniform> gtao: GtaoParams;
 
@@ -268,8 +270,10 @@ fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
     return max(t * mix(1.0, t, gtao.step_power - 1.0) * march_px, f32(i) + 1.0);
 }
 
-// A depth sample on a card (`THIN_CARDS`): the card's view-space normal, and the view
-// rays (any length) that bound the sample's share of the march, its stratum.
+// A depth sample's plane and stratum: on a card (`THIN_CARDS`) or, for a solid sample
+// with `gtao.footprint` > 0, its footprint; the surface's view-space normal, and the view
+// rays (any length) that bound the share of the march the sample blocks on that plane
+// (a card's whole stratum; a solid sample's `footprint` share of it, about the sample).
 struct Card {
     on_card: bool,
     footprint: bool,
@@ -288,7 +292,10 @@ fn usable_card_end(end: vec3<f32>, p: vec3<f32>, radius2: f32) -> bool {
 // for the receiver at `p` on half `side` (+1 towards `t`, −1 away) of the slice: the
 // slab from the visible surface back to `thickness` behind it (with `SECOND_LAYER` and
 // w > 1, back to the second layer's surface at w × its distance along its view ray), joined to the previous
-// sample when both lie on one continuous surface. A sample on a card has no depth behind
+// sample when both lie on one continuous surface, and widened to its footprint on its
+// plane (`card.footprint`: the footprint's ends that lie within r and in front of the
+// eye; in expectation over the jitter a thin occluder then blocks its own width, where a
+// point sample lands on it too rarely). A sample on a card has no depth behind
 // it: it blocks its stratum's footprint on the card's plane instead, so where a stratum
 // is part hole, part card, the holes' share of the samples blocks nothing and over the
 // jittered strata the blocked angles average to the card's. Cards have no inside: no
@@ -354,7 +361,7 @@ fn add_sample(
     let u_b = select(u_b_raw, u_v, u_b_raw < 0.0);
     var lo = min(u_a, u_b);
     var hi = max(u_a, u_b);
-    if (FOOTPRINT && card.footprint) {
+    if (card.footprint) {
         let plane = dot(surface.xyz, card.normal);
         let a = card.ray_a * (plane / dot(card.ray_a, card.normal)) - p;
         let b = card.ray_b * (plane / dot(card.ray_b, card.normal)) - p;
@@ -519,10 +526,10 @@ fn main(
                 // Only a sample within r and above the tangent plane can block: the
                 // others skip the normal's fetch.
                 let to_sample = surface - p;
-                if ((THIN_CARDS || FOOTPRINT) && d > 0.0 && dot(to_sample, to_sample) < limits.radius2 && dot(to_sample, r.normal) > 0.0) {
+                if ((THIN_CARDS || gtao.footprint > 0.0) && d > 0.0 && dot(to_sample, to_sample) < limits.radius2 && dot(to_sample, r.normal) > 0.0) {
                     let n = textureLoad(normal_layers, vec2<i32>(pixel), i32(r.layer), 0);
                     card.on_card = THIN_CARDS && n.w > 0.5;
-                    card.footprint = FOOTPRINT && !card.on_card;
+                    card.footprint = gtao.footprint > 0.0 && !card.on_card;
                     if (card.on_card || card.footprint) {
                         card.normal = n.xyz;
                         // The stratum's ends: where the step would lie with jitter 0 and 1,
@@ -535,8 +542,8 @@ fn main(
                         var qa = centre_px + sign * omega * (first - widen);
                         var qb = centre_px + sign * omega * (last + widen);
                         if (card.footprint) {
-                            qa = mix(q, qa, FOOTPRINT_SCALE);
-                            qb = mix(q, qb, FOOTPRINT_SCALE);
+                            qa = mix(q, qa, gtao.footprint);
+                            qb = mix(q, qb, gtao.footprint);
                         }
                         card.ray_a = view_position_from_distance(qa / size, 1.0, r.eye.tangents);
                         card.ray_b = view_position_from_distance(qb / size, 1.0, r.eye.tangents);

@@ -72,8 +72,9 @@ struct GtaoUniform {
     step_power: f32,
     connect: f32,
     inner_band: u32,
+    footprint: f32,
     /// A uniform struct's size is a multiple of 16 bytes.
-    padding: [u32; 2],
+    padding: u32,
 }
 
 /// GTAO's slices and steps per half-slice for a budget of `samples` depth taps
@@ -130,8 +131,6 @@ impl Kernels {
                 ("CROSSING", f64::from(crossing)),
                 ("THIN_CARDS", f64::from(thin_cards)),
                 ("SECOND_LAYER", f64::from(second_layer)),
-                ("FOOTPRINT", if std::env::var_os("VRAO_FOOTPRINT").is_some() { 1.0 } else { 0.0 }),
-                ("FOOTPRINT_SCALE", std::env::var("VRAO_FP_SCALE").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0)),
             ];
             constants.extend_from_slice(&occlusion::right_eye_constants(right));
             constants.extend_from_slice(&march.constants);
@@ -240,7 +239,8 @@ impl Pass for GtaoPass {
             step_power: own.step_power,
             connect: if second { own.connect_two_layers } else { own.connect },
             inner_band: band,
-            padding: [0; 2],
+            footprint: own.footprint,
+            padding: 0,
         };
         // The AO engine has no scene, and a host's normals mark no cards. Once the
         // caller's interrupt cuts builds short, kernels built now would be stand-ins for
@@ -314,7 +314,7 @@ mod tests {
     fn the_gtao_uniform_matches_gtao_wgsl() {
         #[rustfmt::skip]
         layout_check::check(&[
-            mirror!(GtaoUniform, GTAO_FILES, "GtaoParams", [slices, steps, thickness, step_power, connect, inner_band, padding]),
+            mirror!(GtaoUniform, GTAO_FILES, "GtaoParams", [slices, steps, thickness, step_power, connect, inner_band, footprint, padding]),
         ]);
     }
 
