@@ -125,7 +125,8 @@ pub(crate) struct GtaoArgs {
     #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().thickness)]
     thickness: f32,
     /// GTAO: the share of its stratum a solid depth sample blocks on its own surface's
-    /// plane, 0..=1 (0: its point alone; few samples then step over thin occluders).
+    /// plane, 0..=1 (0: its point alone, and the footprint's code compiled out; few
+    /// samples then step over thin occluders).
     #[arg(long, allow_negative_numbers = true, default_value_t = GtaoSettings::default().footprint)]
     footprint: f32,
     /// GTAO: the samples' spread along a half-slice, 1..=2: sample t ∈ (0, 1) lies at

@@ -66,6 +66,9 @@ override THIN_CARDS: bool = false;
 // (`add_sample`), the thickness only where it holds none. Off, no pixel pays the fetch
 // and the march is today's to the bit.
 override SECOND_LAYER: bool = false;
+// Set where `gtao.footprint` > 0: solid samples block their footprint (`add_sample`). Off,
+// no pixel pays the normal's fetch or the footprint's ends.
+override FOOTPRINT: bool = false;
 @group(0) @binding(12) var second_depth_layers: texture_depth_2d_array;
 
 // The deferred marches (module comment): appended by the dispatches without the band's
@@ -271,7 +274,7 @@ fn step_offset_px(i: u32, steps: u32, jitter: f32, march_px: f32) -> f32 {
 }
 
 // A depth sample's plane and stratum: on a card (`THIN_CARDS`) or, for a solid sample
-// with `gtao.footprint` > 0, its footprint; the surface's view-space normal, and the view
+// with `FOOTPRINT`, its footprint; the surface's view-space normal, and the view
 // rays (any length) that bound the share of the march the sample blocks on that plane
 // (a card's whole stratum; a solid sample's `footprint` share of it, about the sample).
 struct Card {
@@ -361,7 +364,7 @@ fn add_sample(
     let u_b = select(u_b_raw, u_v, u_b_raw < 0.0);
     var lo = min(u_a, u_b);
     var hi = max(u_a, u_b);
-    if (card.footprint) {
+    if (FOOTPRINT && card.footprint) {
         let plane = dot(surface.xyz, card.normal);
         let a = card.ray_a * (plane / dot(card.ray_a, card.normal)) - p;
         let b = card.ray_b * (plane / dot(card.ray_b, card.normal)) - p;
@@ -526,10 +529,10 @@ fn main(
                 // Only a sample within r and above the tangent plane can block: the
                 // others skip the normal's fetch.
                 let to_sample = surface - p;
-                if ((THIN_CARDS || gtao.footprint > 0.0) && d > 0.0 && dot(to_sample, to_sample) < limits.radius2 && dot(to_sample, r.normal) > 0.0) {
+                if ((THIN_CARDS || FOOTPRINT) && d > 0.0 && dot(to_sample, to_sample) < limits.radius2 && dot(to_sample, r.normal) > 0.0) {
                     let n = textureLoad(normal_layers, vec2<i32>(pixel), i32(r.layer), 0);
                     card.on_card = THIN_CARDS && n.w > 0.5;
-                    card.footprint = gtao.footprint > 0.0 && !card.on_card;
+                    card.footprint = FOOTPRINT && !card.on_card;
                     if (card.on_card || card.footprint) {
                         card.normal = n.xyz;
                         // The stratum's ends: where the step would lie with jitter 0 and 1,

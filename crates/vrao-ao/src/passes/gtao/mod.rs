@@ -123,7 +123,8 @@ struct Kernels {
 }
 
 impl Kernels {
-    fn new(gpu: &Gpu, march: &March, thin_cards: bool, second_layer: bool) -> Self {
+    fn new(gpu: &Gpu, march: &March, variant: Variant) -> Self {
+        let Variant { thin_cards, second_layer, footprint } = variant;
         // A deferred march runs the band's code (`band`) over the list (`crossing`).
         let kernel = |entry: &str, band: bool, right: bool, crossing: bool| {
             let mut constants = vec![
@@ -131,6 +132,7 @@ impl Kernels {
                 ("CROSSING", f64::from(crossing)),
                 ("THIN_CARDS", f64::from(thin_cards)),
                 ("SECOND_LAYER", f64::from(second_layer)),
+                ("FOOTPRINT", f64::from(footprint)),
             ];
             constants.extend_from_slice(&occlusion::right_eye_constants(right));
             constants.extend_from_slice(&march.constants);
@@ -148,16 +150,35 @@ impl Kernels {
     }
 }
 
+/// Which of the march's pipelines: its compile-time switches.
+#[derive(Clone, Copy)]
+struct Variant {
+    /// Alpha-tested samples are cards (gtao.wgsl `THIN_CARDS`).
+    thin_cards: bool,
+    /// The march reads a second depth layer (`SECOND_LAYER`).
+    second_layer: bool,
+    /// Solid samples block their footprint (`FOOTPRINT`, `GtaoSettings::footprint` > 0).
+    footprint: bool,
+}
+
+impl Variant {
+    /// The index of the solid or card kernels of this variant.
+    fn slot(self) -> usize {
+        usize::from(self.second_layer) + 2 * usize::from(self.footprint)
+    }
+}
+
 /// GTAO's pipelines and its parameters; with another [`March`], a technique that
 /// marches the same slices (SSDO).
 pub(crate) struct GtaoPass {
     march: March,
-    /// By [one layer, two]: built when the pass is made for an eager [`March`] with one
-    /// layer, else on the first frame that runs them.
-    solid: [std::sync::OnceLock<Kernels>; 2],
-    /// By [one layer, two]: built on the first frame of a scene with alpha-tested
+    /// By [`Variant::slot`] (one layer or two, with or without the footprint): the
+    /// defaults' built when the pass is made for an eager [`March`], the others on the
+    /// first frame that runs them.
+    solid: [std::sync::OnceLock<Kernels>; 4],
+    /// By [`Variant::slot`]: built on the first frame of a scene with alpha-tested
     /// materials.
-    thin_cards: [std::sync::OnceLock<Kernels>; 2],
+    thin_cards: [std::sync::OnceLock<Kernels>; 4],
     params: wgpu::Buffer,
     right_eye: std::sync::Mutex<RightEyeList>,
     /// The marches deferred to the band's pipeline (gtao.wgsl `deferred`), the left eye's
@@ -190,12 +211,14 @@ impl GtaoPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let solid = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+        let solid: [std::sync::OnceLock<Kernels>; 4] = Default::default();
         if march.eager {
-            let _ = solid[0].set(Kernels::new(gpu, &march, false, false));
+            let footprint = crate::GtaoSettings::default().footprint > 0.0;
+            let variant = Variant { thin_cards: false, second_layer: false, footprint };
+            let _ = solid[variant.slot()].set(Kernels::new(gpu, &march, variant));
         }
         let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu, "gtao right-eye pixels"));
-        let thin_cards = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+        let thin_cards = Default::default();
         let deferred = std::sync::Mutex::new(IndirectList::new(gpu, "gtao deferred marches"));
         GtaoPass { march, solid, thin_cards, params, right_eye, deferred }
     }
@@ -246,13 +269,13 @@ impl Pass for GtaoPass {
         // caller's interrupt cuts builds short, kernels built now would be stand-ins for
         // good: the last frames of an ending session take samples as solid instead.
         let cards = ctx.setup.alpha_cards;
-        let layer = usize::from(second);
-        let solid = || self.solid[layer].get_or_init(|| Kernels::new(ctx.gpu, &self.march, false, second));
-        let kernels = match self.thin_cards[layer].get() {
+        let variant = Variant { thin_cards: false, second_layer: second, footprint: own.footprint > 0.0 };
+        let slot = variant.slot();
+        let solid = || self.solid[slot].get_or_init(|| Kernels::new(ctx.gpu, &self.march, variant));
+        let kernels = match self.thin_cards[slot].get() {
             Some(kernels) if cards => kernels,
-            None if cards && !ctx.gpu.builds_cancelled() => {
-                self.thin_cards[layer].get_or_init(|| Kernels::new(ctx.gpu, &self.march, true, second))
-            }
+            None if cards && !ctx.gpu.builds_cancelled() => self.thin_cards[slot]
+                .get_or_init(|| Kernels::new(ctx.gpu, &self.march, Variant { thin_cards: true, ..variant })),
             _ => solid(),
         };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
