@@ -369,17 +369,14 @@ impl CaseRun {
     fn write_comparison(&self, folder: &std::path::Path, reference: &ReferenceImage, limits: &Limits) -> Result<()> {
         let (w, h) = (self.settings.profile.width as usize, self.settings.profile.height as usize);
         let estimate = self.renderer.read_f32(self.output)?.swap_remove(0).into_iter().skip(3).step_by(4).collect();
-        let grid = |cell: &dyn Fn(u32, u32) -> (bool, f32)| {
-            grid_panel(w, h, reference.stride, reference.grid_size(), |i, j| match cell(i, j) {
-                (true, ao) => ao,
-                (false, _) => 1.0,
-            })
-        };
+        // Each traced cell's AO, unoccluded where nothing was hit.
+        let grid = |cell: &dyn Fn(u32, u32) -> f32| grid_panel(w, h, reference.stride, reference.grid_size(), cell);
+        let limit = |limit: &ScreenLimit, i, j| Some(limit.get(0, i, j)).filter(|p| p.hit).map_or(1.0, |p| p.ao);
         let panels = [
             estimate,
-            grid(&|i, j| (limits.one.get(0, i, j).hit, limits.one.get(0, i, j).ao)),
-            grid(&|i, j| (limits.two.get(0, i, j).hit, limits.two.get(0, i, j).ao)),
-            grid(&|i, j| (reference.get(0, i, j).hit, reference.get(0, i, j).ao)),
+            grid(&|i, j| limit(&limits.one, i, j)),
+            grid(&|i, j| limit(&limits.two, i, j)),
+            grid(&|i, j| Some(reference.get(0, i, j)).filter(|p| p.hit).map_or(1.0, |p| p.ao)),
         ];
         std::fs::create_dir_all(folder)
             .map_err(|e| Error::Output { path: folder.into(), message: format!("cannot create this folder: {e}") })?;

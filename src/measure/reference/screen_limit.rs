@@ -556,6 +556,37 @@ mod tests {
         (p.z + 3.0).abs() <= 1e-4 && (-0.3..-0.02).contains(&p.x) && p.y.abs() <= 0.5
     }
 
+    /// The grid cells of `depth` (`size`, every `stride`-th pixel) whose receiver lies
+    /// beside the plate, each with its visibility within `radius` ray cast in `scene`
+    /// (`rays` rays): what the thin-slab tests compare the limits with.
+    fn receivers_beside_the_plate(
+        depth: &[f32],
+        (size, stride): ((u32, u32), u32),
+        scene: &[Rect],
+        radius: f64,
+        rays: usize,
+    ) -> Vec<((u32, u32), f64)> {
+        let (gw, gh) = grid_size(size, stride);
+        let mut receivers = Vec::new();
+        for j in 0..gh {
+            for i in 0..gw {
+                let p = position(depth, size, stride, i, j);
+                if beside_the_plate(p) {
+                    let truth =
+                        visibility_by_ray_casting(p, DVec3::Z, radius, false, rays, |o, d| first_hit(scene, o, d));
+                    receivers.push(((i, j), truth));
+                }
+            }
+        }
+        assert!(receivers.len() > 10, "{} receivers", receivers.len());
+        receivers
+    }
+
+    /// The mean of `f` over `receivers`.
+    fn mean_over(receivers: &[((u32, u32), f64)], f: impl Fn((u32, u32), f64) -> f64) -> f64 {
+        receivers.iter().map(|&(cell, truth)| f(cell, truth)).sum::<f64>() / receivers.len() as f64
+    }
+
     #[test]
     fn a_thin_slab_stops_occluding_behind_itself_within_the_thickness() {
         // The eye looks straight down at a floor 3 m away; a thin horizontal plate 0.5 m
@@ -568,23 +599,9 @@ mod tests {
         let base = LimitSettings { rays_per_pixel: 256, steps: 48, ..LimitSettings::new(radius, stride, NEAR) };
         let (thin, depth) = limit(&[floor, plate], size, LimitSettings { thickness: 0.05, ..base });
         let (solid, _) = limit(&[floor, plate], size, LimitSettings { thickness: 10.0, ..base });
-        let (gw, gh) = thin.grid_size();
-        let (mut n, mut thin_error, mut solid_gap) = (0, 0.0, 0.0);
-        for j in 0..gh {
-            for i in 0..gw {
-                let p = position(&depth, size, stride, i, j);
-                if !beside_the_plate(p) {
-                    continue;
-                }
-                let truth =
-                    visibility_by_ray_casting(p, DVec3::Z, radius, false, 200, |o, d| first_hit(&[floor, plate], o, d));
-                n += 1;
-                thin_error += (thin.get(0, i, j).ao as f64 - truth).abs();
-                solid_gap += truth - solid.get(0, i, j).ao as f64;
-            }
-        }
-        assert!(n > 10, "{n} receivers");
-        let (thin_error, solid_gap) = (thin_error / n as f64, solid_gap / n as f64);
+        let receivers = receivers_beside_the_plate(&depth, (size, stride), &[floor, plate], radius, 200);
+        let thin_error = mean_over(&receivers, |(i, j), truth| (thin.get(0, i, j).ao as f64 - truth).abs());
+        let solid_gap = mean_over(&receivers, |(i, j), truth| truth - solid.get(0, i, j).ao as f64);
         assert!(thin_error < 0.03, "thin thickness: mean |limit − truth| {thin_error}");
         assert!(solid_gap > 0.1, "a thickness above the plate's height darkens by only {solid_gap}");
     }
@@ -612,23 +629,10 @@ mod tests {
         let two = EyeBuffers { second: Some(&second), ..one };
         let one = screen_space_limit(&[one], size, &settings).unwrap();
         let two = screen_space_limit(&[two], size, &settings).unwrap();
-        let (gw, gh) = one.grid_size();
-        let (mut n, mut one_error, mut two_error, mut one_bias) = (0, 0.0, 0.0, 0.0);
-        for j in 0..gh {
-            for i in 0..gw {
-                let p = position(&depth, size, stride, i, j);
-                if !beside_the_plate(p) {
-                    continue;
-                }
-                let truth = visibility_by_ray_casting(p, DVec3::Z, radius, false, 400, |o, d| first_hit(&scene, o, d));
-                n += 1;
-                one_error += (one.get(0, i, j).ao as f64 - truth).abs();
-                one_bias += one.get(0, i, j).ao as f64 - truth;
-                two_error += (two.get(0, i, j).ao as f64 - truth).abs();
-            }
-        }
-        assert!(n > 10, "{n} receivers");
-        let (one_error, two_error, one_bias) = (one_error / n as f64, two_error / n as f64, one_bias / n as f64);
+        let receivers = receivers_beside_the_plate(&depth, (size, stride), &scene, radius, 400);
+        let one_error = mean_over(&receivers, |(i, j), truth| (one.get(0, i, j).ao as f64 - truth).abs());
+        let one_bias = mean_over(&receivers, |(i, j), truth| one.get(0, i, j).ao as f64 - truth);
+        let two_error = mean_over(&receivers, |(i, j), truth| (two.get(0, i, j).ao as f64 - truth).abs());
         assert!(two_error < 0.03, "two layers: mean |limit − truth| {two_error}");
         assert!(one_bias < -0.05, "one layer should over-occlude under the slab: bias {one_bias}");
         assert!(one_error > 2.0 * two_error, "one layer {one_error} against two {two_error}");
@@ -661,23 +665,9 @@ mod tests {
             let eye = EyeBuffers { depth: &depth, normals, fov: fov(), direct: None, second };
             screen_space_limit(&[eye], size, &settings).unwrap()
         });
-        let (gw, gh) = marches[0].grid_size();
-        let (mut n, mut bias) = (0, [0.0; 4]);
-        for j in 0..gh {
-            for i in 0..gw {
-                let p = position(&depth, size, stride, i, j);
-                if !beside_the_plate(p) {
-                    continue;
-                }
-                let truth = visibility_by_ray_casting(p, DVec3::Z, radius, false, 400, |o, d| first_hit(&scene, o, d));
-                n += 1;
-                for (b, limit) in bias.iter_mut().zip(&marches) {
-                    *b += limit.get(0, i, j).ao as f64 - truth;
-                }
-            }
-        }
-        assert!(n > 10, "{n} receivers");
-        let [solid_one, solid_two, card_one, card_two] = bias.map(|b| b / n as f64);
+        let receivers = receivers_beside_the_plate(&depth, (size, stride), &scene, radius, 400);
+        let [solid_one, solid_two, card_one, card_two] =
+            marches.map(|limit| mean_over(&receivers, |(i, j), truth| limit.get(0, i, j).ao as f64 - truth));
         println!("beside a card 0.5 m up, limit − truth: as solid {solid_one:+.3} (one layer), {solid_two:+.3} (two); as a card {card_one:+.3}, {card_two:+.3}");
         assert!(solid_one < -0.02 && solid_two < -0.1, "as solid, the plate over-occludes: {solid_one}, {solid_two}");
         assert!(card_one.abs() < 0.03 && card_two.abs() < 0.03, "as a card: bias {card_one}, {card_two}");
