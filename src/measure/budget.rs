@@ -11,6 +11,7 @@
 use crate::error::Result;
 use crate::formats::spans::{summarize, RightEyeTilesReport, SpanSummary};
 use serde::{Deserialize, Serialize};
+use std::time::{Duration, Instant};
 use vrao_ao::plug::{FrameTiming, Resource};
 use vrao_ao::EyePair;
 use vrao_render::passes::tonemap::COLOR;
@@ -228,6 +229,33 @@ fn pass_times(report: &FrameReport, timing: Timing) -> Vec<(String, f64)> {
     let source = if timing == Timing::Serial { &report.wall_ms } else { &report.gpu_ms };
     // Per-eye sub-spans inside a pass ("gbuffer left") are not passes of their own.
     source.iter().filter(|(name, _)| !FrameTiming::is_per_eye(name)).cloned().collect()
+}
+
+/// How long a measurement's first setting renders before it is measured (when the run
+/// warms up at all, on a GPU), and at most how many rounds that takes. A GPU that idled has
+/// clocked down: a warm-up of a few rounds left the first row far slower than every later
+/// one (docs/records/2026-11-29/measurements-in-code.md, table-settle-time).
+const SETTLE_TIME: Duration = Duration::from_millis(1500);
+const SETTLE_MAX_ROUNDS: u32 = 500;
+
+/// Renders rounds of `how` unmeasured until the device has worked for [`SETTLE_TIME`]
+/// (or [`SETTLE_MAX_ROUNDS`] rounds): its clocks up, its caches and allocations warm.
+/// Nothing without a warm-up (`how.warmup` 0), and nothing on a CPU adapter, whose cores
+/// do not clock down between submissions as an idle GPU does (lavapipe's tests run at a
+/// few pixels, where the settle would only add time).
+pub fn settle(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<()> {
+    if how.warmup == 0 || renderer.gpu().info.device_type == wgpu::DeviceType::Cpu {
+        return Ok(());
+    }
+    let start = Instant::now();
+    let one_round = BudgetRun { warmup: 0, frames: 1, ..how };
+    for _ in 0..SETTLE_MAX_ROUNDS {
+        if start.elapsed() >= SETTLE_TIME {
+            break;
+        }
+        run(renderer, eyes, one_round)?;
+    }
+    Ok(())
 }
 
 /// Renders `warmup + frames` rounds of (stereo frame, left eye alone, right eye alone)

@@ -12,22 +12,14 @@ use crate::measure::bench::Resolution;
 use crate::measure::budget::{self, BudgetReport, BudgetRun, PassTimes, Scope};
 use std::fmt::Write as _;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 use vrao_ao::plug::BLUR_PASS;
-use vrao_ao::{AoSettings, EyePair, Foveation, Quality, Technique};
+use vrao_ao::{AoSettings, Foveation, Quality, Technique};
 use vrao_render::passes::tonemap::COLOR;
 use vrao_render::passes::{composite, shadow};
 use vrao_render::renderer::{Renderer, TimingChoice};
 use vrao_render::scene::Scene;
 use vrao_render::settings::{Settings, ShadowSettings};
 use vrao_render::{BackendChoice, HeadsetProfile};
-
-/// How long each scene's first row renders before it is measured (when the run warms up
-/// at all), and at most how many frames that takes. A GPU that idled has clocked down:
-/// a warm-up of a few rounds left the first row far slower than every later one
-/// (docs/records/2026-11-29/measurements-in-code.md, table-settle-time).
-const SETTLE_TIME: Duration = Duration::from_millis(1500);
-const SETTLE_MAX_ROUNDS: u32 = 500;
 
 /// The most scenes one table takes (each loads its own renderer).
 pub const SCENES_MAX: usize = 16;
@@ -300,8 +292,8 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
         for (i, case) in cases.iter().enumerate() {
             let settings = case.settings(&base);
             renderer.set_settings(&settings)?;
-            if i == 0 && how.warmup > 0 {
-                settle(&mut renderer, &eyes, how)?;
+            if i == 0 {
+                budget::settle(&mut renderer, &eyes, how)?;
             }
             let report = budget::run(&mut renderer, &eyes, how)?;
             let row = TableRow {
@@ -344,20 +336,6 @@ pub fn run_table(scenes: &[(String, Scene)], options: &TableOptions) -> Result<T
         budget_ms,
         scenes: tables,
     })
-}
-
-/// Renders rounds of `how` unmeasured until the device has worked for [`SETTLE_TIME`]
-/// (or [`SETTLE_MAX_ROUNDS`] rounds): its clocks up, its caches and allocations warm.
-fn settle(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<()> {
-    let start = Instant::now();
-    let one_round = BudgetRun { warmup: 0, frames: 1, ..how };
-    for _ in 0..SETTLE_MAX_ROUNDS {
-        if start.elapsed() >= SETTLE_TIME {
-            break;
-        }
-        budget::run(renderer, eyes, one_round)?;
-    }
-    Ok(())
 }
 
 /// A half-resolution row's inline upsampling ([`TableRow::inline_upsampling`]) from the

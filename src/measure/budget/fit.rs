@@ -1,7 +1,7 @@
 //! `vrao budget` as one call: open the device, optionally pick the setting from a bench
 //! file (the least AO error that fits the budget), and measure it.
 
-use super::{run, BudgetReport, BudgetRun, Scope};
+use super::{run, settle, BudgetReport, BudgetRun, Scope};
 use crate::error::{Error, Result};
 use crate::measure::bench::{BenchFile, BenchRecord};
 use std::path::{Path, PathBuf};
@@ -71,6 +71,7 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
     let gpu = Arc::new(vrao_render::open(options.backend)?);
     let timing = options.timing.resolve(&gpu);
     let eyes = settings.profile.eyes(&scene.head.pose_at(0.0), settings.near);
+    let settled = std::cell::Cell::new(false);
     let measure = |settings: &Settings, frames: u32| -> Result<BudgetReport> {
         let output = if options.occlusion_only {
             if settings.ao.technique == vrao_ao::Technique::None {
@@ -83,7 +84,12 @@ pub fn measure_budget(scene: &Scene, settings: &Settings, options: &BudgetOption
         let mut renderer = Renderer::new(gpu.clone(), scene, settings)?;
         // The profile's lens, as a headset run has it (the passes skip it with `--mask on`).
         renderer.set_visibility_mask(Some(crate::xr::profiles::visibility_mask(&settings.profile)));
-        run(&mut renderer, &eyes, BudgetRun { timing, warmup: options.warmup, frames, budget_ms, output })
+        let how = BudgetRun { timing, warmup: options.warmup, frames, budget_ms, output };
+        // The device's clocks come up once, before the first setting measured.
+        if !settled.replace(true) {
+            settle(&mut renderer, &eyes, how)?;
+        }
+        run(&mut renderer, &eyes, how)
     };
     let mut settings = settings.clone();
     let fit = match fit_file {
