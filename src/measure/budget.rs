@@ -111,6 +111,42 @@ pub struct BudgetReport {
     /// the stereo frame (`--mask on`); zeros with `--mask off`.
     #[serde(default)]
     pub hidden_share_per_eye: Vec<f64>,
+    /// The AO chain (the passes the frame graph counts as occlusion cost) in the stereo
+    /// frame against the left eye alone: what the right eye adds; absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ao_chain: Option<AoChainCost>,
+}
+
+/// [`BudgetReport::ao_chain`]: sums of the passes' medians.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct AoChainCost {
+    /// The chain's passes, in frame order.
+    pub passes: Vec<String>,
+    /// The left eye alone (ms).
+    pub left_eye_ms: f64,
+    /// The stereo frame (ms).
+    pub stereo_ms: f64,
+    /// (stereo − left eye alone) / left eye alone: the right eye's cost in the stereo
+    /// frame as a share of the left eye's (about 1 where the eyes are computed alike).
+    pub right_eye_added_share: f64,
+}
+
+impl AoChainCost {
+    /// The chain over `passes` (those of `names` that ran), or `None` when none ran or
+    /// the left eye took no time.
+    fn of(passes: &[PassTimes], names: &[&str]) -> Option<Self> {
+        let chain: Vec<&PassTimes> = passes.iter().filter(|p| names.contains(&p.pass.as_str())).collect();
+        let sum = |scope: fn(&PassTimes) -> &Option<SpanSummary>| {
+            chain.iter().map(|p| scope(p).as_ref().map_or(0.0, |s| s.median_ms)).sum::<f64>()
+        };
+        let (left_eye_ms, stereo_ms) = (sum(|p| &p.left), sum(|p| &p.stereo));
+        (!chain.is_empty() && left_eye_ms > 0.0).then(|| AoChainCost {
+            passes: chain.iter().map(|p| p.pass.clone()).collect(),
+            left_eye_ms,
+            stereo_ms,
+            right_eye_added_share: (stereo_ms - left_eye_ms) / left_eye_ms,
+        })
+    }
 }
 
 /// [`BudgetReport::occlusion_bytes_per_pixel`].
@@ -193,6 +229,16 @@ impl BudgetReport {
                 t.total,
                 100.0 * t.share,
                 t.items
+            );
+        }
+        if let Some(c) = &self.ao_chain {
+            let _ = writeln!(
+                s,
+                "AO chain ({}): left eye alone {:.3} ms, stereo frame {:.3} ms: the right eye adds {:.1} % of the left eye's",
+                c.passes.join(" + "),
+                c.left_eye_ms,
+                c.stereo_ms,
+                100.0 * c.right_eye_added_share
             );
         }
         for v in &self.verdicts {
@@ -301,6 +347,8 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         .iter()
         .map(|p| PassTimes { pass: p.clone(), stereo: find(0, p), left: find(1, p), right: find(2, p) })
         .collect();
+    let chain_names = renderer.plan(2, &[how.output])?.occlusion_passes();
+    let ao_chain = AoChainCost::of(&passes, &chain_names);
     let total = |k: usize| summaries[k].iter().map(|s| s.median_ms).sum::<f64>();
     let per_eye_budget = how.budget_ms / 2.0;
     let verdict = |what: Scope, ms: f64, budget_ms: f64| Verdict { what, ms, budget_ms, pass: ms <= budget_ms };
@@ -336,6 +384,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         right_eye_tiles,
         occlusion_bytes_per_pixel,
         hidden_share_per_eye,
+        ao_chain,
     })
 }
 

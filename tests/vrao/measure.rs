@@ -70,6 +70,20 @@ fn budget_passes_a_generous_budget_with_exit_0_and_fails_a_tiny_one_with_exit_3(
     }
     assert_eq!(report["verdicts"].as_array().unwrap().len(), 3);
     assert_eq!(report["cpu_encode"].as_array().unwrap().len(), 3);
+    // The AO chain sums its passes' medians, and the right eye's added share follows.
+    let chain = &report["ao_chain"];
+    let chain_passes: Vec<&str> =
+        chain["passes"].as_array().expect("ao_chain").iter().map(|p| p.as_str().unwrap()).collect();
+    assert_eq!(chain_passes, ["gtao", "blur"], "{chain}");
+    let median = |pass: &str, scope: &str| -> f64 {
+        passes.iter().find(|p| p["pass"] == pass).unwrap()[scope]["median_ms"].as_f64().unwrap()
+    };
+    let (left, stereo) =
+        (median("gtao", "left") + median("blur", "left"), median("gtao", "stereo") + median("blur", "stereo"));
+    assert!((chain["left_eye_ms"].as_f64().unwrap() - left).abs() < 1e-9, "{chain}");
+    assert!((chain["stereo_ms"].as_f64().unwrap() - stereo).abs() < 1e-9, "{chain}");
+    assert!((chain["right_eye_added_share"].as_f64().unwrap() - (stereo - left) / left).abs() < 1e-9, "{chain}");
+    assert!(t.contains("AO chain (gtao + blur)"), "{t}");
     // The profile's lens is applied (`--mask on`, the default) and skipped when told.
     let hidden = |r: &serde_json::Value| -> Vec<f64> {
         r["hidden_share_per_eye"].as_array().expect("hidden shares").iter().map(|h| h.as_f64().unwrap()).collect()
