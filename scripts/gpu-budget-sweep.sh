@@ -6,7 +6,8 @@
 # and OUT/info.txt (the adapter). The Vulkan loader must be installed (scripts/gpu-table.sh
 # unpacks .gl/*.deb where it is not).
 # The rows alternate their settings inside each scene and resolution, and the whole sweep
-# runs twice, so a GPU whose clocks drift shows it as a difference between the rounds.
+# runs twice (SWEEP_ROUNDS), so clocks that drift show as a difference between the rounds.
+# Each report's `ao_chain.right_eye_added_share` is what the right eye adds to the chain.
 set -uo pipefail
 [ $# -ge 3 ] || { echo "usage: $0 VRAO SCENES OUT [vrao budget options]" >&2; exit 2; }
 bin=$(realpath "$1") scenes=$(realpath "$2") out=$3
@@ -24,8 +25,10 @@ if ! timeout 30 "$bin" info --backend vulkan >"$out/info.txt" 2>&1; then
   echo "$bin info: no Vulkan adapter opened within 30 s; see $out/info.txt (try another machine)" >&2
   exit 1
 fi
-# scene files: the scenes' own poses and 30 cm from a wall
-scene_files="assets/scenes/sibenik.toml assets/scenes/furnished.toml assets/scenes/sibenik-wall.toml assets/scenes/furnished-wall.toml"
+# Scene files (SWEEP_SCENES to choose others): the scenes' own poses and 30 cm from a wall.
+scene_files=${SWEEP_SCENES:-assets/scenes/sibenik.toml assets/scenes/furnished.toml assets/scenes/sibenik-wall.toml assets/scenes/furnished-wall.toml}
+rounds=${SWEEP_ROUNDS:-2}
+case $rounds in [1-9]) ;; *) echo "SWEEP_ROUNDS must be 1..9, not '$rounds'" >&2; exit 2 ;; esac
 declare -A settings=(
   [default]=""
   [independent]="--independent-eyes"
@@ -33,7 +36,7 @@ declare -A settings=(
   [footprint0]="--footprint 0 --thickness 0.75"
   [foveated]="--foveation high"
 )
-for round in 1 2; do
+for round in $(seq "$rounds"); do
   for scene in $scene_files; do
     name=$(basename "$scene" .toml)
     case $name in *-wall) rows="default independent" ;; *) rows="default independent layers2 footprint0 foveated" ;; esac

@@ -184,3 +184,32 @@ fn the_gpu_script_writes_the_table_and_the_adapter_on_lavapipe() {
     assert_eq!(md.lines().filter(|l| l.starts_with("| hbao | low (12) | half | high |")).count(), 1, "{md}");
     assert!(std::fs::read_to_string(out_dir.join("gpu-table.log")).unwrap().contains("wrote"));
 }
+
+#[test]
+fn the_gpu_budget_sweep_writes_one_report_a_row_on_lavapipe() {
+    let dir = common::temp_dir("budget-sweep");
+    let out_dir = dir.join("out");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/gpu-budget-sweep.sh");
+    // The wall pose of the built-in furnished room needs no public scenes.
+    let out = Command::new(script)
+        .args([env!("CARGO_BIN_EXE_vrao"), dir.to_str().unwrap(), out_dir.to_str().unwrap()])
+        .args(["--width", "32", "--height", "36", "--frames", "1", "--warmup", "0"])
+        .env("SWEEP_SCENES", "assets/scenes/furnished-wall.toml")
+        .env("SWEEP_ROUNDS", "1")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(std::fs::read_to_string(out_dir.join("info.txt")).unwrap().contains("adapter:"));
+    for res in ["full", "half"] {
+        for row in ["default", "independent"] {
+            let path = out_dir.join(format!("furnished-wall.{res}.{row}.r1.json"));
+            let report: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path:?}: {e}")))
+                    .unwrap();
+            // The right eye lists only where it reuses the left eye; the chain is stated either way.
+            let lists = report.get("right_eye_tiles").and_then(|t| t.as_array()).map_or(0, |t| t.len());
+            assert_eq!(lists > 0, row == "default", "{path:?}: {report}");
+            assert!(report["ao_chain"]["right_eye_added_share"].as_f64().is_some(), "{path:?}: {report}");
+        }
+    }
+}
