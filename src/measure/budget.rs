@@ -286,9 +286,9 @@ const SETTLE_MAX_ROUNDS: u32 = 500;
 
 /// Renders rounds of `how` unmeasured until the device has worked for [`SETTLE_TIME`]
 /// (or [`SETTLE_MAX_ROUNDS`] rounds): its clocks up, its caches and allocations warm.
-/// Nothing without a warm-up (`how.warmup` 0), and nothing on a CPU adapter, whose cores
-/// do not clock down between submissions as an idle GPU does (lavapipe's tests run at a
-/// few pixels, where the settle would only add time).
+/// Nothing without a warm-up (`how.warmup` 0), and nothing on a CPU adapter (lavapipe):
+/// its first frame already keeps the cores busy, and its tests run at a few pixels, where
+/// the settle would only add time.
 pub fn settle(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<()> {
     if how.warmup == 0 || renderer.gpu().info.device_type == wgpu::DeviceType::Cpu {
         return Ok(());
