@@ -347,8 +347,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
         .iter()
         .map(|p| PassTimes { pass: p.clone(), stereo: find(0, p), left: find(1, p), right: find(2, p) })
         .collect();
-    let chain_names = renderer.plan(2, &[how.output])?.occlusion_passes();
-    let ao_chain = AoChainCost::of(&passes, &chain_names);
+    let ao_chain = AoChainCost::of(&passes, &renderer.plan(2, &[how.output])?.occlusion_passes());
     let total = |k: usize| summaries[k].iter().map(|s| s.median_ms).sum::<f64>();
     let per_eye_budget = how.budget_ms / 2.0;
     let verdict = |what: Scope, ms: f64, budget_ms: f64| Verdict { what, ms, budget_ms, pass: ms <= budget_ms };
