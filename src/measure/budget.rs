@@ -284,8 +284,8 @@ fn pass_times(report: &FrameReport, timing: Timing) -> Vec<(String, f64)> {
 const SETTLE_TIME: Duration = Duration::from_millis(1500);
 const SETTLE_MAX_ROUNDS: u32 = 500;
 
-/// Renders rounds of `how` unmeasured until the device has worked for 1.5 s (or 500
-/// rounds): its clocks up, its caches and allocations warm.
+/// Renders rounds of `how` unmeasured until the device has worked for `SETTLE_TIME` (or
+/// `SETTLE_MAX_ROUNDS` rounds): its clocks up, its caches and allocations warm.
 /// Nothing without a warm-up (`how.warmup` 0), and nothing on a CPU adapter (lavapipe):
 /// its first frame already keeps the cores busy, and its tests run at a few pixels, where
 /// the settle would only add time.
