@@ -293,15 +293,24 @@ pub fn settle(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result
     if how.warmup == 0 || renderer.gpu().info.device_type == wgpu::DeviceType::Cpu {
         return Ok(());
     }
+    // Rounds as `run` renders them, without its report (read-backs, plan, summaries).
+    renderer.set_timing(how.timing);
     let start = Instant::now();
-    let one_round = BudgetRun { warmup: 0, frames: 1, ..how };
     for _ in 0..SETTLE_MAX_ROUNDS {
         if start.elapsed() >= SETTLE_TIME {
             break;
         }
-        run(renderer, eyes, one_round)?;
+        for view in round_views(eyes) {
+            renderer.render_and_wait(view, &[how.output])?;
+        }
     }
     Ok(())
+}
+
+/// One measuring round's views, in order: the stereo frame, the left eye alone, the right
+/// eye alone.
+fn round_views(eyes: &EyePair) -> [&[vrao_ao::Eye]; 3] {
+    [&eyes.eyes, &eyes.eyes[..1], &eyes.eyes[1..]]
 }
 
 /// Renders `warmup + frames` rounds of (stereo frame, left eye alone, right eye alone)
@@ -310,7 +319,7 @@ pub fn run(renderer: &mut Renderer, eyes: &EyePair, how: BudgetRun) -> Result<Bu
     // Bounded counts: `warmup + frames` never wraps, and there is a measured frame.
     crate::measure::check_frames(how.warmup, how.frames)?;
     renderer.set_timing(how.timing);
-    let views: [&[vrao_ao::Eye]; 3] = [&eyes.eyes, &eyes.eyes[..1], &eyes.eyes[1..]];
+    let views = round_views(eyes);
     let mut times: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut encode: [Vec<Vec<(String, f64)>>; 3] = Default::default();
     let mut pass_order: Vec<String> = Vec::new();
