@@ -165,14 +165,19 @@ fn bad_values_exit_2_with_one_line_naming_them_before_any_gpu_work() {
     assert!(!std::path::Path::new(good_out).exists());
 }
 
+/// A GPU script of `scripts/` (`NAME VRAO SCENES OUT [options]`) on this build, with `dir`
+/// as SCENES (built-in scenes need no public ones: any folder will do) and `out_dir` as OUT.
+fn gpu_script(name: &str, dir: &std::path::Path, out_dir: &std::path::Path) -> Command {
+    let mut command = Command::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts").join(name));
+    command.arg(env!("CARGO_BIN_EXE_vrao")).arg(dir).arg(out_dir);
+    command
+}
+
 #[test]
 fn the_gpu_script_writes_the_table_and_the_adapter_on_lavapipe() {
     let dir = common::temp_dir("table-script");
     let out_dir = dir.join("out");
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/gpu-table.sh");
-    // A built-in scene needs no public scenes: any folder will do for SCENES.
-    let out = Command::new(script)
-        .args([env!("CARGO_BIN_EXE_vrao"), dir.to_str().unwrap(), out_dir.to_str().unwrap()])
+    let out = gpu_script("gpu-table.sh", &dir, &out_dir)
         .args(["--scenes", "builtin:room", "--width", "32", "--height", "36", "--frames", "1", "--warmup", "0"])
         .args(["--techniques", "hbao", "--qualities", "low", "--resolutions", "half", "--foveations", "high"])
         .output()
@@ -189,10 +194,8 @@ fn the_gpu_script_writes_the_table_and_the_adapter_on_lavapipe() {
 fn the_gpu_budget_sweep_writes_one_report_a_row_on_lavapipe() {
     let dir = common::temp_dir("budget-sweep");
     let out_dir = dir.join("out");
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/gpu-budget-sweep.sh");
     // The wall pose of the built-in furnished room needs no public scenes.
-    let out = Command::new(script)
-        .args([env!("CARGO_BIN_EXE_vrao"), dir.to_str().unwrap(), out_dir.to_str().unwrap()])
+    let out = gpu_script("gpu-budget-sweep.sh", &dir, &out_dir)
         .args(["--width", "32", "--height", "36", "--frames", "1", "--warmup", "0"])
         .env("SWEEP_SCENES", "assets/scenes/furnished-wall.toml")
         .env("SWEEP_ROUNDS", "1")
