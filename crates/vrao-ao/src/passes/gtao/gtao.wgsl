@@ -291,6 +291,16 @@ fn usable_card_end(end: vec3<f32>, p: vec3<f32>, radius2: f32) -> bool {
     return dot(end, end) < radius2 && end.z + p.z < 0.0;
 }
 
+// The ends of a card's footprint (its rays `ray_a`, `ray_b` met on the plane through
+// `surface` with the card's normal), relative to P.
+fn card_ends(card: Card, surface: vec3<f32>, p: vec3<f32>) -> array<vec3<f32>, 2> {
+    let plane = dot(surface, card.normal);
+    return array<vec3<f32>, 2>(
+        card.ray_a * (plane / dot(card.ray_a, card.normal)) - p,
+        card.ray_b * (plane / dot(card.ray_b, card.normal)) - p,
+    );
+}
+
 // Marks the sectors that the depth sample `surface` (view space, w = 0 when none) blocks
 // for the receiver at `p` on half `side` (+1 towards `t`, −1 away) of the slice: the
 // slab from the visible surface back to `thickness` behind it (with `SECOND_LAYER` and
@@ -326,9 +336,9 @@ fn add_sample(
     var end_a = front;
     var end_b: vec3<f32>;
     if (on_card) {
-        let plane = dot(surface.xyz, card.normal);
-        let a = card.ray_a * (plane / dot(card.ray_a, card.normal)) - p;
-        let b = card.ray_b * (plane / dot(card.ray_b, card.normal)) - p;
+        let ends = card_ends(card, surface.xyz, p);
+        let a = ends[0];
+        let b = ends[1];
         end_a = select(front, a, usable_card_end(a, p, limits.radius2));
         end_b = select(front, b, usable_card_end(b, p, limits.radius2));
     } else {
@@ -365,9 +375,9 @@ fn add_sample(
     var lo = min(u_a, u_b);
     var hi = max(u_a, u_b);
     if (FOOTPRINT && card.footprint) {
-        let plane = dot(surface.xyz, card.normal);
-        let a = card.ray_a * (plane / dot(card.ray_a, card.normal)) - p;
-        let b = card.ray_b * (plane / dot(card.ray_b, card.normal)) - p;
+        let ends = card_ends(card, surface.xyz, p);
+        let a = ends[0];
+        let b = ends[1];
         if (usable_card_end(a, p, limits.radius2)) {
             let raw = sector_coordinate(slice, a, side);
             let ua = select(raw, u_v, raw < 0.0);
