@@ -120,6 +120,46 @@ fn a_second_layer_frees_the_wall_behind_a_thin_board() {
 }
 
 #[test]
+fn behind_a_single_sided_sheet_two_layers_keep_the_thickness() {
+    // A flat sheet 30 cm in front of a closed wall 20 cm thick, far farther than a thin
+    // slab (0.1 r = 5 cm) reaches. Single-sided, the peel keeps the wall's front face
+    // behind the sheet and marks it: the gap is air, the thickness applies, and the wall
+    // beside the sheet reads as with one layer. (Culling front faces, the peel took the
+    // wall's back face, and the sheet for a block 50 cm deep.) Double-sided (OBJ windings
+    // are not trusted) the wall's front counts as the sheet's back: a block on the wall.
+    let sheet_scene = |double_sided| {
+        let mut scene = common::bare_scene(vec![
+            common::cuboid("wall", DVec3::new(0.0, 0.0, WALL_Z - 0.1), Vec3::new(10.0, 10.0, 0.2), 0),
+            common::square("sheet", DVec3::new(0.0, 0.0, WALL_Z + 0.3), 1.2, 0),
+        ]);
+        scene.materials[0].double_sided = double_sided;
+        scene
+    };
+    let s = settings(1);
+    let eyes = s.profile.eyes(&sheet_scene(true).head.pose_at(0.0), s.near);
+    // The reference only picks the wall cells beside the sheet (its first hits are the
+    // same either way).
+    let rs = ReferenceSettings { radius: RADIUS as f64, rays_per_pixel: 16, stride: 2, near: s.near };
+    let reference = trace(&sheet_scene(true), &eyes.eyes, SIZE, &rs, &mut |_| {}).unwrap();
+    let thin_slab = |layers| {
+        let s = settings(layers);
+        Settings { ao: AoSettings { gtao: GtaoSettings { thickness: 0.1, ..s.ao.gtao.clone() }, ..s.ao }, ..s }
+    };
+    let beside =
+        |double_sided, layers| beside_board(&render(&sheet_scene(double_sided), &thin_slab(layers)).0, &reference, 2).0;
+    let (one, single_sided, double_sided) = (beside(false, 1), beside(false, 2), beside(true, 2));
+    println!("wall beside a sheet 0.3 m in front: one layer {one:.3}, two single-sided {single_sided:.3}, two double-sided {double_sided:.3}");
+    assert!(
+        (single_sided - one).abs() < 0.01,
+        "single-sided: the thickness as with one layer: {single_sided} against {one}"
+    );
+    assert!(
+        double_sided < single_sided - 0.03,
+        "double-sided: the span to the wall solid: {double_sided} against {single_sided}"
+    );
+}
+
+#[test]
 fn one_layer_is_gtao_as_before_wherever_the_second_is_left_out() {
     // The crease (a floor and a wall) bounds one convex region with the eyes inside it:
     // nothing lies behind its first layer, so two layers peel nothing and run the
@@ -165,13 +205,14 @@ fn the_peel_runs_only_where_the_ao_reads_it_and_explain_says_why() {
 }
 
 #[test]
-fn a_single_sided_material_peels_only_its_back_faces() {
+fn a_single_sided_material_s_second_layer_says_which_face_it_holds() {
     // A glTF material is single-sided unless marked double-sided, and its winding says
     // which face is the back. Everything here uses such a material. Both objects stand
-    // 30 cm in front of the wall: a closed 2 cm board, whose second layer must be its own back face (not
-    // the wall, which would make the board a block standing on the wall), and a flat
-    // sheet, which has no back: behind it lies only the wall's front face, and the gap to
-    // it is air, so nothing is peeled there (the one-layer rule applies).
+    // 30 cm in front of the wall: a closed 2 cm board, whose second layer must be its own
+    // back face, marked so (not the wall, which would make the board a block standing on
+    // the wall), and a flat sheet, which has no back: behind it lies the wall's front
+    // face, marked as one (the depth's lowest bit), so that the gap to it is taken as air
+    // and the one-layer rule applies there.
     let mut scene = common::bare_scene(vec![
         common::square("wall", DVec3::new(0.0, 0.0, WALL_Z), 10.0, 1),
         common::cuboid("board", DVec3::new(-0.4, 0.0, WALL_Z + 0.31), Vec3::new(0.5, 0.5, 0.02), 1),
@@ -186,26 +227,31 @@ fn a_single_sided_material_peels_only_its_back_faces() {
     let report = renderer.render(&eyes.eyes, &[FINAL_AO]).unwrap();
     assert!(report.plan.runs("depth-peel"), "{}", report.plan);
     let first = common::world_positions(&renderer.read_f32(DEPTH).unwrap(), &eyes.eyes, SIZE.0, SIZE.1, s.near);
-    let second =
-        common::world_positions(&renderer.read_f32(DEPTH_LAYER_2).unwrap(), &eyes.eyes, SIZE.0, SIZE.1, s.near);
+    let second_depth = renderer.read_f32(DEPTH_LAYER_2).unwrap();
+    let second = common::world_positions(&second_depth, &eyes.eyes, SIZE.0, SIZE.1, s.near);
+    let faces_eye: Vec<Vec<bool>> =
+        second_depth.iter().map(|layer| layer.iter().map(|d| d.to_bits() & 1 == 1).collect()).collect();
     let (mut board, mut sheet) = (Vec::new(), Vec::new());
-    for (first, second) in first.iter().zip(&second) {
-        for (p, behind) in first.iter().zip(second) {
+    for ((first, second), faces_eye) in first.iter().zip(&second).zip(&faces_eye) {
+        for ((p, behind), &faces_eye) in first.iter().zip(second).zip(faces_eye) {
             // The objects' centres only: clear of their edges, where a pixel's centre may
             // see past them.
             let Some(p) = p.filter(|p| p.y.abs() < 0.15 && (p.x.abs() - 0.4).abs() < 0.15) else { continue };
             if p.x < 0.0 && (p.z - (WALL_Z + 0.32)).abs() < 0.005 {
-                board.push(behind.map(|b| b.z));
+                board.push(behind.map(|b| (b.z, faces_eye)));
             } else if p.x > 0.0 && (p.z - (WALL_Z + 0.32)).abs() < 0.005 {
-                sheet.push(behind.map(|b| b.z));
+                sheet.push(behind.map(|b| (b.z, faces_eye)));
             }
         }
     }
     assert!(board.len() > 20 && sheet.len() > 20, "board {} and sheet {} pixels", board.len(), sheet.len());
     let back = WALL_Z + 0.30;
     assert!(
-        board.iter().all(|z| z.is_some_and(|z| (z - back).abs() < 0.005)),
+        board.iter().all(|b| b.is_some_and(|(z, faces_eye)| (z - back).abs() < 0.005 && !faces_eye)),
         "behind the board its back face at z = {back}: {board:?}"
     );
-    assert!(sheet.iter().all(Option::is_none), "nothing peeled behind a single-sided sheet: {sheet:?}");
+    assert!(
+        sheet.iter().all(|b| b.is_some_and(|(z, faces_eye)| (z - WALL_Z).abs() < 0.005 && faces_eye)),
+        "behind the single-sided sheet the wall's front face at z = {WALL_Z}: {sheet:?}"
+    );
 }

@@ -191,6 +191,19 @@ fn left_eye_point(
     return point;
 }
 
+// The second depth layer's lowest mantissa bit (passes/inputs.rs `DEPTH_LAYER_2`): 1 where
+// the surface behind the first layer faces the eye. Behind a closed object that surface is
+// its own back face, and the span between the layers is inside it; a front face there
+// means the first layer is a sheet (a wall of one polygon, an open shell) with the next
+// object behind it, and the span is air. One ulp of depth, far below any test's tolerance.
+fn second_layer_with_facing(depth: f32, faces_eye: bool) -> f32 {
+    return bitcast<f32>((bitcast<u32>(depth) & ~1u) | select(0u, 1u, faces_eye));
+}
+
+fn second_layer_faces_eye(depth: f32) -> bool {
+    return (bitcast<u32>(depth) & 1u) != 0u;
+}
+
 // Whether stored depth `depth` (reversed-Z, infinite far: its distance is near / depth)
 // holds a surface within 1 % of `distance`, the stereo reuse's test for the same surface:
 // |near / depth − distance| < 0.01 distance, multiplied through by depth (> 0) so that no

@@ -257,12 +257,14 @@ impl<'a> Marcher<'a> {
     }
 
     /// The view distance of the second layer at a pixel whose first surface lies at
-    /// `first` m, `None` where it has no surface behind the first (or none is given).
+    /// `first` m, `None` where it has no surface behind the first (or none is given), and
+    /// where the surface there faces the eye: the first is a sheet, and the span to the
+    /// next object is air (its depth's lowest bit, as the peel marks it).
     fn second_distance(&self, x: u32, y: u32, first: f64) -> Option<f64> {
-        let second = self.eye.second?;
-        let d = second[y as usize * self.size.0 as usize + x as usize] as f64;
+        let second = self.eye.second?[y as usize * self.size.0 as usize + x as usize];
+        let (d, faces_eye) = (second as f64, second.to_bits() & 1 == 1);
         let distance = self.settings.near / d;
-        (d.is_finite() && d > 0.0 && distance > first).then_some(distance)
+        (d.is_finite() && d > 0.0 && distance > first && !faces_eye).then_some(distance)
     }
 
     /// Where the visible surface at a pixel with depth `d` is a card (the G-buffer
@@ -433,7 +435,8 @@ mod tests {
 
     /// The second depth layer of `rects` as the renderer's peel writes it: through each
     /// pixel centre, the nearest surface farther than the first by `separation` of its
-    /// distance (reversed-Z, 0 where there is none).
+    /// distance (reversed-Z, 0 where there is none), marked as a back face (its lowest
+    /// bit clear).
     fn second_layer(rects: &[Rect], size: (u32, u32), separation: f64) -> Vec<f32> {
         let [l, r, u, d] = fov().tangents();
         let mut second = Vec::new();
@@ -445,7 +448,7 @@ mod tests {
                 let first = hits.iter().copied().fold(f64::INFINITY, f64::min);
                 let next =
                     hits.iter().copied().filter(|&t| t > first * (1.0 + separation)).fold(f64::INFINITY, f64::min);
-                second.push(if next.is_finite() { (NEAR / next) as f32 } else { 0.0 });
+                second.push(if next.is_finite() { f32::from_bits(((NEAR / next) as f32).to_bits() & !1) } else { 0.0 });
             }
         }
         second
@@ -671,6 +674,29 @@ mod tests {
         println!("beside a card 0.5 m up, limit − truth: as solid {solid_one:+.3} (one layer), {solid_two:+.3} (two); as a card {card_one:+.3}, {card_two:+.3}");
         assert!(solid_one < -0.02 && solid_two < -0.1, "as solid, the plate over-occludes: {solid_one}, {solid_two}");
         assert!(card_one.abs() < 0.03 && card_two.abs() < 0.03, "as a card: bias {card_one}, {card_two}");
+    }
+
+    #[test]
+    fn behind_a_sheet_the_two_layer_limit_keeps_the_thickness() {
+        // The plate alone, with no underside: a sheet 0.5 m over the floor. Its second
+        // layer is the floor, a face towards the eye (the peel's lowest bit set): the
+        // span down to it is air, so the two-layer limit is the one-layer limit there,
+        // pixel for pixel. Marked as a back face, the half-metre span reads as solid.
+        let (floor, plate) = floor_and_plate_top();
+        let scene = [floor, plate];
+        let (size, stride, radius) = ((64, 64), 2, 1.0);
+        let settings = LimitSettings { rays_per_pixel: 64, steps: 24, ..LimitSettings::new(radius, stride, NEAR) };
+        let (depth, normals) = rasterise(&scene, size);
+        let back = second_layer(&scene, size, 1e-3);
+        let front: Vec<f32> = back.iter().map(|&d| if d > 0.0 { f32::from_bits(d.to_bits() | 1) } else { d }).collect();
+        assert!(back.iter().any(|&d| d > 0.0));
+        let one = EyeBuffers { depth: &depth, normals: &normals, fov: fov(), direct: None, second: None };
+        let [one, front, back] = [None, Some(&front[..]), Some(&back[..])]
+            .map(|second| screen_space_limit(&[EyeBuffers { second, ..one }], size, &settings).unwrap());
+        assert_eq!(one, front);
+        let receivers = receivers_beside_the_plate(&depth, (size, stride), &scene, radius, 100);
+        let gap = mean_over(&receivers, |(i, j), _| (one.get(0, i, j).ao - back.get(0, i, j).ao) as f64);
+        assert!(gap > 0.02, "the span under the sheet taken as solid darkens by only {gap}");
     }
 
     #[test]

@@ -174,5 +174,7 @@ fn import_second_layer(in: VertexOut) -> @builtin(frag_depth) f32 {
     if (first == 0.0 || !(second > first)) {
         return 0.0;
     }
-    return min(params.near / second, 1.0);
+    // The lowest bit cleared: a host's layer does not say which face it holds, so each
+    // is taken as a back face (the span to it solid; common.wgsl `second_layer_faces_eye`).
+    return bitcast<f32>(bitcast<u32>(min(params.near / second, 1.0)) & ~1u);
 }

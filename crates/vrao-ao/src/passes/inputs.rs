@@ -19,6 +19,9 @@ pub const MOTION: Resource = Resource::attachment("motion", Size::Full, wgpu::Te
 pub const DIRECT_LIGHT: Resource = Resource::storage("direct", Size::Full, wgpu::TextureFormat::Rg32Uint);
 /// The second depth layer (reversed-Z, `Depth32Float`): the nearest surface at least the
 /// settings' `layer_separation` behind [`DEPTH`], 0 where nothing lies behind it. vrao's
-/// renderer peels it (its depth-peel pass) when the occlusion reads two layers.
+/// renderer peels it (its depth-peel pass) when the occlusion reads two layers. The
+/// depth's lowest mantissa bit is 1 where that surface faces the eye (a front face: the
+/// first layer is a sheet and the span between the layers is air, so the occlusion keeps
+/// its thickness there); a host's layer is imported with the bit cleared.
 pub const DEPTH_LAYER_2: Resource =
     Resource::attachment("depth-layer-2", Size::Full, wgpu::TextureFormat::Depth32Float);

@@ -89,10 +89,10 @@ impl MeshPipelines {
 
 /// A pipeline that draws the scene's meshes, writing depth: two-sided for double-sided
 /// materials (OBJ windings are not trusted: the G-buffer faces normals towards the eye,
-/// depth peeling wants the back faces, and both faces of a surface cast shadows). A
-/// single-sided material's back faces are culled in every pass that draws its surface,
-/// shadow maps included, as Unity's and Bevy's shadow casters follow the material's
-/// culling; the depth peel culls its front faces instead (`peel/mod.rs`).
+/// and both faces of a surface cast shadows). A single-sided material's back faces are
+/// culled in every pass that draws its surface, shadow maps included, as Unity's and
+/// Bevy's shadow casters follow the material's culling; the depth peel draws both faces
+/// of every material and marks which it kept (`peel/mod.rs`).
 pub fn mesh_pipeline(device: &wgpu::Device, p: MeshPipeline) -> wgpu::RenderPipeline {
     let (format, compare) = p.depth;
     let alpha_constants = [("ALPHA_TEST", 1.0)];

@@ -568,7 +568,9 @@ fn main(
                 var sample = select(vec4<f32>(0.0), vec4<f32>(surface, 1.0), d > 0.0);
                 if (SECOND_LAYER && d > 0.0) {
                     let d2 = textureLoad(second_depth_layers, vec2<i32>(pixel), i32(r.layer), 0);
-                    if (d2 > 0.0 && d2 < d) {
+                    // A front face behind the sample: the sample is on a sheet, whose
+                    // span to the next object is air; the thickness stands instead.
+                    if (d2 > 0.0 && d2 < d && !second_layer_faces_eye(d2)) {
                         sample.w = d / d2;
                     }
                 }

@@ -78,17 +78,17 @@ impl DepthPeelPass {
                     layout: &layout,
                     module: &module,
                     vertex: ("vs_peel", &MESH_ATTRIBUTES),
-                    // Reversed Z. The back faces are what this pass is for: where a material
-                    // is single-sided its winding says which face is which, and only its
-                    // back faces are peeled (the back of a closed mesh; behind a sheet,
-                    // such as a leaf or a sign, a front face would be the next object and
-                    // the gap to it no part of the sheet). A double-sided material's
-                    // winding is not trusted (OBJ), so both faces are.
+                    // Reversed Z. Both faces of every material: the nearest surface behind
+                    // the first layer is kept, and where the material is single-sided
+                    // with its facing (peel.wgsl): a front face there tells a sheet (a
+                    // sign, a leaf, an open shell) from a closed object, whose back face
+                    // comes first. Culling front faces instead took the next back face
+                    // behind a sheet, and the air between as solid.
                     depth: (DEPTH_LAYER_2.format(), wgpu::CompareFunction::Greater),
-                    fragment: Some(("fs_peel", &[])),
+                    fragment: Some((if kind.cull { "fs_peel_single_sided" } else { "fs_peel" }, &[])),
                     multiview_mask: None,
                     alpha_test: kind.alpha_test,
-                    cull: kind.cull.then_some(wgpu::Face::Front),
+                    cull: None,
                 },
             )
         });

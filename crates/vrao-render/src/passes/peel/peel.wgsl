@@ -1,10 +1,11 @@
 // Depth peeling (Ritschel et al. 2009 §4, Everitt 2001): the second depth layer of each eye,
 // the nearest surface lying behind the G-buffer's depth (the first layer). Depth only, one
 // render pass per eye layer; a fragment not farther than the first layer by PEEL_GAP is
-// discarded, so the depth test keeps the nearest of the rest (of a single-sided material,
-// the nearest back face: peel/mod.rs). On closed geometry the second layer is the back
-// face of the object the first layer sees: SSDO and GTAO then count a sample as an
-// occluder only between the two (inside that object).
+// discarded, so the depth test keeps the nearest of the rest, front or back face, and
+// marks which it is where the material's winding says. On closed geometry the second
+// layer is the back face of the object the first layer sees: SSDO and GTAO then count a
+// sample as an occluder only between the two (inside that object). A front face there
+// means the first layer is a sheet.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 
@@ -40,8 +41,11 @@ fn vs_peel(v: VertexIn) -> PeelVertexOut {
     return out;
 }
 
-@fragment
-fn fs_peel(in: PeelVertexOut) {
+// The fragment's depth, its lowest bit saying whether the surface faces the eye
+// (common.wgsl `second_layer_with_facing`). Only a single-sided material's winding says
+// which face is which (its culling relies on it); OBJ windings are not trusted, so a
+// double-sided material's faces count as back faces, the span to them solid.
+fn peeled_depth(in: PeelVertexOut, faces_eye: bool) -> f32 {
     alpha_test(in.uv, in.vertex_alpha);
     let p = in.clip;
     // Reversed Z with an infinite far plane: distance = near / depth, so "farther than
@@ -55,4 +59,15 @@ fn fs_peel(in: PeelVertexOut) {
     if (peel_eye.separation > 0.0 && !(p.z * (frame.near / first + peel_eye.separation) < frame.near)) {
         discard;
     }
+    return second_layer_with_facing(p.z, faces_eye);
+}
+
+@fragment
+fn fs_peel(in: PeelVertexOut) -> @builtin(frag_depth) f32 {
+    return peeled_depth(in, false);
+}
+
+@fragment
+fn fs_peel_single_sided(in: PeelVertexOut, @builtin(front_facing) front_facing: bool) -> @builtin(frag_depth) f32 {
+    return peeled_depth(in, front_facing);
 }
