@@ -127,7 +127,8 @@ pub struct AoFrame<'a> {
     pub depth_convention: DepthConvention,
     /// The host's second depth layer (its own depth peel: the nearest surface behind
     /// `depth`'s, best its nearest back face where the winding is trusted, so that a
-    /// sheet has nothing behind it), or `None` for one layer. Read only when `AoSettings::layers` is 2, by
+    /// sheet has nothing behind it: the engine takes every surface of it as a back face,
+    /// the span to it solid), or `None` for one layer. Read only when `AoSettings::layers` is 2, by
     /// the techniques that read two layers (GTAO, SSDO): their samples then block the span
     /// back to it instead of a slab `gtao.thickness` deep. The same rules as `depth`: a
     /// depth format of that list, its convention, one layer per view, the engine's size,
