@@ -124,12 +124,12 @@ fn ao_parameters_ui(ui: &mut egui::Ui, ao: &mut AoSettings, quality: &mut Option
     egui::ComboBox::from_label("quality").selected_text(quality_text).show_ui(ui, |ui| {
         for q in Quality::ALL {
             if ui.selectable_value(quality, Some(q), q.name()).clicked() {
-                ao.samples = q.samples();
+                q.apply(ao);
             }
         }
     });
     if ui.add(egui::Slider::new(&mut ao.samples, 1..=256).text("samples")).changed() {
-        *quality = Quality::ALL.into_iter().find(|q| q.samples() == ao.samples);
+        *quality = Quality::of(ao);
     }
     ui.add(egui::Slider::new(&mut ao.radius, 0.01..=4.0).logarithmic(true).text("radius m"));
     ui.add(egui::Slider::new(&mut ao.strength, 0.0..=4.0).text("strength"));

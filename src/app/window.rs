@@ -222,7 +222,7 @@ impl WindowState {
         );
         let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         let settings = frame_loop.renderer.settings().clone();
-        let quality = Quality::ALL.into_iter().find(|q| q.samples() == settings.ao.samples);
+        let quality = Quality::of(&settings.ao);
         Ok(WindowState {
             window,
             surface,
@@ -308,7 +308,7 @@ impl WindowState {
             if governor.changes().len() != self.panel.governor_changes_seen {
                 self.panel.governor_changes_seen = governor.changes().len();
                 self.panel.settings.ao = frame_loop.renderer.settings().ao.clone();
-                self.panel.quality = Quality::ALL.into_iter().find(|q| q.samples() == self.panel.settings.ao.samples);
+                self.panel.quality = Quality::of(&self.panel.settings.ao);
             }
         }
         let mut changed = false;

@@ -175,7 +175,8 @@ pub(crate) struct AoArgs {
     pub lights: LightArgs,
     #[arg(value_parser = choice::<Technique>(), long, default_value_t = AoSettings::default().technique, hide_possible_values = true, help = technique_help())]
     technique: Technique,
-    /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps).
+    /// Sampling preset: low, medium, high or ultra (N = 12, 24, 36, 64 depth taps; ultra
+    /// also reads two depth layers).
     #[arg(value_parser = choice::<Quality>(), long, default_value_t = Quality::default(), hide_possible_values = true)]
     quality: Quality,
     /// Depth taps per pixel, 1..=256 (overrides --quality).
@@ -218,8 +219,9 @@ pub(crate) struct AoArgs {
     /// per eye (the next surface behind the first, --layer-separation behind it) and GTAO
     /// and SSDO count a sample as solid only between the two, not a slab --thickness deep
     /// (kept where nothing lies behind). Costs a depth-only pass per eye and 4 bytes a pixel.
-    #[arg(long, default_value_t = AoSettings::default().layers, value_parser = clap::value_parser!(u32).range(1..=2))]
-    layers: u32,
+    /// Default: the --quality preset's (1; 2 at ultra).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=2))]
+    layers: Option<u32>,
     /// Spatial denoise: tile (edge-aware, 5 taps per axis over the 4×4 noise tile) or
     /// bilateral (separable, --blur px either side).
     #[arg(value_parser = choice::<Denoise>(), long, default_value_t = AoSettings::default().denoise, hide_possible_values = true)]
@@ -308,7 +310,7 @@ impl AoArgs {
             bounce: self.bounce,
             noise: self.noise,
             resolution: vrao_ao::Resolution::from_half_res(self.half_res),
-            layers: self.layers,
+            layers: self.layers.unwrap_or(self.quality.layers()),
             layer_separation: self.gtao.layer_separation,
             denoise: self.denoise,
             blur_radius: self.blur,

@@ -160,10 +160,15 @@ mod tests {
         let settings = args.settings(&Scene::load(&args.scene).unwrap());
         let ao = &settings.ao;
         assert_eq!(
-            (ao.samples, ao.resolution.is_half(), ao.radius, ao.technique),
-            (64, true, 0.25, vrao_ao::Technique::Hbao)
+            (ao.samples, ao.layers, ao.resolution.is_half(), ao.radius, ao.technique),
+            (64, 2, true, 0.25, vrao_ao::Technique::Hbao)
         );
         assert!(ao.temporal.enabled);
         assert_ne!(settings, Settings::default());
+        // --layers overrides the preset's; the default preset reads one layer.
+        for (line, layers) in [("render --quality ultra --layers 1", 1), ("render", 1), ("render --layers 2", 2)] {
+            let args = Render::try_parse_from(line.split(' ')).unwrap().args;
+            assert_eq!(args.settings(&Scene::load(&args.scene).unwrap()).ao.layers, layers, "{line}");
+        }
     }
 }

@@ -114,7 +114,7 @@ fn check_list<T: PartialEq + std::fmt::Debug>(what: &str, list: &[T]) -> Result<
 pub struct TableCase {
     /// The occlusion technique.
     pub technique: Technique,
-    /// The quality preset (its depth taps per pixel).
+    /// The quality preset (its depth taps per pixel and depth layers).
     pub quality: Quality,
     /// The resolution the occlusion runs at.
     pub resolution: Resolution,
@@ -127,7 +127,7 @@ impl TableCase {
     pub fn settings(&self, base: &Settings) -> Settings {
         let mut settings = base.clone();
         settings.ao.technique = self.technique;
-        settings.ao.samples = self.quality.samples();
+        self.quality.apply(&mut settings.ao);
         settings.ao.resolution = self.resolution;
         settings.ao.foveation = self.foveation;
         settings

@@ -75,14 +75,16 @@ fn cases() -> Vec<AoSettings> {
     let defaults = AoSettings::default();
     let mut cases: Vec<AoSettings> = Quality::ALL
         .iter()
-        .map(|q| AoSettings { technique: Technique::Gtao, samples: q.samples(), ..defaults.clone() })
+        .map(|&q| {
+            let mut ao = AoSettings { technique: Technique::Gtao, ..defaults.clone() };
+            q.apply(&mut ao);
+            ao
+        })
         .collect();
-    cases.push(AoSettings {
-        technique: Technique::Gtao,
-        samples: Quality::Ultra.samples(),
-        resolution: vrao_ao::Resolution::Half,
-        ..defaults.clone()
-    });
+    let mut ultra_half =
+        AoSettings { technique: Technique::Gtao, resolution: vrao_ao::Resolution::Half, ..defaults.clone() };
+    Quality::Ultra.apply(&mut ultra_half);
+    cases.push(ultra_half);
     for technique in Technique::estimators() {
         if technique != Technique::Gtao {
             cases.push(AoSettings { technique, ..defaults.clone() });
