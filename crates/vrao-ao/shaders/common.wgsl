@@ -248,7 +248,15 @@ fn left_eye_value(
     // Gathered at the corner pixels base and base + (1, 1) share: in gather order,
     // base + (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
     let corner = (base + vec2<f32>(1.0)) / vec2<f32>(grid);
-    let there = textureGather(3, left_geometry, gather, corner, 0);
+    return left_eye_blend(corner, t, textureGather(3, left_geometry, gather, corner, 0), distance);
+}
+
+// The blend of the 2×2 block gathered at `corner` (its texels' distances `there`, in
+// gather order) for a point at `t` within it and `distance` away: bilinear over the
+// texels on the same surface (within 5 % in distance); not found where none is.
+fn left_eye_blend(corner: vec2<f32>, t: vec2<f32>, there: vec4<f32>, distance: f32) -> LeftEyeValue {
+    var result: LeftEyeValue;
+    result.found = false;
     let bilinear = vec4<f32>((1.0 - t.x) * t.y, t.x * t.y, t.x * (1.0 - t.y), (1.0 - t.x) * (1.0 - t.y));
     let same = (there > vec4<f32>(0.0)) & (abs(there - vec4<f32>(distance)) < vec4<f32>(0.05 * distance));
     let w = select(vec4<f32>(0.0), bilinear, same);

@@ -19,12 +19,15 @@ pub struct RightEyeList {
     /// items (0: none did), and that frame's index.
     tiles: u32,
     frame: u64,
+    /// Workgroups the list's dispatch ran before its items that frame (GTAO's folded
+    /// dispatch: the left eye's interior tiles).
+    before_items: u32,
 }
 
 impl RightEyeList {
     /// An empty list; `label` names its buffers.
     pub fn new(gpu: &Gpu, label: &'static str) -> Self {
-        RightEyeList { list: IndirectList::new(gpu, label), tiles: 0, frame: 0 }
+        RightEyeList { list: IndirectList::new(gpu, label), tiles: 0, frame: 0, before_items: 0 }
     }
 
     /// What binds in the list's place before the right eye's dispatches.
@@ -35,8 +38,28 @@ impl RightEyeList {
     /// Starts this frame's list, with room for `items`, over an image of `tiles` tiles;
     /// returns it.
     fn start(&mut self, ctx: &mut RecordContext, items: u32, tiles: u32) -> wgpu::Buffer {
-        (self.tiles, self.frame) = (tiles, ctx.setup.frame_index);
+        (self.tiles, self.frame, self.before_items) = (tiles, ctx.setup.frame_index, 0);
         self.list.start(ctx, items)
+    }
+
+    /// GTAO's right eye, folded into the left eye's dispatch (gtao.wgsl `FOLDED`): starts
+    /// the list of a `width` × `height` image, whose dispatch runs `before_items`
+    /// workgroups of the left eye first, and returns it; its dispatch arguments follow
+    /// [`RightEyeList::take_arguments`].
+    pub(crate) fn start_folded(&mut self, ctx: &mut RecordContext, (width, height): (u32, u32), before_items: u32) -> wgpu::Buffer {
+        let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
+        self.before_items = before_items;
+        list
+    }
+
+    /// Copies the list's header out as its indirect dispatch's arguments.
+    pub(crate) fn take_arguments(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.list.take_arguments(encoder);
+    }
+
+    /// The indirect dispatch's arguments (offset 0).
+    pub(crate) fn arguments(&self) -> &wgpu::Buffer {
+        self.list.arguments()
     }
 
     /// The right eye after the left (occlusion/right_eye.wgsl): `classify` copies what
@@ -58,13 +81,8 @@ impl RightEyeList {
         (width, height): (u32, u32),
     ) {
         let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
-        let (ao_right, geometry_right) = (ctx.layer_view(AO_RAW, 1), ctx.layer_view(AO_GEOMETRY, 1));
-        let (ao_left, geometry_left) = (ctx.layer_view(AO_RAW, 0), ctx.layer_view(AO_GEOMETRY, 0));
-        let view = wgpu::BindingResource::TextureView;
-        let mut own = vec![view(&ao_left), view(&geometry_left), list.as_entire_binding()];
-        own.extend_from_slice(after_list);
-        let resources =
-            ctx.bind_overriding(binds, &own, &[(AO_RAW, view(&ao_right)), (AO_GEOMETRY, view(&geometry_right))]);
+        let views = RightEyeViews::new(ctx);
+        let resources = views.bind(ctx, binds, &list, after_list);
         let device = &ctx.gpu.device;
         let visibility = ctx.visibility.bind_group();
         classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
@@ -133,6 +151,40 @@ impl RightEyeList {
     /// The counts in a header read back (its first `HEADER_BYTES`).
     fn counts(&self, header: &[u8], pass: &'static str) -> Option<RightEyeTiles> {
         let word = |k: usize| Some(u32::from_le_bytes(header.get(4 * k..4 * k + 4)?.try_into().ok()?));
-        Some(RightEyeTiles { pass, computed: word(0)?, items: word(3)?, total: self.tiles, frame: self.frame })
+        let computed = word(0)?.checked_sub(self.before_items)?;
+        Some(RightEyeTiles { pass, computed, items: word(3)?, total: self.tiles, frame: self.frame })
+    }
+}
+
+/// The views a right-eye dispatch binds: layer 1 of the raw occlusion and its geometry as
+/// its outputs, and their left-eye layer 0 to read.
+pub(crate) struct RightEyeViews {
+    /// Of the raw occlusion, then of its geometry: [left, right].
+    occlusion: [wgpu::TextureView; 2],
+    geometry: [wgpu::TextureView; 2],
+}
+
+impl RightEyeViews {
+    /// The views of this frame's targets.
+    pub(crate) fn new(ctx: &RecordContext) -> Self {
+        RightEyeViews {
+            occlusion: [0, 1].map(|layer| ctx.layer_view(AO_RAW, layer)),
+            geometry: [0, 1].map(|layer| ctx.layer_view(AO_GEOMETRY, layer)),
+        }
+    }
+
+    /// `binds` for a right-eye dispatch: the right eye's layers as the outputs, the left
+    /// eye's at bindings 7 and 8, `list` at 9, then `after_list`.
+    pub(crate) fn bind<'a: 'b, 'b>(
+        &'b self,
+        ctx: &RecordContext<'a>,
+        binds: &[Bind],
+        list: &'b wgpu::Buffer,
+        after_list: &[wgpu::BindingResource<'b>],
+    ) -> Vec<wgpu::BindingResource<'b>> {
+        let view = wgpu::BindingResource::TextureView;
+        let mut own = vec![view(&self.occlusion[0]), view(&self.geometry[0]), list.as_entire_binding()];
+        own.extend_from_slice(after_list);
+        ctx.bind_overriding(binds, &own, &[(AO_RAW, view(&self.occlusion[1])), (AO_GEOMETRY, view(&self.geometry[1]))])
     }
 }

@@ -34,8 +34,12 @@
 // cross the inner border (a surface so near that the radius spans more than the band) is
 // deferred: listed, and marched after by the band's code over the list (CROSSING), so
 // the band's edge leaves no seam however near the surface.
-// With two views and `stereo_reuse`, the right eye then runs as a classifying dispatch
-// and an indirect one over the pixels it listed (RIGHT_EYE).
+// With two views and `stereo_reuse`, the right eye's pixels the left eye cannot give are
+// listed first (`list_right_eye`, from the depth alone) and marched in the left eye's
+// dispatch, after its tiles (FOLDED: one indirect dispatch, so a wide GPU runs the few
+// right-eye marches beside the left eye's instead of in a second dispatch of their own
+// that lasts as long as its longest march); then `copy_right_eye` copies the rest from
+// the left eye's results.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 // The light a march gathers besides the visibility (`begin_light`, `gather_sample` for
@@ -50,7 +54,7 @@ const SECTORS: f32 = 32.0;
 // the rest of the image.
 override INNER_BAND: bool = false;
 
-// The right eye's dispatches (RIGHT_EYE, LISTED_PIXELS, `classify_right_eye`):
+// The right eye's dispatches (RIGHT_EYE, LISTED_PIXELS; `list_right_eye`, `copy_right_eye`):
 // occlusion/right_eye.wgsl, compiled before this file.
 
 // Set when the scene has alpha-tested materials. A depth sample on one (the G-buffer's
@@ -116,9 +120,29 @@ struct GtaoParams {
 };
 @group(0) @binding(11) var<uniform> gtao: GtaoParams;
 
-// The occlusion pixel of invocation `id` (in workgroup `group`, at `local` within it) in
-// this dispatch's part of the image, or none (x = ao_size.x) past its part's width.
-fn dispatch_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
+// The left eye's interior dispatch over its 8×8 tiles followed by the right eye's listed
+// pixels, 64 to a workgroup, in one indirect dispatch (module comment).
+override FOLDED: bool = false;
+
+// The interior's tiles (the image less the inner band, 8×8 pixels each), x and y.
+fn interior_tiles() -> vec2<u32> {
+    let band = min(gtao.inner_band, ao.ao_size.x);
+    return (vec2<u32>(ao.ao_size.x - band, ao.ao_size.y) + vec2<u32>(7u)) / 8u;
+}
+
+// The occlusion pixel of invocation `invocation` (in workgroup `group`, at `local` within
+// it) in this dispatch's part of the image, or none (x = ao_size.x) past its part's width.
+fn dispatch_pixel(invocation: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
+    var id = invocation;
+    if (FOLDED) {
+        let tiles = interior_tiles();
+        let left_tiles = tiles.x * tiles.y;
+        if (group.x >= left_tiles) {
+            return listed_right_pixel((group.x - left_tiles) * 64u + local);
+        }
+        let tile = vec2<u32>(group.x % tiles.x, group.x / tiles.x);
+        id = vec3<u32>(tile * 8u + vec2<u32>(local % 8u, local / 8u), 0u);
+    }
     if (CROSSING) {
         let i = group.x * 64u + local;
         if (i >= atomicLoad(&deferred.count)) {
@@ -602,4 +626,36 @@ fn main(
     }
     let result = saturate_ao(1.0 - ao.strength * (1.0 - visibility));
     store_occlusion(id, vec4<f32>(light_result(light, r, visibility, total), result));
+}
+
+// GTAO's right eye before its folded dispatch: lists the pixels the left eye cannot give
+// (`left_eye_value_from_depth`), and makes the list's dispatch argument count the left
+// eye's interior tiles first.
+@compute @workgroup_size(8, 8, 1)
+fn list_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
+    let id = vec3<u32>(invocation.xy, 1u);
+    if (all(invocation.xy == vec2<u32>(0u))) {
+        let tiles = interior_tiles();
+        atomicAdd(&right_list.groups_x, tiles.x * tiles.y);
+    }
+    let r = receiver_at(id);
+    if (r.valid && !left_eye_value_from_depth(r.position).found) {
+        list_right_pixel(id);
+    }
+}
+
+// GTAO's right eye after its folded dispatch: every pixel's geometry (and the sky), and
+// the left eye's value wherever `list_right_eye` did not list the pixel (the same test).
+@compute @workgroup_size(8, 8, 1)
+fn copy_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
+    let id = vec3<u32>(invocation.xy, 1u);
+    let r = begin_receiver(id);
+    if (!r.valid) {
+        return;
+    }
+    let left = left_eye_value_from_depth(r.position);
+    if (left.found) {
+        let value = chain_gather_blend(left_occlusion, gather, left.corner, 0, left.weights);
+        store_occlusion(id, vec4<f32>(reused_light(value), value.a));
+    }
 }

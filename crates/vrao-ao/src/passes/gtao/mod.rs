@@ -8,9 +8,9 @@
 use super::indirect_list::IndirectList;
 use super::inputs::DEPTH_LAYER_2;
 use super::occlusion::{self, technique_decl, OCCLUSION_WGSL, RIGHT_EYE_WGSL};
-use super::right_eye_list::RightEyeList;
+use super::right_eye_list::{RightEyeList, RightEyeViews};
 use super::{DeclareContext, Pass, RecordContext, RightEyeTiles};
-use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, VISIBILITY};
+use crate::gpu::kernel::{wgsl, Bind, Kernel, Shader, Slot, COMMON, TILE, VISIBILITY};
 use crate::gpu::Gpu;
 use crate::graph::PassDecl;
 use crate::resource::ChainLayout;
@@ -112,24 +112,28 @@ pub(crate) fn gtao_inner_band(width: u32) -> u32 {
 struct Kernels {
     interior: Kernel,
     inner_band: Kernel,
-    /// The band's march over the marches the rest deferred (an indirect dispatch).
+    /// The band's march over the marches the rest deferred (an indirect dispatch), of
+    /// either eye.
     crossing: Kernel,
-    /// The right eye's copy of what the left eye gives, listing the pixels left to march.
-    right_classify: Kernel,
-    /// The right eye's march over the listed pixels (an indirect dispatch).
-    right_listed: Kernel,
-    /// The band's march over the right eye's listed marches that it deferred.
-    right_crossing: Kernel,
+    /// With the stereo reuse: the right eye's pixels the left eye cannot give, listed
+    /// from the depth before the left eye marches.
+    right_list: Kernel,
+    /// The left eye's interior and then the right eye's listed pixels, in one indirect
+    /// dispatch.
+    folded: Kernel,
+    /// The right eye's copies of the left eye's values, after the march.
+    right_copy: Kernel,
 }
 
 impl Kernels {
     fn new(gpu: &Gpu, march: &March, variant: Variant) -> Self {
         let Variant { thin_cards, second_layer, footprint } = variant;
         // A deferred march runs the band's code (`band`) over the list (`crossing`).
-        let kernel = |entry: &str, band: bool, right: bool, crossing: bool| {
+        let kernel = |entry: &str, band: bool, right: bool, crossing: bool, folded: bool| {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
                 ("CROSSING", f64::from(crossing)),
+                ("FOLDED", f64::from(folded)),
                 ("THIN_CARDS", f64::from(thin_cards)),
                 ("SECOND_LAYER", f64::from(second_layer)),
                 ("FOOTPRINT", f64::from(footprint)),
@@ -140,12 +144,12 @@ impl Kernels {
             Kernel::in_chain(gpu, march.label, &march.files, entry, march.binds, &constants, chain)
         };
         Kernels {
-            interior: kernel("main", false, false, false),
-            inner_band: kernel("main", true, false, false),
-            crossing: kernel("main", true, false, true),
-            right_classify: kernel("classify_right_eye", false, true, false),
-            right_listed: kernel("main", false, true, false),
-            right_crossing: kernel("main", true, true, true),
+            interior: kernel("main", false, false, false, false),
+            inner_band: kernel("main", true, false, false, false),
+            crossing: kernel("main", true, false, true, false),
+            right_list: kernel("list_right_eye", false, true, false, false),
+            folded: kernel("main", false, false, false, true),
+            right_copy: kernel("copy_right_eye", false, true, false, false),
         }
     }
 }
@@ -280,41 +284,43 @@ impl Pass for GtaoPass {
         };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         // The left eye (or the only view) marches every pixel, in two parts and the marches
-        // the first part deferred; with two views and `stereo_reuse`, the right eye then
-        // reuses it, else it marches alike. Bindings 7 to 9 are unused before the right
-        // eye's dispatches: the normals and the list's header stand in.
+        // the first part deferred. With two views and `stereo_reuse` the right eye's
+        // pixels the left eye cannot give are listed first and marched in the left eye's
+        // interior dispatch (gtao.wgsl `FOLDED`), and the rest copied last; without it
+        // the right eye marches alike. Bindings 7 to 9 are unused outside the right eye's
+        // dispatches: the normals and the list's header stand in.
         let normals = ctx.view(super::inputs::NORMALS);
-        let header = self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).stand_in();
+        let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
+        let header = right_eye.stand_in();
         let mut deferred = self.deferred.lock().unwrap_or_else(|p| p.into_inner());
         let reuse = ao.stereo_reuse && layers == 2;
         let marched_layers = if reuse { 1 } else { layers };
-        // Room for every pixel of the marched layers: the left eye's (or both eyes') list
-        // and then the right eye's reuse one buffer.
-        let room = width * height * marched_layers;
-        let deferred_list = deferred.start(ctx, room);
-        let stand_ins = [
-            normals.clone(),
-            normals,
-            header.as_entire_binding(),
-            self.params.as_entire_binding(),
-            deferred_list.as_entire_binding(),
-        ];
-        let resources = ctx.bind(self.march.binds, &stand_ins);
+        // Room for every pixel of both eyes: the deferred marches of either.
+        let deferred_list = deferred.start(ctx, width * height * layers);
+        let after_list = [self.params.as_entire_binding(), deferred_list.as_entire_binding()];
+        let resources = ctx.bind(self.march.binds, &own_bindings(&normals, &header, &after_list));
         let visibility = ctx.visibility.bind_group();
-        kernels.interior.dispatch(device, ctx.encoder, visibility, &resources, (width - band, height, marched_layers));
-        kernels.inner_band.dispatch(device, ctx.encoder, visibility, &resources, (band, height, marched_layers));
-        deferred.take_arguments(ctx.encoder);
-        kernels.crossing.dispatch_indirect(device, ctx.encoder, visibility, &resources, deferred.arguments(), 0);
-        if reuse {
-            let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
-            let deferred_list = deferred.start(ctx, room);
-            let own = [self.params.as_entire_binding(), deferred_list.as_entire_binding()];
-            let right_kernels = [&kernels.right_classify, &kernels.right_listed];
-            let then = Some((&kernels.right_crossing, &*deferred));
-            right_eye.record_right_eye(ctx, self.march.binds, &own, right_kernels, then, (width, height));
-        } else {
-            self.right_eye.lock().unwrap_or_else(|p| p.into_inner()).skip();
+        let band_pass = |ctx: &mut RecordContext, deferred: &IndirectList| {
+            kernels.inner_band.dispatch(device, ctx.encoder, visibility, &resources, (band, height, marched_layers));
+            deferred.take_arguments(ctx.encoder);
+            kernels.crossing.dispatch_indirect(device, ctx.encoder, visibility, &resources, deferred.arguments(), 0);
+        };
+        if !reuse {
+            right_eye.skip();
+            kernels.interior.dispatch(device, ctx.encoder, visibility, &resources, (width - band, height, layers));
+            band_pass(ctx, &deferred);
+            return;
         }
+        let interior_tiles = (width - band).div_ceil(TILE) * height.div_ceil(TILE);
+        let list = right_eye.start_folded(ctx, (width, height), interior_tiles);
+        let views = RightEyeViews::new(ctx);
+        let right = views.bind(ctx, self.march.binds, &list, &after_list);
+        kernels.right_list.dispatch(device, ctx.encoder, visibility, &right, (width, height, 1));
+        right_eye.take_arguments(ctx.encoder);
+        let folded = ctx.bind(self.march.binds, &own_bindings(&normals, &list, &after_list));
+        kernels.folded.dispatch_indirect(device, ctx.encoder, visibility, &folded, right_eye.arguments(), 0);
+        band_pass(ctx, &deferred);
+        kernels.right_copy.dispatch(device, ctx.encoder, visibility, &right, (width, height, 1));
     }
 
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
@@ -326,6 +332,18 @@ impl Pass for GtaoPass {
         let right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
         right_eye.read_items(gpu, self.march.label)
     }
+}
+
+/// GTAO's own bindings (from 7 on) outside the right eye's dispatches: the normals stand
+/// in for the left eye's targets at 7 and 8, `list` at 9, then `after_list`.
+fn own_bindings<'b>(
+    normals: &wgpu::BindingResource<'b>,
+    list: &'b wgpu::Buffer,
+    after_list: &[wgpu::BindingResource<'b>],
+) -> Vec<wgpu::BindingResource<'b>> {
+    let mut own = vec![normals.clone(), normals.clone(), list.as_entire_binding()];
+    own.extend_from_slice(after_list);
+    own
 }
 
 #[cfg(test)]

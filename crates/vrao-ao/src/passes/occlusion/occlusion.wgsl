@@ -22,6 +22,8 @@ fn output_layer(id: vec3<u32>) -> i32 {
 struct Receiver {
     // False outside the target or on the sky (the pixel is then already written).
     valid: bool,
+    // False outside the target.
+    in_target: bool,
     layer: u32,
     eye: Eye,
     // The full-resolution G-buffer pixel behind this occlusion pixel.
@@ -30,34 +32,48 @@ struct Receiver {
     normal: vec3<f32>,
 };
 
-// Sets up occlusion pixel `id`: reads its depth and normal and writes its AoGeometry;
-// on the sky it writes "unoccluded" and returns an invalid receiver.
-fn begin_receiver(id: vec3<u32>) -> Receiver {
+// Occlusion pixel `id`'s surface from its depth and normal, writing nothing: invalid
+// outside the target (`in_target` false) and on the sky.
+fn receiver_at(id: vec3<u32>) -> Receiver {
     var r: Receiver;
     r.valid = false;
-    if (id.x >= ao.ao_size.x || id.y >= ao.ao_size.y || id.z >= frame.layers) {
+    r.in_target = id.x < ao.ao_size.x && id.y < ao.ao_size.y && id.z < frame.layers;
+    if (!r.in_target) {
         return r;
     }
     r.layer = id.z;
     r.eye = frame.eyes[id.z];
     r.pixel = full_res_pixel(id.xy, ao.scale, frame.size);
-    // A tile the lens hides (visibility.wgsl) is written as the sky is, before any fetch;
+    // A tile the lens hides (visibility.wgsl) is taken as the sky, before any fetch;
     // its hidden pixels in a tile the lens partly shows read as sky in depth already.
     var depth = 0.0;
     if (tile_rate(id.xy, id.z, ao.scale) > 0.0) {
         depth = textureLoad(depth_layers, vec2<i32>(r.pixel), i32(r.layer), 0);
     }
     if (depth <= 0.0) {
-        store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
-        textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(0.0));
         return r;
     }
     r.position = load_view_position(depth, r.pixel, r.eye, frame.size, frame.near);
     let stored = textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz;
     r.normal = repaired_normal(safe_normal(stored, r.position), r.pixel, r.layer, r.eye, r.position);
+    r.valid = true;
+    return r;
+}
+
+// Sets up occlusion pixel `id` (`receiver_at`) and writes its AoGeometry; on the sky it
+// writes "unoccluded" and returns an invalid receiver.
+fn begin_receiver(id: vec3<u32>) -> Receiver {
+    let r = receiver_at(id);
+    if (!r.in_target) {
+        return r;
+    }
+    if (!r.valid) {
+        store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(0.0));
+        return r;
+    }
     // Clamped to the half float's range (AoGeometry's format): finite at any distance.
     textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, min(-r.position.z, 65504.0)));
-    r.valid = true;
     return r;
 }
 

@@ -11,7 +11,10 @@
 // LISTED_PIXELS runs over the listed pixels alone, 64 to a workgroup, by an indirect
 // dispatch: the right eye pays for the pixels the left eye cannot give, not for every
 // warp that holds one of them (listing 8×8 tiles of the image instead dispatched every
-// tile a silhouette crosses: a quarter of Sibenik's right eye).
+// tile a silhouette crosses: a quarter of Sibenik's right eye). GTAO (and SSDO on its
+// march) goes further: it lists from the depth alone before the left eye marches
+// (`left_eye_value_from_depth`), marches the listed pixels in the left eye's dispatch and
+// copies after (gtao.wgsl `FOLDED`).
 //
 // The includer defines `reused_light(value)`: the rgb a copied value carries (its
 // gathered light for SSDO, 0 for the AO-only techniques).
@@ -38,16 +41,29 @@ struct RightEyeList {
 // The nearest sampler the left eye's 2×2 blocks are gathered through.
 @group(0) @binding(10) var gather: sampler;
 
+// The right eye's listed occlusion pixel `i`, or none (x = ao_size.x) past the list.
+fn listed_right_pixel(i: u32) -> vec3<u32> {
+    if (i >= atomicLoad(&right_list.count)) {
+        return vec3<u32>(ao.ao_size.x, 0u, 1u);
+    }
+    let packed = right_list.pixels[i];
+    return vec3<u32>(packed & 0xffffu, packed >> 16u, 1u);
+}
+
+// Appends right-eye occlusion pixel `id` to the list.
+fn list_right_pixel(id: vec3<u32>) {
+    let i = atomicAdd(&right_list.count, 1u);
+    right_list.pixels[i] = id.x | (id.y << 16u);
+    if (i % 64u == 0u) {
+        atomicAdd(&right_list.groups_x, 1u);
+    }
+}
+
 // The right-eye occlusion pixel of invocation `id` (in workgroup `group`, at `local`
 // within it): the listed pixel, or none (x = ao_size.x) past the list.
 fn right_eye_pixel(id: vec3<u32>, group: vec3<u32>, local: u32) -> vec3<u32> {
     if (LISTED_PIXELS) {
-        let i = group.x * 64u + local;
-        if (i >= atomicLoad(&right_list.count)) {
-            return vec3<u32>(ao.ao_size.x, 0u, 1u);
-        }
-        let packed = right_list.pixels[i];
-        return vec3<u32>(packed & 0xffffu, packed >> 16u, 1u);
+        return listed_right_pixel(group.x * 64u + local);
     }
     return vec3<u32>(id.x, id.y, 1u);
 }
@@ -85,9 +101,40 @@ fn classify_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
     if (reused_from_left_eye(id, begin_receiver(id))) {
         return;
     }
-    let i = atomicAdd(&right_list.count, 1u);
-    right_list.pixels[i] = id.x | (id.y << 16u);
-    if (i % 64u == 0u) {
-        atomicAdd(&right_list.groups_x, 1u);
+    list_right_pixel(id);
+}
+
+// The left eye's occlusion-pixel distance at `q` (clamped to the target, as the gather's
+// sampler clamps), from the depth: what its AoGeometry holds once its march has run (0
+// on the sky and in hidden tiles; rounded to AoGeometry's half float).
+fn left_distance_from_depth(q: vec2<f32>) -> f32 {
+    let p = vec2<u32>(clamp(vec2<i32>(q), vec2<i32>(0), vec2<i32>(ao.ao_size) - vec2<i32>(1)));
+    if (tile_rate(p, 0u, ao.scale) == 0.0) {
+        return 0.0;
     }
+    let d = textureLoad(depth_layers, vec2<i32>(full_res_pixel(p, ao.scale, frame.size)), 0, 0);
+    let distance = select(0.0, min(frame.near / d, 65504.0), d > 0.0);
+    return unpack2x16float(pack2x16float(vec2<f32>(distance, 0.0))).x;
+}
+
+// `left_eye_value` (common.wgsl) with the left eye's distances from its depth instead of
+// its AoGeometry: the same test before the left eye marches (GTAO's folded dispatch lists
+// the right eye first) and after it (the copies), so that the two agree pixel for pixel.
+fn left_eye_value_from_depth(position: vec3<f32>) -> LeftEyeValue {
+    let point = left_eye_point(position, frame.eyes[1], frame.eyes[0], depth_layers, frame.size, frame.near);
+    if (!point.seen) {
+        var none: LeftEyeValue;
+        none.found = false;
+        return none;
+    }
+    let f = point.uv * vec2<f32>(ao.ao_size) - 0.5 / f32(ao.scale);
+    let base = floor(f);
+    // In gather order: base + (0, 1), (1, 1), (1, 0), (0, 0).
+    let there = vec4<f32>(
+        left_distance_from_depth(base + vec2<f32>(0.0, 1.0)),
+        left_distance_from_depth(base + vec2<f32>(1.0, 1.0)),
+        left_distance_from_depth(base + vec2<f32>(1.0, 0.0)),
+        left_distance_from_depth(base),
+    );
+    return left_eye_blend((base + vec2<f32>(1.0)) / vec2<f32>(ao.ao_size), f - base, there, point.distance);
 }
