@@ -46,7 +46,12 @@ impl RightEyeList {
     /// the list of a `width` × `height` image, whose dispatch runs `before_items`
     /// workgroups of the left eye first, and returns it; its dispatch arguments follow
     /// [`RightEyeList::take_arguments`].
-    pub(crate) fn start_folded(&mut self, ctx: &mut RecordContext, (width, height): (u32, u32), before_items: u32) -> wgpu::Buffer {
+    pub(crate) fn start_folded(
+        &mut self,
+        ctx: &mut RecordContext,
+        (width, height): (u32, u32),
+        before_items: u32,
+    ) -> wgpu::Buffer {
         let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
         self.before_items = before_items;
         list

@@ -35,10 +35,10 @@
 // deferred: listed, and marched after by the band's code over the list (CROSSING), so
 // the band's edge leaves no seam however near the surface.
 // With two views and `stereo_reuse`, the right eye's pixels the left eye cannot give are
-// listed first (`list_right_eye`, from the depth alone) and marched in the left eye's
+// listed first (`right_eye_reuse`, from the depth alone) and marched in the left eye's
 // dispatch, after its tiles (FOLDED: one indirect dispatch, so a wide GPU runs the few
 // right-eye marches beside the left eye's instead of in a second dispatch of their own
-// that lasts as long as its longest march); then `copy_right_eye` copies the rest from
+// that lasts as long as its longest march); then `right_eye_reuse` copies the rest from
 // the left eye's results.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
@@ -54,7 +54,7 @@ const SECTORS: f32 = 32.0;
 // the rest of the image.
 override INNER_BAND: bool = false;
 
-// The right eye's dispatches (RIGHT_EYE, LISTED_PIXELS; `list_right_eye`, `copy_right_eye`):
+// The right eye's dispatches (RIGHT_EYE, LISTED_PIXELS; `right_eye_reuse`):
 // occlusion/right_eye.wgsl, compiled before this file.
 
 // Set when the scene has alpha-tested materials. A depth sample on one (the G-buffer's
@@ -115,8 +115,8 @@ struct GtaoParams {
     inner_band: u32,
     // The share of its stratum a solid depth sample blocks on its own plane (`add_sample`).
     footprint: f32,
-    // Pads the struct to 32 bytes, a multiple of 16 (`padding` of GtaoUniform).
-    _pad0: u32,
+    // `right_eye_reuse`'s step: 0 lists, 1 copies (two uniform buffers, one pipeline).
+    right_eye_step: u32,
 };
 @group(0) @binding(11) var<uniform> gtao: GtaoParams;
 
@@ -628,33 +628,36 @@ fn main(
     store_occlusion(id, vec4<f32>(light_result(light, r, visibility, total), result));
 }
 
-// GTAO's right eye before its folded dispatch: lists the pixels the left eye cannot give
-// (`left_eye_value_from_depth`), and makes the list's dispatch argument count the left
-// eye's interior tiles first.
+// GTAO's right eye around its folded dispatch, one pipeline for both steps so that both
+// make the same test on the same inputs with the same code (a pixel listed and copied,
+// or neither, would be a stale value): before it (`right_eye_step` 0) the pixels the left
+// eye cannot give are listed (`left_eye_value_from_depth`), and the list's dispatch
+// argument first counts the left eye's interior tiles; after it (1) every pixel's
+// geometry (and the sky) is written, and the left eye's value wherever the pixel was not
+// listed.
 @compute @workgroup_size(8, 8, 1)
-fn list_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
+fn right_eye_reuse(@builtin(global_invocation_id) invocation: vec3<u32>) {
     let id = vec3<u32>(invocation.xy, 1u);
-    if (all(invocation.xy == vec2<u32>(0u))) {
+    let copy = gtao.right_eye_step == 1u;
+    if (!copy && all(invocation.xy == vec2<u32>(0u))) {
         let tiles = interior_tiles();
         atomicAdd(&right_list.groups_x, tiles.x * tiles.y);
     }
-    let r = receiver_at(id);
-    if (r.valid && !left_eye_value_from_depth(r.position).found) {
-        list_right_pixel(id);
+    var r: Receiver;
+    if (copy) {
+        r = begin_receiver(id);
+    } else {
+        r = receiver_at(id);
     }
-}
-
-// GTAO's right eye after its folded dispatch: every pixel's geometry (and the sky), and
-// the left eye's value wherever `list_right_eye` did not list the pixel (the same test).
-@compute @workgroup_size(8, 8, 1)
-fn copy_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
-    let id = vec3<u32>(invocation.xy, 1u);
-    let r = begin_receiver(id);
     if (!r.valid) {
         return;
     }
     let left = left_eye_value_from_depth(r.position);
-    if (left.found) {
+    if (!left.found) {
+        if (!copy) {
+            list_right_pixel(id);
+        }
+    } else if (copy) {
         let value = chain_gather_blend(left_occlusion, gather, left.corner, 0, left.weights);
         store_occlusion(id, vec4<f32>(reused_light(value), value.a));
     }

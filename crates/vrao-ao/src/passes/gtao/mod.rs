@@ -73,8 +73,8 @@ struct GtaoUniform {
     connect: f32,
     inner_band: u32,
     footprint: f32,
-    /// A uniform struct's size is a multiple of 16 bytes.
-    padding: u32,
+    /// gtao.wgsl `right_eye_reuse`'s step: 0 lists, 1 copies.
+    right_eye_step: u32,
 }
 
 /// GTAO's slices and steps per half-slice for a budget of `samples` depth taps
@@ -115,14 +115,13 @@ struct Kernels {
     /// The band's march over the marches the rest deferred (an indirect dispatch), of
     /// either eye.
     crossing: Kernel,
-    /// With the stereo reuse: the right eye's pixels the left eye cannot give, listed
-    /// from the depth before the left eye marches.
-    right_list: Kernel,
+    /// With the stereo reuse: before the march, the right eye's pixels the left eye
+    /// cannot give, listed from the depth; after it, the copies of the rest (one
+    /// pipeline for both, gtao.wgsl `right_eye_reuse`).
+    right_reuse: Kernel,
     /// The left eye's interior and then the right eye's listed pixels, in one indirect
     /// dispatch.
     folded: Kernel,
-    /// The right eye's copies of the left eye's values, after the march.
-    right_copy: Kernel,
 }
 
 impl Kernels {
@@ -147,9 +146,8 @@ impl Kernels {
             interior: kernel("main", false, false, false, false),
             inner_band: kernel("main", true, false, false, false),
             crossing: kernel("main", true, false, true, false),
-            right_list: kernel("list_right_eye", false, true, false, false),
+            right_reuse: kernel("right_eye_reuse", false, true, false, false),
             folded: kernel("main", false, false, false, true),
-            right_copy: kernel("copy_right_eye", false, true, false, false),
         }
     }
 }
@@ -184,6 +182,8 @@ pub(crate) struct GtaoPass {
     /// materials.
     thin_cards: [std::sync::OnceLock<Kernels>; 4],
     params: wgpu::Buffer,
+    /// `params` with the right eye's copying step (gtao.wgsl `right_eye_reuse`).
+    copy_params: wgpu::Buffer,
     right_eye: std::sync::Mutex<RightEyeList>,
     /// The marches deferred to the band's pipeline (gtao.wgsl `deferred`), the left eye's
     /// (or both eyes' without the reuse) and then the right eye's.
@@ -209,12 +209,15 @@ impl GtaoPass {
 
     /// The pass of another technique on GTAO's march.
     pub(crate) fn with_march(gpu: &Gpu, march: March) -> Self {
-        let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("gtao params"),
-            size: std::mem::size_of::<GtaoUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniform = |label| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: std::mem::size_of::<GtaoUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let (params, copy_params) = (uniform("gtao params"), uniform("gtao right-eye copy params"));
         let solid: [std::sync::OnceLock<Kernels>; 4] = Default::default();
         if march.eager {
             let footprint = crate::GtaoSettings::default().footprint > 0.0;
@@ -224,7 +227,7 @@ impl GtaoPass {
         let right_eye = std::sync::Mutex::new(RightEyeList::new(gpu, "gtao right-eye pixels"));
         let thin_cards = Default::default();
         let deferred = std::sync::Mutex::new(IndirectList::new(gpu, "gtao deferred marches"));
-        GtaoPass { march, solid, thin_cards, params, right_eye, deferred }
+        GtaoPass { march, solid, thin_cards, params, copy_params, right_eye, deferred }
     }
 }
 
@@ -267,7 +270,7 @@ impl Pass for GtaoPass {
             connect: if second { own.connect_two_layers } else { own.connect },
             inner_band: band,
             footprint: own.footprint,
-            padding: 0,
+            right_eye_step: 0,
         };
         // The AO engine has no scene, and a host's normals mark no cards. Once the
         // caller's interrupt cuts builds short, kernels built now would be stand-ins for
@@ -283,6 +286,8 @@ impl Pass for GtaoPass {
             _ => solid(),
         };
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let copy_params = GtaoUniform { right_eye_step: 1, ..params };
+        ctx.gpu.queue.write_buffer(&self.copy_params, 0, bytemuck::bytes_of(&copy_params));
         // The left eye (or the only view) marches every pixel, in two parts and the marches
         // the first part deferred. With two views and `stereo_reuse` the right eye's
         // pixels the left eye cannot give are listed first and marched in the left eye's
@@ -314,13 +319,15 @@ impl Pass for GtaoPass {
         let interior_tiles = (width - band).div_ceil(TILE) * height.div_ceil(TILE);
         let list = right_eye.start_folded(ctx, (width, height), interior_tiles);
         let views = RightEyeViews::new(ctx);
-        let right = views.bind(ctx, self.march.binds, &list, &after_list);
-        kernels.right_list.dispatch(device, ctx.encoder, visibility, &right, (width, height, 1));
+        let listing = views.bind(ctx, self.march.binds, &list, &after_list);
+        kernels.right_reuse.dispatch(device, ctx.encoder, visibility, &listing, (width, height, 1));
         right_eye.take_arguments(ctx.encoder);
         let folded = ctx.bind(self.march.binds, &own_bindings(&normals, &list, &after_list));
         kernels.folded.dispatch_indirect(device, ctx.encoder, visibility, &folded, right_eye.arguments(), 0);
         band_pass(ctx, &deferred);
-        kernels.right_copy.dispatch(device, ctx.encoder, visibility, &right, (width, height, 1));
+        let copy_after = [self.copy_params.as_entire_binding(), deferred_list.as_entire_binding()];
+        let copying = views.bind(ctx, self.march.binds, &list, &copy_after);
+        kernels.right_reuse.dispatch(device, ctx.encoder, visibility, &copying, (width, height, 1));
     }
 
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {
@@ -355,7 +362,7 @@ mod tests {
     fn the_gtao_uniform_matches_gtao_wgsl() {
         #[rustfmt::skip]
         layout_check::check(&[
-            mirror!(GtaoUniform, GTAO_FILES, "GtaoParams", [slices, steps, thickness, step_power, connect, inner_band, footprint, padding]),
+            mirror!(GtaoUniform, GTAO_FILES, "GtaoParams", [slices, steps, thickness, step_power, connect, inner_band, footprint, right_eye_step]),
         ]);
     }
 
