@@ -32,6 +32,7 @@ case $rounds in [1-9]) ;; *) echo "SWEEP_ROUNDS must be 1..9, not '$rounds'" >&2
 declare -A settings=(
   [default]=""
   [independent]="--independent-eyes"
+  [fold]="--fold-right-eye"
   [layers2]="--layers 2"
   [footprint0]="--footprint 0 --thickness 0.75"
   [foveated]="--foveation high"
@@ -39,7 +40,7 @@ declare -A settings=(
 for round in $(seq "$rounds"); do
   for scene in $scene_files; do
     name=$(basename "$scene" .toml)
-    case $name in *-wall) rows="default independent" ;; *) rows="default independent layers2 footprint0 foveated" ;; esac
+    case $name in *-wall) rows="default independent fold" ;; *) rows="default independent fold layers2 footprint0 foveated" ;; esac
     for res in full half; do
       half=""; [ $res = half ] && half="--half-res"
       for row in $rows; do

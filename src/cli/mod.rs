@@ -143,6 +143,11 @@ pub(crate) struct GtaoArgs {
     /// samples; at half resolution the upsampled AO, or SSDO's denoise).
     #[arg(long)]
     independent_eyes: bool,
+    /// GTAO: march the right eye's pixels the left eye cannot give in the left eye's
+    /// dispatch (listed from the depth first, copied after) instead of a dispatch of their
+    /// own; for measuring on a GPU (off by default).
+    #[arg(long)]
+    fold_right_eye: bool,
     /// With two depth layers: the second layer's minimum separation behind the first, as a
     /// fraction of the radius, 0..=1 (0: the next surface, a closed object's own back).
     #[arg(long, allow_negative_numbers = true, default_value_t = AoSettings::default().layer_separation)]
@@ -157,6 +162,7 @@ impl GtaoArgs {
             footprint: self.footprint,
             step_power: self.step_power,
             connect: self.connect,
+            fold_right_eye: self.fold_right_eye,
             ..GtaoSettings::default()
         }
     }

@@ -363,3 +363,44 @@ fn facing_a_wall_the_right_eye_computes_the_strip_the_left_eye_never_sees() {
         }
     }
 }
+
+/// GTAO's right eye folded into the left eye's dispatch (`GtaoSettings::fold_right_eye`:
+/// listed from the depth before the left eye marches, marched after the left eye's tiles,
+/// copied last) is the copied-first right eye: the same pixels listed, the same AO but
+/// for a few pixels at the same-surface test's edge (the left eye's distances read from
+/// its depth instead of its AoGeometry's half floats), the left eye untouched. GTAO and
+/// SSDO on its march, full and half resolution, at the scene's pose and 30 cm from a wall.
+#[test]
+fn the_folded_right_eye_is_the_copied_first_right_eye() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:furnished").unwrap();
+    let wall = HeadPose::look_at(DVec3::new(1.15, 1.6, -5.7), DVec3::new(1.15, 1.4, -6.5)).unwrap();
+    let frame = |s: &vrao_render::Settings, head: &HeadPose| {
+        let mut renderer = vrao_render::Renderer::new(gpu.clone(), &scene, s).unwrap();
+        renderer.render_and_wait(&s.profile.eyes(head, s.near).eyes, &[AO_RAW]).unwrap();
+        let tiles: Vec<(u32, u32)> =
+            renderer.right_eye_tiles().iter().filter(|t| t.pass != "upsample").map(|t| (t.computed, t.items)).collect();
+        (renderer.read_f32(AO_RAW).unwrap(), tiles)
+    };
+    for head in [scene.head.pose_at(0.0), wall] {
+        for (technique, half_res) in [(Technique::Gtao, false), (Technique::Gtao, true), (Technique::Ssdo, true)] {
+            let mut a = ao(technique, 24, 0.3);
+            a.resolution = vrao_ao::Resolution::from_half_res(half_res);
+            let copied_first = settings(192, 216, a.clone());
+            a.gtao.fold_right_eye = true;
+            let folded = settings(192, 216, a);
+            let ((before, listed_before), (after, listed_after)) = (frame(&copied_first, &head), frame(&folded, &head));
+            let case = format!("{technique:?}, half {half_res}, head {head:?}");
+            assert!(before[0] == after[0], "{case}: the left eye changed");
+            assert!(
+                !listed_after.is_empty() && listed_before == listed_after,
+                "{case}: {listed_before:?} against {listed_after:?}"
+            );
+            let differing =
+                before[1].chunks(4).zip(after[1].chunks(4)).filter(|(b, a)| (b[3] - a[3]).abs() > 1e-6).count();
+            let pixels = before[1].len() / 4;
+            eprintln!("{case}: {listed_after:?} listed, {differing} of {pixels} right-eye pixels differ");
+            assert!(differing * 500 < pixels, "{case}: {differing} of {pixels} right-eye pixels differ");
+        }
+    }
+}

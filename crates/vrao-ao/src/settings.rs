@@ -564,6 +564,16 @@ pub struct GtaoSettings {
     /// slice of twice the steps two layers march under 32 taps (0.5 was best with 2 × 6;
     /// docs/records/2026-11-29/two-layers.md).
     pub connect_two_layers: f32,
+    /// GTAO with the stereo reuse: list the right eye's pixels the left eye cannot give
+    /// from the depth before the left eye marches, and march them in the left eye's
+    /// dispatch after its tiles (passes/gtao, `FOLDED`), instead of copying first and
+    /// marching them in a dispatch of their own. A GPU too wide for one eye then runs
+    /// the right eye's few marches beside the left eye's, not as a second dispatch as
+    /// long as its longest march; the images are the same (a few pixels at the
+    /// same-surface test's edge). Off until a GPU has measured it: on lavapipe, which runs
+    /// dispatches one after another, its second full-size pass only costs
+    /// (docs/records/2026-11-29/right-eye-lists.md, the fold).
+    pub fold_right_eye: bool,
 }
 
 impl Default for GtaoSettings {
@@ -574,6 +584,7 @@ impl Default for GtaoSettings {
             step_power: DEFAULT_STEP_POWER,
             connect: DEFAULT_CONNECT,
             connect_two_layers: DEFAULT_CONNECT_TWO_LAYERS,
+            fold_right_eye: false,
         }
     }
 }

@@ -67,19 +67,23 @@ impl RightEyeList {
         self.list.arguments()
     }
 
-    /// The right eye after the left (occlusion/right_eye.wgsl; SSAO's and HBAO's):
-    /// `classify` copies what the left eye gives and lists the occlusion pixels left to
-    /// estimate, then `listed` runs over those by an indirect dispatch. Both write layer 1
-    /// of the raw occlusion and its geometry alone and read the left eye's layer 0 of both
-    /// (bindings 7 and 8), the list at 9; `after_list` fills the technique's own bindings
-    /// after it. GTAO folds its right eye into the left eye's dispatch instead
-    /// ([`RightEyeList::start_folded`]).
+    /// The right eye after the left (occlusion/right_eye.wgsl): `classify` copies what
+    /// the left eye gives and lists the occlusion pixels left to estimate, then `listed`
+    /// runs over those by an indirect dispatch. Both write layer 1 of the raw occlusion
+    /// and its geometry alone and read the left eye's layer 0 of both (bindings 7 and
+    /// 8), the list at 9; `after_list` fills the technique's own bindings after it.
+    /// `deferred`: a kernel the listed dispatch hands some of its pixels to through a
+    /// list of its own (started by the caller, bound in `after_list`), run last over
+    /// those by an indirect dispatch with the same bindings (GTAO's marches that cross
+    /// the inner border). GTAO can fold its right eye into the left eye's dispatch
+    /// instead ([`RightEyeList::start_folded`]).
     pub(crate) fn record_right_eye(
         &mut self,
         ctx: &mut RecordContext,
         binds: &[Bind],
         after_list: &[wgpu::BindingResource],
         [classify, listed]: [&Kernel; 2],
+        deferred: Option<(&Kernel, &IndirectList)>,
         (width, height): (u32, u32),
     ) {
         let list = self.start(ctx, width * height, width.div_ceil(TILE) * height.div_ceil(TILE));
@@ -90,6 +94,10 @@ impl RightEyeList {
         classify.dispatch(device, ctx.encoder, visibility, &resources, (width, height, 1));
         self.list.take_arguments(ctx.encoder);
         listed.dispatch_indirect(device, ctx.encoder, visibility, &resources, self.list.arguments(), 0);
+        if let Some((kernel, list)) = deferred {
+            list.take_arguments(ctx.encoder);
+            kernel.dispatch_indirect(device, ctx.encoder, visibility, &resources, list.arguments(), 0);
+        }
     }
 
     /// The right eye after the left, one invocation per quad of 2×2 pixels (the

@@ -643,11 +643,13 @@ fn right_eye_reuse(@builtin(global_invocation_id) invocation: vec3<u32>) {
         let tiles = interior_tiles();
         atomicAdd(&right_list.groups_x, tiles.x * tiles.y);
     }
-    var r: Receiver;
+    // One call site each for the point and the test, whichever the step: the same code.
+    var r = receiver_point(id);
     if (copy) {
-        r = begin_receiver(id);
-    } else {
-        r = receiver_at(id);
+        if (r.valid) {
+            with_normal(&r);
+        }
+        store_receiver(id, r);
     }
     if (!r.valid) {
         return;

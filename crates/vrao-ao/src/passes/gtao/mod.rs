@@ -115,9 +115,21 @@ struct Kernels {
     /// The band's march over the marches the rest deferred (an indirect dispatch), of
     /// either eye.
     crossing: Kernel,
-    /// With the stereo reuse: before the march, the right eye's pixels the left eye
-    /// cannot give, listed from the depth; after it, the copies of the rest (one
-    /// pipeline for both, gtao.wgsl `right_eye_reuse`).
+    /// The right eye's copy of what the left eye gives, listing the pixels left to march.
+    right_classify: Kernel,
+    /// The right eye's march over the listed pixels (an indirect dispatch).
+    right_listed: Kernel,
+    /// The band's march over the right eye's listed marches that it deferred.
+    right_crossing: Kernel,
+    /// With `GtaoSettings::fold_right_eye`: built on its first frame.
+    fold: std::sync::OnceLock<FoldKernels>,
+}
+
+/// The right eye folded into the left eye's dispatch (`GtaoSettings::fold_right_eye`).
+struct FoldKernels {
+    /// Before the march, the right eye's pixels the left eye cannot give, listed from
+    /// the depth; after it, the copies of the rest (one pipeline for both, gtao.wgsl
+    /// `right_eye_reuse`).
     right_reuse: Kernel,
     /// The left eye's interior and then the right eye's listed pixels, in one indirect
     /// dispatch.
@@ -126,9 +138,39 @@ struct Kernels {
 
 impl Kernels {
     fn new(gpu: &Gpu, march: &March, variant: Variant) -> Self {
+        let kernel = |entry: &str, band: bool, right: bool, crossing: bool| {
+            Self::kernel(gpu, march, variant, entry, [band, right, crossing, false])
+        };
+        Kernels {
+            interior: kernel("main", false, false, false),
+            inner_band: kernel("main", true, false, false),
+            crossing: kernel("main", true, false, true),
+            right_classify: kernel("classify_right_eye", false, true, false),
+            right_listed: kernel("main", false, true, false),
+            right_crossing: kernel("main", true, true, true),
+            fold: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The fold's kernels, built on first use.
+    fn fold(&self, gpu: &Gpu, march: &March, variant: Variant) -> &FoldKernels {
+        self.fold.get_or_init(|| FoldKernels {
+            right_reuse: Self::kernel(gpu, march, variant, "right_eye_reuse", [false, true, false, false]),
+            folded: Self::kernel(gpu, march, variant, "main", [false, false, false, true]),
+        })
+    }
+
+    /// One pipeline of `entry`: a deferred march runs the band's code (`band`) over the
+    /// list (`crossing`); `right`: a right-eye dispatch; `folded`: gtao.wgsl `FOLDED`.
+    fn kernel(
+        gpu: &Gpu,
+        march: &March,
+        variant: Variant,
+        entry: &str,
+        [band, right, crossing, folded]: [bool; 4],
+    ) -> Kernel {
         let Variant { thin_cards, second_layer, footprint } = variant;
-        // A deferred march runs the band's code (`band`) over the list (`crossing`).
-        let kernel = |entry: &str, band: bool, right: bool, crossing: bool, folded: bool| {
+        {
             let mut constants = vec![
                 ("INNER_BAND", f64::from(band)),
                 ("CROSSING", f64::from(crossing)),
@@ -141,13 +183,6 @@ impl Kernels {
             constants.extend_from_slice(&march.constants);
             let chain = ChainLayout::of(march.technique.carries_light(), gpu.caps.scalar_chain);
             Kernel::in_chain(gpu, march.label, &march.files, entry, march.binds, &constants, chain)
-        };
-        Kernels {
-            interior: kernel("main", false, false, false, false),
-            inner_band: kernel("main", true, false, false, false),
-            crossing: kernel("main", true, false, true, false),
-            right_reuse: kernel("right_eye_reuse", false, true, false, false),
-            folded: kernel("main", false, false, false, true),
         }
     }
 }
@@ -231,6 +266,25 @@ impl GtaoPass {
     }
 }
 
+impl GtaoPass {
+    /// The kernels of `variant` for this frame, built on first use, and the variant they
+    /// are: with cards where the scene has alpha-tested materials. The AO engine has no
+    /// scene, and a host's normals mark no cards. Once the caller's interrupt cuts builds
+    /// short, kernels built now would be stand-ins for good: the last frames of an ending
+    /// session take samples as solid instead.
+    fn kernels(&self, ctx: &RecordContext, variant: Variant) -> (&Kernels, Variant) {
+        let slot = variant.slot();
+        let cards = Variant { thin_cards: true, ..variant };
+        match self.thin_cards[slot].get() {
+            Some(kernels) if ctx.setup.alpha_cards => (kernels, cards),
+            None if ctx.setup.alpha_cards && !ctx.gpu.builds_cancelled() => {
+                (self.thin_cards[slot].get_or_init(|| Kernels::new(ctx.gpu, &self.march, cards)), cards)
+            }
+            _ => (self.solid[slot].get_or_init(|| Kernels::new(ctx.gpu, &self.march, variant)), variant),
+        }
+    }
+}
+
 impl Pass for GtaoPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let technique = self.march.technique;
@@ -272,28 +326,19 @@ impl Pass for GtaoPass {
             footprint: own.footprint,
             right_eye_step: 0,
         };
-        // The AO engine has no scene, and a host's normals mark no cards. Once the
-        // caller's interrupt cuts builds short, kernels built now would be stand-ins for
-        // good: the last frames of an ending session take samples as solid instead.
-        let cards = ctx.setup.alpha_cards;
         let variant = Variant { thin_cards: false, second_layer: second, footprint: own.footprint > 0.0 };
-        let slot = variant.slot();
-        let solid = || self.solid[slot].get_or_init(|| Kernels::new(ctx.gpu, &self.march, variant));
-        let kernels = match self.thin_cards[slot].get() {
-            Some(kernels) if cards => kernels,
-            None if cards && !ctx.gpu.builds_cancelled() => self.thin_cards[slot]
-                .get_or_init(|| Kernels::new(ctx.gpu, &self.march, Variant { thin_cards: true, ..variant })),
-            _ => solid(),
-        };
+        let (kernels, variant) = self.kernels(ctx, variant);
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let copy_params = GtaoUniform { right_eye_step: 1, ..params };
         ctx.gpu.queue.write_buffer(&self.copy_params, 0, bytemuck::bytes_of(&copy_params));
         // The left eye (or the only view) marches every pixel, in two parts and the marches
-        // the first part deferred. With two views and `stereo_reuse` the right eye's
-        // pixels the left eye cannot give are listed first and marched in the left eye's
-        // interior dispatch (gtao.wgsl `FOLDED`), and the rest copied last; without it
-        // the right eye marches alike. Bindings 7 to 9 are unused outside the right eye's
-        // dispatches: the normals and the list's header stand in.
+        // the first part deferred. With two views and `stereo_reuse` the right eye then
+        // copies what the left eye gives and marches the rest in a dispatch of its own;
+        // or, folded (`GtaoSettings::fold_right_eye`), its pixels the left eye cannot give
+        // are listed first, marched in the left eye's interior dispatch (gtao.wgsl
+        // `FOLDED`), and the rest copied last. Without the reuse both eyes march alike.
+        // Bindings 7 to 9 are unused outside the right eye's dispatches: the normals and
+        // the list's header stand in.
         let normals = ctx.view(super::inputs::NORMALS);
         let mut right_eye = self.right_eye.lock().unwrap_or_else(|p| p.into_inner());
         let header = right_eye.stand_in();
@@ -316,18 +361,31 @@ impl Pass for GtaoPass {
             band_pass(ctx, &deferred);
             return;
         }
+        if !own.fold_right_eye {
+            // Copied first, the rest marched in a dispatch of its own, which defers its
+            // crossing marches to a list of their own.
+            kernels.interior.dispatch(device, ctx.encoder, visibility, &resources, (width - band, height, 1));
+            band_pass(ctx, &deferred);
+            let right_deferred = deferred.start(ctx, width * height);
+            let after_list = [self.params.as_entire_binding(), right_deferred.as_entire_binding()];
+            let right_kernels = [&kernels.right_classify, &kernels.right_listed];
+            let then = Some((&kernels.right_crossing, &*deferred));
+            right_eye.record_right_eye(ctx, self.march.binds, &after_list, right_kernels, then, (width, height));
+            return;
+        }
+        let fold = kernels.fold(ctx.gpu, &self.march, variant);
         let interior_tiles = (width - band).div_ceil(TILE) * height.div_ceil(TILE);
         let list = right_eye.start_folded(ctx, (width, height), interior_tiles);
         let views = RightEyeViews::new(ctx);
         let listing = views.bind(ctx, self.march.binds, &list, &after_list);
-        kernels.right_reuse.dispatch(device, ctx.encoder, visibility, &listing, (width, height, 1));
+        fold.right_reuse.dispatch(device, ctx.encoder, visibility, &listing, (width, height, 1));
         right_eye.take_arguments(ctx.encoder);
         let folded = ctx.bind(self.march.binds, &own_bindings(&normals, &list, &after_list));
-        kernels.folded.dispatch_indirect(device, ctx.encoder, visibility, &folded, right_eye.arguments(), 0);
+        fold.folded.dispatch_indirect(device, ctx.encoder, visibility, &folded, right_eye.arguments(), 0);
         band_pass(ctx, &deferred);
         let copy_after = [self.copy_params.as_entire_binding(), deferred_list.as_entire_binding()];
         let copying = views.bind(ctx, self.march.binds, &list, &copy_after);
-        kernels.right_reuse.dispatch(device, ctx.encoder, visibility, &copying, (width, height, 1));
+        fold.right_reuse.dispatch(device, ctx.encoder, visibility, &copying, (width, height, 1));
     }
 
     fn right_eye_tiles(&self, gpu: &Gpu) -> Option<RightEyeTiles> {

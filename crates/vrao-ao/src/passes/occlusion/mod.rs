@@ -184,7 +184,7 @@ impl Pass for TechniquePass {
         );
         if reuse {
             let kernels = [&right_eye.classify, &right_eye.listed];
-            list.record_right_eye(ctx, &REUSING_BINDINGS, &[], kernels, (width, height));
+            list.record_right_eye(ctx, &REUSING_BINDINGS, &[], kernels, None, (width, height));
         } else {
             list.skip();
         }

@@ -35,6 +35,15 @@ struct Receiver {
 // Occlusion pixel `id`'s surface from its depth and normal, writing nothing: invalid
 // outside the target (`in_target` false) and on the sky.
 fn receiver_at(id: vec3<u32>) -> Receiver {
+    var r = receiver_point(id);
+    if (r.valid) {
+        with_normal(&r);
+    }
+    return r;
+}
+
+// `receiver_at` without the normal: its pixel, eye and position.
+fn receiver_point(id: vec3<u32>) -> Receiver {
     var r: Receiver;
     r.valid = false;
     r.in_target = id.x < ao.ao_size.x && id.y < ao.ao_size.y && id.z < frame.layers;
@@ -54,26 +63,36 @@ fn receiver_at(id: vec3<u32>) -> Receiver {
         return r;
     }
     r.position = load_view_position(depth, r.pixel, r.eye, frame.size, frame.near);
-    let stored = textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz;
-    r.normal = repaired_normal(safe_normal(stored, r.position), r.pixel, r.layer, r.eye, r.position);
     r.valid = true;
     return r;
+}
+
+// Adds the normal to a valid receiver of `receiver_point`.
+fn with_normal(r: ptr<function, Receiver>) {
+    let stored = textureLoad(normal_layers, vec2<i32>((*r).pixel), i32((*r).layer), 0).xyz;
+    (*r).normal = repaired_normal(safe_normal(stored, (*r).position), (*r).pixel, (*r).layer, (*r).eye, (*r).position);
+}
+
+// Writes occlusion pixel `id`'s AoGeometry for receiver `r` (of `receiver_at`); on the sky
+// "unoccluded" as well.
+fn store_receiver(id: vec3<u32>, r: Receiver) {
+    if (!r.in_target) {
+        return;
+    }
+    if (!r.valid) {
+        store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(0.0));
+        return;
+    }
+    // Clamped to the half float's range (AoGeometry's format): finite at any distance.
+    textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, min(-r.position.z, 65504.0)));
 }
 
 // Sets up occlusion pixel `id` (`receiver_at`) and writes its AoGeometry; on the sky it
 // writes "unoccluded" and returns an invalid receiver.
 fn begin_receiver(id: vec3<u32>) -> Receiver {
     let r = receiver_at(id);
-    if (!r.in_target) {
-        return r;
-    }
-    if (!r.valid) {
-        store_occlusion(id, vec4<f32>(0.0, 0.0, 0.0, 1.0));
-        textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(0.0));
-        return r;
-    }
-    // Clamped to the half float's range (AoGeometry's format): finite at any distance.
-    textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, min(-r.position.z, 65504.0)));
+    store_receiver(id, r);
     return r;
 }
 

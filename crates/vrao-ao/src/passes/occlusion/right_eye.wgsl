@@ -104,17 +104,41 @@ fn classify_right_eye(@builtin(global_invocation_id) invocation: vec3<u32>) {
     list_right_pixel(id);
 }
 
-// The left eye's occlusion-pixel distance at `q` (clamped to the target, as the gather's
-// sampler clamps), from the depth: what its AoGeometry holds once its march has run (0
-// on the sky and in hidden tiles; rounded to AoGeometry's half float).
-fn left_distance_from_depth(q: vec2<f32>) -> f32 {
-    let p = vec2<u32>(clamp(vec2<i32>(q), vec2<i32>(0), vec2<i32>(ao.ao_size) - vec2<i32>(1)));
-    if (tile_rate(p, 0u, ao.scale) == 0.0) {
-        return 0.0;
+// The left eye's distances at the 2×2 block of occlusion pixels from `base` (clamped to
+// the target, as the gather's sampler clamps), in gather order, from its depth: what its
+// AoGeometry holds once its march has run (0 on the sky and in hidden tiles; rounded to
+// AoGeometry's half float). At full resolution one gather; at half, four loads.
+fn left_distances_from_depth(base: vec2<f32>) -> vec4<f32> {
+    let last = vec2<i32>(ao.ao_size) - vec2<i32>(1);
+    let lo = vec2<u32>(clamp(vec2<i32>(base), vec2<i32>(0), last));
+    let hi = vec2<u32>(clamp(vec2<i32>(base) + vec2<i32>(1), vec2<i32>(0), last));
+    var depth: vec4<f32>;
+    if (ao.scale == 1u) {
+        depth = textureGather(depth_layers, gather, (base + vec2<f32>(1.0)) / vec2<f32>(frame.size), 0);
+    } else {
+        let at = vec4<u32>(lo, hi);
+        depth = vec4<f32>(
+            textureLoad(depth_layers, vec2<i32>(full_res_pixel(at.xw, ao.scale, frame.size)), 0, 0),
+            textureLoad(depth_layers, vec2<i32>(full_res_pixel(at.zw, ao.scale, frame.size)), 0, 0),
+            textureLoad(depth_layers, vec2<i32>(full_res_pixel(at.zy, ao.scale, frame.size)), 0, 0),
+            textureLoad(depth_layers, vec2<i32>(full_res_pixel(at.xy, ao.scale, frame.size)), 0, 0),
+        );
     }
-    let d = textureLoad(depth_layers, vec2<i32>(full_res_pixel(p, ao.scale, frame.size)), 0, 0);
-    let distance = select(0.0, min(frame.near / d, 65504.0), d > 0.0);
-    return unpack2x16float(pack2x16float(vec2<f32>(distance, 0.0))).x;
+    // Hidden tiles read as the sky; the block lies in one tile but at a tile's edge.
+    var shown = vec4<bool>(tile_rate(lo, 0u, ao.scale) > 0.0);
+    if (any(lo / 8u != hi / 8u)) {
+        shown = vec4<bool>(
+            tile_rate(vec2<u32>(lo.x, hi.y), 0u, ao.scale) > 0.0,
+            tile_rate(hi, 0u, ao.scale) > 0.0,
+            tile_rate(vec2<u32>(hi.x, lo.y), 0u, ao.scale) > 0.0,
+            shown.w,
+        );
+    }
+    let distance = select(vec4<f32>(0.0), min(vec4<f32>(frame.near) / depth, vec4<f32>(65504.0)), shown & (depth > vec4<f32>(0.0)));
+    return vec4<f32>(
+        unpack2x16float(pack2x16float(distance.xy)),
+        unpack2x16float(pack2x16float(distance.zw)),
+    );
 }
 
 // `left_eye_value` (common.wgsl) with the left eye's distances from its depth instead of
@@ -129,12 +153,6 @@ fn left_eye_value_from_depth(position: vec3<f32>) -> LeftEyeValue {
     }
     let f = point.uv * vec2<f32>(ao.ao_size) - 0.5 / f32(ao.scale);
     let base = floor(f);
-    // In gather order: base + (0, 1), (1, 1), (1, 0), (0, 0).
-    let there = vec4<f32>(
-        left_distance_from_depth(base + vec2<f32>(0.0, 1.0)),
-        left_distance_from_depth(base + vec2<f32>(1.0, 1.0)),
-        left_distance_from_depth(base + vec2<f32>(1.0, 0.0)),
-        left_distance_from_depth(base),
-    );
+    let there = left_distances_from_depth(base);
     return left_eye_blend((base + vec2<f32>(1.0)) / vec2<f32>(ao.ao_size), f - base, there, point.distance);
 }
