@@ -34,12 +34,13 @@
 // cross the inner border (a surface so near that the radius spans more than the band) is
 // deferred: listed, and marched after by the band's code over the list (CROSSING), so
 // the band's edge leaves no seam however near the surface.
-// With two views and `stereo_reuse`, the right eye's pixels the left eye cannot give are
-// listed first (`right_eye_reuse`, from the depth alone) and marched in the left eye's
-// dispatch, after its tiles (FOLDED: one indirect dispatch, so a wide GPU runs the few
-// right-eye marches beside the left eye's instead of in a second dispatch of their own
-// that lasts as long as its longest march); then `right_eye_reuse` copies the rest from
-// the left eye's results.
+// With two views and `stereo_reuse`, the right eye then runs as a classifying dispatch
+// and an indirect one over the pixels it listed (RIGHT_EYE). Or, folded
+// (`GtaoSettings::fold_right_eye`), its pixels the left eye cannot give are listed first
+// (`right_eye_reuse`, from the depth alone) and marched in the left eye's dispatch, after
+// its tiles (FOLDED: one indirect dispatch, so a wide GPU runs the few right-eye marches
+// beside the left eye's instead of in a second dispatch of their own that lasts as long
+// as its longest march); then `right_eye_reuse` copies the rest.
 
 // Bindings and `begin_receiver`: occlusion.wgsl.
 // The light a march gathers besides the visibility (`begin_light`, `gather_sample` for
@@ -54,7 +55,8 @@ const SECTORS: f32 = 32.0;
 // the rest of the image.
 override INNER_BAND: bool = false;
 
-// The right eye's dispatches (RIGHT_EYE, LISTED_PIXELS; `right_eye_reuse`):
+// The right eye's dispatches (RIGHT_EYE, LISTED_PIXELS, `classify_right_eye`; folded,
+// `right_eye_reuse`):
 // occlusion/right_eye.wgsl, compiled before this file.
 
 // Set when the scene has alpha-tested materials. A depth sample on one (the G-buffer's

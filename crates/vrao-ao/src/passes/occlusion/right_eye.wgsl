@@ -12,9 +12,9 @@
 // dispatch: the right eye pays for the pixels the left eye cannot give, not for every
 // warp that holds one of them (listing 8×8 tiles of the image instead dispatched every
 // tile a silhouette crosses: a quarter of Sibenik's right eye). GTAO (and SSDO on its
-// march) goes further: it lists from the depth alone before the left eye marches
-// (`left_eye_value_from_depth`), marches the listed pixels in the left eye's dispatch and
-// copies after (gtao.wgsl `FOLDED`).
+// march) can go further (`GtaoSettings::fold_right_eye`): list from the depth alone
+// before the left eye marches (`left_eye_value_from_depth`), march the listed pixels in
+// the left eye's dispatch and copy after (gtao.wgsl `FOLDED`).
 //
 // The includer defines `reused_light(value)`: the rgb a copied value carries (its
 // gathered light for SSDO, 0 for the AO-only techniques).
