@@ -239,30 +239,37 @@ fn left_eye_value(
     if (!point.seen) {
         return result;
     }
-    let uv = point.uv;
-    let distance = point.distance;
-    // Occlusion pixel k stands for the centre of its top-left full-res pixel.
-    let f = uv * vec2<f32>(grid) - 0.5 / f32(scale);
-    let base = floor(f);
-    let t = f - base;
-    // Gathered at the corner pixels base and base + (1, 1) share: in gather order,
-    // base + (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
-    let corner = (base + vec2<f32>(1.0)) / vec2<f32>(grid);
-    return left_eye_blend(corner, t, textureGather(3, left_geometry, gather, corner, 0), distance);
+    let f = left_eye_coordinate(point.uv, grid, scale);
+    let there = textureGather(3, left_geometry, gather, left_eye_corner(f, grid), 0);
+    return left_eye_blend(f, grid, there, point.distance);
 }
 
-// The blend of the 2×2 block gathered at `corner` (its texels' distances `there`, in
-// gather order) for a point at `t` within it and `distance` away: bilinear over the
+// Left-eye uv `uv` in occlusion pixels of a `grid`-sized target at 1/`scale` resolution:
+// occlusion pixel k stands for the centre of its top-left full-res pixel, so its block
+// of 2×2 pixels starts at the floor.
+fn left_eye_coordinate(uv: vec2<f32>, grid: vec2<u32>, scale: u32) -> vec2<f32> {
+    return uv * vec2<f32>(grid) - 0.5 / f32(scale);
+}
+
+// Where a gather fetches the 2×2 block from floor(`f`) (the corner those pixels share):
+// in gather order, floor(f) + (0, 1), (1, 1), (1, 0), (0, 0) as x, y, z, w.
+fn left_eye_corner(f: vec2<f32>, grid: vec2<u32>) -> vec2<f32> {
+    return (floor(f) + vec2<f32>(1.0)) / vec2<f32>(grid);
+}
+
+// The blend of the 2×2 block at coordinate `f` (`left_eye_coordinate`; its texels'
+// distances `there`, in gather order) for a point `distance` away: bilinear over the
 // texels on the same surface (within 5 % in distance); not found where none is.
-fn left_eye_blend(corner: vec2<f32>, t: vec2<f32>, there: vec4<f32>, distance: f32) -> LeftEyeValue {
+fn left_eye_blend(f: vec2<f32>, grid: vec2<u32>, there: vec4<f32>, distance: f32) -> LeftEyeValue {
     var result: LeftEyeValue;
     result.found = false;
+    let t = f - floor(f);
     let bilinear = vec4<f32>((1.0 - t.x) * t.y, t.x * t.y, t.x * (1.0 - t.y), (1.0 - t.x) * (1.0 - t.y));
     let same = (there > vec4<f32>(0.0)) & (abs(there - vec4<f32>(distance)) < vec4<f32>(0.05 * distance));
     let w = select(vec4<f32>(0.0), bilinear, same);
     let total = dot(w, vec4<f32>(1.0));
     if (total > 1e-6) {
-        result.corner = corner;
+        result.corner = left_eye_corner(f, grid);
         result.weights = w / total;
         result.found = true;
     }

@@ -648,9 +648,7 @@ fn right_eye_reuse(@builtin(global_invocation_id) invocation: vec3<u32>) {
     // One call site each for the point and the test, whichever the step: the same code.
     var r = receiver_point(id);
     if (copy) {
-        if (r.valid) {
-            with_normal(&r);
-        }
+        r = with_normal(r);
         store_receiver(id, r);
     }
     if (!r.valid) {

@@ -32,17 +32,9 @@ struct Receiver {
     normal: vec3<f32>,
 };
 
-// Occlusion pixel `id`'s surface from its depth and normal, writing nothing: invalid
-// outside the target (`in_target` false) and on the sky.
-fn receiver_at(id: vec3<u32>) -> Receiver {
-    var r = receiver_point(id);
-    if (r.valid) {
-        with_normal(&r);
-    }
-    return r;
-}
-
-// `receiver_at` without the normal: its pixel, eye and position.
+// Occlusion pixel `id`'s surface from its depth, without the normal (`with_normal`),
+// writing nothing: its pixel, eye and position; invalid outside the target (`in_target`
+// false) and on the sky.
 fn receiver_point(id: vec3<u32>) -> Receiver {
     var r: Receiver;
     r.valid = false;
@@ -67,13 +59,17 @@ fn receiver_point(id: vec3<u32>) -> Receiver {
     return r;
 }
 
-// Adds the normal to a valid receiver of `receiver_point`.
-fn with_normal(r: ptr<function, Receiver>) {
-    let stored = textureLoad(normal_layers, vec2<i32>((*r).pixel), i32((*r).layer), 0).xyz;
-    (*r).normal = repaired_normal(safe_normal(stored, (*r).position), (*r).pixel, (*r).layer, (*r).eye, (*r).position);
+// Receiver `point` of `receiver_point` with its normal, where it is valid.
+fn with_normal(point: Receiver) -> Receiver {
+    var r = point;
+    if (r.valid) {
+        let stored = textureLoad(normal_layers, vec2<i32>(r.pixel), i32(r.layer), 0).xyz;
+        r.normal = repaired_normal(safe_normal(stored, r.position), r.pixel, r.layer, r.eye, r.position);
+    }
+    return r;
 }
 
-// Writes occlusion pixel `id`'s AoGeometry for receiver `r` (of `receiver_at`); on the sky
+// Writes occlusion pixel `id`'s AoGeometry for receiver `r` (with its normal); on the sky
 // "unoccluded" as well.
 fn store_receiver(id: vec3<u32>, r: Receiver) {
     if (!r.in_target) {
@@ -88,10 +84,10 @@ fn store_receiver(id: vec3<u32>, r: Receiver) {
     textureStore(geometry_out, vec2<i32>(id.xy), output_layer(id), vec4<f32>(r.normal, min(-r.position.z, 65504.0)));
 }
 
-// Sets up occlusion pixel `id` (`receiver_at`) and writes its AoGeometry; on the sky it
-// writes "unoccluded" and returns an invalid receiver.
+// Sets up occlusion pixel `id`: reads its depth and normal and writes its AoGeometry; on
+// the sky it writes "unoccluded" and returns an invalid receiver.
 fn begin_receiver(id: vec3<u32>) -> Receiver {
-    let r = receiver_at(id);
+    let r = with_normal(receiver_point(id));
     store_receiver(id, r);
     return r;
 }

@@ -114,7 +114,7 @@ fn left_distances_from_depth(base: vec2<f32>) -> vec4<f32> {
     let hi = vec2<u32>(clamp(vec2<i32>(base) + vec2<i32>(1), vec2<i32>(0), last));
     var depth: vec4<f32>;
     if (ao.scale == 1u) {
-        depth = textureGather(depth_layers, gather, (base + vec2<f32>(1.0)) / vec2<f32>(frame.size), 0);
+        depth = textureGather(depth_layers, gather, left_eye_corner(base, ao.ao_size), 0);
     } else {
         let at = vec4<u32>(lo, hi);
         depth = vec4<f32>(
@@ -151,8 +151,6 @@ fn left_eye_value_from_depth(position: vec3<f32>) -> LeftEyeValue {
         none.found = false;
         return none;
     }
-    let f = point.uv * vec2<f32>(ao.ao_size) - 0.5 / f32(ao.scale);
-    let base = floor(f);
-    let there = left_distances_from_depth(base);
-    return left_eye_blend((base + vec2<f32>(1.0)) / vec2<f32>(ao.ao_size), f - base, there, point.distance);
+    let f = left_eye_coordinate(point.uv, ao.ao_size, ao.scale);
+    return left_eye_blend(f, ao.ao_size, left_distances_from_depth(floor(f)), point.distance);
 }
