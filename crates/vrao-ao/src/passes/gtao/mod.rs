@@ -329,8 +329,6 @@ impl Pass for GtaoPass {
         let variant = Variant { thin_cards: false, second_layer: second, footprint: own.footprint > 0.0 };
         let (kernels, variant) = self.kernels(ctx, variant);
         ctx.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let copy_params = GtaoUniform { right_eye_step: 1, ..params };
-        ctx.gpu.queue.write_buffer(&self.copy_params, 0, bytemuck::bytes_of(&copy_params));
         // The left eye (or the only view) marches every pixel, in two parts and the marches
         // the first part deferred. With two views and `stereo_reuse` the right eye then
         // copies what the left eye gives and marches the rest in a dispatch of its own;
@@ -374,6 +372,8 @@ impl Pass for GtaoPass {
             return;
         }
         let fold = kernels.fold(ctx.gpu, &self.march, variant);
+        let copy_params = GtaoUniform { right_eye_step: 1, ..params };
+        ctx.gpu.queue.write_buffer(&self.copy_params, 0, bytemuck::bytes_of(&copy_params));
         let interior_tiles = (width - band).div_ceil(TILE) * height.div_ceil(TILE);
         let list = right_eye.start_folded(ctx, (width, height), interior_tiles);
         let views = RightEyeViews::new(ctx);
