@@ -226,9 +226,11 @@ impl FrameLoop {
         let depth = self.renderer.target(DEPTH).ok_or_else(|| Error::gpu("no eye depth"))?;
         let frame = SubmittedFrame { color, depth, eyes: &request.eyes, near: request.eyes.near };
         self.headset.submit(&self.gpu, &request, Some(frame))?;
-        if submitted_at.is_some() {
-            // An empty submission is done when every one before it is: the frame's end.
-            self.completion.watch(report.frame, self.gpu.queue.submit([]));
+        // The frame's own submission (the headset's copy of the eyes is in it): an empty
+        // one of ours would, on lavapipe, block until the frame is done and keep a second
+        // frame from ever being in flight.
+        if let (Some(_), Some(last)) = (submitted_at, self.renderer.last_submission()) {
+            self.completion.watch(report.frame, last.clone());
         }
         self.frames += 1;
         self.cpu_encode_ms.push(report.cpu_encode_ms);

@@ -141,6 +141,11 @@ fn the_run_report_counts_rendered_frames_frames_in_flight_and_the_governors_chan
     assert_eq!(on["frames_in_flight_limit"], 2, "{on}");
     let in_flight = on["frames_in_flight_max"].as_u64().unwrap();
     assert!((1..=2).contains(&in_flight), "{on}");
+    // At 500 Hz each frame's GPU work outlasts the 2 ms period: the next frame is handed
+    // over while it runs. Nothing the frame loop submits of its own may wait for it (an
+    // empty submission to watch the frame's end did, on lavapipe: 1 in flight).
+    let fast = run_report(&dir, "fast.json", &["--refresh", "500"]);
+    assert_eq!(fast["frames_in_flight_max"], 2, "{fast}");
     // Every frame's GPU time came back (the last ones when the session ended), and each
     // over-budget frame is one of them.
     assert_eq!(on["timed_frames"], 12, "{on}");

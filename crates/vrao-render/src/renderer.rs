@@ -134,6 +134,8 @@ pub struct Renderer {
     in_flight: VecDeque<InFlight>,
     frames_in_flight: usize,
     frames_in_flight_max: usize,
+    /// The last frame's submission: the whole frame, what was appended to it included.
+    last_submission: Option<wgpu::SubmissionIndex>,
 }
 
 struct InFlight {
@@ -215,6 +217,7 @@ impl Renderer {
             in_flight: VecDeque::new(),
             frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
             frames_in_flight_max: 0,
+            last_submission: None,
         })
     }
 
@@ -232,6 +235,13 @@ impl Renderer {
     /// The most frames that were on the GPU at once so far.
     pub fn frames_in_flight_max(&self) -> usize {
         self.frames_in_flight_max
+    }
+
+    /// The submission that ends the last frame rendered (none before the first): done
+    /// when the frame is. A caller that waits on it elsewhere need not submit anything of
+    /// its own, which on some drivers (lavapipe) would block until the frame is done.
+    pub fn last_submission(&self) -> Option<&wgpu::SubmissionIndex> {
+        self.last_submission.as_ref()
     }
 
     /// Frames rendered so far.
@@ -462,6 +472,7 @@ impl Renderer {
         let done = Arc::new(AtomicBool::new(false));
         let signal = done.clone();
         self.gpu.queue.on_submitted_work_done(move || signal.store(true, Ordering::Release));
+        self.last_submission = Some(submission.clone());
         self.in_flight.push_back(InFlight { submission, done });
         let frame = self.driver.frame_index();
         self.driver.timer().end_frame(frame)?;
