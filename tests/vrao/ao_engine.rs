@@ -174,6 +174,13 @@ fn every_engine_technique_and_resolution_agrees_with_the_renderer() {
             assert!(error <= 1e-3, "{} half_res {half_res}: RMSE {error}", technique.name());
         }
     }
+    // GTAO's right eye folded into the left eye's dispatch lists it from the host's depth.
+    for half_res in [false, true] {
+        let mut ao = AoSettings { resolution: vrao_ao::Resolution::from_half_res(half_res), ..AoSettings::default() };
+        ao.gtao.fold_right_eye = true;
+        let error = rmse(&engine_ao(&gpu, &ao, HostDepth::ReversedInfinite, true), &renderer_ao(&gpu, &ao));
+        assert!(error <= 1e-3, "gtao folded, half_res {half_res}: RMSE {error}");
+    }
 }
 
 #[test]
