@@ -120,3 +120,30 @@ fn the_plan_explains_what_occlusion_left_out() {
         assert!(others.is_empty(), "{} also runs {others:?}", technique.name());
     }
 }
+
+/// `--fold-right-eye` is said in the plan wherever it is asked for: done for GTAO and SSDO
+/// (their shared march), and of no effect for the other techniques, for one view or with
+/// independent eyes, never dropped in silence.
+#[test]
+fn the_plan_says_where_the_folded_right_eye_applies() {
+    let (gpu, _guard) = common::gpu();
+    let scene = Scene::load("builtin:room").unwrap();
+    let note_of = |technique: Technique, stereo_reuse: bool, views: u32| {
+        let mut ao = AoSettings { technique, stereo_reuse, ..AoSettings::default() };
+        ao.gtao.fold_right_eye = true;
+        let renderer = Renderer::new(gpu.clone(), &scene, &settings(64, 72, ao)).unwrap();
+        let plan = renderer.plan(views, &[COLOR]).unwrap();
+        let notes: Vec<String> =
+            plan.notes.iter().filter(|(_, note)| note.contains("fold-right-eye")).map(|(_, n)| n.clone()).collect();
+        assert_eq!(notes.len(), 1, "{technique:?}: one note on the fold, not {notes:?}");
+        notes[0].clone()
+    };
+    for technique in [Technique::Gtao, Technique::Ssdo] {
+        assert!(note_of(technique, true, 2).contains("left eye's dispatch"), "{technique:?}");
+        assert!(note_of(technique, false, 2).contains("no effect"), "{technique:?} with independent eyes");
+        assert!(note_of(technique, true, 1).contains("no effect"), "{technique:?} with one view");
+    }
+    for technique in [Technique::Ssao, Technique::Hbao] {
+        assert!(note_of(technique, true, 2).contains("no effect"), "{technique:?}");
+    }
+}

@@ -156,7 +156,13 @@ impl TechniquePass {
 impl Pass for TechniquePass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let binds: &[Bind] = if self.right_eye.is_some() { &REUSING_BINDINGS } else { &BINDINGS };
-        technique_decl(self.technique.name(), binds, &[self.technique], setup)
+        let decl = technique_decl(self.technique.name(), binds, &[self.technique], setup);
+        // Asked for with a technique it does not apply to: said, not silently dropped.
+        if setup.settings.ao.gtao.fold_right_eye {
+            decl.note("fold-right-eye has no effect here: it folds GTAO's (and SSDO's) march alone")
+        } else {
+            decl
+        }
     }
 
     fn record(&self, ctx: &mut RecordContext) {
