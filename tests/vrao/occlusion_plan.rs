@@ -143,7 +143,7 @@ fn the_plan_says_where_the_folded_right_eye_applies() {
         assert!(note_of(technique, false, 2).contains("no effect"), "{technique:?} with independent eyes");
         assert!(note_of(technique, true, 1).contains("no effect"), "{technique:?} with one view");
     }
-    for technique in [Technique::Ssao, Technique::Hbao] {
+    for technique in [Technique::Ssao, Technique::Hbao, Technique::FetchOnly, Technique::SsdoPoints] {
         assert!(note_of(technique, true, 2).contains("no effect"), "{technique:?}");
     }
 }

@@ -285,20 +285,6 @@ impl GtaoPass {
     }
 }
 
-/// What `--explain` says of `GtaoSettings::fold_right_eye` where it was asked for: folded,
-/// or why it cannot be (it folds the stereo reuse's right eye, so it needs both).
-fn fold_right_eye_note(ao: &crate::settings::AoSettings, views: u32) -> Option<&'static str> {
-    if !ao.gtao.fold_right_eye {
-        None
-    } else if views < 2 {
-        Some("fold-right-eye has no effect: one view")
-    } else if !ao.stereo_reuse {
-        Some("fold-right-eye has no effect: the eyes are computed independently")
-    } else {
-        Some("the right eye's pixels the left eye cannot give march in the left eye's dispatch (fold-right-eye)")
-    }
-}
-
 impl Pass for GtaoPass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let technique = self.march.technique;
@@ -314,10 +300,6 @@ impl Pass for GtaoPass {
                 .note("one depth layer: no second layer this frame (depth-peel or ao-import says why)")
         } else {
             decl.unbind(DEPTH_LAYER_2)
-        };
-        let decl = match fold_right_eye_note(ao, setup.views) {
-            Some(note) => decl.note(note),
-            None => decl,
         };
         if setup.alpha_cards {
             decl.note("alpha-tested samples are cards: each blocks its footprint on the card, not a slab")
@@ -450,17 +432,5 @@ mod tests {
         for (samples, split) in [(12, (1, 6)), (24, (1, 12)), (31, (1, 15)), (36, (2, 9)), (64, (2, 16)), (1, (1, 1))] {
             assert_eq!(gtao_slices_steps(samples, true), split, "{samples} taps reading two layers");
         }
-    }
-
-    /// `--explain` says whether the fold asked for happens, and why not where it cannot.
-    #[test]
-    fn the_plan_says_whether_the_right_eye_folds() {
-        let mut ao = crate::settings::AoSettings::default();
-        assert_eq!(fold_right_eye_note(&ao, 2), None, "not asked for: nothing said");
-        ao.gtao.fold_right_eye = true;
-        assert!(fold_right_eye_note(&ao, 2).unwrap().contains("left eye's dispatch"));
-        assert!(fold_right_eye_note(&ao, 1).unwrap().contains("no effect: one view"));
-        ao.stereo_reuse = false;
-        assert!(fold_right_eye_note(&ao, 2).unwrap().contains("no effect: the eyes are computed independently"));
     }
 }

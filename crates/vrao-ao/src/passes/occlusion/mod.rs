@@ -12,7 +12,7 @@ use crate::gpu::Gpu;
 use crate::graph::{PassDecl, Resource, Size, OCCLUSION};
 use crate::passes::inputs::{DEPTH, NORMALS};
 use crate::resource::ChainLayout;
-use crate::settings::Technique;
+use crate::settings::{AoSettings, Technique};
 
 /// Occlusion as computed (at AO resolution): rgb = SSDO's gathered irradiance
 /// (environment through unblocked directions plus the bounce), a = AO.
@@ -93,11 +93,34 @@ pub fn technique_decl(name: &'static str, binds: &[Bind], runs_for: &[Technique]
     } else {
         format!("technique is {}", chosen.name())
     };
-    PassDecl::new(name)
+    let decl = PassDecl::new(name)
         .bindings(binds)
         .provide(OCCLUSION, AO_RAW)
         .occlusion_cost()
-        .disabled_if(!runs_for.contains(&chosen), reason)
+        .disabled_if(!runs_for.contains(&chosen), reason);
+    match fold_right_eye_note(&setup.settings.ao, setup.views) {
+        Some(note) if runs_for.contains(&chosen) => decl.note(note),
+        _ => decl,
+    }
+}
+
+/// What `--explain` says of `GtaoSettings::fold_right_eye` where it was asked for: folded,
+/// or why it has no effect. It folds the stereo reuse's right eye into the march on GTAO's
+/// bitmask (GTAO and SSDO: `Technique::reads_second_layer`'s set), so it needs both eyes,
+/// the reuse and that march; said here, where every technique pass is declared, so no
+/// technique drops it in silence.
+fn fold_right_eye_note(ao: &AoSettings, views: u32) -> Option<&'static str> {
+    if !ao.gtao.fold_right_eye {
+        None
+    } else if !ao.technique.reads_second_layer() {
+        Some("fold-right-eye has no effect here: it folds GTAO's (and SSDO's) march alone")
+    } else if views < 2 {
+        Some("fold-right-eye has no effect: one view")
+    } else if !ao.stereo_reuse {
+        Some("fold-right-eye has no effect: the eyes are computed independently")
+    } else {
+        Some("the right eye's pixels the left eye cannot give march in the left eye's dispatch (fold-right-eye)")
+    }
 }
 
 /// A technique that is one kernel of the shared layout: its WGSL defines the
@@ -156,13 +179,7 @@ impl TechniquePass {
 impl Pass for TechniquePass {
     fn declare(&self, setup: &DeclareContext) -> PassDecl {
         let binds: &[Bind] = if self.right_eye.is_some() { &REUSING_BINDINGS } else { &BINDINGS };
-        let decl = technique_decl(self.technique.name(), binds, &[self.technique], setup);
-        // Asked for with a technique it does not apply to: said, not silently dropped.
-        if setup.settings.ao.gtao.fold_right_eye {
-            decl.note("fold-right-eye has no effect here: it folds GTAO's (and SSDO's) march alone")
-        } else {
-            decl
-        }
+        technique_decl(self.technique.name(), binds, &[self.technique], setup)
     }
 
     fn record(&self, ctx: &mut RecordContext) {
@@ -206,5 +223,25 @@ impl Pass for TechniquePass {
         let right_eye = self.right_eye.as_ref()?;
         let list = right_eye.list.lock().unwrap_or_else(|p| p.into_inner());
         list.read_items(gpu, self.technique.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--explain` says whether the fold asked for happens, and why not where it cannot.
+    #[test]
+    fn the_plan_says_whether_the_right_eye_folds() {
+        let mut ao = AoSettings::default();
+        assert_eq!(fold_right_eye_note(&ao, 2), None, "not asked for: nothing said");
+        ao.gtao.fold_right_eye = true;
+        assert!(fold_right_eye_note(&ao, 2).unwrap().contains("left eye's dispatch"));
+        assert!(fold_right_eye_note(&ao, 1).unwrap().contains("no effect: one view"));
+        ao.technique = Technique::Hbao;
+        assert!(fold_right_eye_note(&ao, 2).unwrap().contains("no effect here"));
+        ao.technique = Technique::Gtao;
+        ao.stereo_reuse = false;
+        assert!(fold_right_eye_note(&ao, 2).unwrap().contains("no effect: the eyes are computed independently"));
     }
 }
