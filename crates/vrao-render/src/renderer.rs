@@ -134,8 +134,6 @@ pub struct Renderer {
     in_flight: VecDeque<InFlight>,
     frames_in_flight: usize,
     frames_in_flight_max: usize,
-    /// The last frame's submission: the whole frame, what was appended to it included.
-    last_submission: Option<wgpu::SubmissionIndex>,
 }
 
 struct InFlight {
@@ -217,7 +215,6 @@ impl Renderer {
             in_flight: VecDeque::new(),
             frames_in_flight: DEFAULT_FRAMES_IN_FLIGHT,
             frames_in_flight_max: 0,
-            last_submission: None,
         })
     }
 
@@ -237,11 +234,12 @@ impl Renderer {
         self.frames_in_flight_max
     }
 
-    /// The submission that ends the last frame rendered (none before the first): done
-    /// when the frame is. A caller that waits on it elsewhere need not submit anything of
-    /// its own, which on some drivers (lavapipe) would block until the frame is done.
+    /// The submission that ends the last frame rendered, what was appended to it included
+    /// (none before the first, or once [`Renderer::finish`] has waited for every frame):
+    /// done when the frame is. A caller that waits on it elsewhere need not submit anything
+    /// of its own, which on some drivers (lavapipe) would block until the frame is done.
     pub fn last_submission(&self) -> Option<&wgpu::SubmissionIndex> {
-        self.last_submission.as_ref()
+        self.in_flight.back().map(|frame| &frame.submission)
     }
 
     /// Frames rendered so far.
@@ -472,7 +470,6 @@ impl Renderer {
         let done = Arc::new(AtomicBool::new(false));
         let signal = done.clone();
         self.gpu.queue.on_submitted_work_done(move || signal.store(true, Ordering::Release));
-        self.last_submission = Some(submission.clone());
         self.in_flight.push_back(InFlight { submission, done });
         let frame = self.driver.frame_index();
         self.driver.timer().end_frame(frame)?;

@@ -264,9 +264,7 @@ impl GtaoPass {
         let deferred = std::sync::Mutex::new(IndirectList::new(gpu, "gtao deferred marches"));
         GtaoPass { march, solid, thin_cards, params, copy_params, right_eye, deferred }
     }
-}
 
-impl GtaoPass {
     /// The kernels of `variant` for this frame, built on first use, and the variant they
     /// are: with cards where the scene has alpha-tested materials. The AO engine has no
     /// scene, and a host's normals mark no cards. Once the caller's interrupt cuts builds
